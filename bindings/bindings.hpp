@@ -1,0 +1,8 @@
+// One binder per C++ header; module.cpp calls them all. Bindings are thin: no logic here.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace snakehead::bindings {
+void bind_model(pybind11::module_& m);
+}  // namespace snakehead::bindings

@@ -1,0 +1,6 @@
+#include "bindings.hpp"
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep";
+  snakehead::bindings::bind_model(m);
+}

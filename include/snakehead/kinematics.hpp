@@ -1,0 +1,32 @@
+// Forward kinematics and the geometric Jacobian of a ChainModel.
+//
+// Free functions over an immutable model, with no allocation on the hot path beyond the outputs:
+// safe to call from many threads at once. KDL's recursive solvers are the reference; these are
+// tested equal to them (tests/cpp/test_kinematics.cpp).
+#pragma once
+
+#include "snakehead/model.hpp"
+
+#include <vector>
+
+namespace snakehead {
+
+using Frames = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
+using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// Pose of the tip in the base frame. q is not checked (use model.check_configuration first).
+Eigen::Isometry3d forward_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q);
+
+// Poses of every link of model.links() in the base frame.
+void link_frames(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Frames& out);
+
+// 6 x n geometric Jacobian of the tip, rows (v; omega), expressed in the base frame with the
+// reference point at the tip origin (KDL's ChainJntToJacSolver convention). Also returns the tip pose.
+void tip_jacobian(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Jacobian& jac,
+                  Eigen::Isometry3d& tip);
+
+// Reference implementations through KDL's own solvers (for tests and benchmarks).
+Eigen::Isometry3d kdl_forward_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q);
+Jacobian kdl_jacobian(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q);
+
+}  // namespace snakehead
