@@ -62,6 +62,20 @@ void bind_model(py::module_& m) {
                                for (int i = 0; i < c.n_joints(); ++i) e[i] = c.joints()[i].velocity;
                                return e;
                              })
+      .def_property_readonly("joint_axes",
+                             [](const ChainModel& c) {
+                               RowMat v(c.n_joints(), 3);
+                               for (int i = 0; i < c.n_joints(); ++i) v.row(i) = c.segments()[i].axis;
+                               return v;
+                             },
+                             "(n, 3) unit joint axes, each in the frame of the link the joint moves")
+      .def_property_readonly("joint_child_links",
+                             [](const ChainModel& c) {
+                               std::vector<int> idx;
+                               for (const auto& s : c.segments()) idx.push_back(c.link_index(s.link));
+                               return idx;
+                             },
+                             "index into link_names of the link each joint moves (its frame is the joint frame)")
       .def_property_readonly("reach", &ChainModel::reach)
       .def_property_readonly("hash", &ChainModel::hash)
       .def_property_readonly("link_names",
