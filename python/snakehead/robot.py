@@ -90,8 +90,7 @@ class SnakeRobot:
                 raise ValueError(f"the {name} part's joints {sl.start}..{sl.stop - 1} do not fit {n} joints")
         for name in (parts.base_end, parts.neck_end):
             self.body.link_index(name)
-        self._head_chain: Chain | None = None
-        self._head6_chain: Chain | None = None
+        self._chains: dict[tuple[str, str], Chain] = {}
 
     @classmethod
     def default(cls) -> "SnakeRobot":
@@ -103,19 +102,27 @@ class SnakeRobot:
     def n_joints(self) -> int:
         return self.body.n_joints
 
+    def sub_chain(self, base: str, tip: str) -> Chain:
+        """The chain between two frames of the body (cached; chains are immutable)."""
+        key = (base, tip)
+        if key not in self._chains:
+            self._chains[key] = Chain.from_urdf(self.urdf, base, tip)
+        return self._chains[key]
+
     @property
     def head_chain(self) -> Chain:
         """The head part, neck_end -> head_tip (7 DOF on the default robot)."""
-        if self._head_chain is None:
-            self._head_chain = Chain.from_urdf(self.urdf, self.parts.neck_end, self.parts.head_tip)
-        return self._head_chain
+        return self.sub_chain(self.parts.neck_end, self.parts.head_tip)
 
     @property
     def head6_chain(self) -> Chain:
         """The 6-DOF head variant of Section 2.2 (link_10 -> head_tip on the default robot)."""
-        if self._head6_chain is None:
-            self._head6_chain = Chain.from_urdf(self.urdf, self.parts.head6_root, self.parts.head_tip)
-        return self._head6_chain
+        return self.sub_chain(self.parts.head6_root, self.parts.head_tip)
+
+    @property
+    def neck_chain(self) -> Chain:
+        """The neck part, base_end (P0) -> neck_end (B0)."""
+        return self.sub_chain(self.parts.base_end, self.parts.neck_end)
 
     @property
     def lower(self) -> np.ndarray:
