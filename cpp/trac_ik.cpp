@@ -1,0 +1,699 @@
+#include "snakehead/trac_ik.hpp"
+
+#include "snakehead/kinematics.hpp"
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_nr_jl.hpp>
+#include <kdl/chainiksolvervel_pinv.hpp>
+#include <nlopt.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <random>
+#include <thread>
+
+namespace snakehead {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Nominal kinematics evaluations per second that turn a seeded call's timeout into an evaluation budget.
+// One evaluation (FK + Jacobian + residual) of the 7-DOF head costs well under a microsecond on the
+// development machine; SQP's own bookkeeping adds to it, so this is a conservative rate.
+constexpr double kEvaluationsPerSecond = 1.0e6;
+
+// Local-search limits. A Newton descent that has not converged in this many iterations is treated as
+// stuck; so is an SLSQP run that used its evaluations.
+constexpr int kNewtonIterations = 60;
+constexpr int kSqpEvaluations = 120;
+constexpr double kMaxStep = 0.6;  // rad (or m): largest joint change of one Newton step
+
+// ---------------------------------------------------------------------------------------------------------
+// Random numbers: a deterministic generator and our own uniform mapping (std::uniform_real_distribution
+// is implementation-defined, and seeded results should not depend on the standard library).
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+std::mt19937_64& thread_rng() {
+  thread_local std::mt19937_64 rng([] {
+    std::random_device rd;
+    std::seed_seq seq{rd(), rd(), rd(), rd()};
+    return std::mt19937_64(seq);
+  }());
+  return rng;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The worker pool: threads made once; jobs are stack objects of the calling thread, so a job can be
+// cancelled (removed) while queued, and the caller waits for a running job before returning.
+
+class WorkerPool {
+ public:
+  struct Job {
+    std::function<void()> fn;
+    bool running = false;  // guarded by the pool mutex
+    std::mutex m;
+    std::condition_variable cv;
+    bool done = false;  // guarded by m
+  };
+
+  explicit WorkerPool(int n) {
+    for (int i = 0; i < n; ++i) threads_.emplace_back([this] { loop(); });
+  }
+  ~WorkerPool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      quit_ = true;
+    }
+    cv_.notify_all();
+    for (auto& t : threads_) t.join();
+  }
+  int size() const { return static_cast<int>(threads_.size()); }
+
+  void submit(Job& job) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(&job);
+    }
+    cv_.notify_one();
+  }
+
+  // Removes the job if no worker has taken it yet; otherwise waits until it has finished.
+  // Returns true when the job ran.
+  bool cancel_or_wait(Job& job) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!job.running) {
+        auto it = std::find(queue_.begin(), queue_.end(), &job);
+        if (it != queue_.end()) {
+          queue_.erase(it);
+          return false;
+        }
+      }
+    }
+    std::unique_lock<std::mutex> lock(job.m);
+    job.cv.wait(lock, [&] { return job.done; });
+    return true;
+  }
+
+ private:
+  void loop() {
+    for (;;) {
+      Job* job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [&] { return quit_ || !queue_.empty(); });
+        if (quit_ && queue_.empty()) return;
+        job = queue_.front();
+        queue_.pop_front();
+        job->running = true;
+      }
+      job->fn();  // jobs catch their own exceptions
+      {
+        std::lock_guard<std::mutex> lock(job->m);
+        job->done = true;
+        job->cv.notify_all();  // under the lock: the job may be destroyed as soon as it is released
+      }
+    }
+  }
+
+  std::vector<std::thread> threads_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Job*> queue_;
+  bool quit_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// One call's problem and shared control.
+
+struct Problem {
+  const ChainModel& model;
+  Eigen::Isometry3d target;
+  Vector6d bounds;
+  double epsilon;
+  SolveType type;
+  const Eigen::VectorXd& q_init;
+  const Eigen::VectorXd& sample_lo;  // finite sampling range ([-pi, pi] for continuous joints)
+  const Eigen::VectorXd& sample_hi;
+};
+
+struct CallControl {
+  std::atomic<bool> stop{false};
+  std::atomic<bool> claimed{false};  // Speed: the first solution claims the win
+  Clock::time_point deadline;
+  bool budgeted = false;  // seeded: bounded by evaluations (single thread, so a plain counter)
+  long evals = 0;
+  long max_evals = LONG_MAX;
+};
+
+// The best solution a search has seen; score: lower is better.
+struct Best {
+  bool found = false;
+  Eigen::VectorXd q;
+  double score = std::numeric_limits<double>::infinity();
+  int count = 0;
+};
+
+double manipulability_score(SolveType type, const Matrix6Xd& jac) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(jac);
+  const auto& s = svd.singularValues();  // min(6, n) values, descending
+  if (type == SolveType::Manip1) return -s.prod();  // = sqrt(det(J J^T)) for n >= 6
+  return s[0] > 0 ? -(s[s.size() - 1] / s[0]) : 0.0;
+}
+
+// One solver's per-call state: workspace, generator, best solution. Lives on its thread's stack.
+class Search {
+ public:
+  Search(const Problem& p, CallControl& c, std::mt19937_64& rng)
+      : p(p), c(c), rng(rng), n(p.model.n_joints()), jac(6, n), dr(6, n), jac_try(6, n), dr_try(6, n), dq(n),
+        q_try(n) {}
+
+  bool should_stop() {
+    if (c.stop.load(std::memory_order_relaxed)) return true;
+    if (c.budgeted && c.evals >= c.max_evals) return halt();
+    if (Clock::now() >= c.deadline) return halt();
+    return false;
+  }
+  bool halt() {
+    c.stop.store(true, std::memory_order_relaxed);
+    return true;
+  }
+
+  // FK + Jacobian + residual at q into (tip, jac, r, dr); returns the raw error.
+  Vector6d evaluate(const Eigen::VectorXd& q, Matrix6Xd& J, Vector6d& r, Matrix6Xd& D) {
+    ++c.evals;  // only read in seeded (single-thread) mode
+    Eigen::Isometry3d tip;
+    tip_jacobian(p.model, q, J, tip);
+    return residual_and_jacobian(p.target, tip, J, p.bounds, r, D);
+  }
+
+  // Records a solution (q within the limits, pose reached). Returns true when the search should end.
+  void offer(const Eigen::VectorXd& q, const Matrix6Xd& J) {
+    if (p.type == SolveType::Speed) {
+      bool expected = false;
+      if (c.claimed.compare_exchange_strong(expected, true)) {
+        best.found = true;
+        best.q = q;
+        best.count = 1;
+      }
+      c.stop.store(true, std::memory_order_relaxed);
+      return;
+    }
+    double score;
+    if (p.type == SolveType::Distance)
+      score = (q - p.q_init).squaredNorm();
+    else
+      score = manipulability_score(p.type, J);
+    ++best.count;
+    if (!best.found || score < best.score) {
+      best.found = true;
+      best.q = q;
+      best.score = score;
+    }
+  }
+
+  void random_configuration(Eigen::VectorXd& q) {
+    for (int i = 0; i < n; ++i) q[i] = p.sample_lo[i] + (p.sample_hi[i] - p.sample_lo[i]) * uniform01(rng);
+  }
+
+  void clamp(Eigen::VectorXd& q) const {
+    q = q.cwiseMax(p.model.lower()).cwiseMin(p.model.upper());
+  }
+
+  const Problem& p;
+  CallControl& c;
+  std::mt19937_64& rng;
+  const int n;
+  Matrix6Xd jac, dr, jac_try, dr_try;
+  Eigen::VectorXd dq, q_try;
+  Best best;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// KDL-RR's local step: Levenberg-Marquardt-damped Newton-Raphson on the residual, with the joint limits
+// enforced by clamping. Returns true when the target was reached (q is then the solution). A descent is
+// abandoned as a local minimum when the damping has to grow without bound (no step reduces the error),
+// when the error stops decreasing, or after kNewtonIterations.
+bool newton_descent(Search& s, Eigen::VectorXd& q) {
+  if (s.should_stop()) return false;
+  Vector6d r, r_try;
+  Vector6d e = s.evaluate(q, s.jac, r, s.dr);
+  if (pose_reached(e, s.p.bounds, s.p.epsilon)) {
+    s.offer(q, s.jac);
+    return true;
+  }
+  double err = r.squaredNorm();
+  double lambda = 1e-4;
+  double checkpoint = err;
+  for (int it = 0; it < kNewtonIterations; ++it) {
+    if (s.should_stop()) return false;
+    // dq = -D^T (D D^T + lambda I)^{-1} r: the 6x6 form of the damped normal equations.
+    Eigen::Matrix<double, 6, 6> A;
+    A.noalias() = s.dr * s.dr.transpose();
+    A.diagonal().array() += lambda;
+    const Vector6d y = A.ldlt().solve(r);
+    s.dq.noalias() = -s.dr.transpose() * y;
+    const double big = s.dq.cwiseAbs().maxCoeff();
+    if (big > kMaxStep) s.dq *= kMaxStep / big;
+    s.q_try = q + s.dq;
+    s.clamp(s.q_try);
+    if ((s.q_try - q).cwiseAbs().maxCoeff() < 1e-12) return false;  // pinned at the limits: a local minimum
+    e = s.evaluate(s.q_try, s.jac_try, r_try, s.dr_try);
+    if (pose_reached(e, s.p.bounds, s.p.epsilon)) {
+      q = s.q_try;
+      s.offer(q, s.jac_try);
+      return true;
+    }
+    const double err_try = r_try.squaredNorm();
+    if (err_try < err) {
+      q.swap(s.q_try);
+      s.jac.swap(s.jac_try);
+      s.dr.swap(s.dr_try);
+      r = r_try;
+      err = err_try;
+      lambda = std::max(lambda * 0.2, 1e-12);
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e4) return false;
+    }
+    // No real progress over 8 iterations: stuck in a local minimum.
+    if ((it + 1) % 8 == 0) {
+      if (err > 0.9 * checkpoint) return false;
+      checkpoint = err;
+    }
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// SQP: SLSQP on f(q) = |r(q)|^2 with grad = 2 D^T r, the joint limits as bounds.
+
+struct SqpContext {
+  Search* s;
+  nlopt::opt* opt;
+  bool found = false;
+};
+
+double sqp_objective(unsigned n, const double* x, double* grad, void* data) {
+  auto* ctx = static_cast<SqpContext*>(data);
+  Search& s = *ctx->s;
+  if (s.should_stop()) {
+    ctx->opt->force_stop();
+    if (grad) std::fill(grad, grad + n, 0.0);
+    return 0.0;
+  }
+  // SLSQP may step a hair outside the bounds; evaluate (and report) the clamped point.
+  s.q_try = Eigen::Map<const Eigen::VectorXd>(x, n);
+  s.clamp(s.q_try);
+  Vector6d r;
+  const Vector6d e = s.evaluate(s.q_try, s.jac_try, r, s.dr_try);
+  if (pose_reached(e, s.p.bounds, s.p.epsilon)) {
+    ctx->found = true;
+    s.offer(s.q_try, s.jac_try);
+    ctx->opt->force_stop();  // this local search is done; Speed stops everything, the others restart
+  }
+  if (grad) Eigen::Map<Eigen::VectorXd>(grad, n).noalias() = 2.0 * s.dr_try.transpose() * r;
+  return r.squaredNorm();
+}
+
+class SqpSolver {
+ public:
+  explicit SqpSolver(Search& s) : s_(s), opt_(nlopt::LD_SLSQP, static_cast<unsigned>(s.n)), x_(s.n) {
+    const auto& lo = s.p.model.lower();
+    const auto& hi = s.p.model.upper();
+    opt_.set_lower_bounds(std::vector<double>(lo.data(), lo.data() + lo.size()));
+    opt_.set_upper_bounds(std::vector<double>(hi.data(), hi.data() + hi.size()));
+    opt_.set_stopval(s.p.epsilon * s.p.epsilon);  // |r|^2 <= eps^2 implies every |r_i| <= eps
+    opt_.set_xtol_abs(1e-10);
+    opt_.set_ftol_abs(1e-16);
+    opt_.set_maxeval(kSqpEvaluations);
+  }
+
+  // One local search from q (within the limits). True when it reached the target.
+  bool descent(const Eigen::VectorXd& q) {
+    if (s_.should_stop()) return false;
+    SqpContext ctx{&s_, &opt_};
+    opt_.set_min_objective(sqp_objective, &ctx);
+    if (!s_.c.budgeted) {
+      const double left = std::chrono::duration<double>(s_.c.deadline - Clock::now()).count();
+      if (left <= 0) return false;
+      opt_.set_maxtime(left);
+    }
+    std::copy(q.data(), q.data() + s_.n, x_.begin());
+    double f = 0;
+    try {
+      opt_.optimize(x_, f);
+    } catch (...) {
+      // forced stop, round-off limited, or SLSQP's own failure: the search just moves on
+    }
+    return ctx.found;
+  }
+
+ private:
+  Search& s_;
+  nlopt::opt opt_;
+  std::vector<double> x_;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Search loops.
+
+// KDL-RR from `start`, then random restarts, until stopped.
+void kdl_rr_loop(Search& s, const Eigen::VectorXd& start) {
+  Eigen::VectorXd q = start;
+  for (;;) {
+    newton_descent(s, q);
+    if (s.should_stop()) return;
+    s.random_configuration(q);
+  }
+}
+
+void sqp_loop(Search& s, const Eigen::VectorXd& start) {
+  SqpSolver sqp(s);
+  Eigen::VectorXd q = start;
+  for (;;) {
+    sqp.descent(q);
+    if (s.should_stop()) return;
+    s.random_configuration(q);
+  }
+}
+
+// Both solvers in one thread, alternating one local search each: the seeded and the batch schedule.
+void interleaved_loop(Search& nr, Search& sq) {
+  SqpSolver sqp(sq);
+  Eigen::VectorXd qn = nr.p.q_init, qs = nr.p.q_init;
+  for (;;) {
+    newton_descent(nr, qn);
+    if (nr.should_stop()) return;
+    sqp.descent(qs);
+    if (sq.should_stop()) return;
+    nr.random_configuration(qn);
+    sq.random_configuration(qs);
+  }
+}
+
+// Picks the better of the two searches' results (ties: KDL-RR, for determinism).
+const Best* pick(const Best& a, const Best& b) {
+  if (a.found && (!b.found || a.score <= b.score)) return &a;
+  if (b.found) return &b;
+  return nullptr;
+}
+
+bool finite_isometry(const Eigen::Isometry3d& t) { return t.matrix().allFinite(); }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+
+SolveType solve_type_from_string(const std::string& name) {
+  if (name == "Speed") return SolveType::Speed;
+  if (name == "Distance") return SolveType::Distance;
+  if (name == "Manip1") return SolveType::Manip1;
+  if (name == "Manip2") return SolveType::Manip2;
+  throw InputError("unknown solve type '" + name + "'; expected Speed, Distance, Manip1 or Manip2");
+}
+
+const char* to_string(SolveType type) {
+  switch (type) {
+    case SolveType::Speed: return "Speed";
+    case SolveType::Distance: return "Distance";
+    case SolveType::Manip1: return "Manip1";
+    case SolveType::Manip2: return "Manip2";
+  }
+  return "?";
+}
+
+void check_options(const TracIKOptions& o) {
+  if (!(o.timeout > 0) || !std::isfinite(o.timeout))
+    throw InputError("timeout must be a positive finite number of seconds, got " + std::to_string(o.timeout));
+  if (!(o.epsilon > 0) || !std::isfinite(o.epsilon))
+    throw InputError("epsilon must be a positive finite number, got " + std::to_string(o.epsilon));
+  for (int i = 0; i < 6; ++i)
+    if (std::isnan(o.bounds[i]) || o.bounds[i] < 0)
+      throw InputError("bounds must be 6 tolerances >= 0 (inf leaves an axis free); bounds[" + std::to_string(i) +
+                       "] = " + std::to_string(o.bounds[i]));
+  switch (o.solve_type) {
+    case SolveType::Speed: case SolveType::Distance: case SolveType::Manip1: case SolveType::Manip2: break;
+    default: throw InputError("unknown solve type");
+  }
+}
+
+void check_pose(const Eigen::Isometry3d& target, const char* what) {
+  if (!finite_isometry(target)) throw InputError(std::string(what) + " contains NaN or inf");
+  const Eigen::Matrix4d& m = target.matrix();
+  if ((m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9)
+    throw InputError(std::string(what) + ": last row must be [0, 0, 0, 1]");
+  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
+  const double err = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (err > 1e-6 || R.determinant() < 0)
+    throw InputError(std::string(what) + ": rotation is not orthonormal and right-handed (error " +
+                     std::to_string(err) + ", det " + std::to_string(R.determinant()) + ")");
+}
+
+struct TracIK::Impl {
+  std::shared_ptr<const ChainModel> model;
+  TracIKOptions options;
+  Eigen::VectorXd sample_lo, sample_hi;
+  mutable WorkerPool pool;  // thread-safe: its own mutex guards it
+
+  Impl(std::shared_ptr<const ChainModel> m, const TracIKOptions& o)
+      : model(std::move(m)), options(o), pool(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {
+    const int n = model->n_joints();
+    sample_lo.resize(n);
+    sample_hi.resize(n);
+    for (int i = 0; i < n; ++i) {
+      sample_lo[i] = std::isfinite(model->lower()[i]) ? model->lower()[i] : -M_PI;
+      sample_hi[i] = std::isfinite(model->upper()[i]) ? model->upper()[i] : M_PI;
+    }
+  }
+
+  void check_q_init(const Eigen::Ref<const Eigen::VectorXd>& q) const {
+    model->check_configuration(q, "q_init");
+    for (int i = 0; i < q.size(); ++i)
+      if (q[i] < model->lower()[i] - 1e-9 || q[i] > model->upper()[i] + 1e-9)
+        throw InputError("q_init[" + std::to_string(i) + "] = " + std::to_string(q[i]) + " is outside the limits [" +
+                         std::to_string(model->lower()[i]) + ", " + std::to_string(model->upper()[i]) + "]");
+  }
+
+  // mode: how the two solvers are scheduled.
+  enum class Schedule { Race, Interleaved };
+
+  IKResult run(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, const TracIKOptions& o,
+               IKAlgorithm algorithm, Schedule schedule, std::uint64_t stream) const {
+    const auto t0 = Clock::now();
+    const Problem p{*model, target, o.bounds, o.epsilon, o.solve_type, q_init, sample_lo, sample_hi};
+    CallControl c;
+    std::mt19937_64 rng_nr, rng_sq;
+    if (o.seed) {
+      c.budgeted = true;
+      c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
+      c.deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(std::max(10 * o.timeout, o.timeout + 0.05)));
+      const std::uint64_t base = splitmix64(*o.seed ^ splitmix64(stream));
+      rng_nr.seed(splitmix64(base ^ 0x6E72ULL));
+      rng_sq.seed(splitmix64(base ^ 0x737170ULL));
+      schedule = Schedule::Interleaved;
+    } else {
+      c.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.timeout));
+      rng_nr.seed(thread_rng()());
+      rng_sq.seed(thread_rng()());
+    }
+    Search nr(p, c, rng_nr), sq(p, c, rng_sq);
+
+    if (algorithm == IKAlgorithm::KdlRR) {
+      kdl_rr_loop(nr, q_init);
+    } else if (algorithm == IKAlgorithm::Sqp) {
+      sqp_loop(sq, q_init);
+    } else if (schedule == Schedule::Interleaved) {
+      interleaved_loop(nr, sq);
+    } else {
+      // Race. For Speed, a cheap Newton descent from q_init in this thread first: it solves most targets
+      // in microseconds, well before a worker thread could even wake up. Only then is SQP handed off.
+      Eigen::VectorXd q = q_init;
+      const bool speed = o.solve_type == SolveType::Speed;
+      if (speed) newton_descent(nr, q);
+      if (!nr.should_stop()) {
+        WorkerPool::Job job;
+        job.fn = [&] {
+          try {
+            sqp_loop(sq, q_init);
+          } catch (...) {  // e.g. std::bad_alloc: give up the SQP half, never take the process down
+            c.stop.store(true);
+          }
+        };
+        pool.submit(job);
+        try {
+          if (speed) {
+            for (;;) {  // KDL-RR restarts
+              nr.random_configuration(q);
+              newton_descent(nr, q);
+              if (nr.should_stop()) break;
+            }
+          } else {
+            kdl_rr_loop(nr, q_init);
+          }
+        } catch (...) {
+          c.stop.store(true);
+          pool.cancel_or_wait(job);
+          throw;
+        }
+        c.stop.store(true);
+        pool.cancel_or_wait(job);
+      }
+    }
+
+    IKResult res;
+    const Best* b = pick(nr.best, sq.best);
+    res.found = b != nullptr;
+    res.q = b ? b->q : q_init;
+    res.solutions = nr.best.count + sq.best.count;
+    res.error = pose_error(target, forward_kinematics(*model, res.q));
+    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return res;
+  }
+};
+
+TracIK::TracIK(const ChainModel& model, const TracIKOptions& options)
+    : TracIK(std::make_shared<const ChainModel>(model), options) {}
+
+TracIK::TracIK(std::shared_ptr<const ChainModel> model, const TracIKOptions& options) {
+  if (!model) throw InputError("TracIK needs a chain model");
+  if (model->n_joints() < 1) throw InputError("TracIK needs a chain with at least one moving joint");
+  check_options(options);
+  impl_ = std::make_unique<Impl>(std::move(model), options);
+}
+
+TracIK::~TracIK() = default;
+
+const ChainModel& TracIK::model() const { return *impl_->model; }
+std::shared_ptr<const ChainModel> TracIK::shared_model() const { return impl_->model; }
+const TracIKOptions& TracIK::options() const { return impl_->options; }
+int TracIK::n_joints() const { return impl_->model->n_joints(); }
+int TracIK::n_workers() const { return impl_->pool.size(); }
+
+bool TracIK::solve(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
+                   Eigen::VectorXd& q_out) const {
+  return solve(target, q_init, impl_->options.bounds, q_out);
+}
+
+bool TracIK::solve(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
+                   const Vector6d& bounds, Eigen::VectorXd& q_out) const {
+  TracIKOptions o = impl_->options;
+  o.bounds = bounds;
+  IKResult r = solve_ex(target, q_init, o);
+  q_out = std::move(r.q);
+  return r.found;
+}
+
+IKResult TracIK::solve_ex(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
+                          const TracIKOptions& options, IKAlgorithm algorithm) const {
+  check_options(options);
+  check_pose(target);
+  impl_->check_q_init(q_init);
+  Eigen::VectorXd q0 = q_init.cwiseMax(impl_->model->lower()).cwiseMin(impl_->model->upper());
+  return impl_->run(target, q0, options, algorithm, Impl::Schedule::Race, 0);
+}
+
+void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& targets,
+                        const Eigen::Ref<const Eigen::MatrixXd>& q_inits, Eigen::MatrixXd& q_out,
+                        std::vector<bool>& ok) const {
+  const int n = n_joints();
+  const auto T = static_cast<Eigen::Index>(targets.size());
+  if (q_inits.rows() != n || q_inits.cols() != T)
+    throw InputError("q_inits must be " + std::to_string(n) + " x " + std::to_string(T) + " (one column per target), got " +
+                     std::to_string(q_inits.rows()) + " x " + std::to_string(q_inits.cols()));
+  for (Eigen::Index k = 0; k < T; ++k) {
+    check_pose(targets[k], ("targets[" + std::to_string(k) + "]").c_str());
+    impl_->check_q_init(q_inits.col(k));
+  }
+  q_out.resize(n, T);
+  std::vector<char> found(static_cast<std::size_t>(T), 0);
+  std::atomic<Eigen::Index> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&] {
+    try {
+      for (Eigen::Index k; !failed.load() && (k = next.fetch_add(1)) < T;) {
+        Eigen::VectorXd q0 = q_inits.col(k).cwiseMax(impl_->model->lower()).cwiseMin(impl_->model->upper());
+        IKResult r = impl_->run(targets[k], q0, impl_->options, IKAlgorithm::TracIK, Impl::Schedule::Interleaved,
+                                static_cast<std::uint64_t>(k));
+        q_out.col(k) = r.q;
+        found[k] = r.found;
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      failed.store(true);
+    }
+  };
+  std::vector<WorkerPool::Job> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size(), T)));
+  for (auto& j : jobs) {
+    j.fn = work;
+    impl_->pool.submit(j);
+  }
+  work();
+  for (auto& j : jobs) impl_->pool.cancel_or_wait(j);
+  if (error) std::rethrow_exception(error);
+  ok.assign(found.begin(), found.end());
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+bool kdl_nr_jl_ik(const ChainModel& model, const Eigen::Isometry3d& target,
+                  const Eigen::Ref<const Eigen::VectorXd>& q_init, Eigen::VectorXd& q_out, double timeout,
+                  double epsilon) {
+  check_pose(target);
+  model.check_configuration(q_init, "q_init");
+  if (!(timeout > 0) || !std::isfinite(timeout)) throw InputError("timeout must be a positive finite number");
+  if (!(epsilon > 0) || !std::isfinite(epsilon)) throw InputError("epsilon must be a positive finite number");
+  const auto t0 = Clock::now();
+  const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const KDL::Chain& chain = model.kdl_chain();
+  const unsigned n = chain.getNrOfJoints();
+  KDL::JntArray lo(n), hi(n), q(n), out(n);
+  lo.data = model.lower();
+  hi.data = model.upper();
+  q.data = q_init;
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::ChainIkSolverVel_pinv vik(chain);
+  // One iteration per call so that the clock is checked between iterations (KDL itself has no timeout);
+  // each call continues from the previous result, which is exactly KDL's own iteration.
+  KDL::ChainIkSolverPos_NR_JL ik(chain, lo, hi, fk, vik, 1, epsilon);
+  KDL::Frame f;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) f.M(r, c) = target.linear()(r, c);
+    f.p[r] = target.translation()[r];
+  }
+  bool ok = false;
+  while (Clock::now() < deadline) {
+    const int rc = ik.CartToJnt(q, f, out);
+    q = out;
+    if (rc >= 0) {
+      ok = true;
+      break;
+    }
+  }
+  q_out = q.data;
+  return ok;
+}
+
+}  // namespace snakehead
