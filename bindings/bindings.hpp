@@ -5,4 +5,5 @@
 
 namespace snakehead::bindings {
 void bind_model(pybind11::module_& m);
+void bind_trac_ik(pybind11::module_& m);
 }  // namespace snakehead::bindings

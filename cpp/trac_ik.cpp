@@ -37,6 +37,9 @@ constexpr double kEvaluationsPerSecond = 1.0e6;
 constexpr int kNewtonIterations = 60;
 constexpr int kSqpEvaluations = 120;
 constexpr double kMaxStep = 0.6;  // rad (or m): largest joint change of one Newton step
+// Share of the timeout that a Speed call spends on KDL-RR in the calling thread before it starts the race
+// (measured: see bench/RESULTS.md).
+constexpr double kInlineFraction = 0.05;
 
 // ---------------------------------------------------------------------------------------------------------
 // Random numbers: a deterministic generator and our own uniform mapping (std::uniform_real_distribution
@@ -183,7 +186,7 @@ double manipulability_score(SolveType type, const Matrix6Xd& jac) {
 class Search {
  public:
   Search(const Problem& p, CallControl& c, std::mt19937_64& rng)
-      : p(p), c(c), rng(rng), n(p.model.n_joints()), jac(6, n), dr(6, n), jac_try(6, n), dr_try(6, n), dq(n),
+      : p(p), c(c), rng(rng), n(p.model.n_joints()), jac(6, n), dr(6, n), jac_try(6, n), dr_try(6, n), dr_step(6, n), dq(n),
         q_try(n) {}
 
   bool should_stop() {
@@ -242,7 +245,7 @@ class Search {
   CallControl& c;
   std::mt19937_64& rng;
   const int n;
-  Matrix6Xd jac, dr, jac_try, dr_try;
+  Matrix6Xd jac, dr, jac_try, dr_try, dr_step;
   Eigen::VectorXd dq, q_try;
   Best best;
 };
@@ -265,12 +268,26 @@ bool newton_descent(Search& s, Eigen::VectorXd& q) {
   double checkpoint = err;
   for (int it = 0; it < kNewtonIterations; ++it) {
     if (s.should_stop()) return false;
-    // dq = -D^T (D D^T + lambda I)^{-1} r: the 6x6 form of the damped normal equations.
-    Eigen::Matrix<double, 6, 6> A;
-    A.noalias() = s.dr * s.dr.transpose();
-    A.diagonal().array() += lambda;
-    const Vector6d y = A.ldlt().solve(r);
-    s.dq.noalias() = -s.dr.transpose() * y;
+    // dq = -D^T (D D^T + lambda I)^{-1} r: the 6x6 form of the damped normal equations. A joint at a
+    // limit that the step would push further out is taken out of the step (its column zeroed) and the
+    // step recomputed, so the other joints do the work instead of the step being clamped away.
+    s.dr_step = s.dr;
+    for (int pass = 0; pass < 3; ++pass) {
+      Eigen::Matrix<double, 6, 6> A;
+      A.noalias() = s.dr_step * s.dr_step.transpose();
+      A.diagonal().array() += lambda;
+      const Vector6d y = A.ldlt().solve(r);
+      s.dq.noalias() = -s.dr_step.transpose() * y;
+      bool blocked = false;
+      for (int i = 0; i < s.n; ++i) {
+        if (s.dq[i] == 0.0) continue;
+        if ((s.dq[i] < 0 && q[i] <= s.p.model.lower()[i]) || (s.dq[i] > 0 && q[i] >= s.p.model.upper()[i])) {
+          s.dr_step.col(i).setZero();
+          blocked = true;
+        }
+      }
+      if (!blocked) break;
+    }
     const double big = s.dq.cwiseAbs().maxCoeff();
     if (big > kMaxStep) s.dq *= kMaxStep / big;
     s.q_try = q + s.dq;
@@ -525,11 +542,20 @@ struct TracIK::Impl {
     } else if (schedule == Schedule::Interleaved) {
       interleaved_loop(nr, sq);
     } else {
-      // Race. For Speed, a cheap Newton descent from q_init in this thread first: it solves most targets
-      // in microseconds, well before a worker thread could even wake up. Only then is SQP handed off.
+      // Race. For Speed, KDL-RR first runs alone in this thread for a short while (kInlineFraction of the
+      // timeout): its descent from q_init solves most targets in tens of microseconds, less than it takes
+      // to wake a worker thread and to stop it again. Only targets that survive this are raced.
       Eigen::VectorXd q = q_init;
       const bool speed = o.solve_type == SolveType::Speed;
-      if (speed) newton_descent(nr, q);
+      if (speed) {
+        const auto inline_end = t0 + std::chrono::duration_cast<Clock::duration>(
+                                         std::chrono::duration<double>(kInlineFraction * o.timeout));
+        newton_descent(nr, q);
+        while (!nr.should_stop() && Clock::now() < inline_end) {
+          nr.random_configuration(q);
+          newton_descent(nr, q);
+        }
+      }
       if (!nr.should_stop()) {
         WorkerPool::Job job;
         job.fn = [&] {
