@@ -120,7 +120,7 @@ def test_polygon_margin_against_brute_force():
     active = rng.random((T, N)) < 0.85
     active[:, :3] = True
     xy = rng.normal(scale=1.2, size=(T, 2))
-    m = st.polygon_margin_many(pts, active, xy, chunk=64)
+    m = st.polygon_margin_many(pts, active, xy)
     for t in range(T):
         p = pts[t][active[t]]
         hull = ConvexHull(p)
@@ -158,3 +158,183 @@ def test_stability_bad_input(robot):
     q[0] = np.nan
     with pytest.raises(ValueError):
         st.support_polygon(robot, q)
+
+
+def test_polygon_margin_with_collinear_and_duplicate_points():
+    # integer grid points: many collinear and repeated points, the worst case for a hull
+    rng = np.random.default_rng(3)
+    T, N = 200, 12
+    pts = rng.integers(0, 4, size=(T, N, 2)).astype(float)
+    active = np.ones((T, N), bool)
+    xy = rng.uniform(-1, 4, size=(T, 2))
+    m = st.polygon_margin_many(pts, active, xy)
+    for t in range(T):
+        p = np.unique(pts[t], axis=0)
+        if np.linalg.matrix_rank(p - p[0]) < 2:
+            continue
+        v = p[ConvexHull(p).vertices]
+        e = np.roll(v, -1, axis=0) - v
+        w = xy[t] - v
+        line = (e[:, 0] * w[:, 1] - e[:, 1] * w[:, 0]) / np.linalg.norm(e, axis=1)
+        u = np.clip((w * e).sum(1) / (e * e).sum(1), 0, 1)
+        seg = np.linalg.norm(w - u[:, None] * e, axis=1).min()
+        assert m[t] == pytest.approx(seg if line.min() >= 0 else -seg, abs=1e-12)
+
+
+# ---------------------------------------------------------------- Eqs. 25-31: momenta
+def smooth_trajectory(robot, rng, T=400, dt=0.002):
+    """q(t) = q0 + sum_k a_k sin(w_k t + phi_k) with its exact first and second derivatives."""
+    t = np.arange(T) * dt
+    n = robot.n_joints
+    q0 = rng.uniform(-0.8, 0.8, n)
+    a = rng.uniform(-0.4, 0.4, (3, n))
+    w = rng.uniform(0.5, 4.0, (3, n))
+    phi = rng.uniform(0, 2 * np.pi, (3, n))
+    arg = w[None] * t[:, None, None] + phi[None]
+    q = q0 + (a * np.sin(arg)).sum(1)
+    qd = (a * w * np.cos(arg)).sum(1)
+    qdd = (-a * w ** 2 * np.sin(arg)).sum(1)
+    return t, q, qd, qdd
+
+
+def pin_world_momenta(model, data, base, q, v):
+    """pinocchio's centroidal momentum moved to our world origin: (P, L_O) with L_O = L_G + c x P."""
+    h = pin.computeCentroidalMomentum(model, data, q, v)  # about the moving bodies' CoM, root-frame axes
+    c = data.com[0]
+    P, L = h.linear, h.angular + np.cross(c, h.linear)
+    M = base.matrix()
+    Pw = M[:3, :3] @ P
+    return Pw, M[:3, :3] @ L + np.cross(M[:3, 3], Pw)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_momenta_match_pinocchio_centroidal_momentum(robot, pin_model, seed):
+    model, data = pin_model
+    rng = np.random.default_rng(seed)
+    base = BasePlacement(*rng.uniform(-1, 1, 2), rng.uniform(-np.pi, np.pi))
+    t, q, qd, _ = smooth_trajectory(robot, rng, T=60)
+    P, L = st.momenta_from_velocities(robot, q, qd, base)
+    assert P.shape == L.shape == (60, 3)
+    for k in range(len(t)):
+        Pr, Lr = pin_world_momenta(model, data, base, q[k], qd[k])
+        np.testing.assert_allclose(P[k], Pr, atol=1e-9, rtol=0)
+        np.testing.assert_allclose(L[k], Lr, atol=1e-9, rtol=0)
+    # the trajectory form with exact velocities is the same function
+    P2, L2 = st.momenta(robot, t, q, base, qd=qd)
+    np.testing.assert_array_equal(P2, P)
+    np.testing.assert_array_equal(L2, L)
+    # single sample form
+    P1, L1 = st.momenta_from_velocities(robot, q[5], qd[5], base)
+    np.testing.assert_allclose(P1, P[5], atol=1e-15)
+    np.testing.assert_allclose(L1, L[5], atol=1e-15)
+
+
+def test_linear_momentum_is_mass_times_com_velocity(robot):
+    rng = np.random.default_rng(5)
+    t, q, qd, _ = smooth_trajectory(robot, rng, T=200, dt=0.001)
+    P, _ = st.momenta_from_velocities(robot, q, qd)
+    c = st.center_of_mass(robot, q)
+    cdot = np.gradient(c, t, axis=0, edge_order=2)
+    np.testing.assert_allclose(P[2:-2], robot.total_mass * cdot[2:-2], atol=1e-5)
+
+
+def test_momenta_from_samples_converge_to_exact(robot):
+    rng = np.random.default_rng(6)
+    t, q, qd, _ = smooth_trajectory(robot, rng, T=500, dt=0.002)
+    P, L = st.momenta(robot, t, q)  # qd by np.gradient
+    Pe, Le = st.momenta_from_velocities(robot, q, qd)
+    assert np.abs(P - Pe).max() < 1e-4 and np.abs(L - Le).max() < 1e-4
+
+
+# ---------------------------------------------------------------- Eqs. 36-40: ZMP
+def test_zmp_at_rest_is_com_projection(robot):
+    q = arc_base(robot, 0.4)
+    q[7] = -0.8
+    q[9] = 0.6
+    t = np.arange(50) * 0.002
+    qs = np.tile(q, (50, 1))
+    base = BasePlacement(0.5, -0.3, 1.0)
+    p = st.zmp(robot, t, qs, base)
+    c = st.center_of_mass(robot, q, base)
+    np.testing.assert_allclose(p, np.tile(c[:2], (50, 1)), atol=1e-12)
+
+
+def test_zmp_matches_pinocchio_momentum_rate(robot, pin_model):
+    """ZMP from numerical derivatives of our momenta vs Eqs. 39-40 fed with pinocchio's exact momentum rate."""
+    model, data = pin_model
+    rng = np.random.default_rng(11)
+    base = BasePlacement(0.1, 0.4, 0.3)
+    t, q, qd, qdd = smooth_trajectory(robot, rng, T=300, dt=0.002)
+    ours = st.zmp(robot, t, q, base, qd=qd)
+    M = base.matrix()
+    R0, p0 = M[:3, :3], M[:3, 3]
+    mass = robot.total_mass
+    com = st.center_of_mass(robot, q, base)
+    ref = np.empty((len(t), 2))
+    for k in range(len(t)):
+        dh = pin.computeCentroidalMomentumTimeVariation(model, data, q[k], qd[k], qdd[k])
+        c = data.com[0]
+        Pdot = dh.linear
+        Ldot = dh.angular + np.cross(c, Pdot)  # d/dt(c x P) = cdot x P + c x Pdot, and cdot x P = 0
+        Pdot_w = R0 @ Pdot
+        Ldot_w = R0 @ Ldot + np.cross(p0, Pdot_w)
+        den = mass * st.GRAVITY + Pdot_w[2]
+        ref[k] = [(mass * st.GRAVITY * com[k, 0] - Ldot_w[1]) / den, (mass * st.GRAVITY * com[k, 1] + Ldot_w[0]) / den]
+    # central differences are O(dt^2) inside; one-sided second order at the ends
+    np.testing.assert_allclose(ours[1:-1], ref[1:-1], atol=2e-5)
+    np.testing.assert_allclose(ours, ref, atol=2e-4)
+
+
+def test_dynamic_stability_verdict(robot):
+    q0 = arc_base(robot, 0.5)
+    q0[8] = q0[10] = np.pi / 2  # neck and head folded back over the base: stable
+    q1 = arc_base(robot, 0.4)
+    q1[7] = q1[8] = -np.pi / 2  # neck up, head swung out sideways: CoM outside
+    t = np.linspace(0, 4, 2001)
+    s = (t / 4) ** 3 * (10 - 15 * t / 4 + 6 * (t / 4) ** 2)
+    qs = q0 + (q1 - q0) * s[:, None]
+    res = st.dynamic_stability(robot, t, qs)
+    assert res.inside[0] and not res.inside[-1] and not res.stable
+    assert res.min_margin == pytest.approx(res.margin.min()) and res.margin[res.argmin] == res.min_margin
+    # at the (resting) ends the margin equals the static margin, up to the one-sided difference's error
+    assert res.margin[0] == pytest.approx(st.static_margin(robot, q0), abs=1e-4)
+    assert res.margin[-1] == pytest.approx(st.static_margin(robot, q1), abs=1e-4)
+    # a slow, stable motion is stable throughout
+    res2 = st.dynamic_stability(robot, t, np.tile(q0, (len(t), 1)))
+    assert res2.stable and res2.min_margin == pytest.approx(st.static_margin(robot, q0), abs=1e-12)
+
+
+def test_dynamic_stability_with_moving_base_matches_per_sample_polygons(robot):
+    rng = np.random.default_rng(2)
+    T = 40
+    t = np.arange(T) * 0.05
+    qs = np.zeros((T, 16))
+    qs[:, 0:7:2] = np.linspace(0.1, 0.6, T)[:, None]  # the base curls up along the way
+    qs[:, 8] = qs[:, 10] = np.pi / 2
+    for contact in ("endpoints", "footprint"):
+        res = st.dynamic_stability(robot, t, qs, contact=contact)
+        for k in rng.choice(T, 6, replace=False):
+            poly = st.support_polygon(robot, qs[k], contact=contact)
+            ref = st.polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), res.zmp[k][None])[0]
+            assert res.margin[k] == pytest.approx(ref, abs=1e-12)
+
+
+def test_trajectory_bad_input(robot):
+    t = np.arange(10) * 0.002
+    q = np.zeros((10, 16))
+    with pytest.raises(ValueError, match="increase"):
+        st.zmp(robot, t[::-1], q)
+    with pytest.raises(ValueError, match="samples"):
+        st.momenta(robot, t[:9], q)
+    with pytest.raises(ValueError, match="at least two"):
+        st.momenta(robot, t[:1], q[:1])
+    with pytest.raises(ValueError, match="shape"):
+        st.momenta(robot, t, q[:, :15])
+    bad = q.copy()
+    bad[3, 4] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        st.dynamic_stability(robot, t, bad)
+    with pytest.raises(ValueError, match="shape"):
+        st.momenta_from_velocities(robot, q, q[:, :3])
+    with pytest.raises(ValueError, match="NaN"):
+        st.zmp(robot, t, q, qd=np.full((10, 16), np.inf))
