@@ -4,7 +4,8 @@ The C++ core (``snakehead._core``) does kinematics, TRAC-IK and the workspace sw
 modules plan with it. Start with ``SnakeRobot.default()``.
 """
 from .chain import Chain
+from .ik import TracIK
 from .robot import BasePlacement, RobotParts, SnakeRobot, default_urdf_path
 
-__all__ = ["Chain", "SnakeRobot", "BasePlacement", "RobotParts", "default_urdf_path"]
+__all__ = ["Chain", "TracIK", "SnakeRobot", "BasePlacement", "RobotParts", "default_urdf_path"]
 __version__ = "0.1.0"
