@@ -68,7 +68,7 @@ YAW = "yaw"
 PITCH = "pitch"
 
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
-DEFAULT_FD_STEP = 5e-3
+DEFAULT_FD_STEP = 2e-3
 
 #: Default relative tolerance of the arc-length / phase / bending integration (scipy solve_ivp, DOP853).
 DEFAULT_RTOL = 1e-10
@@ -451,7 +451,9 @@ def curve_joint_angles(robot: SnakeRobot, curve: SpaceCurve, joints: slice, *, s
         (3, 3) there (see :meth:`SpaceCurve.initial_phase`); default 0 (the curve's normal along the body's y).
 
     Returns (len(joints),) joint angles: +theta_y (Eq. 5) at +z yaw joints, -theta_p (Eq. 6) at +y pitch
-    joints. Raises ValueError if the curve is too short for the joints, or both phi0 and frame0 are given.
+    joints, over the intervals of :func:`joint_intervals` on the part's stretch of the curve: from its start
+    to the first joint after the slice (or the body's last frame); a longer curve is cut there. Raises
+    ValueError if the curve is too short for the joints, or both phi0 and frame0 are given.
     """
     lay = joint_layout(robot)
     idx = np.arange(robot.n_joints)[joints]
@@ -466,11 +468,17 @@ def curve_joint_angles(robot: SnakeRobot, curve: SpaceCurve, joints: slice, *, s
         phi0 = curve.initial_phase(np.asarray(frame0, dtype=np.float64)[:3, :3])
     phi0 = 0.0 if phi0 is None else _finite_float(phi0, "phi0")
     s_on = lay.s[idx] - s_start
+    if s_on[0] < -1e-12:
+        raise ValueError(f"the curve starts at body arc length {s_start:.6g} m, after the first joint")
     if s_on[-1] > curve.length + 1e-12:
         raise ValueError(f"the curve ({curve.length:.6g} m) is shorter than the body it must cover "
                          f"({s_on[-1]:.6g} m to the last joint)")
+    # the part ends where the next joint begins (or at the body's last frame); a longer curve is cut there
+    part_end = (lay.s[idx[-1] + 1] if idx[-1] + 1 < robot.n_joints else lay.length) - s_start
     kinds = [lay.kinds[i] for i in idx]
-    theta = discretize(curve, s_on, kinds, phi0=phi0)
+    iv = joint_intervals(np.maximum(s_on, 0.0), kinds, min(curve.length, part_end))
+    ty, tp = curve.bending(iv[:, 0], iv[:, 1], phi0=phi0)
+    theta = np.where(np.array(kinds) == YAW, ty, tp)
     sign = np.where(np.array(kinds) == YAW, 1.0, -1.0) * lay.signs[idx]
     return sign * theta
 
