@@ -692,10 +692,10 @@ def _targets(robot, planned_t, planned_q, base, targets):
         targets = [float(planned_t[-1])]
     out = []
     for k, tg in enumerate(targets):
-        if np.ndim(tg) == 0:
+        if isinstance(tg, (int, float, np.integer, np.floating)) or (isinstance(tg, np.ndarray) and tg.ndim == 0):
             time, pos, dirn = float(tg), None, None
         else:
-            if len(tg) != 3:
+            if not isinstance(tg, (tuple, list)) or len(tg) != 3:
                 raise ValueError(f"targets[{k}] must be a time or (time, position, direction), got {tg!r}")
             time, pos, dirn = tg
             time = float(finite_array(time, f"targets[{k}] time", ()))

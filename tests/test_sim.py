@@ -1,0 +1,276 @@
+"""The MuJoCo dynamics check (snakehead.sim): model against the robot, physics sanity, tracking, bad input."""
+import sys
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco")
+
+from snakehead import BasePlacement, SnakeRobot, sim, stability  # noqa: E402
+
+#: A curled base (yaw joints 0.879 rad) with the neck turned inwards and the head part raised 0.42 m:
+#: statically stable with a ~3 cm margin (endpoints polygon) all along the joint-space path from flat.
+Q_LIFTED = np.array([0.879, 0.0, 0.879, 0.0, 0.879, 0.0, 0.879, 0.0,
+                     1.485, -1.208, 0.151, -0.2, 0.292, 0.977, -0.451, 0.599])
+PITCH = [7, 9, 11, 13, 15]
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return SnakeRobot.default()
+
+
+def flat_of(q):
+    q = q.copy()
+    q[PITCH] = 0.0
+    return q
+
+
+def quintic(q0, q1, duration, dt=0.002):
+    t = np.arange(0.0, duration + 1e-9, dt)
+    s = t / duration
+    h = 10 * s**3 - 15 * s**4 + 6 * s**5
+    return t, q0 + h[:, None] * (q1 - q0)
+
+
+# ------------------------------------------------------------------------------------------------
+# the model against the robot
+# ------------------------------------------------------------------------------------------------
+def test_masses_and_inertias_match_the_robot(robot):
+    s = sim.build_model(robot)
+    m = s.model
+    assert m.body_mass.sum() == pytest.approx(robot.total_mass, abs=1e-9)
+    np.testing.assert_allclose(m.body_mass[s.body_ids], robot.masses, atol=1e-9)
+    for i, b in enumerate(s.body_ids):
+        if robot.masses[i] == 0:
+            continue
+        np.testing.assert_allclose(m.body_ipos[b], robot.coms[i], atol=1e-9)
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, m.body_iquat[b])
+        R = R.reshape(3, 3)
+        I = R @ np.diag(m.body_inertia[b]) @ R.T  # principal axes back to the link frame
+        np.testing.assert_allclose(I, robot.inertias[i], atol=1e-9 * np.abs(robot.inertias[i]).max())
+    assert m.opt.timestep <= 0.002
+    assert m.nu == robot.n_joints
+    np.testing.assert_allclose(m.actuator_forcerange[:, 1], robot.body.model.effort)
+    jid = m.dof_jntid[s.dof_adr]
+    np.testing.assert_allclose(m.jnt_range[jid], np.column_stack([robot.lower, robot.upper]))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_kinematics_match_robot_frames(robot, seed):
+    rng = np.random.default_rng(seed)
+    s = sim.build_model(robot)
+    d = mujoco.MjData(s.model)
+    q = robot.body.random_configuration(rng)
+    base = BasePlacement(*rng.uniform(-1, 1, 2), rng.uniform(-np.pi, np.pi))
+    s.set_state(d, q, base)
+    expected = robot.frames(q, base)
+    np.testing.assert_allclose(s.frames(d), expected, atol=1e-9)
+    np.testing.assert_allclose(d.site_xpos[s.site_ids], expected[:, :3, 3], atol=1e-9)
+    np.testing.assert_allclose(d.site_xmat[s.site_ids].reshape(-1, 3, 3), expected[:, :3, :3], atol=1e-9)
+
+
+def test_momenta_of_a_state_three_ways(robot):
+    """Subtree momenta == per-body sum == the planner's Eqs. 25-31 (root held still), and P == M dc/dt."""
+    rng = np.random.default_rng(3)
+    s = sim.build_model(robot)
+    d = mujoco.MjData(s.model)
+    q = robot.body.random_configuration(rng)
+    qd = rng.uniform(-1, 1, robot.n_joints)
+    base = BasePlacement(0.2, -0.1, 0.4)
+    s.set_state(d, q, base)
+    d.qvel[s.dof_adr] = qd
+    mujoco.mj_forward(s.model, d)
+    P, L = sim.momenta_of_state(s, d)
+    P2, L2 = sim.momenta_per_body(s, d)
+    P3, L3 = stability.momenta_from_velocities(robot, q, qd, base)
+    np.testing.assert_allclose(P, P2, atol=1e-9)
+    np.testing.assert_allclose(L, L2, atol=1e-9)
+    np.testing.assert_allclose(P, P3, atol=1e-9)
+    np.testing.assert_allclose(L, L3, atol=1e-9)
+    h = 1e-6
+    c = [stability.center_of_mass(robot, q + sgn * h * qd, base) for sgn in (1, -1)]
+    np.testing.assert_allclose(P, robot.total_mass * (c[0] - c[1]) / (2 * h), atol=1e-7)
+
+
+def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(robot):
+    rng = np.random.default_rng(4)
+    s = sim.build_model(robot)
+    d = mujoco.MjData(s.model)
+    q = robot.body.random_configuration(rng)
+    s.set_state(d, q)
+    W = np.ones((robot.n_joints, len(robot.link_names)))
+    for j, c in enumerate(robot.body.model.joint_child_links):
+        W[j, :c] = 0.0
+    np.testing.assert_allclose(sim.gravity_torques(s, d, W), d.qfrc_bias[s.dof_adr], atol=1e-10)
+    # a flat robot on the ground carries nothing: every link rests on the ground
+    Wflat = sim.carried_weights(robot, robot.frames_many(np.zeros((1, robot.n_joints))))[0]
+    assert np.all(Wflat == 0.0)
+    # the raised head part is carried by joint 10 (index 9), the base by nobody
+    Wl = sim.carried_weights(robot, robot.frames_many(Q_LIFTED[None]))[0]
+    head_links = [robot.link_names.index(f"link_{i}") for i in range(10, 17)]
+    assert np.all(Wl[9, head_links] == 1.0)
+    assert np.all(Wl[:7] == 0.0)
+
+
+# ------------------------------------------------------------------------------------------------
+# physics sanity
+# ------------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def held(robot):
+    """Hold the raised, statically stable configuration for 1 s."""
+    t = np.array([0.0, 1.0])
+    q = np.array([Q_LIFTED, Q_LIFTED])
+    return t, q, sim.simulate(robot, t, q, base=BasePlacement(0.1, 0.2, 0.3))
+
+
+def test_holding_a_stable_configuration_stays_put(robot, held):
+    t, q, res = held
+    assert res.t[0] == 0.0 and res.t[-1] == pytest.approx(1.0)
+    assert res.base_slide_m < 1e-3
+    assert res.base_lift_m < 1e-3
+    disp = np.linalg.norm(res.base_positions[-1] - res.base_positions[0], axis=1).max()
+    assert disp < 1e-3
+    # at rest the centre of pressure is the CoM's ground projection
+    assert np.all(np.isfinite(res.zmp))
+    err = np.linalg.norm(res.zmp - res.com[:, :2], axis=1)
+    assert err.max() < 3e-3, err.max()
+    # and the CoM is where the plan puts it
+    c = stability.center_of_mass(robot, Q_LIFTED, res.base)
+    assert np.linalg.norm(res.com[-1] - c) < 2e-3
+    # the ground carries the whole weight
+    fz = sum(f[:, 2].sum() for f in res.contact_forces[-10:]) / 10
+    assert fz == pytest.approx(robot.total_mass * sim.GRAVITY, rel=1e-3)
+
+
+@pytest.fixture(scope="module")
+def lift(robot):
+    """A slow 3 s lift of the head part from the flat curled pose, then 0.5 s of holding."""
+    t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 3.0)
+    res = sim.simulate(robot, t, q, torque_limit=10.0, hold=0.5)
+    return t, q, res
+
+
+def test_contact_zmp_matches_the_momentum_zmp(robot, lift):
+    """Centre of pressure of the contact forces == Eqs. 39-40 on the simulated momenta (Newton-Euler)."""
+    t, q, res = lift
+    edge = 2
+    Pdot = np.gradient(res.P, res.t, axis=0, edge_order=edge)
+    Ldot = np.gradient(res.L, res.t, axis=0, edge_order=edge)
+    M, g = robot.total_mass, sim.GRAVITY
+    den = M * g + Pdot[:, 2]
+    px = (M * g * res.com[:, 0] - Ldot[:, 1]) / den
+    py = (M * g * res.com[:, 1] + Ldot[:, 0]) / den
+    err = np.hypot(px - res.zmp[:, 0], py - res.zmp[:, 1])[5:-5]  # skip the one-sided ends
+    assert np.median(err) < 1e-3
+    assert np.percentile(err, 99) < 5e-3
+
+
+def test_tracking_a_slow_lift(robot, lift):
+    t, q, res = lift
+    report = sim.compare(robot, t, q, res, targets=[t[-1], t[-1] + 0.5])
+    for key in ("position_error_m", "direction_error_deg", "max_linear_momentum_error",
+                "max_angular_momentum_error", "zmp_inside"):
+        assert key in report
+        assert np.isfinite(report[key])
+    # measured: ~0.7 mm and ~0.1 deg with kp 200, kd 3 (bench/RESULTS.md); bounds with margin
+    assert report["position_error_m"] < 5e-3
+    assert report["direction_error_deg"] < 1.0
+    assert report["zmp_inside"] is True
+    assert report["base_slide_m"] < 2e-3
+    # the head really went up: 0.42 m
+    assert res.head_position[-1, 2] > 0.4
+    # momenta are close to the plan (planned peak |P| ~ 0.2 kg m/s)
+    assert report["max_linear_momentum_error"] < 0.1
+    assert report["max_angular_momentum_error"] < 0.02
+    # explicit target: the planned head pose itself is the target, so the error is the same
+    H = robot.head_pose(Q_LIFTED, res.base)
+    r2 = sim.compare(robot, t, q, res, targets=[(t[-1], H[:3, 3], H[:3, 0])])
+    assert r2["position_error_m"] == pytest.approx(report["position_errors_m"][0], abs=1e-12)
+
+
+def test_the_urdf_effort_cannot_lift_the_head_part(robot):
+    """3 N m servos cannot raise the 1.3 kg head part from flat: the simulation shows it (documented)."""
+    t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 1.5)
+    res = sim.simulate(robot, t, q, settle=0.1)
+    assert res.saturation_fraction > 0.0
+    assert res.head_position[-1, 2] < 0.2
+
+
+# ------------------------------------------------------------------------------------------------
+# obstacles
+# ------------------------------------------------------------------------------------------------
+def _inside_box(p, ob):
+    c, s, yaw = np.array(ob.center), np.array(ob.size), ob.yaw
+    R = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
+    local = R.T @ (np.asarray(p) - c)
+    return np.all(np.abs(local) <= s / 2 + 1e-12)
+
+
+def test_wall_with_hole(robot):
+    centre = np.array([0.2, 0.5, 0.4])
+    boxes = sim.wall_with_hole(centre, hole_diameter=0.07, yaw=0.3)
+    u = np.array([np.cos(0.3), np.sin(0.3), 0.0])
+    assert not any(_inside_box(centre, b) for b in boxes)
+    assert not any(_inside_box(centre + 0.03 * u, b) for b in boxes)
+    assert any(_inside_box(centre + 0.036 * u, b) for b in boxes)
+    assert any(_inside_box(centre + np.array([0, 0, 0.036]), b) for b in boxes)
+    assert any(_inside_box(centre + 0.3 * u - np.array([0, 0, 0.35]), b) for b in boxes)  # near the ground
+    area = sum(b.size[0] * b.size[2] for b in boxes)
+    opening = 0.7 * 0.58 - area  # a staircase inscribed in the circle: smaller, but not by much
+    assert 0.75 * np.pi * 0.035**2 < opening < np.pi * 0.035**2
+    s = sim.build_model(robot, obstacles=boxes)
+    assert s.model.ngeom == 1 + len(boxes) + 17
+    with pytest.raises(ValueError, match="hole"):
+        sim.wall_with_hole((0.2, 0.5, 0.01))
+
+
+# ------------------------------------------------------------------------------------------------
+# bad input
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("mutate, match", [
+    (lambda t, q: (t[:-1], q), "different lengths"),
+    (lambda t, q: (t, q[:, :15]), "shape"),
+    (lambda t, q: (t, np.where(np.arange(q.size).reshape(q.shape) == 5, np.nan, q)), "NaN"),
+    (lambda t, q: (np.array([0.0, 0.1, 0.1, 0.3]), q), "increasing"),
+    (lambda t, q: (t, q + 2.0), "limits"),
+    (lambda t, q: (t[:1], q[:1]), "at least 2"),
+])
+def test_bad_trajectories(robot, mutate, match):
+    t = np.array([0.0, 0.1, 0.2, 0.3])
+    q = np.zeros((4, robot.n_joints))
+    tt, qq = mutate(t, q)
+    with pytest.raises(ValueError, match=match):
+        sim.simulate(robot, tt, qq)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(kp=0.0), "kp"), (dict(kp=-1.0), "kp"), (dict(kp=np.ones(3)), "kp"), (dict(kd=-1.0), "kd"),
+    (dict(kp=np.nan), "NaN"), (dict(control_dt=0.0015), "multiple"), (dict(settle=-1.0), "settle"),
+    (dict(torque_limit=0.0), "torque"), (dict(gravity_compensation="lifted"), "gravity_compensation"),
+    (dict(timestep=0.0), "timestep"), (dict(friction=-0.1), "friction"),
+])
+def test_bad_parameters(robot, kwargs, match):
+    t = np.array([0.0, 0.1])
+    q = np.zeros((2, robot.n_joints))
+    with pytest.raises(ValueError, match=match):
+        sim.simulate(robot, t, q, **kwargs)
+
+
+def test_bad_compare_input(robot, held):
+    t, q, res = held
+    with pytest.raises(ValueError, match="outside the simulated span"):
+        sim.compare(robot, t, q, res, targets=[5.0])
+    with pytest.raises(ValueError, match="zero length"):
+        sim.compare(robot, t, q, res, targets=[(1.0, np.zeros(3), np.zeros(3))])
+    with pytest.raises(ValueError, match="targets"):
+        sim.compare(robot, t, q, res, targets=[(1.0, np.zeros(3))])
+    with pytest.raises(TypeError):
+        sim.compare(robot, t, q, "not a result")
+
+
+def test_missing_mujoco_names_the_extra(monkeypatch, robot):
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    with pytest.raises(ImportError, match=r"snakehead\[sim\]"):
+        sim.build_model(robot)
