@@ -428,3 +428,31 @@ def test_unreachable_or_inflected_up_curve(robot):
     with pytest.raises(ValueError, match="inflection"):  # ends pointing forward: needs an S-bend
         bb.initial_configuration(robot, central_angle=2.0,
                                  shape=bb.UpCurveShape(height=0.3, reach=0.5, tip_angle=0.2))
+
+
+def test_curve_that_starts_straight(robot):
+    """z = x^3 in the x-z plane: kappa(0) = 0, no inflection on [0, 0.8]. With the body along +x and z up the
+    normal is +z (phi0 = pi/2): only pitch joints bend, and their angles add up to minus the tangent's
+    elevation at the part's end (Eq. 6 integrates kappa_p = d(elevation)/ds)."""
+    c = bb.SpaceCurve(lambda t: np.array([t, 0.0, t ** 3]), 0.0, 0.8)
+    assert c.initial_phase(np.eye(3)) == pytest.approx(math.pi / 2, abs=1e-9)
+    q = bb.curve_joint_angles(robot, c, slice(0, 10), frame0=np.eye(3))
+    np.testing.assert_allclose(q[0::2], 0.0, atol=1e-12)
+    t_end = c.t_at(0.0405 + 10 * 0.0865)  # the part ends at joint 11
+    assert q[1::2].sum() == pytest.approx(-math.atan(3 * t_end ** 2), abs=1e-8)
+    assert np.all(q[1::2] < 0)  # bending up is negative pitch
+
+
+def test_figures(tmp_path, default_backbone):
+    import matplotlib.pyplot as plt
+
+    from snakehead import backbone_plots as bp
+
+    figs = [bp.plot_arc_discretisation(central_angle=2.0, path=tmp_path / "fig3.png"),
+            bp.plot_initial_configuration(default_backbone, path=tmp_path / "fig14.png"),
+            bp.plot_area_vs_angle(default_backbone.optimum, path=tmp_path / "area.png")]
+    for name in ("fig3.png", "fig14.png", "area.png"):
+        assert (tmp_path / name).stat().st_size > 20_000
+    assert len(figs[1].axes) == 2 and figs[1].axes[1].name == "3d"
+    for f in figs:
+        plt.close(f)

@@ -48,9 +48,10 @@ total yaw bending of the curve (for the plane arc: its central angle), so the la
 curve's end tangent when the first lies along its start tangent.
 
 Limitations. Eqs. 3-4 use the Frenet frame, which is undefined where the curvature vanishes; a curve whose
-curvature passes through zero (an inflection, a straight piece between bends) flips its normal there and
-is rejected with a ValueError (split it into pieces and give each piece its own initial frame). A curve
-that is straight everywhere is accepted (all angles zero).
+normal flips where its curvature passes through zero (an inflection) is rejected with a ValueError (split
+it into pieces and give each piece its own initial frame). A curve that is straight everywhere is accepted
+(all angles zero), and so is one that starts straight (kappa(t0) = 0): its initial phase is read where it
+first bends.
 """
 from __future__ import annotations
 
@@ -244,14 +245,16 @@ class SpaceCurve:
             self._straight = True
             return
         self._straight = False
-        bad = norms < STRAIGHT_TOLERANCE * norms.max() * 1e3
-        B = cs / np.maximum(np.linalg.norm(cs, axis=1), 1e-300)[:, None]
-        flips = np.einsum("ij,ij->i", B[1:], B[:-1]) < 0.0
-        if bad.any() or flips.any():
-            i = int(np.argmax(bad)) if bad.any() else int(np.argmax(flips))
+        # an inflection flips the binormal B = r' x r'' / |r' x r''| (and the normal) across a zero of kappa
+        ok = norms > STRAIGHT_TOLERANCE * norms.max()
+        B = cs[ok] / np.linalg.norm(cs[ok], axis=1)[:, None]
+        flips = np.flatnonzero(np.einsum("ij,ij->i", B[1:], B[:-1]) < 0.0)
+        if len(flips):
+            i = np.flatnonzero(ok)[flips[0]]
             raise ValueError(
-                f"the curvature of the curve vanishes near t = {ts[i]:.6g} (an inflection or straight piece): "
-                "the Frenet frame of Eqs. 3-4 is undefined there; split the curve at that point")
+                f"the curvature of the curve vanishes between t = {ts[i]:.6g} and the next sample and its normal "
+                "flips there (an inflection): the Frenet frame of Eqs. 3-4 is undefined; split the curve at that point")
+        self._first_curved_t = float(ts[np.flatnonzero(ok)[0]])
 
     # -- integration of s, phi and the bending integrals -----------------------------------------
     def _rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -350,10 +353,23 @@ class SpaceCurve:
         if abs(float(R[:, 0] @ F[:, 0]) - 1.0) > 1e-6:
             raise ValueError("the body frame's x-axis is not the curve's start tangent: "
                              f"x = {R[:, 0].round(6).tolist()}, T(t0) = {F[:, 0].round(6).tolist()}")
-        if self._straight or not np.all(np.isfinite(F[:, 1])):
+        if self._straight:
             return 0.0
-        N = F[:, 1]
-        return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1]))
+        k0 = self._kappa_tau(self.t0)[0]
+        if np.all(np.isfinite(F[:, 1])) and k0 > STRAIGHT_TOLERANCE * 1e3 * self._kappa_scale():
+            N = F[:, 1]
+            return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1]))
+        # the curve starts straight (kappa(t0) = 0): take the normal where it first bends and undo the
+        # torsion accumulated up to there (Eq. 3), with the body frame carried along (without twist) as
+        # the start is straight
+        t1 = self._first_curved_t
+        N = self.frenet(t1)[:, 1]
+        s1 = self.arc_length(t1)
+        return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1])) - self.phase(s1)
+
+    def _kappa_scale(self) -> float:
+        ts = np.linspace(self.t0, self.t1, 33)
+        return max(self._kappa_tau(t)[0] for t in ts)
 
 
 # ---------------------------------------------------------------------------------------------------
