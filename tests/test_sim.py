@@ -274,3 +274,17 @@ def test_missing_mujoco_names_the_extra(monkeypatch, robot):
     monkeypatch.setitem(sys.modules, "mujoco", None)
     with pytest.raises(ImportError, match=r"snakehead\[sim\]"):
         sim.build_model(robot)
+
+
+def test_plots_write_pngs(robot, lift, tmp_path):
+    from snakehead import sim_plots
+
+    t, q, res = lift
+    paths = sim_plots.plot_dynamics_check(robot, t, q, res, tmp_path)
+    assert [p.name for p in paths] == ["sim_angular_momentum.png", "sim_linear_momentum.png", "sim_zmp.png"]
+    for p in paths:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
+    with pytest.raises(ValueError, match="which"):
+        sim_plots.plot_momentum(t, res.P[:len(t)], res.t, res.P, "spin", tmp_path / "x.png")
+    with pytest.raises(ValueError, match="polygon"):
+        sim_plots.plot_zmp(np.zeros((3, 3)), res, tmp_path / "z.png")
