@@ -74,7 +74,8 @@ DEFAULT_FD_STEP = 2e-3
 #: Default relative tolerance of the arc-length / phase / bending integration (scipy solve_ivp, DOP853).
 DEFAULT_RTOL = 1e-10
 
-#: A curve is straight where |r' x r''| < this times max |r' x r''| (Frenet frame undefined there).
+#: A curve counts as straight (tau = 0, Frenet frame undefined) where its curvature is below this times its
+#: largest curvature (sampled on 257 points of [t0, t1]).
 STRAIGHT_TOLERANCE = 1e-7
 
 # ---------------------------------------------------------------------------------------------------
@@ -193,7 +194,7 @@ class SpaceCurve:
 
         kappa = |r' x r''| / |r'|^3,   tau = (r' x r'') . r''' / |r' x r''|^2.
 
-        Where the curve is straight (|r' x r''| below ``STRAIGHT_TOLERANCE`` of its scale) tau is 0.
+        Where the curve is straight (kappa below ``STRAIGHT_TOLERANCE`` times its largest) tau is 0.
         """
         ts = np.atleast_1d(np.asarray(t, dtype=np.float64))
         k = np.empty(ts.shape)
@@ -210,8 +211,8 @@ class SpaceCurve:
         c2 = float(c @ c)
         speed = float(np.linalg.norm(d1))
         kappa = math.sqrt(c2) / speed ** 3  # Eq. 7
-        straight = c2 <= (STRAIGHT_TOLERANCE * speed ** 2 * max(float(np.linalg.norm(d2)), 1e-300)) ** 2 \
-            or c2 == 0.0
+        # straight here: the Frenet frame (and tau) is undefined; finite-difference noise must not twist phi
+        straight = c2 == 0.0 or kappa <= STRAIGHT_TOLERANCE * self._kappa_max
         tau = 0.0 if straight else float(c @ d3) / c2  # Eq. 7
         return kappa, tau, speed
 
@@ -241,10 +242,13 @@ class SpaceCurve:
             i = int(np.argmin(speeds))
             raise ValueError(f"the curve is not regular: r'(t) = 0 near t = {ts[i]:.6g}")
         norms = np.linalg.norm(cs, axis=1) / speeds ** 3  # kappa
-        if norms.max() == 0.0 or norms.max() < 1e-12 / max(speeds.max(), 1e-300):
+        approx_length = float(speeds.mean()) * (self.t1 - self.t0)
+        if norms.max() * approx_length < 1e-8:  # bends by less than 1e-8 rad in all: a straight line
             self._straight = True
+            self._kappa_max = math.inf  # every point counts as straight: tau = 0
             return
         self._straight = False
+        self._kappa_max = float(norms.max())
         # an inflection flips the binormal B = r' x r'' / |r' x r''| (and the normal) across a zero of kappa
         ok = norms > STRAIGHT_TOLERANCE * norms.max()
         B = cs[ok] / np.linalg.norm(cs[ok], axis=1)[:, None]
@@ -356,7 +360,7 @@ class SpaceCurve:
         if self._straight:
             return 0.0
         k0 = self._kappa_tau(self.t0)[0]
-        if np.all(np.isfinite(F[:, 1])) and k0 > STRAIGHT_TOLERANCE * 1e3 * self._kappa_scale():
+        if np.all(np.isfinite(F[:, 1])) and k0 > STRAIGHT_TOLERANCE * 1e3 * self._kappa_max:
             N = F[:, 1]
             return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1]))
         # the curve starts straight (kappa(t0) = 0): take the normal where it first bends and undo the
@@ -366,10 +370,6 @@ class SpaceCurve:
         N = self.frenet(t1)[:, 1]
         s1 = self.arc_length(t1)
         return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1])) - self.phase(s1)
-
-    def _kappa_scale(self) -> float:
-        ts = np.linspace(self.t0, self.t1, 33)
-        return max(self._kappa_tau(t)[0] for t in ts)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -572,7 +572,8 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot | No
 
     Parameters
     ----------
-    length : arc length l (m), > 0; it starts at the tail end and must reach past the last base joint
+    length : arc length l (m), > 0; it starts at the tail end (at the first selected joint when ``joints``
+        does not start at joint 0) and must reach past the last selected joint
         (the default robot's base is 0.646 m: :func:`base_length`).
     central_angle : theta (rad), in (0, 2 pi].
     robot : default ``SnakeRobot.default()``.
@@ -826,7 +827,7 @@ def optimize_base_arc(robot: SnakeRobot | None = None, q_up=None, base: BasePlac
         raise ValueError(f"min_margin must be >= 0 m, got {min_margin}")
     nb = robot.parts.base.stop
     if q_up is None:
-        q_up = _default_q_up(robot)
+        q_up = _q_up_for(robot, UpCurveShape(), turn)[0]
     q_up = finite_array(q_up, "q_up", (robot.n_joints - nb,))
     lim = arc_angle_limit(robot, turn=turn)
     lo, hi = (0.05, lim) if bounds is None else (
@@ -1005,10 +1006,6 @@ def _q_up_for(robot: SnakeRobot, shape: UpCurveShape, turn: int) -> tuple[np.nda
     phi0 = curve.initial_phase(R0)
     q_up = curve_joint_angles(robot, curve, slice(nb, robot.n_joints), phi0=phi0)
     return q_up, curve, P, phi0
-
-
-def _default_q_up(robot: SnakeRobot) -> np.ndarray:
-    return _q_up_for(robot, UpCurveShape(), 1)[0]
 
 
 @dataclass(frozen=True)
