@@ -456,3 +456,20 @@ def test_figures(tmp_path, default_backbone):
     assert len(figs[1].axes) == 2 and figs[1].axes[1].name == "3d"
     for f in figs:
         plt.close(f)
+
+
+def test_exact_chord_polygon_is_largest_on_a_semicircle(robot, default_backbone):
+    """With exact chords the base polygon has fixed sides and a free closing side, so its area is largest when
+    it is inscribed in a semicircle on that side (theta = pi): Eq. 2's maximiser, reached by the optimiser."""
+    opt = bb.optimize_base_arc(robot, default_backbone.q[7:], chords="exact")
+    assert opt.central_angle == pytest.approx(math.pi, abs=1e-5)
+    assert opt.area == pytest.approx(scipy_hull_area(robot, opt.q), rel=1e-12)
+    # the vertices (tail end, yaw joints, P0) then see the chord P0 - tail end at a right angle (Thales)
+    F = robot.frames(opt.q)
+    ends = F[point_index(robot, "link_0"), :2, 3], F[point_index(robot, "base_end"), :2, 3]
+    for name in ("link_1", "link_3", "link_5", "link_7"):
+        v = F[point_index(robot, name), :2, 3]
+        assert np.dot(ends[0] - v, ends[1] - v) == pytest.approx(0.0, abs=1e-5)
+    lim = bb.arc_angle_limit(robot, chords="exact")
+    q = bb.arc_joint_angles(L_BASE, lim, robot, chords="exact")
+    assert np.abs(q).max() == pytest.approx(math.pi / 2, abs=1e-9)
