@@ -20,7 +20,7 @@ Model (:func:`build_mjcf`), generated from the robot's own data, not from the UR
   (:func:`wall_with_hole` builds the paper's wall of Section 4.2). Robot boxes collide with the ground and the
   obstacles; not with each other unless ``self_collision=True`` (parent/child pairs never);
 * timestep 1 ms (physics) under the 2 ms control period of the paper; integrator ``implicitfast``;
-  contact ``solref = (0.005 s, 1)`` (stiff: ~0.05 mm sinkage under the robot's weight);
+  contact ``solref = (0.005 s, 1)`` (stiff: the resting body sinks ~1 um into the ground);
 * servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
   0.02 N m s/rad -- our choice, not the paper's.
 
@@ -29,12 +29,20 @@ updated (zero-order hold); the joint torque is
 
     tau = kp (q_ref - q) + kd (qdot_ref - qdot) + g_mj(q, qdot)     clipped to +-torque_limit
 
-where g_mj is MuJoCo's bias force ``qfrc_bias`` (gravity + Coriolis, with the floating root held) on the
-compensated joints. The PD part is a MuJoCo affine actuator, i.e. evaluated at every physics step as in a
-servo's inner loop, with the velocity gain integrated implicitly (stable for the light distal links).
-By default only the lifted part (neck and head joints) is gravity compensated: for a joint of the base the
-bias term is the torque that would hold the whole distal body as a cantilever from the tail, which the ground
-actually carries -- applying it would try to lift the tail.
+where g_mj is a gravity term on the joints. The PD part is a MuJoCo affine actuator, i.e. evaluated at every
+physics step as in a servo's inner loop, with the velocity gain integrated implicitly (stable for the light
+distal links). Gravity compensation (``gravity_compensation``):
+
+* "supported" (default): each joint holds the weight of the run of lifted links hanging from it, up to the
+  first link that rests on the ground in the plan (:func:`carried_weights`, :func:`gravity_torques`); links
+  on the ground are carried by the ground;
+* "bias": MuJoCo's ``qfrc_bias`` (gravity + Coriolis) on every joint, the textbook term for a fixed-base arm.
+  For a snake lying on the ground it is wrong at the base joints: it is the torque that would hold the whole
+  distal body as a cantilever from the tail, so the base pitch joints push against the ground;
+* "none": PD only.
+
+Default gains kp = 200 N m/rad, kd = 3 N m s/rad. The URDF's 3 N m effort cannot lift the head part from flat
+(joint 10 needs ~3.9 N m); pass ``torque_limit`` to raise it (bench/RESULTS.md).
 """
 from __future__ import annotations
 
@@ -145,7 +153,12 @@ def _vec(v) -> str:
 
 
 def _quat(R: np.ndarray) -> str:
-    """(w, x, y, z) of a rotation matrix (Shepperd's method)."""
+    """MJCF text of the unit quaternion (w, x, y, z) of a rotation matrix."""
+    return _vec(_quat_array(R))
+
+
+def _quat_array(R: np.ndarray) -> np.ndarray:
+    """(w, x, y, z) of a rotation matrix (Shepperd's method), (4,)."""
     R = np.asarray(R, float)
     tr = np.trace(R)
     if tr > 0:
@@ -160,7 +173,7 @@ def _quat(R: np.ndarray) -> str:
         q[1 + i] = 0.25 * s
         q[1 + j] = (R[j, i] + R[i, j]) / s
         q[1 + k] = (R[k, i] + R[i, k]) / s
-    return _vec(q)
+    return np.asarray(q, float)
 
 
 def _check_robot(robot) -> SnakeRobot:
@@ -302,7 +315,7 @@ class SimModel:
         data.qpos[:] = 0.0
         data.qvel[:] = 0.0
         data.qpos[0:3] = T[:3, 3] + (0.0, 0.0, lift)
-        data.qpos[3:7] = np.fromstring(_quat(T[:3, :3]), sep=" ")
+        data.qpos[3:7] = _quat_array(T[:3, :3])
         data.qpos[self.qpos_adr] = q
         mj.mj_forward(self.model, data)
 
