@@ -206,6 +206,11 @@ def test_general_discretisation_of_a_plane_arc_equals_eq9(robot):
     fd_arc = bb.SpaceCurve(r, -math.pi / 2, -math.pi / 2 + theta)
     q_fd = bb.curve_joint_angles(robot, fd_arc, robot.parts.base, frame0=np.eye(3))
     np.testing.assert_allclose(q_fd, q_special, atol=1e-7)
+    # a right turn: the normal points along -y, phi0 = pi, kappa_y = -kappa, negative yaw
+    right = bb.base_arc(robot, theta, turn=-1).curve()
+    assert right.initial_phase(np.eye(3)) == pytest.approx(math.pi, abs=1e-12)
+    np.testing.assert_allclose(bb.curve_joint_angles(robot, right, robot.parts.base, frame0=np.eye(3)),
+                               bb.arc_joint_angles(L_BASE, theta, robot, turn=-1), atol=1e-8)
 
 
 def test_helix_gives_yaw_and_pitch_and_fk_follows_it(robot):
@@ -355,6 +360,14 @@ def test_bad_central_angle(robot, theta):
         bb.arc_joint_angles(L_BASE, theta, robot)
     with pytest.raises(ValueError, match="central_angle"):
         bb.arc_segment_area(L_BASE, theta if theta is not None else float("nan"))
+
+
+@pytest.mark.parametrize("kwargs", [dict(radius=0.0, central_angle=1.0), dict(radius=0.2, central_angle=7.0),
+                                    dict(radius=0.2, central_angle=1.0, turn=2),
+                                    dict(radius=0.2, central_angle=1.0, start=[0.0, float("nan")])])
+def test_bad_plane_arc(kwargs):
+    with pytest.raises(ValueError):
+        bb.PlaneArc(**kwargs)
 
 
 def test_other_bad_arc_input(robot):

@@ -411,7 +411,8 @@ def joint_layout(robot: SnakeRobot) -> JointLayout:
         elif np.allclose(np.abs(a), (0, 1, 0), atol=1e-9):
             kinds.append(PITCH)
         else:
-            raise ValueError(f"joint {i + 1} has axis {a.tolist()}; only yaw (+-z) and pitch (+-y) joints bend a backbone")
+            raise ValueError(f"joint {i + 1} has axis {a.tolist()}; "
+                             "only yaw (+-z) and pitch (+-y) joints bend a backbone")
         signs.append(1.0 if a.sum() > 0 else -1.0)
     return JointLayout(s=s, kinds=tuple(kinds), signs=np.array(signs), length=float(p[-1, 0] - p[0, 0]))
 
@@ -520,6 +521,14 @@ class PlaneArc:
     turn: int = 1
     height: float = BODY_AXIS_HEIGHT
 
+    def __post_init__(self):
+        positive(self.radius, "radius")
+        _check_central_angle(self.central_angle)
+        _check_turn(self.turn)
+        object.__setattr__(self, "start", finite_array(self.start, "start", (2,)))
+        _finite_float(self.heading, "heading")
+        _finite_float(self.height, "height")
+
     @property
     def length(self) -> float:
         """Arc length r * theta (m), Eq. 1."""
@@ -548,7 +557,7 @@ class PlaneArc:
 
     def curve(self) -> SpaceCurve:
         """The arc as a :class:`SpaceCurve` parametrised by arc length, with exact derivatives."""
-        r, k = self.radius, self.turn / self.radius
+        k = self.turn / self.radius  # signed curvature
 
         def d1(t):
             return self.tangent(t)
@@ -561,7 +570,6 @@ class PlaneArc:
             a = self.heading + k * t
             return -k * k * np.array([math.cos(a), math.sin(a), 0.0])
 
-        del r
         return SpaceCurve(self.point, 0.0, self.length, derivatives=(d1, d2, d3))
 
 
