@@ -18,7 +18,7 @@ HEAD_LENGTH = 0.046  # link_16, the head link (m)
 SECTION = 0.043  # square cross-section of a module (m)
 MASS_PER_MODULE = 0.2  # kg per MODULE_LENGTH of body
 JOINT_LIMIT = 1.5707963267948966  # +-90 deg
-EFFORT = 3.0  # N m   (our choice, not in the paper)
+EFFORT = 10.0  # N m (our choice, not in the paper: holding the 7-link head part horizontal needs ~3.9 N m at joint 10)
 VELOCITY = 3.0  # rad/s (our choice, not in the paper)
 
 # Marker frames: name -> (link it is fixed to, offset along that link's x).  They sit inline in the
