@@ -209,7 +209,7 @@ TEST(TracIK, DistanceUnseededIsNoFartherThanSpeed) {
   // does, so when Speed's answer comes from that descent Distance cannot be farther.
   const auto model = head7();
   TracIKOptions o;
-  o.timeout = 0.004;
+  o.timeout = 0.05;  // long enough that a busy machine cannot cut Distance's first descent short
   TracIK speed(model, o);
   o.solve_type = SolveType::Distance;
   TracIK dist(model, o);
