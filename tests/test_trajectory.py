@@ -1,0 +1,412 @@
+"""Trajectories (Section 3.2): the joint-space spline, the Cartesian interpolation of Eqs. 41-44 against
+closed forms and brute force, ground clearance, box and wall collisions against brute force; bad input."""
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+from scipy.spatial.transform import Rotation
+
+from snakehead import BasePlacement, SnakeRobot
+from snakehead import trajectory as tr
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return SnakeRobot.default()
+
+
+def lift_motion(robot):
+    """The paper's Fig. 11 / Fig. 13 situation: the neck and head lie curled on the ground beside a base
+    bent in an arc (State 1), and end raised with the head bent forward and down (State 2)."""
+    q_start = np.zeros(robot.n_joints)
+    q_start[0:7:2] = 0.65  # base arc: yaw joints 1, 3, 5, 7
+    q_end = q_start.copy()
+    q_start[8:16:2] = 0.5  # neck and head curled on the ground: yaw joints 9, 11, 13, 15
+    q_end[7] = -1.5  # joint 8 (pitch) raises the neck
+    q_end[8] = 1.5  # joint 9 (yaw) turns the head
+    q_end[[9, 11, 13, 15]] = [0.5, 0.5, 0.4, 0.3]  # head pitch joints bend it forward and down
+    return q_start, q_end
+
+
+# ---------------------------------------------------------------- joint-space interpolation
+def test_joint_interpolation_through_waypoints_smooth_and_at_rest():
+    rng = np.random.default_rng(0)
+    times = np.array([0.0, 1.3, 2.0, 4.1, 5.0])
+    wps = rng.uniform(-1, 1, (5, 16))
+    traj = tr.joint_trajectory(times, wps, dt=0.002)
+    t, q = tr.joint_interpolation(times, wps, dt=0.002)
+    np.testing.assert_array_equal(t, traj.t)
+    np.testing.assert_array_equal(q, traj.q)
+    # 2 ms samples from the first to the last time
+    assert t[0] == 0.0 and t[-1] == 5.0 and np.allclose(np.diff(t), 0.002)
+    # through every waypoint (they fall on samples here)
+    for tk, wk in zip(times, wps):
+        k = int(round(tk / 0.002))
+        np.testing.assert_allclose(q[k], wk, atol=1e-12)
+    np.testing.assert_array_equal(q[0], wps[0])
+    np.testing.assert_array_equal(q[-1], wps[-1])
+    # velocities and accelerations: at rest at both ends, and they are the derivatives of the samples
+    assert np.abs(traj.qd[[0, -1]]).max() == 0 and np.abs(traj.qdd[[0, -1]]).max() == 0
+    assert np.abs(traj.spline(times[[0, -1]], 1)).max() < 1e-9 and np.abs(traj.spline(times[[0, -1]], 2)).max() < 1e-9
+    np.testing.assert_allclose(np.gradient(q, t, axis=0)[1:-1], traj.qd[1:-1], atol=1e-4)
+    np.testing.assert_allclose(np.gradient(traj.qd, t, axis=0)[1:-1], traj.qdd[1:-1], atol=2e-3)
+    # velocity and acceleration continuous across the interior waypoints: left and right limits agree
+    for tk in times[1:-1]:
+        for nu in (0, 1, 2):
+            left, right = traj.spline(tk - 1e-9, nu), traj.spline(tk + 1e-9, nu)
+            np.testing.assert_allclose(left, right, atol=1e-5)
+    # and along the samples: the acceleration changes by at most max|jerk| dt per sample (no jumps)
+    jerk = np.abs(traj.spline(np.linspace(0, 5, 20001), 3)).max(axis=0)
+    assert np.all(np.abs(np.diff(traj.qdd, axis=0)).max(axis=0) <= jerk * 0.002 * 1.01)
+
+
+def test_two_waypoints_give_minimum_jerk_quintic():
+    t, q = tr.joint_interpolation([0.0, 2.0], [np.zeros(3), np.array([1.0, -2.0, 0.5])], dt=0.01)
+    s = t / 2.0
+    ref = (10 * s**3 - 15 * s**4 + 6 * s**5)[:, None] * np.array([1.0, -2.0, 0.5])
+    np.testing.assert_allclose(q, ref, atol=1e-12)
+
+
+def test_duration_not_a_multiple_of_dt_ends_exactly():
+    t, q = tr.joint_interpolation([0.0, 0.0105], [[0.0], [1.0]], dt=0.002)
+    assert t[-1] == 0.0105 and q[-1, 0] == 1.0 and np.all(np.diff(t) > 0)
+
+
+def test_joint_limits_overshoot_is_reported():
+    wps = np.array([[0.0], [1.5], [1.5], [0.0]])
+    with pytest.raises(ValueError, match="overshoots the upper limit"):
+        tr.joint_trajectory([0, 1, 1.2, 2.0], wps, lower=[-1.55], upper=[1.55])
+
+
+def test_joint_interpolation_bad_input():
+    wps = np.zeros((3, 16))
+    with pytest.raises(ValueError, match="increase"):
+        tr.joint_interpolation([0, 2, 1], wps)
+    with pytest.raises(ValueError, match="increase"):
+        tr.joint_interpolation([0, 1, 1], wps)
+    with pytest.raises(ValueError, match="shape"):
+        tr.joint_interpolation([0, 1, 2], np.zeros((4, 16)))
+    with pytest.raises(ValueError, match="shape"):
+        tr.joint_interpolation([[0, 1, 2]], wps)
+    with pytest.raises(ValueError, match="at least two"):
+        tr.joint_interpolation([0.0], wps[:1])
+    with pytest.raises(ValueError, match="NaN"):
+        tr.joint_interpolation([0, np.nan, 2], wps)
+    bad = wps.copy()
+    bad[1, 3] = np.inf
+    with pytest.raises(ValueError, match="NaN or inf"):
+        tr.joint_interpolation([0, 1, 2], bad)
+    for dt in (0.0, -0.002, np.nan):
+        with pytest.raises(ValueError, match="dt"):
+            tr.joint_interpolation([0, 1, 2], wps, dt=dt)
+
+
+# ---------------------------------------------------------------- Eqs. 41-44
+def test_cartesian_interpolation_ends_base_and_points(robot):
+    q0, q1 = lift_motion(robot)
+    q0 = q0.copy()
+    q0[0:7:2] = 0.5  # the base moves too
+    base = BasePlacement(0.2, -0.1, 0.4)
+    res = tr.cartesian_interpolation(robot, q0, q1, 50, base, full_output=True)
+    q = res.q
+    assert q.shape == (50, 16)
+    np.testing.assert_array_equal(q[0], q0)
+    np.testing.assert_array_equal(q[-1], q1)
+    # base joints: linear in joint space
+    s = np.linspace(0, 1, 50)
+    np.testing.assert_allclose(q[:, :7], (1 - s)[:, None] * q0[:7] + s[:, None] * q1[:7], atol=1e-15)
+    # Eq. 41: interpolated points are linear between the end configurations' joint positions
+    F0, F1 = robot.frames(q0, base), robot.frames(q1, base)
+    names = robot.link_names
+    idx = [names.index(n) for n in ["link_8", "link_9", *[f"link_{i}" for i in range(10, 17)], "head_tip"]]
+    np.testing.assert_allclose(res.points[0], F0[idx, :3, 3], atol=1e-15)
+    np.testing.assert_allclose(res.points[-1], F1[idx, :3, 3], atol=1e-15)
+    np.testing.assert_allclose(res.points[17], (1 - s[17]) * F0[idx, :3, 3] + s[17] * F1[idx, :3, 3], atol=1e-15)
+    # the deviation report is the distance between recovered and interpolated joint positions
+    Fk = robot.frames(q[17], base)
+    assert res.deviation[17] == pytest.approx(np.linalg.norm(Fk[idx, :3, 3] - res.points[17], axis=1).max())
+    assert res.deviation[0] < 1e-12 and res.deviation[-1] < 1e-12
+    assert res.max_deviation == pytest.approx(res.deviation.max())
+    np.testing.assert_array_equal(tr.cartesian_interpolation(robot, q0, q1, 50, base), q)
+
+
+def test_cartesian_interpolation_of_a_still_robot_is_still(robot):
+    q0, _ = lift_motion(robot)
+    q0 = q0.copy()
+    q0[[7, 9]] = -0.4, 0.3  # raised a little, so that every link has a well-defined angle
+    res = tr.cartesian_interpolation(robot, q0, q0, 10, full_output=True)
+    np.testing.assert_allclose(res.q, np.tile(q0, (10, 1)), atol=1e-12)
+    assert res.max_deviation < 1e-12
+
+
+def test_recovered_angles_reproduce_the_start_without_snapping(robot):
+    # samples next to the ends converge to the ends as n grows: the recovery inverts FK at t_j = 0 and 1
+    q0, q1 = lift_motion(robot)
+    steps = []
+    for n in (50, 200, 800):
+        q = tr.cartesian_interpolation(robot, q0, q1, n)
+        steps.append(max(np.abs(q[1] - q[0]).max(), np.abs(q[-1] - q[-2]).max()))
+    assert steps[0] > steps[1] > steps[2] and steps[2] < 0.005
+
+
+def test_eq42_literal_and_brute_force_projection(robot):
+    """Eq. 42-43 as printed (yaw joints: theta = pi/2 - arccos(T_y . l_p/|l_p|)), the pitch analogue, and a
+    brute-force maximisation of the projected alignment, against joint_angle_towards."""
+    rng = np.random.default_rng(4)
+    R0 = Rotation.random(200, random_state=rng).as_matrix()
+    l = rng.normal(size=(200, 3))
+    l /= np.linalg.norm(l, axis=1, keepdims=True)
+    x = np.array([1.0, 0.0, 0.0])
+    for axis in (np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])):
+        theta, ok = tr.joint_angle_towards(R0, axis, x, l)
+        assert ok.all()
+        Tx, Ty, Tz = R0[:, :, 0], R0[:, :, 1], R0[:, :, 2]
+        a = R0 @ axis
+        lp = l - np.sum(l * a, 1, keepdims=True) * a  # Eq. 43
+        lp /= np.linalg.norm(lp, axis=1, keepdims=True)
+        front = np.sum(Tx * lp, 1) > 0  # Eq. 42 covers |theta| <= 90 deg
+        other = Ty if axis[2] == 1 else -Tz  # the D-H y-axis of the joint: z_DH x x
+        literal = np.pi / 2 - np.arccos(np.clip(np.sum(other * lp, 1), -1, 1))
+        np.testing.assert_allclose(theta[front], literal[front], atol=1e-9)
+        # brute force: the rotation about the axis that brings the link closest to l
+        grid = np.linspace(-np.pi, np.pi, 20001)
+        for k in range(0, 200, 20):
+            rots = Rotation.from_rotvec(grid[:, None] * axis).as_matrix()  # (G, 3, 3) in the joint frame
+            dirs = R0[k] @ (rots @ x).T  # (3, G)
+            best = grid[np.argmax(l[k] @ dirs)]
+            assert abs(np.angle(np.exp(1j * (best - theta[k])))) < 1e-3
+
+
+def test_recovered_links_point_along_the_segments(robot):
+    """Each recovered (unclipped) link lies in the plane spanned by its joint axis and its segment."""
+    q0, q1 = lift_motion(robot)
+    q1 = q1.copy()
+    q1[[9, 11, 13, 15]] = 0.2
+    res = tr.cartesian_interpolation(robot, q0, q1, 40, full_output=True)
+    F = robot.frames_many(res.q)
+    model = robot.body.model
+    names = robot.link_names
+    idx = [names.index(n) for n in ["link_8", "link_9", *[f"link_{i}" for i in range(10, 17)], "head_tip"]]
+    for i, j in enumerate(range(7, 16)):
+        frame = F[:, model.joint_child_links[j]]
+        a = frame[:, :3, :3] @ model.joint_axes[j]
+        link = F[:, idx[i + 1], :3, 3] - F[:, idx[i], :3, 3]
+        seg = res.points[:, i + 1] - res.points[:, i]
+        normal = np.cross(a, seg)
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        off_plane = np.abs(np.sum(normal * link, 1)) / np.linalg.norm(link, axis=1)
+        ok = ~res.clipped[:, i]
+        assert off_plane[ok].max() < 1e-9
+        assert np.all(np.sum(link * seg, 1)[ok] > 0)  # pointing forward along the segment
+
+
+def test_cartesian_interpolation_clears_the_ground_where_joint_space_does_not(robot):
+    """Fig. 11 vs Fig. 13: the head hits the ground under joint interpolation, not under Eqs. 41-44."""
+    q0, q1 = lift_motion(robot)
+    n = 200
+    links = tr.non_base_links(robot)
+    # the ends themselves: lying on the ground (touching, clearance 0) and raised clear of it
+    c_end = tr.ground_clearance(robot, np.stack([q0, q1]))[:, links]
+    assert abs(c_end[0].min()) < 1e-12 and c_end[1].min() > 0.01
+    q_joint = q0 + (q1 - q0) * np.linspace(0, 1, n)[:, None]
+    joint_clear = tr.ground_clearance(robot, q_joint)[:, links].min(axis=1)
+    assert joint_clear.min() < -0.04  # 4 cm into the ground
+    assert tr.below_ground(robot, q_joint).any()
+    q_cart = tr.cartesian_interpolation(robot, q0, q1, n)
+    cart_clear = tr.ground_clearance(robot, q_cart)[:, links].min(axis=1)
+    assert cart_clear.min() > -tr.GROUND_TOLERANCE
+    assert not tr.below_ground(robot, q_cart).any()
+    # the base stays on the ground throughout
+    base_links = [robot.link_names.index(f"link_{i}") for i in range(8)]
+    np.testing.assert_allclose(tr.ground_clearance(robot, q_cart)[:, base_links], 0.0, atol=1e-12)
+
+
+def test_cartesian_interpolation_bad_input(robot):
+    q = np.zeros(16)
+    with pytest.raises(ValueError, match="n must be"):
+        tr.cartesian_interpolation(robot, q, q, 1)
+    with pytest.raises(ValueError, match="n must be"):
+        tr.cartesian_interpolation(robot, q, q, 2.5)
+    with pytest.raises(ValueError, match="shape"):
+        tr.cartesian_interpolation(robot, q[:15], q, 5)
+    with pytest.raises(ValueError, match="NaN"):
+        tr.cartesian_interpolation(robot, q, np.full(16, np.nan), 5)
+    with pytest.raises(ValueError, match="aim"):
+        tr.cartesian_interpolation(robot, q, q, 5, aim="sideways")
+
+
+# ---------------------------------------------------------------- ground clearance
+def test_ground_clearance_closed_form(robot):
+    q = np.zeros(16)
+    c = tr.ground_clearance(robot, q)
+    boxed = np.all(robot.box_sizes > 0, axis=1)
+    np.testing.assert_allclose(c[0, boxed], 0.0, atol=1e-15)
+    assert np.all(np.isinf(c[0, ~boxed]))
+    # raise the neck by theta with joint 8 (pitch): link_8's lowest corner is its distal bottom edge... no:
+    # rotating up about the joint, the proximal bottom corner goes to z = 0.0215 - 0.0215 cos(theta) and the
+    # distal bottom corner higher, so the lowest point of link_8 is h/2 (1 - cos theta) above the ground
+    th = 0.6
+    q[7] = -th
+    c = tr.ground_clearance(robot, q)[0]
+    k = robot.link_names.index("link_8")
+    assert c[k] == pytest.approx(0.0215 * (1 - np.cos(th)), abs=1e-12)
+    # and the head, bent down by 2 theta at joint 10 after the 2-link neck, dips this far
+    q[9] = 2 * th
+    c = tr.ground_clearance(robot, q)[0]
+    k10 = robot.link_names.index("link_10")
+    z_joint = 0.0215 + 2 * 0.0865 * np.sin(th)  # height of joint 10 (link_8, link_9 both at angle theta)
+    # link_10 points down at angle theta; its lowest corner is the distal bottom one
+    ref = z_joint - 0.0865 * np.sin(th) - 0.0215 * np.cos(th)
+    assert c[k10] == pytest.approx(ref, abs=1e-12)
+    # a batch gives the same rows
+    np.testing.assert_allclose(tr.ground_clearance(robot, np.stack([q, q]))[1], c, atol=0)
+
+
+def test_ground_clearance_bad_input(robot):
+    with pytest.raises(ValueError, match="shape"):
+        tr.ground_clearance(robot, np.zeros((3, 15)))
+    with pytest.raises(ValueError, match="NaN"):
+        tr.ground_clearance(robot, np.full((3, 16), np.nan))
+    with pytest.raises(TypeError):
+        tr.ground_clearance(robot, np.zeros(16), base="origin")
+
+
+# ---------------------------------------------------------------- obstacles
+def random_boxes(rng, n):
+    c = rng.normal(scale=0.25, size=(n, 3))
+    R = Rotation.random(n, random_state=rng).as_matrix()
+    h = rng.uniform(0.02, 0.2, (n, 3))
+    return c, R, h
+
+
+def brute_box_distance(ca, Ra, ha, cb, Rb, hb, rng):
+    f = lambda z: np.sum((ca + Ra @ z[:3] - cb - Rb @ z[3:]) ** 2)  # noqa: E731
+    bounds = list(zip(-ha, ha)) + list(zip(-hb, hb))
+    best = np.inf
+    for _ in range(4):
+        z0 = np.r_[rng.uniform(-ha, ha), rng.uniform(-hb, hb)]
+        r = minimize(f, z0, bounds=bounds, method="L-BFGS-B", options=dict(ftol=1e-15, gtol=1e-12))
+        best = min(best, np.sqrt(max(r.fun, 0.0)))
+    return best
+
+
+def test_box_box_distance_against_optimisation():
+    rng = np.random.default_rng(0)
+    ca, Ra, ha = random_boxes(rng, 60)
+    cb, Rb, hb = random_boxes(rng, 60)
+    d = tr.box_box_distance(ca, Ra, ha, cb, Rb, hb)
+    sat = tr.box_box_sat(ca, Ra, ha, cb, Rb, hb)
+    n_apart = 0
+    for k in range(60):
+        ref = brute_box_distance(ca[k], Ra[k], ha[k], cb[k], Rb[k], hb[k], rng)
+        if d[k] > 0:
+            n_apart += 1
+            assert d[k] == pytest.approx(ref, abs=1e-7)
+            assert sat[k] <= d[k] + 1e-12  # the separating gap is a lower bound
+        else:
+            assert ref < 1e-6  # they do intersect
+    assert 10 < n_apart < 60  # both cases were exercised
+
+
+def test_box_box_penetration_depth_closed_form():
+    # two axis-aligned unit cubes overlapping by 0.1 along x: depth 0.1
+    I = np.eye(3)
+    h = np.full(3, 0.5)
+    assert tr.box_box_distance([0, 0, 0], I, h, [0.9, 0.2, 0], I, h) == pytest.approx(-0.1)
+    assert tr.box_box_distance([0, 0, 0], I, h, [1.3, 0.0, 0], I, h) == pytest.approx(0.3)
+    # corner to corner along the diagonal
+    assert tr.box_box_distance([0, 0, 0], I, h, [1.5, 1.5, 1.5], I, h) == pytest.approx(np.sqrt(3) * 0.5)
+
+
+def wall_solid_contains(wall, p):
+    loc = (p - wall.centre) @ wall.rotation
+    rel = loc[..., :2] - wall.hole_offset
+    in_slab = np.all(np.abs(rel) <= wall.size[:2] / 2, -1) & (np.abs(loc[..., 2]) <= wall.size[2] / 2)
+    return in_slab & (np.linalg.norm(loc[..., :2], axis=-1) > wall.hole_diameter / 2)
+
+
+def test_box_wall_collision_against_dense_sampling():
+    rng = np.random.default_rng(1)
+    wall = tr.WallWithHole([0.2, 0.5, 0.4], [0, 1, 0], (0.7, 0.58, 0.01), 0.07)
+    n = 200
+    # link-sized boxes near the hole, randomly placed and turned
+    c = wall.centre + rng.normal(scale=[0.04, 0.05, 0.04], size=(n, 3))
+    R = Rotation.random(n, random_state=rng).as_matrix()
+    R[: n // 2] = Rotation.from_euler("z", rng.normal(90, 8, (n // 2, 1)), degrees=True).as_matrix()  # along the axis
+    h = np.array([0.0865, 0.043, 0.043]) / 2
+    got = tr.box_wall_collision(c, R, np.broadcast_to(h, (n, 3)), wall)
+    g = np.linspace(-1, 1, 31)
+    grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    n_hit = 0
+    for k in range(n):
+        pts = c[k] + (grid * h) @ R[k].T
+        ref = wall_solid_contains(wall, pts).any()
+        if ref:
+            assert got[k]  # a sampled point inside the solid: it collides
+        n_hit += got[k]
+        if got[k] and not ref:  # the sampling may miss a sliver: then the overlap must be tiny
+            dist = wall.distance_to_points(pts)
+            assert dist.min() < 0.003
+    assert 20 < n_hit < n - 20
+    # boxes passing straight through the middle of the hole do not collide; one beside it does
+    Rx = np.column_stack([[0, 1, 0], [-1, 0, 0], [0, 0, 1]])
+    assert not tr.box_wall_collision(wall.centre, Rx, h, wall)
+    assert tr.box_wall_collision(wall.centre + [0.03, 0, 0], Rx, h, wall)
+    assert not tr.box_wall_collision(wall.centre + [0.0, 0.2, 0], Rx, h, wall)  # in front of the wall
+
+
+def test_wall_point_distance_closed_form():
+    wall = tr.WallWithHole([0, 0, 0.4], [1, 0, 0], (0.6, 0.5, 0.02), 0.1)
+    # wall axes: width along world -y or +y, height along z, normal along x
+    assert wall.distance_to_points([0.0, 0.0, 0.4]) == pytest.approx(0.05)  # hole centre: to the rim
+    assert wall.distance_to_points([0.11, 0.0, 0.4]) == pytest.approx(np.hypot(0.05, 0.1))  # in front of it
+    assert wall.distance_to_points([0.11, 0.0, 0.6]) == pytest.approx(0.1)  # in front of the solid part
+    assert wall.distance_to_points([0.0, 0.0, 0.6]) == 0.0  # inside the solid
+    assert wall.distance_to_points([0.0, 0.0, 0.4 + 0.25 + 0.03]) == pytest.approx(0.03)  # above the wall
+
+
+def test_collision_check_on_the_robot(robot):
+    q0, q1 = lift_motion(robot)
+    qs = tr.cartesian_interpolation(robot, q0, q1, 30)
+    F = robot.frames(q1)
+    tip = F[robot.link_names.index("head_tip"), :3, 3]
+    box = tr.BoxObstacle(tip + [0.0, 0.0, 0.1], [0.1, 0.1, 0.05])  # 10 cm over the final head tip
+    ground_box = tr.BoxObstacle([0, 0, -0.05], [5, 5, 0.1])  # the ground as a box: the base touches it
+    rep = tr.collision_check(robot, qs, [box, ground_box])
+    assert rep.link_distance.shape == (30, 17, 2)
+    assert rep.collides.all()  # the base lies on the ground box
+    assert not rep.link_collides[..., 0].any()
+    d_box = rep.link_distance[..., 0].min(1)
+    assert d_box[-1] == pytest.approx(0.1 - 0.025 - 0.0, abs=0.05) and d_box.min() > 0
+    # consistent with ground_clearance for the ground box (distance = clearance for boxes above it)
+    clear = tr.ground_clearance(robot, qs)[:, rep.links]
+    np.testing.assert_allclose(np.maximum(rep.link_distance[..., 1], 0), np.maximum(clear, 0), atol=1e-12)
+    # a wall: sampled distance is an upper bound within the spacing of the exact clearance to the slab
+    wall = tr.WallWithHole([0.6, 0.4, 0.2], [1, 0, 0], (0.4, 0.3, 0.01), 0.07)  # beyond the body (x < 0.23)
+    rep2 = tr.collision_check(robot, qs, wall, spacing=0.004)
+    assert not rep2.collides.any()
+    slab = wall.slab()
+    links, c, R, h = tr._link_boxes(robot, qs, BasePlacement())
+    exact = tr.box_box_distance(c, R, h[None], slab.centre, slab.rotation, slab.size / 2)
+    near = exact.min(1)
+    assert np.all(rep2.distance >= near - 1e-12) and np.all(rep2.distance <= near + 0.004)
+
+
+def test_obstacle_bad_input(robot):
+    with pytest.raises(ValueError, match="size"):
+        tr.BoxObstacle([0, 0, 0], [1, -1, 1])
+    with pytest.raises(ValueError, match="rotation"):
+        tr.BoxObstacle([0, 0, 0], [1, 1, 1], np.ones((3, 3)))
+    with pytest.raises(ValueError, match="NaN"):
+        tr.BoxObstacle([0, np.nan, 0], [1, 1, 1])
+    with pytest.raises(ValueError, match="zero length"):
+        tr.WallWithHole([0, 0, 0], [0, 0, 0], (1, 1, 0.01), 0.1)
+    with pytest.raises(ValueError, match="inside the wall"):
+        tr.WallWithHole([0, 0, 0], [1, 0, 0], (0.1, 0.1, 0.01), 0.2)
+    with pytest.raises(ValueError, match="hole_diameter"):
+        tr.WallWithHole([0, 0, 0], [1, 0, 0], (1, 1, 0.01), -0.1)
+    with pytest.raises(ValueError, match="no obstacles"):
+        tr.collision_check(robot, np.zeros((2, 16)), [])
+    with pytest.raises(TypeError):
+        tr.collision_check(robot, np.zeros((2, 16)), ["a wall"])
+    with pytest.raises(ValueError, match="shape"):
+        tr.collision_check(robot, np.zeros((2, 17)), tr.BoxObstacle([0, 0, 1], [1, 1, 1]))
