@@ -371,7 +371,7 @@ def test_collision_check_on_the_robot(robot):
     tip = F[robot.link_names.index("head_tip"), :3, 3]
     box = tr.BoxObstacle(tip + [0.0, 0.0, 0.1], [0.1, 0.1, 0.05])  # 10 cm over the final head tip
     ground_box = tr.BoxObstacle([0, 0, -0.05], [5, 5, 0.1])  # the ground as a box: the base touches it
-    rep = tr.collision_check(robot, qs, [box, ground_box])
+    rep = tr.collision_check(robot, qs, [box, ground_box], exact_within=np.inf)
     assert rep.link_distance.shape == (30, 17, 2)
     assert rep.collides.all()  # the base lies on the ground box
     assert not rep.link_collides[..., 0].any()
@@ -382,13 +382,19 @@ def test_collision_check_on_the_robot(robot):
     np.testing.assert_allclose(np.maximum(rep.link_distance[..., 1], 0), np.maximum(clear, 0), atol=1e-12)
     # a wall: sampled distance is an upper bound within the spacing of the exact clearance to the slab
     wall = tr.WallWithHole([0.6, 0.4, 0.2], [1, 0, 0], (0.4, 0.3, 0.01), 0.07)  # beyond the body (x < 0.23)
-    rep2 = tr.collision_check(robot, qs, wall, spacing=0.004)
+    rep2 = tr.collision_check(robot, qs, wall, spacing=0.004, exact_within=1.0)
     assert not rep2.collides.any()
     slab = wall.slab()
     links, c, R, h = tr._link_boxes(robot, qs, BasePlacement())
     exact = tr.box_box_distance(c, R, h[None], slab.centre, slab.rotation, slab.size / 2)
     near = exact.min(1)
     assert np.all(rep2.distance >= near - 1e-12) and np.all(rep2.distance <= near + 0.004)
+    # with the default band, distances beyond it are lower bounds above it; inside it they are exact
+    rep3 = tr.collision_check(robot, qs, [box, ground_box], exact_within=0.05)
+    exact3 = rep.link_distance
+    band = exact3 <= 0.05
+    np.testing.assert_array_equal(rep3.link_distance[band], exact3[band])
+    assert np.all(rep3.link_distance[~band] > 0.05) and np.all(rep3.link_distance[~band] <= exact3[~band] + 1e-12)
 
 
 def test_obstacle_bad_input(robot):

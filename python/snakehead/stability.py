@@ -228,8 +228,10 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
     robot = _check_robot(robot)
     base = _check_base(base)
     qs, single = _joint_matrix(robot, q)
-    frames = robot.frames_many(qs, base)
+    frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
     c = np.einsum("l,tli->ti", robot.masses, link_coms_world(robot, frames)) / robot.total_mass
+    W = base.matrix()
+    c = c @ W[:3, :3].T + W[:3, 3]
     return c[0] if single else c
 
 

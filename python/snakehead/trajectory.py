@@ -535,14 +535,19 @@ class CollisionReport:
 
 
 def collision_check(robot: SnakeRobot, qs, obstacles, base: BasePlacement | None = None, *,
-                    spacing: float = 0.004) -> CollisionReport:
+                    exact_within: float = 0.05, spacing: float = 0.004) -> CollisionReport:
     """Collisions of every link's collision box with obstacles along a trajectory qs (T, 16).
 
-    * :class:`BoxObstacle`: exact signed distance (:func:`box_box_distance`; separating axes for the
-      intersection test).
-    * :class:`WallWithHole`: exact intersection test (:func:`box_wall_collision`); the distance of a link that
-      does not collide is the smallest exact distance from points on its box's surface, at most ``spacing`` m
-      apart, to the wall: an upper bound, too large by at most about spacing / sqrt(2). Colliding links get 0.
+    The collision flags are exact. The distances are exact wherever they are below ``exact_within`` m; pairs
+    that the separating-axis test already puts farther apart report that test's gap, a lower bound that is
+    itself above ``exact_within`` (this keeps long trajectories fast).
+
+    * :class:`BoxObstacle`: exact signed distance (:func:`box_box_distance`; minus the penetration depth when
+      they intersect).
+    * :class:`WallWithHole`: exact intersection test (:func:`box_wall_collision`); the distance of a nearby
+      link that does not collide is the smallest exact distance from points on its box's surface, at most
+      ``spacing`` m apart, to the wall's solid: an upper bound, too large by at most about spacing / sqrt(2).
+      Colliding links get 0.
     """
     robot = _check_robot(robot)
     base = _check_base(base)
@@ -552,24 +557,38 @@ def collision_check(robot: SnakeRobot, qs, obstacles, base: BasePlacement | None
     obstacles = list(obstacles)
     if not obstacles:
         raise ValueError("no obstacles given")
+    for ob in obstacles:
+        if not isinstance(ob, (BoxObstacle, WallWithHole)):
+            raise TypeError(f"obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
     spacing = positive(spacing, "spacing")
+    try:
+        exact_within = float(exact_within)
+    except (TypeError, ValueError):
+        raise ValueError(f"exact_within must be a number (m, may be inf), got {exact_within!r}") from None
+    if np.isnan(exact_within):
+        raise ValueError("exact_within is NaN")
     links, c, R, h = _link_boxes(robot, qs, base)
     T, k = c.shape[:2]
+    hb = np.broadcast_to(h, (T, k, 3))
     dist = np.empty((T, k, len(obstacles)))
     hit = np.empty((T, k, len(obstacles)), bool)
     for o, ob in enumerate(obstacles):
+        box = ob if isinstance(ob, BoxObstacle) else ob.slab()
+        d = box_box_sat(c, R, hb, box.centre, box.rotation, box.size / 2)  # lower bound of the distance
+        near = d <= exact_within
         if isinstance(ob, BoxObstacle):
-            d = box_box_distance(c, R, h[None], ob.centre, ob.rotation, ob.size / 2)
-            dist[..., o], hit[..., o] = d, d <= 0.0
-        elif isinstance(ob, WallWithHole):
-            collide = box_wall_collision(c, R, h[None], ob)
-            d = np.empty((T, k))
-            for li in range(k):  # per link (its own surface samples), vectorised over time
-                s = _box_surface_points(h[li], spacing)  # (S, 3)
-                p = c[:, li, None, :] + np.einsum("tik,sk->tsi", R[:, li], s)
-                d[:, li] = ob.distance_to_points(p).min(axis=1)
-            dist[..., o] = np.where(collide, 0.0, d)
-            hit[..., o] = collide
+            d[near] = box_box_distance(c[near], R[near], hb[near], box.centre, box.rotation, box.size / 2)
+            collide = d <= 0.0
         else:
-            raise TypeError(f"obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
+            collide = np.zeros((T, k), bool)
+            collide[near] = box_wall_collision(c[near], R[near], hb[near], ob)
+            for li in range(k):  # per link (its own surface samples), vectorised over the near samples
+                rows = np.flatnonzero(near[:, li] & ~collide[:, li])
+                if rows.size == 0:
+                    continue
+                s = _box_surface_points(h[li], spacing)  # (S, 3)
+                p = c[rows, li, None, :] + np.einsum("tik,sk->tsi", R[rows, li], s)
+                d[rows, li] = ob.distance_to_points(p).min(axis=1)
+            d = np.where(collide, 0.0, d)
+        dist[..., o], hit[..., o] = d, collide
     return CollisionReport(dist.min(axis=(1, 2)), hit.any(axis=(1, 2)), dist, hit, links)

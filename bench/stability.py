@@ -1,0 +1,90 @@
+"""Benchmark: momenta, ZMP and stability along a 36 s trajectory at the 2 ms control period (18,001 samples),
+and the trajectory tools. Prints a table (best and median of repeated runs, wall-clock). Not a test.
+
+    python3 bench/stability.py [--repeat 7]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+
+from snakehead import SnakeRobot
+from snakehead import stability as st
+from snakehead import trajectory as tr
+
+
+def scenario(robot: SnakeRobot):
+    """A 36 s, 5-waypoint motion like the paper's sphere scenario: curl the base, lift the head, move it."""
+    q0 = np.zeros(robot.n_joints)
+    q1 = q0.copy()
+    q1[0:7:2] = 1.0
+    q1[8:16:2] = 0.3
+    q2 = q1.copy()
+    q2[7], q2[8] = -1.2, 0.9
+    q2[[9, 11, 13]] = 0.4
+    q3 = q2.copy()
+    q3[[10, 12]] = 0.3
+    q4 = q3.copy()
+    q4[[9, 11, 13, 15]] = [0.2, 0.6, 0.5, 0.3]
+    times = np.array([0.0, 8.0, 18.0, 27.0, 36.0])
+    return tr.joint_trajectory(times, np.stack([q0, q1, q2, q3, q4]), dt=0.002)
+
+
+def timeit(fn, repeat: int) -> tuple[float, float]:
+    fn()  # warm-up
+    ts = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return min(ts), float(np.median(ts))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=7)
+    args = ap.parse_args()
+    robot = SnakeRobot.default()
+    traj = scenario(robot)
+    t, q, qd = traj.t, traj.q, traj.qd
+    T = len(t)
+    q_moving_base = q.copy()
+    q_const_base = q.copy()
+    q_const_base[:, robot.parts.base] = q[-1, robot.parts.base]
+    box = tr.BoxObstacle([0.3, 0.4, 0.3], [0.1, 0.1, 0.1])
+    rows = [
+        ("frames_many (C++ FK, all frames)", T, lambda: robot.frames_many(q)),
+        ("center_of_mass (Eq. 23)", T, lambda: st.center_of_mass(robot, q)),
+        ("momenta_from_velocities, exact qdot (Eqs. 25-31)", T, lambda: st.momenta_from_velocities(robot, q, qd)),
+        ("momenta, qdot by np.gradient", T, lambda: st.momenta(robot, t, q)),
+        ("zmp (momenta + Eqs. 36-40)", T, lambda: st.zmp(robot, t, q)),
+        ("dynamic_stability, fixed base", T, lambda: st.dynamic_stability(robot, t, q_const_base)),
+        ("dynamic_stability, moving base (endpoints)", T, lambda: st.dynamic_stability(robot, t, q_moving_base)),
+        ("dynamic_stability, moving base (footprint)", T,
+         lambda: st.dynamic_stability(robot, t, q_moving_base, contact="footprint")),
+        ("joint_trajectory (quintic spline, 2 ms)", T,
+         lambda: tr.joint_trajectory([0, 8, 18, 27, 36], q[[0, 4000, 9000, 13500, -1]])),
+        ("ground_clearance", T, lambda: tr.ground_clearance(robot, q)),
+        ("collision_check, one box obstacle", T, lambda: tr.collision_check(robot, q, box)),
+        ("cartesian_interpolation (Eqs. 41-44)", 1000,
+         lambda: tr.cartesian_interpolation(robot, q[9000], q[-1], 1000)),
+    ]
+    print(f"machine: {platform.machine()} {platform.processor() or ''} {os.cpu_count()} CPUs, "
+          f"Python {platform.python_version()}, numpy {np.__version__}")
+    print(f"trajectory: {t[-1]:.0f} s at {1000 * (t[1] - t[0]):.0f} ms = {T} samples; repeat {args.repeat}\n")
+    print(f"| {'operation':<50} | {'samples':>7} | {'best (ms)':>9} | {'median (ms)':>11} |")
+    print(f"|{'-' * 52}|{'-' * 9}|{'-' * 11}|{'-' * 13}|")
+    for name, n, fn in rows:
+        best, med = timeit(fn, args.repeat)
+        print(f"| {name:<50} | {n:>7} | {1000 * best:>9.1f} | {1000 * med:>11.1f} |")
+    res = st.dynamic_stability(robot, t, q_moving_base)
+    print(f"\nscenario verdict: stable={res.stable}, min ZMP margin {res.min_margin * 1000:.1f} mm "
+          f"at t = {t[res.argmin]:.2f} s")
+
+
+if __name__ == "__main__":
+    main()
