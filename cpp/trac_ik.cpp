@@ -38,6 +38,11 @@ constexpr double kEvaluationsPerSecond = 7.0e5;
 constexpr int kNewtonIterations = 60;
 constexpr int kSqpEvaluations = 120;
 constexpr double kMaxStep = 0.6;  // rad (or m): largest joint change of one Newton step
+constexpr double kLambda0 = 1e-2;  // initial Levenberg-Marquardt damping
+constexpr int kProgressWindow = 3;
+constexpr double kProgress = 0.3;
+// (Tuned on the default robot's 6- and 7-DOF heads: quick abandonment and restarts beat long descents;
+// median evaluations per solve 26 -> 16 against demanding a 10 % decrease every 8 iterations.)
 // Share of the timeout that a Speed call spends on KDL-RR in the calling thread before it starts the race
 // (measured: see bench/RESULTS.md).
 constexpr double kInlineFraction = 0.05;
@@ -203,6 +208,7 @@ class Search {
 
   // FK + Jacobian + residual at q into (tip, jac, r, dr); returns the raw error.
   Vector6d evaluate(const Eigen::VectorXd& q, Matrix6Xd& J, Vector6d& r, Matrix6Xd& D) {
+    ++evals;
     if (c.budgeted) ++c.evals;  // seeded calls run in one thread; racing threads never touch the counter
     Eigen::Isometry3d tip;
     tip_jacobian(p.model, q, J, tip);
@@ -249,6 +255,7 @@ class Search {
   Matrix6Xd jac, dr, jac_try, dr_try, dr_step;
   Eigen::VectorXd dq, q_try;
   Best best;
+  long evals = 0;  // this search's own count (statistics)
 };
 
 // ---------------------------------------------------------------------------------------------------------
@@ -265,7 +272,7 @@ bool newton_descent(Search& s, Eigen::VectorXd& q) {
     return true;
   }
   double err = r.squaredNorm();
-  double lambda = 1e-4;
+  double lambda = kLambda0;
   double checkpoint = err;
   for (int it = 0; it < kNewtonIterations; ++it) {
     if (s.should_stop()) return false;
@@ -312,9 +319,10 @@ bool newton_descent(Search& s, Eigen::VectorXd& q) {
       lambda *= 10.0;
       if (lambda > 1e4) return false;
     }
-    // No real progress over 8 iterations: stuck in a local minimum.
-    if ((it + 1) % 8 == 0) {
-      if (err > 0.9 * checkpoint) return false;
+    // Newton converges quadratically near a solution; a descent whose error does not fall below kProgress
+    // times its value kProgressWindow iterations earlier is creeping into a local minimum: restart instead.
+    if ((it + 1) % kProgressWindow == 0) {
+      if (err > kProgress * checkpoint) return false;
       checkpoint = err;
     }
   }
@@ -594,6 +602,7 @@ struct TracIK::Impl {
     res.solutions = nr.best.count + sq.best.count;
     res.error = pose_error(target, forward_kinematics(*model, res.q));
     res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    res.evaluations = nr.evals + sq.evals;
     return res;
   }
 };

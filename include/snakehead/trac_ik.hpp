@@ -64,6 +64,7 @@ struct IKResult {
   Vector6d error = Vector6d::Zero();  // pose_error(target, fk(q))
   int solutions = 0;        // distinct solutions seen (more than 1 only for non-Speed solve types)
   double seconds = 0.0;     // wall-clock time of the call
+  long evaluations = 0;     // kinematics evaluations (FK + Jacobian) made by both solvers
 };
 
 class TracIK {
