@@ -98,7 +98,7 @@ def test_solutions_reach_the_pose_within_the_limits(chain):
 
 @pytest.mark.parametrize("solve_type", ["Speed", "Distance", "Manip1", "Manip2"])
 def test_every_solve_type_solves_reachable_targets(head7, solve_type):
-    ik = TracIK.from_chain(head7, timeout=0.003, solve_type=solve_type)
+    ik = TracIK.from_chain(head7, timeout=0.02, solve_type=solve_type)
     rng = np.random.default_rng(2)
     for _ in range(5):
         T = head7.fk(head7.random_configuration(rng))
@@ -139,7 +139,7 @@ def test_manipulability_types_do_no_worse_than_speed(head7):
 
 
 def test_free_roll(chain):
-    ik = TracIK.from_chain(chain, timeout=0.01)
+    ik = TracIK.from_chain(chain, timeout=0.03)
     rng = np.random.default_rng(5)
     solved = rolled = 0
     for _ in range(30):
@@ -185,7 +185,9 @@ def test_seeded_calls_are_identical(chain):
         np.testing.assert_array_equal(a.ik(T), b.ik(T))
 
 
-def test_eight_threads_share_one_solver(head7, solver7):
+def test_eight_threads_share_one_solver(head7):
+    # A generous timeout: 8 threads on a small, busy machine must not turn scheduling delays into failures.
+    solver7 = TracIK.from_chain(head7, timeout=0.05)
     rng = np.random.default_rng(7)
     jobs = [[(head7.fk(head7.random_configuration(rng)), head7.random_configuration(rng)) for _ in range(20)]
             for _ in range(8)]
