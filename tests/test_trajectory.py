@@ -412,3 +412,20 @@ def test_obstacle_bad_input(robot):
         tr.collision_check(robot, np.zeros((2, 16)), ["a wall"])
     with pytest.raises(ValueError, match="shape"):
         tr.collision_check(robot, np.zeros((2, 17)), tr.BoxObstacle([0, 0, 1], [1, 1, 1]))
+
+
+def test_cartesian_trajectory_is_timed_min_jerk(robot):
+    q0, q1 = lift_motion(robot)
+    traj = tr.cartesian_trajectory(robot, q0, q1, duration=2.0, dt=0.002)
+    assert traj.t[0] == 0 and traj.t[-1] == 2.0 and len(traj.t) == 1001
+    s = tr.minimum_jerk(traj.t / 2.0)
+    np.testing.assert_allclose(traj.q, tr.cartesian_interpolation(robot, q0, q1, s), atol=1e-12)
+    np.testing.assert_array_equal(traj.q[[0, -1]], np.stack([q0, q1]))
+    assert np.abs(traj.qd[[0, 1, -2, -1]]).max() < 1e-3  # at rest at both ends
+    # explicit parameters must run from 0 to 1
+    with pytest.raises(ValueError, match="from exactly 0"):
+        tr.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.5, 0.9]))
+    with pytest.raises(ValueError, match="non-decreasing"):
+        tr.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.6, 0.5, 1.0]))
+    with pytest.raises(ValueError, match="duration"):
+        tr.cartesian_trajectory(robot, q0, q1, duration=0.0)

@@ -35,13 +35,14 @@ GROUND_TOLERANCE = 1e-3
 @dataclass(frozen=True)
 class JointTrajectory:
     """A sampled joint trajectory: t (T,) s, q (T, n) rad, qd (T, n) rad/s, qdd (T, n) rad/s^2, and the
-    spline it samples (``spline(t, nu)`` evaluates the nu-th derivative anywhere)."""
+    spline it samples (``spline(t, nu)`` evaluates the nu-th derivative anywhere; None for
+    :func:`cartesian_trajectory`)."""
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
-    spline: BSpline
+    spline: BSpline | None
 
 
 def _check_waypoints(times, waypoints) -> tuple[np.ndarray, np.ndarray]:
@@ -176,9 +177,28 @@ def joint_angle_towards(R0: np.ndarray, axis_local: np.ndarray, d_local: np.ndar
     return theta, ok
 
 
-def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n: int, base: BasePlacement | None = None, *,
+def _interpolation_parameters(n) -> np.ndarray:
+    """Eq. 41's t_0 .. t_m: n evenly spaced in [0, 1] for an integer n >= 2, or the given non-decreasing values
+    from 0 to 1."""
+    if isinstance(n, (int, np.integer)) and not isinstance(n, bool):
+        if n < 2:
+            raise ValueError(f"n must be an integer >= 2 (samples including both ends), got {n!r}")
+        return np.linspace(0.0, 1.0, int(n))
+    if np.ndim(n) != 1:
+        raise ValueError(f"n must be an integer >= 2 or a 1-D array of interpolation parameters, got {n!r}")
+    s = finite_array(n, "interpolation parameters", (None,))
+    if len(s) < 2 or s[0] != 0.0 or s[-1] != 1.0 or np.any(np.diff(s) < 0):
+        raise ValueError("interpolation parameters must be non-decreasing from exactly 0 to exactly 1 "
+                         "(at least two)")
+    return s
+
+
+def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlacement | None = None, *,
                             aim: str = "segment", full_output: bool = False):
     """Whole-body interpolation in Cartesian space, Eqs. 41-44: n configurations (n, 16) from q_start to q_end.
+
+    ``n`` is the number of samples (t_j of Eq. 41 evenly spaced in [0, 1]) or the t_j themselves, a
+    non-decreasing 1-D array from 0 to 1 (see :func:`cartesian_trajectory` for a timed motion).
 
     * The base joints interpolate linearly in joint space (the base stays on the ground).
     * The joint positions of the neck and head (world points of the joint frames from the neck's first joint
@@ -204,12 +224,10 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n: int, base: Bas
     nj = robot.n_joints
     q_start = joint_vector(q_start, nj, "q_start")
     q_end = joint_vector(q_end, nj, "q_end")
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-        raise ValueError(f"n must be an integer >= 2 (samples including both ends), got {n!r}")
+    s = _interpolation_parameters(n)
+    n = len(s)
     if aim not in ("segment", "points"):
         raise ValueError(f"aim must be 'segment' (Eq. 44) or 'points', got {aim!r}")
-    n = int(n)
-    s = np.linspace(0.0, 1.0, n)
     q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # base joints: linear (and the fallback)
     joints = _interpolated_joints(robot)
     pts_idx = _joint_point_frames(robot, joints)
@@ -245,6 +263,33 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n: int, base: Bas
     actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
     dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
     return CartesianInterpolation(q, s, P, actual, dev, float(dev.max()), clipped)
+
+
+def minimum_jerk(tau: np.ndarray) -> np.ndarray:
+    """The rest-to-rest time scaling 10 tau^3 - 15 tau^4 + 6 tau^5 of tau in [0, 1]."""
+    tau = np.asarray(tau, float)
+    return tau ** 3 * (10.0 - 15.0 * tau + 6.0 * tau ** 2)
+
+
+def cartesian_trajectory(robot: SnakeRobot, q_start, q_end, duration: float, dt: float = CONTROL_PERIOD,
+                         base: BasePlacement | None = None, *, aim: str = "segment") -> JointTrajectory:
+    """A timed whole-body Cartesian motion: Eqs. 41-44 sampled every ``dt`` s over ``duration`` s.
+
+    Eq. 41's parameter follows the minimum-jerk scaling t_j = s(t / duration) (:func:`minimum_jerk`), so the
+    motion starts and ends at rest. q is :func:`cartesian_interpolation` at those parameters; qd and qdd are
+    its finite differences along the samples (np.gradient), zero at the ends. ``spline`` is None.
+    """
+    duration = positive(duration, "duration")
+    t = sample_times(0.0, duration, dt)
+    s = minimum_jerk(t / duration)
+    s[0], s[-1] = 0.0, 1.0
+    q = cartesian_interpolation(robot, q_start, q_end, s, base, aim=aim)
+    edge = 2 if len(t) > 2 else 1
+    qd = np.gradient(q, t, axis=0, edge_order=edge)
+    qdd = np.gradient(qd, t, axis=0, edge_order=edge)
+    qd[[0, -1]] = 0.0
+    qdd[[0, -1]] = 0.0
+    return JointTrajectory(t, q, qd, qdd, None)
 
 
 # ------------------------------------------------------------------------------------------------
