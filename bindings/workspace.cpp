@@ -1,0 +1,158 @@
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "snakehead/workspace.hpp"
+
+namespace py = pybind11;
+
+namespace snakehead::bindings {
+namespace {
+
+using RowMat3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+template <class T>
+py::array_t<T> to_array(const std::vector<T>& v) {
+  py::array_t<T> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+// Runs `fn` without the GIL; the progress callback takes it back only while it runs Python. An
+// exception raised by the callback (KeyboardInterrupt from tqdm's loop, say) stops the sweep and
+// is re-raised here.
+template <class Fn>
+auto without_gil(const py::object& progress, Fn fn) {
+  ProgressCallback cb;
+  if (!progress.is_none()) {
+    cb = [progress](std::int64_t done, std::int64_t total) {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      py::object r = progress(done, total);
+      return r.is_none() || r.cast<bool>();
+    };
+  }
+  py::gil_scoped_release release;
+  return fn(cb);
+}
+
+py::dict map_to_dict(const ReachabilityMap& m) {
+  py::dict d;
+  d["centers"] = py::array_t<double>(py::array::ShapeContainer{static_cast<py::ssize_t>(m.centres.rows()), py::ssize_t{3}},
+                                     m.centres.data());
+  d["solved"] = to_array(m.solved);
+  d["voxel_ids"] = to_array(m.voxel_ids);
+  d["tried"] = m.tried;
+  d["grid_origin"] = Eigen::Vector3d(m.grid.origin);
+  d["grid_size"] = m.grid.side();
+  d["grid_shape"] = std::vector<int>{m.grid.n, m.grid.n, m.grid.n};
+  d["hull_voxels"] = m.hull_voxels;
+  d["hull_facets"] = m.hull_facets;
+  d["reach"] = m.reach;
+  d["chain_hash"] = m.chain_hash;
+  d["base"] = m.base;
+  d["tip"] = m.tip;
+  d["ik_calls"] = m.ik_calls;
+  d["cheap_exits"] = m.cheap_exits;
+  d["seconds"] = m.seconds;
+  d["threads"] = m.threads_used;
+  return d;
+}
+
+}  // namespace
+
+void bind_workspace(py::module_& m) {
+  py::enum_<ApproachAxis>(m, "ApproachAxis").value("X", ApproachAxis::X).value("Z", ApproachAxis::Z);
+
+  py::class_<WorkspaceOptions>(m, "WorkspaceOptions", "Parameters of a reachability sweep (workspace.hpp).")
+      .def(py::init<>())
+      .def_readwrite("voxel_size", &WorkspaceOptions::voxel_size)
+      .def_readwrite("directions", &WorkspaceOptions::directions)
+      .def_readwrite("rolls", &WorkspaceOptions::rolls)
+      .def_readwrite("free_roll", &WorkspaceOptions::free_roll)
+      .def_property(
+          "approach_axis", [](const WorkspaceOptions& o) { return std::string(approach_axis_name(o.approach)); },
+          [](WorkspaceOptions& o, const std::string& s) { o.approach = parse_approach_axis(s); })
+      .def_readwrite("timeout", &WorkspaceOptions::timeout)
+      .def_readwrite("epsilon", &WorkspaceOptions::epsilon)
+      .def_readwrite("cloud_samples", &WorkspaceOptions::cloud_samples)
+      .def_readwrite("seed", &WorkspaceOptions::seed)
+      .def_readwrite("threads", &WorkspaceOptions::threads)
+      .def_readwrite("shard_index", &WorkspaceOptions::shard_index)
+      .def_readwrite("shard_count", &WorkspaceOptions::shard_count)
+      .def("validate", &WorkspaceOptions::validate)
+      .def_property_readonly("poses_per_voxel", &WorkspaceOptions::poses_per_voxel);
+
+  m.def("fibonacci_directions",
+        [](int n) {
+          const auto d = fibonacci_directions(n);
+          RowMat3 out(static_cast<Eigen::Index>(d.size()), 3);
+          for (std::size_t k = 0; k < d.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = d[k].transpose();
+          return out;
+        },
+        py::arg("n"), "n unit vectors spread evenly on the sphere (Fibonacci lattice), (n, 3)");
+  m.def("approach_frame",
+        [](const Eigen::Vector3d& point, const Eigen::Vector3d& direction, double roll, const std::string& axis) {
+          return Eigen::Matrix4d(approach_frame(point, direction, roll, parse_approach_axis(axis)).matrix());
+        },
+        py::arg("point"), py::arg("direction"), py::arg("roll") = 0.0, py::arg("axis") = "x",
+        "4x4 frame at point whose x- (or z-) axis is direction, rolled by roll rad about it");
+  m.def("sample_tip_positions",
+        [](const ChainModel& model, int samples, std::uint64_t seed) {
+          std::vector<Eigen::Vector3d> p;
+          {
+            py::gil_scoped_release release;
+            p = sample_tip_positions(model, samples, seed);
+          }
+          RowMat3 out(static_cast<Eigen::Index>(p.size()), 3);
+          for (std::size_t k = 0; k < p.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = p[k].transpose();
+          return out;
+        },
+        py::arg("model"), py::arg("samples"), py::arg("seed"));
+  m.def("convex_hull",
+        [](const Eigen::Ref<const RowMat3>& points) {
+          std::vector<Eigen::Vector3d> p(static_cast<std::size_t>(points.rows()));
+          for (Eigen::Index k = 0; k < points.rows(); ++k) p[static_cast<std::size_t>(k)] = points.row(k).transpose();
+          if (!points.allFinite()) throw InputError("points must be finite");
+          const ConvexHull h = ConvexHull::of(p);
+          py::dict d;
+          d["normals"] = RowMat3(h.normals);
+          d["offsets"] = Eigen::VectorXd(h.offsets);
+          d["volume"] = h.volume;
+          d["n_vertices"] = h.n_vertices;
+          return d;
+        },
+        py::arg("points"), "qhull's hull of (n, 3) points: facet planes normal . x + offset <= 0 inside, volume");
+  m.def("evaluate_voxels",
+        [](const ChainModel& model, const WorkspaceOptions& o, const Eigen::Ref<const RowMat3>& centres,
+           std::vector<std::uint64_t> stream_ids, const py::object& progress) {
+          const RowMat3 c = centres;  // own copy: the sweep runs without the GIL
+          VoxelEvaluation e = without_gil(progress, [&](const ProgressCallback& cb) {
+            return evaluate_voxels(model, o, c, stream_ids, cb);
+          });
+          py::dict d;
+          d["solved"] = to_array(e.solved);
+          d["tried"] = e.tried;
+          d["ik_calls"] = e.ik_calls;
+          d["cheap_exits"] = e.cheap_exits;
+          d["seconds"] = e.seconds;
+          d["threads"] = e.threads_used;
+          return d;
+        },
+        py::arg("model"), py::arg("options"), py::arg("centers"), py::arg("stream_ids"),
+        py::arg("progress") = py::none(),
+        "Algorithm 1's lines 9-21 for spheres at the given centres; progress(done, total) -> bool");
+  m.def("compute_reachability",
+        [](const ChainModel& model, const WorkspaceOptions& o, const py::object& progress) {
+          ReachabilityMap r = without_gil(progress, [&](const ProgressCallback& cb) {
+            return compute_reachability(model, o, cb);
+          });
+          return map_to_dict(r);
+        },
+        py::arg("model"), py::arg("options"), py::arg("progress") = py::none(),
+        "Algorithm 1 over options' shard; returns the map's arrays and statistics as a dict");
+}
+
+}  // namespace snakehead::bindings

@@ -1,0 +1,572 @@
+#include "snakehead/workspace.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <random>
+#include <thread>
+
+extern "C" {
+#include <libqhull_r/qhull_ra.h>
+}
+
+#include "snakehead/kinematics.hpp"
+#include "snakehead/npz.hpp"
+#include "snakehead/trac_ik.hpp"
+
+namespace snakehead {
+namespace {
+
+// SplitMix64: turns (seed, index) into well-mixed, independent stream seeds.
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t salt, std::uint64_t index) {
+  return splitmix64(splitmix64(seed ^ splitmix64(salt)) ^ index);
+}
+
+// Uniform in [0, 1) from 53 random bits: the same numbers on every standard library (unlike
+// std::uniform_real_distribution, whose algorithm is unspecified).
+double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+Eigen::VectorXd random_configuration(const ChainModel& model, std::mt19937_64& rng) {
+  Eigen::VectorXd q(model.n_joints());
+  for (int i = 0; i < model.n_joints(); ++i) {
+    const double lo = std::isfinite(model.lower()[i]) ? model.lower()[i] : -M_PI;
+    const double hi = std::isfinite(model.upper()[i]) ? model.upper()[i] : M_PI;
+    q[i] = lo + (hi - lo) * unit_uniform(rng);
+  }
+  return q;
+}
+
+constexpr std::uint64_t kCloudSalt = 0xC10D;
+constexpr std::uint64_t kVoxelSalt = 0x70CE1;
+
+class TracIKPoseSolver : public PoseSolver {
+ public:
+  TracIKPoseSolver(std::shared_ptr<const TracIK> ik, const WorkspaceOptions& o) : ik_(std::move(ik)) {
+    opts_.timeout = o.timeout;
+    opts_.epsilon = o.epsilon;
+    opts_.solve_type = SolveType::Speed;
+    opts_.bounds.setZero();
+    if (o.free_roll) opts_.bounds[o.approach == ApproachAxis::X ? 3 : 5] = std::numeric_limits<double>::infinity();
+  }
+  bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, std::uint64_t call_seed,
+             Eigen::VectorXd& q_out) override {
+    opts_.seed = call_seed;  // seeded TRAC-IK: a pure function of its inputs, run in this thread
+    IKResult r = ik_->solve_ex(target, q_init, opts_);
+    if (r.found) q_out = r.q;
+    return r.found;
+  }
+
+ private:
+  std::shared_ptr<const TracIK> ik_;
+  TracIKOptions opts_;
+};
+
+}  // namespace
+
+ReachBound::ReachBound(const ChainModel& model, const WorkspaceOptions& o)
+    : reach_(model.reach()), approach_(o.approach) {
+  const auto& segs = model.segments();
+  revolute_ = std::none_of(segs.begin(), segs.end(), [](const SegmentGeometry& s) { return s.prismatic; });
+  first_joint_ = segs.front().pre.translation();
+  // Distances between consecutive joint origins do not change with a revolute joint's angle (each
+  // joint turns about an axis through its own origin).
+  arm_ = 0.0;
+  for (std::size_t k = 0; k + 1 < segs.size(); ++k) arm_ += (segs[k].post * segs[k + 1].pre).translation().norm();
+  // The last joint's origin in the tip frame: T_tip = J * Motion(q) * post, and Motion fixes J's origin.
+  wrist_in_tip_ = segs.back().post.inverse().translation();
+  const Eigen::Vector3d a = o.approach == ApproachAxis::X ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+  wrist_along_ = wrist_in_tip_.dot(a);
+  wrist_radius_ = (wrist_in_tip_ - wrist_along_ * a).norm();
+  slack_ = 1e-6 + 2.0 * o.epsilon;  // never reject a pose the IK would accept within its tolerance
+
+  // The second-last joint's origin (the "elbow") in the tip frame turns on an arc about the last
+  // joint's axis as the last joint moves within its limits; sample the arc. A point of the arc lies
+  // within rho * step / 2 of a sample (rho: the arc's radius), which the test adds as slack.
+  const int n = static_cast<int>(segs.size());
+  if (!revolute_ || n < 2) return;
+  const Eigen::Isometry3d link = segs[n - 2].post * segs[n - 1].pre;  // joint n-2 frame -> joint n-1 frame
+  const Eigen::Vector3d elbow = link.inverse().translation();         // elbow in the last joint's frame
+  arm2_ = arm_ - link.translation().norm();
+  const Eigen::Vector3d axis = segs[n - 1].axis;
+  const double rho = (elbow - elbow.dot(axis) * axis).norm();
+  const double lo = std::isfinite(model.lower()[n - 1]) ? model.lower()[n - 1] : -M_PI;
+  const double hi = std::isfinite(model.upper()[n - 1]) ? model.upper()[n - 1] : M_PI;
+  const int samples = 64;
+  const double step = (hi - lo) / (samples - 1);
+  const Eigen::Isometry3d post_inv = segs[n - 1].post.inverse();
+  for (int k = 0; k < samples; ++k) {
+    const double q = lo + step * k;
+    elbow_in_tip_.push_back(post_inv * (Eigen::AngleAxisd(-q, axis) * elbow));
+  }
+  elbow_slack_ = rho * step / 2.0;
+  // Free roll: the elbow points also turn about the approach axis through the tip; sampling the roll
+  // in `roll_samples_` steps adds (distance from the axis) * roll_step / 2.
+  double far = 0.0;
+  for (const auto& e : elbow_in_tip_) far = std::max(far, (e - e.dot(a) * a).norm());
+  roll_step_ = 2.0 * M_PI / kRollSamples;
+  roll_slack_ = far * roll_step_ / 2.0;
+  approach_local_ = a;
+}
+
+bool ReachBound::elbow_possible(const Eigen::Isometry3d& target, double extra_slack) const {
+  if (elbow_in_tip_.empty()) return true;
+  const double limit = arm2_ + slack_ + elbow_slack_ + extra_slack;
+  const double limit2 = limit * limit;
+  for (const auto& e : elbow_in_tip_)
+    if (((target * e) - first_joint_).squaredNorm() <= limit2) return true;
+  return false;
+}
+
+bool ReachBound::possible(const Eigen::Isometry3d& target) const {
+  if (target.translation().norm() > reach_ + slack_) return false;
+  if (!revolute_) return true;
+  if (((target * wrist_in_tip_) - first_joint_).norm() > arm_ + slack_) return false;
+  return elbow_possible(target, 0.0);
+}
+
+bool ReachBound::possible_any_roll(const Eigen::Vector3d& p, const Eigen::Vector3d& a) const {
+  if (p.norm() > reach_ + slack_) return false;
+  if (!revolute_) return true;
+  // With the roll about the approach axis a free, the wrist point runs on a circle about a: take
+  // the point of the circle closest to the first joint.
+  const Eigen::Vector3d m = p + wrist_along_ * a;
+  const Eigen::Vector3d d = first_joint_ - m;
+  const double h = d.dot(a);
+  const double radial = (d - h * a).norm();
+  if (std::hypot(h, radial - wrist_radius_) > arm_ + slack_) return false;
+  if (elbow_in_tip_.empty()) return true;
+  const Eigen::Isometry3d frame = approach_frame(p, a, 0.0, approach_);
+  for (int r = 0; r < kRollSamples; ++r) {
+    Eigen::Isometry3d rolled = frame;
+    rolled.linear() = frame.linear() * Eigen::AngleAxisd(roll_step_ * r, approach_local_).toRotationMatrix();
+    if (elbow_possible(rolled, roll_slack_)) return true;
+  }
+  return false;
+}
+
+ApproachAxis parse_approach_axis(const std::string& s) {
+  if (s == "x" || s == "X") return ApproachAxis::X;
+  if (s == "z" || s == "Z") return ApproachAxis::Z;
+  throw InputError("approach axis must be 'x' or 'z', got '" + s + "'");
+}
+
+const char* approach_axis_name(ApproachAxis a) { return a == ApproachAxis::X ? "x" : "z"; }
+
+void WorkspaceOptions::validate() const {
+  if (!(std::isfinite(voxel_size) && voxel_size > 0))
+    throw InputError("voxel size must be a positive number of metres, got " + std::to_string(voxel_size));
+  if (directions < 1) throw InputError("directions must be at least 1, got " + std::to_string(directions));
+  if (!free_roll && rolls < 1) throw InputError("rolls must be at least 1 (or use free roll), got " + std::to_string(rolls));
+  if (!(std::isfinite(timeout) && timeout > 0))
+    throw InputError("timeout must be a positive number of seconds, got " + std::to_string(timeout));
+  if (!(std::isfinite(epsilon) && epsilon > 0))
+    throw InputError("epsilon must be positive, got " + std::to_string(epsilon));
+  if (cloud_samples < 100)
+    throw InputError("cloud_samples must be at least 100 (the hull needs a cloud), got " +
+                     std::to_string(cloud_samples));
+  if (threads < 0) throw InputError("threads must be >= 0 (0 = all cores), got " + std::to_string(threads));
+  if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
+    throw InputError("shard must be i/N with 0 <= i < N, got " + std::to_string(shard_index) + "/" +
+                     std::to_string(shard_count));
+}
+
+VoxelGrid VoxelGrid::around(const Eigen::Vector3d& centre, double side, double voxel) {
+  if (!(std::isfinite(voxel) && voxel > 0)) throw InputError("voxel size must be positive");
+  if (!(std::isfinite(side) && side > 0)) throw InputError("grid side must be positive");
+  const double cells = std::ceil(side / voxel - 1e-9);
+  if (cells > 2000) throw InputError("voxel size too small for the grid: more than 2000 voxels per axis");
+  VoxelGrid g;
+  g.n = std::max(1, static_cast<int>(cells));
+  g.voxel = voxel;
+  g.origin = centre - Eigen::Vector3d::Constant(0.5 * g.n * voxel);
+  return g;
+}
+
+Eigen::Vector3d VoxelGrid::centre_of(std::int64_t k) const {
+  const std::int64_t l = k % n, j = (k / n) % n, i = k / (static_cast<std::int64_t>(n) * n);
+  return origin + voxel * Eigen::Vector3d(i + 0.5, j + 0.5, l + 0.5);
+}
+
+ConvexHull ConvexHull::of(const std::vector<Eigen::Vector3d>& points) {
+  if (points.size() < 4) throw InputError("a convex hull in 3-D needs at least 4 points");
+  std::vector<coordT> coords(points.size() * 3);
+  for (std::size_t k = 0; k < points.size(); ++k)
+    for (int d = 0; d < 3; ++d) coords[3 * k + d] = points[k][d];
+
+  qhT qh_storage;
+  qhT* qh = &qh_storage;
+  // Qhull reports errors by printing them; keep them for the exception message.
+  std::FILE* err = std::tmpfile();
+  qh_zero(qh, err ? err : stderr);
+  char flags[] = "qhull Qt";  // Qt: triangulated output (simplicial facets, planes as computed)
+  const int status = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, flags, nullptr,
+                                  err ? err : stderr);
+  ConvexHull hull;
+  std::string message;
+  if (status == 0) {
+    std::vector<Eigen::Vector3d> normals;
+    std::vector<double> offsets;
+    facetT* facet;
+    FORALLfacets {
+      normals.emplace_back(facet->normal[0], facet->normal[1], facet->normal[2]);
+      offsets.push_back(facet->offset);
+    }
+    hull.normals.resize(static_cast<Eigen::Index>(normals.size()), 3);
+    hull.offsets.resize(static_cast<Eigen::Index>(offsets.size()));
+    for (std::size_t k = 0; k < normals.size(); ++k) {
+      hull.normals.row(static_cast<Eigen::Index>(k)) = normals[k].transpose();
+      hull.offsets[static_cast<Eigen::Index>(k)] = offsets[k];
+    }
+    hull.n_vertices = qh->num_vertices;
+    qh_getarea(qh, qh->facet_list);
+    hull.volume = qh->totvol;
+  } else if (err) {
+    std::rewind(err);
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, err) && message.size() < 400) message += buf;
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong = 0, totlong = 0;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  if (err) std::fclose(err);
+  if (status != 0)
+    throw InputError("the tip's point cloud spans no volume, so it has no convex hull (qhull: " +
+                     message.substr(0, message.find('\n')) + ")");
+  return hull;
+}
+
+bool ConvexHull::contains(const Eigen::Vector3d& p, double tolerance) const {
+  if (offsets.size() == 0) return false;
+  return ((normals * p + offsets).array() <= tolerance).all();
+}
+
+std::vector<Eigen::Vector3d> fibonacci_directions(int n) {
+  if (n < 1) throw InputError("directions must be at least 1, got " + std::to_string(n));
+  // Points at equal-area heights z_k = 1 - (2k + 1) / n, turned by the golden angle each step.
+  const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
+  std::vector<Eigen::Vector3d> d(n);
+  for (int k = 0; k < n; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / n;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden_angle * k;
+    d[k] = Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  return d;
+}
+
+Eigen::Isometry3d approach_frame(const Eigen::Vector3d& point, const Eigen::Vector3d& direction, double roll,
+                                 ApproachAxis axis) {
+  const double norm = direction.norm();
+  if (!(std::isfinite(norm) && norm > 0)) throw InputError("approach direction must be a finite non-zero vector");
+  if (!point.allFinite() || !std::isfinite(roll)) throw InputError("approach frame point and roll must be finite");
+  const Eigen::Vector3d a = direction / norm;
+  // Roll 0: the first tangent axis is the world axis least aligned with a, made perpendicular to it.
+  Eigen::Index least;
+  a.cwiseAbs().minCoeff(&least);
+  Eigen::Vector3d u = Eigen::Vector3d::Unit(least) - a[least] * a;
+  u.normalize();
+  const Eigen::Vector3d v = a.cross(u);
+  const Eigen::Vector3d t = std::cos(roll) * u + std::sin(roll) * v;
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  if (axis == ApproachAxis::X) {
+    f.linear().col(0) = a;  // x = a, y = t, z = x cross y
+    f.linear().col(1) = t;
+    f.linear().col(2) = a.cross(t);
+  } else {
+    f.linear().col(2) = a;  // z = a, x = t, y = z cross x
+    f.linear().col(0) = t;
+    f.linear().col(1) = a.cross(t);
+  }
+  f.translation() = point;
+  return f;
+}
+
+std::vector<Eigen::Vector3d> sample_tip_positions(const ChainModel& model, int samples, std::uint64_t seed) {
+  if (samples < 1) throw InputError("samples must be at least 1");
+  std::mt19937_64 rng(stream_seed(seed, kCloudSalt, 0));
+  std::vector<Eigen::Vector3d> pts(samples);
+  for (int k = 0; k < samples; ++k) pts[k] = forward_kinematics(model, random_configuration(model, rng)).translation();
+  return pts;
+}
+
+PoseSolverFactory trac_ik_solver_factory() {
+  return [](const ChainModel& model, const WorkspaceOptions& o) -> std::unique_ptr<PoseSolver> {
+    TracIKOptions t;
+    t.timeout = o.timeout;
+    t.epsilon = o.epsilon;
+    auto ik = std::make_shared<const TracIK>(model, t);
+    return std::make_unique<TracIKPoseSolver>(std::move(ik), o);
+  };
+}
+
+Eigen::VectorXd ReachabilityMap::indices() const {
+  Eigen::VectorXd d(static_cast<Eigen::Index>(solved.size()));
+  for (std::size_t k = 0; k < solved.size(); ++k)
+    d[static_cast<Eigen::Index>(k)] = tried > 0 ? 100.0 * solved[k] / tried : 0.0;
+  return d;
+}
+
+VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions& options,
+                                const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
+                                const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress,
+                                const PoseSolverFactory& factory_in) {
+  options.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto total = static_cast<std::int64_t>(centres.rows());
+  if (static_cast<std::int64_t>(stream_ids.size()) != total)
+    throw InputError("one stream id per voxel centre is needed");
+  if (!centres.allFinite()) throw InputError("voxel centres must be finite");
+  const PoseSolverFactory factory = factory_in ? factory_in : trac_ik_solver_factory();
+
+  VoxelEvaluation out;
+  out.tried = options.poses_per_voxel();
+  out.solved.assign(total, 0);
+  const std::vector<Eigen::Vector3d> dirs = fibonacci_directions(options.directions);
+  const int n_rolls = options.free_roll ? 1 : options.rolls;
+  const ReachBound bound(model, options);
+  const double radius = 0.5 * options.voxel_size;
+  int n_threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  n_threads = static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), total)));
+  out.threads_used = n_threads;
+  // Solvers are made here, so that a bad option fails before any thread starts.
+  std::vector<std::unique_ptr<PoseSolver>> solvers;
+  for (int t = 0; t < n_threads; ++t) solvers.push_back(factory(model, options));
+
+  std::atomic<std::int64_t> next{0}, done{0}, ik_calls{0}, cheap{0};
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::exception_ptr failure;
+
+  // Dynamic scheduling (an atomic counter) balances voxels of very different cost; each voxel is
+  // computed start to finish by one thread, so the result does not depend on the thread count.
+  auto work = [&](PoseSolver& solver) {
+    std::int64_t my_calls = 0, my_cheap = 0;
+    Eigen::VectorXd q_out(model.n_joints());
+    try {
+      for (std::int64_t v = next++; v < total && !stop.load(std::memory_order_relaxed); v = next++) {
+        const Eigen::Vector3d c = centres.row(v).transpose();
+        std::mt19937_64 rng(stream_seed(options.seed, kVoxelSalt, stream_ids[v]));
+        int solved = 0;
+        // Cheap exit for the whole voxel: its sphere lies beyond the tip's reach.
+        if (c.norm() - radius <= bound.reach() + 1e-9) {
+          for (const Eigen::Vector3d& d : dirs) {
+            const Eigen::Vector3d p = c + radius * d;
+            for (int r = 0; r < n_rolls; ++r) {
+              const double roll = 2.0 * M_PI * r / n_rolls;
+              const Eigen::Isometry3d target = approach_frame(p, d, roll, options.approach);
+              const bool possible = options.free_roll ? bound.possible_any_roll(p, d) : bound.possible(target);
+              if (!possible) {
+                ++my_cheap;
+                continue;
+              }
+              const Eigen::VectorXd q_init = random_configuration(model, rng);
+              const std::uint64_t call_seed = rng();
+              ++my_calls;
+              if (solver.solve(target, q_init, call_seed, q_out)) ++solved;
+            }
+          }
+        } else {
+          my_cheap += out.tried;
+        }
+        out.solved[v] = solved;
+        if (++done == total) cv.notify_all();
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!failure) failure = std::current_exception();
+      stop = true;
+      cv.notify_all();
+    }
+    ik_calls += my_calls;
+    cheap += my_cheap;
+  };
+
+  std::vector<std::thread> pool;
+  pool.reserve(n_threads);
+  for (int t = 0; t < n_threads; ++t) pool.emplace_back(work, std::ref(*solvers[t]));
+  bool cancelled = false;
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (done.load() < total && !stop.load()) {
+      cv.wait_for(lock, std::chrono::milliseconds(100));
+      if (progress && !stop.load()) {
+        lock.unlock();
+        bool go_on = false;
+        try {
+          go_on = progress(done.load(), total);
+        } catch (...) {
+          // The callback's own exception (e.g. Python's KeyboardInterrupt) wins over Cancelled.
+          lock.lock();
+          if (!failure) failure = std::current_exception();
+          stop = true;
+          break;
+        }
+        lock.lock();
+        if (!go_on) {
+          cancelled = true;
+          stop = true;
+        }
+      }
+    }
+  }
+  for (auto& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
+  if (cancelled) throw Cancelled("workspace sweep cancelled");
+  if (progress) progress(done.load(), total);
+
+  out.ik_calls = ik_calls.load();
+  out.cheap_exits = cheap.load();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOptions& options,
+                                     const ProgressCallback& progress, const PoseSolverFactory& factory) {
+  options.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  ReachabilityMap map;
+  map.options = options;
+  map.chain_hash = model.hash();
+  map.base = model.base_name();
+  map.tip = model.tip_name();
+  map.reach = model.reach();
+  map.tried = options.poses_per_voxel();
+
+  // Lines 1-8 of Algorithm 1: the point cloud, its hull, the grid and the voxels inside the hull.
+  // Every shard computes the same cloud and hull (they depend on the seed only), so the in-hull
+  // list, and with it the split k % N, is the same in all shards.
+  const ConvexHull hull = ConvexHull::of(sample_tip_positions(model, options.cloud_samples, options.seed));
+  map.hull_facets = hull.n_facets();
+  map.grid = VoxelGrid::around(Eigen::Vector3d::Zero(), 2.0 * model.reach(), options.voxel_size);
+  std::vector<std::int64_t> in_hull;
+  for (std::int64_t k = 0; k < map.grid.count(); ++k)
+    if (hull.contains(map.grid.centre_of(k))) in_hull.push_back(k);
+  map.hull_voxels = static_cast<std::int64_t>(in_hull.size());
+  for (std::size_t p = 0; p < in_hull.size(); ++p)
+    if (static_cast<int>(p % options.shard_count) == options.shard_index) map.voxel_ids.push_back(in_hull[p]);
+  const auto total = static_cast<Eigen::Index>(map.voxel_ids.size());
+  map.centres.resize(total, 3);
+  for (Eigen::Index v = 0; v < total; ++v) map.centres.row(v) = map.grid.centre_of(map.voxel_ids[v]).transpose();
+
+  const std::vector<std::uint64_t> streams(map.voxel_ids.begin(), map.voxel_ids.end());
+  VoxelEvaluation e = evaluate_voxels(model, options, map.centres, streams, progress, factory);
+  map.solved = std::move(e.solved);
+  map.ik_calls = e.ik_calls;
+  map.cheap_exits = e.cheap_exits;
+  map.threads_used = e.threads_used;
+  map.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return map;
+}
+
+namespace {
+bool same_options(const WorkspaceOptions& a, const WorkspaceOptions& b) {
+  return a.voxel_size == b.voxel_size && a.directions == b.directions &&
+         (a.free_roll ? b.free_roll : !b.free_roll && a.rolls == b.rolls) && a.approach == b.approach &&
+         a.timeout == b.timeout && a.epsilon == b.epsilon &&
+         a.cloud_samples == b.cloud_samples && a.seed == b.seed && a.shard_count == b.shard_count;
+}
+}  // namespace
+
+ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards) {
+  if (shards.empty()) throw InputError("merge needs at least one shard");
+  const ReachabilityMap& first = shards.front();
+  const int n = first.options.shard_count;
+  if (static_cast<int>(shards.size()) != n)
+    throw InputError("the map has " + std::to_string(n) + " shards; got " + std::to_string(shards.size()));
+  std::vector<bool> seen(n, false);
+  for (const auto& s : shards) {
+    if (!same_options(s.options, first.options) || s.chain_hash != first.chain_hash ||
+        s.hull_voxels != first.hull_voxels || s.grid.n != first.grid.n || s.grid.voxel != first.grid.voxel)
+      throw InputError("shards of different maps (parameters, chain or grid differ) cannot be merged");
+    const int i = s.options.shard_index;
+    if (seen[i]) throw InputError("shard " + std::to_string(i) + "/" + std::to_string(n) + " given twice");
+    seen[i] = true;
+  }
+  std::map<std::int64_t, std::pair<Eigen::Vector3d, std::int32_t>> voxels;
+  ReachabilityMap out = first;
+  out.ik_calls = out.cheap_exits = 0;
+  out.seconds = 0.0;
+  for (const auto& s : shards) {
+    for (std::size_t v = 0; v < s.voxel_ids.size(); ++v)
+      if (!voxels.emplace(s.voxel_ids[v], std::make_pair(Eigen::Vector3d(s.centres.row(v).transpose()), s.solved[v])).second)
+        throw InputError("voxel " + std::to_string(s.voxel_ids[v]) + " appears in two shards");
+    out.ik_calls += s.ik_calls;
+    out.cheap_exits += s.cheap_exits;
+    out.seconds += s.seconds;
+  }
+  if (static_cast<std::int64_t>(voxels.size()) != first.hull_voxels)
+    throw InputError("the shards hold " + std::to_string(voxels.size()) + " voxels; the map has " +
+                     std::to_string(first.hull_voxels));
+  out.options.shard_index = 0;
+  out.options.shard_count = 1;
+  out.voxel_ids.clear();
+  out.solved.clear();
+  out.centres.resize(static_cast<Eigen::Index>(voxels.size()), 3);
+  Eigen::Index row = 0;
+  for (const auto& [k, v] : voxels) {
+    out.voxel_ids.push_back(k);
+    out.centres.row(row++) = v.first.transpose();
+    out.solved.push_back(v.second);
+  }
+  return out;
+}
+
+void save_npz(const ReachabilityMap& map, const std::string& path, const std::string& command) {
+  const auto m = static_cast<std::int64_t>(map.voxel_ids.size());
+  NpzWriter w;
+  w.add_string("format", "snakehead-reachability-1");
+  std::vector<double> centres(map.centres.data(), map.centres.data() + map.centres.size());
+  w.add_f64("centers", centres, {m, 3});
+  const Eigen::VectorXd d = map.indices();
+  w.add_f64("indices", std::vector<double>(d.data(), d.data() + d.size()), {m});
+  w.add_i32("solved", map.solved, {m});
+  w.add_i64("voxel_ids", map.voxel_ids, {m});
+  w.add_scalar("tried", static_cast<std::int64_t>(map.tried));
+  w.add_f64("grid_origin", {map.grid.origin.x(), map.grid.origin.y(), map.grid.origin.z()}, {3});
+  w.add_scalar("grid_size", map.grid.side());
+  w.add_i64("grid_shape", {map.grid.n, map.grid.n, map.grid.n}, {3});
+  w.add_scalar("hull_voxels", map.hull_voxels);
+  w.add_scalar("hull_facets", static_cast<std::int64_t>(map.hull_facets));
+  w.add_scalar("reach", map.reach);
+  const WorkspaceOptions& o = map.options;
+  w.add_scalar("voxel_size", o.voxel_size);
+  w.add_scalar("directions", static_cast<std::int64_t>(o.directions));
+  w.add_scalar("rolls", static_cast<std::int64_t>(o.free_roll ? 0 : o.rolls));
+  w.add_bool("free_roll", o.free_roll);
+  w.add_string("approach_axis", approach_axis_name(o.approach));
+  w.add_scalar("timeout", o.timeout);
+  w.add_scalar("epsilon", o.epsilon);
+  w.add_scalar("cloud_samples", static_cast<std::int64_t>(o.cloud_samples));
+  w.add_u64("seed", {o.seed}, {});
+  w.add_i64("shard", {o.shard_index, o.shard_count}, {2});
+  w.add_string("chain_hash", map.chain_hash);
+  w.add_string("base", map.base);
+  w.add_string("tip", map.tip);
+  w.add_string("command", command);
+  w.add_scalar("ik_calls", map.ik_calls);
+  w.add_scalar("cheap_exits", map.cheap_exits);
+  w.add_scalar("seconds", map.seconds);
+  w.add_scalar("threads", static_cast<std::int64_t>(map.threads_used));
+  try {
+    w.write(path);
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+}
+
+}  // namespace snakehead
