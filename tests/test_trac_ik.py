@@ -369,3 +369,16 @@ def test_bad_algorithm_and_fk(solver7, head7):
         solver7.fk(np.zeros(3))
     with pytest.raises(TypeError):
         TracIK.from_chain("not a chain")
+
+
+def test_pose_and_start_forms_accepted(solver7, head7):
+    # Lists, integer arrays and a last row within 1e-9 of [0, 0, 0, 1] pass (the fast check defers to
+    # _validate.pose for anything it does not accept outright).
+    T = good_pose(head7)
+    assert solver7.ik(T.tolist(), np.zeros(7).tolist()) is not None
+    T2 = T.copy()
+    T2[3, 3] += 1e-12
+    assert solver7.ik(T2, np.zeros(7, dtype=int)) is not None
+    I = np.eye(4, dtype=int)
+    I[0, 3] = 5  # out of reach, but a valid pose
+    assert TracIK.from_chain(head7, timeout=0.001).ik(I, np.zeros(7)) is None

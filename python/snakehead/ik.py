@@ -12,12 +12,13 @@ x-axis free. The GIL is released while solving, and one solver may be shared by 
 """
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
 
 from . import _core
-from ._validate import finite_array, joint_vector, pose as check_pose, positive
+from ._validate import ORTHONORMAL_TOLERANCE, finite_array, joint_vector, pose as check_pose, positive
 from .chain import Chain
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
@@ -35,6 +36,24 @@ def _bounds(bounds) -> np.ndarray:
     if np.any(np.isnan(b)) or np.any(b < 0):
         raise ValueError(f"bounds must be >= 0 (inf leaves an axis free), got {b.tolist()}")
     return b
+
+
+def _pose(T, name: str = "pose") -> np.ndarray:
+    """``T`` as a valid 4x4 pose. The common case (a valid float64 array) is checked in plain Python, several
+    times faster than the numpy checks of ``_validate.pose`` for one small matrix; anything that fails here
+    goes to ``_validate.pose``, whose message says what is wrong (same tolerances)."""
+    a = np.asarray(T, dtype=np.float64) if isinstance(T, np.ndarray) else None
+    if a is not None and a.shape == (4, 4):
+        m = a.tolist()
+        r0, r1, r2, last = m
+        if (all(math.isfinite(v) for row in m for v in row) and last == [0.0, 0.0, 0.0, 1.0]):
+            c = [[r0[i] * r0[j] + r1[i] * r1[j] + r2[i] * r2[j] for j in range(3)] for i in range(3)]
+            err = max(abs(c[i][j] - (1.0 if i == j else 0.0)) for i in range(3) for j in range(3))
+            det = (r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
+                   + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]))
+            if err <= ORTHONORMAL_TOLERANCE and det > 0:
+                return a
+    return check_pose(T, name)
 
 
 def _seed(seed) -> int | None:
@@ -77,6 +96,7 @@ class TracIK:
         self._solver = _core.TracIK(chain.model, positive(timeout, "timeout"), positive(epsilon, "epsilon"),
                                     solve_type, _bounds(np.zeros(6) if bounds is None else bounds), _seed(seed))
         self._rng = np.random.default_rng(seed)
+        self._lo, self._hi = self._solver.lower.tolist(), self._solver.upper.tolist()
 
     # --- description -------------------------------------------------------------------------
     @property
@@ -121,6 +141,10 @@ class TracIK:
         return self._solver.fk(joint_vector(q, self.n_joints))
 
     def _q_init(self, q_init, name="q_init") -> np.ndarray:
+        if isinstance(q_init, np.ndarray) and q_init.shape == (self.n_joints,) and q_init.dtype == np.float64:
+            # The common case in plain Python (faster than numpy's reductions for a few values).
+            if all(lo - 1e-9 <= v <= hi + 1e-9 for v, lo, hi in zip(q_init.tolist(), self._lo, self._hi)):
+                return q_init  # NaN fails the comparisons and goes to the checks below
         q = joint_vector(q_init, self.n_joints, name)
         lo, hi = self.lower, self.upper
         bad = np.flatnonzero((q < lo - 1e-9) | (q > hi + 1e-9))
@@ -145,7 +169,7 @@ class TracIK:
     def ik_ex(self, pose, q_init=None, bounds=None, algorithm: str = "TRAC-IK", timeout: float | None = None):
         """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
         and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
-        T = check_pose(pose)
+        T = _pose(pose)
         q = self.random_configuration() if q_init is None else self._q_init(q_init)
         b = None if bounds is None else _bounds(bounds)
         t = None if timeout is None else positive(timeout, "timeout")
@@ -161,7 +185,7 @@ class TracIK:
         """
         P = finite_array(poses, "poses", (None, 4, 4))
         for k in range(P.shape[0]):
-            check_pose(P[k], f"poses[{k}]")
+            _pose(P[k], f"poses[{k}]")
         if q_inits is None:
             Q = np.array([self.random_configuration() for _ in range(P.shape[0])]).reshape(P.shape[0], self.n_joints)
         else:
