@@ -429,3 +429,13 @@ def test_cartesian_trajectory_is_timed_min_jerk(robot):
         tr.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.6, 0.5, 1.0]))
     with pytest.raises(ValueError, match="duration"):
         tr.cartesian_trajectory(robot, q0, q1, duration=0.0)
+
+
+def test_figures_are_written(tmp_path):
+    from snakehead import plots
+
+    paths = plots.lift_head_figures(tmp_path, duration=2.0)
+    assert [p.name for p in paths] == ["fig11_13_interpolation.png", "fig18_19_momenta.png", "fig20_zmp.png"]
+    for p in paths:
+        assert p.stat().st_size > 20_000
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
