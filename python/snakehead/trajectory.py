@@ -455,20 +455,30 @@ def box_box_sat(ca, Ra, ha, cb, Rb, hb) -> np.ndarray:
 
     Returns the largest gap (m) over the 15 candidate axes (3 + 3 face normals, 9 edge cross products): > 0 the
     boxes are apart (and this is a lower bound of their distance), <= 0 they intersect (and minus it is the
-    penetration depth along the best axis).
+    penetration depth along the best axis). Worked in B's frame with C = Rb^T Ra (Gottschalk's OBB test, with
+    each gap divided by its axis' length so that it is in metres).
     """
     ca, Ra, ha, cb, Rb, hb = _broadcast_boxes(ca, Ra, ha, cb, Rb, hb)
-    ax = [Ra[..., :, k] for k in range(3)] + [Rb[..., :, k] for k in range(3)]
-    ax += [np.cross(Ra[..., :, i], Rb[..., :, k]) for i in range(3) for k in range(3)]
-    L = np.stack(ax, axis=-2)  # (..., 15, 3)
-    norm = np.linalg.norm(L, axis=-1)
-    valid = norm > 1e-9  # parallel edges give no axis
-    L = L / np.where(valid, norm, 1.0)[..., None]
-    ra = np.abs(np.einsum("...ai,...ik->...ak", L, Ra)) @ ha[..., :, None]
-    rb = np.abs(np.einsum("...ai,...ik->...ak", L, Rb)) @ hb[..., :, None]
-    dist = np.abs(np.einsum("...ai,...i->...a", L, cb - ca))
-    gap = dist - ra[..., 0] - rb[..., 0]
-    return np.where(valid, gap, -np.inf).max(axis=-1)
+    RbT = np.swapaxes(Rb, -1, -2)
+    C = RbT @ Ra  # column i: A's axis i in B's frame
+    t = (RbT @ (ca - cb)[..., None])[..., 0]  # A's centre in B's frame
+    absC = np.abs(C)
+    gaps = []
+    for j in range(3):  # B's face normals
+        gaps.append(np.abs(t[..., j]) - hb[..., j] - (absC[..., j, :] * ha).sum(-1))
+    for i in range(3):  # A's face normals
+        gaps.append(np.abs((C[..., :, i] * t).sum(-1)) - ha[..., i] - (absC[..., :, i] * hb).sum(-1))
+    for i in range(3):  # A's edge i x B's edge j
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        for j in range(3):
+            j1, j2 = (j + 1) % 3, (j + 2) % 3
+            length = np.sqrt(np.maximum(1.0 - C[..., j, i] ** 2, 0.0))
+            proj = np.abs(t[..., j2] * C[..., j1, i] - t[..., j1] * C[..., j2, i])
+            ra = ha[..., i1] * absC[..., j, i2] + ha[..., i2] * absC[..., j, i1]
+            rb = hb[..., j1] * absC[..., j2, i] + hb[..., j2] * absC[..., j1, i]
+            ok = length > 1e-9  # parallel edges give no axis
+            gaps.append(np.where(ok, (proj - ra - rb) / np.where(ok, length, 1.0), -np.inf))
+    return np.max(np.stack(gaps, axis=-1), axis=-1)
 
 
 def _point_box_distance(p, c, R, h) -> np.ndarray:
