@@ -229,7 +229,13 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
     base = _check_base(base)
     qs, single = _joint_matrix(robot, q)
     frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
-    c = np.einsum("l,tli->ti", robot.masses, link_coms_world(robot, frames)) / robot.total_mass
+    m = robot.masses
+    # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product
+    W = np.zeros((len(m), 3, 4, 3))
+    for i in range(3):
+        W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
+        W[:, i, 3, i] = m  # coefficient of p_l[i]
+    c = (frames[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
     W = base.matrix()
     c = c @ W[:3, :3].T + W[:3, 3]
     return c[0] if single else c
