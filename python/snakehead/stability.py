@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 from scipy.spatial import QhullError
 
-from ._validate import finite_array, joint_vector, positive
+from ._validate import finite_array, joint_vector
 from .robot import BasePlacement, SnakeRobot
 
 #: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
@@ -215,11 +215,6 @@ def polygon_margin_many(points, active, xy) -> np.ndarray:
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
-def link_coms_world(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
-    """World centres of mass of every frame of ``link_names``: frames (T, L, 4, 4) -> (T, L, 3)."""
-    return frames[..., :3, 3] + np.einsum("tlij,lj->tli", frames[..., :3, :3], robot.coms)
-
-
 def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
 
@@ -504,7 +499,8 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
     # the contacts depend on the base joints only: build hull edges once per distinct base configuration
-    uniq, inv = np.unique(q[:, robot.parts.base], axis=0, return_inverse=True)
+    # (rounded to 1e-12 rad, so that a spline's round-off in a still base does not split it)
+    uniq, inv = np.unique(np.round(q[:, robot.parts.base], 12), axis=0, return_inverse=True)
     inv = inv.reshape(-1)
     first = np.zeros(len(uniq), int)
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
