@@ -338,3 +338,19 @@ def test_trajectory_bad_input(robot):
         st.momenta_from_velocities(robot, q, q[:, :3])
     with pytest.raises(ValueError, match="NaN"):
         st.zmp(robot, t, q, qd=np.full((10, 16), np.inf))
+
+
+def test_zmp_undefined_when_the_ground_would_pull(robot):
+    """A violent flick of the raised neck: the CoM accelerates downwards faster than gravity at times, so
+    M g + dP_z/dt < 0 there; those samples have no ZMP and the motion is not stable."""
+    t = np.arange(500) * 0.002
+    q = np.tile(arc_base(robot, 0.5), (500, 1))
+    q[:, 7] = -0.8 + 0.6 * np.sin(2 * np.pi * 12 * t)  # joint 8, 12 Hz
+    P, _ = st.momenta(robot, t, q)
+    Pdot_z = np.gradient(P[:, 2], t, edge_order=2)
+    pulls = robot.total_mass * st.GRAVITY + Pdot_z <= 0
+    assert pulls.any() and not pulls.all()
+    p = st.zmp(robot, t, q)
+    assert np.array_equal(np.isnan(p).any(axis=1), pulls)
+    res = st.dynamic_stability(robot, t, q)
+    assert np.all(res.margin[pulls] == -np.inf) and not res.stable and res.min_margin == -np.inf

@@ -199,6 +199,43 @@ def test_recovered_links_point_along_the_segments(robot):
         assert np.all(np.sum(link * seg, 1)[ok] > 0)  # pointing forward along the segment
 
 
+def test_rigid_rotation_directions_exact_positions_shrink(robot):
+    """Raising a straight neck and head rigidly by joint 8: every segment keeps the links' direction, so the
+    recovered angles are the linear ones and the direction error is 0; the positions stray by the chord's
+    shortening, |tip - interpolated tip| = L (1 - cos(a s)) ... in closed form below."""
+    q0 = np.zeros(16)
+    q1 = q0.copy()
+    q1[7] = -1.0
+    res = tr.cartesian_interpolation(robot, q0, q1, 21, full_output=True)
+    s = res.s
+    # the straight line from joint 8 rotates rigidly about it; interpolated points lie on the chords
+    np.testing.assert_allclose(res.q[:, 7], -np.arctan2(np.sin(1.0) * s, 1 - s + s * np.cos(1.0)), atol=1e-12)
+    np.testing.assert_allclose(res.q[:, 8:], 0.0, atol=1e-12)
+    assert res.direction_error.max() < 1e-9
+    L = 1.384 - 0.646  # joint 8 to the head tip
+    chord = np.hypot(1 - s + s * np.cos(1.0), s * np.sin(1.0))  # interpolated tip distance / L
+    np.testing.assert_allclose(res.deviation, L * (1 - chord), atol=1e-12)
+
+
+def test_aim_at_points_tracks_the_interpolated_points(robot):
+    q0, q1 = lift_motion(robot)
+    seg = tr.cartesian_interpolation(robot, q0, q1, 60, full_output=True)
+    pts = tr.cartesian_interpolation(robot, q0, q1, 60, aim="points", full_output=True)
+    np.testing.assert_array_equal(pts.q[[0, -1]], np.stack([q0, q1]))
+    assert pts.max_deviation < seg.max_deviation  # aiming at the points keeps closer to them
+    # each unclipped link lies in the plane of its joint axis and the line from its actual joint to the next point
+    F = robot.frames_many(pts.q)
+    model = robot.body.model
+    for i, j in enumerate(range(7, 16)):
+        a = F[:, model.joint_child_links[j], :3, :3] @ model.joint_axes[j]
+        want = pts.points[:, i + 1] - pts.actual[:, i]
+        link = pts.actual[:, i + 1] - pts.actual[:, i]
+        normal = np.cross(a, want)
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        ok = ~pts.clipped[:, i]
+        assert (np.abs(np.sum(normal * link, 1)) / np.linalg.norm(link, axis=1))[ok].max() < 1e-9
+
+
 def test_cartesian_interpolation_clears_the_ground_where_joint_space_does_not(robot):
     """Fig. 11 vs Fig. 13: the head hits the ground under joint interpolation, not under Eqs. 41-44."""
     q0, q1 = lift_motion(robot)

@@ -133,7 +133,10 @@ class CartesianInterpolation:
     q (n, 16) rad; s (n,) the interpolation parameters t_j of Eq. 41; points (n, m, 3) the interpolated joint
     positions p_ij (m = neck + head joints + 1: from the neck's first joint to the head tip), actual (n, m, 3)
     where the recovered configuration puts them; deviation (n,) the largest distance between the two per
-    sample (m), max_deviation its maximum; clipped (n, k) which joint angles were clipped to a limit.
+    sample (m), max_deviation its maximum; direction_error (n,) the largest angle (rad) between a recovered
+    link (joint to next joint) and its interpolated segment; clipped (n, k) which joint angles were clipped to a
+    limit. The positions stray even when the directions are exact: a straight-line interpolation between two
+    poses shortens the segments (chords), while the links keep their length.
     """
 
     q: np.ndarray
@@ -142,6 +145,7 @@ class CartesianInterpolation:
     actual: np.ndarray
     deviation: np.ndarray
     max_deviation: float
+    direction_error: np.ndarray
     clipped: np.ndarray
 
 
@@ -262,7 +266,11 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlac
         return q
     actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
     dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
-    return CartesianInterpolation(q, s, P, actual, dev, float(dev.max()), clipped)
+    links = np.diff(actual, axis=1)
+    segs = np.diff(P, axis=1)
+    angle = np.arctan2(np.linalg.norm(np.cross(links, segs), axis=2), np.sum(links * segs, axis=2))
+    angle = np.where(np.linalg.norm(segs, axis=2) > 1e-12, angle, 0.0)  # a segment of zero length: no direction
+    return CartesianInterpolation(q, s, P, actual, dev, float(dev.max()), angle.max(axis=1), clipped)
 
 
 def minimum_jerk(tau: np.ndarray) -> np.ndarray:
