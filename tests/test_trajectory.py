@@ -248,6 +248,9 @@ def test_cartesian_interpolation_clears_the_ground_where_joint_space_does_not(ro
     joint_clear = tr.ground_clearance(robot, q_joint)[:, links].min(axis=1)
     assert joint_clear.min() < -0.04  # 4 cm into the ground
     assert tr.below_ground(robot, q_joint).any()
+    # at the start the neck and head lie on the ground: touching, not below it
+    assert tr.touching_ground(robot, q0)[0, links].all() and not tr.below_ground(robot, q0).any()
+    assert not tr.touching_ground(robot, q1).any()
     q_cart = tr.cartesian_interpolation(robot, q0, q1, n)
     cart_clear = tr.ground_clearance(robot, q_cart)[:, links].min(axis=1)
     assert cart_clear.min() > -tr.GROUND_TOLERANCE

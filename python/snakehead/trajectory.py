@@ -5,7 +5,8 @@ and collisions with obstacles (paper, Section 3.2; DESIGN.md).
   sampled at the 2 ms control period.
 * :func:`cartesian_interpolation` -- Eqs. 41-44: the neck's and head's joint positions move on straight lines
   and the joint angles follow them link by link.
-* :func:`ground_clearance`, :func:`below_ground` -- how high every link's collision box stays above the ground.
+* :func:`ground_clearance`, :func:`below_ground`, :func:`touching_ground` -- how high every link's
+  collision box stays above the ground.
 * :class:`BoxObstacle`, :class:`WallWithHole`, :func:`collision_check` -- the links' boxes against obstacles.
 
 Everything is vectorised over the time samples (numpy); Python loops run over joints, links or box features.
@@ -346,6 +347,18 @@ def below_ground(robot: SnakeRobot, qs, base: BasePlacement | None = None,
     out = np.zeros(clearance.shape, bool)
     links = non_base_links(robot)
     out[:, links] = clearance[:, links] < -tolerance
+    return out
+
+
+def touching_ground(robot: SnakeRobot, qs, base: BasePlacement | None = None,
+                    tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
+    """(T, n_links) bool: the neck and head links whose boxes come within ``tolerance`` m of the ground (or
+    below it). The base links, which lie on the ground, are never flagged."""
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    clearance = ground_clearance(robot, qs, base)
+    out = np.zeros(clearance.shape, bool)
+    links = non_base_links(robot)
+    out[:, links] = clearance[:, links] < tolerance
     return out
 
 
