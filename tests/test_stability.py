@@ -86,6 +86,19 @@ def test_footprint_polygon_of_straight_base_is_rectangle(robot):
     np.testing.assert_allclose(seg, [[0, 0], [0.646, 0]], atol=1e-12)
 
 
+def test_ground_contact_model_counts_every_link_lying_down(robot):
+    # the straight robot lying flat: the whole body's footprint, 1.384 m x 0.043 m; CoM in the middle
+    poly = st.support_polygon(robot, np.zeros(16), contact="ground")
+    np.testing.assert_allclose(np.sort(poly[:, 0]), [0, 0, 1.384, 1.384], atol=1e-12)
+    np.testing.assert_allclose(np.sort(poly[:, 1]), [-0.0215, -0.0215, 0.0215, 0.0215], atol=1e-12)
+    assert st.static_margin(robot, np.zeros(16), contact="ground") == pytest.approx(0.0215, abs=1e-12)
+    # raising the neck lifts the neck and head off the ground: back to the base's footprint
+    q = np.zeros(16)
+    q[7] = -0.5
+    np.testing.assert_allclose(st.support_polygon(robot, q, contact="ground"),
+                               st.support_polygon(robot, q, contact="footprint"), atol=1e-12)
+
+
 def test_static_margin_closed_form(robot):
     # straight robot: CoM at x = 0.692 > 0.646 (end of the base): outside by 0.046 m
     assert st.static_margin(robot, np.zeros(16)) == pytest.approx(-(0.692 - 0.646), abs=1e-12)
@@ -311,9 +324,11 @@ def test_dynamic_stability_with_moving_base_matches_per_sample_polygons(robot):
     qs = np.zeros((T, 16))
     qs[:, 0:7:2] = np.linspace(0.1, 0.6, T)[:, None]  # the base curls up along the way
     qs[:, 8] = qs[:, 10] = np.pi / 2
-    for contact in ("endpoints", "footprint"):
+    qs[:, 7] = np.where(np.arange(T) < T // 2, 0.0, np.linspace(0.0, -0.6, T))  # the neck lifts off halfway
+    qs[:, 8] = np.pi / 2 * (np.arange(T) < T // 2)
+    for contact in ("endpoints", "footprint", "ground"):
         res = st.dynamic_stability(robot, t, qs, contact=contact)
-        for k in rng.choice(T, 6, replace=False):
+        for k in np.r_[rng.choice(T, 8, replace=False), T // 2 - 1, T // 2]:
             poly = st.support_polygon(robot, qs[k], contact=contact)
             ref = st.polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), res.zmp[k][None])[0]
             assert res.margin[k] == pytest.approx(ref, abs=1e-12)

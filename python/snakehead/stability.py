@@ -31,7 +31,7 @@ GRAVITY = 9.80665
 CONTACT_TOLERANCE = 1e-3
 
 #: Contact models of :func:`support_polygon`.
-CONTACT_MODELS = ("endpoints", "footprint")
+CONTACT_MODELS = ("endpoints", "footprint", "ground")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -102,7 +102,7 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     if contact not in CONTACT_MODELS:
         raise ValueError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
     first, end = _base_link_range(robot)
-    links = np.arange(first, end - 1)
+    links = np.arange(first, end - 1) if contact != "ground" else np.arange(len(robot.link_names))
     links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
     if links.size == 0:
         raise ValueError("the base part has no links with a collision box; no support polygon")
@@ -117,7 +117,7 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
         active[:, np.searchsorted(idx, links)] |= on_ground
         active[:, np.searchsorted(idx, links + 1)] |= on_ground
         return pts, active
-    # footprint: the four bottom corners of each base box (its face nearest the ground).
+    # footprint / ground: the four bottom corners of each box (its face nearest the ground).
     B = frames[:, links] @ robot.box_origins[links]  # (T, k, 4, 4)
     half = 0.5 * robot.box_sizes[links]  # (k, 3)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
@@ -272,9 +272,11 @@ def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
       This is conservative: the true footprint of the 0.043 m wide modules is larger.
     * ``"footprint"``: the four bottom corners of every base link's collision box -- the physical contact
       footprint of the modules; use it for an (almost) straight base, whose endpoints are collinear.
+    * ``"ground"``: the four bottom corners of every link's box that lies on the ground, the neck's and head's
+      included -- the physical support of a robot that still lies (partly) flat, e.g. before the head is lifted.
 
-    Only base links lying on the ground count (the lowest corner of their box below ``tolerance`` m); the
-    neck and head never support the body in the paper's model, even when they touch the ground.
+    Only links lying on the ground count (the lowest corner of their box below ``tolerance`` m). In the paper's
+    model (the first two) only the base supports the body, even when the neck and head touch the ground.
     If the contact points are collinear the "polygon" is the segment between the extreme points (2, 2): it
     has no interior, so :func:`static_margin` is <= 0 for it.
     """
@@ -492,15 +494,29 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
     The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
-    distinct base configuration along the trajectory (the base joints may move, e.g. into the initial arc).
+    distinct contact configuration along the trajectory (the base joints may move, e.g. into the initial arc;
+    with ``contact="ground"`` the neck and head may lie down or lift off).
     """
     robot = _check_robot(robot)
     base = _check_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
-    # the contacts depend on the base joints only: build hull edges once per distinct base configuration
-    # (rounded to 1e-12 rad, so that a spline's round-off in a still base does not split it)
-    uniq, inv = np.unique(np.round(q[:, robot.parts.base], 12), axis=0, return_inverse=True)
+    # build the hull once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    # round-off in a still base does not split it): the base joints decide the base's contacts; with
+    # contact="ground" also the joints before the last link on the ground (those after it move nothing that
+    # touches)
+    if contact == "ground":
+        lowest = np.full((len(q), len(robot.link_names)), np.inf)
+        boxed = _box_links(robot)
+        lowest[:, boxed] = _lowest_corner_z(robot.frames_many(q, base), robot, boxed)
+        touching = lowest <= tolerance
+        last = np.where(touching.any(axis=1), len(robot.link_names) - 1 - np.argmax(touching[:, ::-1], axis=1), -1)
+        child = np.asarray(robot.body.model.joint_child_links)
+        key = np.where(child[None, :] <= last[:, None], np.round(q, 12), 0.0)
+        key = np.column_stack([key, last])
+    else:
+        key = np.round(q[:, robot.parts.base], 12)
+    uniq, inv = np.unique(key, axis=0, return_inverse=True)
     inv = inv.reshape(-1)
     first = np.zeros(len(uniq), int)
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
