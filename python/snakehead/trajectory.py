@@ -207,14 +207,13 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlac
 
     * The base joints interpolate linearly in joint space (the base stays on the ground).
     * The joint positions of the neck and head (world points of the joint frames from the neck's first joint
-      to the head tip, p_0 .. p_{m-1}) interpolate linearly, p_ij = (1 - t_j) p_si + t_j p_fi (Eq. 41), with
-      t_j evenly spaced in [0, 1].
+      to the head tip, p_0 .. p_{m-1}) interpolate linearly, p_ij = (1 - t_j) p_si + t_j p_fi (Eq. 41).
     * The joint angles are recovered link by link in chain order: joint i's frame is known from the joints
       before it; its link should point along l_i = (p_{i+1,j} - p_{ij}) / |.| (Eq. 44); the link direction
-      and l_i are projected on the plane of the joint's rotation (Eq. 43) and the angle between them (Eq. 42,
-      see :func:`joint_angle_towards` for the form for any axis) is clipped to the joint's limits.  Where the wanted
-      direction passes behind a link (beyond +-90 deg) the clipped angle jumps from one limit to the other:
-      ``full_output`` reports the clipped samples; such a motion needs intermediate waypoints.
+      and l_i are projected on the plane of the joint's rotation (Eq. 43) and the angle between them (Eq. 42;
+      see :func:`joint_angle_towards` for the form for any axis) is clipped to the joint's limits. Where the
+      wanted direction passes behind a link (beyond +-90 deg) the clipped angle jumps from one limit to the
+      other: ``full_output`` reports the clipped samples; such a motion needs intermediate waypoints.
       ``aim="points"`` instead aims each link from where the recovered chain has put its joint at the next
       interpolated point (the same equations with p_ij replaced by the actual joint position): the chain then
       tracks the interpolated points instead of only their directions.
