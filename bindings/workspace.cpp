@@ -71,6 +71,7 @@ void bind_workspace(py::module_& m) {
       .def_readwrite("voxel_size", &WorkspaceOptions::voxel_size)
       .def_readwrite("directions", &WorkspaceOptions::directions)
       .def_readwrite("rolls", &WorkspaceOptions::rolls)
+      .def_readwrite("any_roll", &WorkspaceOptions::any_roll)
       .def_readwrite("free_roll", &WorkspaceOptions::free_roll)
       .def_property(
           "approach_axis", [](const WorkspaceOptions& o) { return std::string(approach_axis_name(o.approach)); },

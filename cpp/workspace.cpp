@@ -52,6 +52,7 @@ Eigen::VectorXd random_configuration(const ChainModel& model, std::mt19937_64& r
 
 constexpr std::uint64_t kCloudSalt = 0xC10D;
 constexpr std::uint64_t kVoxelSalt = 0x70CE1;
+constexpr std::uint64_t kBackwardSalt = 0xBAC4;
 
 class TracIKPoseSolver : public PoseSolver {
  public:
@@ -320,11 +321,17 @@ Eigen::VectorXd ReachabilityMap::indices() const {
   return d;
 }
 
-VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions& options,
-                                const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
-                                const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress,
-                                const PoseSolverFactory& factory_in) {
-  options.validate();
+namespace {
+
+// A run: rows [start, start + length) of the centres, neighbouring voxels along a grid line.
+struct Run {
+  std::int64_t start, length;
+};
+
+VoxelEvaluation evaluate_runs(const ChainModel& model, const WorkspaceOptions& options,
+                              const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
+                              const std::vector<std::uint64_t>& stream_ids, const std::vector<Run>& runs,
+                              const ProgressCallback& progress, const PoseSolverFactory& factory_in) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto total = static_cast<std::int64_t>(centres.rows());
   if (static_cast<std::int64_t>(stream_ids.size()) != total)
@@ -340,7 +347,8 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
   const ReachBound bound(model, options);
   const double radius = 0.5 * options.voxel_size;
   int n_threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  n_threads = static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), total)));
+  n_threads = static_cast<int>(
+      std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), static_cast<std::int64_t>(runs.size()))));
   out.threads_used = n_threads;
   // Solvers are made here, so that a bad option fails before any thread starts.
   std::vector<std::unique_ptr<PoseSolver>> solvers;
@@ -354,37 +362,101 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
 
   // Dynamic scheduling (an atomic counter) balances voxels of very different cost; each voxel is
   // computed start to finish by one thread, so the result does not depend on the thread count.
+  // One task is one run, computed start to finish by one thread: the result does not depend on the
+  // thread count. Dynamic scheduling (an atomic counter) balances runs of very different cost.
+  //
+  // A voxel's "units" are what the index counts: its directions when any roll will do (the paper's
+  // rule, and free roll), else its (direction, roll) frames. A unit is reached when one of its
+  // candidate frames is solved. Within a run, frame c of a voxel is frame c of its neighbour moved by
+  // one voxel, so the neighbour's solution is an excellent initial guess (a few Newton steps away).
+  // A forward pass tries each unit's frames, first the one the previous voxel solved (from its
+  // solution), the others from random guesses, until one is solved; a backward pass gives the units
+  // still unreached one more try from the next voxel's solution. Most reachable frames are thus
+  // found within a short budget; unreachable ones, which always cost the full budget, cost it about once.
+  const int n_dirs = options.directions;
+  const int per_unit = options.free_roll || !options.any_roll ? 1 : options.rolls;  // candidate frames
+  const int units = options.poses_per_voxel();
+  const int frames_per_voxel = units * per_unit;  // = directions * n_rolls
   auto work = [&](PoseSolver& solver) {
     std::int64_t my_calls = 0, my_cheap = 0;
     Eigen::VectorXd q_out(model.n_joints());
+    std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets;
+    std::vector<char> possible;
+    std::vector<int> reached_by;  // per unit: the candidate that reached it, or -1
+    std::vector<Eigen::VectorXd> solutions, guesses;
+    std::vector<std::uint64_t> seeds;
+    auto attempt = [&](std::int64_t unit, int c, const Eigen::VectorXd& q_init, std::uint64_t seed) {
+      const std::int64_t f = unit * per_unit + c;
+      if (!possible[f]) return false;
+      ++my_calls;
+      if (!solver.solve(targets[f], q_init, seed, q_out)) return false;
+      reached_by[unit] = c;
+      solutions[unit] = q_out;
+      return true;
+    };
     try {
-      for (std::int64_t v = next++; v < total && !stop.load(std::memory_order_relaxed); v = next++) {
-        const Eigen::Vector3d c = centres.row(v).transpose();
-        std::mt19937_64 rng(stream_seed(options.seed, kVoxelSalt, stream_ids[v]));
-        int solved = 0;
-        // Cheap exit for the whole voxel: its sphere lies beyond the tip's reach.
-        if (c.norm() - radius <= bound.reach() + 1e-9) {
-          for (const Eigen::Vector3d& d : dirs) {
+      for (std::int64_t t = next++; t < static_cast<std::int64_t>(runs.size()) && !stop.load(std::memory_order_relaxed);
+           t = next++) {
+        const Run run = runs[t];
+        const std::int64_t n_frames = run.length * frames_per_voxel;
+        targets.resize(n_frames);
+        possible.assign(n_frames, 0);
+        guesses.resize(n_frames);
+        seeds.resize(n_frames);
+        reached_by.assign(run.length * units, -1);
+        solutions.resize(run.length * units);
+        // Lines 11-15: the frames of every voxel of the run (frame index = (voxel, direction, roll)),
+        // the cheap exits, and each frame's random guess and IK seed from the voxel's own stream.
+        for (std::int64_t l = 0; l < run.length; ++l) {
+          const Eigen::Vector3d c = centres.row(run.start + l).transpose();
+          std::mt19937_64 rng(stream_seed(options.seed, kVoxelSalt, stream_ids[run.start + l]));
+          // The whole sphere beyond the tip's reach: index 0 without looking at a single frame.
+          const bool in_reach = c.norm() - radius <= bound.reach() + 1e-9;
+          for (int di = 0; di < n_dirs; ++di) {
+            const Eigen::Vector3d& d = dirs[di];
             const Eigen::Vector3d p = c + radius * d;
             for (int r = 0; r < n_rolls; ++r) {
-              const double roll = 2.0 * M_PI * r / n_rolls;
-              const Eigen::Isometry3d target = approach_frame(p, d, roll, options.approach);
-              const bool possible = options.free_roll ? bound.possible_any_roll(p, d) : bound.possible(target);
-              if (!possible) {
-                ++my_cheap;
-                continue;
-              }
-              const Eigen::VectorXd q_init = random_configuration(model, rng);
-              const std::uint64_t call_seed = rng();
-              ++my_calls;
-              if (solver.solve(target, q_init, call_seed, q_out)) ++solved;
+              const std::int64_t f = l * frames_per_voxel + di * n_rolls + r;
+              targets[f] = approach_frame(p, d, 2.0 * M_PI * r / n_rolls, options.approach);
+              possible[f] = in_reach && (options.free_roll ? bound.possible_any_roll(p, d) : bound.possible(targets[f]));
+              my_cheap += !possible[f];
+              guesses[f] = random_configuration(model, rng);
+              seeds[f] = rng();
             }
           }
-        } else {
-          my_cheap += out.tried;
         }
-        out.solved[v] = solved;
-        if (++done == total) cv.notify_all();
+        // Forward pass.
+        for (std::int64_t l = 0; l < run.length; ++l) {
+          for (int u = 0; u < units; ++u) {
+            const std::int64_t unit = l * units + u;
+            const std::int64_t prev = unit - units;
+            int first = -1;
+            if (l > 0 && reached_by[prev] >= 0) {
+              first = reached_by[prev];
+              if (attempt(unit, first, solutions[prev], seeds[unit * per_unit + first])) continue;
+            }
+            for (int c = 0; c < per_unit; ++c) {
+              if (c == first) continue;
+              const std::int64_t f = unit * per_unit + c;
+              if (attempt(unit, c, guesses[f], seeds[f])) break;
+            }
+          }
+        }
+        // Backward pass: second chances from the next voxel's solutions (seeds from another stream).
+        for (std::int64_t l = run.length - 2; l >= 0; --l) {
+          for (int u = 0; u < units; ++u) {
+            const std::int64_t unit = l * units + u, after = unit + units;
+            if (reached_by[unit] >= 0 || reached_by[after] < 0) continue;
+            const int c = reached_by[after];
+            attempt(unit, c, solutions[after], splitmix64(seeds[unit * per_unit + c] ^ kBackwardSalt));
+          }
+        }
+        for (std::int64_t l = 0; l < run.length; ++l) {
+          int count = 0;
+          for (int u = 0; u < units; ++u) count += reached_by[l * units + u] >= 0;
+          out.solved[run.start + l] = count;
+        }
+        if ((done += run.length) == total) cv.notify_all();
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(mutex);
@@ -435,6 +507,18 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
   return out;
 }
 
+}  // namespace
+
+VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions& options,
+                                const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
+                                const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress,
+                                const PoseSolverFactory& factory) {
+  options.validate();
+  std::vector<Run> runs;
+  for (std::int64_t v = 0; v < centres.rows(); ++v) runs.push_back({v, 1});
+  return evaluate_runs(model, options, centres, stream_ids, runs, progress, factory);
+}
+
 ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOptions& options,
                                      const ProgressCallback& progress, const PoseSolverFactory& factory) {
   options.validate();
@@ -453,18 +537,34 @@ ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOpt
   const ConvexHull hull = ConvexHull::of(sample_tip_positions(model, options.cloud_samples, options.seed));
   map.hull_facets = hull.n_facets();
   map.grid = VoxelGrid::around(Eigen::Vector3d::Zero(), 2.0 * model.reach(), options.voxel_size);
-  std::vector<std::int64_t> in_hull;
-  for (std::int64_t k = 0; k < map.grid.count(); ++k)
-    if (hull.contains(map.grid.centre_of(k))) in_hull.push_back(k);
-  map.hull_voxels = static_cast<std::int64_t>(in_hull.size());
-  for (std::size_t p = 0; p < in_hull.size(); ++p)
-    if (static_cast<int>(p % options.shard_count) == options.shard_index) map.voxel_ids.push_back(in_hull[p]);
+  // The in-hull voxels in runs of neighbours along z (the grid's fastest index). Shard i of N takes
+  // the runs r with r % N == i: a run is never split, so every voxel sees the same neighbours in
+  // every shard and the merged shards equal the unsharded map.
+  std::vector<Run> runs;
+  map.hull_voxels = 0;
+  std::int64_t run_index = 0;
+  const int n = map.grid.n;
+  for (std::int64_t line = 0; line < static_cast<std::int64_t>(n) * n; ++line) {
+    std::int64_t previous = -2;
+    for (int l = 0; l < n; ++l) {
+      const std::int64_t k = line * n + l;
+      if (!hull.contains(map.grid.centre_of(k))) continue;
+      ++map.hull_voxels;
+      const bool starts_run = k != previous + 1;
+      previous = k;
+      if (starts_run) ++run_index;
+      if ((run_index - 1) % options.shard_count != options.shard_index) continue;
+      if (starts_run) runs.push_back({static_cast<std::int64_t>(map.voxel_ids.size()), 0});
+      map.voxel_ids.push_back(k);
+      ++runs.back().length;
+    }
+  }
   const auto total = static_cast<Eigen::Index>(map.voxel_ids.size());
   map.centres.resize(total, 3);
   for (Eigen::Index v = 0; v < total; ++v) map.centres.row(v) = map.grid.centre_of(map.voxel_ids[v]).transpose();
 
   const std::vector<std::uint64_t> streams(map.voxel_ids.begin(), map.voxel_ids.end());
-  VoxelEvaluation e = evaluate_voxels(model, options, map.centres, streams, progress, factory);
+  VoxelEvaluation e = evaluate_runs(model, options, map.centres, streams, runs, progress, factory);
   map.solved = std::move(e.solved);
   map.ik_calls = e.ik_calls;
   map.cheap_exits = e.cheap_exits;
@@ -476,7 +576,7 @@ ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOpt
 namespace {
 bool same_options(const WorkspaceOptions& a, const WorkspaceOptions& b) {
   return a.voxel_size == b.voxel_size && a.directions == b.directions &&
-         (a.free_roll ? b.free_roll : !b.free_roll && a.rolls == b.rolls) && a.approach == b.approach &&
+         (a.free_roll ? b.free_roll : !b.free_roll && a.rolls == b.rolls && a.any_roll == b.any_roll) && a.approach == b.approach &&
          a.timeout == b.timeout && a.epsilon == b.epsilon &&
          a.cloud_samples == b.cloud_samples && a.seed == b.seed && a.shard_count == b.shard_count;
 }
@@ -548,6 +648,7 @@ void save_npz(const ReachabilityMap& map, const std::string& path, const std::st
   w.add_scalar("directions", static_cast<std::int64_t>(o.directions));
   w.add_scalar("rolls", static_cast<std::int64_t>(o.free_roll ? 0 : o.rolls));
   w.add_bool("free_roll", o.free_roll);
+  w.add_bool("any_roll", o.any_roll);
   w.add_string("approach_axis", approach_axis_name(o.approach));
   w.add_scalar("timeout", o.timeout);
   w.add_scalar("epsilon", o.epsilon);

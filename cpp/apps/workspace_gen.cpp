@@ -24,7 +24,8 @@ const char* kUsage = R"(usage: workspace_gen --urdf FILE --base LINK --tip LINK 
 
 Computes the reachability map of the chain BASE -> TIP (Algorithm 1 of the paper): voxels of the
 cube of side 2 * reach centred on BASE that lie inside the hull of random tip positions get the
-index D = 100 * (poses solved by TRAC-IK) / (poses tried) over points spread on their inscribed sphere.
+index D = 100 * (points reached by TRAC-IK) / (points tried) over points spread on their inscribed
+sphere (a point is reached when one of its rolled frames is solved; --each-roll counts frames).
 
 required:
   --urdf FILE            the robot description
@@ -36,8 +37,10 @@ options:
   --directions N         points per voxel sphere, Fibonacci lattice (default 20)
   --rolls R              frames about the approach axis per point (default 4)
   --free-roll            instead of rolls: one IK call per point with the roll left free
+  --each-roll            count every (point, roll) frame; by default a point counts as reached
+                         when any of its rolls is solved (the paper's Algorithm 1)
   --approach-axis x|z    tip axis that approaches the sphere point (default x, the head's direction)
-  --timeout S            IK budget per pose in seconds (default 0.005)
+  --timeout S            IK budget per call in seconds (default 0.0003)
   --epsilon E            IK tolerance (default 1e-5)
   --cloud-samples N      random configurations for the hull (default 50000)
   --seed N               random seed (default 1); the map is a function of the seed
@@ -124,6 +127,8 @@ int main(int argc, char** argv) {
       } else if (a == "--rolls") {
         opt.rolls = parse_count(a, value());
         rolls_given = true;
+      } else if (a == "--each-roll") {
+        opt.any_roll = false;
       } else if (a == "--free-roll") {
         opt.free_roll = true;
       } else if (a == "--approach-axis") {
@@ -154,7 +159,8 @@ int main(int argc, char** argv) {
     }
     if (urdf.empty() || base.empty() || tip.empty() || out.empty())
       throw UsageError("--urdf, --base, --tip and --out are required (see --help)");
-    if (opt.free_roll && rolls_given) throw UsageError("give either --rolls or --free-roll, not both");
+    if (opt.free_roll && (rolls_given || !opt.any_roll))
+      throw UsageError("--free-roll leaves the roll free: it takes neither --rolls nor --each-roll");
     opt.validate();
     check_writable(out);
   } catch (const std::exception& e) {

@@ -6,11 +6,18 @@
 // 3. For each kept voxel, N directions spread evenly on its inscribed sphere (a Fibonacci lattice);
 //    at each point a frame whose approach axis (the tip's x- or z-axis) runs from the sphere's centre
 //    to the point, rolled evenly R times about that axis (or with the roll left free: one IK call
-//    with the roll tolerance open); the reachability index D = 100 * solved / tried.
+//    with the roll tolerance open); the reachability index D = 100 * solved / tried, where a point
+//    counts as solved when any of its frames is (the paper's rule; or each frame counts on its own).
+//
+// Unreachable poses dominate the cost (each spends the whole IK budget), so poses that distance
+// bounds prove unreachable get no IK call (ReachBound), and the voxels are swept in runs of
+// neighbours along a grid line, each pose's IK starting from the neighbouring voxel's solution of
+// the same pose when there is one (a forward and a backward pass): reachable poses are then found
+// within a short budget.
 //
 // Results are deterministic for a given seed whatever the thread count: every voxel draws its
-// random numbers from its own stream (derived from the seed and the voxel's grid index) and its
-// poses are solved in a fixed order by one thread, each by a seeded TRAC-IK call (a pure function of
+// random numbers from its own stream (derived from the seed and the voxel's grid index), and a run
+// is solved in a fixed order by one thread, each by a seeded TRAC-IK call (a pure function of
 // its inputs whose search is bounded by an evaluation budget derived from the timeout, not the clock).
 #pragma once
 
@@ -38,9 +45,13 @@ struct WorkspaceOptions {
   double voxel_size = 0.05;      // m, edge of the cubic voxels (> 0)
   int directions = 20;           // points on each voxel's inscribed sphere (>= 1)
   int rolls = 4;                 // frames about the approach axis per point (>= 1), unless free_roll
+  // The paper's rule (Algorithm 1, lines 13-18): a point counts as reached when any of its rolled
+  // frames is solved, and D = 100 * reached points / points. false: every (point, roll) frame counts,
+  // D = 100 * solved frames / frames.
+  bool any_roll = true;
   bool free_roll = false;        // one IK call per point with the roll about the approach axis free
   ApproachAxis approach = ApproachAxis::X;
-  double timeout = 0.005;        // s per IK call (> 0)
+  double timeout = 0.0003;       // s per IK call (> 0); seeded TRAC-IK turns it into an evaluation budget
   double epsilon = 1e-5;         // IK tolerance on the pose error (> 0)
   int cloud_samples = 50000;     // random configurations for the hull (>= 100)
   std::uint64_t seed = 1;
@@ -50,7 +61,8 @@ struct WorkspaceOptions {
 
   // Throws InputError naming the first bad field.
   void validate() const;
-  int poses_per_voxel() const { return free_roll ? directions : directions * rolls; }
+  // What the index counts per voxel ("tried"): points, or (point, roll) frames when !any_roll.
+  int poses_per_voxel() const { return free_roll || any_roll ? directions : directions * rolls; }
 };
 
 // A cubic grid of n x n x n voxels; voxel (i, j, l) has linear index (i * n + j) * n + l and its
@@ -146,7 +158,7 @@ struct ReachabilityMap {
   std::int64_t hull_voxels = 0;  // in-hull voxels of the whole map (all shards)
   int hull_facets = 0;
   // Statistics of this run (not part of the map's identity).
-  std::int64_t ik_calls = 0, cheap_exits = 0;  // poses sent to IK / rejected by a reach bound
+  std::int64_t ik_calls = 0, cheap_exits = 0;  // IK calls / frames rejected by a reach bound
   double seconds = 0.0;
   int threads_used = 0;
 
@@ -162,8 +174,9 @@ class Cancelled : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Lines 9-21 of Algorithm 1 for voxels (spheres of diameter options.voxel_size) at any centres:
-// solved[k] of options.poses_per_voxel() poses. Voxel k draws from the random stream
+// Lines 9-21 of Algorithm 1 for voxels (spheres of diameter options.voxel_size) at any centres, each
+// on its own (random initial guesses only; no runs of neighbours): solved[k] of
+// options.poses_per_voxel() poses. Voxel k draws from the random stream
 // stream_ids[k] (the grid index in a map). `factory` defaults to TRAC-IK.
 struct VoxelEvaluation {
   std::vector<std::int32_t> solved;
@@ -177,7 +190,8 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
                                 const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress = nullptr,
                                 const PoseSolverFactory& factory = nullptr);
 
-// Algorithm 1 over the voxels of options' shard. `factory` defaults to TRAC-IK.
+// Algorithm 1 over the voxels of options' shard (runs of neighbours along z, shard i of N taking
+// every N-th run). `factory` defaults to TRAC-IK.
 ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOptions& options,
                                      const ProgressCallback& progress = nullptr,
                                      const PoseSolverFactory& factory = nullptr);

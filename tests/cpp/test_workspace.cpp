@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "snakehead/kinematics.hpp"
@@ -185,7 +186,7 @@ TEST(Sweep, VoxelBeyondReachHasIndexZeroWithoutIK) {
   const VoxelEvaluation e = evaluate_voxels(m, o, c, {0, 1}, nullptr, half_space(&calls));
   EXPECT_EQ(e.solved, (std::vector<std::int32_t>{0, 0}));
   EXPECT_EQ(calls.load(), 0);
-  EXPECT_EQ(e.cheap_exits, 2 * o.poses_per_voxel());
+  EXPECT_EQ(e.cheap_exits, 2 * o.directions * o.rolls);  // every frame of both voxels
   // And with TRAC-IK.
   const VoxelEvaluation t = evaluate_voxels(m, o, c, {0, 1});
   EXPECT_EQ(t.solved, (std::vector<std::int32_t>{0, 0}));
@@ -198,22 +199,34 @@ TEST(Sweep, PlumbingAgainstAKnownSolver) {
   const ChainModel& m = head7();
   WorkspaceOptions o = coarse();
   o.directions = 9;
+  o.any_roll = false;  // every (direction, roll) frame counts
   std::atomic<long> calls{0};
   const ReachabilityMap map = compute_reachability(m, o, nullptr, half_space(&calls));
+  EXPECT_EQ(map.tried, 18);
   ASSERT_GT(map.voxel_ids.size(), 10u);
   const auto dirs = fibonacci_directions(o.directions);
   const ReachBound bound(m, o);
+  // Calls: one per pose the bounds let through, plus a second chance for each failed pose whose
+  // neighbour in +z (the next voxel of its run) solved the same pose.
+  auto pose_ok = [&](std::int64_t k, const Eigen::Vector3d& d, int r, bool& possible) {
+    const Eigen::Vector3d p = map.grid.centre_of(k) + 0.5 * o.voxel_size * d;
+    possible = bound.possible(approach_frame(p, d, 2 * M_PI * r / o.rolls, o.approach));
+    return possible && p.z() >= 0;
+  };
+  const std::set<std::int64_t> ids(map.voxel_ids.begin(), map.voxel_ids.end());
   long expected_calls = 0;
   for (std::size_t v = 0; v < map.voxel_ids.size(); ++v) {
-    const Eigen::Vector3d c = map.grid.centre_of(map.voxel_ids[v]);
-    EXPECT_LT((c - map.centres.row(v).transpose()).norm(), 1e-15);
+    const std::int64_t k = map.voxel_ids[v];
+    EXPECT_LT((map.grid.centre_of(k) - map.centres.row(v).transpose()).norm(), 1e-15);
+    const bool has_next = (k + 1) % map.grid.n != 0 && ids.count(k + 1);
     int expected = 0;
     for (const auto& d : dirs)
       for (int r = 0; r < o.rolls; ++r) {
-        const Eigen::Vector3d p = c + 0.5 * o.voxel_size * d;
-        if (!bound.possible(approach_frame(p, d, 2 * M_PI * r / o.rolls, o.approach))) continue;
-        ++expected_calls;
-        expected += p.z() >= 0;
+        bool possible = false, next_possible = false;
+        const bool ok = pose_ok(k, d, r, possible);
+        expected += ok;
+        expected_calls += possible;
+        if (possible && !ok && has_next && pose_ok(k + 1, d, r, next_possible)) ++expected_calls;
       }
     EXPECT_EQ(map.solved[v], expected);
   }
@@ -222,6 +235,31 @@ TEST(Sweep, PlumbingAgainstAKnownSolver) {
   const Eigen::VectorXd d = map.indices();
   EXPECT_GE(d.minCoeff(), 0.0);
   EXPECT_LE(d.maxCoeff(), 100.0);
+}
+
+TEST(Sweep, AnyRollCountsDirections) {
+  // The paper's rule: a direction is reached when one of its rolls is. With the half-space stand-in,
+  // a direction is reached when its point has z >= 0 and the bounds let one of its rolls through.
+  const ChainModel& m = head7();
+  WorkspaceOptions o = coarse();
+  o.directions = 9;
+  o.rolls = 3;
+  std::atomic<long> calls{0};
+  const ReachabilityMap map = compute_reachability(m, o, nullptr, half_space(&calls));
+  EXPECT_EQ(map.tried, 9);
+  const auto dirs = fibonacci_directions(o.directions);
+  const ReachBound bound(m, o);
+  for (std::size_t v = 0; v < map.voxel_ids.size(); ++v) {
+    const Eigen::Vector3d c = map.grid.centre_of(map.voxel_ids[v]);
+    int expected = 0;
+    for (const auto& d : dirs) {
+      const Eigen::Vector3d p = c + 0.5 * o.voxel_size * d;
+      bool any = false;
+      for (int r = 0; r < o.rolls; ++r) any |= bound.possible(approach_frame(p, d, 2 * M_PI * r / o.rolls, o.approach));
+      expected += any && p.z() >= 0;
+    }
+    EXPECT_EQ(map.solved[v], expected);
+  }
 }
 
 TEST(Sweep, IndicesWithinRangeAndIdenticalForAnyThreadCount) {
