@@ -422,17 +422,30 @@ void sqp_loop(Search& s, const Eigen::VectorXd& start) {
   }
 }
 
-// Both solvers in one thread, alternating one local search each: the seeded and the batch schedule.
-void interleaved_loop(Search& nr, Search& sq) {
-  SqpSolver sqp(sq);
+// Both solvers in one thread: the seeded and the batch schedule. As in a raced call, KDL-RR first runs alone
+// for kInlineFraction of the budget (evaluations when seeded, else the clock); then the two share the thread
+// as two threads would share the machine: whichever has made fewer kinematics evaluations runs its next
+// local search (SQP first, from q_init). Every decision depends on counts only, so a seeded run repeats.
+void interleaved_loop(Search& nr, Search& sq, Clock::time_point inline_end) {
+  const long inline_evals = static_cast<long>(kInlineFraction * static_cast<double>(nr.c.max_evals));
+  auto inline_phase = [&] { return nr.c.budgeted ? nr.evals < inline_evals : Clock::now() < inline_end; };
   Eigen::VectorXd qn = nr.p.q_init, qs = nr.p.q_init;
-  for (;;) {
-    newton_descent(nr, qn);
-    if (nr.should_stop()) return;
-    sqp.descent(qs);
-    if (sq.should_stop()) return;
+  newton_descent(nr, qn);
+  while (!nr.should_stop() && inline_phase()) {
     nr.random_configuration(qn);
-    sq.random_configuration(qs);
+    newton_descent(nr, qn);
+  }
+  if (nr.should_stop()) return;
+  SqpSolver sqp(sq);
+  for (;;) {
+    if (sq.evals <= nr.evals) {
+      sqp.descent(qs);
+      sq.random_configuration(qs);
+    } else {
+      nr.random_configuration(qn);
+      newton_descent(nr, qn);
+    }
+    if (nr.should_stop()) return;
   }
 }
 
@@ -543,13 +556,15 @@ struct TracIK::Impl {
       rng_sq.seed(thread_rng()());
     }
     Search nr(p, c, rng_nr), sq(p, c, rng_sq);
+    const auto inline_end =
+        t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kInlineFraction * o.timeout));
 
     if (algorithm == IKAlgorithm::KdlRR) {
       kdl_rr_loop(nr, q_init);
     } else if (algorithm == IKAlgorithm::Sqp) {
       sqp_loop(sq, q_init);
     } else if (schedule == Schedule::Interleaved) {
-      interleaved_loop(nr, sq);
+      interleaved_loop(nr, sq, inline_end);
     } else {
       // Race. For Speed, KDL-RR first runs alone in this thread for a short while (kInlineFraction of the
       // timeout): its descent from q_init solves most targets in tens of microseconds, less than it takes
@@ -557,8 +572,6 @@ struct TracIK::Impl {
       Eigen::VectorXd q = q_init;
       const bool speed = o.solve_type == SolveType::Speed;
       if (speed) {
-        const auto inline_end = t0 + std::chrono::duration_cast<Clock::duration>(
-                                         std::chrono::duration<double>(kInlineFraction * o.timeout));
         newton_descent(nr, q);
         while (!nr.should_stop() && Clock::now() < inline_end) {
           nr.random_configuration(q);
@@ -681,7 +694,9 @@ void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allo
       failed.store(true);
     }
   };
-  std::vector<WorkerPool::Job> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size(), T)));
+  // The calling thread works too, so one thread fewer from the pool: more threads than cores would let the
+  // scheduler park a thread, mid-target, for longer than a timeout.
+  std::vector<WorkerPool::Job> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size() - 1, T)));
   for (auto& j : jobs) {
     j.fn = work;
     impl_->pool.submit(j);

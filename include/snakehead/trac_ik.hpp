@@ -18,11 +18,12 @@
 //
 // Determinism. Without a seed, restarts draw from a per-thread random generator and the race is decided
 // by timing. With a seed, the call is a pure function of (model, target, q_init, options): both solvers
-// run interleaved in the calling thread (one KDL-RR attempt, then one SQP attempt, ...) from random
-// generators derived from the seed alone (no call counter), and the search is bounded by a budget of
-// kinematics evaluations derived from the timeout (kEvaluationsPerSecond) instead of the clock. A hard
-// wall-clock guard of max(10 x timeout, timeout + 50 ms) still applies so that no call can hang; it can
-// only cut a seeded search on a machine far slower than the nominal rate.
+// run interleaved in the calling thread (KDL-RR alone first, as in a raced call; then whichever solver has
+// made fewer kinematics evaluations runs its next local search) from random generators derived from the
+// seed alone (no call counter), and the search is bounded by a budget of kinematics evaluations derived
+// from the timeout (kEvaluationsPerSecond in trac_ik.cpp) instead of the clock. A hard wall-clock guard of
+// max(10 x timeout, timeout + 50 ms) still applies so that no call can hang; it can only cut a seeded search
+// on a machine (or a sanitizer build) ten times slower than the nominal rate, and then results may differ.
 #pragma once
 
 #include "snakehead/model.hpp"
@@ -93,9 +94,9 @@ class TracIK {
   IKResult solve_ex(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
                     const TracIKOptions& options, IKAlgorithm algorithm = IKAlgorithm::TracIK) const;
 
-  // Solve many targets across all cores (the pool's workers and the calling thread). q_inits is n x T
-  // (one column per target). Each target gets the full timeout; its two solvers run interleaved in one
-  // thread. With a seed, target k uses a generator derived from (seed, k), so results do not depend on
+  // Solve many targets across all cores (the calling thread and pool workers, one thread per core). q_inits
+  // is n x T (one column per target). Each target gets the full timeout; its two solvers run interleaved in
+  // one thread (the seeded schedule above, on the clock when unseeded). With a seed, target k uses a generator derived from (seed, k), so results do not depend on
   // which thread solved it. q_out is resized to n x T; ok to T.
   void solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& targets,
                   const Eigen::Ref<const Eigen::MatrixXd>& q_inits, Eigen::MatrixXd& q_out,
