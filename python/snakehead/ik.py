@@ -154,13 +154,19 @@ class TracIK:
         return q
 
     def random_configuration(self) -> np.ndarray:
-        """Uniform within the limits ([-pi, pi] for continuous joints); reproducible when seeded."""
+        """Uniform within the limits ([-pi, pi] for continuous joints), from the solver's own generator."""
         return self._chain.random_configuration(self._rng)
+
+    def _start_generator(self) -> np.random.Generator:
+        # Starts drawn when q_init is omitted: with a seed, a fresh generator from the seed alone, so that
+        # identical calls get identical starts (and results); without one, the solver's running generator.
+        return self._rng if self.seed is None else np.random.default_rng(self.seed)
 
     def ik(self, pose, q_init=None, bounds=None) -> np.ndarray | None:
         """Joint angles putting the tip at ``pose`` (4x4, base frame), or None if none was found in time.
 
-        ``q_init``: the start (and the reference of ``Distance``); random within the limits when omitted.
+        ``q_init``: the start (and the reference of ``Distance``); random within the limits when omitted (with a
+        seed, the same start on every call, so identical calls return identical results).
         ``bounds``: per-axis tolerances (vx vy vz wx wy wz, target frame) for this call.
         """
         found, q, _ = self.ik_ex(pose, q_init, bounds)
@@ -170,7 +176,7 @@ class TracIK:
         """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
         and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
         T = _pose(pose)
-        q = self.random_configuration() if q_init is None else self._q_init(q_init)
+        q = self._chain.random_configuration(self._start_generator()) if q_init is None else self._q_init(q_init)
         b = None if bounds is None else _bounds(bounds)
         t = None if timeout is None else positive(timeout, "timeout")
         if algorithm not in ("TRAC-IK", "KDL-RR", "SQP"):
@@ -187,7 +193,9 @@ class TracIK:
         for k in range(P.shape[0]):
             _pose(P[k], f"poses[{k}]")
         if q_inits is None:
-            Q = np.array([self.random_configuration() for _ in range(P.shape[0])]).reshape(P.shape[0], self.n_joints)
+            rng = self._start_generator()
+            Q = np.array([self._chain.random_configuration(rng) for _ in range(P.shape[0])]).reshape(
+                P.shape[0], self.n_joints)
         else:
             Q = finite_array(q_inits, "q_inits", (P.shape[0], self.n_joints))
             for k in range(Q.shape[0]):
