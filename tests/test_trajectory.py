@@ -500,3 +500,51 @@ def test_figures_are_written(tmp_path):
     for p in paths:
         assert p.stat().st_size > 20_000
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# ------------------------------------------------------------------------------------------------
+# the monotone multi-segment quintic
+# ------------------------------------------------------------------------------------------------
+def test_monotone_quintic_passes_waypoints_without_overshoot():
+    from snakehead.trajectory import MonotoneQuintic
+
+    rng = np.random.default_rng(11)
+    times = np.cumsum(rng.uniform(0.2, 2.0, 12))
+    way = rng.uniform(-1.5, 1.5, (12, 4))
+    way[3:6, 1] = 1.5707963  # a run of waypoints on a limit: the C4 spline overshoots there
+    f = MonotoneQuintic(times, way)
+    np.testing.assert_allclose(f(times), way, atol=1e-12)
+    t = np.linspace(times[0], times[-1], 20001)
+    q = f(t)
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    lo = np.minimum(way[k], way[k + 1])
+    hi = np.maximum(way[k], way[k + 1])
+    assert np.all(q >= lo - 1e-12) and np.all(q <= hi + 1e-12)
+    assert q[:, 1].max() <= 1.5707963 + 1e-12
+
+
+def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
+    from snakehead.trajectory import MonotoneQuintic
+
+    rng = np.random.default_rng(12)
+    times = np.cumsum(rng.uniform(0.5, 1.5, 8))
+    way = rng.normal(size=(8, 3))
+    f = MonotoneQuintic(times, way)
+    h = 1e-6
+    for nu in (1, 2):
+        # across every interior knot, the left and right limits agree (C2)
+        np.testing.assert_allclose(f(times[1:-1] - 1e-9, nu), f(times[1:-1] + 1e-9, nu), atol=1e-5)
+    t = np.linspace(times[0] + 0.01, times[-1] - 0.01, 50)
+    np.testing.assert_allclose(f(t, 1), (f(t + h) - f(t - h)) / (2 * h), atol=1e-6)
+    np.testing.assert_allclose(f(t, 2), (f(t + h, 1) - f(t - h, 1)) / (2 * h), atol=1e-5)
+    np.testing.assert_allclose(f(times[[0, -1]], 1), 0.0, atol=1e-12)  # at rest at both ends
+    np.testing.assert_allclose(f(times[[0, -1]], 2), 0.0, atol=1e-12)
+
+
+def test_joint_trajectory_monotone_method_and_bad_method():
+    times = np.array([0.0, 1.0, 2.0])
+    way = np.array([[0.0], [1.0], [1.0]])
+    traj = tr.joint_trajectory(times, way, method="monotone")
+    assert traj.q.max() <= 1.0 + 1e-12
+    with pytest.raises(ValueError, match="method"):
+        tr.joint_trajectory(times, way, method="cubic")

@@ -88,6 +88,15 @@ def _finish(ik: TracIK, q, target, tried, solved, t0, candidates) -> HeadIKResul
     return HeadIKResult(q, T, pe, de, _roll_between(T, target), tried, solved, time.perf_counter() - t0, candidates)
 
 
+def rotated_result(ik: TracIK, target, q, previous: HeadIKResult, candidates) -> HeadIKResult:
+    """A result like ``previous`` but keeping ``q`` (None: nothing kept) among ``candidates``."""
+    res = _finish(ik, q, np.asarray(target, float), previous.tried, len(candidates), 0.0, candidates)
+    res.seconds = previous.seconds
+    if q is None:
+        res.solved = previous.solved  # solutions were found, none kept
+    return res
+
+
 def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=None) -> HeadIKResult:
     """The paper's method: solve ``n_frames`` frames rolled evenly about the target's x-axis, keep one.
 
@@ -109,15 +118,18 @@ def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=N
     # All rolled frames at once: the batch call spreads them over every core.
     qs, ok = ik.ik_many(np.stack([roll_about_x(target, a) for a in angles]), np.tile(seed_q, (len(angles), 1)))
     candidates = [(float(a), q) for a, q, good in zip(angles, qs, ok) if good]
-    best, best_score = None, np.inf
-    for angle, q in candidates:
-        if q_prev is not None:
-            score = float(np.linalg.norm(q - q_prev))
-        else:
-            score = abs(np.arctan2(np.sin(angle), np.cos(angle)))
-        if score < best_score:
-            best, best_score = q, score
+    best = select(candidates, q_prev)
     return _finish(ik, best, target, int(n_frames), len(candidates), t0, candidates)
+
+
+def select(candidates, q_prev=None):
+    """The kept solution among (roll angle, q) candidates: closest to ``q_prev`` in joint space when given,
+    else the least rolled from the desired frame. None when there is no candidate."""
+    if not candidates:
+        return None
+    if q_prev is not None:
+        return min(candidates, key=lambda c: float(np.linalg.norm(c[1] - q_prev)))[1]
+    return min(candidates, key=lambda c: abs(np.arctan2(np.sin(c[0]), np.cos(c[0]))))[1]
 
 
 def free_roll(ik: TracIK, target, q_init=None, attempts: int = 1) -> HeadIKResult:

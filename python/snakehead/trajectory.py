@@ -73,6 +73,47 @@ def joint_spline(times, waypoints) -> BSpline:
     return make_interp_spline(times, waypoints, k=5, bc_type=(ends, ends), axis=0)
 
 
+class MonotoneQuintic:
+    """Piecewise quintic Hermite interpolation that does not overshoot: times (K,) s, waypoints (K, n).
+
+    Each segment is the quintic with the waypoints' positions, zero accelerations and velocities chosen like
+    PCHIP's (Fritsch-Carlson): zero where the neighbouring slopes differ in sign or at either end, else their
+    harmonic mean. Position, velocity and acceleration are continuous (the acceleration is zero at every
+    waypoint), and a joint never leaves the range of the two waypoints around it: safe for waypoints that
+    sit on a joint limit, where the C4 spline of :func:`joint_spline` can overshoot. Call as ``f(t, nu)``.
+    """
+
+    def __init__(self, times, waypoints):
+        self.times, self.q = _check_waypoints(times, waypoints)
+        h = np.diff(self.times)[:, None]
+        d = np.diff(self.q, axis=0) / h  # secant slopes (K-1, n)
+        v = np.zeros_like(self.q)
+        a, b = d[:-1], d[1:]
+        same = a * b > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            hm = np.where(same, 2 * a * b / (a + b), 0.0)
+        v[1:-1] = hm
+        self.v = v
+
+    def __call__(self, t, nu: int = 0) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, float))
+        k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
+        h = (self.times[k + 1] - self.times[k])[:, None]
+        s = ((t - self.times[k])[:, None]) / h
+        p0, p1, v0, v1 = self.q[k], self.q[k + 1], self.v[k], self.v[k + 1]
+        s2, s3, s4, s5 = s * s, s**3, s**4, s**5
+        if nu == 0:
+            return ((1 - 10 * s3 + 15 * s4 - 6 * s5) * p0 + h * (s - 6 * s3 + 8 * s4 - 3 * s5) * v0
+                    + (10 * s3 - 15 * s4 + 6 * s5) * p1 + h * (-4 * s3 + 7 * s4 - 3 * s5) * v1)
+        if nu == 1:
+            return ((-30 * s2 + 60 * s3 - 30 * s4) * (p0 - p1) / h + (1 - 18 * s2 + 32 * s3 - 15 * s4) * v0
+                    + (-12 * s2 + 28 * s3 - 15 * s4) * v1)
+        if nu == 2:
+            return ((-60 * s + 180 * s2 - 120 * s3) * (p0 - p1) / h**2 + (-36 * s + 96 * s2 - 60 * s3) * v0 / h
+                    + (-24 * s + 84 * s2 - 60 * s3) * v1 / h)
+        raise ValueError("nu must be 0, 1 or 2")
+
+
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:
     """t0, t0 + dt, ... up to t1, with t1 itself as the last sample: (T,) s."""
     dt = positive(dt, "dt")
@@ -84,18 +125,25 @@ def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray
     return t
 
 
-def joint_trajectory(times, waypoints, dt: float = CONTROL_PERIOD, *, lower=None, upper=None
-                     ) -> JointTrajectory:
+def joint_trajectory(times, waypoints, dt: float = CONTROL_PERIOD, *, lower=None, upper=None,
+                     method: str = "spline") -> JointTrajectory:
     """Multi-segment joint-space interpolation through waypoints, sampled every ``dt`` s.
 
     times (K,) strictly increasing (s); waypoints (K, n) joint vectors (rad), the first at rest and the last at
-    rest. See :func:`joint_spline` for the interpolant. The samples are t0, t0 + dt, ... and the last time;
+    rest. ``method``: "spline", the C4 quintic spline of :func:`joint_spline`, or "monotone", the piecewise
+    quintic of :class:`MonotoneQuintic` that never overshoots the waypoints (use it for dense waypoints or
+    waypoints on joint limits). The samples are t0, t0 + dt, ... and the last time;
     the first and last samples equal the first and last waypoints exactly. With ``lower``/``upper`` ((n,), rad)
     a trajectory that overshoots the joint limits raises ValueError.
     """
     dt = positive(dt, "dt")
     times, waypoints = _check_waypoints(times, waypoints)
-    spline = joint_spline(times, waypoints)
+    if method == "spline":
+        spline = joint_spline(times, waypoints)
+    elif method == "monotone":
+        spline = MonotoneQuintic(times, waypoints)
+    else:
+        raise ValueError(f"method must be 'spline' or 'monotone', got {method!r}")
     t = sample_times(times[0], times[-1], dt)
     q, qd, qdd = spline(t), spline(t, 1), spline(t, 2)
     q[0], q[-1] = waypoints[0], waypoints[-1]

@@ -1,0 +1,297 @@
+"""The paper's Section 4, end to end: catching two virtual spheres, and getting the head through a hole in a wall.
+
+Each scenario strings the control process of Section 3.3 together: from the initial state of Section 3.3 (1)
+(the base on its optimised arc, the neck and head on the Bezier backbone, ``backbone.initial_configuration``),
+the head targets are solved by ``HeadController`` and joined by whole-body moves (Section 3.2: the Cartesian
+interpolation of Eqs. 41-44 where it is valid, else joint space; see ``_Plan.move``), sampled at the 2 ms
+control period by the multi-segment interpolation; the result is checked for the ZMP inside the support
+polygon, ground clearance and (for the hole) collision with the wall.
+
+Not planned here: the paper's first phases, from the robot lying on the ground to the initial state. On the
+default robot the neck and head (1.7 kg) outweigh the base (1.5 kg): lifting them as a cantilever from the
+end of the base tips the body over whatever the interpolation, so that lift needs the head to stay on the
+ground until its mass is over the base (a support the paper's model leaves out); the scenarios start from
+the initial state.
+
+Choices the paper leaves open, and ours:
+- The spheres are caught with the head pointing along +y, the scene's forward direction (as for the hole);
+  sphere 1 is released by backing the head off 6 cm along that direction.
+- The wall stands on the ground, 0.7 m wide, 0.58 m high, 0.01 m thick, facing +y, with the hole's centre
+  (0.2, 0.5, 0.4) on its vertical centre line; the head approaches along +y, the hole's axis.
+- The head link is "through" when the head tip is 0.033 m beyond the wall's far face (link_16 is 0.046 m
+  long: its proximal joint stays 2 mm in front of the wall, so no other link enters the hole).
+- Segment durations grow with the largest joint change (``speed``), with a floor; each target is held.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import stability
+from . import trajectory as tr
+from ._validate import positive, unit_vector3, vector3
+from .controller import HeadController, HeadSolution
+from .robot import BasePlacement, SnakeRobot
+
+SPHERE_1 = np.array([-4.05e-2, 0.5443, 0.3])  # m, Section 4.1
+SPHERE_2 = np.array([0.1505, 0.5076, 0.3954])
+SPHERE_DIAMETER = 0.04
+SPHERE_DIRECTION = np.array([0.0, 1.0, 0.0])  # our choice: the scene's forward direction, as for the hole
+RELEASE_DISTANCE = 0.06  # m the head backs off along its direction to release sphere 1
+HOLE_CENTRE = np.array([0.2, 0.5, 0.4])  # m, Section 4.2
+HOLE_DIAMETER = 0.07
+WALL_SIZE = np.array([0.7, 0.58, 0.01])  # width, height, thickness (m)
+HOLE_AXIS = np.array([0.0, 1.0, 0.0])
+WALL_CLEARANCE = 0.002  # m: the least distance a solved configuration keeps from the wall
+
+
+@dataclass
+class TargetResult:
+    """One head target of a scenario and how well the plan reaches it."""
+
+    name: str
+    position: np.ndarray  # (3,) m
+    direction: np.ndarray  # (3,) unit
+    time: float  # s: when the plan arrives
+    solution: HeadSolution
+
+    @property
+    def position_error_m(self) -> float:
+        return self.solution.position_error
+
+    @property
+    def direction_error_deg(self) -> float:
+        return self.solution.direction_error
+
+
+@dataclass
+class ScenarioResult:
+    """A planned scenario: the 2 ms joint trajectory, its states and targets, and its checks."""
+
+    name: str
+    base: BasePlacement
+    t: np.ndarray  # (T,) s
+    q: np.ndarray  # (T, 16) rad
+    qd: np.ndarray  # (T, 16) rad/s
+    states: list  # (label, time s, q (16,)) of every waypoint
+    targets: list  # TargetResult
+    stability: stability.DynamicStability
+    ground_clearance: np.ndarray  # (T,) m: lowest neck/head box corner above the ground
+    obstacles: list = field(default_factory=list)
+    obstacle_distance: np.ndarray | None = None  # (T,) m, None without obstacles
+    planning_time_s: float = 0.0
+    notes: list = field(default_factory=list)
+    segments: list = field(default_factory=list)  # (segment, interpolation used)
+
+    @property
+    def min_zmp_margin_m(self) -> float:
+        return float(self.stability.min_margin)
+
+    @property
+    def min_ground_clearance_m(self) -> float:
+        return float(self.ground_clearance.min())
+
+    @property
+    def touches_obstacle(self) -> bool:
+        return self.obstacle_distance is not None and bool((self.obstacle_distance <= 0).any())
+
+    @property
+    def success(self) -> bool:
+        return (all(tg.solution.success for tg in self.targets) and self.stability.stable
+                and self.min_ground_clearance_m > -tr.GROUND_TOLERANCE and not self.touches_obstacle)
+
+
+class _Plan:
+    """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
+
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float):
+        self.robot, self.base = robot, base
+        self.speed, self.min_segment = speed, min_segment
+        self.labels: list[str] = []
+        self.qs: list[np.ndarray] = []
+        self.times: list[float] = []
+        self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
+
+    def start(self, label: str, q):
+        self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
+
+    def move_joint(self, label: str, q, duration: float | None = None):
+        q = np.asarray(q, float)
+        step = np.abs(q - self.qs[-1]).max()
+        self.qs.append(q)
+        self.labels.append(label)
+        self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
+
+    def move(self, label: str, q, n: int = 12) -> str:
+        """A whole-body move from the last state to q (Section 3.2); returns the method used.
+
+        The Cartesian interpolation of Eqs. 41-44 (n configurations) is used when its configurations stay
+        within the joint limits without clipping, above the ground and statically stable; otherwise (the
+        interpolated joint points are closer than the links are long, so the links cannot follow them, and
+        clipped angles jump between limits) the move is a joint-space one, which is checked the same way.
+        """
+        q = np.asarray(q, float)
+        path = tr.cartesian_interpolation(self.robot, self.qs[-1], q, n, self.base, aim="points", full_output=True)
+        if not path.clipped.any() and self._acceptable(path.q):
+            qs, method = path.q, "cartesian (Eqs. 41-44)"
+        else:
+            qs, method = self.qs[-1] + np.linspace(0.0, 1.0, n)[:, None] * (q - self.qs[-1]), "joint space"
+        steps = np.abs(np.diff(qs, axis=0)).max(axis=1) / self.speed
+        floor = self.min_segment / (n - 1)
+        for k in range(1, n):
+            self.qs.append(qs[k])
+            self.labels.append(label if k == n - 1 else f"{label} ({k}/{n - 1})")
+            self.times.append(self.times[-1] + max(floor, steps[k - 1]))
+        self.methods.append((label, method))
+        return method
+
+    def _acceptable(self, qs: np.ndarray) -> bool:
+        clearance = tr.ground_clearance(self.robot, qs, self.base)[:, tr.non_base_links(self.robot)]
+        if clearance.min() < -tr.GROUND_TOLERANCE:
+            return False
+        return all(stability.static_margin(self.robot, q, self.base, contact="ground") > 0 for q in qs)
+
+    def hold(self, seconds: float):
+        self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
+
+    def sample(self, notes: list) -> tr.JointTrajectory:
+        """The multi-segment interpolation through the waypoints at 2 ms (``trajectory.MonotoneQuintic``:
+        dense Cartesian waypoints often sit on joint limits, and it never overshoots them)."""
+        traj = tr.joint_trajectory(np.array(self.times), np.array(self.qs), method="monotone")
+        lo, hi = self.robot.lower, self.robot.upper
+        over = float(max((lo - traj.q).max(), (traj.q - hi).max(), 0.0))
+        if over > 1e-9:
+            notes.append(f"the spline overshot a joint limit by up to {np.degrees(over):.3f} deg; clipped")
+            np.clip(traj.q, lo, hi, out=traj.q)
+        return traj
+
+
+def _finish(name, plan: _Plan, targets, t_start, obstacles=(), notes=()) -> ScenarioResult:
+    robot, base = plan.robot, plan.base
+    notes = list(notes)
+    traj = plan.sample(notes)
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
+    clearance = tr.ground_clearance(robot, traj.q, base)[:, tr.non_base_links(robot)].min(axis=1)
+    distance = None
+    if obstacles:
+        distance = tr.collision_check(robot, traj.q, list(obstacles), base).distance
+    states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
+    return ScenarioResult(name=name, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
+                          stability=dyn, ground_clearance=clearance, obstacles=list(obstacles),
+                          obstacle_distance=distance, planning_time_s=time.perf_counter() - t_start,
+                          notes=notes, segments=list(plan.methods))
+
+
+def _target(controller: HeadController, name, position, direction, q_prev, base, plan: _Plan,
+            targets: list, notes: list, cartesian: bool = True, accept=None) -> np.ndarray:
+    sol = controller.solve(position, direction, q_prev=q_prev, base=base, accept=accept)
+    if sol.base_moved:
+        notes.append(f"{name}: the base would have to move to {sol.base}; kept at {base}")
+    if not sol.success:
+        notes.append(f"{name}: {sol.message}")
+    if cartesian:
+        plan.move(name, sol.q)
+    else:
+        plan.move_joint(name, sol.q)
+    targets.append(TargetResult(name, np.asarray(position, float), unit_vector3(direction, "direction"),
+                                plan.times[-1], sol))
+    return sol.q
+
+
+def choose_base(controller: HeadController, targets) -> tuple[BasePlacement, list[str]]:
+    """One base placement for a whole scenario: the controller's when every target (position, direction) is
+    solved from it with the body statically stable; otherwise the first of the planar moves that bring a
+    target (or their mean) in the accepted range from which all are. Returns the placement and notes."""
+    from . import neck as nk
+
+    robot = controller.robot
+    q = controller.q_initial
+    P0 = robot.frame(q, robot.parts.base_end, controller.base)
+    P0_local = np.linalg.inv(controller.base.matrix()) @ P0
+    positions = [np.asarray(p, float) for p, _ in targets]
+    candidates = [controller.base]
+    for p in [np.mean(positions, axis=0)] + positions:
+        moved = nk.base_move_into_range(p, P0_local, controller.base, controller.Lc, controller.neck_length,
+                                        controller.slack)
+        if moved is not None:
+            candidates.append(moved)
+    for k, base in enumerate(candidates):
+        sols = [controller.solve(p, d, base=base) for p, d in targets]
+        if all(s.success and s.static_stable and not s.base_moved for s in sols):
+            note = [] if k == 0 else [f"the base was moved to {base} (rolling / turning in place) to bring the "
+                                      "targets in range"]
+            return base, note
+    return controller.base, ["no single base placement reaches every target stably; kept the controller's"]
+
+
+def catch_spheres(controller: HeadController | None = None, *, speed: float = 0.12, min_segment: float = 2.0,
+                  hold: float = 2.0) -> ScenarioResult:
+    """Section 4.1: from the current state to the initial state, catch sphere 1, release it, catch sphere 2.
+
+    ``speed`` (rad/s) is the largest joint rate a segment is planned for; ``min_segment`` (s) the shortest
+    segment; ``hold`` (s) how long each sphere is held.
+    """
+    t_start = time.perf_counter()
+    controller = controller if controller is not None else HeadController()
+    speed, min_segment, hold = positive(speed, "speed"), positive(min_segment, "min_segment"), positive(hold, "hold")
+    robot = controller.robot
+    base, notes = choose_base(controller, [(SPHERE_1, SPHERE_DIRECTION), (SPHERE_2, SPHERE_DIRECTION)])
+    plan = _Plan(robot, base, speed, min_segment)
+    plan.start("initial state (head lifted)", controller.q_initial)
+    targets: list[TargetResult] = []
+
+    q = _target(controller, "sphere 1", SPHERE_1, SPHERE_DIRECTION, controller.q_initial, base, plan, targets, notes)
+    plan.hold(hold)
+    release = SPHERE_1 - RELEASE_DISTANCE * SPHERE_DIRECTION
+    q = _target(controller, "release sphere 1", release, SPHERE_DIRECTION, q, base, plan, [], notes)
+    q = _target(controller, "sphere 2", SPHERE_2, SPHERE_DIRECTION, q, base, plan, targets, notes)
+    plan.hold(hold)
+    return _finish("spheres", plan, targets, t_start, notes=notes)
+
+
+def hole_wall() -> tr.WallWithHole:
+    """The wall of Section 4.2 as placed here: standing on the ground, the hole on its vertical centre line."""
+    # The wall's centre is below the hole: its bottom on the ground (z = 0).
+    return tr.WallWithHole(centre=HOLE_CENTRE, normal=HOLE_AXIS, size=WALL_SIZE, hole_diameter=HOLE_DIAMETER,
+                           hole_offset=np.array([0.0, WALL_SIZE[1] / 2 - HOLE_CENTRE[2]]))
+
+
+def through_hole(controller: HeadController | None = None, *, speed: float = 0.12, min_segment: float = 2.0,
+                 approach: float = 0.12, step: float = 0.01) -> ScenarioResult:
+    """Section 4.2: lift the head, put it on the hole's axis ``approach`` m in front of the hole, then move it
+    along the axis in ``step`` m increments (each solved from the previous joints, keeping the smallest joint
+    change) until the head link is through the wall."""
+    t_start = time.perf_counter()
+    controller = controller if controller is not None else HeadController()
+    speed, min_segment = positive(speed, "speed"), positive(min_segment, "min_segment")
+    approach, step = positive(approach, "approach"), positive(step, "step")
+    robot = controller.robot
+    wall = hole_wall()
+    straight = robot.frames(np.zeros(robot.n_joints))
+    head_link = robot.body.model.joint_child_links[-1]  # the link the last joint moves: the head link
+    head_length = float(np.linalg.norm(straight[-1, :3, 3] - straight[head_link, :3, 3]))
+    through = HOLE_CENTRE[1] + WALL_SIZE[2] / 2 + head_length - 0.013  # head tip beyond the far face
+    start = HOLE_CENTRE - approach * HOLE_AXIS
+    base, notes = choose_base(controller, [(start, HOLE_AXIS), (HOLE_CENTRE, HOLE_AXIS)])
+    plan = _Plan(robot, base, speed, min_segment)
+    plan.start("initial state (head lifted)", controller.q_initial)
+    targets: list[TargetResult] = []
+    def clear_of_wall(q, b) -> bool:  # the solutions kept must leave every link clear of the wall
+        return bool(tr.collision_check(robot, q[None], [wall], b).distance[0] > WALL_CLEARANCE)
+
+    q = _target(controller, "in front of the hole", start, HOLE_AXIS, controller.q_initial, base, plan, targets,
+                notes, accept=clear_of_wall)
+    distances = np.arange(approach - step, HOLE_CENTRE[1] - through - 1e-9, -step)
+    distances = np.append(distances, HOLE_CENTRE[1] - through)
+    for k, d in enumerate(distances):
+        last = k == len(distances) - 1
+        name = "through the hole" if last else f"along the axis, {d * 100:+.0f} cm"
+        sink = targets if last or abs(d) < step / 2 else []
+        if abs(d) < step / 2:
+            name = "entering the hole"
+        q = _target(controller, name, HOLE_CENTRE - d * HOLE_AXIS, HOLE_AXIS, q, base, plan, sink, notes,
+                    cartesian=False, accept=clear_of_wall)
+    plan.hold(1.0)
+    return _finish("hole", plan, targets, t_start, obstacles=[wall], notes=notes)
