@@ -63,7 +63,7 @@ import numpy as np
 from scipy import integrate, optimize
 
 from ._validate import finite_array, positive
-from .robot import BODY_AXIS_HEIGHT, BasePlacement, SnakeRobot
+from .robot import BODY_AXIS_HEIGHT, BasePlacement, SnakeRobot, as_robot
 
 YAW = "yaw"
 PITCH = "pitch"
@@ -92,11 +92,6 @@ def _finite_float(x, name: str) -> float:
         raise ValueError(f"{name} must be finite, got {x!r}")
     return v
 
-
-def _check_robot(robot) -> SnakeRobot:
-    if not isinstance(robot, SnakeRobot):
-        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
-    return robot
 
 
 def _check_central_angle(theta) -> float:
@@ -396,7 +391,7 @@ def joint_layout(robot: SnakeRobot) -> JointLayout:
 
     Raises ValueError unless the body is straight along x at q = 0 and every axis is +-y or +-z.
     """
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     F = robot.body.fk_all(np.zeros(robot.n_joints))
     p = F[:, :3, 3]
     if np.abs(p[:, 1:]).max() > 1e-9 or np.any(np.diff(p[:, 0]) < -1e-12):
@@ -611,7 +606,7 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot | No
     turn = _check_turn(turn)
     if chords not in CHORD_MODES:
         raise ValueError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
-    robot = SnakeRobot.default() if robot is None else _check_robot(robot)
+    robot = SnakeRobot.default() if robot is None else as_robot(robot)
     joints = robot.parts.base if joints is None else joints
     lay = joint_layout(robot)
     idx = np.arange(robot.n_joints)[joints]
@@ -659,7 +654,7 @@ def exact_chord_radius(chords, central_angle: float) -> float:
 
 def base_length(robot: SnakeRobot | None = None) -> float:
     """Body arc length of P0 (the ``base_end`` frame) from the tail end (m): the base arc's length l."""
-    robot = SnakeRobot.default() if robot is None else _check_robot(robot)
+    robot = SnakeRobot.default() if robot is None else as_robot(robot)
     F = robot.body.fk_all(np.zeros(robot.n_joints))
     k = robot.body.link_index(robot.parts.base_end)
     return float(F[k, 0, 3] - F[0, 0, 3])
@@ -681,7 +676,7 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
     other joints lie within the discretisation error of the arc (about 1.4 cm at theta = 3 on the default
     robot, growing with theta).
     """
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     theta = _check_central_angle(central_angle)
     turn = _check_turn(turn)
     if anchor not in ("tail", "end"):
@@ -777,7 +772,7 @@ def arc_angle_limit(robot: SnakeRobot, *, turn: int = 1, chords: str = "arclengt
     root (scipy.optimize.brentq) of max_i q_i(theta) / limit_i = 1, capped where the chords stop fitting
     on minor arcs (:func:`exact_chord_radius`).
     """
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     turn = _check_turn(turn)
     if chords not in CHORD_MODES:
         raise ValueError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
@@ -866,7 +861,7 @@ def optimize_base_arc(robot: SnakeRobot | None = None, q_up=None, base: BasePlac
     * The margin constraint is inactive there (the margin grows with theta); asking 3 cm moves theta* to
       4.23 rad (242 deg, area 536.6 cm^2).
     """
-    robot = SnakeRobot.default() if robot is None else _check_robot(robot)
+    robot = SnakeRobot.default() if robot is None else as_robot(robot)
     turn = _check_turn(turn)
     min_margin = _finite_float(min_margin, "min_margin")
     if min_margin < 0:
@@ -1099,7 +1094,7 @@ def initial_backbone(robot: SnakeRobot | None = None, *, central_angle: float | 
     tangent, which is the Bezier's start tangent; the up curve is discretised by the general method
     (Eqs. 3-7) with the phase read from the robot's P0 frame. Raises ValueError if a joint leaves its limits.
     """
-    robot = SnakeRobot.default() if robot is None else _check_robot(robot)
+    robot = SnakeRobot.default() if robot is None else as_robot(robot)
     shape = UpCurveShape() if shape is None else shape
     base = BasePlacement() if base is None else base
     turn = _check_turn(turn)

@@ -21,7 +21,7 @@ import numpy as np
 from . import head as head_ik
 from . import neck as nk
 from . import stability
-from ._validate import finite_array, joint_vector, positive, unit_vector3, vector3
+from ._validate import joint_vector, positive, unit_vector3, vector3
 from .ik import TracIK
 from .robot import BasePlacement, SnakeRobot
 
@@ -77,7 +77,11 @@ class HeadController:
         if workspace_map is None:
             from . import workspace
 
-            workspace_map = workspace.load_default(self.robot)
+            workspace_map = workspace.default_map("head")
+        chain_hash = getattr(workspace_map, "chain_hash", None)
+        if chain_hash is not None and chain_hash != self.robot.head_chain.hash:
+            raise ValueError("the workspace map was made for another head chain (hash "
+                             f"{chain_hash} != {self.robot.head_chain.hash}); compute one for this robot's head")
         self.map = workspace_map
         self.G0_local = vector3(self.map.center(), "dexterous centre G0")
         self.Lc = nk.dexterous_distance(self.G0_local)

@@ -187,11 +187,23 @@ class SnakeRobot:
 
     @staticmethod
     def _world(base: BasePlacement | None) -> np.ndarray:
-        if base is None:
-            base = BasePlacement()
-        if not isinstance(base, BasePlacement):
-            raise TypeError(f"base must be a BasePlacement, got {type(base).__name__}")
-        return base.matrix()
+        return as_base(base).matrix()
 
     def __repr__(self) -> str:
         return f"SnakeRobot({self.urdf!r}, {self.n_joints} joints)"
+
+
+def as_robot(robot) -> SnakeRobot:
+    """``robot`` itself if it is a SnakeRobot, else TypeError (the check every planning function makes)."""
+    if not isinstance(robot, SnakeRobot):
+        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+    return robot
+
+
+def as_base(base) -> BasePlacement:
+    """``base`` if it is a BasePlacement, the default placement for None, else TypeError."""
+    if base is None:
+        return BasePlacement()
+    if not isinstance(base, BasePlacement):
+        raise TypeError(f"base must be a BasePlacement or None, got {type(base).__name__}")
+    return base

@@ -31,7 +31,7 @@ import numpy as np
 
 from . import stability
 from . import trajectory as tr
-from ._validate import positive, unit_vector3, vector3
+from ._validate import positive, unit_vector3
 from .controller import HeadController, HeadSolution
 from .robot import BasePlacement, SnakeRobot
 

@@ -53,7 +53,7 @@ from typing import Sequence
 import numpy as np
 
 from ._validate import finite_array, positive
-from .robot import BasePlacement, SnakeRobot
+from .robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
@@ -176,18 +176,6 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     return np.asarray(q, float)
 
 
-def _check_robot(robot) -> SnakeRobot:
-    if not isinstance(robot, SnakeRobot):
-        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
-    return robot
-
-
-def _check_base(base) -> BasePlacement:
-    if base is None:
-        return BasePlacement()
-    if not isinstance(base, BasePlacement):
-        raise TypeError(f"base must be a BasePlacement or None, got {type(base).__name__}")
-    return base
 
 
 def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
@@ -214,7 +202,7 @@ def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     ``obstacle_<k>``. Units SI; ``timestep`` s, ``friction`` the sliding coefficient, ``joint_damping``
     N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default the URDF effort).
     """
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     timestep = positive(timestep, "timestep")
     friction = positive(friction, "friction")
     if not (np.isfinite(joint_damping) and joint_damping >= 0):
@@ -311,7 +299,7 @@ class SimModel:
     def set_state(self, data, q, base: BasePlacement | None = None, lift: float = 0.0) -> None:
         """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
         mj = _mujoco()
-        T = _check_base(base).matrix()
+        T = as_base(base).matrix()
         data.qpos[:] = 0.0
         data.qvel[:] = 0.0
         data.qpos[0:3] = T[:3, 3] + (0.0, 0.0, lift)
@@ -331,7 +319,7 @@ class SimModel:
 def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
     """Compile :func:`build_mjcf` (same keyword arguments) into a :class:`SimModel`."""
     mj = _mujoco()
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     xml = build_mjcf(robot, **kwargs)
     model = mj.MjModel.from_xml_string(xml)
     names = robot.link_names
@@ -600,8 +588,8 @@ def simulate(robot: SnakeRobot, t, q, base: BasePlacement | None = None, kp=DEFA
     Returns a :class:`SimResult` sampled at every control tick from t[0] to t[-1] + hold.
     """
     mj = _mujoco()
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     t, q = check_trajectory(robot, t, q)
     n = robot.n_joints
     kp = _gains(kp, n, "kp", allow_zero=False)
@@ -752,10 +740,10 @@ def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=
     """
     from . import stability
 
-    robot = _check_robot(robot)
+    robot = as_robot(robot)
     if not isinstance(result, SimResult):
         raise TypeError(f"result must be a SimResult, got {type(result).__name__}")
-    base = result.base if base is None else _check_base(base)
+    base = result.base if base is None else as_base(base)
     planned_t, planned_q = check_trajectory(robot, planned_t, planned_q)
 
     pos_err, dir_err = [], []
@@ -809,7 +797,7 @@ def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t, planned_q, base
     """
     from . import stability
 
-    base = result.base if base is None else _check_base(base)
+    base = result.base if base is None else as_base(base)
     n = robot.n_joints
     bs = robot.parts.base
     out = np.full(len(result.t), np.nan)

@@ -21,7 +21,7 @@ from scipy.spatial import ConvexHull
 from scipy.spatial import QhullError
 
 from ._validate import finite_array, joint_vector
-from .robot import BasePlacement, SnakeRobot
+from .robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 #: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
 GRAVITY = 9.80665
@@ -37,18 +37,6 @@ CONTACT_MODELS = ("endpoints", "footprint", "ground")
 # ------------------------------------------------------------------------------------------------
 # helpers
 # ------------------------------------------------------------------------------------------------
-def _check_robot(robot) -> SnakeRobot:
-    if not isinstance(robot, SnakeRobot):
-        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
-    return robot
-
-
-def _check_base(base) -> BasePlacement:
-    if base is None:
-        return BasePlacement()
-    if not isinstance(base, BasePlacement):
-        raise TypeError(f"base must be a BasePlacement or None, got {type(base).__name__}")
-    return base
 
 
 def _joint_matrix(robot: SnakeRobot, q, name: str = "q") -> tuple[np.ndarray, bool]:
@@ -220,8 +208,8 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
 
     q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3).
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     qs, single = _joint_matrix(robot, q)
     frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
     m = robot.masses
@@ -280,8 +268,8 @@ def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     If the contact points are collinear the "polygon" is the segment between the extreme points (2, 2): it
     has no interior, so :func:`static_margin` is <= 0 for it.
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     q = joint_vector(q, robot.n_joints)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     frames = robot.frames_many(q[None, :], base)
@@ -299,8 +287,8 @@ def static_margin(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     Static stability (Section 3.1): the robot is statically stable if c is in C (Eq. 23, 24).
     Outside the polygon the value is minus the distance to the polygon.
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     q = joint_vector(q, robot.n_joints)
     poly = support_polygon(robot, q, base, contact=contact, tolerance=tolerance)
     c = center_of_mass(robot, q, base)
@@ -408,8 +396,8 @@ def momenta_from_velocities(robot: SnakeRobot, q, qd, base: BasePlacement | None
     q, qd: joint positions (rad) and velocities (rad/s), (T, 16) each (or (16,) each -> (3,), (3,)).
     The root link is fixed to the ground at ``base`` (it does not move).
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     qs, single = _joint_matrix(robot, q)
     qds, _ = _joint_matrix(robot, qd, "qd")
     if qds.shape != qs.shape:
@@ -425,8 +413,8 @@ def momenta(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None
     P in kg m/s; L in kg m^2/s about the world origin. The joint velocities are ``qd`` when given (e.g. a
     spline's exact derivative), otherwise :func:`joint_velocities` of the samples (np.gradient).
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     P, L, _ = _momenta(robot, q, qd, base)
@@ -464,8 +452,8 @@ def zmp(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None) -> 
     At rest the ZMP is the ground projection of the centre of mass. Samples where the ground would have to
     pull (M g + dP_z/dt <= 0: the body would take off) have no ZMP: NaN.
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     return _zmp(robot, t, q, base, qd)[0]
 
 
@@ -497,8 +485,8 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     distinct contact configuration along the trajectory (the base joints may move, e.g. into the initial arc;
     with ``contact="ground"`` the neck and head may lie down or lift off).
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
     # build the hull once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's

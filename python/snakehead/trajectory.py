@@ -19,8 +19,8 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from ._validate import finite_array, joint_vector, positive, rotation_matrix, unit_vector3, vector3
-from .robot import BasePlacement, SnakeRobot
-from .stability import _box_links, _check_base, _check_robot, _lowest_corner_z
+from .robot import BasePlacement, SnakeRobot, as_base, as_robot
+from .stability import _box_links, _lowest_corner_z
 
 #: The joint controller's period (s), Section 4.
 CONTROL_PERIOD = 0.002
@@ -271,8 +271,8 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlac
     Returns q (n, 16), or a :class:`CartesianInterpolation` with ``full_output=True`` (how far the
     recovered joints stray from the interpolated points, m).
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     nj = robot.n_joints
     q_start = joint_vector(q_start, nj, "q_start")
     q_end = joint_vector(q_end, nj, "q_end")
@@ -366,8 +366,8 @@ def ground_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -
     qs (T, 16) (or (16,) -> (1, n_links)). Negative values are below the ground. The base links lying flat are
     at 0 (touching); frames without a box (markers) get +inf.
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     qs = _trajectory(robot, qs)
     frames = robot.frames_many(qs, base)
     out = np.full(frames.shape[:2], np.inf)
@@ -672,8 +672,8 @@ def collision_check(robot: SnakeRobot, qs, obstacles, base: BasePlacement | None
       ``spacing`` m apart, to the wall's solid: an upper bound, too large by at most about spacing / sqrt(2).
       Colliding links get 0.
     """
-    robot = _check_robot(robot)
-    base = _check_base(base)
+    robot = as_robot(robot)
+    base = as_base(base)
     qs = _trajectory(robot, qs)
     if isinstance(obstacles, (BoxObstacle, WallWithHole)):
         obstacles = [obstacles]

@@ -1,0 +1,122 @@
+"""HeadController: the segmented head control of Section 3.3 on the default robot and its shipped map."""
+import numpy as np
+import pytest
+
+from snakehead import SnakeRobot, stability
+from snakehead import scenarios as sc
+from snakehead.controller import HeadController
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return SnakeRobot.default()
+
+
+@pytest.fixture(scope="module", params=["free_roll", "rotated"])
+def controller(request, robot):
+    return HeadController(robot, method=request.param, seed=2)
+
+
+def check_solution(robot, sol, position, direction):
+    """Independent checks: whole-body FK of the returned joints, the limits, the static verdict."""
+    T = robot.head_pose(sol.q, sol.base)
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    assert np.linalg.norm(T[:3, 3] - position) <= 1e-4  # 0.1 mm
+    assert np.degrees(np.arccos(np.clip(T[:3, 0] @ d, -1, 1))) <= 0.05
+    np.testing.assert_allclose(T, sol.head_frame, atol=1e-12)
+    assert np.all(sol.q >= robot.lower - 1e-12) and np.all(sol.q <= robot.upper + 1e-12)
+    margin = stability.static_margin(robot, sol.q, sol.base)
+    assert sol.static_margin == pytest.approx(margin, abs=1e-12)
+    assert sol.static_stable == (margin > 0)
+
+
+@pytest.mark.parametrize("position,direction", [
+    (sc.SPHERE_1, sc.SPHERE_DIRECTION), (sc.SPHERE_2, sc.SPHERE_DIRECTION), (sc.HOLE_CENTRE, sc.HOLE_AXIS),
+])
+def test_paper_targets(controller, robot, position, direction):
+    sol = controller.solve(position, direction)
+    assert sol.success, sol.message
+    check_solution(robot, sol, position, direction)
+    np.testing.assert_array_equal(sol.q[robot.parts.base], controller.q_initial[robot.parts.base])
+    assert set(sol.timings) >= {"neck", "head", "check", "total"}
+    # Eq. 20's geometry for the goal the neck was given
+    g = sol.neck_goal
+    assert np.linalg.norm(g.G0 - g.P_d) == pytest.approx(controller.Lc)
+    np.testing.assert_allclose(g.G0, position)
+
+
+def test_random_reachable_targets_are_verified_by_fk(robot):
+    controller = HeadController(robot, method="free_roll", seed=5)
+    rng = np.random.default_rng(3)
+    solved = 0
+    for _ in range(30):
+        q = controller.q_initial.copy()
+        sl = slice(robot.parts.neck.start, robot.parts.head.stop)
+        q[sl] = rng.uniform(robot.lower[sl], robot.upper[sl])
+        T = robot.head_pose(q)
+        sol = controller.solve(T[:3, 3], T[:3, 0])
+        if sol.success:
+            solved += 1
+            check_solution(robot, sol, T[:3, 3], T[:3, 0])
+        else:
+            assert sol.message
+    assert solved > 0
+
+
+def test_keeps_closest_to_previous_joints(robot):
+    controller = HeadController(robot, method="rotated", n_frames=12, seed=1)
+    first = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION)
+    moved = controller.solve(sc.SPHERE_2 + [0.0, -0.01, 0.0], sc.SPHERE_DIRECTION, q_prev=first.q)
+    assert moved.success
+    cands = moved.head.candidates
+    dists = [np.linalg.norm(q - first.q[robot.parts.head]) for _, q in cands]
+    assert np.linalg.norm(moved.q[robot.parts.head] - first.q[robot.parts.head]) == pytest.approx(min(dists))
+
+
+def test_unreachable_target_fails_with_a_reason(robot):
+    controller = HeadController(robot, method="free_roll", timeout=0.002, seed=0)
+    sol = controller.solve([0.0, 0.4, 3.0], [0, 1, 0])  # 3 m up: beyond the whole body
+    assert not sol.success
+    assert "no planar base move" in sol.message and "no solution" in sol.message
+
+
+def test_accept_hook_filters_solutions(robot):
+    controller = HeadController(robot, method="rotated", n_frames=6, seed=0)
+    sol = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION, accept=lambda q, base: False)
+    assert not sol.success and "acceptance" in sol.message
+    low = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION, accept=lambda q, base: q[12] > 0)
+    if low.success:
+        assert low.q[12] > 0
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    (dict(method="nope"), "method"),
+    (dict(n_frames=0), "n_frames"),
+    (dict(timeout=0.0), "timeout"),
+    (dict(slack=-1.0), "slack"),
+    (dict(base_configuration=np.zeros(3)), "shape"),
+])
+def test_bad_construction(robot, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        HeadController(robot, **kwargs)
+
+
+def test_map_of_another_chain_is_rejected(robot):
+    from snakehead import workspace
+
+    with pytest.raises(ValueError, match="another head chain"):
+        HeadController(robot, workspace_map=workspace.default_map("head6"))
+
+
+@pytest.mark.parametrize("position,direction,message", [
+    ([0.1, 0.5, 0.3], [0, 0, 0], "zero length"),
+    ([0.1, np.nan, 0.3], [0, 1, 0], "NaN"),
+    ([0.1, 0.5], [0, 1, 0], "shape"),
+    ([0.1, 0.5, 0.3], [0, 1, np.inf], "NaN or inf"),
+])
+def test_bad_solve_input(robot, position, direction, message):
+    controller = HeadController(robot, method="free_roll")
+    with pytest.raises(ValueError, match=message):
+        controller.solve(position, direction)
+    with pytest.raises(ValueError, match="shape"):
+        controller.solve([0.1, 0.5, 0.3], [0, 1, 0], q_prev=np.zeros(5))
