@@ -801,16 +801,20 @@ def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t, planned_q, base
     n = robot.n_joints
     bs = robot.parts.base
     out = np.full(len(result.t), np.nan)
-    cache: dict = {}
-    for k, time in enumerate(result.t):
-        if not np.all(np.isfinite(result.zmp[k])):
-            continue
-        qk = np.array([np.interp(time, planned_t, planned_q[:, j]) for j in range(n)])
-        key = tuple(np.round(qk[bs], 9))
-        if key not in cache:
-            qb = np.zeros(n)
-            qb[bs] = qk[bs]  # the polygon depends on the base joints only
-            cache[key] = stability.support_polygon(robot, qb, base, contact=contact)
-        poly = cache[key]
-        out[k] = stability.polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), result.zmp[k][None])[0]
+    loaded = np.flatnonzero(np.all(np.isfinite(result.zmp), axis=1))
+    if loaded.size == 0:
+        return out
+    ts = result.t[loaded]
+    qb_ticks = np.column_stack([np.interp(ts, planned_t, planned_q[:, j]) for j in range(n)])[:, bs]
+    # one polygon per distinct base configuration; all of its ticks at once
+    keys, group = np.unique(np.round(qb_ticks, 9), axis=0, return_inverse=True)
+    group = np.asarray(group).reshape(-1)
+    for g in range(len(keys)):
+        ticks = np.flatnonzero(group == g)
+        qb = np.zeros(n)
+        qb[bs] = qb_ticks[ticks[0]]  # the polygon depends on the base joints only
+        poly = stability.support_polygon(robot, qb, base, contact=contact)
+        pts = np.broadcast_to(poly, (len(ticks),) + poly.shape)
+        out[loaded[ticks]] = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool),
+                                                           result.zmp[loaded[ticks]])
     return out
