@@ -1,0 +1,338 @@
+"""Reachability maps (Algorithm 1): the sweep through the bindings, files, shards, Dask, workspace_gen, G0."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from snakehead import Chain, SnakeRobot
+from snakehead import workspace as ws
+
+SMALL = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return SnakeRobot.default()
+
+
+@pytest.fixture(scope="module")
+def small(robot):
+    return ws.compute(robot, progress=False, **SMALL)
+
+
+def workspace_gen() -> str:
+    exe = shutil.which("workspace_gen")
+    assert exe, "workspace_gen is not on PATH (the wheel installs it)"
+    return exe
+
+
+def gen_args(robot, out, **kw):
+    args = [workspace_gen(), "--urdf", str(robot.urdf), "--base", kw.pop("base", "neck_end"),
+            "--tip", kw.pop("tip", "head_tip"), "--out", str(out), "--quiet"]
+    for k, v in kw.items():
+        args += [f"--{k.replace('_', '-')}", str(v)]
+    return args
+
+
+# --- geometry ---------------------------------------------------------------------------------------
+def test_fibonacci_directions_unit_and_well_spread():
+    for n in (1, 5, 20, 300):
+        d = ws.fibonacci_directions(n)
+        assert d.shape == (n, 3)
+        np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    d = ws.fibonacci_directions(300)
+    # Evenly spread: centred, isotropic second moment, no two points much closer than an even
+    # covering's spacing, and no spherical cap of the covering's size left empty.
+    assert np.linalg.norm(d.mean(axis=0)) < 0.01
+    np.testing.assert_allclose(d.T @ d / len(d), np.eye(3) / 3, atol=0.01)
+    gaps = np.linalg.norm(d[:, None] - d[None], axis=2) + 10 * np.eye(len(d))
+    spacing = np.sqrt(4 * np.pi / len(d))
+    assert gaps.min() > 0.7 * spacing
+    probes = np.random.default_rng(0).normal(size=(2000, 3))
+    probes /= np.linalg.norm(probes, axis=1, keepdims=True)
+    assert np.max(np.min(np.linalg.norm(probes[:, None] - d[None], axis=2), axis=1)) < 1.2 * spacing
+    with pytest.raises(ValueError):
+        ws.fibonacci_directions(0)
+
+
+@pytest.mark.parametrize("axis, col", [("x", 0), ("z", 2)])
+def test_approach_frame_axis_is_the_direction(axis, col):
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        d, p, roll = rng.normal(size=3), rng.normal(size=3), rng.uniform(-4, 4)
+        T = ws.approach_frame(p, d, roll, axis)
+        R = T[:3, :3]
+        np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+        assert np.linalg.det(R) == pytest.approx(1.0)
+        np.testing.assert_allclose(R[:, col], d / np.linalg.norm(d), atol=1e-12)
+        np.testing.assert_allclose(T[:3, 3], p)
+        np.testing.assert_allclose(T[3], [0, 0, 0, 1])
+    with pytest.raises(ValueError):
+        ws.approach_frame([0, 0, 0], [0, 0, 0])
+    with pytest.raises(ValueError):
+        ws.approach_frame([0, 0, 0], [1, 0, 0], axis="y")
+
+
+# --- the sweep ---------------------------------------------------------------------------------------
+def test_voxel_out_of_reach_has_index_zero(robot):
+    reach = robot.head_chain.reach
+    far = [[0.0, 0.0, 2 * reach], [reach + 0.1, 0.0, 0.0], [-reach, -reach, 0.0]]
+    np.testing.assert_array_equal(ws.evaluate(robot, far, voxel=0.1, directions=8), 0.0)
+
+
+def test_small_map_indices_in_range(small, robot):
+    d = small.indices
+    assert len(small) > 50 and small.tried == 6
+    assert d.min() >= 0.0 and d.max() <= 100.0 and d.max() > 0.0
+    assert np.all(np.linalg.norm(small.centers, axis=1) <= robot.head_chain.reach)
+    assert small.chain_hash == robot.head_chain.hash and (small.base, small.tip) == ("neck_end", "head_tip")
+    # Centres are those of their grid ids.
+    n = small.grid_shape[0]
+    ijk = np.stack([small.voxel_ids // (n * n), (small.voxel_ids // n) % n, small.voxel_ids % n], axis=1)
+    np.testing.assert_allclose(small.centers, small.grid_origin + (ijk + 0.5) * small.voxel_size, atol=1e-12)
+    assert small.grid_size == pytest.approx(n * 0.15) and small.grid_size >= 2 * robot.head_chain.reach
+
+
+def test_same_map_for_any_thread_count(robot, small):
+    one = ws.compute(robot, progress=False, threads=1, **SMALL)
+    three = ws.compute(robot, progress=False, threads=3, **SMALL)
+    assert one.same_map_as(small) and three.same_map_as(small)
+    assert one.stats["threads"] == 1 and three.stats["threads"] == 3
+
+
+def test_shards_merge_exactly(robot, small):
+    parts = [ws.compute(robot, progress=False, shard=(i, 3), **SMALL) for i in (2, 0, 1)]
+    assert sum(len(p) for p in parts) == len(small)
+    merged = ws.merge(parts)
+    assert merged.same_map_as(small) and merged.shard == (0, 1)
+    with pytest.raises(ValueError, match="3 shards"):
+        ws.merge(parts[:2])
+    with pytest.raises(ValueError, match="twice"):
+        ws.merge([parts[0], parts[0], parts[1]])
+    other = ws.compute(robot, progress=False, shard="1/3", **{**SMALL, "seed": 4})
+    with pytest.raises(ValueError, match="different maps"):
+        ws.merge([parts[0], parts[1], other])
+
+
+def test_executor_shards_equal_one_process(robot, small):
+    with ThreadPoolExecutor(2) as ex:
+        m = ws.compute(robot, progress=False, executor=ex, shards=4, **SMALL)
+    assert m.same_map_as(small)
+
+
+def test_dask_local_cluster(robot, small):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            m = ws.compute(robot, progress=False, executor=client.get_executor(), shards=3, **SMALL)
+    assert m.same_map_as(small)
+    assert "shards=3" in m.command
+
+
+def test_chain_with_executor_needs_its_urdf(robot, small):
+    chain = robot.head_chain
+    with ThreadPoolExecutor(1) as ex:
+        with pytest.raises(ValueError, match="urdf="):
+            ws.compute(chain, progress=False, executor=ex, **SMALL)
+        m = ws.compute(chain, progress=False, executor=ex, shards=2, urdf=robot.urdf, **SMALL)
+        assert m.same_map_as(small)
+        six = robot.head6_chain
+        with pytest.raises(ValueError, match="different kinematics"):
+            ws.compute(six, progress=False, executor=ex, urdf=_other_urdf(robot), **SMALL)
+
+
+def _other_urdf(robot) -> str:
+    # The same robot with the head link 1 cm longer: a different chain.
+    text = Path(robot.urdf).read_text()
+    return text.replace('<origin xyz="0.046 0 0"', '<origin xyz="0.056 0 0"', 1)
+
+
+def test_progress_bar(robot, capsys):
+    m = ws.compute(robot, progress=True, **SMALL)
+    assert len(m) > 0
+    assert "reachability" in capsys.readouterr().err
+
+
+# --- files --------------------------------------------------------------------------------------------
+def test_round_trip(small, tmp_path):
+    path = tmp_path / "map.npz"
+    small.save(path)
+    back = ws.load(path)
+    assert back.same_map_as(small)
+    assert back.params == small.params and back.shard == small.shard and back.command == small.command
+    z = np.load(path, allow_pickle=False)
+    np.testing.assert_allclose(z["indices"], small.indices)
+    assert str(z["approach_axis"]) == "x" and int(z["directions"]) == 6
+
+
+def test_workspace_gen_output_reads_with_numpy(robot, small, tmp_path):
+    out = tmp_path / "gen.npz"
+    args = gen_args(robot, out, voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4,
+                    threads=2)
+    subprocess.run(args, check=True, capture_output=True, text=True, timeout=120)
+    z = np.load(out, allow_pickle=False)
+    assert z["centers"].shape == (len(small), 3) and z["centers"].dtype == np.float64
+    np.testing.assert_allclose(z["indices"], small.indices)
+    assert str(z["chain_hash"]) == robot.head_chain.hash
+    assert str(z["base"]) == "neck_end" and str(z["tip"]) == "head_tip"
+    assert float(z["voxel_size"]) == 0.15 and int(z["rolls"]) == 2 and bool(z["any_roll"])
+    assert list(z["shard"]) == [0, 1] and list(z["grid_shape"]) == [small.grid_shape[0]] * 3
+    assert "--voxel 0.15" in str(z["command"])
+    assert ws.load(out).same_map_as(small)
+    # A shard from workspace_gen merges with shards from Python.
+    gen_shard = tmp_path / "s0.npz"
+    subprocess.run(gen_args(robot, gen_shard, voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3,
+                            timeout=3e-4, shard="0/2"), check=True, timeout=120)
+    assert list(np.load(gen_shard)["shard"]) == [0, 2]
+    merged = ws.merge([ws.load(gen_shard), ws.compute(robot, progress=False, shard=(1, 2), **SMALL)])
+    assert merged.same_map_as(small)
+
+
+def test_load_rejects_foreign_files(tmp_path):
+    np.savez(tmp_path / "other.npz", a=np.zeros(3))
+    with pytest.raises(ValueError, match="not a snakehead"):
+        ws.load(tmp_path / "other.npz")
+    with pytest.raises(ValueError, match="cannot read"):
+        ws.load(tmp_path / "missing.npz")
+
+
+# --- bad input ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kw, match", [
+    ({"voxel": 0.0}, "voxel"), ({"voxel": -0.05}, "voxel"), ({"voxel": float("nan")}, "voxel"),
+    ({"directions": 0}, "directions"), ({"rolls": 0}, "rolls"), ({"timeout": 0.0}, "timeout"),
+    ({"approach_axis": "y"}, "approach"), ({"shard": (3, 3)}, "shard"), ({"shard": "a/b"}, "shard"),
+    ({"directions": 2.5}, "directions"), ({"seed": -1}, "seed"), ({"threads": -1}, "threads"),
+])
+def test_bad_arguments_are_value_errors(robot, kw, match):
+    with pytest.raises(ValueError, match=match):
+        ws.compute(robot, progress=False, **{**SMALL, **kw})
+
+
+def test_bad_chain_and_output(robot, small, tmp_path):
+    with pytest.raises(ValueError, match="no_such_link"):
+        ws.compute(Chain.from_urdf(robot.urdf, "neck_end", "no_such_link"), progress=False, **SMALL)
+    with pytest.raises(ValueError, match="expected a Chain"):
+        ws.compute("neck_end", progress=False, **SMALL)
+    with pytest.raises(ValueError, match="cannot write"):
+        small.save(tmp_path / "no-such-dir" / "map.npz")
+    with pytest.raises(ValueError, match=".npz"):
+        small.save(tmp_path / "map.txt")
+
+
+@pytest.mark.parametrize("kw, message", [
+    ({"voxel": 0}, "voxel size"), ({"voxel": -1}, "voxel size"), ({"directions": 0}, "directions"),
+    ({"tip": "no_such_link"}, "no_such_link"), ({"base": "nope"}, "nope"), ({"shard": "2/2"}, "shard"),
+    ({"approach_axis": "q"}, "approach"), ({"voxel": "abc"}, "expects a number"), ({"bogus": 1}, "unknown argument"),
+])
+def test_workspace_gen_bad_arguments_exit_nonzero(robot, tmp_path, kw, message):
+    out = tmp_path / "m.npz"
+    r = subprocess.run(gen_args(robot, out, **{"voxel": 0.2, "directions": 2, **kw}), capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode != 0
+    assert message in r.stderr and "error" in r.stderr
+    assert not out.exists()
+
+
+def test_workspace_gen_unwritable_output_and_help(robot, tmp_path):
+    r = subprocess.run(gen_args(robot, tmp_path / "missing-dir" / "m.npz", voxel=0.2, directions=2),
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "cannot write" in r.stderr
+    r = subprocess.run([workspace_gen(), "--help"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and "--free-roll" in r.stdout and "--shard" in r.stdout
+    r = subprocess.run([workspace_gen()], capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "required" in r.stderr
+
+
+# --- Table 2, the dexterous workspace, G0 ------------------------------------------------------------------
+def synthetic(indices, centers=None) -> ws.ReachabilityMap:
+    d = np.asarray(indices, dtype=float)
+    n = len(d)
+    c = np.zeros((n, 3)) if centers is None else np.asarray(centers, dtype=float)
+    return ws.ReachabilityMap(
+        centers=c, solved=np.round(d / 5).astype(np.int32), voxel_ids=np.arange(n, dtype=np.int64), tried=20,
+        grid_origin=np.zeros(3), grid_size=1.0, grid_shape=(10, 10, 10), hull_voxels=n, chain_hash="x",
+        base="b", tip="t", params={"voxel_size": 0.1, "directions": 20})
+
+
+def test_histogram_uses_table2_bins():
+    m = synthetic([0, 15, 20, 35, 40, 55, 60, 75, 80, 95, 100, 100])
+    counts, pct = m.histogram()
+    np.testing.assert_array_equal(counts, [2, 2, 2, 2, 4])  # [80, 100] is closed
+    np.testing.assert_allclose(pct, 100 * np.array([2, 2, 2, 2, 4]) / 12)
+    with pytest.raises(ValueError):
+        m.histogram([0, 50, 20])
+
+
+def test_clusters_and_center_on_known_blobs():
+    rng = np.random.default_rng(5)
+    means = np.array([[0.3, 0.0, 0.1], [0.0, 0.3, 0.2], [-0.2, -0.2, 0.3]])
+    sizes = [40, 25, 15]
+    pts = np.concatenate([m + 0.01 * rng.normal(size=(s, 3)) for m, s in zip(means, sizes)])
+    # Dexterous blobs plus voxels of lower index that must be left out.
+    centers = np.concatenate([pts, rng.uniform(-1, 1, size=(30, 3))])
+    m = synthetic([100] * len(pts) + [50] * 30, centers)
+    np.testing.assert_allclose(m.dexterous(), pts)
+    c = m.clusters(k=3)
+    np.testing.assert_array_equal(c.sizes, sizes)  # ordered by size
+    for j, (mean, s) in enumerate(zip(means, sizes)):
+        np.testing.assert_allclose(c.centroids[j], pts[sum(sizes[:j]):sum(sizes[:j]) + s].mean(axis=0), atol=1e-12)
+    np.testing.assert_allclose(c.center, c.centroids[0])  # the largest cluster
+    np.testing.assert_allclose(m.center(k=3), c.center)
+    assert m.clusters(k=3, random_state=7).chosen == 0
+    with pytest.raises(ValueError, match="at least"):
+        synthetic([100, 100]).clusters(k=3)
+    with pytest.raises(ValueError):
+        m.clusters(k=0)
+    with pytest.raises(ValueError):
+        m.dexterous(threshold=101)
+
+
+def test_index_at(small):
+    np.testing.assert_allclose(small.index_at(small.centers), small.indices)
+    assert small.index_at([10.0, 0.0, 0.0])[0] == 0.0
+
+
+# --- the shipped maps -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("part, chain", [("head", "head_chain"), ("head6", "head6_chain")])
+def test_shipped_maps(robot, part, chain):
+    path = ws.DATA_DIR / ws.DEFAULT_MAPS[part]
+    assert path.stat().st_size < 1_000_000
+    m = ws.default_map(part)
+    assert m.chain_hash == getattr(robot, chain).hash
+    assert m.params["voxel_size"] == 0.05 and m.params["directions"] == 20 and m.params["rolls"] == 4
+    assert m.command.startswith("workspace_gen ") and "--voxel 0.05" in m.command
+    assert len(m) == m.hull_voxels > 1000 and m.indices.max() <= 100
+    readme = (ws.DATA_DIR / "README.md").read_text()
+    assert m.command in readme
+
+
+def test_shipped_head_map_g0(robot):
+    m = ws.default_map("head")
+    c = m.clusters(k=3)
+    assert len(c.points) >= 3 and np.all(np.isfinite(c.center))
+    # G0 lies within the head's reach, among the voxels of high index.
+    assert np.linalg.norm(c.center) < robot.head_chain.reach
+    assert m.index_at(c.center)[0] >= 50
+
+
+# --- figures ------------------------------------------------------------------------------------------------
+def test_figures(small, tmp_path):
+    from snakehead import workspace_plots as wp
+
+    paths = wp.save_figures(small, tmp_path, prefix="small", k=2)
+    assert [p.name for p in paths] == ["small_map.png", "small_dexterous.png", "small_clusters.png"]
+    for p in paths:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
+    ax = wp.plot_section(small, axis="y", value=0.01)
+    h = small.voxel_size
+    layer_y = small.grid_origin[1] + (np.floor((0.01 - small.grid_origin[1]) / h) + 0.5) * h  # the layer holding y
+    assert len(ax.collections[0].get_array()) == np.sum(np.isclose(small.centers[:, 1], layer_y)) > 0
+    with pytest.raises(ValueError):
+        wp.plot_section(small, axis="w")
+    with pytest.raises(ValueError, match="outside"):
+        wp.plot_section(small, axis="z", value=5.0)
