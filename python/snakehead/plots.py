@@ -172,14 +172,15 @@ def plot_interpolation_comparison(robot: SnakeRobot | None = None, q_start=None,
 
 
 def plot_momenta(t, P, L, path="fig18_19_momenta.png", *, other=None, labels=("planned", "simulated"),
-                 title: str = "") -> Path:
+                 title: str = "", figures: tuple[int, int] = (18, 19)) -> Path:
     """Figs. 18-19: angular momentum L (kg m^2/s, top row) and linear momentum P (kg m/s, bottom row) about the
-    world origin, x, y, z components against time t (s). ``other`` = (t2, P2, L2) overlays a second run."""
+    world origin, x, y, z components against time t (s). ``other`` = (t2, P2, L2) overlays a second run.
+    ``figures``: the paper's figure numbers of the two rows in the panel titles ((23, 24) for the hole)."""
     t = np.asarray(t, float)
     P, L = np.asarray(P, float), np.asarray(L, float)
     plt = _plt()
     fig, axes = plt.subplots(2, 3, figsize=(13, 6), sharex=True)
-    for row, (X, name, unit, fig_no) in enumerate([(L, "L", "kg m$^2$/s", 18), (P, "P", "kg m/s", 19)]):
+    for row, (X, name, unit, fig_no) in enumerate([(L, "L", "kg m$^2$/s", figures[0]), (P, "P", "kg m/s", figures[1])]):
         for c, comp in enumerate("xyz"):
             ax = axes[row, c]
             ax.plot(t, X[:, c], color=_CARTESIAN, lw=1.8, label=labels[0])

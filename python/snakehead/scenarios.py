@@ -295,3 +295,31 @@ def through_hole(controller: HeadController | None = None, *, speed: float = 0.1
                     cartesian=False, accept=clear_of_wall)
     plan.hold(1.0)
     return _finish("hole", plan, targets, t_start, obstacles=[wall], notes=notes)
+
+
+def reach_target(controller: HeadController | None = None, position=None, direction=None, *, name: str = "target",
+                 speed: float = 0.12, min_segment: float = 2.0, hold: float = 1.0, obstacles=()) -> ScenarioResult:
+    """One head target end to end, as the scenarios do it: from the controller's initial state, solve the head
+    at ``position`` (3,) m pointing along ``direction`` (3,) (Section 3.3 steps 3-4, the base placement chosen by
+    :func:`choose_base`), move there by :meth:`_Plan.move` (Section 3.2), hold ``hold`` s, sample at 2 ms and check
+    stability, ground clearance and the optional ``obstacles`` (``trajectory`` obstacles: the solution must
+    clear them). ``speed`` rad/s and ``min_segment`` s as in :func:`catch_spheres`."""
+    from ._validate import vector3
+
+    t_start = time.perf_counter()
+    controller = controller if controller is not None else HeadController()
+    position, direction = vector3(position, "position"), unit_vector3(direction, "direction")
+    speed, min_segment, hold = positive(speed, "speed"), positive(min_segment, "min_segment"), positive(hold, "hold")
+    robot = controller.robot
+    obstacles = list(obstacles)
+    accept = None
+    if obstacles:
+        def accept(q, b) -> bool:
+            return bool(tr.collision_check(robot, q[None], obstacles, b).distance[0] > WALL_CLEARANCE)
+    base, notes = choose_base(controller, [(position, direction)])
+    plan = _Plan(robot, base, speed, min_segment)
+    plan.start("initial state (head lifted)", controller.q_initial)
+    targets: list[TargetResult] = []
+    _target(controller, name, position, direction, controller.q_initial, base, plan, targets, notes, accept=accept)
+    plan.hold(hold)
+    return _finish(name, plan, targets, t_start, obstacles=obstacles, notes=notes)
