@@ -336,3 +336,29 @@ def test_figures(small, tmp_path):
         wp.plot_section(small, axis="w")
     with pytest.raises(ValueError, match="outside"):
         wp.plot_section(small, axis="z", value=5.0)
+
+
+def test_sweep_releases_the_gil(robot):
+    # The progress callback runs about every 0.1 s in the sweep's calling thread; between two calls the
+    # main thread must be able to run Python (it could not if the sweep held the GIL).
+    import threading
+
+    from snakehead import _core
+
+    ticks = [0]
+    seen = []
+    done = threading.Event()
+    o = ws._options(**{**SMALL, "voxel": 0.1}, any_roll=True, free_roll=False, approach_axis="x", epsilon=1e-5,
+                    threads=1, shard=None)
+
+    def run():
+        _core.compute_reachability(robot.head_chain.model, o, lambda d, t: seen.append(ticks[0]) or True)
+        done.set()
+
+    t = threading.Thread(target=run)
+    t.start()
+    while not done.is_set():
+        ticks[0] += 1
+    t.join()
+    assert len(seen) >= 3, "the sweep was too quick to tell"
+    assert seen[-1] - seen[0] > 1000

@@ -376,7 +376,10 @@ def _bar(progress: bool, total: int, unit: str):
 
 def _compute_local(chain: Chain, options, progress: bool) -> ReachabilityMap:
     bar = _bar(progress, 0, "voxel")
-    callback = None
+
+    def callback(done, total):  # called about every 0.1 s; the binding checks for Ctrl-C before each call
+        return True
+
     if bar is not None:
         def callback(done, total):
             if bar.total != total:
