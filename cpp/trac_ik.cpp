@@ -70,18 +70,21 @@ std::mt19937_64& thread_rng() {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// The worker pool: threads made once; jobs are stack objects of the calling thread, so a job can be
-// cancelled (removed) while queued, and the caller waits for a running job before returning.
+// The worker pool: threads made once. A job is shared between its submitter and the worker that runs it, so
+// a caller may either wait for it (a batch, whose jobs write into the caller's arrays) or abandon it (a
+// race, whose SQP half owns everything it touches and is told to stop).
 
 class WorkerPool {
  public:
   struct Job {
+    explicit Job(std::function<void()> f) : fn(std::move(f)) {}
     std::function<void()> fn;
     bool running = false;  // guarded by the pool mutex
     std::mutex m;
     std::condition_variable cv;
     bool done = false;  // guarded by m
   };
+  using JobPtr = std::shared_ptr<Job>;
 
   explicit WorkerPool(int n) {
     for (int i = 0; i < n; ++i) threads_.emplace_back([this] { loop(); });
@@ -96,41 +99,40 @@ class WorkerPool {
   }
   int size() const { return static_cast<int>(threads_.size()); }
 
-  void submit(Job& job) {
+  void submit(const JobPtr& job) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back(&job);
+      queue_.push_back(job);
     }
     cv_.notify_one();
   }
 
-  // Removes the job if no worker has taken it yet; otherwise waits until it has finished.
-  // Returns true when the job ran.
-  bool cancel_or_wait(Job& job) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!job.running) {
-        auto it = std::find(queue_.begin(), queue_.end(), &job);
-        if (it != queue_.end()) {
-          queue_.erase(it);
-          return false;
-        }
-      }
-    }
-    std::unique_lock<std::mutex> lock(job.m);
-    job.cv.wait(lock, [&] { return job.done; });
+  // Removes the job if no worker has taken it yet. Returns false when it is already running (or done).
+  bool cancel(const JobPtr& job) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (job->running) return false;
+    auto it = std::find(queue_.begin(), queue_.end(), job);
+    if (it == queue_.end()) return false;
+    queue_.erase(it);
     return true;
+  }
+
+  // Removes the job if it is still queued, else waits until it has finished.
+  void cancel_or_wait(const JobPtr& job) {
+    if (cancel(job)) return;
+    std::unique_lock<std::mutex> lock(job->m);
+    job->cv.wait(lock, [&] { return job->done; });
   }
 
  private:
   void loop() {
     for (;;) {
-      Job* job;
+      JobPtr job;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         cv_.wait(lock, [&] { return quit_ || !queue_.empty(); });
-        if (quit_ && queue_.empty()) return;
-        job = queue_.front();
+        if (queue_.empty()) return;  // quitting; queued jobs are still run (they are told to stop)
+        job = std::move(queue_.front());
         queue_.pop_front();
         job->running = true;
       }
@@ -138,15 +140,15 @@ class WorkerPool {
       {
         std::lock_guard<std::mutex> lock(job->m);
         job->done = true;
-        job->cv.notify_all();  // under the lock: the job may be destroyed as soon as it is released
       }
+      job->cv.notify_all();
     }
   }
 
   std::vector<std::thread> threads_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<Job*> queue_;
+  std::deque<JobPtr> queue_;
   bool quit_ = false;
 };
 
@@ -166,7 +168,8 @@ struct Problem {
 
 struct CallControl {
   std::atomic<bool> stop{false};
-  std::atomic<bool> claimed{false};  // Speed: the first solution claims the win
+  std::mutex result;     // guards `claimed` and both searches' Best (the racing threads offer under it)
+  bool claimed = false;  // Speed: the first solution claims the win
   Clock::time_point deadline;
   bool budgeted = false;  // seeded: bounded by evaluations (single thread, so a plain counter)
   long evals = 0;
@@ -188,7 +191,7 @@ double manipulability_score(SolveType type, const Matrix6Xd& jac) {
   return s[0] > 0 ? -(s[s.size() - 1] / s[0]) : 0.0;
 }
 
-// One solver's per-call state: workspace, generator, best solution. Lives on its thread's stack.
+// One solver's per-call state: workspace, generator, best solution (guarded by c.result).
 class Search {
  public:
   Search(const Problem& p, CallControl& c, std::mt19937_64& rng)
@@ -208,21 +211,24 @@ class Search {
 
   // FK + Jacobian + residual at q into (tip, jac, r, dr); returns the raw error.
   Vector6d evaluate(const Eigen::VectorXd& q, Matrix6Xd& J, Vector6d& r, Matrix6Xd& D) {
-    ++evals;
+    evals.fetch_add(1, std::memory_order_relaxed);
     if (c.budgeted) ++c.evals;  // seeded calls run in one thread; racing threads never touch the counter
     Eigen::Isometry3d tip;
     tip_jacobian(p.model, q, J, tip);
     return residual_and_jacobian(p.target, tip, J, p.bounds, r, D);
   }
 
-  // Records a solution (q within the limits, pose reached). Returns true when the search should end.
+  // Records a solution (q within the limits, pose reached).
   void offer(const Eigen::VectorXd& q, const Matrix6Xd& J) {
     if (p.type == SolveType::Speed) {
-      bool expected = false;
-      if (c.claimed.compare_exchange_strong(expected, true)) {
-        best.found = true;
-        best.q = q;
-        best.count = 1;
+      {
+        std::lock_guard<std::mutex> lock(c.result);
+        if (!c.claimed) {
+          c.claimed = true;
+          best.found = true;
+          best.q = q;
+          best.count = 1;
+        }
       }
       c.stop.store(true, std::memory_order_relaxed);
       return;
@@ -232,6 +238,7 @@ class Search {
       score = (q - p.q_init).squaredNorm();
     else
       score = manipulability_score(p.type, J);
+    std::lock_guard<std::mutex> lock(c.result);
     ++best.count;
     if (!best.found || score < best.score) {
       best.found = true;
@@ -255,7 +262,7 @@ class Search {
   Matrix6Xd jac, dr, jac_try, dr_try, dr_step;
   Eigen::VectorXd dq, q_try;
   Best best;
-  long evals = 0;  // this search's own count (statistics)
+  std::atomic<long> evals{0};  // this search's own count (statistics; read by the other thread)
 };
 
 // ---------------------------------------------------------------------------------------------------------
@@ -535,12 +542,28 @@ struct TracIK::Impl {
   // mode: how the two solvers are scheduled.
   enum class Schedule { Race, Interleaved };
 
+  // Everything one call's searches share. Heap-allocated and shared with a racing SQP job, so that the
+  // caller can return as soon as it has an answer without waiting for the worker to notice the stop
+  // (a worker that the scheduler has parked could otherwise hold the caller for milliseconds).
+  struct CallState {
+    CallState(const ChainModel& model, const Eigen::Isometry3d& target, const Eigen::VectorXd& q0,
+              const TracIKOptions& o, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi)
+        : q_init(q0), p{model, target, o.bounds, o.epsilon, o.solve_type, q_init, lo, hi}, sq(p, c, rng_sq) {}
+    Eigen::VectorXd q_init;
+    Problem p;
+    CallControl c;
+    std::mt19937_64 rng_sq;
+    Search sq;  // the SQP half
+  };
+
+  // The pool is destroyed before the other members (declared after them), so a job still running when the
+  // solver is destroyed finishes while the model and the sampling ranges it refers to still exist.
   IKResult run(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, const TracIKOptions& o,
                IKAlgorithm algorithm, Schedule schedule, std::uint64_t stream) const {
     const auto t0 = Clock::now();
-    const Problem p{*model, target, o.bounds, o.epsilon, o.solve_type, q_init, sample_lo, sample_hi};
-    CallControl c;
-    std::mt19937_64 rng_nr, rng_sq;
+    auto st = std::make_shared<CallState>(*model, target, q_init, o, sample_lo, sample_hi);
+    CallControl& c = st->c;
+    std::mt19937_64 rng_nr;
     if (o.seed) {
       c.budgeted = true;
       c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
@@ -548,14 +571,15 @@ struct TracIK::Impl {
                             std::chrono::duration<double>(std::max(10 * o.timeout, o.timeout + 0.05)));
       const std::uint64_t base = splitmix64(*o.seed ^ splitmix64(stream));
       rng_nr.seed(splitmix64(base ^ 0x6E72ULL));
-      rng_sq.seed(splitmix64(base ^ 0x737170ULL));
+      st->rng_sq.seed(splitmix64(base ^ 0x737170ULL));
       schedule = Schedule::Interleaved;
     } else {
       c.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.timeout));
       rng_nr.seed(thread_rng()());
-      rng_sq.seed(thread_rng()());
+      st->rng_sq.seed(thread_rng()());
     }
-    Search nr(p, c, rng_nr), sq(p, c, rng_sq);
+    Search nr(st->p, c, rng_nr);
+    Search& sq = st->sq;
     const auto inline_end =
         t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kInlineFraction * o.timeout));
 
@@ -579,14 +603,14 @@ struct TracIK::Impl {
         }
       }
       if (!nr.should_stop()) {
-        WorkerPool::Job job;
-        job.fn = [&] {
+        // The job owns a reference to the call state; it never touches this stack frame.
+        auto job = std::make_shared<WorkerPool::Job>([st] {
           try {
-            sqp_loop(sq, q_init);
+            sqp_loop(st->sq, st->q_init);
           } catch (...) {  // e.g. std::bad_alloc: give up the SQP half, never take the process down
-            c.stop.store(true);
+            st->c.stop.store(true);
           }
-        };
+        });
         pool.submit(job);
         try {
           if (speed) {
@@ -600,22 +624,25 @@ struct TracIK::Impl {
           }
         } catch (...) {
           c.stop.store(true);
-          pool.cancel_or_wait(job);
+          pool.cancel(job);
           throw;
         }
         c.stop.store(true);
-        pool.cancel_or_wait(job);
+        pool.cancel(job);  // if it is running, it stops at its next evaluation, on its own time
       }
     }
 
     IKResult res;
-    const Best* b = pick(nr.best, sq.best);
-    res.found = b != nullptr;
-    res.q = b ? b->q : q_init;
-    res.solutions = nr.best.count + sq.best.count;
+    {
+      std::lock_guard<std::mutex> lock(c.result);  // the SQP half may still be running
+      const Best* b = pick(nr.best, sq.best);
+      res.found = b != nullptr;
+      res.q = b ? b->q : q_init;
+      res.solutions = nr.best.count + sq.best.count;
+    }
     res.error = pose_error(target, forward_kinematics(*model, res.q));
     res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    res.evaluations = nr.evals + sq.evals;
+    res.evaluations = nr.evals.load() + sq.evals.load();
     return res;
   }
 };
@@ -696,9 +723,9 @@ void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allo
   };
   // The calling thread works too, so one thread fewer from the pool: more threads than cores would let the
   // scheduler park a thread, mid-target, for longer than a timeout.
-  std::vector<WorkerPool::Job> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size() - 1, T)));
+  std::vector<WorkerPool::JobPtr> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size() - 1, T)));
   for (auto& j : jobs) {
-    j.fn = work;
+    j = std::make_shared<WorkerPool::Job>(work);
     impl_->pool.submit(j);
   }
   work();
