@@ -544,9 +544,28 @@ ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOpt
   map.hull_voxels = 0;
   std::int64_t run_index = 0;
   const int n = map.grid.n;
+  const double h = map.grid.voxel;
   for (std::int64_t line = 0; line < static_cast<std::int64_t>(n) * n; ++line) {
+    // The hull cuts a z-line in one interval: bound it from the facet planes first, so that only a
+    // few voxels per line need the full test (a grid of n^3 voxels costs n^2 * facets, not n^3 * facets).
+    const Eigen::Vector3d c0 = map.grid.centre_of(line * n);
+    double zlo = -std::numeric_limits<double>::infinity(), zhi = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < hull.n_facets() && zlo <= zhi; ++f) {
+      const double nz = hull.normals(f, 2);
+      const double rest = hull.normals(f, 0) * c0.x() + hull.normals(f, 1) * c0.y() + hull.offsets[f];
+      if (std::abs(nz) < 1e-12) {
+        if (rest > 1e-9) zlo = std::numeric_limits<double>::infinity();  // the line misses this facet's half-space
+      } else if (nz > 0) {
+        zhi = std::min(zhi, -rest / nz);
+      } else {
+        zlo = std::max(zlo, -rest / nz);
+      }
+    }
+    if (!(zlo <= zhi)) continue;
+    const int l_first = static_cast<int>(std::max(0.0, std::floor((zlo - map.grid.origin.z()) / h - 0.5) - 1));
+    const int l_last = static_cast<int>(std::min(n - 1.0, std::ceil((zhi - map.grid.origin.z()) / h - 0.5) + 1));
     std::int64_t previous = -2;
-    for (int l = 0; l < n; ++l) {
+    for (int l = l_first; l <= l_last; ++l) {
       const std::int64_t k = line * n + l;
       if (!hull.contains(map.grid.centre_of(k))) continue;
       ++map.hull_voxels;
