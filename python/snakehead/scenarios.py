@@ -176,7 +176,8 @@ def _finish(name, plan: _Plan, targets, t_start, obstacles=(), notes=()) -> Scen
     clearance = tr.ground_clearance(robot, traj.q, base)[:, tr.non_base_links(robot)].min(axis=1)
     distance = None
     if obstacles:
-        distance = tr.collision_check(robot, traj.q, list(obstacles), base).distance
+        # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
+        distance = tr.collision_check(robot, traj.q, list(obstacles), base, exact_within=0.005).distance
     states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
     return ScenarioResult(name=name, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
                           stability=dyn, ground_clearance=clearance, obstacles=list(obstacles),
@@ -279,7 +280,7 @@ def through_hole(controller: HeadController | None = None, *, speed: float = 0.1
     plan.start("initial state (head lifted)", controller.q_initial)
     targets: list[TargetResult] = []
     def clear_of_wall(q, b) -> bool:  # the solutions kept must leave every link clear of the wall
-        return bool(tr.collision_check(robot, q[None], [wall], b).distance[0] > WALL_CLEARANCE)
+        return bool(tr.collision_check(robot, q[None], [wall], b, exact_within=0.005).distance[0] > WALL_CLEARANCE)
 
     q = _target(controller, "in front of the hole", start, HOLE_AXIS, controller.q_initial, base, plan, targets,
                 notes, accept=clear_of_wall)
