@@ -58,14 +58,30 @@ std::uint64_t splitmix64(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+// SplitMix64 as the generator itself: 8 bytes of state, so seeding one per call costs nothing (a Mersenne
+// twister's 2.5 kB state took a noticeable share of a 20 us solve), and statistically ample for restarts.
+struct Rng {
+  std::uint64_t state = 0;
+  void seed(std::uint64_t s) { state = s; }
+  std::uint64_t operator()() {
+    state += 0x9E3779B97F4A7C15ULL;
+    std::uint64_t z = state;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+  }
+};
 
-std::mt19937_64& thread_rng() {
-  thread_local std::mt19937_64 rng([] {
+double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+// Unseeded calls draw their generators' seeds from a per-thread generator seeded once by the OS.
+Rng& thread_rng() {
+  thread_local Rng rng = [] {
     std::random_device rd;
-    std::seed_seq seq{rd(), rd(), rd(), rd()};
-    return std::mt19937_64(seq);
-  }());
+    Rng r;
+    r.seed((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
+    return r;
+  }();
   return rng;
 }
 
@@ -194,7 +210,7 @@ double manipulability_score(SolveType type, const Matrix6Xd& jac) {
 // One solver's per-call state: workspace, generator, best solution (guarded by c.result).
 class Search {
  public:
-  Search(const Problem& p, CallControl& c, std::mt19937_64& rng)
+  Search(const Problem& p, CallControl& c, Rng& rng)
       : p(p), c(c), rng(rng), n(p.model.n_joints()), jac(6, n), dr(6, n), jac_try(6, n), dr_try(6, n), dr_step(6, n), dq(n),
         q_try(n) {}
 
@@ -257,7 +273,7 @@ class Search {
 
   const Problem& p;
   CallControl& c;
-  std::mt19937_64& rng;
+  Rng& rng;
   const int n;
   Matrix6Xd jac, dr, jac_try, dr_try, dr_step;
   Eigen::VectorXd dq, q_try;
@@ -291,7 +307,10 @@ bool newton_descent(Search& s, Eigen::VectorXd& q) {
       Eigen::Matrix<double, 6, 6> A;
       A.noalias() = s.dr_step * s.dr_step.transpose();
       A.diagonal().array() += lambda;
-      const Vector6d y = A.ldlt().solve(r);
+      // A is symmetric positive definite (lambda > 0): Cholesky, with LDLT as the fallback when rounding
+      // makes a nearly singular A lose definiteness.
+      const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(A);
+      const Vector6d y = llt.info() == Eigen::Success ? Vector6d(llt.solve(r)) : Vector6d(A.ldlt().solve(r));
       s.dq.noalias() = -s.dr_step.transpose() * y;
       bool blocked = false;
       for (int i = 0; i < s.n; ++i) {
@@ -552,7 +571,7 @@ struct TracIK::Impl {
     Eigen::VectorXd q_init;
     Problem p;
     CallControl c;
-    std::mt19937_64 rng_sq;
+    Rng rng_sq;
     Search sq;  // the SQP half
   };
 
@@ -563,7 +582,7 @@ struct TracIK::Impl {
     const auto t0 = Clock::now();
     auto st = std::make_shared<CallState>(*model, target, q_init, o, sample_lo, sample_hi);
     CallControl& c = st->c;
-    std::mt19937_64 rng_nr;
+    Rng rng_nr;
     if (o.seed) {
       c.budgeted = true;
       c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
