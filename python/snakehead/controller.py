@@ -112,8 +112,8 @@ class HeadController:
         and the move is made only when that fails or leaves the body statically unstable.
 
         ``accept``: an optional test ``accept(q (16,), base) -> bool`` of a whole-body solution (e.g. no
-        collision with an obstacle). With the rotated-frames method only the accepted candidates are kept;
-        with free roll, up to ``n_frames`` random restarts are tried until one is accepted.
+        collision with an obstacle). Only accepted solutions are kept: with free roll, when its solution is
+        rejected, the ``n_frames`` rolled frames of the paper's method are solved and filtered.
         """
         t_start = time.perf_counter()
         position = vector3(position, "position")
@@ -170,19 +170,15 @@ class HeadController:
             q_full[parts.head] = q_head
             return bool(accept(q_full, base))
 
-        if self.method == "rotated":
+        if self.method == "free_roll":
+            head = head_ik.free_roll(self.ik, target, q_init=q[parts.head], attempts=3)
+        if self.method == "rotated" or (accept is not None and head.success and not accepted(head.q)):
+            # The paper's rolled frames give a set of candidates to choose from (also when the free-roll
+            # solution fails the caller's test).
             head = head_ik.rotated_frames(self.ik, target, self.n_frames, q_init=q[parts.head], q_prev=q_close)
             if accept is not None and head.success and not accepted(head.q):
                 kept = [c for c in head.candidates if accepted(c[1])]
                 head = head_ik.rotated_result(self.ik, target, head_ik.select(kept, q_close), head, kept)
-        else:
-            head = head_ik.free_roll(self.ik, target, q_init=q[parts.head], attempts=3)
-            tries = 1
-            while accept is not None and head.success and not accepted(head.q) and tries < self.n_frames:
-                head = head_ik.free_roll(self.ik, target, q_init=self.ik.random_configuration())
-                tries += 1
-            if accept is not None and head.success and not accepted(head.q):
-                head = head_ik.rotated_result(self.ik, target, None, head, [])
         timings["head"] = time.perf_counter() - t0
         if head.success:
             q[parts.head] = head.q

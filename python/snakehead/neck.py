@@ -16,6 +16,8 @@ from .robot import BasePlacement, SnakeRobot
 
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
+#: How much lower (m^2) Eq. 22's cost from another start must be to leave the minimum reached from q_init.
+CONTINUITY_TOLERANCE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,8 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
     ``neck`` is the chain from the base's end frame (P0) to the neck end frame (B0); ``P0_frame`` (4, 4) is
     the world pose of P0. Eq. 22 is a sum of squares of six residuals, so it is solved by a bounded
     Levenberg-Marquardt with the analytic Jacobian (a general-purpose scipy minimiser costs ~10x more here),
-    started from ``q_init`` and from the best points of a coarse grid (Eq. 22 is not convex).
+    started from ``q_init`` and from the best point of a coarse grid (Eq. 22 is not convex); the minimum
+    reached from ``q_init`` is kept unless the grid's is lower by more than ``CONTINUITY_TOLERANCE``.
     """
     P0_frame = finite_array(P0_frame, "P0_frame", (4, 4))
     h = positive(h, "h")
@@ -121,9 +124,11 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
     ranked = grid[np.argsort(grid_costs)[:1]]
     starts = ranked if q_init is None else np.vstack([finite_array(q_init, "q_init", (neck.n_joints,)), ranked])
     best_q, best_cost = None, np.inf
-    for q0 in starts:
+    for k, q0 in enumerate(starts):
         q, cost = _bounded_least_squares(residual, np.clip(q0, lo, hi), lo, hi)
-        if cost < best_cost:
+        # Continuity: the solution reached from q_init (tried first) is kept unless another start is
+        # clearly better, so that nearby targets give nearby necks instead of jumping between minima.
+        if k == 0 or cost < best_cost - CONTINUITY_TOLERANCE:
             best_q, best_cost = q, cost
     T = P0_frame @ neck.fk(best_q)
     cosang = float(np.clip(T[:3, 0] @ goal.r_d, -1.0, 1.0))

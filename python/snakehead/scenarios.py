@@ -45,6 +45,10 @@ HOLE_DIAMETER = 0.07
 WALL_SIZE = np.array([0.7, 0.58, 0.01])  # width, height, thickness (m)
 HOLE_AXIS = np.array([0.0, 1.0, 0.0])
 WALL_CLEARANCE = 0.002  # m: the least distance a solved configuration keeps from the wall
+DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
+DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
+DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
+DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 
 
 @dataclass
@@ -130,28 +134,61 @@ class _Plan:
         The Cartesian interpolation of Eqs. 41-44 (n configurations) is used when its configurations stay
         within the joint limits without clipping, above the ground and statically stable; otherwise (the
         interpolated joint points are closer than the links are long, so the links cannot follow them, and
-        clipped angles jump between limits) the move is a joint-space one, which is checked the same way.
+        clipped angles jump between limits) the move is a joint-space one, through a detour waypoint when the
+        straight joint path would leave the support polygon (see ``_joint_path``).
         """
         q = np.asarray(q, float)
         path = tr.cartesian_interpolation(self.robot, self.qs[-1], q, n, self.base, aim="points", full_output=True)
-        if not path.clipped.any() and self._acceptable(path.q):
+        if not path.clipped.any() and self._feasible(path.q).all():
             qs, method = path.q, "cartesian (Eqs. 41-44)"
         else:
-            qs, method = self.qs[-1] + np.linspace(0.0, 1.0, n)[:, None] * (q - self.qs[-1]), "joint space"
+            qs, method = self._joint_path(self.qs[-1], q, n)
         steps = np.abs(np.diff(qs, axis=0)).max(axis=1) / self.speed
-        floor = self.min_segment / (n - 1)
-        for k in range(1, n):
+        floor = self.min_segment / (len(qs) - 1)
+        for k in range(1, len(qs)):
             self.qs.append(qs[k])
-            self.labels.append(label if k == n - 1 else f"{label} ({k}/{n - 1})")
+            self.labels.append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})")
             self.times.append(self.times[-1] + max(floor, steps[k - 1]))
         self.methods.append((label, method))
         return method
 
-    def _acceptable(self, qs: np.ndarray) -> bool:
-        clearance = tr.ground_clearance(self.robot, qs, self.base)[:, tr.non_base_links(self.robot)]
-        if clearance.min() < -tr.GROUND_TOLERANCE:
-            return False
-        return all(stability.static_margin(self.robot, q, self.base, contact="ground") > 0 for q in qs)
+    def _margins(self, qs: np.ndarray) -> np.ndarray:
+        """Static margins (m) of configurations qs (m, 16) that share this move's base (the paper's polygon)."""
+        poly = stability.support_polygon(self.robot, qs[0], self.base)
+        com = stability.center_of_mass(self.robot, qs, self.base)
+        pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
+        return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
+
+    def _feasible(self, qs: np.ndarray) -> np.ndarray:
+        """(m,) bool: above the ground and statically stable with DETOUR_MARGIN to spare."""
+        clearance = tr.ground_clearance(self.robot, qs, self.base)[:, tr.non_base_links(self.robot)].min(axis=1)
+        return (clearance >= -tr.GROUND_TOLERANCE) & (self._margins(qs) >= DETOUR_MARGIN)
+
+    def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
+        """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
+
+        The straight path when it does; else the shortest of DETOUR_TRIALS two-piece paths through a waypoint
+        drawn around the midpoint (neck and head joints perturbed, seeded: plans are reproducible) whose every
+        configuration passes; else the one with the largest worst margin (the scenario's checks report it).
+        """
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        straight = qa + s * (qb - qa)
+        if self._feasible(straight).all():
+            return straight, "joint space"
+        movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
+        rng = np.random.default_rng(DETOUR_SEED)
+        W = np.tile(0.5 * (qa + qb), (DETOUR_TRIALS, 1))
+        W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
+        W = np.clip(W, self.robot.lower, self.robot.upper)
+        paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
+        flat = paths.reshape(-1, qa.size)
+        ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
+        if ok.any():
+            length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
+            k = int(np.argmin(np.where(ok, length, np.inf)))
+            return paths[k], "joint space via a stable detour"
+        worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
+        return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
 
     def hold(self, seconds: float):
         self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
@@ -282,18 +319,33 @@ def through_hole(controller: HeadController | None = None, *, speed: float = 0.1
     def clear_of_wall(q, b) -> bool:  # the solutions kept must leave every link clear of the wall
         return bool(tr.collision_check(robot, q[None], [wall], b, exact_within=0.005).distance[0] > WALL_CLEARANCE)
 
-    q = _target(controller, "in front of the hole", start, HOLE_AXIS, controller.q_initial, base, plan, targets,
-                notes, accept=clear_of_wall)
-    distances = np.arange(approach - step, HOLE_CENTRE[1] - through - 1e-9, -step)
+    # Poses along the axis, from the approach point to through the wall.
+    distances = np.arange(approach, HOLE_CENTRE[1] - through - 1e-9, -step)
     distances = np.append(distances, HOLE_CENTRE[1] - through)
-    for k, d in enumerate(distances):
-        last = k == len(distances) - 1
-        name = "through the hole" if last else f"along the axis, {d * 100:+.0f} cm"
-        sink = targets if last or abs(d) < step / 2 else []
-        if abs(d) < step / 2:
-            name = "entering the hole"
-        q = _target(controller, name, HOLE_CENTRE - d * HOLE_AXIS, HOLE_AXIS, q, base, plan, sink, notes,
-                    cartesian=False, accept=clear_of_wall)
+    names = [f"along the axis, {d * 100:+.0f} cm" for d in distances]
+    names[0], names[-1] = "in front of the hole", "through the hole"
+    entering = int(np.argmin(np.abs(distances)))
+    names[entering] = "entering the hole"
+    # Solve them backwards, from the deepest pose (the most constrained: only the head link may be in the
+    # hole) out to the approach point, each from the previous joints: a branch of solutions that clears the
+    # wall deep in the hole also clears it further out, while one chosen from the outside may run into it.
+    solutions = [None] * len(distances)
+    q = controller.q_initial
+    for k in range(len(distances) - 1, -1, -1):
+        solutions[k] = controller.solve(HOLE_CENTRE - distances[k] * HOLE_AXIS, HOLE_AXIS, q_prev=q, base=base,
+                                        accept=clear_of_wall)
+        if solutions[k].success:
+            q = solutions[k].q
+        else:
+            notes.append(f"{names[k]}: {solutions[k].message}")
+    for k, sol in enumerate(solutions):
+        if k == 0:
+            plan.move(names[k], sol.q)
+        else:
+            plan.move_joint(names[k], sol.q)
+        if k in (0, entering, len(distances) - 1):
+            targets.append(TargetResult(names[k], HOLE_CENTRE - distances[k] * HOLE_AXIS, HOLE_AXIS,
+                                        plan.times[-1], sol))
     plan.hold(1.0)
     return _finish("hole", plan, targets, t_start, obstacles=[wall], notes=notes)
 
