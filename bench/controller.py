@@ -42,12 +42,12 @@ def run(controller: HeadController, targets) -> dict:
 
 def random_targets(robot: SnakeRobot, q_initial: np.ndarray, n: int, rng: np.random.Generator):
     out = []
-    for _ in range(n):
+    while len(out) < n:
         q = q_initial.copy()
         sl = slice(robot.parts.neck.start, robot.parts.head.stop)
         q[sl] = rng.uniform(robot.lower[sl], robot.upper[sl])
         T = robot.head_pose(q)
-        if T[2, 3] < 0.05:  # keep targets off the ground
+        if T[2, 3] < 0.05:  # targets at least 5 cm off the ground (about half of the draws)
             continue
         out.append((T[:3, 3], T[:3, 0]))
     return out

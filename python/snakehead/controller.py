@@ -94,6 +94,7 @@ class HeadController:
         if base_configuration is None:
             base_configuration = backbone.initial_configuration(self.robot)
         self.q_initial = joint_vector(base_configuration, self.robot.n_joints, "base_configuration")
+        self._polygons: dict = {}  # (base placement, base joints) -> support polygon
         self.ik = TracIK.from_chain(self.robot.head_chain, timeout=positive(timeout, "timeout"),
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 
@@ -187,7 +188,7 @@ class HeadController:
         t0 = time.perf_counter()
         achieved = self.robot.head_pose(q, base)
         pe, de = head_ik.position_and_direction_error(achieved, desired)
-        margin = stability.static_margin(self.robot, q, base)
+        margin = self._static_margin(q, base)
         timings["check"] = time.perf_counter() - t0
         if head.success:
             message = "solved" if margin > 0 else "solved, but the centre of mass is outside the support polygon"
@@ -200,3 +201,15 @@ class HeadController:
                             position_error=pe, direction_error=de, success=head.success, message=message,
                             static_stable=margin > 0, static_margin=margin, timings=timings, neck_goal=goal,
                             neck=neck, head=head)
+
+    def _static_margin(self, q: np.ndarray, base: BasePlacement) -> float:
+        """``stability.static_margin`` with the support polygon cached: it depends only on the base joints
+        and placement, which a controller keeps (the polygon is the costly part: a convex hull)."""
+        key = (base, q[self.robot.parts.base].tobytes())
+        poly = self._polygons.get(key)
+        if poly is None:
+            if len(self._polygons) > 64:
+                self._polygons.clear()
+            poly = self._polygons[key] = stability.support_polygon(self.robot, q, base)
+        c = stability.center_of_mass(self.robot, q, base)
+        return float(stability.polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), c[None, :2])[0])

@@ -107,13 +107,15 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
 
     S_rd = _skew(goal.r_d)  # r_d x (.) as a matrix: np.cross is slow on tiny arrays
 
+    model = neck.model  # the C++ model checks q itself; skipping the Python checks halves this loop's cost
+
     def residual(q, with_jacobian=True):
-        T = neck.fk(q)
+        T = model.fk(q)
         ra = R0 @ T[:3, 0]
         r = np.concatenate([R0 @ T[:3, 3] + p0 - goal.P_d, sqrt_h * (S_rd @ ra)])
         if not with_jacobian:
             return r, None
-        J = neck.jacobian(q)
+        J = model.jacobian(q)
         # d(P_a)/dq = R0 Jv;  d(r_a)/dq = (R0 Jw) x r_a = -[r_a]x R0 Jw;  d(r_d x r_a) = [r_d]x d(r_a)
         dra = -_skew(ra) @ (R0 @ J[3:])
         return r, np.vstack([R0 @ J[:3], sqrt_h * (S_rd @ dra)])
@@ -141,7 +143,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _bounded_least_squares(residual, q, lo, hi, iterations: int = 100, tol: float = 1e-14):
+def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float = 1e-12):
     """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
     r, J = residual(q)
     cost = float(r @ r)
