@@ -134,7 +134,7 @@ def write_json(report: dict, path: str | os.PathLike) -> Path:
 
 def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
     """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
-    time in s and the joint angles in rad (T rows of 1 + n columns)."""
+    time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)
     if q.ndim != 2 or q.shape[0] != t.shape[0]:
         raise ValueError(f"t {t.shape} and q {q.shape} do not match")
@@ -146,7 +146,7 @@ def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str]
         w = csv.writer(f)
         w.writerow(["time_s"] + [f"{n}_rad" for n in names])
         for row in np.column_stack([t, q]):
-            w.writerow([f"{row[0]:.3f}"] + [f"{v:.7f}" for v in row[1:]])
+            w.writerow([f"{row[0]:.6f}"] + [f"{v:.7f}" for v in row[1:]])
     return path
 
 

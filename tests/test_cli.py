@@ -1,0 +1,253 @@
+"""The ``snakehead`` command: what ``demo`` and ``plan`` write, ``workspace``, help, and bad arguments.
+
+``demo`` runs once (module fixture, ``--fast``: the same pipeline with faster joint motions and shorter
+animations) with MuJoCo when it is installed; everything runs as a subprocess (``python -m snakehead``).
+"""
+from __future__ import annotations
+
+import csv
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from snakehead import BasePlacement, SnakeRobot
+
+HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
+SCENARIO_FILES = ["{}_trajectory.csv", "{}_snapshots.png", "{}_momenta.png", "{}_zmp.png", "{}.gif"]
+SIM_KEYS = {"position_error_m": float, "direction_error_deg": float, "max_linear_momentum_error": float,
+            "max_angular_momentum_error": float, "zmp_inside": bool}
+
+
+def run(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "snakehead", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo") / "out"  # created by the command
+    proc = run("demo", "--out", str(out), "--fast", "--seed", "1")
+    assert proc.returncode in (0, 1), proc.stderr
+    return proc, out, json.loads((out / "report.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def plan(tmp_path_factory):
+    out = tmp_path_factory.mktemp("plan")
+    proc = run("plan", "--position", "0.1", "0.5", "0.35", "--direction", "0", "2", "0", "--out", str(out),
+               "--no-sim", "--fast")
+    assert proc.returncode in (0, 1), proc.stderr
+    return proc, out, json.loads((out / "report.json").read_text())
+
+
+# ------------------------------------------------------------------------------------------------
+# demo
+# ------------------------------------------------------------------------------------------------
+def test_demo_writes_every_file(demo):
+    proc, out, _ = demo
+    names = ["report.json", "summary.md"] + [f.format(s) for s in ("spheres", "hole") for f in SCENARIO_FILES]
+    for name in names:
+        path = out / name
+        assert path.is_file() and path.stat().st_size > 0, name
+    for png in out.glob("*.png"):
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", png.name
+    from PIL import Image
+
+    for name in ("spheres.gif", "hole.gif"):
+        path = out / name
+        assert path.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+        assert path.stat().st_size < 5e6, f"{name} is {path.stat().st_size / 1e6:.1f} MB"
+        with Image.open(path) as im:
+            assert im.n_frames > 10
+    assert str(out.resolve()) in proc.stdout  # says where the output went
+
+
+def test_demo_progress_on_stderr(demo):
+    proc, _, _ = demo
+    for stage in ("spheres: planning", "hole: planning", "figures", "animation"):
+        assert stage in proc.stderr, stage
+    assert ("MuJoCo simulation" in proc.stderr) == HAVE_MUJOCO
+    assert "done in" in proc.stderr
+
+
+def test_demo_exit_status_follows_success(demo):
+    proc, _, rep = demo
+    ok = all(s["success"] for s in rep["scenarios"].values())
+    assert proc.returncode == (0 if ok else 1)
+
+
+@pytest.mark.parametrize("name", ["spheres", "hole"])
+def test_report_keys_and_types(demo, name):
+    _, _, rep = demo
+    sc = rep["scenarios"][name]
+    assert isinstance(sc["success"], bool)
+    assert isinstance(sc["targets"], list) and sc["targets"]
+    for tg in sc["targets"]:
+        assert isinstance(tg["name"], str)
+        assert isinstance(tg["position_error_m"], float) and tg["position_error_m"] >= 0
+        assert isinstance(tg["direction_error_deg"], float) and 0 <= tg["direction_error_deg"] <= 180
+    for key in ("min_zmp_margin_m", "min_ground_clearance_m", "planning_time_s"):
+        assert isinstance(sc[key], float), key
+    assert sc["planning_time_s"] > 0
+    if HAVE_MUJOCO:
+        assert isinstance(sc["sim"], dict)
+        for key, typ in SIM_KEYS.items():
+            assert isinstance(sc["sim"][key], typ), key
+        assert sc["sim"]["position_error_m"] >= 0 and sc["sim"]["max_linear_momentum_error"] >= 0
+    else:
+        assert sc["sim"] is None
+    assert sc["paper"]["position_error_m"] == {"spheres": 1.8e-3, "hole": 1.39e-3}[name]
+
+
+def test_report_targets_are_the_papers(demo):
+    _, _, rep = demo
+    names = [tg["name"] for tg in rep["scenarios"]["spheres"]["targets"]]
+    assert names == ["sphere 1", "sphere 2"]
+    assert np.allclose(rep["scenarios"]["spheres"]["targets"][0]["position_m"], [-4.05e-2, 0.5443, 0.3])
+    assert rep["scenarios"]["hole"]["targets"][-1]["name"] == "through the hole"
+    assert rep["versions"]["snakehead"] and rep["machine"]["cores"] >= 1
+    assert rep["run_time_s"] > 0 and rep["stages"]
+
+
+def test_hole_simulated_with_the_wall(demo):
+    _, _, rep = demo
+    if not HAVE_MUJOCO:
+        pytest.skip("MuJoCo not installed")
+    assert any("boxes" in s["stage"] and "0 obstacle" not in s["stage"] and s["stage"].startswith("hole")
+               for s in rep["stages"])
+
+
+def _read_csv(path: Path):
+    with path.open() as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array(rows[1:], float)
+
+
+@pytest.mark.parametrize("name", ["spheres", "hole"])
+def test_trajectory_csv(demo, name):
+    _, out, rep = demo
+    header, data = _read_csv(out / f"{name}_trajectory.csv")
+    assert header == ["time_s"] + [f"joint_{j}_rad" for j in range(1, 17)]
+    sc = rep["scenarios"][name]
+    assert data.shape == (sc["samples"], 17)
+    dt = np.diff(data[:, 0])
+    assert np.all(dt > 0) and np.all(dt <= 0.002 + 1e-6)  # the 2 ms period; the last step may be shorter
+    assert np.allclose(dt[:-1], 0.002, atol=1e-6)
+    assert data[0, 0] == 0.0 and abs(data[-1, 0] - sc["duration_s"]) < 1e-5
+    assert np.all(np.abs(data[:, 1:]) <= np.pi / 2 + 1e-6)  # +-90 deg joint limits
+
+
+@pytest.mark.parametrize("name", ["spheres", "hole"])
+def test_csv_reaches_the_reported_targets(demo, name):
+    """The head by forward kinematics of the CSV's joints at each target's time is as far from the target as the
+    report says (to the 2 ms sampling: the plan is at rest at its waypoints)."""
+    _, out, rep = demo
+    _, data = _read_csv(out / f"{name}_trajectory.csv")
+    sc = rep["scenarios"][name]
+    robot = SnakeRobot.default()
+    base = BasePlacement(sc["base"]["x_m"], sc["base"]["y_m"], sc["base"]["yaw_rad"])
+    for tg in sc["targets"]:
+        k = int(np.argmin(np.abs(data[:, 0] - tg["time_s"])))
+        p = robot.head_pose(data[k, 1:], base)[:3, 3]
+        assert abs(np.linalg.norm(p - tg["position_m"]) - tg["position_error_m"]) < 2e-4, tg["name"]
+
+
+def test_summary(demo):
+    _, out, rep = demo
+    text = (out / "summary.md").read_text()
+    assert "## spheres" in text and "## hole" in text
+    assert "1.800" in text and "1.390" in text  # the paper's position errors (mm) beside ours
+    for name, sc in rep["scenarios"].items():
+        assert f"{1000 * sc['min_zmp_margin_m']:.1f}" in text
+
+
+# ------------------------------------------------------------------------------------------------
+# plan
+# ------------------------------------------------------------------------------------------------
+def test_plan_writes_the_same_kinds_of_files(plan):
+    proc, out, rep = plan
+    for f in ["report.json", "summary.md"] + [f.format("target") for f in SCENARIO_FILES]:
+        assert (out / f).is_file(), f
+    sc = rep["scenarios"]["target"]
+    assert sc["sim"] is None  # --no-sim
+    assert [tg["name"] for tg in sc["targets"]] == ["target"]
+    assert np.allclose(sc["targets"][0]["position_m"], [0.1, 0.5, 0.35])
+    assert np.allclose(sc["targets"][0]["direction"], [0, 1, 0])  # normalised
+    assert proc.returncode == (0 if sc["success"] else 1)
+    header, data = _read_csv(out / "target_trajectory.csv")
+    assert data.shape == (sc["samples"], 17)
+
+
+# ------------------------------------------------------------------------------------------------
+# workspace, help, bad arguments
+# ------------------------------------------------------------------------------------------------
+def test_workspace_writes_a_map(tmp_path):
+    from snakehead import workspace
+
+    path = tmp_path / "map.npz"
+    proc = run("workspace", "--out", str(path), "--part", "head6", "--voxel", "0.2", "--directions", "2",
+               "--rolls", "1", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    m = workspace.load(path)
+    assert m.chain_hash == SnakeRobot.default().head6_chain.hash
+    assert m.voxel_size == 0.2 and m.params["directions"] == 2
+    assert str(path) in proc.stdout
+
+
+@pytest.mark.parametrize("cmd", [[], ["info"], ["demo"], ["plan"], ["workspace"]])
+def test_help(cmd):
+    proc = run(*cmd, "--help", timeout=60)
+    assert proc.returncode == 0
+    assert proc.stdout.startswith("usage: snakehead")
+    if cmd in (["demo"], ["plan"]):
+        assert "--out" in proc.stdout and "--no-sim" in proc.stdout and "report.json" in proc.stdout
+
+
+def test_info():
+    proc = run("info", timeout=60)
+    assert proc.returncode == 0 and "joints: 16" in proc.stdout
+
+
+@pytest.fixture
+def a_file(tmp_path):
+    path = tmp_path / "a_file"
+    path.write_text("not a directory")
+    return path
+
+
+BAD = [
+    (["frobnicate"], "invalid choice"),
+    ([], "required"),
+    (["demo"], "--out"),
+    (["demo", "--out", "{tmp}/o", "--seed", "x"], "not an integer"),
+    (["demo", "--out", "{tmp}/o", "--seed", "-1"], ">= 0"),
+    (["demo", "--out", "{file}"], "not a directory"),
+    (["demo", "--out", "{file}/sub"], "cannot write"),
+    (["demo", "--out", "{tmp}/o", "--map", "{tmp}/missing.npz"], "cannot read the map"),
+    (["plan", "--position", "a", "0", "0.3", "--direction", "0", "1", "0", "--out", "{tmp}/o"], "not a number"),
+    (["plan", "--position", "0", "0.5", "nan", "--direction", "0", "1", "0", "--out", "{tmp}/o"], "finite"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "inf", "0", "--out", "{tmp}/o"], "finite"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "0", "0", "--out", "{tmp}/o"], "zero"),
+    (["plan", "--position", "0", "0.5", "--direction", "0", "1", "0", "--out", "{tmp}/o"], "--position"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "1", "0", "--out", "{file}/sub"], "cannot write"),
+    (["workspace", "--out", "{tmp}/map.txt"], ".npz"),
+    (["workspace", "--out", "{tmp}/nowhere/map.npz"], "does not exist"),
+    (["workspace", "--out", "{tmp}/map.npz", "--voxel", "-0.1"], "positive"),
+    (["workspace", "--out", "{tmp}/map.npz", "--part", "tail"], "invalid choice"),
+    (["workspace", "--out", "{tmp}/map.npz", "--shard", "3/2", "--quiet"], "shard"),
+]
+
+
+@pytest.mark.parametrize("argv,message", BAD, ids=[" ".join(a)[:60] or "(none)" for a, _ in BAD])
+def test_bad_arguments(argv, message, tmp_path, a_file):
+    argv = [a.format(tmp=tmp_path, file=a_file) for a in argv]
+    proc = run(*argv, timeout=120)
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    assert "Traceback" not in proc.stderr
+    assert "error" in proc.stderr and message in proc.stderr, proc.stderr
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())  # nothing half-written
