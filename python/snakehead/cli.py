@@ -226,8 +226,8 @@ def _run_scenario(name: str, plan_fn, controller, out: Path, args, progress: Pro
         paths = [
             scenario_plots.plot_snapshots(robot, result, out / f"{name}_snapshots.png", spheres=spheres,
                                           n_panels=n_panels, columns=cols,
-                                          title=f"{label} (cf. the paper's Fig. {snap}): the body at its states "
-                                                "(collision boxes; axes in m, equal scales)"),
+                                          title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                                "the body at its states (collision boxes; axes in m, equal scales)"),
             scenario_plots.plot_momenta(result, out / f"{name}_momenta.png", sim_result=sim_result,
                                         figures=(mom1, mom2),
                                         title=f"{label}: momenta about the world origin, planned"
@@ -316,7 +316,9 @@ def _plan(args: argparse.Namespace) -> int:
     entries = {"target": _run_scenario(
         "target", lambda c: scenarios.reach_target(c, position, direction, speed=s["speed"],
                                                    min_segment=s["min_segment"]),
-        controller, out, args, progress, label=f"the head to {np.round(position, 4).tolist()} m")}
+        controller, out, args, progress, figures=(None, 18, 19, 20),
+        label=f"the head to ({', '.join(f'{v:g}' for v in position)}) m along "
+              f"({', '.join(f'{v:.3g}' for v in direction)})")}
     return _finish("plan", out, entries, progress, args)
 
 

@@ -206,7 +206,7 @@ def plot_snapshots(robot: SnakeRobot, result, path: str | os.PathLike, *, sphere
     for k, (label, time, q) in enumerate(picks):
         ax = fig.add_subplot(rows, columns, k + 1, projection="3d", computed_zorder=False)
         _setup_axes(ax, lo, hi, elev, azim, labels=False, zoom=1.2)
-        _draw_scenery(ax, result, spheres, arrows=False)
+        _draw_scenery(ax, result, spheres, arrows=not spheres and not result.obstacles)
         _draw_body(ax, robot, robot.frames(q, result.base))
         tip = robot.head_pose(q, result.base)[:3, 3]
         ax.scatter(*tip, color="k", s=6)
@@ -223,7 +223,7 @@ def plot_snapshots(robot: SnakeRobot, result, path: str | os.PathLike, *, sphere
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
     fig.suptitle(title or f"{result.name}: the body at the scenario's states (axes in m, equal scales)", fontsize=11)
     fig.subplots_adjust(left=0.0, right=0.97, bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(),
-                        wspace=0.05, hspace=0.12)
+                        wspace=0.12, hspace=0.12)
     return plots._save(fig, path)
 
 
