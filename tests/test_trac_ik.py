@@ -387,3 +387,18 @@ def test_pose_and_start_forms_accepted(solver7, head7):
     I = np.eye(4, dtype=int)
     I[0, 3] = 5  # out of reach, but a valid pose
     assert TracIK.from_chain(head7, timeout=0.001).ik(I, np.zeros(7)) is None
+
+
+def test_mixed_chain_with_continuous_and_prismatic_joints():
+    # Unbounded (continuous) and prismatic joints; position-only target (all rotation bounds open).
+    from pathlib import Path
+    chain = snakehead.Chain.from_urdf(Path(__file__).parent / "data" / "mixed_chain.urdf", "world", "tool")
+    assert "continuous" in chain.joint_types and "prismatic" in chain.joint_types
+    ik = TracIK.from_chain(chain, timeout=0.02, bounds=[0, 0, 0, np.inf, np.inf, np.inf])
+    rng = np.random.default_rng(10)
+    for _ in range(10):
+        T = chain.fk(chain.random_configuration(rng))
+        q = ik.ik(T)
+        assert q is not None
+        assert np.all(q >= chain.lower) and np.all(q <= chain.upper)
+        assert np.linalg.norm(chain.fk(q)[:3, 3] - T[:3, 3]) <= np.sqrt(3) * EPS
