@@ -198,8 +198,10 @@ def main(argv=None) -> int:
                          + f" {r['failed']}" + ("" if r["parked"] is None else f" ({r['parked']})") + " |")
             print(lines[-1], flush=True)
         if "pytracik" in rows:
-            ratios.append(f"{dof}-DOF: TRAC-IK median / pytracik median = "
-                          f"{rows['TRAC-IK']['median'] / rows['pytracik']['median']:.3f}")
+            ours, theirs = rows["TRAC-IK"]["median"], rows["pytracik"]["median"]
+            ratios.append(f"{dof}-DOF: TRAC-IK median / pytracik median = {ours:.3f} ms / {theirs:.3f} ms = "
+                          f"{ours / theirs:.3f}")
+    load_end = os.getloadavg()
     text = "\n".join(lines + [""] + ratios + ["", NOTES])
     print()
     print("\n".join(ratios))
@@ -214,8 +216,9 @@ def main(argv=None) -> int:
             "Times: wall clock of one call of the compiled solver from Python. Solve rate: solutions verified with "
             "snakehead's FK (within the limits; position error and rotation angle within sqrt(3) epsilon, which any "
             "per-axis test at epsilon implies); 'claimed' when a solver reported more successes than verified.",
-            "", "Machine (`lscpu | head`), load average (1, 5, 15 min) at the start: "
-            f"{' '.join(f'{x:.2f}' for x in load)}", "", "```", *machine()[:10], "```", "", text, ""])
+            "", "Machine (`lscpu | head`); load average (1, 5, 15 min) at the start "
+            f"{' '.join(f'{x:.2f}' for x in load)}, at the end {' '.join(f'{x:.2f}' for x in load_end)} "
+            "(2 cores, shared with other jobs):", "", "```", *machine()[:10], "```", "", text, ""])
         path = HERE / "RESULTS.md"
         old = path.read_text() if path.exists() else "# Benchmark results\n\nEach section is written by the script named in its heading.\n\n"
         pattern = re.compile(re.escape(HEADING) + r".*?(?=^## |\Z)", re.S | re.M)
