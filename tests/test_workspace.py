@@ -362,3 +362,18 @@ def test_sweep_releases_the_gil(robot):
     t.join()
     assert len(seen) >= 3, "the sweep was too quick to tell"
     assert seen[-1] - seen[0] > 1000
+
+
+def test_free_roll_and_z_approach(robot, small):
+    free = ws.compute(robot, progress=False, free_roll=True, **SMALL)
+    assert free.tried == SMALL["directions"] and free.params["free_roll"] and free.params["rolls"] == 0
+    assert 0 <= free.indices.min() and free.indices.max() <= 100
+    # A free roll relaxes the 2 fixed rolls: it reaches at least about as much.
+    assert free.indices.mean() >= small.indices.mean() - 2.0
+    each = ws.compute(robot, progress=False, any_roll=False, **SMALL)
+    assert each.tried == SMALL["directions"] * SMALL["rolls"]
+    # Counting every frame cannot reach more than counting a point when any of its frames is solved.
+    assert each.indices.mean() <= small.indices.mean() + 2.0
+    z = ws.compute(robot, progress=False, approach_axis="z", **SMALL)
+    assert z.params["approach_axis"] == "z" and np.array_equal(z.voxel_ids, small.voxel_ids)
+    assert not np.array_equal(z.solved, small.solved)
