@@ -15,7 +15,6 @@ Positions in m, times in s, world frame z up with the ground at z = 0. Every fun
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 from typing import Sequence
 
@@ -168,9 +167,6 @@ def _view(result) -> tuple[float, float]:
 # ----------------------------------------------------------------------------------------------
 # Figs. 17 / 22
 # ----------------------------------------------------------------------------------------------
-_PROGRESS = re.compile(r" \((\d+)/(\d+)\)$")
-
-
 def snapshot_states(result, n_panels: int = 12) -> list[tuple[str, float, np.ndarray]]:
     """Up to ``n_panels`` of the scenario's states (label, time s, q (16,)) in time order: the first and last,
     every target, then the waypoints nearest to evenly spaced times. Holds are left out."""
