@@ -377,3 +377,31 @@ def test_free_roll_and_z_approach(robot, small):
     z = ws.compute(robot, progress=False, approach_axis="z", **SMALL)
     assert z.params["approach_axis"] == "z" and np.array_equal(z.voxel_ids, small.voxel_ids)
     assert not np.array_equal(z.solved, small.solved)
+
+
+def test_bad_inputs_of_the_helpers(robot, small, tmp_path):
+    with pytest.raises(ValueError, match="centers"):
+        ws.evaluate(robot, [[np.nan, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="centers"):
+        ws.evaluate(robot, [1.0, 2.0])
+    with pytest.raises(ValueError):
+        ws.evaluate(robot, [[0.1, 0.0, 0.0]], voxel=-1.0)
+    with pytest.raises(ValueError):
+        small.index_at([[np.inf, 0.0, 0.0]])
+    with pytest.raises(ValueError):
+        ws.default_map("tail")
+    with pytest.raises(ValueError, match="at least one"):
+        ws.merge([])
+    with pytest.raises(ValueError, match="ReachabilityMap"):
+        ws.merge(["map.npz"])
+    with pytest.raises(ValueError, match="ReachabilityMap"):
+        ws.save("map", tmp_path / "m.npz")
+    with ThreadPoolExecutor(1) as ex:
+        with pytest.raises(ValueError, match="not both"):
+            ws.compute(robot, progress=False, executor=ex, shard=(0, 2), **SMALL)
+        with pytest.raises(ValueError, match="shards"):
+            ws.compute(robot, progress=False, executor=ex, shards=0, **SMALL)
+    with pytest.raises(ValueError, match="executor"):
+        ws.compute(robot, progress=False, shards=2, **SMALL)
+    with pytest.raises(ValueError, match="Executor"):
+        ws.compute(robot, progress=False, executor=object(), **SMALL)
