@@ -218,6 +218,9 @@ def test_bad_chain_and_output(robot, small, tmp_path):
         ws.compute(Chain.from_urdf(robot.urdf, "neck_end", "no_such_link"), progress=False, **SMALL)
     with pytest.raises(ValueError, match="expected a Chain"):
         ws.compute("neck_end", progress=False, **SMALL)
+    # One joint: the tip moves on an arc, whose points span no volume (no hull).
+    with pytest.raises(ValueError, match="no volume"):
+        ws.compute(Chain.from_urdf(robot.urdf, "link_15", "head_tip"), progress=False, **SMALL)
     with pytest.raises(ValueError, match="cannot write"):
         small.save(tmp_path / "no-such-dir" / "map.npz")
     with pytest.raises(ValueError, match=".npz"):
