@@ -64,3 +64,16 @@ def test_bad_parameters(controller):
         sc.catch_spheres(controller, speed=0.0)
     with pytest.raises(ValueError, match="step"):
         sc.through_hole(controller, step=-0.01)
+
+
+def test_wall_stands_on_the_ground():
+    wall = sc.hole_wall()
+    R = wall.rotation
+    centre = wall.centre + R[:, :2] @ wall.hole_offset  # the wall's own centre
+    corners = np.array([centre + R @ (np.array([sx, sy, sz]) * wall.size / 2)
+                        for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    assert corners[:, 2].min() == pytest.approx(0.0, abs=1e-12)
+    assert corners[:, 2].max() == pytest.approx(sc.WALL_SIZE[1])
+    # the hole's centre is in the wall and free; a point of the wall just outside the hole's rim is solid
+    assert wall.distance_to_points(sc.HOLE_CENTRE[None])[0] == pytest.approx(sc.HOLE_DIAMETER / 2)
+    assert wall.distance_to_points((sc.HOLE_CENTRE + [0, 0, -0.05])[None])[0] == 0.0

@@ -49,6 +49,7 @@ DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
 DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
+BASE_STEPS = (0.05, 0.1, 0.15, 0.2)  # m: how far choose_base tries stepping the base back from the targets
 
 
 @dataclass
@@ -238,10 +239,12 @@ def _target(controller: HeadController, name, position, direction, q_prev, base,
     return sol.q
 
 
-def choose_base(controller: HeadController, targets) -> tuple[BasePlacement, list[str]]:
+def choose_base(controller: HeadController, targets, accept=None) -> tuple[BasePlacement, list[str]]:
     """One base placement for a whole scenario: the controller's when every target (position, direction) is
-    solved from it with the body statically stable; otherwise the first of the planar moves that bring a
-    target (or their mean) in the accepted range from which all are. Returns the placement and notes."""
+    solved from it with the body statically stable (and passing ``accept(q, base)`` when given); otherwise the
+    first that does among the planar moves that bring a target (or their mean) into the accepted range, and
+    those placements stepped back from the targets by BASE_STEPS (room for the body in front of an obstacle).
+    Returns the placement and notes."""
     from . import neck as nk
 
     robot = controller.robot
@@ -249,17 +252,24 @@ def choose_base(controller: HeadController, targets) -> tuple[BasePlacement, lis
     P0 = robot.frame(q, robot.parts.base_end, controller.base)
     P0_local = np.linalg.inv(controller.base.matrix()) @ P0
     positions = [np.asarray(p, float) for p, _ in targets]
+    mean = np.mean(positions, axis=0)
     candidates = [controller.base]
-    for p in [np.mean(positions, axis=0)] + positions:
+    for p in [mean] + positions:
         moved = nk.base_move_into_range(p, P0_local, controller.base, controller.Lc, controller.neck_length,
                                         controller.slack)
         if moved is not None:
             candidates.append(moved)
+    for base in list(candidates):
+        away = (base.matrix() @ P0_local)[:2, 3] - mean[:2]
+        if np.linalg.norm(away) > 1e-9:
+            away /= np.linalg.norm(away)
+            candidates += [BasePlacement(float(base.x + d * away[0]), float(base.y + d * away[1]), base.yaw)
+                           for d in BASE_STEPS]
     for k, base in enumerate(candidates):
-        sols = [controller.solve(p, d, base=base) for p, d in targets]
+        sols = [controller.solve(p, d, base=base, accept=accept) for p, d in targets]
         if all(s.success and s.static_stable and not s.base_moved for s in sols):
-            note = [] if k == 0 else [f"the base was moved to {base} (rolling / turning in place) to bring the "
-                                      "targets in range"]
+            note = [] if k == 0 else [f"the base was moved to {base} (rolling / turning in place) so that every "
+                                      "target is reached"]
             return base, note
     return controller.base, ["no single base placement reaches every target stably; kept the controller's"]
 
@@ -291,9 +301,13 @@ def catch_spheres(controller: HeadController | None = None, *, speed: float = 0.
 
 def hole_wall() -> tr.WallWithHole:
     """The wall of Section 4.2 as placed here: standing on the ground, the hole on its vertical centre line."""
-    # The wall's centre is below the hole: its bottom on the ground (z = 0).
+    facing = tr.WallWithHole(centre=HOLE_CENTRE, normal=HOLE_AXIS, size=WALL_SIZE, hole_diameter=HOLE_DIAMETER)
+    # hole_offset is the wall centre's position relative to the hole along the wall's own (width, height)
+    # axes; the wall's centre is half its height above the ground, straight below the hole.
+    centre = np.array([HOLE_CENTRE[0], HOLE_CENTRE[1], WALL_SIZE[1] / 2])
+    offset = (centre - HOLE_CENTRE) @ facing.rotation[:, :2]
     return tr.WallWithHole(centre=HOLE_CENTRE, normal=HOLE_AXIS, size=WALL_SIZE, hole_diameter=HOLE_DIAMETER,
-                           hole_offset=np.array([0.0, WALL_SIZE[1] / 2 - HOLE_CENTRE[2]]))
+                           hole_offset=offset)
 
 
 def through_hole(controller: HeadController | None = None, *, speed: float = 0.12, min_segment: float = 2.0,
@@ -312,12 +326,14 @@ def through_hole(controller: HeadController | None = None, *, speed: float = 0.1
     head_length = float(np.linalg.norm(straight[-1, :3, 3] - straight[head_link, :3, 3]))
     through = HOLE_CENTRE[1] + WALL_SIZE[2] / 2 + head_length - 0.013  # head tip beyond the far face
     start = HOLE_CENTRE - approach * HOLE_AXIS
-    base, notes = choose_base(controller, [(start, HOLE_AXIS), (HOLE_CENTRE, HOLE_AXIS)])
+    def clear_of_wall(q, b) -> bool:  # the solutions kept must leave every link clear of the wall
+        return bool(tr.collision_check(robot, q[None], [wall], b, exact_within=0.005).distance[0] > WALL_CLEARANCE)
+
+    deepest = HOLE_CENTRE + (through - HOLE_CENTRE[1]) * HOLE_AXIS
+    base, notes = choose_base(controller, [(deepest, HOLE_AXIS), (start, HOLE_AXIS)], accept=clear_of_wall)
     plan = _Plan(robot, base, speed, min_segment)
     plan.start("initial state (head lifted)", controller.q_initial)
     targets: list[TargetResult] = []
-    def clear_of_wall(q, b) -> bool:  # the solutions kept must leave every link clear of the wall
-        return bool(tr.collision_check(robot, q[None], [wall], b, exact_within=0.005).distance[0] > WALL_CLEARANCE)
 
     # Poses along the axis, from the approach point to through the wall.
     distances = np.arange(approach, HOLE_CENTRE[1] - through - 1e-9, -step)
