@@ -120,3 +120,13 @@ def test_bad_solve_input(robot, position, direction, message):
         controller.solve(position, direction)
     with pytest.raises(ValueError, match="shape"):
         controller.solve([0.1, 0.5, 0.3], [0, 1, 0], q_prev=np.zeros(5))
+
+
+def test_solution_figure(robot, tmp_path):
+    from snakehead import scenario_plots
+
+    controller = HeadController(robot, method="free_roll", seed=0)
+    sol = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION)
+    path = scenario_plots.plot_head_solution(robot, sol, tmp_path / "solution.png")
+    assert path.exists() and path.stat().st_size > 20_000
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

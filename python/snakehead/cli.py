@@ -159,24 +159,8 @@ def _sim_available() -> bool:
     return importlib.util.find_spec("mujoco") is not None
 
 
-def _wall_note(result) -> list[str]:
-    """A note when a planned wall does not stand on the ground (the simulated one does)."""
-    from . import trajectory as tr
-
-    notes = []
-    for ob in result.obstacles:
-        if isinstance(ob, tr.WallWithHole):
-            slab = ob.slab()
-            bottom = float(slab.centre[2] - 0.5 * np.abs(slab.rotation[2]) @ slab.size)
-            if abs(bottom) > 1e-3:
-                notes.append(f"the planned wall's bottom is at z = {bottom:.3f} m, not on the ground; the simulated "
-                             "wall (sim.wall_with_hole) stands on the ground, so the simulation checks the plan "
-                             "against a wall the planner did not see below the hole")
-    return notes
-
-
 def _run_scenario(name: str, plan_fn, controller, out: Path, args, progress: Progress, *, spheres=(),
-                  sim_obstacles=(), figures=(17, 18, 19, 20), label: str = "") -> dict:
+                  sim_obstacles=(), figures=(17, 18, 19, 20), label: str = "", solution_figure: bool = False) -> dict:
     """Plan one scenario, simulate it (unless --no-sim), write its CSV, figures and animation; its report entry."""
     from . import report, scenario_plots
 
@@ -193,8 +177,11 @@ def _run_scenario(name: str, plan_fn, controller, out: Path, args, progress: Pro
     csv_path = report.write_trajectory_csv(result, out / f"{name}_trajectory.csv",
                                            [f"joint_{j + 1}" for j in range(robot.n_joints)])
     files.append(csv_path.name)
+    if solution_figure and result.targets:
+        path = scenario_plots.plot_head_solution(robot, result.targets[0].solution, out / f"{name}_solution.png")
+        files.append(path.name)
 
-    sim_result, metrics, notes = None, None, _wall_note(result)
+    sim_result, metrics, notes = None, None, []
     if args.no_sim:
         notes.append("dynamics check skipped (--no-sim)")
     elif not _sim_available():
@@ -318,7 +305,7 @@ def _plan(args: argparse.Namespace) -> int:
                                                    min_segment=s["min_segment"]),
         controller, out, args, progress, figures=(None, 18, 19, 20),
         label=f"the head to ({', '.join(f'{v:g}' for v in position)}) m along "
-              f"({', '.join(f'{v:.3g}' for v in direction)})")}
+              f"({', '.join(f'{v:.3g}' for v in direction)})", solution_figure=True)}
     return _finish("plan", out, entries, progress, args)
 
 

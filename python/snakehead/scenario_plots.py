@@ -344,3 +344,74 @@ def animate(robot: SnakeRobot, result, path: str | os.PathLike, *, spheres: Sequ
     anim.save(path, writer=PillowWriter(fps=fps), dpi=dpi)
     plt.close(fig)
     return path
+
+
+# ----------------------------------------------------------------------------------------------
+# one head solution: the robot in 3-D and the neck geometry of Fig. 8
+# ----------------------------------------------------------------------------------------------
+def plot_head_solution(robot: SnakeRobot, solution, path: str | os.PathLike) -> Path:
+    """A ``HeadController`` solution: the body in 3-D (left) and the neck geometry of Fig. 8 (right).
+
+    Right: in the vertical plane through P0 and the target, P0 (end of the base), G0 (where the dexterous
+    centre should go: the target), P_d and r_d (Eqs. 19-20: the desired neck end), and the neck end B0 and its
+    x-axis r_a that Eq. 22 reached; the neck and head drawn as their joint chain. Lengths in m.
+    """
+    plt = _plt()
+    frames = robot.frames(solution.q, solution.base)
+    fig = plt.figure(figsize=(12, 5.5))
+    ax = fig.add_subplot(1, 2, 1, projection="3d")
+    _draw_body(ax, robot, frames)
+    p, d = solution.desired_frame[:3, 3], 0.08 * solution.desired_frame[:3, 0]
+    ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.2, arrow_length_ratio=0.3)
+    pts = frames[:, :3, 3]
+    lo = np.minimum(pts.min(axis=0), p) - 0.08
+    hi = np.maximum(pts.max(axis=0), p) + 0.08
+    _setup_axes(ax, lo, hi, elev=22.0, azim=-60.0)
+    ax.set_title(f"head at the target: {1000 * solution.position_error:.4f} mm, {solution.direction_error:.4f} deg\n"
+                 f"static margin {1000 * solution.static_margin:.1f} mm", fontsize=9)
+
+    ax2 = fig.add_subplot(1, 2, 2)
+    g = solution.neck_goal
+    if g is not None and solution.neck is not None:
+        # the plane through P0 spanned by the horizontal direction to G0 and the vertical
+        u = g.G0 - g.P0
+        u[2] = 0.0
+        u = u / np.linalg.norm(u) if np.linalg.norm(u) > 1e-9 else np.array([1.0, 0.0, 0.0])
+
+        def plane(x):
+            x = np.atleast_2d(np.asarray(x, float)) - g.P0
+            return np.column_stack([x @ u, x[:, 2]])
+
+        start = robot.link_names.index(robot.parts.base_end)
+        chain = plane(pts[start:])
+        ax2.plot(chain[:, 0], chain[:, 1], "-o", color=_HEAD, ms=3, lw=1.5, label="neck and head joints (projected)")
+        neck_end = robot.link_names.index(robot.parts.neck_end)
+        ax2.plot(*plane(pts[start:neck_end + 1]).T, "-o", color=_NECK, ms=4, lw=2.5, label="neck")
+        P0, G0, Pd = plane(g.P0)[0], plane(g.G0)[0], plane(g.P_d)[0]
+        ax2.plot(*np.vstack([P0, G0]).T, ":", color="k", lw=1)
+        ax2.plot(*P0, "s", color=_BASE, ms=8, label="P0 (end of the base)")
+        ax2.plot(*G0, "*", color=_SPHERE, ms=14, label="G0 = target (Eq. 19)")
+        ax2.plot(*Pd, "D", color="k", ms=6, mfc="none", label="P_d (Eq. 20)")
+        B0 = plane(solution.neck.frame[:3, 3])[0]
+        ra = solution.neck.frame[:3, 0]
+        rd_dir = plane(g.P0 + g.r_d)[0] - P0
+        ra_dir = plane(g.P0 + ra)[0] - P0
+        ax2.plot(*B0, "o", color=_NECK, ms=8, mfc="white", label="B0 reached (Eq. 22)")
+        ax2.quiver(*Pd, *(0.08 * rd_dir), angles="xy", scale_units="xy", scale=1, color="k", width=0.004,
+                   label="r_d")
+        ax2.quiver(*B0, *(0.08 * ra_dir), angles="xy", scale_units="xy", scale=1, color=_NECK, width=0.004,
+                   label="r_a")
+        ax2.axhline(-g.P0[2], color=plots._GROUND, lw=2)
+        ax2.set_aspect("equal")
+        ax2.set_xlabel("horizontal distance from P0 towards the target (m)")
+        ax2.set_ylabel("height above P0 (m)")
+        ax2.set_title(f"Fig. 8: the neck end frame; L_c = {g.Lc:.3f} m; |P_a - P_d| = "
+                      f"{1000 * solution.neck.position_error:.1f} mm, angle(r_a, r_d) = "
+                      f"{solution.neck.direction_error_deg:.1f} deg", fontsize=9)
+        ax2.legend(fontsize=7, loc="lower right")
+        ax2.grid(alpha=0.3)
+    else:
+        ax2.text(0.5, 0.5, "no neck goal: " + solution.message, ha="center", va="center", wrap=True)
+        ax2.set_axis_off()
+    fig.suptitle("HeadController solution (Section 2.4, Fig. 8)")
+    return plots._save(fig, path)
