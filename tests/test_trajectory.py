@@ -548,3 +548,11 @@ def test_joint_trajectory_monotone_method_and_bad_method():
     assert traj.q.max() <= 1.0 + 1e-12
     with pytest.raises(ValueError, match="method"):
         tr.joint_trajectory(times, way, method="cubic")
+
+
+def test_sample_times_never_adds_a_sample_a_hair_after_the_last():
+    for t1 in (1.0, 1.0 + 1e-9, 1.0 + 5e-7, 1.0 + 2e-6, 36.000000013):
+        t = tr.sample_times(0.0, t1)
+        assert t[0] == 0.0 and t[-1] == t1
+        d = np.diff(t)
+        assert d.min() > 1e-6 and d.max() <= 0.002 + 1e-6

@@ -135,12 +135,16 @@ def test_dask_local_cluster(robot, small):
 
 
 def test_chain_with_executor_needs_its_urdf(robot, small):
-    chain = robot.head_chain
+    from snakehead import Chain
+
+    chain = robot.head_chain  # made by Chain.from_urdf: it knows its URDF
+    bare = Chain(chain.model)  # made from a model alone: it does not
     with ThreadPoolExecutor(1) as ex:
         with pytest.raises(ValueError, match="urdf="):
-            ws.compute(chain, progress=False, executor=ex, **SMALL)
-        m = ws.compute(chain, progress=False, executor=ex, shards=2, urdf=robot.urdf, **SMALL)
+            ws.compute(bare, progress=False, executor=ex, **SMALL)
+        m = ws.compute(bare, progress=False, executor=ex, shards=2, urdf=robot.urdf, **SMALL)
         assert m.same_map_as(small)
+        assert ws.compute(chain, progress=False, executor=ex, shards=2, **SMALL).same_map_as(small)
         six = robot.head6_chain
         with pytest.raises(ValueError, match="different kinematics"):
             ws.compute(six, progress=False, executor=ex, urdf=_other_urdf(robot), **SMALL)

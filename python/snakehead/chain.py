@@ -17,8 +17,10 @@ class Chain:
     moving segments, but every link on the path (fixed ones included) has a frame in ``fk_all``.
     """
 
-    def __init__(self, model: _core.ChainModel):
+    def __init__(self, model: _core.ChainModel, urdf: str | None = None):
         self._model = model
+        #: The URDF the chain was read from (a path or the XML), when known: lets workers rebuild it.
+        self.urdf = urdf
 
     @classmethod
     def from_urdf(cls, urdf: str | os.PathLike, base: str, tip: str) -> "Chain":
@@ -33,7 +35,7 @@ class Chain:
             raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
         if not isinstance(base, str) or not isinstance(tip, str):
             raise TypeError("base and tip must be link names (str)")
-        return cls(_core.ChainModel.from_urdf(urdf, base, tip))
+        return cls(_core.ChainModel.from_urdf(urdf, base, tip), urdf)
 
     # --- description -------------------------------------------------------------------------
     @property

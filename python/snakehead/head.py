@@ -142,7 +142,10 @@ def free_roll(ik: TracIK, target, q_init=None, attempts: int = 1) -> HeadIKResul
     tried = 0
     for attempt in range(max(1, int(attempts))):
         tried += 1
-        q = ik.ik(target, q_init=q0 if attempt == 0 else None, bounds=FREE_ROLL_BOUNDS)
+        # Later attempts restart from fixed pseudo-random joints (a seeded solver given no start would
+        # start every attempt from the same point, and an unseeded one would not be reproducible).
+        start = q0 if attempt == 0 else np.random.default_rng(attempt).uniform(ik.lower, ik.upper)
+        q = ik.ik(target, q_init=start, bounds=FREE_ROLL_BOUNDS)
         if q is not None:
             break
     candidates = [] if q is None else [(np.nan, q)]

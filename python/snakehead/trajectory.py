@@ -119,7 +119,9 @@ def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray
     dt = positive(dt, "dt")
     steps = int(np.floor((t1 - t0) / dt + 1e-9))
     t = t0 + dt * np.arange(steps + 1)
-    if t1 - t[-1] > 1e-9 * max(1.0, abs(t1)):
+    # A gap under a microsecond is round-off, not a sample: stretch the last step to t1 instead of adding a
+    # sample a hair after it (two samples closer than any controller or file can tell apart).
+    if t1 - t[-1] > min(1e-6, 1e-3 * dt):
         t = np.append(t, t1)
     t[-1] = t1
     return t

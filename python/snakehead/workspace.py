@@ -354,7 +354,7 @@ def _urdf_text(chain_or_robot, urdf) -> str:
     source = urdf if urdf is not None else getattr(chain_or_robot, "urdf", None)
     if source is None:
         raise ValueError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
-                         "pass a SnakeRobot, or urdf= (a path or the XML) with a Chain")
+                         "pass a SnakeRobot or a Chain made by Chain.from_urdf, or urdf= (a path or the XML)")
     source = os.fspath(source) if isinstance(source, os.PathLike) else source
     if not isinstance(source, str):
         raise ValueError("urdf must be a path or an XML string")
