@@ -143,7 +143,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float = 1e-12):
+def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float = 1e-9):
     """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
     r, J = residual(q)
     cost = float(r @ r)
@@ -161,7 +161,8 @@ def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float
         r_new, J_new = residual(q_new)
         cost_new = float(r_new @ r_new)
         if cost_new < cost:
-            done = cost - cost_new < tol * max(cost, 1e-30) or np.abs(q_new - q).max() < 1e-12
+            # The neck needs no more than ~1e-9 rad: the head's IK absorbs what the neck leaves.
+            done = cost - cost_new < tol * max(cost, 1e-30) or np.abs(q_new - q).max() < 1e-9
             q, r, J, cost = q_new, r_new, J_new, cost_new
             lam = max(lam / 10, 1e-12)
             if done:
