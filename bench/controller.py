@@ -11,13 +11,13 @@ frame they give (position and x-axis) is the target, so every target is reachabl
 from __future__ import annotations
 
 import argparse
-import platform
 import time
 
 import numpy as np
 
 from snakehead import SnakeRobot, scenarios
 from snakehead.controller import HeadController
+from snakehead.report import cpu_name
 
 
 def run(controller: HeadController, targets) -> dict:
@@ -62,8 +62,8 @@ def main() -> None:
     rng = np.random.default_rng(args.seed)
     paper = [(scenarios.SPHERE_1, scenarios.SPHERE_DIRECTION), (scenarios.SPHERE_2, scenarios.SPHERE_DIRECTION),
              (scenarios.HOLE_CENTRE, scenarios.HOLE_AXIS)]
-    print(f"# HeadController.solve, {platform.processor() or platform.machine()}, {time.strftime('%Y-%m-%d')}")
-    print(f"| method | targets | n | success % | statically stable % | median ms | mean ms | p95 ms "
+    print(f"# HeadController.solve, {cpu_name()}, {time.strftime('%Y-%m-%d')}")
+    print("| method | targets | n | success % | statically stable % | median ms | mean ms | p95 ms "
           "| max position error mm | max direction error deg |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for method in ("free_roll", "rotated"):

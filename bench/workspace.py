@@ -21,6 +21,7 @@ import numpy as np
 
 from snakehead import SnakeRobot
 from snakehead import workspace as ws
+from snakehead.report import cpu_name
 
 PAPER = {  # Table 2 and Section 2.2 of the paper
     "head": {"bins": [8.22, 15.87, 16.96, 25.80, 33.15], "max": 100.0, "above90": 14.79, "at100": 3.69},
@@ -29,16 +30,7 @@ PAPER = {  # Table 2 and Section 2.2 of the paper
 
 
 def machine() -> str:
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+    return f"{cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
 def table2() -> None:

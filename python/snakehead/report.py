@@ -113,16 +113,20 @@ def environment() -> dict:
             versions[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:
             versions[dist] = None
-    cpu = platform.processor() or platform.machine()
+    return {"machine": {"cpu": cpu_name(), "cores": os.cpu_count(), "system": platform.platform()},
+            "versions": versions}
+
+
+def cpu_name() -> str:
+    """The CPU's model name (Linux: /proc/cpuinfo), else what ``platform`` knows."""
     try:
         with open("/proc/cpuinfo") as f:
             for line in f:
                 if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
+                    return line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return {"machine": {"cpu": cpu, "cores": os.cpu_count(), "system": platform.platform()}, "versions": versions}
+    return platform.processor() or platform.machine()
 
 
 def write_json(report: dict, path: str | os.PathLike) -> Path:

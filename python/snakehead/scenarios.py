@@ -381,11 +381,11 @@ def reach_target(controller: HeadController | None = None, position=None, direct
     speed, min_segment, hold = positive(speed, "speed"), positive(min_segment, "min_segment"), positive(hold, "hold")
     robot = controller.robot
     obstacles = list(obstacles)
-    accept = None
-    if obstacles:
-        def accept(q, b) -> bool:
-            return bool(tr.collision_check(robot, q[None], obstacles, b).distance[0] > WALL_CLEARANCE)
-    base, notes = choose_base(controller, [(position, direction)])
+    def clear(q, b) -> bool:
+        return bool(tr.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0] > WALL_CLEARANCE)
+
+    accept = clear if obstacles else None
+    base, notes = choose_base(controller, [(position, direction)], accept=accept)
     plan = _Plan(robot, base, speed, min_segment)
     plan.start("initial state (head lifted)", controller.q_initial)
     targets: list[TargetResult] = []
