@@ -34,6 +34,7 @@ def check(result, robot):
     assert result.stability.inside.all(), f"ZMP outside at t = {result.t[result.stability.argmin]:.3f} s"
     below = tr.below_ground(robot, result.q, result.base)
     assert not below.any()
+    assert tr.self_clearance(robot, result.q[::5], result.base).min() > 0  # no two links overlap
     assert np.all(np.diff(result.t) > 0) and result.q.shape == (len(result.t), 16)
     assert np.all(result.q >= robot.lower - 1e-9) and np.all(result.q <= robot.upper + 1e-9)
     assert result.success
@@ -41,6 +42,10 @@ def check(result, robot):
 
 def test_spheres(spheres, controller):
     check(spheres, controller.robot)
+    # the paper's phases: lying straight, bending, lifting the head, then the targets
+    labels = [lab for lab, _, _ in spheres.states]
+    assert labels[0] == "current state (lying straight)" and "bending state" in labels
+    np.testing.assert_array_equal(spheres.states[0][2], 0.0)
     names = [t.name for t in spheres.targets]
     assert names == ["sphere 1", "sphere 2"]
 
@@ -77,3 +82,28 @@ def test_wall_stands_on_the_ground():
     # the hole's centre is in the wall and free; a point of the wall just outside the hole's rim is solid
     assert wall.distance_to_points(sc.HOLE_CENTRE[None])[0] == pytest.approx(sc.HOLE_DIAMETER / 2)
     assert wall.distance_to_points((sc.HOLE_CENTRE + [0, 0, -0.05])[None])[0] == 0.0
+
+
+def test_bending_state(controller):
+    robot = controller.robot
+    q = sc.bending_state(controller)
+    np.testing.assert_array_equal(q[robot.parts.base], controller.q_initial[robot.parts.base])
+    pitch = np.abs(np.asarray(robot.body.model.joint_axes)[:, 1]) > 0.5
+    np.testing.assert_array_equal(q[pitch], 0.0)  # everything lies flat on the ground
+    clearance = tr.ground_clearance(robot, q)[0]
+    boxed = np.isfinite(clearance)
+    np.testing.assert_allclose(clearance[boxed], 0.0, atol=1e-12)
+    assert tr.self_clearance(robot, q)[0] > sc.BENDING_CLEARANCE
+    # once lifted, only the base supports: the curl keeps the whole body's CoM over the base's polygon
+    from snakehead import stability
+
+    assert stability.static_margin(robot, q) > 0.02
+
+
+def test_self_clearance_detects_overlap(controller):
+    robot = controller.robot
+    assert tr.self_clearance(robot, np.zeros(16))[0] == pytest.approx(0.0865)  # straight: a module apart
+    q = sc.bending_state(controller)
+    yaw_up = [8, 10, 12, 14]
+    q[yaw_up] = np.radians([90, 90, 0, 0])  # curls the head across the base: link_14 lies on link_4
+    assert tr.self_clearance(robot, q)[0] < 0

@@ -1,17 +1,16 @@
 """The paper's Section 4, end to end: catching two virtual spheres, and getting the head through a hole in a wall.
 
-Each scenario strings the control process of Section 3.3 together: from the initial state of Section 3.3 (1)
+Each scenario strings the control process of Section 3.3 together: up to the initial state of Section 3.3 (1)
 (the base on its optimised arc, the neck and head on the Bezier backbone, ``backbone.initial_configuration``),
 the head targets are solved by ``HeadController`` and joined by whole-body moves (Section 3.2: the Cartesian
 interpolation of Eqs. 41-44 where it is valid, else joint space; see ``_Plan.move``), sampled at the 2 ms
 control period by the multi-segment interpolation; the result is checked for the ZMP inside the support
 polygon, ground clearance and (for the hole) collision with the wall.
 
-Not planned here: the paper's first phases, from the robot lying on the ground to the initial state. On the
-default robot the neck and head (1.7 kg) outweigh the base (1.5 kg): lifting them as a cantilever from the
-end of the base tips the body over whatever the interpolation, so that lift needs the head to stay on the
-ground until its mass is over the base (a support the paper's model leaves out); the scenarios start from
-the initial state.
+The first phases follow the paper's figures: the current state (lying straight), the bending state (the base on
+its arc, the neck and head curled flat on the ground inside it: ``bending_state``) and the lift to the initial
+state. On the default robot the neck and head (1.7 kg) outweigh the base (1.5 kg): lifted as a cantilever beyond
+P0 they would tip the body, so they are curled over the base before they rise.
 
 Choices the paper leaves open, and ours:
 - The spheres are caught with the head pointing along +y, the scene's forward direction (as for the hole);
@@ -49,6 +48,9 @@ DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
 DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
+LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
+BENDING_GRID_DEG = 15.0  # deg: grid of the neck and head's yaw joints searched for the bending state
+BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the bending state
 BASE_STEPS = (0.05, 0.1, 0.15, 0.2)  # m: how far choose_base tries stepping the base back from the targets
 
 
@@ -154,16 +156,19 @@ class _Plan:
         return method
 
     def _margins(self, qs: np.ndarray) -> np.ndarray:
-        """Static margins (m) of configurations qs (m, 16) that share this move's base (the paper's polygon)."""
-        poly = stability.support_polygon(self.robot, qs[0], self.base)
-        com = stability.center_of_mass(self.robot, qs, self.base)
-        pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
-        return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
+        """Static margins (m) of configurations qs (m, 16): the CoM's distance inside the support polygon of
+        every link lying on the ground (``contact="ground"``; once the head is up, the base's footprint)."""
+        still = np.zeros_like(qs)
+        dyn = stability.dynamic_stability(self.robot, np.arange(len(qs), dtype=float), qs, self.base, still,
+                                          contact="ground")
+        return dyn.margin  # with no motion the ZMP is the CoM's ground projection
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
-        """(m,) bool: above the ground and statically stable with DETOUR_MARGIN to spare."""
+        """(m,) bool: above the ground, no two non-neighbouring links overlapping, and statically stable with
+        DETOUR_MARGIN to spare."""
         clearance = tr.ground_clearance(self.robot, qs, self.base)[:, tr.non_base_links(self.robot)].min(axis=1)
-        return (clearance >= -tr.GROUND_TOLERANCE) & (self._margins(qs) >= DETOUR_MARGIN)
+        return ((clearance >= -tr.GROUND_TOLERANCE) & (tr.self_clearance(self.robot, qs, self.base) > 0.0)
+                & (self._margins(qs) >= DETOUR_MARGIN))
 
     def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
         """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
@@ -221,6 +226,36 @@ def _finish(name, plan: _Plan, targets, t_start, obstacles=(), notes=()) -> Scen
                           stability=dyn, ground_clearance=clearance, obstacles=list(obstacles),
                           obstacle_distance=distance, planning_time_s=time.perf_counter() - t_start,
                           notes=notes, segments=list(plan.methods))
+
+
+def bending_state(controller: HeadController) -> np.ndarray:
+    """The bending state (Figs. 17b, 22a): the base on its arc and the neck and head curled flat on the ground
+    inside it, so that lifting them keeps their mass over the base (16,).
+
+    On the default robot the neck and head (1.7 kg) outweigh the base (1.5 kg): lifted from a straight line
+    beyond P0 they tip the body. Here the pitch joints are 0 (everything lies on the ground) and the neck and
+    head's yaw joints are chosen on a 15 deg grid for the largest static margin over the base's support polygon
+    alone (the support left once they are lifted), among the curls in which no two non-neighbouring links
+    overlap. Deterministic."""
+    robot = controller.robot
+    q = np.zeros(robot.n_joints)
+    q[robot.parts.base] = controller.q_initial[robot.parts.base]
+    up = np.arange(robot.parts.neck.start, robot.parts.head.stop)
+    yaw = up[np.abs(np.asarray(robot.body.model.joint_axes)[up, 2]) > 0.5]  # about the link's z: yaw when flat
+    grid = np.radians(np.arange(-90.0, 90.0 + 1e-9, BENDING_GRID_DEG))
+    combos = np.stack(np.meshgrid(*[grid] * len(yaw), indexing="ij"), -1).reshape(-1, len(yaw))
+    qs = np.tile(q, (len(combos), 1))
+    qs[:, yaw] = np.clip(combos, robot.lower[yaw], robot.upper[yaw])
+    poly = stability.support_polygon(robot, q)  # the base's, placement-independent in its own frame
+    com = stability.center_of_mass(robot, qs)
+    pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
+    margin = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
+    order = np.argsort(-margin)
+    for chunk in np.array_split(order[margin[order] > 0], max(1, int(np.sum(margin > 0)) // 500 + 1)):
+        ok = tr.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
+        if ok.any():
+            return qs[chunk[np.argmax(ok)]]
+    raise ValueError("no curl of the neck and head on the ground keeps their mass over the base")
 
 
 def _target(controller: HeadController, name, position, direction, q_prev, base, plan: _Plan,
@@ -287,7 +322,9 @@ def catch_spheres(controller: HeadController | None = None, *, speed: float = 0.
     robot = controller.robot
     base, notes = choose_base(controller, [(SPHERE_1, SPHERE_DIRECTION), (SPHERE_2, SPHERE_DIRECTION)])
     plan = _Plan(robot, base, speed, min_segment)
-    plan.start("initial state (head lifted)", controller.q_initial)
+    plan.start("current state (lying straight)", np.zeros(robot.n_joints))
+    plan.move("bending state", bending_state(controller))
+    plan.move("initial state (head lifted)", controller.q_initial, n=LIFT_STEPS)
     targets: list[TargetResult] = []
 
     q = _target(controller, "sphere 1", SPHERE_1, SPHERE_DIRECTION, controller.q_initial, base, plan, targets, notes)
@@ -332,7 +369,8 @@ def through_hole(controller: HeadController | None = None, *, speed: float = 0.1
     deepest = HOLE_CENTRE + (through - HOLE_CENTRE[1]) * HOLE_AXIS
     base, notes = choose_base(controller, [(deepest, HOLE_AXIS), (start, HOLE_AXIS)], accept=clear_of_wall)
     plan = _Plan(robot, base, speed, min_segment)
-    plan.start("initial state (head lifted)", controller.q_initial)
+    plan.start("bending state", bending_state(controller))
+    plan.move("initial state (head lifted)", controller.q_initial, n=LIFT_STEPS)
     targets: list[TargetResult] = []
 
     # Poses along the axis, from the approach point to through the wall.

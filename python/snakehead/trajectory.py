@@ -509,6 +509,21 @@ def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement):
     return links, B[..., :3, 3], B[..., :3, :3], 0.5 * robot.box_sizes[links]
 
 
+def self_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -> np.ndarray:
+    """Self-collision of the body along a trajectory: (T,) the smallest separating-axis gap (m) between the
+    collision boxes of any two links that are not neighbours in the chain (neighbours share a joint and
+    always touch there). > 0: no two such boxes meet (and this is a lower bound of their distance); <= 0: some
+    overlap. qs (T, 16) or (16,) -> (1,).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    qs = _trajectory(robot, qs)
+    links, c, R, h = _link_boxes(robot, qs, base)
+    i, j = np.triu_indices(len(links), k=2)  # boxed links two or more apart in the chain
+    gaps = box_box_sat(c[:, i], R[:, i], h[i], c[:, j], R[:, j], h[j])  # (T, pairs)
+    return gaps.min(axis=1)
+
+
 def _broadcast_boxes(ca, Ra, ha, cb, Rb, hb):
     """Broadcast two batches of boxes (centres (..., 3), rotations (..., 3, 3), half extents (..., 3))."""
     arrs = [np.asarray(v, float) for v in (ca, Ra, ha, cb, Rb, hb)]
