@@ -42,10 +42,10 @@ def check(result, robot):
 
 def test_spheres(spheres, controller):
     check(spheres, controller.robot)
-    # the paper's phases: lying straight, bending, lifting the head, then the targets
+    # the paper's phases: the bending state (on the ground), lifting the head, then the targets
     labels = [lab for lab, _, _ in spheres.states]
-    assert labels[0] == "current state (lying straight)" and "bending state" in labels
-    np.testing.assert_array_equal(spheres.states[0][2], 0.0)
+    assert labels[0] == "bending state" and "initial state (head lifted)" in labels
+    np.testing.assert_array_equal(spheres.states[0][2], sc.bending_state(controller))
     names = [t.name for t in spheres.targets]
     assert names == ["sphere 1", "sphere 2"]
 
