@@ -95,3 +95,21 @@ def test_unreachable_target_fails_cleanly(ik):
 def test_bad_input(ik, call, message):
     with pytest.raises(ValueError, match=message):
         call(ik)
+
+
+def test_angle_between_against_closed_form():
+    assert head.angle_between_deg([1, 0, 0], [0, 2, 0]) == pytest.approx(90.0)
+    assert head.angle_between_deg([1, 1, 0], [1, 0, 0]) == pytest.approx(45.0)
+    assert head.angle_between_deg([0, 0, 3], [0, 0, -1]) == pytest.approx(180.0)
+
+
+def test_rotated_frames_accept_filters_candidates(ik, chain):
+    T = reachable_targets(chain, 1, seed=9)[0]
+    every = head.rotated_frames(ik, T, n_frames=8)
+    assert every.solved >= 2
+    keep = lambda q: q[0] >= every.q[0]  # noqa: E731  (rejects some solutions, keeps the unfiltered choice)
+    some = head.rotated_frames(ik, T, n_frames=8, accept=keep)
+    assert some.solved == every.solved  # solutions found, before the test
+    assert all(keep(q) for _, q in some.candidates)
+    none = head.rotated_frames(ik, T, n_frames=8, accept=lambda q: False)
+    assert not none.success and none.solved == every.solved and none.candidates == []

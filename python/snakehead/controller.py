@@ -176,10 +176,8 @@ class HeadController:
         if self.method == "rotated" or (accept is not None and head.success and not accepted(head.q)):
             # The paper's rolled frames give a set of candidates to choose from (also when the free-roll
             # solution fails the caller's test).
-            head = head_ik.rotated_frames(self.ik, target, self.n_frames, q_init=q[parts.head], q_prev=q_close)
-            if accept is not None and head.success and not accepted(head.q):
-                kept = [c for c in head.candidates if accepted(c[1])]
-                head = head_ik.rotated_result(self.ik, target, head_ik.select(kept, q_close), head, kept)
+            head = head_ik.rotated_frames(self.ik, target, self.n_frames, q_init=q[parts.head], q_prev=q_close,
+                                          accept=None if accept is None else accepted)
         timings["head"] = time.perf_counter() - t0
         if head.success:
             q[parts.head] = head.q

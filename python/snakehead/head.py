@@ -49,11 +49,17 @@ def roll_about_x(T, angle: float) -> np.ndarray:
     return out
 
 
+def angle_between_deg(a, b) -> float:
+    """Angle (deg) between two directions (3,), e.g. an achieved and a desired head x-axis."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    cosang = float(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0))
+    return float(np.degrees(np.arccos(cosang)))
+
+
 def position_and_direction_error(achieved, desired) -> tuple[float, float]:
     """|p_a - p_d| (m) and the angle between the x-axes (deg) of two frames (4, 4)."""
     achieved, desired = np.asarray(achieved), np.asarray(desired)
-    cosang = float(np.clip(achieved[:3, 0] @ desired[:3, 0], -1.0, 1.0))
-    return float(np.linalg.norm(achieved[:3, 3] - desired[:3, 3])), float(np.degrees(np.arccos(cosang)))
+    return float(np.linalg.norm(achieved[:3, 3] - desired[:3, 3])), angle_between_deg(achieved[:3, 0], desired[:3, 0])
 
 
 @dataclass
@@ -88,22 +94,15 @@ def _finish(ik: TracIK, q, target, tried, solved, t0, candidates) -> HeadIKResul
     return HeadIKResult(q, T, pe, de, _roll_between(T, target), tried, solved, time.perf_counter() - t0, candidates)
 
 
-def rotated_result(ik: TracIK, target, q, previous: HeadIKResult, candidates) -> HeadIKResult:
-    """A result like ``previous`` but keeping ``q`` (None: nothing kept) among ``candidates``."""
-    res = _finish(ik, q, np.asarray(target, float), previous.tried, len(candidates), 0.0, candidates)
-    res.seconds = previous.seconds
-    if q is None:
-        res.solved = previous.solved  # solutions were found, none kept
-    return res
-
-
-def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=None) -> HeadIKResult:
+def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=None, accept=None) -> HeadIKResult:
     """The paper's method: solve ``n_frames`` frames rolled evenly about the target's x-axis, keep one.
 
     ``target`` (4, 4) is the desired head frame in the head chain's base frame (its roll is the preferred
     one). Each rolled frame is solved from ``q_init`` (or ``q_prev``, or zeros). The kept solution is the
     one closest to ``q_prev`` in joint space when ``q_prev`` is given (Section 4.2: the smallest change from
-    the previous state), else the one whose frame is closest to ``target`` (smallest roll).
+    the previous state), else the one whose frame is closest to ``target`` (smallest roll). ``accept``: an
+    optional test ``accept(q) -> bool`` of a head solution; only accepted solutions are candidates (``solved``
+    still counts every solution found).
     """
     target = pose(target, "target")
     if int(n_frames) != n_frames or n_frames < 1:
@@ -117,9 +116,9 @@ def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=N
     angles = 2 * np.pi * np.arange(int(n_frames)) / n_frames
     # All rolled frames at once: the batch call spreads them over every core.
     qs, ok = ik.ik_many(np.stack([roll_about_x(target, a) for a in angles]), np.tile(seed_q, (len(angles), 1)))
-    candidates = [(float(a), q) for a, q, good in zip(angles, qs, ok) if good]
-    best = select(candidates, q_prev)
-    return _finish(ik, best, target, int(n_frames), len(candidates), t0, candidates)
+    found = [(float(a), q) for a, q, good in zip(angles, qs, ok) if good]
+    candidates = found if accept is None else [c for c in found if accept(c[1])]
+    return _finish(ik, select(candidates, q_prev), target, int(n_frames), len(found), t0, candidates)
 
 
 def select(candidates, q_prev=None):

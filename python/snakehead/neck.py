@@ -12,6 +12,7 @@ import numpy as np
 
 from ._validate import finite_array, positive, vector3
 from .chain import Chain
+from .head import angle_between_deg
 from .robot import BasePlacement, SnakeRobot
 
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
@@ -133,10 +134,9 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
         if k == 0 or cost < best_cost - CONTINUITY_TOLERANCE:
             best_q, best_cost = q, cost
     T = P0_frame @ neck.fk(best_q)
-    cosang = float(np.clip(T[:3, 0] @ goal.r_d, -1.0, 1.0))
     return NeckSolution(q=best_q, frame=T, cost=float(best_cost),
                         position_error=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
-                        direction_error_deg=float(np.degrees(np.arccos(cosang))))
+                        direction_error_deg=angle_between_deg(T[:3, 0], goal.r_d))
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

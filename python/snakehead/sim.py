@@ -53,6 +53,7 @@ from typing import Sequence
 import numpy as np
 
 from ._validate import finite_array, positive
+from .head import angle_between_deg
 from .robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
@@ -754,7 +755,7 @@ def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=
         x = np.array([np.interp(time, result.t, result.head_direction[:, i]) for i in range(3)])
         x /= np.linalg.norm(x)
         pos_err.append(float(np.linalg.norm(p - pos)))
-        dir_err.append(float(np.degrees(np.arccos(np.clip(x @ dirn, -1.0, 1.0)))))
+        dir_err.append(angle_between_deg(x, dirn))
 
     # planned momenta on the simulated ticks within the plan
     inside = result.t <= planned_t[-1] + 1e-9
