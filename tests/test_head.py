@@ -113,3 +113,10 @@ def test_rotated_frames_accept_filters_candidates(ik, chain):
     assert all(keep(q) for _, q in some.candidates)
     none = head.rotated_frames(ik, T, n_frames=8, accept=lambda q: False)
     assert not none.success and none.solved == every.solved and none.candidates == []
+
+
+@pytest.mark.parametrize("a,b,message", [([0, 0, 0], [1, 0, 0], "zero length"), ([1, 0], [1, 0, 0], "shape"),
+                                          ([np.nan, 0, 1], [1, 0, 0], "NaN")])
+def test_angle_between_bad_input(a, b, message):
+    with pytest.raises(ValueError, match=message):
+        head.angle_between_deg(a, b)

@@ -107,3 +107,9 @@ def test_self_clearance_detects_overlap(controller):
     yaw_up = [8, 10, 12, 14]
     q[yaw_up] = np.radians([90, 90, 0, 0])  # curls the head across the base: link_14 lies on link_4
     assert tr.self_clearance(robot, q)[0] < 0
+
+
+@pytest.mark.parametrize("qs", [np.zeros(15), np.zeros((3, 4)), np.full(16, np.nan)])
+def test_self_clearance_bad_input(controller, qs):
+    with pytest.raises(ValueError):
+        tr.self_clearance(controller.robot, qs)

@@ -51,8 +51,8 @@ def roll_about_x(T, angle: float) -> np.ndarray:
 
 def angle_between_deg(a, b) -> float:
     """Angle (deg) between two directions (3,), e.g. an achieved and a desired head x-axis."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    cosang = float(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0))
+    a, b = unit_vector3(a, "direction a"), unit_vector3(b, "direction b")
+    cosang = float(np.clip(a @ b, -1.0, 1.0))
     return float(np.degrees(np.arccos(cosang)))
 
 
