@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from snakehead import BasePlacement, SnakeRobot, sim
+from snakehead.sim import tracking
 from snakehead.dynamics import stability
 
 Q_A = np.array([0.879, 0.0, 0.879, 0.0, 0.879, 0.0, 0.879, 0.0,
@@ -62,11 +63,11 @@ def plan(dt: float = 0.002):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=None, help="directory for the figures (PNG)")
-    ap.add_argument("--kp", type=float, default=sim.DEFAULT_KP)
-    ap.add_argument("--kd", type=float, default=sim.DEFAULT_KD)
+    ap.add_argument("--kp", type=float, default=tracking.DEFAULT_KP)
+    ap.add_argument("--kd", type=float, default=tracking.DEFAULT_KD)
     ap.add_argument("--torque-limit", type=float, default=10.0,
                     help="N m; the URDF's 3 N m cannot lift the head part (see RESULTS.md)")
-    ap.add_argument("--gravity-compensation", default="supported", choices=sim.GRAVITY_COMPENSATION)
+    ap.add_argument("--gravity-compensation", default="supported", choices=tracking.GRAVITY_COMPENSATION)
     args = ap.parse_args()
 
     robot = SnakeRobot.default()
@@ -115,7 +116,7 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
           f"python {platform.python_version()}")
     if args.out:
-        from snakehead.sim_plots import plot_dynamics_check
+        from snakehead.viz.sim import plot_dynamics_check
 
         for p in plot_dynamics_check(robot, t, q, res, args.out, base):
             print("wrote", p)
