@@ -113,44 +113,48 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
     if settings.figures:
-        files += _figures(scene, result, sim_result, out, s, progress, solution_figure)
+        files += _figures(scene, result, sim_result, out, s, progress, solution_figure, controller.map)
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return entry
 
 
-def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, solution_figure: bool) -> list[str]:
-    from ..viz import scenario as scenario_plots
+def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, solution_figure: bool,
+             workspace_map=None) -> list[str]:
+    """The figures, the GIF and the 3-D viewer's files of one scene; their names."""
+    from ..viz import animation, body, dynamics, save, viewer
 
     robot = result.robot
     name = scene.name
     paper = rep.PAPER.get(name, {})
     snap, mom, zmp = paper.get("figures", (None, None, None))
-    spheres = [(t.position, t.sphere_diameter) for t in scene.targets if t.sphere_diameter is not None]
     label = scene.description or name
+    spheres = body.plan_spheres(result)
     files = []
     with progress.stage(f"{name}: figures"):
         if solution_figure and result.targets:
-            files.append(scenario_plots.plot_head_solution(robot, result.targets[0].solution,
-                                                           out / f"{name}_solution.png").name)
+            files.append(save(body.plot_head_solution(robot, result.targets[0].solution),
+                              out / f"{name}_solution.png").name)
         cols = 4 if len(result.targets) + 2 > 9 or len(spheres) else 3
         n_panels = 12 if cols == 4 else 9
-        paths = [
-            scenario_plots.plot_snapshots(robot, result, out / f"{name}_snapshots.png", spheres=spheres,
-                                          n_panels=n_panels, columns=cols,
-                                          title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                                "the body at its states (collision boxes; axes in m, equal scales)"),
-            scenario_plots.plot_momenta(result, out / f"{name}_momenta.png", sim_result=sim_result,
-                                        figures=mom or (None, None),
-                                        title=f"{label}: momenta about the world origin, planned"
-                                              + (" and simulated" if sim_result is not None else "")),
-            scenario_plots.plot_zmp(robot, result, out / f"{name}_zmp.png", sim_result=sim_result, figure=zmp,
-                                    title=f"{label}: zero-moment point"),
-        ]
-        files += [p.name for p in paths]
+        simulated = " and simulated" if sim_result is not None else ""
+        figures = {
+            "snapshots": body.plot_snapshots(result, n_panels=n_panels, columns=cols,
+                                             title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                                   "the body at its states (collision boxes; axes in m, equal scales)"),
+            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
+                                             figures=mom or (None, None),
+                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
+            "zmp": dynamics.plot_zmp(robot, result.t, result.q, base=result.base, stability=result.stability,
+                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
+        }
+        files += [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
     with progress.stage(f"{name}: animation"):
-        files.append(scenario_plots.animate(robot, result, out / f"{name}.gif", spheres=spheres,
-                                            max_frames=s["max_frames"]).name)
+        files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
+    with progress.stage(f"{name}: 3-D viewer page"):
+        data = viewer.viewer_scene(result, workspace_map=workspace_map, title=label)
+        files.append(viewer.save_viewer_scene(data, out / f"{name}{viewer.SCENE_SUFFIX}").name)
+        files.append(viewer.write_html(data, out / f"{name}.html").name)
     return files
 
 

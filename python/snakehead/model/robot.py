@@ -311,6 +311,13 @@ class SnakeRobot:
         return axes
 
     @cached_property
+    def joint_frames(self) -> np.ndarray:
+        """(n,) index (link_names) of each joint's frame: the link it moves, whose frame sits on the joint."""
+        child = np.asarray(self.body.model.joint_child_links, dtype=np.intp)
+        child.setflags(write=False)
+        return child
+
+    @cached_property
     def joint_kinds(self) -> tuple[str, ...]:
         """Each joint's kind: ``"yaw"`` (axis +-z of the root frame) or ``"pitch"`` (+-y)."""
         return tuple(YAW if abs(a[2]) > 0.5 else PITCH for a in self.joint_axes)
