@@ -244,7 +244,6 @@ def test_the_page_shows_the_robot_and_the_slider_moves_it(browser, planned, scen
         img = _settled_screenshot(browser)
         share, mask = _robot_seen(img, scene, k, _canvas_rect(browser))
         shots.append((k, share, mask, img))
-        print("SHOT", fraction, t_shown, k, share, mask.sum())
     from PIL import Image
 
     for (k, share, mask, img), name in zip(shots, ("start", "end")):

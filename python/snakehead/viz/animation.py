@@ -4,8 +4,9 @@
 
 Why not ``matplotlib.animation.FuncAnimation``: saving one redraws the whole 3-D figure (axes, ticks, grid, walls)
 twice per frame. Here the still part of the picture is drawn once and every frame draws only what moves -- the
-body, the head tip's trace and the clock -- over a copy of it (blitting). The picture is the same: in these axes
-the moving artists are drawn after the scenery anyway (``computed_zorder=False``).
+body, the head tip's trace and the clock -- over a copy of it (blitting), followed by the still artists that a full
+draw puts over the body (higher ``zorder``, e.g. the rim of a wall's hole), so that each frame is the picture a full
+draw would make (``computed_zorder=False``: artists are drawn by zorder, then in the order they were added).
 """
 from __future__ import annotations
 
@@ -53,7 +54,12 @@ class BodyAnimation:
         ax = fig.axes[0]
         body, trace, clock = self._artists
         tip = self._frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
-        for artist in (body, trace, clock):
+        # what a full draw puts after the body: the trace and any still artist of a higher zorder, in draw order
+        added = [a for a in ax.get_children() if a in (*ax.collections, *ax.lines, *ax.patches, *ax.texts)]
+        over = sorted([a for a in added if a is not body and (a is trace or a.get_zorder() > body.get_zorder())],
+                      key=lambda a: a.get_zorder())  # stable: equal zorders keep the order they were added in
+        moving = [body, *over, clock]
+        for artist in moving:
             artist.set_animated(True)  # left out of the full draw: the background is everything else
         canvas.draw()
         background = canvas.copy_from_bbox(fig.bbox)
@@ -64,11 +70,11 @@ class BodyAnimation:
             body.do_3d_projection()
             trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
             clock.set_text(f"{plan.name}: t = {self.times[k]:5.1f} s  (x{self._speedup:.1f} speed)")
-            ax.draw_artist(body)
-            ax.draw_artist(trace)
+            for artist in (body, *over):
+                ax.draw_artist(artist)
             fig.draw_artist(clock)
             yield Image.frombuffer("RGBA", (width, height), bytes(canvas.buffer_rgba()), "raw", "RGBA", 0, 1)
-        for artist in (body, trace, clock):
+        for artist in moving:
             artist.set_animated(False)
 
     def write_gif(self, file: IO[bytes]) -> None:
