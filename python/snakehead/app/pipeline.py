@@ -56,13 +56,15 @@ def mujoco_available() -> bool:
 @dataclass
 class Settings:
     """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
-    figures: write figures and the animation."""
+    figures: write figures, the animation and the 3-D viewer's page; parallel: draw what needs only the plan in a
+    second process while MuJoCo simulates (Linux)."""
 
     method: str = "rotated"
     seed: int | None = 1
     fast: bool = False
     simulate: bool = True
     figures: bool = True
+    parallel: bool = True
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
@@ -86,6 +88,10 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
+    drawing = None
+    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates
+        drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
+                          progress, parallel=settings.parallel)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -112,43 +118,34 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
-    if settings.figures:
-        files += _figures(scene, result, sim_result, out, s, progress, solution_figure, controller.map)
+    if drawing is not None:
+        files += _dynamics_figures(scene, result, sim_result, out, progress)
+        files += drawing.files()
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return entry
 
 
-def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, solution_figure: bool,
-             workspace_map=None) -> list[str]:
-    """The figures, the GIF and the 3-D viewer's files of one scene; their names."""
-    from ..viz import animation, body, dynamics, save, viewer
+def _plan_outputs(scene, result, out: Path, s: dict, progress: Progress, solution_figure: bool,
+                  workspace_map=None) -> list[str]:
+    """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
+    from ..viz import animation, body, save, viewer
 
     robot = result.robot
     name = scene.name
-    paper = rep.PAPER.get(name, {})
-    snap, mom, zmp = paper.get("figures", (None, None, None))
+    snap = rep.PAPER.get(name, {}).get("figures", (None, None, None))[0]
     label = scene.description or name
-    spheres = body.plan_spheres(result)
     files = []
     with progress.stage(f"{name}: figures"):
         if solution_figure and result.targets:
             files.append(save(body.plot_head_solution(robot, result.targets[0].solution),
                               out / f"{name}_solution.png").name)
-        cols = 4 if len(result.targets) + 2 > 9 or len(spheres) else 3
+        cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3
         n_panels = 12 if cols == 4 else 9
-        simulated = " and simulated" if sim_result is not None else ""
-        figures = {
-            "snapshots": body.plot_snapshots(result, n_panels=n_panels, columns=cols,
-                                             title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                                   "the body at its states (collision boxes; axes in m, equal scales)"),
-            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
-                                             figures=mom or (None, None),
-                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
-            "zmp": dynamics.plot_zmp(robot, result.t, result.q, base=result.base, stability=result.stability,
-                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
-        }
-        files += [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
+        snapshots = body.plot_snapshots(result, n_panels=n_panels, columns=cols,
+                                        title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                              "the body at its states (collision boxes; axes in m, equal scales)")
+        files.append(save(snapshots, out / f"{name}_snapshots.png").name)
     with progress.stage(f"{name}: animation"):
         files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
     with progress.stage(f"{name}: 3-D viewer page"):
@@ -156,6 +153,71 @@ def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, 
         files.append(viewer.save_viewer_scene(data, out / f"{name}{viewer.SCENE_SUFFIX}").name)
         files.append(viewer.write_html(data, out / f"{name}.html").name)
     return files
+
+
+def _dynamics_figures(scene, result, sim_result, out: Path, progress: Progress) -> list[str]:
+    """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
+    from ..viz import dynamics, save
+
+    name = scene.name
+    _, mom, zmp = rep.PAPER.get(name, {}).get("figures", (None, None, None))
+    label = scene.description or name
+    simulated = " and simulated" if sim_result is not None else ""
+    with progress.stage(f"{name}: momenta and ZMP figures"):
+        figures = {
+            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
+                                             figures=mom or (None, None),
+                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
+            "zmp": dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base, stability=result.stability,
+                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
+        }
+        return [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
+
+
+class _Beside:
+    """Runs ``work(progress)`` (-> list of file names) beside the caller: in a forked child process on Linux, so
+    that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
+    elsewhere, or with ``parallel=False``. :meth:`files` waits for it; the child's stage times join ``progress``."""
+
+    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True):
+        import multiprocessing
+
+        self.progress = progress
+        self.proc = None
+        if not (parallel and sys.platform.startswith("linux")):
+            self._files = work(progress)
+            return
+        ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
+        self.recv, send = ctx.Pipe(duplex=False)
+        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-figures", daemon=True)
+        self.proc.start()
+        send.close()
+
+    def files(self) -> list[str]:
+        if self.proc is None:
+            return self._files
+        try:
+            ok, value, stages = self.recv.recv()
+        except EOFError:
+            self.proc.join()
+            raise RuntimeError(f"the process drawing the figures died (exit code {self.proc.exitcode})") from None
+        self.proc.join()
+        self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
+        if not ok:
+            raise RuntimeError(f"drawing the figures failed: {value}")
+        return value
+
+
+def _child(work: Callable[[Progress], list[str]], progress: Progress, send) -> None:
+    import traceback
+
+    progress.stages = []
+    try:
+        send.send((True, work(progress), progress.stages))
+    except BaseException as exc:  # noqa: BLE001 -- reported to the parent, which raises
+        send.send((False, f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}", progress.stages))
+    finally:
+        send.close()
 
 
 def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None, workspace_map=None,

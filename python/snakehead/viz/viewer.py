@@ -159,7 +159,6 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     head's ``workspace_map`` (a map of the robot's head chain, in the head's base frame) and the support polygons
     of ``contact`` (the contact model the plan was checked with)."""
     from ..dynamics import stability as st
-    from .dynamics import distinct_support_polygons
 
     if not (np.isfinite(frame_step_s) and frame_step_s > 0):
         raise ValueError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
@@ -186,11 +185,15 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     else:
         voxels, indices, voxel_size = np.zeros((0, 3)), np.zeros(0), 0.0
 
-    # the support polygons: a few distinct ones; each frame stands on the first that equals its own
-    polys = distinct_support_polygons(robot, plan.q, plan.base, contact)
+    # the support polygon of each frame; the frames share a few distinct ones (the base keeps its shape)
+    polys: list[np.ndarray] = []
     of_frame = np.zeros(len(idx), np.int32)
     for k, qk in enumerate(q):
         poly = st.support_polygon(robot, qk, plan.base, contact=contact)
+        last = polys[of_frame[k - 1]] if k else None
+        if last is not None and last.shape == poly.shape and np.allclose(last, poly, atol=1e-6):
+            of_frame[k] = of_frame[k - 1]
+            continue
         match = [i for i, p in enumerate(polys) if p.shape == poly.shape and np.allclose(p, poly, atol=1e-6)]
         if not match:
             polys.append(poly)
