@@ -97,7 +97,7 @@ class HeadController:
         self.base = base_pose if base_pose is not None else BasePlacement()
         if not isinstance(self.base, BasePlacement):
             raise TypeError("base_pose must be a BasePlacement")
-        self.neck_length = self.robot.neck_length
+        self.neck_length = self.robot.lift_length  # the part of the neck that can lift (all of it, usually)
         self.slack = positive(slack, "slack") if slack is not None else self.neck_length / 2
         self.allow_base_move = bool(allow_base_move)
         if base_configuration is None:
@@ -133,7 +133,7 @@ class HeadController:
         if not isinstance(base, BasePlacement):
             raise TypeError("base must be a BasePlacement")
         desired = head_ik.frame_from_direction(position, direction)
-        P0_frame = self.robot.frame(q, self.robot.parts.base_end, base)
+        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         check = nk.accepted_range(position, P0_frame[:3, 3], self.Lc, self.neck_length, self.slack)
         solution = self._solve_from(base, q, desired, q_prev is not None, accept)
         if not check.accepted:
@@ -163,10 +163,14 @@ class HeadController:
         position = desired[:3, 3]
 
         t0 = time.perf_counter()
-        P0_frame = self.robot.frame(q, parts.base_end, base)
+        # Eqs. 18-22 pivot on P0; on a neck that begins with yaw joints, on the frame where its lifting begins
+        # (the joints before it keep the initial state's angles: see SnakeRobot.lift_joints)
+        lift = self.robot.lift_joints
+        q[parts.neck.start:lift.start] = self.q_initial[parts.neck.start:lift.start]
+        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         goal = nk.neck_goal(P0_frame[:3, 3], position, self.Lc)
-        neck = nk.solve_neck(self.robot.neck_chain, P0_frame, goal, q_init=q[parts.neck])
-        q[parts.neck] = neck.q
+        neck = nk.solve_neck(self.robot.lift_chain, P0_frame, goal, q_init=q[lift])
+        q[lift] = neck.q
         timings["neck"] = time.perf_counter() - t0
 
         # Step 4: the head, from the neck end frame B0.

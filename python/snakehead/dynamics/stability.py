@@ -462,10 +462,29 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
-    # build the hull once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
-    # round-off in a still base does not split it): the base joints decide the base's contacts; with
-    # contact="ground" also the joints before the last link on the ground (those after it move nothing that
-    # touches)
+    flying = ~np.all(np.isfinite(p), axis=1)
+    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance)
+    margin[flying] = -np.inf  # no ZMP: the body would leave the ground
+    inside = margin > 0.0
+    k = int(np.argmin(margin))
+    return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
+
+
+def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None, *, contact: str = "endpoints",
+                    tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+    """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
+    (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
+
+    The polygon is built once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    round-off in a still base does not split it): the base joints decide the base's contacts; with
+    contact="ground" also the joints before the last link on the ground (those after it move nothing that
+    touches).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q, _ = _joint_matrix(robot, q)
+    xy = finite_array(xy, "xy", (q.shape[0], 2))
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
         boxed = robot.boxed_links
@@ -483,9 +502,4 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
     pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
     idx, count = _hull_vertices(pts, active)
-    flying = ~np.all(np.isfinite(p), axis=1)
-    margin = _margins(pts[inv], idx[inv], count[inv], np.where(flying[:, None], 0.0, p))
-    margin[flying] = -np.inf  # no ZMP: the body would leave the ground
-    inside = margin > 0.0
-    k = int(np.argmin(margin))
-    return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
+    return _margins(pts[inv], idx[inv], count[inv], xy)
