@@ -127,7 +127,7 @@ def plot_zmp(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, *, base: Bas
         z = simulated.zmp
         ax.plot(z[:, 0], z[:, 1], "-", color=SIMULATED_COLOR, lw=0.7, alpha=0.8, label="ZMP simulated (MuJoCo)",
                 zorder=5)
-        margins_sim = zmp_margins(robot, simulated, t, q, base)
+        margins_sim = zmp_margins(robot, simulated, t, q, base, contact=contact)
     fig.colorbar(sc, ax=ax, label="t (s)", shrink=0.8)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
@@ -139,7 +139,7 @@ def plot_zmp(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, *, base: Bas
     ax2.plot(t, 1000 * dyn.margin, color=PLANNED_COLOR, lw=1.8, label="planned ZMP")
     if simulated is not None and margins_sim is not None:
         ax2.plot(simulated.t, 1000 * margins_sim, color=SIMULATED_COLOR, lw=0.8,
-                 label="simulated ZMP (footprint polygon)")
+                 label=f"simulated ZMP ({contact} polygon)")
     ax2.axhline(0, color="k", lw=1)
     ax2.set_xlabel("t (s)")
     ax2.set_ylabel("distance to the polygon's edge (mm, > 0 inside)")
