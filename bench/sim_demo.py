@@ -118,7 +118,6 @@ def main() -> None:
     if args.out:
         from pathlib import Path
 
-        from snakehead.dynamics import stability
         from snakehead.viz import dynamics, save
 
         P, L = stability.momenta(robot, t, q, base)
