@@ -8,6 +8,8 @@ import tempfile
 from pathlib import Path
 from typing import IO, Iterator
 
+from typing import Any
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -20,7 +22,7 @@ _FILE_MODE = 0o666 & ~_umask()
 
 
 @contextlib.contextmanager
-def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs) -> Iterator[IO]:
+def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs: Any) -> Iterator[IO]:
     """Open a temporary file beside ``path`` for writing; on success it replaces ``path``, on any error it is
     removed and ``path`` is left as it was. ``mode`` is "w" (text; ``kwargs`` go to ``open``) or "wb"."""
     if mode not in ("w", "wb"):

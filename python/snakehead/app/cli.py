@@ -26,6 +26,8 @@ import numpy as np
 
 from .pipeline import FAST, NORMAL
 
+from typing import Any, Callable
+
 
 class UsageError(Exception):
     """A mistake in the command line or its input files: reported on stderr, exit status 2."""
@@ -101,7 +103,7 @@ def _robot(args: argparse.Namespace):
     return SnakeRobot.from_file(args.robot)
 
 
-def _map(args: argparse.Namespace, robot):
+def _map(args: argparse.Namespace, robot: SnakeRobot):
     """The map given with --map (checked against the robot's head), else None (the pipeline finds one)."""
     from ..kinematics import workspace
 
@@ -140,13 +142,13 @@ def _info(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 # demo and plan
 # ----------------------------------------------------------------------------------------------
-def _settings(args):
+def _settings(args: argparse.Namespace):
     from .pipeline import Settings
 
     return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)
 
 
-def _done(command: str, out: Path, report: dict, progress) -> int:
+def _done(command: str, out: Path, report: dict, progress: Any) -> int:
     entries = report["scenarios"]
     ok = all(e["success"] for e in entries.values())
     progress.say(f"done in {progress.elapsed():.1f} s")
@@ -296,7 +298,7 @@ _OUTPUTS = """outputs (in DIR):
 """
 
 
-def _planning_parser(sub, name: str, func, help_text: str, description: str) -> argparse.ArgumentParser:
+def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: str, description: str) -> argparse.ArgumentParser:
     p = sub.add_parser(name, help=help_text, description=description, epilog=_OUTPUTS,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_planning_options(p)

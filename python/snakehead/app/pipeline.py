@@ -17,6 +17,13 @@ from typing import Callable, Sequence
 
 from . import report as rep
 
+from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..kinematics.workspace import ReachabilityMap
+    from ..scenes.scene import Scene
+
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
 FAST = {"speed": 0.24, "min_segment": 1.0, "max_frames": 30}
@@ -26,7 +33,7 @@ NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
 class Progress:
     """Stage lines on stderr (``[  12.3 s] what ...`` / ``... done in 1.2 s``) and a record of the stage times."""
 
-    def __init__(self, quiet: bool = False, stream=None):
+    def __init__(self, quiet: bool = False, stream: Any=None) -> None:
         self.t0 = time.perf_counter()
         self.quiet = quiet
         self.stream = stream
@@ -72,7 +79,7 @@ class Settings:
                 "min_segment_s": s["min_segment"], "simulation": bool(self.simulate and mujoco_available())}
 
 
-def run_scene(scene, controller, out: Path, settings: Settings, progress: Progress, *,
+def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
               solution_figure: bool = False) -> dict:
     """One scene through the pipeline; its report entry (``report.scenario_entry``) with the files written."""
     from ..motion.planner import plan
@@ -126,8 +133,8 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
     return entry
 
 
-def _plan_outputs(scene, result, out: Path, s: dict, progress: Progress, solution_figure: bool,
-                  workspace_map=None) -> list[str]:
+def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progress, solution_figure: bool,
+                  workspace_map: ReachabilityMap | None=None) -> list[str]:
     """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
     from ..viz import animation, body, save, viewer
 
@@ -155,7 +162,7 @@ def _plan_outputs(scene, result, out: Path, s: dict, progress: Progress, solutio
     return files
 
 
-def _dynamics_figures(scene, result, sim_result, out: Path, progress: Progress) -> list[str]:
+def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress) -> list[str]:
     """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
     from ..viz import dynamics, save
 
@@ -179,7 +186,7 @@ class _Beside:
     that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
     elsewhere, or with ``parallel=False``. :meth:`files` waits for it; the child's stage times join ``progress``."""
 
-    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True):
+    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True) -> None:
         import multiprocessing
 
         self.progress = progress
@@ -208,7 +215,7 @@ class _Beside:
         return value
 
 
-def _child(work: Callable[[Progress], list[str]], progress: Progress, send) -> None:
+def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
     import traceback
 
     progress.stages = []
@@ -220,7 +227,7 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send) -> N
         send.close()
 
 
-def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None, workspace_map=None,
+def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController | None=None, robot: SnakeRobot | None=None, workspace_map: ReachabilityMap | None=None,
                settings: Settings | None = None, progress: Progress | None = None, command: str = "plan",
                notes: Sequence[str] = (), solution_figure: bool = False,
                on_controller: Callable | None = None) -> dict:
@@ -269,5 +276,5 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None
     return report
 
 
-def _map_label(m) -> str:
+def _map_label(m: Any) -> str:
     return str(m.path) if getattr(m, "path", None) is not None else "computed in this run"

@@ -25,6 +25,9 @@ import numpy as np
 
 from .._files import atomic_open, write_text_atomic
 
+import numpy.typing as npt
+from typing import Any
+
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
 #: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
 PAPER = {
@@ -41,7 +44,7 @@ SIM_KEYS = ("position_error_m", "direction_error_deg", "max_linear_momentum_erro
             "zmp_inside")
 
 
-def jsonable(x):
+def jsonable(x: npt.ArrayLike):
     """``x`` with numpy scalars and arrays turned into Python numbers and lists, non-finite floats into None,
     tuples into lists and dict keys into strings (recursively)."""
     if isinstance(x, dict):
@@ -64,7 +67,7 @@ def jsonable(x):
     return str(x)
 
 
-def scenario_entry(result, sim_metrics: dict | None = None, *, extra: dict | None = None) -> dict:
+def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict | None = None) -> dict:
     """The report entry of one planned scenario (``snakehead.scenarios.ScenarioResult``).
 
     ``sim_metrics``: the dict of :func:`snakehead.sim.compare` (None without a dynamics check). ``extra``: more
@@ -139,7 +142,7 @@ def write_json(report: dict, path: str | os.PathLike) -> Path:
     return write_text_atomic(path, json.dumps(jsonable(report), indent=2, allow_nan=False) + "\n")
 
 
-def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
+def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
     """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
     time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)
@@ -157,7 +160,7 @@ def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str]
     return path
 
 
-def _fmt(x, scale: float = 1.0, digits: int = 2) -> str:
+def _fmt(x: np.ndarray, scale: float = 1.0, digits: int = 2) -> str:
     if x is None:
         return "-"
     if isinstance(x, bool):

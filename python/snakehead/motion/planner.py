@@ -34,6 +34,9 @@ from ..scenes.scene import Scene, Target
 from . import interpolation as interp
 from .cartesian import tracking_interpolation
 
+import numpy.typing as npt
+from typing import Any, Sequence
+
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
 DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
@@ -148,7 +151,7 @@ class Plan:
 class _Waypoints:
     """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
 
-    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles=()):
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles: Sequence[Any]=()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
         self.speed, self.min_segment = speed, min_segment
@@ -157,10 +160,10 @@ class _Waypoints:
         self.times: list[float] = []
         self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
 
-    def start(self, label: str, q):
+    def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
 
-    def move_joint(self, label: str, q, duration: float | None = None):
+    def move_joint(self, label: str, q: npt.ArrayLike, duration: float | None = None) -> None:
         """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
         the straight step is not safe throughout."""
         q = np.asarray(q, float)
@@ -174,7 +177,7 @@ class _Waypoints:
         self.labels.append(label)
         self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
 
-    def move(self, label: str, q, n: int = 12) -> str:
+    def move(self, label: str, q: npt.ArrayLike, n: int = 12) -> str:
         """A whole-body move from the last state to q (Section 3.2); returns the method used.
 
         First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
@@ -241,7 +244,7 @@ class _Waypoints:
         worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
         return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
 
-    def hold(self, seconds: float):
+    def hold(self, seconds: float) -> None:
         self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
 
     def sample(self, notes: list) -> interp.JointTrajectory:
@@ -256,7 +259,7 @@ class _Waypoints:
         return traj
 
 
-def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), scene=None) -> Plan:
+def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any]=(), notes: list[str]=(), scene: Scene | None=None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
@@ -347,7 +350,7 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[BasePlacement, np.ndarray,
+def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any]=()) -> tuple[BasePlacement, np.ndarray,
                                                                            Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
@@ -360,13 +363,13 @@ def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[Base
     obstacles = list(obstacles)
     targets = list(targets)
 
-    def clear(q, b) -> bool:
+    def clear(q: np.ndarray, b: Any) -> bool:
         if not obstacles:
             return True
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
-    def failing(b, q_shape):
+    def failing(b: Any, q_shape: Any):
         """The first target not solved from this base (None: all are), or the start state in an obstacle."""
         if not clear(bending_state(controller, q_shape), b):
             return "the start", None
@@ -411,7 +414,7 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
 
 
-def _solve(controller: HeadController, position, direction, q_prev, base, obstacles, name: str, notes: list,
+def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray, base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list,
            near: bool = False):
     """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
     from ..control.whole_body import solve_target
@@ -423,7 +426,7 @@ def _solve(controller: HeadController, position, direction, q_prev, base, obstac
     return sol
 
 
-def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Scene:
+def as_scene(targets: Any, *, obstacles: Sequence[Any]=(), base: BasePlacement | None = None) -> Scene:
     """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
     import os
 
@@ -440,7 +443,7 @@ def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Sce
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
 
 
-def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
+def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles: Sequence[Any]=(),
          base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
          speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).

@@ -72,7 +72,7 @@ class Target:
     via: bool = False
     sphere_diameter: float | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
         object.__setattr__(self, "position", vector3(self.position, f"target {self.name!r} position"))
@@ -108,7 +108,7 @@ class Scene:
     description: str = ""
     path: Path | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         targets = tuple(self.targets)
         if not targets:
             raise ValueError(f"scene {self.name!r} has no targets")

@@ -59,6 +59,9 @@ from .._validate import finite_array, positive
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
+import numpy.typing as npt
+from typing import Any
+
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
 
@@ -86,7 +89,7 @@ def _mujoco():
 DEFAULT_HOLE_SLICES = 32
 
 
-def obstacle_boxes(obstacles, hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
+def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
     """The scene's obstacles as MuJoCo can collide them: boxes.
 
     A :class:`~snakehead.geometry.obstacles.WallWithHole` becomes the boxes of the wall around its hole, the round
@@ -137,7 +140,7 @@ def _f(x: float) -> str:
     return repr(float(x))
 
 
-def _vec(v) -> str:
+def _vec(v: npt.ArrayLike) -> str:
     return " ".join(_f(x) for x in np.asarray(v, float).ravel())
 
 
@@ -167,7 +170,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
 
 
 
-def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
+def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
         lim = np.asarray(robot.body.model.effort, float)
@@ -180,7 +183,7 @@ def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
 
 
 def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
-               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit=None,
+               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None=None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                contact_solref: tuple = (0.005, 1.0)) -> str:
     """MJCF text of the robot (free-floating root) on a ground plane, with optional obstacle boxes.
@@ -282,7 +285,7 @@ class SimModel:
     robot_geoms: np.ndarray
     torque_limit: np.ndarray
 
-    def set_state(self, data, q, base: BasePlacement | None = None, lift: float = 0.0) -> None:
+    def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
         """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
         mj = _mujoco()
         T = self.robot.root_pose(base)
@@ -293,7 +296,7 @@ class SimModel:
         data.qpos[self.qpos_adr] = q
         mj.mj_forward(self.model, data)
 
-    def frames(self, data) -> np.ndarray:
+    def frames(self, data: Any) -> np.ndarray:
         """World poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics)."""
         out = np.zeros((len(self.body_ids), 4, 4))
         out[:, :3, :3] = data.xmat[self.body_ids].reshape(-1, 3, 3)
@@ -302,7 +305,7 @@ class SimModel:
         return out
 
 
-def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
+def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
     """Compile :func:`build_mjcf` (same keyword arguments) into a :class:`SimModel`."""
     mj = _mujoco()
     robot = as_robot(robot)

@@ -19,6 +19,8 @@ from ..dynamics import stability as st
 from ..model.robot import BasePlacement, SnakeRobot
 from ._common import PLANNED_COLOR, SIMULATED_COLOR, new_figure
 
+from typing import Any
+
 if TYPE_CHECKING:
     from ..sim.tracking import SimResult
 
@@ -70,7 +72,7 @@ def plot_momenta(t: npt.ArrayLike, P: npt.ArrayLike, L: npt.ArrayLike, *, simula
     return fig
 
 
-def _base_footprint(ax, robot: SnakeRobot, frames: np.ndarray) -> None:
+def _base_footprint(ax: Any, robot: SnakeRobot, frames: np.ndarray) -> None:
     """The base's boxes seen from above (grey)."""
     for li in robot.base_links:
         if not np.all(robot.box_sizes[li] > 0):

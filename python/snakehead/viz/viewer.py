@@ -291,7 +291,7 @@ class SceneNodes:
 
     LAYERS = ("robot", "reachability map", "ZMP and support polygon", "targets", "obstacles", "head tip path")
 
-    def __init__(self, scene_api: viser.SceneApi, data: ViewerScene, root: str = "/snakehead"):
+    def __init__(self, scene_api: viser.SceneApi, data: ViewerScene, root: str = "/snakehead") -> None:
         self.data = data
         self.root = root
         self.frame = -1
@@ -441,7 +441,7 @@ class Viewer:
 
     SPEEDS = ("0.5x", "1x", "2x", "4x", "8x", "16x")
 
-    def __init__(self, scenes: Sequence[ViewerScene], *, host: str = "127.0.0.1", port: int = 8080):
+    def __init__(self, scenes: Sequence[ViewerScene], *, host: str = "127.0.0.1", port: int = 8080) -> None:
         import viser
 
         if not scenes:
