@@ -6,9 +6,8 @@ import contextlib
 import os
 import tempfile
 from pathlib import Path
-from typing import IO, Iterator
+from typing import Any, IO, Iterator
 
-from typing import Any
 
 
 def _umask() -> int:

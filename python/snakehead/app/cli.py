@@ -26,7 +26,10 @@ import numpy as np
 
 from .pipeline import FAST, NORMAL
 
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
+
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
 
 
 class UsageError(Exception):
@@ -298,7 +301,8 @@ _OUTPUTS = """outputs (in DIR):
 """
 
 
-def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: str, description: str) -> argparse.ArgumentParser:
+def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: str, description: str
+                     ) -> argparse.ArgumentParser:
     p = sub.add_parser(name, help=help_text, description=description, epilog=_OUTPUTS,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_planning_options(p)

@@ -13,15 +13,15 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from . import report as rep
 
-from typing import Any
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from ..control.controller import HeadController
     from ..kinematics.workspace import ReachabilityMap
+    from ..model.robot import SnakeRobot
     from ..scenes.scene import Scene
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
@@ -33,7 +33,7 @@ NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
 class Progress:
     """Stage lines on stderr (``[  12.3 s] what ...`` / ``... done in 1.2 s``) and a record of the stage times."""
 
-    def __init__(self, quiet: bool = False, stream: Any=None) -> None:
+    def __init__(self, quiet: bool = False, stream: Any = None) -> None:
         self.t0 = time.perf_counter()
         self.quiet = quiet
         self.stream = stream
@@ -134,7 +134,7 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
 
 
 def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progress, solution_figure: bool,
-                  workspace_map: ReachabilityMap | None=None) -> list[str]:
+                  workspace_map: ReachabilityMap | None = None) -> list[str]:
     """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
     from ..viz import animation, body, save, viewer
 
@@ -227,10 +227,10 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any)
         send.close()
 
 
-def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController | None=None, robot: SnakeRobot | None=None, workspace_map: ReachabilityMap | None=None,
+def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController | None = None,
+               robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
                settings: Settings | None = None, progress: Progress | None = None, command: str = "plan",
-               notes: Sequence[str] = (), solution_figure: bool = False,
-               on_controller: Callable | None = None) -> dict:
+               notes: Sequence[str] = (), solution_figure: bool = False, on_controller: Callable | None = None) -> dict:
     """Every scene through :func:`run_scene` with one controller; writes ``report.json`` and ``summary.md`` into
     ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
     file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed)."""

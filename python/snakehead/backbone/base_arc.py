@@ -351,7 +351,7 @@ class ArcOptimum:
     grid: np.ndarray
 
 
-def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None=None, base: BasePlacement | None = None, *,
+def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base: BasePlacement | None = None, *,
                       min_margin: float = 0.0, turn: int = 1, bounds: tuple[float, float] | None = None,
                       n_grid: int = 41, chords: str = "arclength") -> ArcOptimum:
     """The base arc's central angle that maximises the area of the discretised support polygon

@@ -18,7 +18,7 @@ first bends.
 from __future__ import annotations
 
 import math
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 from scipy import integrate, optimize
@@ -26,7 +26,6 @@ from scipy import integrate, optimize
 from .._validate import finite_array, finite_float, positive
 
 import numpy.typing as npt
-from typing import Any
 
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
 DEFAULT_FD_STEP = 2e-3

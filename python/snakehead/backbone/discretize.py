@@ -91,7 +91,7 @@ def discretize(curve: SpaceCurve, s_joints: np.ndarray, kinds: Sequence[str], *,
 
 
 def curve_joint_angles(robot: SnakeRobot, curve: SpaceCurve, joints: slice, *, s_start: float | None = None,
-                       phi0: float | None = None, frame0: npt.ArrayLike | None=None) -> np.ndarray:
+                       phi0: float | None = None, frame0: npt.ArrayLike | None = None) -> np.ndarray:
     """URDF joint angles (rad) of ``robot.joints[joints]`` that lay the body along ``curve``.
 
     Parameters

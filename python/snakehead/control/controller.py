@@ -26,8 +26,7 @@ from ..kinematics.ik import TracIK
 from ..model.robot import BasePlacement, SnakeRobot
 
 import numpy.typing as npt
-from typing import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:
     from ..kinematics.workspace import ReachabilityMap
@@ -72,10 +71,10 @@ class HeadController:
     solutions reproducible.
     """
 
-    def __init__(self, robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None=None, base_pose: BasePlacement | None = None,
-                 *, method: str = "rotated", n_frames: int = 10, timeout: float = 0.005, epsilon: float = 1e-5,
-                 seed: int | None = None, slack: float | None = None, base_configuration: npt.ArrayLike | None=None,
-                 allow_base_move: bool = True) -> None:
+    def __init__(self, robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
+                 base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
+                 timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
+                 base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
         from .. import backbone  # late: heavier imports, only needed here
 
         self.robot = robot if robot is not None else SnakeRobot.default()
@@ -115,8 +114,9 @@ class HeadController:
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 
     # --- the process ---------------------------------------------------------------------------
-    def solve(self, position: npt.ArrayLike, direction: npt.ArrayLike, q_prev: npt.ArrayLike | None=None, base: BasePlacement | None = None,
-              accept: Callable[[np.ndarray], bool] | None=None, allow_base_move: bool | None = None) -> HeadSolution:
+    def solve(self, position: npt.ArrayLike, direction: npt.ArrayLike, q_prev: npt.ArrayLike | None = None,
+              base: BasePlacement | None = None, accept: Callable[[np.ndarray], bool] | None = None,
+              allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
         ``q_prev`` (16,): the current joints; the base keeps its shape from it and the neck and head start
@@ -166,7 +166,7 @@ class HeadController:
         return solution
 
     def _solve_from(self, base: BasePlacement, q: np.ndarray, desired: np.ndarray, keep_close: bool,
-                    accept: Callable[[np.ndarray], bool] | None=None) -> HeadSolution:
+                    accept: Callable[[np.ndarray], bool] | None = None) -> HeadSolution:
         """Steps 3-5 with the base where it is: the neck by Eqs. 18-22, the head by TRAC-IK, the static check."""
         timings: dict[str, float] = {}
         q = q.copy()

@@ -24,7 +24,8 @@ from typing import Any, Callable
 FREE_ROLL_BOUNDS = np.array([0.0, 0.0, 0.0, np.inf, 0.0, 0.0])
 
 
-def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: npt.ArrayLike=(0.0, 0.0, 1.0)) -> np.ndarray:
+def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)
+                         ) -> np.ndarray:
     """A 4x4 frame at ``position`` (3,) whose x-axis is ``direction`` (3,), z as close to ``up`` as possible.
 
     When the direction is parallel to ``up``, world x (or y) is used instead, so every direction has a frame.
@@ -89,7 +90,8 @@ def _roll_between(achieved: np.ndarray, desired: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(R[2, 1], R[1, 1])))
 
 
-def _finish(ik: TracIK, q: np.ndarray, target: Any, tried: int, solved: int, t0: float, candidates: list[Any]) -> HeadIKResult:
+def _finish(ik: TracIK, q: np.ndarray, target: Any, tried: int, solved: int, t0: float, candidates: list[Any]
+            ) -> HeadIKResult:
     if q is None:
         return HeadIKResult(None, None, np.inf, np.inf, np.nan, tried, solved, time.perf_counter() - t0, candidates)
     T = ik.fk(q)
@@ -97,7 +99,9 @@ def _finish(ik: TracIK, q: np.ndarray, target: Any, tried: int, solved: int, t0:
     return HeadIKResult(q, T, pe, de, _roll_between(T, target), tried, solved, time.perf_counter() - t0, candidates)
 
 
-def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None=None, q_prev: npt.ArrayLike | None=None, accept: Callable[[np.ndarray], bool] | None=None) -> HeadIKResult:
+def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None = None,
+                   q_prev: npt.ArrayLike | None = None, accept: Callable[[np.ndarray], bool] | None = None
+                   ) -> HeadIKResult:
     """The paper's method: solve ``n_frames`` frames rolled evenly about the target's x-axis, keep one.
 
     ``target`` (4, 4) is the desired head frame in the head chain's base frame (its roll is the preferred
@@ -124,7 +128,7 @@ def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarr
     return _finish(ik, select(candidates, q_prev), target, int(n_frames), len(found), t0, candidates)
 
 
-def select(candidates: list[Any], q_prev: np.ndarray | None=None):
+def select(candidates: list[Any], q_prev: np.ndarray | None = None):
     """The kept solution among (roll angle, q) candidates: closest to ``q_prev`` in joint space when given,
     else the least rolled from the desired frame. None when there is no candidate."""
     if not candidates:
@@ -134,7 +138,7 @@ def select(candidates: list[Any], q_prev: np.ndarray | None=None):
     return min(candidates, key=lambda c: abs(np.arctan2(np.sin(c[0]), np.cos(c[0]))))[1]
 
 
-def free_roll(ik: TracIK, target: Any, q_init: npt.ArrayLike | None=None, attempts: int = 1) -> HeadIKResult:
+def free_roll(ik: TracIK, target: Any, q_init: npt.ArrayLike | None = None, attempts: int = 1) -> HeadIKResult:
     """One TRAC-IK call (or ``attempts`` calls from random seeds) with the roll about x left free."""
     target = pose(target, "target")
     n = ik.n_joints

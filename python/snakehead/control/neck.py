@@ -93,7 +93,8 @@ class NeckSolution:
     direction_error_deg: float  # angle between r_a and r_d (deg)
 
 
-def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = DEFAULT_H, q_init: npt.ArrayLike | None=None) -> NeckSolution:
+def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = DEFAULT_H,
+               q_init: npt.ArrayLike | None = None) -> NeckSolution:
     """Eq. 22: argmin |P_a - P_d|^2 + h |r_d x r_a|^2 over the neck joints within their limits.
 
     ``neck`` is the chain from the base's end frame (P0) to the neck end frame (B0); ``P0_frame`` (4, 4) is
@@ -118,7 +119,7 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
 
     model = neck.model  # the C++ model checks q itself; skipping the Python checks halves this loop's cost
 
-    def residual(q: np.ndarray, with_jacobian: bool=True):
+    def residual(q: np.ndarray, with_jacobian: bool = True):
         T = model.fk(q)
         ra = R0 @ T[:3, 0]
         r = np.concatenate([R0 @ T[:3, 3] + p0 - goal.P_d, sqrt_h * (S_rd @ ra)])
@@ -151,7 +152,8 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _bounded_least_squares(residual: np.ndarray, q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60, tol: float = 1e-9):
+def _bounded_least_squares(residual: np.ndarray, q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60,
+                           tol: float = 1e-9):
     """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
     r, J = residual(q)
     cost = float(r @ r)
@@ -182,8 +184,8 @@ def _bounded_least_squares(residual: np.ndarray, q: np.ndarray, lo: np.ndarray, 
     return q, cost
 
 
-def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: BasePlacement, Lc: float, length: float, slack: float,
-                         height: float) -> BasePlacement | None:
+def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: BasePlacement, Lc: float, length: float,
+                         slack: float, height: float) -> BasePlacement | None:
     """The planar move of the base (as the rolling gait or turning in place would give) that brings P_hd in range.
 
     ``P0_local`` (4, 4) is P0's pose relative to the root frame (fixed while the base keeps its shape);

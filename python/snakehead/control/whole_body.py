@@ -33,8 +33,7 @@ from ..geometry import collision as coll
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
-from typing import Any, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Sequence
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -264,9 +263,9 @@ def _direction_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class _Objective:
     """The optimisation problem for one target, variables z = (free joints, [x, y, yaw] when the base moves)."""
 
-    def __init__(self, prob: BodyProblem, q_template: np.ndarray, base0: BasePlacement, position: np.ndarray, direction: np.ndarray,
-                 move_base: bool, obstacles: Sequence[Any], min_margin: float, self_clearance: float, obstacle_clearance: float,
-                 regularise: np.ndarray | None) -> None:
+    def __init__(self, prob: BodyProblem, q_template: np.ndarray, base0: BasePlacement, position: np.ndarray,
+                 direction: np.ndarray, move_base: bool, obstacles: Sequence[Any], min_margin: float,
+                 self_clearance: float, obstacle_clearance: float, regularise: np.ndarray | None) -> None:
         self.prob, self.r = prob, prob.robot
         self.q_template = q_template.copy()
         self.q_template[prob.flat] = 0.0
@@ -420,8 +419,8 @@ def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[n
     return d0, g
 
 
-def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray, obstacles: Sequence[Any]=(),
-                   *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
+def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
+                   obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
                    obstacle_clearance: float = OBSTACLE_CLEARANCE) -> dict:
     """Exact checks of a configuration: head errors, static margin (support polygon of the boxes lying on the
     ground), lowest lifted box corner, separating-axis self clearance, obstacle clearance, and the verdict
@@ -448,10 +447,10 @@ def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, positi
             "ground_clearance_m": ground, "self_clearance_m": selfc, "obstacle_clearance_m": obst, "reason": reason}
 
 
-def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np.ndarray, direction: np.ndarray, *, move_base: bool,
-           obstacles: Sequence[Any]=(), min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
-           obstacle_clearance: float = OBSTACLE_CLEARANCE, max_iterations: int = MAX_ITERATIONS
-           ) -> tuple[np.ndarray, BasePlacement]:
+def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np.ndarray, direction: np.ndarray, *,
+           move_base: bool, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
+           self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
+           max_iterations: int = MAX_ITERATIONS) -> tuple[np.ndarray, BasePlacement]:
     """One SLSQP run from (q0, base0): the configuration and placement it ends at."""
     obj = _Objective(prob, q0, base0, position, direction, move_base, obstacles, min_margin, self_clearance,
                      obstacle_clearance, None)
@@ -465,10 +464,10 @@ def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np
     return obj.unpack(res.x)
 
 
-def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: np.ndarray, *, move_base: bool = True, obstacles: Sequence[Any]=(),
-                     min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
-                     obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None,
-                     time_budget: float = 3.0) -> WholeBodySolution:
+def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: np.ndarray, *,
+                     move_base: bool = True, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
+                     self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
+                     problem: BodyProblem | None = None, time_budget: float = 3.0) -> WholeBodySolution:
     """The whole-body solve from ``starts``, a sequence of (q (n,), BasePlacement) in the order to try; the first
     whose refined solution passes every exact check is returned (stage "whole-body, base kept" when its base is
     the first start's, else "whole-body, base moved"), else the best attempt with the reason it fails.
@@ -524,8 +523,8 @@ CANDIDATE_ROLLS = 8
 CANDIDATE_SEEDS = 2
 
 
-def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
-                      seed: int = 0) -> list[np.ndarray]:
+def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray,
+                      direction: np.ndarray, seed: int = 0) -> list[np.ndarray]:
     """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
     chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
     frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
@@ -551,8 +550,8 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     return out
 
 
-def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray, seed: int
-                   ) -> np.ndarray | None:
+def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray,
+                   direction: np.ndarray, seed: int) -> np.ndarray | None:
     """The lifted chain's IK from the current joints, the roll about the direction free: the nearest solution."""
     from ..kinematics.ik import FREE_ROLL
     from .head import frame_from_direction
@@ -570,7 +569,8 @@ def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, po
     return q
 
 
-def solve_target(controller: HeadController, position: npt.ArrayLike, direction: npt.ArrayLike, *, q_prev: npt.ArrayLike | None=None, base: BasePlacement | None = None, obstacles: Sequence[Any]=(),
+def solve_target(controller: HeadController, position: npt.ArrayLike, direction: npt.ArrayLike, *,
+                 q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None, obstacles: Sequence[Any] = (),
                  allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
                  problem: BodyProblem | None = None, seed: int = 0, near: bool = False) -> WholeBodySolution:
     """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
@@ -687,7 +687,8 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     return best
 
 
-def placements(prob: BodyProblem, P0_local: np.ndarray, position: np.ndarray, direction: np.ndarray) -> list[BasePlacement]:
+def placements(prob: BodyProblem, P0_local: np.ndarray, position: np.ndarray, direction: np.ndarray
+               ) -> list[BasePlacement]:
     """Base placements that put the frame the neck lifts from (``P0_local``: its pose in the root frame, for the
     base's shape) a few horizontal distances short of the target, its body axis pointing at the target along the
     head's direction or its opposite's horizontal part: where the lifted chain can reach the target whatever its

@@ -393,8 +393,8 @@ def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, ba
     return (P[0], L[0]) if single else (P, L)
 
 
-def momenta(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: npt.ArrayLike | None=None
-            ) -> tuple[np.ndarray, np.ndarray]:
+def momenta(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
+            qd: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Momenta along a sampled trajectory, Eqs. 25-31: t (T,) s, q (T, 16) rad -> P (T, 3), L (T, 3).
 
     P in kg m/s; L in kg m^2/s about the world origin. The joint velocities are ``qd`` when given (e.g. a
@@ -421,7 +421,8 @@ def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz:
     return np.stack([px, py], axis=1)
 
 
-def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None, qd: npt.ArrayLike) -> tuple[np.ndarray, ...]:
+def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None, qd: npt.ArrayLike
+         ) -> tuple[np.ndarray, ...]:
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     P, L, com = _momenta(robot, q, qd, base)
@@ -431,7 +432,8 @@ def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | 
     return _zmp_from(com, Pdot, Ldot, robot.total_mass), P, L, com, q
 
 
-def zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: np.ndarray | None=None) -> np.ndarray:
+def zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: np.ndarray | None = None
+        ) -> np.ndarray:
     """Zero-moment point on the ground along a trajectory, Eqs. 36-40 with p_z = 0: (T, 2) world (x, y), m.
 
     The time derivatives of P and L (Eqs. 33, 34) are taken numerically along the samples (np.gradient);
@@ -464,8 +466,9 @@ class DynamicStability:
     com: np.ndarray
 
 
-def dynamic_stability(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: np.ndarray | None=None, *,
-                      contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> DynamicStability:
+def dynamic_stability(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
+                      qd: np.ndarray | None = None, *, contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE
+                      ) -> DynamicStability:
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
     The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
@@ -484,8 +487,8 @@ def dynamic_stability(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Bas
     return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
 
 
-def support_margins(robot: SnakeRobot, q: np.ndarray, xy: npt.ArrayLike, base: BasePlacement | None = None, *, contact: str = "endpoints",
-                    tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+def support_margins(robot: SnakeRobot, q: np.ndarray, xy: npt.ArrayLike, base: BasePlacement | None = None, *,
+                    contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 

@@ -119,7 +119,8 @@ def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndar
     return [np.broadcast_to(a, batch + cs) for a, cs in zip(arrs, core)]
 
 
-def box_box_sat(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> np.ndarray:
+def box_box_sat(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray
+                ) -> np.ndarray:
     """Separating-axis test of boxes A (centres (..., 3), rotations (..., 3, 3), half extents (..., 3)) and B.
 
     Returns the largest gap (m) over the 15 candidate axes (3 + 3 face normals, 9 edge cross products): > 0 the
@@ -180,7 +181,8 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     return np.linalg.norm(diff, axis=-1)
 
 
-def box_box_distance(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> np.ndarray:
+def box_box_distance(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray
+                     ) -> np.ndarray:
     """Signed distance (m) between boxes A and B (shapes as :func:`box_box_sat`): exact when apart (the
     smallest of vertex-box and edge-edge distances, which covers every closest-feature pair of two convex
     polyhedra), minus the separating-axis penetration depth when they intersect."""

@@ -68,7 +68,8 @@ class WallWithHole:
             raise ValueError("the hole does not lie inside the wall")
 
     @classmethod
-    def standing(cls, hole_centre: npt.ArrayLike, normal: npt.ArrayLike, size: npt.ArrayLike, hole_diameter: float) -> "WallWithHole":
+    def standing(cls, hole_centre: npt.ArrayLike, normal: npt.ArrayLike, size: npt.ArrayLike, hole_diameter: float
+                 ) -> "WallWithHole":
         """A wall standing on the ground (its bottom at z = 0) with the hole on its vertical centre line, facing
         along the horizontal ``normal``: the paper's wall of Section 4.2 as snakehead places it."""
         normal = unit_vector3(normal, "wall normal")

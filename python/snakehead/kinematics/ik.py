@@ -79,12 +79,12 @@ class TracIK:
     """
 
     def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = 0.005,
-                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds: Any=None) -> None:
+                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds: Any = None) -> None:
         self._init(Chain.from_urdf(urdf, base, tip), timeout, epsilon, solve_type, seed, bounds)
 
     @classmethod
     def from_chain(cls, chain: Chain, timeout: float = 0.005, epsilon: float = 1e-5, solve_type: str = "Speed",
-                   seed: int | None = None, bounds: Any=None) -> "TracIK":
+                   seed: int | None = None, bounds: Any = None) -> "TracIK":
         """A solver for an existing :class:`Chain` (its model is copied into the solver)."""
         if not isinstance(chain, Chain):
             raise TypeError(f"chain must be a snakehead.Chain, got {type(chain).__name__}")
@@ -92,7 +92,8 @@ class TracIK:
         self._init(chain, timeout, epsilon, solve_type, seed, bounds)
         return self
 
-    def _init(self, chain: Chain, timeout: float, epsilon: float, solve_type: str, seed: int | None, bounds: Any) -> None:
+    def _init(self, chain: Chain, timeout: float, epsilon: float, solve_type: str, seed: int | None, bounds: Any
+              ) -> None:
         if solve_type not in SOLVE_TYPES:
             raise ValueError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
         self._chain = chain
@@ -143,7 +144,7 @@ class TracIK:
         """Pose of the tip in the base frame, (4, 4)."""
         return self._solver.fk(joint_vector(q, self.n_joints))
 
-    def _q_init(self, q_init: npt.ArrayLike, name: str="q_init") -> np.ndarray:
+    def _q_init(self, q_init: npt.ArrayLike, name: str = "q_init") -> np.ndarray:
         if isinstance(q_init, np.ndarray) and q_init.shape == (self.n_joints,) and q_init.dtype == np.float64:
             # The common case in plain Python (faster than numpy's reductions for a few values).
             if all(lo - 1e-9 <= v <= hi + 1e-9 for v, lo, hi in zip(q_init.tolist(), self._lo, self._hi)):
@@ -165,7 +166,7 @@ class TracIK:
         # identical calls get identical starts (and results); without one, the solver's running generator.
         return self._rng if self.seed is None else np.random.default_rng(self.seed)
 
-    def ik(self, pose: np.ndarray, q_init: np.ndarray | None=None, bounds: Any=None) -> np.ndarray | None:
+    def ik(self, pose: np.ndarray, q_init: np.ndarray | None = None, bounds: Any = None) -> np.ndarray | None:
         """Joint angles putting the tip at ``pose`` (4x4, base frame), or None if none was found in time.
 
         ``q_init``: the start (and the reference of ``Distance``); random within the limits when omitted (with a
@@ -175,7 +176,8 @@ class TracIK:
         found, q, _ = self.ik_ex(pose, q_init, bounds)
         return q if found else None
 
-    def ik_ex(self, pose: npt.ArrayLike, q_init: npt.ArrayLike | None=None, bounds: Any=None, algorithm: str = "TRAC-IK", timeout: float | None = None):
+    def ik_ex(self, pose: npt.ArrayLike, q_init: npt.ArrayLike | None = None, bounds: Any = None,
+              algorithm: str = "TRAC-IK", timeout: float | None = None):
         """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
         and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
         T = _pose(pose)
@@ -186,7 +188,7 @@ class TracIK:
             raise ValueError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
         return self._solver.ik(T, q, b, t, algorithm)
 
-    def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None=None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Solve many targets across all cores: poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
 
         Rows of ``q`` where ``ok`` is False hold the start configuration. With a seed, target k's search

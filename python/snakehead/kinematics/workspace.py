@@ -21,15 +21,17 @@ import os
 from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
 import numpy as np
 
 from .. import _core
 from ..model.chain import Chain
 
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
+
 import numpy.typing as npt
-from typing import Any, Callable
 
 FORMAT = "snakehead-reachability-1"
 #: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
@@ -238,8 +240,9 @@ def _param_equal(a: Any, b: Any) -> bool:
 
 
 # --- computing -------------------------------------------------------------------------------------------
-def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: np.ndarray, timeout: float, epsilon: float, cloud_samples: int, seed: int | None,
-             threads: int | None, shard: Any) -> _core.WorkspaceOptions:
+def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: np.ndarray,
+             timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any
+             ) -> _core.WorkspaceOptions:
     o = _core.WorkspaceOptions()
     for name, value in (("directions", directions), ("rolls", rolls), ("cloud_samples", cloud_samples),
                         ("seed", seed)):
@@ -329,11 +332,11 @@ def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, cou
     return _from_result(d, o, f"snakehead.workspace.compute(shard={index}/{count})")
 
 
-def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4, any_roll: bool = True,
-            free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4, epsilon: float = 1e-5,
-            cloud_samples: int = 50000, seed: int = 1, threads: int | None = None, shard: Any=None,
-            executor: Executor | None = None, shards: int | None = None, urdf: str | os.PathLike | None = None,
-            progress: bool = True) -> ReachabilityMap:
+def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
+            any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
+            epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, threads: int | None = None,
+            shard: Any = None, executor: Executor | None = None, shards: int | None = None,
+            urdf: str | os.PathLike | None = None, progress: bool = True) -> ReachabilityMap:
     """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
 
     voxel: voxel edge (m); directions: points per voxel sphere; rolls: frames about the approach axis per
@@ -439,9 +442,9 @@ def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMa
     return _from_result(d, options, "snakehead.workspace.compute")
 
 
-def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
-             any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
-             epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
+def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = 0.05, directions: int = 20,
+             rolls: int = 4, any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x",
+             timeout: float = 3e-4, epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
     """Reachability index of voxels at arbitrary centres, each on its own (random initial guesses only).
 
     An independent check of a map (e.g. with a long timeout on a sample of its voxels), (k,) for (k, 3).

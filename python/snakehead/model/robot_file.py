@@ -19,6 +19,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from typing import Sequence
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.

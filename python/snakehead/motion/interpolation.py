@@ -113,8 +113,9 @@ def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray
     return t
 
 
-def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD, *, lower: np.ndarray | None=None, upper: np.ndarray | None=None,
-                     method: str = "spline") -> JointTrajectory:
+def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD, *,
+                     lower: np.ndarray | None = None, upper: np.ndarray | None = None, method: str = "spline"
+                     ) -> JointTrajectory:
     """Multi-segment joint-space interpolation through waypoints, sampled every ``dt`` s.
 
     times (K,) strictly increasing (s); waypoints (K, n) joint vectors (rad), the first at rest and the last at
@@ -150,7 +151,8 @@ def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTR
     return JointTrajectory(t, q, qd, qdd, spline)
 
 
-def joint_interpolation(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
+def joint_interpolation(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD
+                        ) -> tuple[np.ndarray, np.ndarray]:
     """Multi-segment joint-space interpolation (Section 3.2): -> (t (T,) s, q (T, n) rad) at the control period.
 
     Continuous in velocity and acceleration, at rest at both ends; see :func:`joint_trajectory` for the

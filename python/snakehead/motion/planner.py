@@ -151,7 +151,8 @@ class Plan:
 class _Waypoints:
     """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
 
-    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles: Sequence[Any]=()) -> None:
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float,
+                 obstacles: Sequence[Any] = ()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
         self.speed, self.min_segment = speed, min_segment
@@ -259,7 +260,8 @@ class _Waypoints:
         return traj
 
 
-def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any]=(), notes: list[str]=(), scene: Scene | None=None) -> Plan:
+def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
+            notes: list[str] = (), scene: Scene | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
@@ -350,8 +352,8 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any]=()) -> tuple[BasePlacement, np.ndarray,
-                                                                           Relocation | None, list[str]]:
+def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = ()
+                ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -414,8 +416,8 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
 
 
-def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray, base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list,
-           near: bool = False):
+def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
+           base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list, near: bool = False):
     """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
     from ..control.whole_body import solve_target
 
@@ -426,7 +428,7 @@ def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarr
     return sol
 
 
-def as_scene(targets: Any, *, obstacles: Sequence[Any]=(), base: BasePlacement | None = None) -> Scene:
+def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
     """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
     import os
 
@@ -443,9 +445,9 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any]=(), base: BasePlacement |
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
 
 
-def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles: Sequence[Any]=(),
-         base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
-         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
+def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadController | None = None,
+         obstacles: Sequence[Any] = (), base: BasePlacement | None = None, method: str = "rotated",
+         seed: int | None = 1, speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters

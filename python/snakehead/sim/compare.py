@@ -40,7 +40,7 @@ def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, ba
     return out
 
 
-def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, result: SimResult, targets: Any=None,
+def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, result: SimResult, targets: Any = None,
             base: BasePlacement | None = None) -> dict:
     """Compare a simulation with its plan, as the paper does in Section 4.
 
@@ -112,8 +112,8 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
     }
 
 
-def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement | None = None,
-                contact: str = "ground") -> np.ndarray:
+def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t: np.ndarray, planned_q: np.ndarray,
+                base: BasePlacement | None = None, contact: str = "ground") -> np.ndarray:
     """Signed distance (m, positive inside) of each simulated ZMP to the planned support polygon at that tick.
 
     The polygon is :func:`snakehead.dynamics.stability.support_polygon` of the planned configuration interpolated

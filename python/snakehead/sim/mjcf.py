@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -60,7 +60,6 @@ from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
-from typing import Any
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
@@ -183,7 +182,7 @@ def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np
 
 
 def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
-               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None=None,
+               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                contact_solref: tuple = (0.005, 1.0)) -> str:
     """MJCF text of the robot (free-floating root) on a ground plane, with optional obstacle boxes.

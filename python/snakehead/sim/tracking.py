@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -15,7 +15,6 @@ from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_KD, DEFAULT_
                    build_model)
 
 import numpy.typing as npt
-from typing import Any
 
 
 # ------------------------------------------------------------------------------------------------
@@ -249,11 +248,13 @@ def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray
     return -np.einsum("nl,nlk,nk->n", weights, torque, a)
 
 
-def simulate_trajectory(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, kp: float=DEFAULT_KP, kd: float=DEFAULT_KD, *,
-             control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3,
-             hold: float = 0.0, gravity_compensation: str = "supported", torque_limit: float | npt.ArrayLike | None=None, friction: float = 0.8,
-             joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES,
-             self_collision: bool = False, drop: float = 2e-4) -> SimResult:
+def simulate_trajectory(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
+                        kp: float = DEFAULT_KP, kd: float = DEFAULT_KD, *, control_dt: float = DEFAULT_CONTROL_DT,
+                        timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3, hold: float = 0.0,
+                        gravity_compensation: str = "supported", torque_limit: float | npt.ArrayLike | None = None,
+                        friction: float = 0.8, joint_damping: float = 0.02, armature: float = 1e-3,
+                        obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
+                        drop: float = 2e-4) -> SimResult:
     """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly

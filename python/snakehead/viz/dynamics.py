@@ -9,7 +9,7 @@ Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Sequence, Union
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -19,7 +19,6 @@ from ..dynamics import stability as st
 from ..model.robot import BasePlacement, SnakeRobot
 from ._common import PLANNED_COLOR, SIMULATED_COLOR, new_figure
 
-from typing import Any
 
 if TYPE_CHECKING:
     from ..sim.tracking import SimResult
