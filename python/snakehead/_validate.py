@@ -1,6 +1,8 @@
 """Input checks shared by every public function: numpy in, a clear ValueError out."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 import numpy.typing as npt
@@ -65,7 +67,7 @@ def positive(x: npt.ArrayLike, name: str) -> float:
     return v
 
 
-def finite_float(x: npt.ArrayLike, name: str) -> float:
+def finite_float(x: Any, name: str) -> float:
     """``x`` as a finite float; ValueError naming ``name`` otherwise."""
     try:
         v = float(x)

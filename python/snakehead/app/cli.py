@@ -98,7 +98,7 @@ def _writable_dir(path: str) -> Path:
 # ----------------------------------------------------------------------------------------------
 # the robot and its map
 # ----------------------------------------------------------------------------------------------
-def _robot(args: argparse.Namespace):
+def _robot(args: argparse.Namespace) -> SnakeRobot:
     from ..model.robot import SnakeRobot
 
     if getattr(args, "robot", None) is None:
@@ -106,7 +106,7 @@ def _robot(args: argparse.Namespace):
     return SnakeRobot.from_file(args.robot)
 
 
-def _map(args: argparse.Namespace, robot: SnakeRobot):
+def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
     """The map given with --map (checked against the robot's head), else None (the pipeline finds one)."""
     from ..kinematics import workspace
 
@@ -145,7 +145,7 @@ def _info(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 # demo and plan
 # ----------------------------------------------------------------------------------------------
-def _settings(args: argparse.Namespace):
+def _settings(args: argparse.Namespace) -> Any:
     from .pipeline import Settings
 
     return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)

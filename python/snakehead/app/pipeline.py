@@ -13,7 +13,7 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from . import report as rep
 
@@ -47,7 +47,7 @@ class Progress:
             print(f"[{self.elapsed():7.1f} s] {text}", file=self.stream or sys.stderr, flush=True)
 
     @contextlib.contextmanager
-    def stage(self, what: str):
+    def stage(self, what: str) -> Iterator[None]:
         self.say(f"{what} ...")
         start = time.perf_counter()
         yield

@@ -44,7 +44,7 @@ SIM_KEYS = ("position_error_m", "direction_error_deg", "max_linear_momentum_erro
             "zmp_inside")
 
 
-def jsonable(x: npt.ArrayLike):
+def jsonable(x: npt.ArrayLike) -> Any:
     """``x`` with numpy scalars and arrays turned into Python numbers and lists, non-finite floats into None,
     tuples into lists and dict keys into strings (recursively)."""
     if isinstance(x, dict):

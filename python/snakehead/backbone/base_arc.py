@@ -91,14 +91,14 @@ class PlaneArc:
         """The arc as a :class:`SpaceCurve` parametrised by arc length, with exact derivatives."""
         k = self.turn / self.radius  # signed curvature
 
-        def d1(t: np.ndarray):
+        def d1(t: np.ndarray) -> np.ndarray:
             return self.tangent(t)
 
-        def d2(t: np.ndarray):
+        def d2(t: np.ndarray) -> np.ndarray:
             a = self.heading + k * t
             return k * np.array([-math.sin(a), math.cos(a), 0.0])
 
-        def d3(t: np.ndarray):
+        def d3(t: np.ndarray) -> np.ndarray:
             a = self.heading + k * t
             return -k * k * np.array([math.cos(a), math.sin(a), 0.0])
 
@@ -174,7 +174,7 @@ def exact_chord_radius(chords: str, central_angle: float) -> float:
         raise ValueError("chord lengths must be positive")
     theta = _check_central_angle(central_angle)
 
-    def span(r: Any):
+    def span(r: Any) -> float:
         return float(np.sum(2.0 * np.arcsin(np.minimum(c / (2.0 * r), 1.0))))
 
     r_min = 0.5 * c.max()
@@ -281,7 +281,7 @@ def polygon_area(vertices: npt.ArrayLike) -> float:
     return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
-def _stability():
+def _stability() -> Any:
     from ..dynamics import stability  # imported lazily: stability.py imports robot only, not this module
     return stability
 

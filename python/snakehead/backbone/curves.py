@@ -192,7 +192,7 @@ class SpaceCurve:
         # ds/dt = |r'|; dphi/dt = tau ds/dt (Eq. 3); d/dt int kappa cos(phi) ds, int kappa sin(phi) ds (Eq. 4)
         return np.array([speed, tau * speed, kappa * math.cos(phi) * speed, kappa * math.sin(phi) * speed])
 
-    def _solution(self):
+    def _solution(self) -> Any:
         if self._sol is None:
             sol = integrate.solve_ivp(self._rhs, (self.t0, self.t1), np.zeros(4), method="DOP853",
                                       rtol=self.rtol, atol=self.rtol * 1e-3, dense_output=True)
@@ -302,18 +302,18 @@ def cubic_bezier(control_points: npt.ArrayLike) -> SpaceCurve:
     points (m), as a :class:`SpaceCurve` with its exact derivatives."""
     P = finite_array(control_points, "control_points", (4, 3))
 
-    def r(t: np.ndarray):
+    def r(t: np.ndarray) -> np.ndarray:
         u = 1.0 - t
         return u ** 3 * P[0] + 3 * u * u * t * P[1] + 3 * u * t * t * P[2] + t ** 3 * P[3]
 
-    def d1(t: np.ndarray):
+    def d1(t: np.ndarray) -> np.ndarray:
         u = 1.0 - t
         return 3.0 * (u * u * (P[1] - P[0]) + 2 * u * t * (P[2] - P[1]) + t * t * (P[3] - P[2]))
 
-    def d2(t: np.ndarray):
+    def d2(t: np.ndarray) -> np.ndarray:
         return 6.0 * ((1.0 - t) * (P[2] - 2 * P[1] + P[0]) + t * (P[3] - 2 * P[2] + P[1]))
 
-    def d3(t: np.ndarray):
+    def d3(t: np.ndarray) -> np.ndarray:
         return 6.0 * (P[3] - 3 * P[2] + 3 * P[1] - P[0])
 
     return SpaceCurve(r, 0.0, 1.0, derivatives=(d1, d2, d3))

@@ -226,7 +226,7 @@ class HeadController:
                             neck=neck, head=head)
 
     @property
-    def body_problem(self):
+    def body_problem(self) -> Any:
         """The geometry the whole-body solve needs for this robot (``control.whole_body.BodyProblem``), made once."""
         if getattr(self, "_body_problem", None) is None:
             from .whole_body import BodyProblem

@@ -128,7 +128,7 @@ def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarr
     return _finish(ik, select(candidates, q_prev), target, int(n_frames), len(found), t0, candidates)
 
 
-def select(candidates: list[Any], q_prev: np.ndarray | None = None):
+def select(candidates: list[Any], q_prev: np.ndarray | None = None) -> Any:
     """The kept solution among (roll angle, q) candidates: closest to ``q_prev`` in joint space when given,
     else the least rolled from the desired frame. None when there is no candidate."""
     if not candidates:

@@ -16,6 +16,7 @@ from .head import angle_between_deg
 from ..model.robot import BasePlacement
 
 import numpy.typing as npt
+from typing import Any, Callable
 
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
@@ -119,7 +120,7 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
 
     model = neck.model  # the C++ model checks q itself; skipping the Python checks halves this loop's cost
 
-    def residual(q: np.ndarray, with_jacobian: bool = True):
+    def residual(q: np.ndarray, with_jacobian: bool = True) -> Any:
         T = model.fk(q)
         ra = R0 @ T[:3, 0]
         r = np.concatenate([R0 @ T[:3, 3] + p0 - goal.P_d, sqrt_h * (S_rd @ ra)])
@@ -152,8 +153,8 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _bounded_least_squares(residual: np.ndarray, q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60,
-                           tol: float = 1e-9):
+def _bounded_least_squares(residual: Callable[..., Any], q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60,
+                           tol: float = 1e-9) -> Any:
     """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
     r, J = residual(q)
     cost = float(r @ r)

@@ -98,12 +98,12 @@ class WholeBodySolution:
                 f"{1000 * self.ground_clearance_m:.1f} mm, self clearance {1000 * self.self_clearance_m:.1f} mm")
 
     @property
-    def neck_goal(self):
+    def neck_goal(self) -> Any:
         """Eqs. 18-20's goal of the segmented solve, when that solve is the solution (for Fig. 8)."""
         return getattr(self.segmented, "neck_goal", None) if self.stage == STAGES[0] else None
 
     @property
-    def neck(self):
+    def neck(self) -> Any:
         return getattr(self.segmented, "neck", None) if self.stage == STAGES[0] else None
 
 
@@ -143,7 +143,7 @@ class BodyProblem:
         self.head_index = robot.link_index(robot.parts.head_tip)
         self._iks: dict = {}
 
-    def lifted_ik(self, seed: int = 0):
+    def lifted_ik(self, seed: int = 0) -> Any:
         """TRAC-IK of the lifted chain (lift_frame -> head_tip), seeded (made once per seed)."""
         from ..kinematics.ik import TracIK
 
@@ -234,7 +234,7 @@ class BodyProblem:
         return margin, g
 
 
-def _segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray):
+def _segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> Any:
     """Closest points of segments [p1, q1], [p2, q2] (arrays (..., 3)): (s, t) parameters (Ericson 5.1.9)."""
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
     a = np.sum(d1 * d1, -1)
@@ -381,7 +381,7 @@ class _Objective:
         self._cache_z, self._cache = z.copy(), out
         return out
 
-    def objective(self, z: np.ndarray):
+    def objective(self, z: np.ndarray) -> Any:
         e = self.evaluate(z)
         f = -e["margin"]
         if self.reg is not None:
@@ -389,7 +389,7 @@ class _Objective:
             f += 1e-3 * float(d @ d)
         return f
 
-    def objective_jac(self, z: np.ndarray):
+    def objective_jac(self, z: np.ndarray) -> Any:
         e = self.evaluate(z)
         g = -e["margin_jac"].copy()
         if self.reg is not None:
@@ -401,7 +401,7 @@ def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[n
     """An obstacle's distance at points (P, 3) and its gradient by central differences."""
     from ..geometry.obstacles import BoxObstacle
 
-    def dist(x: np.ndarray):
+    def dist(x: np.ndarray) -> Any:
         if isinstance(ob, BoxObstacle):
             loc = (x - ob.centre) @ ob.rotation
             q = np.abs(loc) - ob.size / 2
@@ -601,10 +601,10 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     prob = problem if problem is not None else BodyProblem(robot)
     obstacles = list(obstacles)
 
-    def check(q: np.ndarray, b: Any):
+    def check(q: np.ndarray, b: Any) -> Any:
         return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin)
 
-    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: np.ndarray):
+    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: np.ndarray) -> Any:
         return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
                                  position_error_m=chk["position_error_m"],
                                  direction_error_deg=chk["direction_error_deg"],
@@ -613,14 +613,14 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
                                  obstacle_clearance_m=chk["obstacle_clearance_m"], starts=starts,
                                  seconds=time.perf_counter() - t0)
 
-    def accept(q: np.ndarray, b: Any):
+    def accept(q: np.ndarray, b: Any) -> Any:
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
     best = None
     seg_holder = [None]
 
-    def consider(q: np.ndarray, b: Any, stage: str, starts: np.ndarray):
+    def consider(q: np.ndarray, b: Any, stage: str, starts: np.ndarray) -> Any:
         """Check a configuration; keep the best attempt; return the solution when it passes."""
         nonlocal best
         chk = check(q, b)

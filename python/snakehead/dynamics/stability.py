@@ -211,10 +211,10 @@ def hull_indices(pts: np.ndarray, eps: float = 1e-12) -> list[int]:
         return []
     scale = eps * max(1.0, float(np.abs(pts).max()))
 
-    def cross(o: Any, a: Any, b: Any):
+    def cross(o: Any, a: Any, b: Any) -> float:
         return (P[a][0] - P[o][0]) * (P[b][1] - P[o][1]) - (P[a][1] - P[o][1]) * (P[b][0] - P[o][0])
 
-    def half(seq: Any):
+    def half(seq: Any) -> list[Any]:
         out: list[int] = []
         for i in seq:
             while len(out) >= 2 and cross(out[-2], out[-1], i) <= scale * scale:

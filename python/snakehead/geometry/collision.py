@@ -85,7 +85,7 @@ _EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)
                    if np.count_nonzero(_SIGNS[a] != _SIGNS[b]) == 1])  # (12, 2) vertex pairs
 
 
-def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement):
+def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """World collision boxes of the links along a trajectory: links (k,), centres (T, k, 3), rotations
     (T, k, 3, 3), half extents (k, 3)."""
     links = robot.boxed_links
@@ -108,7 +108,7 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
     return gaps.min(axis=1)
 
 
-def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray):
+def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> tuple[np.ndarray, ...]:
     """Broadcast two batches of boxes (centres (..., 3), rotations (..., 3, 3), half extents (..., 3))."""
     arrs = [np.asarray(v, float) for v in (ca, Ra, ha, cb, Rb, hb)]
     core = [(3,), (3, 3), (3,), (3,), (3, 3), (3,)]

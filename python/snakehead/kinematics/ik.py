@@ -177,7 +177,7 @@ class TracIK:
         return q if found else None
 
     def ik_ex(self, pose: npt.ArrayLike, q_init: npt.ArrayLike | None = None, bounds: Any = None,
-              algorithm: str = "TRAC-IK", timeout: float | None = None):
+              algorithm: str = "TRAC-IK", timeout: float | None = None) -> Any:
         """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
         and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
         T = _pose(pose)

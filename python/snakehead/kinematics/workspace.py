@@ -413,7 +413,7 @@ def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str])
         raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
 
 
-def _bar(progress: bool, total: int, unit: str):
+def _bar(progress: bool, total: int, unit: str) -> Any:
     if not progress:
         return None
     from tqdm.auto import tqdm
@@ -424,11 +424,11 @@ def _bar(progress: bool, total: int, unit: str):
 def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMap:
     bar = _bar(progress, 0, "voxel")
 
-    def callback(done: int, total: int):  # called about every 0.1 s; the binding checks for Ctrl-C before each call
+    def callback(done: int, total: int) -> None:  # called about every 0.1 s; the binding checks for Ctrl-C before each call
         return True
 
     if bar is not None:
-        def callback(done: int, total: int):
+        def callback(done: int, total: int) -> None:
             if bar.total != total:
                 bar.total = total
                 bar.refresh()
@@ -512,7 +512,7 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
         if "format" not in z.files or str(z["format"]) != FORMAT:
             raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
 
-        def scalar(k: int, cast: Callable[[Any], Any]):
+        def scalar(k: int, cast: Callable[[Any], Any]) -> Any:
             return cast(z[k][()])
 
         params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")

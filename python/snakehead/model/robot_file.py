@@ -107,8 +107,8 @@ def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_e
     out = Path(path)
     folder = out.resolve().parent
 
-    def rel(p: np.ndarray) -> str:
-        p = Path(p).resolve()
+    def rel(where: str | os.PathLike[str]) -> str:
+        p = Path(where).resolve()
         try:
             return p.relative_to(folder).as_posix()
         except ValueError:

@@ -88,7 +88,7 @@ def _interpolation_parameters(n: int) -> np.ndarray:
 
 
 def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
-                            base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False):
+                            base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False) -> Any:
     """Whole-body interpolation in Cartesian space, Eqs. 41-44: n configurations (n, 16) from q_start to q_end.
 
     ``n`` is the number of samples (t_j of Eq. 41 evenly spaced in [0, 1]) or the t_j themselves, a

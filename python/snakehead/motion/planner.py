@@ -371,7 +371,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
-    def failing(b: Any, q_shape: Any):
+    def failing(b: Any, q_shape: Any) -> Any:
         """The first target not solved from this base (None: all are), or the start state in an obstacle."""
         if not clear(bending_state(controller, q_shape), b):
             return "the start", None
@@ -417,7 +417,7 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
 
 
 def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
-           base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list, near: bool = False):
+           base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list, near: bool = False) -> Any:
     """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
     from ..control.whole_body import solve_target
 

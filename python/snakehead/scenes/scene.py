@@ -210,7 +210,7 @@ def _target_from(entry: Any, where: str) -> Target:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _obstacle_from(entry: Any, where: str):
+def _obstacle_from(entry: Any, where: str) -> BoxObstacle | WallWithHole:
     entry = _table(entry, where)
     kind = entry.get("kind")
     if kind not in _OBSTACLE_KEYS:

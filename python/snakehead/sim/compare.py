@@ -11,7 +11,7 @@ from .tracking import SimResult, check_trajectory
 from typing import Any
 
 
-def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement | None, targets: Any):
+def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement | None, targets: Any) -> list[tuple[float, np.ndarray, np.ndarray]]:
     """[(time, desired position (3,), desired unit direction (3,))]."""
     if targets is None:
         targets = [float(planned_t[-1])]

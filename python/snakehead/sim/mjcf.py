@@ -76,7 +76,7 @@ _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
 
 
-def _mujoco():
+def _mujoco() -> Any:
     """Import MuJoCo lazily; ImportError naming the extra when it is missing."""
     try:
         import mujoco
@@ -128,7 +128,7 @@ def _wall_boxes(wall: WallWithHole, slices: int) -> list[BoxObstacle]:
         if ub - ua <= 1e-12 or vb - va <= 1e-12:
             continue
         centre = wall.centre + R @ np.array([(ua + ub) / 2, (va + vb) / 2, 0.0])
-        boxes.append(BoxObstacle(centre, (ub - ua, vb - va, thickness), R))
+        boxes.append(BoxObstacle(centre, np.array([ub - ua, vb - va, thickness]), R))
     return boxes
 
 
@@ -154,7 +154,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     tr = np.trace(R)
     if tr > 0:
         s = 2.0 * math.sqrt(tr + 1.0)
-        q = (0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
     else:
         i = int(np.argmax(np.diag(R)))
         j, k = (i + 1) % 3, (i + 2) % 3
@@ -169,7 +169,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
 
 
 
-def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np.ndarray:
+def _torque_limits(robot: SnakeRobot, torque_limit: npt.ArrayLike | None) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
         lim = np.asarray(robot.body.model.effort, float)
