@@ -30,7 +30,7 @@ from typing import Any
 
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
 #: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
-PAPER = {
+PAPER: dict[str, dict[str, Any]] = {
     "spheres": {"section": "4.1 (Figs. 17-20)", "position_error_m": 1.8e-3, "direction_error_deg": 0.76,
                 "max_angular_momentum_magnitude_error": 0.0383, "max_linear_momentum_magnitude_error": 0.216,
                 "zmp_inside": True, "duration_s": 36.0, "figures": (17, (18, 19), 20)},
@@ -44,7 +44,7 @@ SIM_KEYS = ("position_error_m", "direction_error_deg", "max_linear_momentum_erro
             "zmp_inside")
 
 
-def jsonable(x: npt.ArrayLike) -> Any:
+def jsonable(x: Any) -> Any:
     """``x`` with numpy scalars and arrays turned into Python numbers and lists, non-finite floats into None,
     tuples into lists and dict keys into strings (recursively)."""
     if isinstance(x, dict):
@@ -115,7 +115,7 @@ def environment() -> dict:
 
     from .. import __version__
 
-    versions = {"snakehead": __version__, "python": platform.python_version()}
+    versions: dict[str, str | None] = {"snakehead": __version__, "python": platform.python_version()}
     for dist in ("numpy", "scipy", "matplotlib", "mujoco", "scikit-learn", "pillow"):
         try:
             versions[dist] = metadata.version(dist)
@@ -160,7 +160,7 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     return path
 
 
-def _fmt(x: np.ndarray, scale: float = 1.0, digits: int = 2) -> str:
+def _fmt(x: Any, scale: float = 1.0, digits: int = 2) -> str:
     if x is None:
         return "-"
     if isinstance(x, bool):

@@ -91,14 +91,14 @@ class PlaneArc:
         """The arc as a :class:`SpaceCurve` parametrised by arc length, with exact derivatives."""
         k = self.turn / self.radius  # signed curvature
 
-        def d1(t: np.ndarray) -> np.ndarray:
+        def d1(t: float) -> np.ndarray:
             return self.tangent(t)
 
-        def d2(t: np.ndarray) -> np.ndarray:
+        def d2(t: float) -> np.ndarray:
             a = self.heading + k * t
             return k * np.array([-math.sin(a), math.cos(a), 0.0])
 
-        def d3(t: np.ndarray) -> np.ndarray:
+        def d3(t: float) -> np.ndarray:
             a = self.heading + k * t
             return -k * k * np.array([math.cos(a), math.sin(a), 0.0])
 
@@ -166,7 +166,7 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     return turn * q * robot.joint_signs[idx]
 
 
-def exact_chord_radius(chords: str, central_angle: float) -> float:
+def exact_chord_radius(chords: npt.ArrayLike, central_angle: float) -> float:
     """Radius r of the circle on which a polyline with chord lengths ``chords`` (m) spans ``central_angle``
     (rad): sum_j 2 asin(c_j / 2r) = theta. ValueError when no such circle exists (theta too large)."""
     c = finite_array(chords, "chords", (None,))
@@ -236,7 +236,7 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
     return arc
 
 
-def arc_segment_area(length: float, central_angle: float) -> np.ndarray | float:
+def arc_segment_area(length: float, central_angle: npt.ArrayLike) -> np.ndarray | float:
     """Eq. 2 with Eq. 1: the area (m^2) between a plane arc of length l and its chord,
     S(theta) = 1/2 r^2 (theta - sin theta) with r = l / theta; theta scalar or array in (0, 2 pi]."""
     l = positive(length, "length")

@@ -213,7 +213,7 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
                            shape=shape, base=base, optimum=optimum)
 
 
-def _searched_backbone(robot: SnakeRobot, central_angle: float, base: BasePlacement | None, turn: int,
+def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: BasePlacement | None, turn: int,
                        min_margin: float, first_error: ValueError) -> InitialBackbone:
     """The backbone of SHAPE_SEARCH's shapes with the largest static margin (see :func:`initial_backbone`)."""
     from ..dynamics import stability

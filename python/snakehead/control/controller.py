@@ -26,7 +26,7 @@ from ..kinematics.ik import TracIK
 from ..model.robot import BasePlacement, SnakeRobot
 
 import numpy.typing as npt
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 if TYPE_CHECKING:
     from ..kinematics.workspace import ReachabilityMap
@@ -115,7 +115,7 @@ class HeadController:
 
     # --- the process ---------------------------------------------------------------------------
     def solve(self, position: npt.ArrayLike, direction: npt.ArrayLike, q_prev: npt.ArrayLike | None = None,
-              base: BasePlacement | None = None, accept: Callable[[np.ndarray], bool] | None = None,
+              base: BasePlacement | None = None, accept: Callable[..., bool] | None = None,
               allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
@@ -166,7 +166,7 @@ class HeadController:
         return solution
 
     def _solve_from(self, base: BasePlacement, q: np.ndarray, desired: np.ndarray, keep_close: bool,
-                    accept: Callable[[np.ndarray], bool] | None = None) -> HeadSolution:
+                    accept: Callable[..., bool] | None = None) -> HeadSolution:
         """Steps 3-5 with the base where it is: the neck by Eqs. 18-22, the head by TRAC-IK, the static check."""
         timings: dict[str, float] = {}
         q = q.copy()
@@ -189,7 +189,7 @@ class HeadController:
         target = np.linalg.inv(neck.frame) @ desired
         q_close = q[parts.head].copy() if keep_close else None
 
-        def accepted(q_head: np.ndarray) -> bool:
+        def accepted(q_head: Any) -> bool:
             if accept is None:
                 return True
             q_full = q.copy()

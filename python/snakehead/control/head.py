@@ -90,7 +90,7 @@ def _roll_between(achieved: np.ndarray, desired: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(R[2, 1], R[1, 1])))
 
 
-def _finish(ik: TracIK, q: np.ndarray, target: Any, tried: int, solved: int, t0: float, candidates: list[Any]
+def _finish(ik: TracIK, q: np.ndarray | None, target: Any, tried: int, solved: int, t0: float, candidates: list[Any]
             ) -> HeadIKResult:
     if q is None:
         return HeadIKResult(None, None, np.inf, np.inf, np.nan, tried, solved, time.perf_counter() - t0, candidates)
@@ -100,7 +100,7 @@ def _finish(ik: TracIK, q: np.ndarray, target: Any, tried: int, solved: int, t0:
 
 
 def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None = None,
-                   q_prev: npt.ArrayLike | None = None, accept: Callable[[np.ndarray], bool] | None = None
+                   q_prev: npt.ArrayLike | None = None, accept: Callable[..., bool] | None = None
                    ) -> HeadIKResult:
     """The paper's method: solve ``n_frames`` frames rolled evenly about the target's x-axis, keep one.
 

@@ -143,6 +143,7 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
         # clearly better, so that nearby targets give nearby necks instead of jumping between minima.
         if k == 0 or cost < best_cost - CONTINUITY_TOLERANCE:
             best_q, best_cost = q, cost
+    assert best_q is not None  # starts holds at least one start
     T = P0_frame @ neck.fk(best_q)
     return NeckSolution(q=best_q, frame=T, cost=float(best_cost),
                         position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),

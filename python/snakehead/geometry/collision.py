@@ -85,7 +85,7 @@ _EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)
                    if np.count_nonzero(_SIGNS[a] != _SIGNS[b]) == 1])  # (12, 2) vertex pairs
 
 
-def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """World collision boxes of the links along a trajectory: links (k,), centres (T, k, 3), rotations
     (T, k, 3, 3), half extents (k, 3)."""
     links = robot.boxed_links
@@ -108,7 +108,7 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
     return gaps.min(axis=1)
 
 
-def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> tuple[np.ndarray, ...]:
+def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> list[np.ndarray]:
     """Broadcast two batches of boxes (centres (..., 3), rotations (..., 3, 3), half extents (..., 3))."""
     arrs = [np.asarray(v, float) for v in (ca, Ra, ha, cb, Rb, hb)]
     core = [(3,), (3, 3), (3,), (3,), (3, 3), (3,)]
@@ -317,4 +317,4 @@ def collision_check(robot: SnakeRobot, qs: np.ndarray, obstacles: Sequence[Any],
                 d[rows, li] = ob.distance_to_points(p).min(axis=1)
             d = np.where(collide, 0.0, d)
         dist[..., o], hit[..., o] = d, collide
-    return CollisionReport(dist.min(axis=(1, 2)), hit.any(axis=(1, 2)), dist, hit, links)
+    return CollisionReport(dist.min(axis=(1, 2)), np.asarray(hit.any(axis=(1, 2))), dist, hit, links)

@@ -29,11 +29,11 @@ class BoxObstacle:
         object.__setattr__(self, "rotation", rotation_matrix(self.rotation, "box rotation"))
 
     @classmethod
-    def from_yaw(cls, centre: np.ndarray, size: np.ndarray, yaw: float = 0.0) -> "BoxObstacle":
+    def from_yaw(cls, centre: npt.ArrayLike, size: npt.ArrayLike, yaw: float = 0.0) -> "BoxObstacle":
         """A box standing upright, turned by ``yaw`` rad about the world z-axis."""
         yaw = finite_float(yaw, "box yaw")
         c, s = np.cos(yaw), np.sin(yaw)
-        return cls(centre, size, np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
+        return cls(np.asarray(centre, float), np.asarray(size, float), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
 
 
 @dataclass(frozen=True)

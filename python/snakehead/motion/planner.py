@@ -63,7 +63,7 @@ class TargetResult:
     position: np.ndarray  # (3,) m
     direction: np.ndarray  # (3,) unit
     time_s: float  # when the plan arrives
-    solution: object  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
+    solution: Any  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
 
     @property
     def position_error_m(self) -> float:
@@ -138,7 +138,7 @@ class Plan:
             k = int(np.argmin(self.ground_clearance))
             return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
                     f"t = {self.t[k]:.2f} s")
-        if self.touches_obstacle:
+        if self.touches_obstacle and self.obstacle_distance is not None:
             k = int(np.argmax(self.obstacle_distance <= 0))
             return f"a link touches an obstacle at t = {self.t[k]:.2f} s"
         return None
@@ -261,7 +261,7 @@ class _Waypoints:
 
 
 def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
-            notes: list[str] = (), scene: Scene | None = None) -> Plan:
+            notes: Sequence[str] = (), scene: Scene | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
@@ -475,8 +475,9 @@ def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadContr
             raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
         if robot is not None and robot is not controller.robot:
             raise ValueError("give a robot or a controller (whose robot is used), not both")
-        if base is not None or scene.base is not None:
-            controller.base = base if base is not None else scene.base
+        chosen = base if base is not None else scene.base
+        if chosen is not None:
+            controller.base = chosen
     else:
         if robot is None:
             robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()

@@ -204,8 +204,8 @@ def _target_from(entry: Any, where: str) -> Target:
             raise ValueError(f"{where}: via must be true or false, got {entry['via']!r}")
         kwargs["via"] = entry["via"]
     try:
-        return Target(name, _number_list(entry["position"], f"{where}: position"),
-                      _number_list(entry["direction"], f"{where}: direction"), **kwargs)
+        return Target(name, np.asarray(_number_list(entry["position"], f"{where}: position")),
+                      np.asarray(_number_list(entry["direction"], f"{where}: direction")), **kwargs)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 

@@ -484,7 +484,7 @@ class Viewer:
             step = float(max(0.01, np.round(duration / 1000, 2)))
             self.time.max = max(round(duration, 2), step)
             self.time.step = step
-            self.time.value = 0.0
+            self.time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
             self._apply_layers()
 
     def _frame_at(self, t_rel: float) -> int:
@@ -517,7 +517,7 @@ class Viewer:
             t_next = self.time.value + factor * dt
             if t_next > self.time.max:
                 t_next = 0.0
-            self.time.value = t_next  # its on_update moves the scene
+            self.time.value = t_next  # type: ignore[misc]  # (viser: assignable, typed read-only); moves the scene
 
     def close(self) -> None:
         self._stop.set()

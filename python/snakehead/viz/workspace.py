@@ -131,7 +131,9 @@ def plot_section(m: ReachabilityMap, ax: Axes | None = None, axis: str = "z", va
     ax.set_title(f"section {axis} = {at:+.3f} m ({int(keep.sum())} voxels)")
     if colorbar:
         _colorbar(ax.figure, pc, ax)
-    return ax.figure
+    fig = ax.get_figure(root=True)
+    assert fig is not None  # the axes belong to a figure
+    return fig
 
 
 def figure_map(m: ReachabilityMap, axis: str = "z", value: float = 0.0, title: str | None = None) -> Figure:
