@@ -83,7 +83,7 @@ class SpaceCurve:
         if derivatives is not None:
             if len(derivatives) != 3 or not all(callable(d) for d in derivatives):
                 raise ValueError("derivatives must be three callables (dr, d2r, d3r), each t -> (3,) array")
-            self._d = tuple(derivatives)
+            self._d: tuple[Callable[[float], np.ndarray], ...] | None = tuple(derivatives)
         else:
             self._d = None
         span = self.t1 - self.t0
@@ -105,7 +105,7 @@ class SpaceCurve:
         """r(t), (3,) m."""
         return self._call(self._r, float(t), "r")
 
-    def derivs(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def derivs(self, t: float) -> tuple[np.ndarray, ...]:
         """(r'(t), r''(t), r'''(t)), each (3,): supplied, or central finite differences."""
         t = float(t)
         if self._d is not None:
@@ -114,7 +114,7 @@ class SpaceCurve:
         P = np.array([self._call(self._r, t + k * h, "r") for k in _OFFSETS])  # (7, 3)
         return _D1 @ P / h, _D2 @ P / h ** 2, _D3 @ P / h ** 3
 
-    def curvature_torsion(self, t: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    def curvature_torsion(self, t: npt.ArrayLike) -> tuple[Any, Any]:
         """Curvature kappa (1/m) and torsion tau (1/m) at t (scalar or (m,)), Eq. 7:
 
         kappa = |r' x r''| / |r'|^3,   tau = (r' x r'') . r''' / |r' x r''|^2.
@@ -156,13 +156,13 @@ class SpaceCurve:
         """Regularity and no inflection: sample r' and r' x r'' on an even grid of t."""
         ts = np.linspace(self.t0, self.t1, n)
         self.point(self.t0)  # shape / NaN check of r itself
-        speeds, cs = [], []
+        speed_list, cross_list = [], []
         for t in ts:
             d1, d2, _ = self.derivs(t)
-            speeds.append(np.linalg.norm(d1))
-            cs.append(np.cross(d1, d2))
-        speeds = np.array(speeds)
-        cs = np.array(cs)
+            speed_list.append(np.linalg.norm(d1))
+            cross_list.append(np.cross(d1, d2))
+        speeds = np.array(speed_list)
+        cs = np.array(cross_list)
         if speeds.min() <= 1e-9 * max(speeds.max(), 1e-300):
             i = int(np.argmin(speeds))
             raise ValueError(f"the curve is not regular: r'(t) = 0 near t = {ts[i]:.6g}")
@@ -235,12 +235,12 @@ class SpaceCurve:
         t = np.atleast_1d(self.t_at(s))
         return self._solution().sol(t)  # (4, m)
 
-    def phase(self, s: np.ndarray, phi0: float = 0.0) -> np.ndarray | float:
+    def phase(self, s: npt.ArrayLike, phi0: float = 0.0) -> Any:
         """phi(s) = phi0 + int_0^s tau ds (rad), Eq. 3; scalar or array."""
         phi = self._state_at_s(s)[1] + finite_float(phi0, "phi0")
         return float(phi[0]) if np.ndim(s) == 0 else phi
 
-    def curvature_projections(self, s: npt.ArrayLike, phi0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def curvature_projections(self, s: npt.ArrayLike, phi0: float = 0.0) -> tuple[Any, Any]:
         """(kappa_y, kappa_p) = kappa (cos phi, sin phi) at arc lengths s (1/m), Eq. 4."""
         sa = np.atleast_1d(np.asarray(s, dtype=np.float64))
         t = np.atleast_1d(self.t_at(sa))
@@ -251,7 +251,7 @@ class SpaceCurve:
             return float(ky[0]), float(kp[0])
         return ky, kp
 
-    def bending(self, s1: Any, s2: Any, phi0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def bending(self, s1: Any, s2: Any, phi0: float = 0.0) -> tuple[Any, Any]:
         """(theta_y, theta_p) = (int_s1^s2 kappa_y ds, int_s1^s2 kappa_p ds) in rad, Eqs. 5-6.
 
         s1, s2 scalars or equal-shape arrays (m) within [0, L]. phi0 is the phase at s = 0 (Eq. 3's
@@ -302,18 +302,18 @@ def cubic_bezier(control_points: npt.ArrayLike) -> SpaceCurve:
     points (m), as a :class:`SpaceCurve` with its exact derivatives."""
     P = finite_array(control_points, "control_points", (4, 3))
 
-    def r(t: np.ndarray) -> np.ndarray:
+    def r(t: float) -> np.ndarray:
         u = 1.0 - t
         return u ** 3 * P[0] + 3 * u * u * t * P[1] + 3 * u * t * t * P[2] + t ** 3 * P[3]
 
-    def d1(t: np.ndarray) -> np.ndarray:
+    def d1(t: float) -> np.ndarray:
         u = 1.0 - t
         return 3.0 * (u * u * (P[1] - P[0]) + 2 * u * t * (P[2] - P[1]) + t * t * (P[3] - P[2]))
 
-    def d2(t: np.ndarray) -> np.ndarray:
+    def d2(t: float) -> np.ndarray:
         return 6.0 * ((1.0 - t) * (P[2] - 2 * P[1] + P[0]) + t * (P[3] - 2 * P[2] + P[1]))
 
-    def d3(t: np.ndarray) -> np.ndarray:
+    def d3(t: float) -> np.ndarray:
         return 6.0 * (P[3] - 3 * P[2] + 3 * P[1] - P[0])
 
     return SpaceCurve(r, 0.0, 1.0, derivatives=(d1, d2, d3))

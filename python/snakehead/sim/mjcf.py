@@ -274,7 +274,7 @@ class SimModel:
     """
 
     robot: SnakeRobot
-    model: object
+    model: Any  # mujoco.MjModel
     body_ids: np.ndarray
     site_ids: np.ndarray
     qpos_adr: np.ndarray

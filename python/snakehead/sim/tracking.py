@@ -224,7 +224,7 @@ def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RA
     return W
 
 
-def _compensated_mode(gravity_compensation: bool) -> str:
+def _compensated_mode(gravity_compensation: str) -> str:
     if gravity_compensation not in GRAVITY_COMPENSATION:
         raise ValueError(f"gravity_compensation must be one of {GRAVITY_COMPENSATION}, got {gravity_compensation!r}")
     return gravity_compensation
@@ -248,8 +248,8 @@ def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray
     return -np.einsum("nl,nlk,nk->n", weights, torque, a)
 
 
-def simulate_trajectory(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
-                        kp: float = DEFAULT_KP, kd: float = DEFAULT_KD, *, control_dt: float = DEFAULT_CONTROL_DT,
+def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
+                        kp: npt.ArrayLike = DEFAULT_KP, kd: npt.ArrayLike = DEFAULT_KD, *, control_dt: float = DEFAULT_CONTROL_DT,
                         timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3, hold: float = 0.0,
                         gravity_compensation: str = "supported", torque_limit: float | npt.ArrayLike | None = None,
                         friction: float = 0.8, joint_damping: float = 0.02, armature: float = 1e-3,
@@ -300,8 +300,10 @@ def simulate_trajectory(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: B
     qdot_plan = np.gradient(q, t, axis=0)
     qa, da = sim.qpos_adr, sim.dof_adr
 
-    def control(qr: np.ndarray, qdr: np.ndarray, W: np.ndarray) -> None:
+    def control(qr: np.ndarray, qdr: np.ndarray, W: np.ndarray | None) -> None:
+        tau_g: np.ndarray | float
         if mode == "supported":
+            assert W is not None  # the supported mode computes the weights
             tau_g = gravity_torques(sim, d, W)
         elif mode == "bias":
             tau_g = d.qfrc_bias[da]
