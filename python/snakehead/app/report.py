@@ -25,7 +25,6 @@ import numpy as np
 
 from .._files import atomic_open, write_text_atomic
 
-import numpy.typing as npt
 from typing import Any
 
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the

@@ -231,7 +231,7 @@ class SpaceCurve:
                 out[i] = optimize.brentq(lambda t: sol(t)[0] - si, self.t0, self.t1, xtol=1e-15, rtol=1e-15)
         return float(out[0]) if np.ndim(s) == 0 else out
 
-    def _state_at_s(self, s: np.ndarray) -> np.ndarray:
+    def _state_at_s(self, s: npt.ArrayLike) -> np.ndarray:
         t = np.atleast_1d(self.t_at(s))
         return self._solution().sol(t)  # (4, m)
 

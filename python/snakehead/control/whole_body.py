@@ -464,7 +464,7 @@ def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np
     return obj.unpack(res.x)
 
 
-def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: np.ndarray, *,
+def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: Sequence[Any], *,
                      move_base: bool = True, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
                      self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
                      problem: BodyProblem | None = None, time_budget: float = 3.0) -> WholeBodySolution:
@@ -604,7 +604,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     def check(q: np.ndarray, b: Any) -> Any:
         return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin)
 
-    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: np.ndarray) -> Any:
+    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: int) -> Any:
         return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
                                  position_error_m=chk["position_error_m"],
                                  direction_error_deg=chk["direction_error_deg"],
@@ -620,7 +620,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     best = None
     seg_holder = [None]
 
-    def consider(q: np.ndarray, b: Any, stage: str, starts: np.ndarray) -> Any:
+    def consider(q: np.ndarray, b: Any, stage: str, starts: int) -> Any:
         """Check a configuration; keep the best attempt; return the solution when it passes."""
         nonlocal best
         chk = check(q, b)

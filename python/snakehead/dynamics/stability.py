@@ -421,7 +421,7 @@ def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz:
     return np.stack([px, py], axis=1)
 
 
-def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None, qd: npt.ArrayLike
+def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None
          ) -> tuple[np.ndarray, ...]:
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)

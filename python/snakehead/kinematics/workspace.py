@@ -240,7 +240,7 @@ def _param_equal(a: Any, b: Any) -> bool:
 
 
 # --- computing -------------------------------------------------------------------------------------------
-def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: np.ndarray,
+def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: str,
              timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any
              ) -> _core.WorkspaceOptions:
     o = _core.WorkspaceOptions()
@@ -424,11 +424,11 @@ def _bar(progress: bool, total: int, unit: str) -> Any:
 def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMap:
     bar = _bar(progress, 0, "voxel")
 
-    def callback(done: int, total: int) -> None:  # called about every 0.1 s; the binding checks for Ctrl-C before each call
+    def callback(done: int, total: int) -> bool:  # called about every 0.1 s; the binding checks for Ctrl-C before each call
         return True
 
     if bar is not None:
-        def callback(done: int, total: int) -> None:
+        def callback(done: int, total: int) -> bool:
             if bar.total != total:
                 bar.total = total
                 bar.refresh()
@@ -512,7 +512,7 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
         if "format" not in z.files or str(z["format"]) != FORMAT:
             raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
 
-        def scalar(k: int, cast: Callable[[Any], Any]) -> Any:
+        def scalar(k: str, cast: Callable[[Any], Any]) -> Any:
             return cast(z[k][()])
 
         params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")

@@ -14,6 +14,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
 
 import numpy.typing as npt
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,7 @@ def _interpolation_parameters(n: int) -> np.ndarray:
     return s
 
 
-def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int | npt.ArrayLike,
                             base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False) -> Any:
     """Whole-body interpolation in Cartesian space, Eqs. 41-44: n configurations (n, 16) from q_start to q_end.
 

@@ -34,8 +34,13 @@ from ..scenes.scene import Scene, Target
 from . import interpolation as interp
 from .cartesian import tracking_interpolation
 
+import os
+
 import numpy.typing as npt
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
+
+if TYPE_CHECKING:
+    from ..geometry.obstacles import BoxObstacle, WallWithHole
 
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
@@ -445,8 +450,9 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
 
 
-def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadController | None = None,
-         obstacles: Sequence[Any] = (), base: BasePlacement | None = None, method: str = "rotated",
+def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike, npt.ArrayLike]], *,
+         robot: SnakeRobot | None = None, controller: HeadController | None = None,
+         obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None, method: str = "rotated",
          seed: int | None = 1, speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
@@ -504,14 +510,14 @@ def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadContr
         q = way.qs[-1]
     results: list[TargetResult] = []
     k = 0
-    targets = scene.targets
-    while k < len(targets):
+    scene_targets = scene.targets
+    while k < len(scene_targets):
         # a run: this target and the following ones approached along a line from it
         end = k
-        while end + 1 < len(targets) and targets[end + 1].approach == "line":
+        while end + 1 < len(scene_targets) and scene_targets[end + 1].approach == "line":
             end += 1
         if end == k:
-            tg = targets[k]
+            tg = scene_targets[k]
             sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
             way.move(tg.name, sol.q)
             q = sol.q
@@ -525,13 +531,13 @@ def plan(targets: Any, *, robot: SnakeRobot | None = None, controller: HeadContr
         # a hole) out to the run's first target, each from the previous joints: a branch of solutions that clears
         # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
         poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
-            (targets[k].name, targets[k].position, targets[k].direction, targets[k])]
+            (scene_targets[k].name, scene_targets[k].position, scene_targets[k].direction, scene_targets[k])]
         for j in range(k + 1, end + 1):
-            line = _line_poses(targets[j - 1], targets[j])
+            line = _line_poses(scene_targets[j - 1], scene_targets[j])
             for m, p in enumerate(line):
                 last = m == len(line) - 1
-                label = targets[j].name if last else f"{targets[j].name} ({m + 1}/{len(line)})"
-                poses.append((label, p, targets[j].direction, targets[j] if last else None))
+                label = scene_targets[j].name if last else f"{scene_targets[j].name} ({m + 1}/{len(line)})"
+                poses.append((label, p, scene_targets[j].direction, scene_targets[j] if last else None))
         sols: list = [None] * len(poses)
         q_back = q
         for m in range(len(poses) - 1, -1, -1):
