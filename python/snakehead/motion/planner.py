@@ -545,16 +545,16 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
             if sols[m].success:
                 q_back = sols[m].q
-        for m, (label, p, d, tg) in enumerate(poses):
+        for m, (label, p, d, line_target) in enumerate(poses):
             if m == 0:
                 way.move(label, sols[m].q)
             else:
                 way.move_joint(label, sols[m].q)
-            if tg is not None:
-                if not tg.via:
-                    results.append(TargetResult(tg.name, tg.position, tg.direction, way.times[-1], sols[m]))
-                if tg.hold_s > 0:
-                    way.hold(tg.hold_s)
+            if line_target is not None:
+                if not line_target.via:
+                    results.append(TargetResult(line_target.name, line_target.position, line_target.direction, way.times[-1], sols[m]))
+                if line_target.hold_s > 0:
+                    way.hold(line_target.hold_s)
         q = sols[-1].q
         k = end + 1
     plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)
