@@ -136,8 +136,9 @@ _ITEM = re.compile(r"^(\s*)([-*]|\d+\.) \S")
 def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
     """The docstrings are written for ``help()``: plain text with a little reStructuredText (````code````, roles).
     Make the plain-text habits valid reStructuredText: norms written |a - b| are not substitutions; a parameter
-    line "name : what" continued on indented lines is one line; lists and indented blocks get the blank lines
-    around them that reStructuredText needs."""
+    line "name : what" continued on indented lines is one line; an indented block after "text:" is shown as
+    written (a literal block); lists and indented blocks get the blank lines around them that reStructuredText
+    needs."""
     text = [line.replace("|", "\\|") for line in lines]
     joined: list[str] = []
     for line in text:
@@ -145,6 +146,12 @@ def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
             joined[-1] += " " + line.strip()
         else:
             joined.append(line)
+    # "text:" introducing an indented block (a formula, a table of values) makes it a literal block
+    for i in range(len(joined) - 2):
+        line, gap, block = joined[i], joined[i + 1], joined[i + 2]
+        if (line.rstrip().endswith(":") and not line.rstrip().endswith("::") and not gap.strip()
+                and block.startswith(" ") and block.strip() and not _ITEM.match(block)):
+            joined[i] = line.rstrip() + ":"
     out: list[str] = []
     for line in joined:
         prev = out[-1] if out else ""
