@@ -274,8 +274,9 @@ def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), sc
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
-    clearance = coll.ground_clearance(robot, traj.q, base)[:, robot.lifted_links].min(axis=1)
+    frames = robot.frames_many(traj.q, base)  # once, for every check below
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
+    clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
