@@ -203,33 +203,62 @@ def _wait_for_page(driver, timeout: float = 90.0):
         EC.presence_of_element_located((By.CSS_SELECTOR, ".mantine-Slider-root")))
 
 
-def _seek(driver, slider, fraction: float) -> float:
-    """Click the time slider at ``fraction`` of its length (this pauses playback); the time (s) it shows."""
+def _shown_time(driver) -> float:
+    return float(driver.execute_script("return document.querySelector('input.mantine-NumberInput-input').value;"))
+
+
+def _pause(driver, slider) -> float:
+    """Press the playback bar's play/pause button (the page plays on load) and wait until the time stands still;
+    the time (s) it shows."""
+    from selenium.webdriver.common.by import By
+
+    bar = slider.find_element(By.XPATH, "./ancestor::div[contains(@class, 'mantine-Paper-root')][1]")
+    bar.find_elements(By.TAG_NAME, "button")[0].click()
+    shown = _shown_time(driver)
+    for _ in range(120):
+        time.sleep(1.0)
+        now = _shown_time(driver)
+        if now == shown:
+            return now
+        shown = now
+    raise AssertionError("the time kept running after pause")
+
+
+def _seek(driver, slider, fraction: float, duration: float) -> float:
+    """Click the time slider at ``fraction`` of its length (this pauses playback) and wait until the page shows
+    that time (to 5 % of the recording's ``duration``; SwiftShader under load can take seconds); the time shown."""
     from selenium.webdriver.common.action_chains import ActionChains
 
     width = slider.size["width"]
     ActionChains(driver).move_to_element_with_offset(slider, int((fraction - 0.5) * width), 0).click().perform()
-    shown = None
-    for _ in range(120):  # wait until the page shows the new, paused time (SwiftShader renders slowly)
-        time.sleep(0.5)
-        value = driver.execute_script("return document.querySelector('input.mantine-NumberInput-input').value;")
-        if value == shown:
+    shown = _shown_time(driver)
+    for _ in range(240):
+        if abs(shown - fraction * duration) < 0.05 * duration:
             break
-        shown = value
-    return float(shown)
+        time.sleep(0.5)
+        shown = _shown_time(driver)
+    assert abs(shown - fraction * duration) < 0.05 * duration, (shown, fraction * duration)
+    return shown
 
 
-def _settled_screenshot(driver, timeout: float = 60.0) -> np.ndarray:
-    """A screenshot once the picture stops changing (the page fades in; a frame takes a while in SwiftShader)."""
-    previous = _screenshot(driver)
+def _settled_screenshot(driver, timeout: float = 90.0) -> np.ndarray:
+    """A screenshot once the picture stops changing: three in a row, a second apart, alike and with as many
+    clearly coloured pixels (the page fades in, and a frame takes a while in SwiftShader on a loaded machine)."""
+    def coloured(img: np.ndarray) -> int:
+        x = img.astype(float) / 255.0
+        return int(((x.max(axis=2) - x.min(axis=2)) > 0.2).sum())
+
+    shots = [_screenshot(driver)]
     end = time.monotonic() + timeout
     while time.monotonic() < end:
-        time.sleep(0.7)
-        img = _screenshot(driver)
-        if np.abs(img.astype(int) - previous).mean() < 0.05:
-            return img
-        previous = img
-    return previous
+        time.sleep(1.0)
+        shots = shots[-2:] + [_screenshot(driver)]
+        if len(shots) == 3:
+            counts = [coloured(im) for im in shots]
+            alike = all(np.abs(a.astype(int) - b).mean() < 0.05 for a, b in zip(shots, shots[1:]))
+            if alike and max(counts) - min(counts) <= 0.02 * max(counts) and counts[-1] > 0:
+                return shots[-1]
+    return shots[-1]
 
 
 def test_the_page_shows_the_robot_and_the_slider_moves_it(browser, planned, scene, tmp_path):
@@ -237,9 +266,12 @@ def test_the_page_shows_the_robot_and_the_slider_moves_it(browser, planned, scen
     browser.get(page.resolve().as_uri())
     slider = _wait_for_page(browser)
     times = scene.times - scene.times[0]
+    duration = float(times[-1]) + 1.0  # the recording holds the last frame 1 s
     shots = []
-    for fraction in (0.03, 0.97):
-        t_shown = _seek(browser, slider, fraction)
+    # paused early in the motion, then the slider stepped forward to its end (a step back would replay the
+    # recording from its start, its nodes fading in again: slow in SwiftShader)
+    for step in ("pause", "slider"):
+        t_shown = _pause(browser, slider) if step == "pause" else _seek(browser, slider, 0.97, duration)
         k = int(np.searchsorted(times, t_shown + 0.05, side="right") - 1)  # the time is shown to 0.1 s
         img = _settled_screenshot(browser)
         share, mask = _robot_seen(img, scene, k, _canvas_rect(browser))
