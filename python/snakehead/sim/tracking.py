@@ -262,7 +262,7 @@ def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = No
     carries the lifted run of links hanging from it, judged from the planned configuration, see
     :func:`carried_weights`), "bias" (MuJoCo's ``qfrc_bias`` on every joint: gravity and Coriolis as if the tail
     were clamped) or "none". ``torque_limit`` N m: scalar or (n,), default the URDF
-    effort. Other keywords go to :func:`build_mjcf`.
+    effort. Other keywords go to :func:`snakehead.sim.build_spec`.
 
     Returns a :class:`SimResult` sampled at every control tick from t[0] to t[-1] + hold.
     """
