@@ -26,7 +26,7 @@ it), generated from the robot's own data, not from the URDF importer:
 * servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
   0.02 N m s/rad -- our choice, not the paper's.
 
-Controller (:func:`simulate`): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
+Controller (:func:`snakehead.sim.simulate_trajectory`, in ``tracking.py``): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
 updated (zero-order hold); the joint torque is
 
     tau = kp (q_ref - q) + kd (qdot_ref - qdot) + g_mj(q, qdot)     clipped to +-torque_limit
@@ -43,8 +43,9 @@ distal links). Gravity compensation (``gravity_compensation``):
   distal body as a cantilever from the tail, so the base pitch joints push against the ground;
 * "none": PD only.
 
-Default gains kp = 200 N m/rad, kd = 3 N m s/rad. The URDF's 3 N m effort cannot lift the head part from flat
-(joint 10 needs ~3.9 N m); pass ``torque_limit`` to raise it (bench/RESULTS.md).
+Default gains and torque limits come from each joint's load (:mod:`snakehead.sim.gains`), so they suit any robot's
+masses; the torque limit is the URDF's effort (a 3 N m servo cannot lift the default robot's head part from flat:
+joint 10 needs ~3.9 N m).
 """
 from __future__ import annotations
 
@@ -57,6 +58,7 @@ import numpy as np
 from .._validate import finite_array, positive
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from .gains import default_torque_limits
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
@@ -64,10 +66,6 @@ GRAVITY = 9.80665
 #: Physics timestep (s) and control period (s) used by default.
 DEFAULT_TIMESTEP = 0.001
 DEFAULT_CONTROL_DT = 0.002
-
-#: Default PD gains (N m/rad, N m s/rad) for every joint.
-DEFAULT_KP = 200.0
-DEFAULT_KD = 3.0
 
 _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
@@ -154,7 +152,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
 def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
-        lim = np.asarray(robot.body.model.effort, float)
+        lim = default_torque_limits(robot)
     else:
         lim = np.broadcast_to(finite_array(torque_limit, "torque_limit"), (n,)).astype(float) \
             if np.ndim(torque_limit) == 0 else finite_array(torque_limit, "torque_limit", (n,))
@@ -193,8 +191,8 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     actuators ``act_<joint>`` (affine: force = ctrl - kp q - kd qdot, gains set by the caller); the floor geom
     ``floor``; obstacle geoms ``obstacle_<k>``. Names are data: characters that mean something in XML are kept
     as they are and cannot add elements. Units SI; ``timestep`` s, ``friction`` the sliding coefficient,
-    ``joint_damping`` N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default the URDF
-    effort), ``contact_solref`` (time constant s, damping ratio) of every contact.
+    ``joint_damping`` N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default
+    :func:`snakehead.sim.gains.default_torque_limits`: the URDF effort), ``contact_solref`` (time constant s, damping ratio) of every contact.
     """
     mj = _mujoco()
     robot = as_robot(robot)
