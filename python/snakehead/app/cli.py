@@ -264,6 +264,14 @@ _OUTPUTS = """outputs (in DIR):
 """
 
 
+def _planning_parser(sub, name: str, func, help_text: str, description: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(name, help=help_text, description=description, epilog=_OUTPUTS,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_planning_options(p)
+    p.set_defaults(func=func)
+    return p
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="snakehead", description=__doc__.split("\n\n")[0],
                                      epilog=__doc__.split("\n\n", 1)[1],
@@ -274,21 +282,16 @@ def build_parser() -> argparse.ArgumentParser:
     _add_robot_option(p)
     p.set_defaults(func=_info)
 
-    p = sub.add_parser("demo", help="the paper's two scenarios (Section 4) with figures, animations and a report",
-                       description="Plan the paper's two scenarios on the default robot (catching two spheres, "
-                                   "Section 4.1; getting the head through a hole in a wall, Section 4.2), check them "
-                                   "in MuJoCo (the hole's wall included), and write a report, trajectories, "
-                                   "figures and animations. NAME is spheres and hole.",
-                       epilog=_OUTPUTS, formatter_class=argparse.RawDescriptionHelpFormatter)
-    _add_planning_options(p)
-    p.set_defaults(func=_demo)
-
-    p = sub.add_parser("plan", help="head targets: --position/--direction, or a scene file",
-                       description="Plan the head from the bending state on the ground to POSITION pointing along "
-                                   "DIRECTION (world frame, z up, ground at z = 0), or through the targets of a "
-                                   "scene file (--scene; TOML: targets and obstacles), check it, and write the same "
-                                   "outputs as demo with NAME = target (or the scene's name).",
-                       epilog=_OUTPUTS, formatter_class=argparse.RawDescriptionHelpFormatter)
+    _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",
+                     "Plan the paper's two scenarios (catching two spheres, Section 4.1; getting the head through a "
+                     "hole in a wall, Section 4.2; on the default robot unless --robot), check them in MuJoCo (the "
+                     "hole's wall included), and write a report, trajectories, figures and animations. NAME is "
+                     "spheres and hole.")
+    p = _planning_parser(sub, "plan", _plan, "head targets: --position/--direction, or a scene file",
+                         "Plan the head from the bending state on the ground to POSITION pointing along DIRECTION "
+                         "(world frame, z up, ground at z = 0), or through the targets of a scene file (--scene; "
+                         "TOML: targets and obstacles), check it, and write the same outputs as demo with NAME = "
+                         "target (or the scene's name).")
     p.add_argument("--position", type=_finite_float, nargs=3, default=None, metavar=("X", "Y", "Z"),
                    help="desired head position (m, world)")
     p.add_argument("--direction", type=_finite_float, nargs=3, default=None, metavar=("DX", "DY", "DZ"),
@@ -296,8 +299,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scene", default=None, metavar="SCENE.toml",
                    help="a scene file: targets (name, position, direction, hold_s, ...) and obstacles; its robot "
                         "file is used unless --robot is given")
-    _add_planning_options(p)
-    p.set_defaults(func=_plan)
 
     p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
                        description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "

@@ -145,7 +145,7 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     idx = np.arange(robot.n_joints)[joints]
     s_joint = robot.joint_arc_lengths
     s = s_joint[idx] - (0.0 if idx[0] == 0 else s_joint[idx[0]])
-    if s[-1] >= l:
+    if s[-1] > l + 1e-12:
         raise ValueError(f"the arc ({l:.6g} m) does not reach past the last joint ({s[-1]:.6g} m)")
     kinds = [robot.joint_kinds[i] for i in idx]
     q = np.zeros(len(idx))

@@ -131,7 +131,7 @@ def _q_up_for(robot: SnakeRobot, shape: UpCurveShape, turn: int) -> tuple[np.nda
     R0 = F[robot.body.link_index(robot.parts.base_end), :3, :3]
     curve, P = up_curve(arc, shape, up_length(robot))
     phi0 = curve.initial_phase(R0)
-    q_up = curve_joint_angles(robot, curve, slice(nb, robot.n_joints), phi0=phi0)
+    q_up = curve_joint_angles(robot, curve, slice(nb, robot.n_joints), s_start=robot.base_length, phi0=phi0)
     return q_up, curve, P, phi0
 
 

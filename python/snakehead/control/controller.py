@@ -97,7 +97,7 @@ class HeadController:
         self.base = base_pose if base_pose is not None else BasePlacement()
         if not isinstance(self.base, BasePlacement):
             raise TypeError("base_pose must be a BasePlacement")
-        self.neck_length = self.robot.neck_length
+        self.neck_length = self.robot.lift_length  # the part of the neck that can lift (all of it, usually)
         self.slack = positive(slack, "slack") if slack is not None else self.neck_length / 2
         self.allow_base_move = bool(allow_base_move)
         if base_configuration is None:
@@ -109,7 +109,7 @@ class HeadController:
 
     # --- the process ---------------------------------------------------------------------------
     def solve(self, position, direction, q_prev=None, base: BasePlacement | None = None,
-              accept=None) -> HeadSolution:
+              accept=None, allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
         ``q_prev`` (16,): the current joints; the base keeps its shape from it and the neck and head start
@@ -120,6 +120,9 @@ class HeadController:
         ``allow_base_move``) by the planar move that brings the target in range; the accepted range is a
         sufficient test, not a necessary one, so a target out of range is first tried from where the base is,
         and the move is made only when that fails or leaves the body statically unstable.
+
+        ``allow_base_move``: whether a target out of range may move the base (default: the controller's
+        ``allow_base_move``).
 
         ``accept``: an optional test ``accept(q (16,), base) -> bool`` of a whole-body solution (e.g. no
         collision with an obstacle). Only accepted solutions are kept: with free roll, when its solution is
@@ -133,12 +136,13 @@ class HeadController:
         if not isinstance(base, BasePlacement):
             raise TypeError("base must be a BasePlacement")
         desired = head_ik.frame_from_direction(position, direction)
-        P0_frame = self.robot.frame(q, self.robot.parts.base_end, base)
+        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         check = nk.accepted_range(position, P0_frame[:3, 3], self.Lc, self.neck_length, self.slack)
         solution = self._solve_from(base, q, desired, q_prev is not None, accept)
         if not check.accepted:
             note = f"the target is outside the accepted range from the given base ({check.reason})"
-            if not (solution.success and solution.static_stable) and self.allow_base_move:
+            move = self.allow_base_move if allow_base_move is None else bool(allow_base_move)
+            if not (solution.success and solution.static_stable) and move:
                 P0_local = np.linalg.inv(self.robot.root_pose(base)) @ P0_frame
                 moved = nk.base_move_into_range(position, P0_local, base, self.Lc, self.neck_length, self.slack,
                                                      self.robot.body_axis_height)
@@ -163,10 +167,14 @@ class HeadController:
         position = desired[:3, 3]
 
         t0 = time.perf_counter()
-        P0_frame = self.robot.frame(q, parts.base_end, base)
+        # Eqs. 18-22 pivot on P0; on a neck that begins with yaw joints, on the frame where its lifting begins
+        # (the joints before it keep the initial state's angles: see SnakeRobot.lift_joints)
+        lift = self.robot.lift_joints
+        q[parts.neck.start:lift.start] = self.q_initial[parts.neck.start:lift.start]
+        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         goal = nk.neck_goal(P0_frame[:3, 3], position, self.Lc)
-        neck = nk.solve_neck(self.robot.neck_chain, P0_frame, goal, q_init=q[parts.neck])
-        q[parts.neck] = neck.q
+        neck = nk.solve_neck(self.robot.lift_chain, P0_frame, goal, q_init=q[lift])
+        q[lift] = neck.q
         timings["neck"] = time.perf_counter() - t0
 
         # Step 4: the head, from the neck end frame B0.

@@ -102,6 +102,12 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
     """
     P0_frame = finite_array(P0_frame, "P0_frame", (4, 4))
     h = positive(h, "h")
+    if neck.n_joints == 0:  # nothing to move: the neck end is where the chain puts it
+        T = P0_frame @ neck.fk(np.zeros(0))
+        ra = T[:3, 0]
+        cost = float(np.sum((T[:3, 3] - goal.P_d) ** 2) + h * np.sum(np.cross(goal.r_d, ra) ** 2))
+        return NeckSolution(q=np.zeros(0), frame=T, cost=cost, position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
+                            direction_error_deg=angle_between_deg(ra, goal.r_d))
     R0, p0 = P0_frame[:3, :3], P0_frame[:3, 3]
     lo, hi = neck.lower, neck.upper
     sqrt_h = np.sqrt(h)

@@ -17,8 +17,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull
-from scipy.spatial import QhullError
 
 from .._validate import finite_array, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -200,26 +198,39 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
 # ------------------------------------------------------------------------------------------------
 # Eq. 24: support polygon
 # ------------------------------------------------------------------------------------------------
+def hull_indices(pts: np.ndarray, eps: float = 1e-12) -> list[int]:
+    """Indices of the counter-clockwise convex hull vertices of 2-D points (N, 2), collinear points on edges left
+    out (Andrew's monotone chain): one index for coincident points, the two extremes for collinear points."""
+    pts = np.asarray(pts, float)
+    order = np.lexsort((pts[:, 1], pts[:, 0])).tolist()
+    P = pts.tolist()
+    if len(order) == 0:
+        return []
+    scale = eps * max(1.0, float(np.abs(pts).max()))
+
+    def cross(o, a, b):
+        return (P[a][0] - P[o][0]) * (P[b][1] - P[o][1]) - (P[a][1] - P[o][1]) * (P[b][0] - P[o][0])
+
+    def half(seq):
+        out: list[int] = []
+        for i in seq:
+            while len(out) >= 2 and cross(out[-2], out[-1], i) <= scale * scale:
+                out.pop()
+            if out and abs(P[out[-1]][0] - P[i][0]) <= scale and abs(P[out[-1]][1] - P[i][1]) <= scale:
+                continue  # the same point again
+            out.append(i)
+        return out
+
+    lower, upper = half(order), half(order[::-1])
+    hull = lower[:-1] + upper[:-1]
+    if len(hull) < 2:  # all points coincide (or two points)
+        return lower[:2] if len(lower) >= 2 else lower[:1]
+    return hull
+
+
 def _hull_ccw(pts: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull vertices of 2-D points; a 2-point segment or 1 point when degenerate."""
-    uniq = np.unique(pts, axis=0)
-    if len(uniq) == 1:
-        return uniq
-    centred = uniq - uniq.mean(axis=0)
-    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
-    if sv[-1] <= 1e-12 * max(1.0, sv[0]):  # collinear: the polygon degenerates to a segment
-        s = centred @ vt[0]
-        return uniq[[int(np.argmin(s)), int(np.argmax(s))]]
-    try:
-        hull = ConvexHull(uniq)
-    except QhullError as exc:  # pragma: no cover - guarded by the rank test above
-        raise ValueError(f"cannot build the support polygon: {exc}") from None
-    v = uniq[hull.vertices]  # scipy orders 2-D hull vertices counter-clockwise
-    # drop vertices lying on the line of their neighbours (collinear contact points along a straight edge)
-    prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)
-    a, b = v - prev, nxt - v
-    turn = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-    return v[turn > 1e-9]
+    return np.asarray(pts, float)[hull_indices(pts)]
 
 
 def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
@@ -462,10 +473,29 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
-    # build the hull once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
-    # round-off in a still base does not split it): the base joints decide the base's contacts; with
-    # contact="ground" also the joints before the last link on the ground (those after it move nothing that
-    # touches)
+    flying = ~np.all(np.isfinite(p), axis=1)
+    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance)
+    margin[flying] = -np.inf  # no ZMP: the body would leave the ground
+    inside = margin > 0.0
+    k = int(np.argmin(margin))
+    return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
+
+
+def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None, *, contact: str = "endpoints",
+                    tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+    """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
+    (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
+
+    The polygon is built once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    round-off in a still base does not split it): the base joints decide the base's contacts; with
+    contact="ground" also the joints before the last link on the ground (those after it move nothing that
+    touches).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q, _ = _joint_matrix(robot, q)
+    xy = finite_array(xy, "xy", (q.shape[0], 2))
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
         boxed = robot.boxed_links
@@ -483,9 +513,4 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
     pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
     idx, count = _hull_vertices(pts, active)
-    flying = ~np.all(np.isfinite(p), axis=1)
-    margin = _margins(pts[inv], idx[inv], count[inv], np.where(flying[:, None], 0.0, p))
-    margin[flying] = -np.inf  # no ZMP: the body would leave the ground
-    inside = margin > 0.0
-    k = int(np.argmin(margin))
-    return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
+    return _margins(pts[inv], idx[inv], count[inv], xy)

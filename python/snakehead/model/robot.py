@@ -236,6 +236,33 @@ class SnakeRobot:
         """The head part, neck_end (B0) -> head_tip."""
         return self.sub_chain(self.parts.neck_end, self.parts.head_tip)
 
+    @cached_property
+    def lift_joints(self) -> slice:
+        """The neck joints that lift and aim it: from the neck's first pitch joint to the neck's end.
+
+        A neck that begins with yaw joints has links before its first pitch joint that cannot leave the ground
+        (no joint lifts them): turning them would drag them, loaded by the lifted body, across the ground and
+        push the base. They are held where the initial configuration puts them, like the base's joints.
+        """
+        neck = self.parts.neck
+        first = next((j for j in range(neck.start, neck.stop) if self.joint_kinds[j] == PITCH), neck.stop)
+        return slice(first, neck.stop)
+
+    @property
+    def lift_frame(self) -> str:
+        """Where the neck's lifting begins: the frame just before the neck's first pitch joint (``base_end`` when
+        the neck begins with a pitch joint; ``neck_end`` when it has none). The neck's Eqs. 18-22 pivot on it."""
+        start = self.lift_joints.start
+        if start == self.parts.neck.stop:
+            return self.parts.neck_end
+        child = int(self.body.model.joint_child_links[start])
+        return self.link_names[child - 1]
+
+    @property
+    def lift_chain(self) -> Chain:
+        """The lifting part of the neck, :attr:`lift_frame` -> neck_end (the whole neck on the default robot)."""
+        return self.sub_chain(self.lift_frame, self.parts.neck_end)
+
     @property
     def lower(self) -> np.ndarray:
         return self.body.lower
@@ -346,6 +373,11 @@ class SnakeRobot:
     def neck_length(self) -> float:
         """Length of the neck part, P0 -> B0 along the straight body (m)."""
         return self.frame_arc_length(self.parts.neck_end) - self.base_length
+
+    @property
+    def lift_length(self) -> float:
+        """Length of the neck's lifting part, :attr:`lift_frame` -> B0 along the straight body (m)."""
+        return self.frame_arc_length(self.parts.neck_end) - self.frame_arc_length(self.lift_frame)
 
     @property
     def head_length(self) -> float:

@@ -273,7 +273,12 @@ def bending_state(controller: HeadController) -> np.ndarray:
     q = np.zeros(robot.n_joints)
     q[robot.parts.base] = controller.q_initial[robot.parts.base]
     up = np.arange(robot.parts.neck.start, robot.parts.head.stop)
-    yaw = np.array([j for j in up if robot.joint_kinds[j] == "yaw"], int)  # bend in the ground plane when flat
+    # the links before the first pitch joint of the neck cannot leave the ground: their yaw joints keep the initial
+    # state's angles, or the lift would sweep those links across the ground and the friction would push the base
+    pitch = [j for j in up if robot.joint_kinds[j] == "pitch"]
+    first_pitch = pitch[0] if pitch else robot.n_joints
+    q[up[up < first_pitch]] = controller.q_initial[up[up < first_pitch]]
+    yaw = np.array([j for j in up if robot.joint_kinds[j] == "yaw" and j > first_pitch], int)  # bend when flat
     if len(yaw) == 0:
         return q
     # the finest grid (at most BENDING_GRID_DEG) with at most BENDING_COMBINATIONS curls
@@ -309,7 +314,7 @@ def choose_base(controller: HeadController, targets, accept=None) -> tuple[BaseP
 
     robot = controller.robot
     q = controller.q_initial
-    P0 = robot.frame(q, robot.parts.base_end, controller.base)
+    P0 = robot.frame(q, robot.lift_frame, controller.base)
     P0_local = np.linalg.inv(robot.root_pose(controller.base)) @ P0
     positions = [np.asarray(p, float) for p, _ in targets]
     mean = np.mean(positions, axis=0)

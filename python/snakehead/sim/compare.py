@@ -54,10 +54,10 @@ def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=
       ``direction_errors_deg``;
     * ``max_linear_momentum_error`` (kg m/s) / ``max_angular_momentum_error`` (kg m^2/s): max over the ticks of
       |P_sim - P_plan| and |L_sim - L_plan| (vector difference, about the world origin; planned from
-      :func:`snakehead.stability.momenta`); ``..._magnitude_error``: max ||P_sim| - |P_plan|| (the paper's wording);
+      :func:`snakehead.dynamics.stability.momenta`); ``..._magnitude_error``: max ||P_sim| - |P_plan|| (the paper's wording);
     * ``zmp_inside``: whether every simulated ZMP lay inside the support polygon of the planned configuration
-      (:func:`snakehead.stability.support_polygon`, footprint contact model -- the physical contact area of the
-      boxes); ``zmp_min_margin_m`` the smallest signed distance (positive inside);
+      (:func:`zmp_margins`: the footprint of the links lying on the ground in the plan -- the physical contact area
+      of the boxes); ``zmp_min_margin_m`` the smallest signed distance (positive inside);
     * ``base_slide_m``, ``base_lift_m``, ``max_torque_nm``, ``torque_saturation_fraction``.
     """
     from ..dynamics import stability
@@ -111,32 +111,22 @@ def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=
 
 
 def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t, planned_q, base: BasePlacement | None = None,
-                contact: str = "footprint") -> np.ndarray:
+                contact: str = "ground") -> np.ndarray:
     """Signed distance (m, positive inside) of each simulated ZMP to the planned support polygon at that tick.
 
-    The polygon is :func:`snakehead.stability.support_polygon` of the planned configuration (interpolated to the
-    tick; recomputed only when the base joints change). Ticks without ground load get NaN.
+    The polygon is :func:`snakehead.dynamics.stability.support_polygon` of the planned configuration interpolated
+    to the tick, with ``contact="ground"`` by default: the footprint of every link lying on the ground in the plan
+    (the one the planner checks its own ZMP against). Ticks without ground load get NaN.
     """
     from ..dynamics import stability
 
     base = result.base if base is None else as_base(base)
     n = robot.n_joints
-    bs = robot.parts.base
     out = np.full(len(result.t), np.nan)
     loaded = np.flatnonzero(np.all(np.isfinite(result.zmp), axis=1))
     if loaded.size == 0:
         return out
     ts = result.t[loaded]
-    qb_ticks = np.column_stack([np.interp(ts, planned_t, planned_q[:, j]) for j in range(n)])[:, bs]
-    # one polygon per distinct base configuration; all of its ticks at once
-    keys, group = np.unique(np.round(qb_ticks, 9), axis=0, return_inverse=True)
-    group = np.asarray(group).reshape(-1)
-    for g in range(len(keys)):
-        ticks = np.flatnonzero(group == g)
-        qb = np.zeros(n)
-        qb[bs] = qb_ticks[ticks[0]]  # the polygon depends on the base joints only
-        poly = stability.support_polygon(robot, qb, base, contact=contact)
-        pts = np.broadcast_to(poly, (len(ticks),) + poly.shape)
-        out[loaded[ticks]] = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool),
-                                                           result.zmp[loaded[ticks]])
+    q_ticks = np.column_stack([np.interp(ts, planned_t, planned_q[:, j]) for j in range(n)])
+    out[loaded] = stability.support_margins(robot, q_ticks, result.zmp[loaded], base, contact=contact)
     return out
