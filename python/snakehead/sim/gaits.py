@@ -178,8 +178,10 @@ class GaitSimulator:
         self._mj.mj_forward(self.sim.model, d)
 
     def _step(self, q_ref, qd_ref) -> None:
+        """One control period; then the positions of everything (what the sensors read) for the new state."""
         self.data.ctrl[:] = self.kp * q_ref + self.kd * qd_ref
         self._mj.mj_step(self.sim.model, self.data, self.substeps)
+        self._mj.mj_kinematics(self.sim.model, self.data)
 
     # --- measurements ---------------------------------------------------------------------------------
     def joint_angles(self) -> np.ndarray:
