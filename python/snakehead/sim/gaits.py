@@ -93,8 +93,9 @@ class GaitRun:
 
     @property
     def turn_deg(self) -> float:
-        """The true change of the body's heading over the run (deg, counter-clockwise positive)."""
-        return math.degrees(_wrap(self.truth.heading - self.start_truth.heading))
+        """The true change of the body's heading over the run (deg, counter-clockwise positive; followed through
+        the run, so a turn of more than half a revolution counts in full)."""
+        return math.degrees(self.heading_truth[-1] - self.start_truth.heading)
 
     def body_lengths_per_cycle(self, robot: SnakeRobot) -> float:
         return float(np.linalg.norm(self.travel)) / robot.body_length / self.cycles
@@ -102,10 +103,6 @@ class GaitRun:
     @property
     def turn_deg_per_cycle(self) -> float:
         return self.turn_deg / self.cycles
-
-
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 class GaitSimulator:
@@ -197,8 +194,8 @@ class GaitSimulator:
             R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R
         return R
 
-    def true_pose(self) -> BodyPose:
-        """MuJoCo's pose of the body now (ground truth)."""
+    def true_pose(self, previous: BodyPose | None = None) -> BodyPose:
+        """MuJoCo's pose of the body now (ground truth); the chassis' x-axis kept close to ``previous``'s."""
         d = self.data
         root = np.eye(4)
         rb = self.sim.root_body
@@ -207,7 +204,8 @@ class GaitSimulator:
         points = d.xpos[self._box_bodies] + np.einsum(
             "kij,kj->ki", d.xmat[self._box_bodies].reshape(-1, 3, 3),
             self.robot.box_origins[self.robot.boxed_links][:, :3, 3])
-        return BodyPose(root=root, chassis=virtual_chassis(points, None, points[-1] - points[0]))
+        chassis = virtual_chassis(points, None if previous is None else previous.chassis, points[-1] - points[0])
+        return BodyPose(root=root, chassis=chassis)
 
     def _box_heights(self) -> tuple[float, float]:
         """(highest point of any box above the ground (m), share of boxes within 3 mm of it)."""
@@ -243,7 +241,7 @@ class GaitSimulator:
         qd_plan = np.gradient(q_plan, self.control_dt, axis=0)
         qd_plan[len(q_plan) - n_rest:] = 0.0
 
-        start_truth = self.true_pose()
+        start_truth = truth = self.true_pose()
         est0 = start_truth if start_estimate is None else start_estimate
         if not isinstance(est0, BodyPose):
             raise TypeError(f"start_estimate must be a BodyPose, got {type(est0).__name__}")
@@ -255,9 +253,9 @@ class GaitSimulator:
             self.estimator.update(self.joint_angles(), self.imu_orientation())
             if k % record_every == 0 or k == len(q_plan) - 1:
                 estimate = self.estimator.pose()
-                truth = self.true_pose()
+                truth = self.true_pose(truth)
                 h, c = self._box_heights()
-                rec["t"].append(t[k] + self.control_dt)
+                rec["t"].append(self.time)
                 rec["q"].append(self.joint_angles())
                 rec["q_ref"].append(q_plan[k])
                 rec["ct"].append(truth.chassis[:3, 3])
@@ -270,10 +268,13 @@ class GaitSimulator:
                 raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {gait.name} gait")
         end = self._snapshot(self.time)
         arr = {k: np.asarray(v) for k, v in rec.items()}
-        return GaitRun(gait=gait, cycles=float(cycles), state=end, estimate=estimate, truth=self.true_pose(),
-                       start_truth=start_truth, t=state.time + arr["t"], q=arr["q"], q_ref=arr["q_ref"],
-                       chassis_truth=arr["ct"], chassis_estimate=arr["ce"], heading_truth=np.unwrap(arr["ht"]),
-                       heading_estimate=np.unwrap(arr["he"]), height=arr["height"], contact_fraction=arr["contact"],
+        # headings unwrapped from the start's, so that turns beyond half a revolution count in full
+        heading_truth = np.unwrap(np.concatenate([[start_truth.heading], arr["ht"]]))[1:]
+        heading_estimate = np.unwrap(np.concatenate([[est0.heading], arr["he"]]))[1:]
+        return GaitRun(gait=gait, cycles=float(cycles), state=end, estimate=estimate, truth=truth,
+                       start_truth=start_truth, t=arr["t"], q=arr["q"], q_ref=arr["q_ref"],
+                       chassis_truth=arr["ct"], chassis_estimate=arr["ce"], heading_truth=heading_truth,
+                       heading_estimate=heading_estimate, height=arr["height"], contact_fraction=arr["contact"],
                        settings=dict(imu_link=self.estimator.imu_link, control_dt=self.control_dt,
                                      imu_yaw_drift_deg_per_s=math.degrees(self.imu_yaw_drift),
                                      rest_s=float(rest_s), kp=self.kp.tolist(), kd=self.kd.tolist()))
