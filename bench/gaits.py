@@ -17,24 +17,12 @@ import time
 
 import numpy as np
 
-from snakehead import BasePlacement, SnakeRobot
-from snakehead.model.generate import SnakeSpec, snake_urdf
+from _robots import ROBOTS  # bench/_robots.py
+from snakehead import BasePlacement
 from snakehead.motion.gaits import make_gait
 from snakehead.sim import GaitSimulator
 
 
-def generated(n_joints, module, section, mass, first_axis="yaw", head=7, neck=2):
-    base = n_joints - head - neck
-    urdf = snake_urdf(SnakeSpec(n_joints=n_joints, module_length=module, section=section, mass_per_module=mass,
-                                first_axis=first_axis, markers={"p0": base, "b0": base + neck}))
-    return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
-
-
-ROBOTS = {
-    "default": SnakeRobot.default,
-    "twenty": lambda: generated(20, 0.07, 0.05, 0.2),
-    "pitch_first": lambda: generated(13, 0.10, 0.06, 0.3, "pitch", head=6, neck=1),
-}
 RUNS = [("rolling", 1), ("rolling", -1), ("sidewinding", 1), ("sidewinding", -1), ("turning", 1), ("turning", -1),
         ("lateral_undulation", 1)]
 
@@ -42,14 +30,14 @@ RUNS = [("rolling", 1), ("rolling", -1), ("sidewinding", 1), ("sidewinding", -1)
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cycles", type=float, default=3.0)
-    ap.add_argument("--robots", default=",".join(ROBOTS))
+    ap.add_argument("--robots", default="default,twenty,pitch_first")
     args = ap.parse_args()
     print("| robot | gait | dir | body lengths / cycle | direction (deg) | turn (deg / cycle) | highest box (mm) "
           "| end tilt (deg) | estimate: position (mm) | (% of root travel) | estimate: heading (deg) | wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     t_all = time.perf_counter()
     for key in args.robots.split(","):
-        robot = ROBOTS[key]()
+        robot = ROBOTS[key][1]()
         sim = GaitSimulator(robot)
         for name, direction in RUNS:
             gait = make_gait(name, direction)

@@ -92,7 +92,7 @@ def test_virtual_chassis_of_simple_shapes():
     (lambda: make_gait("rolling", amplitude=-0.1), ValueError, "amplitude must be >= 0"),
     (lambda: make_gait("sidewinding", pitch_amplitude=float("nan")), ValueError, "amplitude"),
     (lambda: make_gait("sidewinding", waves=float("inf")), ValueError, "waves"),
-    (lambda: make_gait("turning", frequency=0.0), ValueError, "frequency must be > 0"),
+    (lambda: make_gait("turning", frequency=0.0), ValueError, "frequency must be a positive"),
     (lambda: make_gait("turning", frequency=-1.0), ValueError, "frequency"),
     (lambda: make_gait("rolling", ramp_s=-1.0), ValueError, "ramp_s"),
     (lambda: make_gait("rolling", direction=0), ValueError, "direction must be"),

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_float
+from .._validate import finite_float, positive
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .interpolation import CONTROL_PERIOD
 
@@ -59,13 +59,6 @@ def _non_negative(value, name: str) -> float:
     v = finite_float(value, name)
     if v < 0:
         raise ValueError(f"{name} must be >= 0, got {value!r}")
-    return v
-
-
-def _positive(value, name: str) -> float:
-    v = finite_float(value, name)
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
     return v
 
 
@@ -117,7 +110,7 @@ class Gait:
     parameters: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
-        object.__setattr__(self, "frequency", _positive(self.frequency, "frequency"))
+        object.__setattr__(self, "frequency", positive(self.frequency, "frequency"))
         object.__setattr__(self, "ramp_s", _non_negative(self.ramp_s, "ramp_s"))
         object.__setattr__(self, "direction", _direction(self.direction))
         if self.motion not in ("translate", "turn", "forward"):
@@ -131,7 +124,7 @@ class Gait:
 
     def duration(self, cycles: float) -> float:
         """Length (s) of a run of ``cycles`` cycles with its two ramps."""
-        return _positive(cycles, "cycles") / self.frequency + 2.0 * self.ramp_s
+        return positive(cycles, "cycles") / self.frequency + 2.0 * self.ramp_s
 
     def check(self, robot: SnakeRobot) -> None:
         """ValueError if the robot cannot run the gait: joints beyond their limits, or too few joints of a kind
@@ -165,7 +158,7 @@ class Gait:
         if not np.all(np.isfinite(t)):
             raise ValueError("t contains NaN or inf")
         self.check(robot)
-        cycles = _positive(cycles, "cycles")
+        cycles = positive(cycles, "cycles")
         running = cycles / self.frequency
         tr = t - self.ramp_s
         phase = self.frequency * np.clip(tr, 0.0, running)  # in cycles
@@ -202,7 +195,7 @@ class Gait:
     def trajectory(self, robot: SnakeRobot, cycles: float, dt: float = CONTROL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
         """A run of ``cycles`` cycles sampled every ``dt`` s: t (T,) s from 0, q (T, n) rad; straight at both ends
         (unless the waves have offsets)."""
-        dt = _positive(dt, "dt")
+        dt = positive(dt, "dt")
         total = self.duration(cycles)
         t = np.arange(0.0, total + 0.5 * dt, dt)
         t[-1] = min(t[-1], total)
