@@ -218,6 +218,15 @@ class HeadController:
                             static_stable=margin > 0, static_margin_m=margin, timings=timings, neck_goal=goal,
                             neck=neck, head=head)
 
+    @property
+    def body_problem(self):
+        """The geometry the whole-body solve needs for this robot (``control.whole_body.BodyProblem``), made once."""
+        if getattr(self, "_body_problem", None) is None:
+            from .whole_body import BodyProblem
+
+            self._body_problem = BodyProblem(self.robot)
+        return self._body_problem
+
     def _static_margin(self, q: np.ndarray, base: BasePlacement) -> float:
         """``stability.static_margin`` with the support polygon cached: it depends only on the base joints
         and placement, which a controller keeps (the polygon is the costly part: a convex hull)."""

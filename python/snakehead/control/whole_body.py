@@ -74,10 +74,31 @@ class WholeBodySolution:
     starts: int = 0
     seconds: float = 0.0
     notes: list = field(default_factory=list)
+    #: the paper's segmented solution (a ``HeadSolution``) tried first, when there was one
+    segmented: object | None = None
+    #: the desired head frame (4, 4) (x-axis the direction)
+    desired_frame: np.ndarray | None = None
 
     @property
     def success(self) -> bool:
         return self.reason is None
+
+    @property
+    def message(self) -> str:
+        if self.success:
+            return f"solved ({self.stage})"
+        return (f"{self.reason}: head {1000 * self.position_error_m:.1f} mm / {self.direction_error_deg:.2f} deg off, "
+                f"static margin {1000 * self.static_margin_m:.1f} mm, ground clearance "
+                f"{1000 * self.ground_clearance_m:.1f} mm, self clearance {1000 * self.self_clearance_m:.1f} mm")
+
+    @property
+    def neck_goal(self):
+        """Eqs. 18-20's goal of the segmented solve, when that solve is the solution (for Fig. 8)."""
+        return getattr(self.segmented, "neck_goal", None) if self.stage == STAGES[0] else None
+
+    @property
+    def neck(self):
+        return getattr(self.segmented, "neck", None) if self.stage == STAGES[0] else None
 
 
 class BodyProblem:
@@ -129,35 +150,13 @@ class BodyProblem:
     def frames(self, q: np.ndarray, base: BasePlacement) -> np.ndarray:
         return self.robot.frames(q, base)
 
-    def joint_axes_world(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(n, 3) world axes and (n, 3) world origins of the joints."""
-        R = F[self.child, :3, :3]
-        return np.einsum("jik,jk->ji", R, self.axis_local), F[self.child, :3, 3]
-
     def point_jacobians(self, F: np.ndarray, base: BasePlacement, points: np.ndarray, links: np.ndarray
                         ) -> np.ndarray:
-        """d(point)/d(q, x, y, yaw) for world points rigidly attached to ``links``: (P, 3, n + 3).
-
-        A revolute joint j moves the points distal to it by a_j x (p - o_j); the base's planar placement moves
-        every point by (1, 0, 0), (0, 1, 0) and e_z x (p - root)."""
-        a, o = self.joint_axes_world(F)
-        n = len(a)
-        J = np.zeros((len(points), 3, n + 3))
-        moved = self.child[None, :] <= np.asarray(links)[:, None]  # (P, n): joint j moves link i
-        r = points[:, None, :] - o[None, :, :]  # (P, n, 3)
-        J[:, 0, :n] = (a[None, :, 1] * r[..., 2] - a[None, :, 2] * r[..., 1]) * moved
-        J[:, 1, :n] = (a[None, :, 2] * r[..., 0] - a[None, :, 0] * r[..., 2]) * moved
-        J[:, 2, :n] = (a[None, :, 0] * r[..., 1] - a[None, :, 1] * r[..., 0]) * moved
-        root = F[0, :3, 3]
-        J[:, 0, n] = 1.0
-        J[:, 1, n + 1] = 1.0
-        J[:, 0, n + 2] = -(points[:, 1] - root[1])  # e_z x (p - root)
-        J[:, 1, n + 2] = points[:, 0] - root[0]
-        return J
+        return self.robot.point_jacobians(F, points, links)
 
     def vector_jacobian(self, F: np.ndarray, v: np.ndarray, link: int) -> np.ndarray:
         """d(v)/d(q, x, y, yaw) of a world direction v attached to ``link``: (3, n + 3)."""
-        a, _ = self.joint_axes_world(F)
+        a, _ = self.robot.joint_axes_world(F)
         n = len(a)
         J = np.zeros((3, n + 3))
         J[:, :n] = (np.cross(a, v) * (self.child <= link)[:, None]).T
@@ -545,9 +544,28 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     return out
 
 
+def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position, direction, seed: int
+                   ) -> np.ndarray | None:
+    """The lifted chain's IK from the current joints, the roll about the direction free: the nearest solution."""
+    from ..kinematics.ik import FREE_ROLL
+    from .head import frame_from_direction
+
+    robot = prob.robot
+    start = robot.lift_joints.start
+    T0 = robot.frame(q_now, robot.lift_frame, base)
+    target = np.linalg.inv(T0) @ frame_from_direction(position, direction)
+    qk = prob.lifted_ik(seed).ik(target, q_init=np.clip(q_now[start:], robot.lower[start:], robot.upper[start:]),
+                                 bounds=FREE_ROLL)
+    if qk is None:
+        return None
+    q = q_now.copy()
+    q[start:] = qk
+    return q
+
+
 def solve_target(controller, position, direction, *, q_prev=None, base: BasePlacement | None = None, obstacles=(),
                  allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
-                 problem: BodyProblem | None = None, seed: int = 0) -> WholeBodySolution:
+                 problem: BodyProblem | None = None, seed: int = 0, near: bool = False) -> WholeBodySolution:
     """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
 
     Stages, the first that passes every exact check wins:
@@ -559,6 +577,10 @@ def solve_target(controller, position, direction, *, q_prev=None, base: BasePlac
        the placement that brings the target into the neck's accepted range (Section 3.3 (3)), the segmented
        solution and the IK candidates from there, then the whole-body optimisation over the base's yaw joints,
        its placement and the lifted joints.
+
+    With ``near`` (for poses close to the previous one, e.g. along a line), a first attempt continues from
+    ``q_prev``: the lifted chain's IK started from its joints with the roll free, kept when it passes every check
+    (stage "whole-body, base kept"), so that consecutive poses stay on one branch of solutions.
 
     The result says which stage solved it, or why the best attempt fails (``REASONS``).
     """
@@ -589,19 +611,27 @@ def solve_target(controller, position, direction, *, q_prev=None, base: BasePlac
                     > OBSTACLE_CLEARANCE)
 
     best = None
+    seg_holder = [None]
 
     def consider(q, b, stage, starts):
         """Check a configuration; keep the best attempt; return the solution when it passes."""
         nonlocal best
         chk = check(q, b)
         sol = solution(q, b, chk, stage, starts)
+        sol.segmented = seg_holder[0]
+        sol.desired_frame = None if seg_holder[0] is None else seg_holder[0].desired_frame
         if best is None or _rank(sol) > _rank(best):
             best = sol
         return sol if sol.success else None
 
+    if near and q_prev is not None:
+        q = _continue_from(prob, q_now, base, position, direction, seed)
+        if q is not None and (found := consider(q, base, STAGES[1], 1)):
+            return found
     # 1. the paper's segmented solve
     seg = controller.solve(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
                            allow_base_move=False)
+    seg_holder[0] = seg
     if found := consider(seg.q, seg.base, STAGES[0], 0):
         return found
     # 2. the base kept
