@@ -25,8 +25,8 @@ import numpy as np
 
 from .._validate import finite_float, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-from ..motion.gaits import Gait
-from .estimate import BodyPose, BodyPoseEstimator, pose_error, virtual_chassis
+from ..motion.gaits import Gait, virtual_chassis
+from .estimate import BodyPose, BodyPoseEstimator, pose_error
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
 from .tracking import _gains
