@@ -41,6 +41,8 @@ DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straigh
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move
+ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
 BENDING_COMBINATIONS = 30000  # the grid coarsens so that it never holds more curls than this
@@ -127,10 +129,11 @@ class Plan:
         for tg in self.targets:
             if not tg.solved:
                 return f"target {tg.name!r} not solved: {tg.solution.message}"
-        if not self.stability.stable:
+        if self.min_zmp_margin_m < ZMP_MARGIN:
             k = self.stability.argmin
-            return (f"the ZMP leaves the support polygon (by {-1000 * self.min_zmp_margin_m:.1f} mm at "
-                    f"t = {self.t[k]:.2f} s)")
+            where = "leaves the support polygon by" if self.min_zmp_margin_m < 0 else "comes within"
+            return (f"the ZMP {where} {abs(1000 * self.min_zmp_margin_m):.1f} mm of its edge at t = {self.t[k]:.2f} s "
+                    f"(a plan keeps it {1000 * ZMP_MARGIN:.0f} mm inside)")
         if self.min_ground_clearance_m <= -coll.GROUND_TOLERANCE:
             k = int(np.argmin(self.ground_clearance))
             return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
@@ -143,6 +146,17 @@ class Plan:
     @property
     def success(self) -> bool:
         return self.failure is None
+
+
+def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
+    """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
+    (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
+    qs = np.asarray(qs, float)
+    s = np.arange(between + 1) / (between + 1)
+    a, b = qs[..., :-1, :], qs[..., 1:, :]
+    fine = a[..., None, :] + s[:, None] * (b - a)[..., None, :]  # (..., K-1, between+1, n)
+    fine = fine.reshape(qs.shape[:-2] + (-1, qs.shape[-1]))
+    return np.concatenate([fine, qs[..., -1:, :]], axis=-2)
 
 
 class _Waypoints:
@@ -184,7 +198,7 @@ class _Waypoints:
         """
         q = np.asarray(q, float)
         path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
-        if self._feasible(path.q).all():
+        if self._feasible(_densify(path.q)).all():
             qs, method = path.q, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
@@ -224,7 +238,7 @@ class _Waypoints:
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = qa + s * (qb - qa)
-        if self._feasible(straight).all():
+        if self._feasible(_densify(straight)).all():
             return straight, "joint space"
         movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -232,7 +246,7 @@ class _Waypoints:
         W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
         W = np.clip(W, self.robot.lower, self.robot.upper)
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
-        flat = paths.reshape(-1, qa.size)
+        flat = _densify(paths).reshape(-1, qa.size)
         ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
         if ok.any():
             length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
@@ -260,8 +274,9 @@ def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), sc
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
-    clearance = coll.ground_clearance(robot, traj.q, base)[:, robot.lifted_links].min(axis=1)
+    frames = robot.frames_many(traj.q, base)  # once, for every check below
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
+    clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
