@@ -23,7 +23,10 @@
 #include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
 #include "snakehead/trac_ik.hpp"
+#include "snakehead/urdf_input.hpp"
 #include "snakehead/workspace.hpp"
+
+#include <console_bridge/console.h>
 
 using namespace snakehead;
 
@@ -160,4 +163,224 @@ TEST(HostileSizes, TinyVoxelsAreRejectedBeforeTheSweep) {
   EXPECT_TRUE(contains(m, std::to_string(limits::kMaxDirections))) << m;
   m = input_error([&] { sample_tip_positions(*model, 2'000'000'000, 1); });
   EXPECT_TRUE(contains(m, std::to_string(limits::kMaxCloudSamples))) << m;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Robot descriptions: checked before urdfdom's recursive XML parser (TinyXML) sees them.
+
+namespace {
+
+std::string nested(int depth, const std::string& open = "<a>", const std::string& close = "</a>") {
+  std::string s = "<robot name='r'>";
+  for (int k = 0; k < depth; ++k) s += open;
+  for (int k = 0; k < depth; ++k) s += close;
+  return s + "</robot>";
+}
+
+// A two-link robot with one revolute joint; `link_b` is the second link's body.
+std::string two_links(const std::string& link_b, const std::string& joint_extra = "") {
+  return "<?xml version='1.0'?><robot name='r'><link name='a'/>" + link_b +
+         "<joint name='j' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/>"
+         "<limit lower='-1' upper='1' effort='1' velocity='1'" + joint_extra + "/></joint></robot>";
+}
+
+std::string link_b(const std::string& mass, const std::string& inertia, const std::string& box = "0.1 0.1 0.1") {
+  return "<link name='b'><inertial><mass value='" + mass + "'/><inertia " + inertia +
+         "/></inertial><collision><geometry><box size='" + box + "'/></geometry></collision></link>";
+}
+
+const std::string kGoodInertia = "ixx='1e-3' ixy='0' ixz='0' iyy='1e-3' iyz='0' izz='1e-3'";
+
+std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/snakehead_hostile_" + name; }
+
+}  // namespace
+
+TEST(HostileUrdf, DeepNestingIsRejectedBeforeTheParser) {
+  // 40,000 levels (280 kB) overflowed TinyXML's stack (SIGSEGV).
+  const std::string deep = nested(40000);
+  EXPECT_LT(deep.size(), 300'000u);
+  std::string m = input_error([&] { ChainModel::from_urdf(deep, "a", "b"); });
+  EXPECT_TRUE(contains(m, "nested") && contains(m, std::to_string(limits::kMaxUrdfDepth))) << m;
+  // The limit counts the robot element too: robot + 99 levels pass the scan, robot + 100 do not.
+  EXPECT_NO_THROW(check_urdf_document(nested(limits::kMaxUrdfDepth - 1)));
+  EXPECT_THROW(check_urdf_document(nested(limits::kMaxUrdfDepth)), InputError);
+  // Self-closed elements, comments, CDATA and declarations do not nest.
+  EXPECT_NO_THROW(check_urdf_document(nested(5000, "<a/>", "")));
+  EXPECT_NO_THROW(check_urdf_document(nested(5000, "<!-- <a> -->", "")));
+  EXPECT_NO_THROW(check_urdf_document(nested(5000, "<![CDATA[<a>]]>", "")));
+  // ...but the scan reads the text as TinyXML does: a quoted "/>" does not close a tag, attributes may be
+  // unquoted, end tags take white space, and a declaration's version may hold '>'.
+  EXPECT_THROW(check_urdf_document(nested(200, "<a x=\"/>\">")), InputError);
+  EXPECT_THROW(check_urdf_document(nested(200, "<a x=y>", "</a >")), InputError);
+  EXPECT_THROW(check_urdf_document("<?xml version='>'?>" + nested(200)), InputError);
+  EXPECT_THROW(check_urdf_document("<?xml version='1' ?>\n<!DOCTYPE robot>" + nested(200)), InputError);
+  // TinyXML's numeric references search for the next ';' and skip what lies before it, end tags included:
+  // only well-formed ones pass.
+  EXPECT_NO_THROW(check_urdf_document("<robot name='r&#x41;&#66;'>&#x263A;&amp;&#10;</robot>"));
+  m = input_error([&] { check_urdf_document(nested(3, "<a>&#x", "</a>x1;")); });
+  EXPECT_TRUE(contains(m, "character reference")) << m;
+  EXPECT_THROW(check_urdf_document("<robot name='&#12'></robot>"), InputError);
+}
+
+TEST(HostileUrdf, SizeNulAndEncodingAreChecked) {
+  std::string big = "<robot name='r'>" + std::string(limits::kMaxUrdfBytes, ' ') + "</robot>";
+  std::string m = input_error([&] { ChainModel::from_urdf(big, "a", "b"); });
+  EXPECT_TRUE(contains(m, "bytes") && contains(m, std::to_string(limits::kMaxUrdfBytes))) << m;
+  m = input_error([&] { check_urdf_document(std::string("<robot name='r'>\n\0</robot>", 26)); });
+  EXPECT_TRUE(contains(m, "NUL") && contains(m, "line 2")) << m;
+  m = input_error([&] { check_urdf_document("<robot name='\xC3('></robot>"); });
+  EXPECT_TRUE(contains(m, "UTF-8")) << m;
+  EXPECT_THROW(check_urdf_document("<robot name='r'>\xEF\xBB\xBF</robot>"), InputError);
+  EXPECT_NO_THROW(check_urdf_document("\xEF\xBB\xBF<robot name='r\xC3\xA9'></robot>"));  // a leading BOM is fine
+}
+
+TEST(HostileUrdf, OnlyRegularFilesOfBoundedSizeAreRead) {
+  // /dev/zero read forever; a FIFO waited for a writer; a directory gave a confusing parse error.
+  std::string m = input_error([] { ChainModel::from_urdf("/dev/zero", "a", "b"); });
+  EXPECT_TRUE(contains(m, "/dev/zero") && contains(m, "character device")) << m;
+  const std::string fifo = temp_path("fifo.urdf");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  m = input_error([&] { ChainModel::from_urdf(fifo, "a", "b"); });
+  EXPECT_TRUE(contains(m, "FIFO")) << m;
+  std::remove(fifo.c_str());
+  m = input_error([] { ChainModel::from_urdf(::testing::TempDir(), "a", "b"); });
+  EXPECT_TRUE(contains(m, "directory")) << m;
+  m = input_error([] { ChainModel::from_urdf("/no/such/robot.urdf", "a", "b"); });
+  EXPECT_TRUE(contains(m, "No such file")) << m;
+  const std::string huge = temp_path("huge.urdf");  // sparse: no disk space used
+  {
+    std::ofstream f(huge);
+  }
+  ASSERT_EQ(truncate(huge.c_str(), static_cast<off_t>(limits::kMaxUrdfBytes) + 1), 0);
+  m = input_error([&] { read_urdf_file(huge); });
+  EXPECT_TRUE(contains(m, "bytes")) << m;
+  std::remove(huge.c_str());
+  EXPECT_EQ(read_urdf_file(kSnake).substr(0, 5), "<?xml");
+}
+
+TEST(HostileUrdf, UrdfdomMessagesBecomeTheErrorAndAreNeverPrinted) {
+  const std::string no_limits =
+      "<robot name='r'><link name='a'/><link name='b'/><joint name='j1' type='revolute'>"
+      "<parent link='a'/><child link='b'/><axis xyz='0 0 1'/></joint></robot>";
+  // A successful parse that makes urdfdom warn (an undefined material) must be quiet too.
+  const std::string warns = two_links("<link name='b'><visual><geometry><box size='1 1 1'/></geometry>"
+                                      "<material name='nowhere'/></visual></link>");
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const std::string m = input_error([&] { ChainModel::from_urdf(no_limits, "a", "b"); });
+  const std::string tinyxml = input_error([] { ChainModel::from_urdf("<robot name='r'><link name='a'></robot>", "a", "b"); });
+  EXPECT_NO_THROW(ChainModel::from_urdf(warns, "a", "b"));
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(contains(m, "j1") && contains(m, "does not specify limits")) << m;
+  EXPECT_TRUE(contains(tinyxml, "end tag")) << tinyxml;  // TinyXML's own description
+  EXPECT_EQ(out, "");
+  EXPECT_EQ(err, "");
+}
+
+namespace {
+struct RecordingHandler : console_bridge::OutputHandler {
+  void log(const std::string& text, console_bridge::LogLevel, const char*, int) override { seen.push_back(text); }
+  std::vector<std::string> seen;
+};
+}  // namespace
+
+TEST(HostileUrdf, CaptureIsPerThreadAndRestoresTheHandler) {
+  // Eight threads parse broken robots at once, each with its own joint name: each error holds its own
+  // joint's message and no other's.
+  std::vector<std::string> messages(8);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t)
+    threads.emplace_back([t, &messages] {
+      const std::string joint = "joint_of_thread_" + std::to_string(t);
+      const std::string xml = "<robot name='r'><link name='a'/><link name='b'/><joint name='" + joint +
+                              "' type='prismatic'><parent link='a'/><child link='b'/></joint></robot>";
+      for (int k = 0; k < 20; ++k) {
+        try {
+          ChainModel::from_urdf(xml, "a", "b");
+        } catch (const InputError& e) {
+          messages[t] = e.what();
+        }
+      }
+    });
+  for (auto& th : threads) th.join();
+  for (int t = 0; t < 8; ++t) {
+    EXPECT_TRUE(contains(messages[t], "joint_of_thread_" + std::to_string(t))) << messages[t];
+    for (int u = 0; u < 8; ++u)
+      if (u != t) EXPECT_FALSE(contains(messages[t], "joint_of_thread_" + std::to_string(u) + "]")) << messages[t];
+  }
+  // The handler installed before is back afterwards, and gets what others log.
+  RecordingHandler recording;
+  console_bridge::OutputHandler* before = console_bridge::getOutputHandler();
+  console_bridge::useOutputHandler(&recording);
+  EXPECT_THROW(ChainModel::from_urdf("<robot name='r'/>", "a", "b"), InputError);
+  EXPECT_EQ(console_bridge::getOutputHandler(), &recording);
+  CONSOLE_BRIDGE_logError("a message of someone else");
+  console_bridge::useOutputHandler(before);
+  ASSERT_EQ(recording.seen.size(), 1u);
+  EXPECT_EQ(recording.seen[0], "a message of someone else");
+}
+
+TEST(HostileUrdf, MalformedInertialOrCollisionNamesTheLinkAndElement) {
+  // urdfdom dropped these elements (and printed to the console), leaving the link massless or boxless.
+  struct Case {
+    std::string link, what;
+  };
+  const std::vector<Case> cases = {
+      {link_b("0,2", kGoodInertia), "inertial"},
+      {link_b("nan", kGoodInertia), "inertial"},
+      {link_b("0.2", "ixx='1e-3' ixy='0' ixz='0' iyy='inf' iyz='0' izz='1e-3'"), "inertial"},
+      {link_b("0.2", kGoodInertia, "0,1 0.1 0.1"), "collision"},
+      {link_b("0.2", kGoodInertia, "0.1 nan 0.1"), "collision"},
+      {link_b("-0.2", kGoodInertia), "mass"},
+      {link_b("0.2", "ixx='1e-3' ixy='2e-3' ixz='0' iyy='1e-3' iyz='0' izz='1e-3'"), "positive semidefinite"},
+      {link_b("0.2", "ixx='1e-3' ixy='0' ixz='0' iyy='1e-3' iyz='0' izz='5e-3'"), "triangle"},
+      {link_b("0.2", kGoodInertia, "0.1 0 0.1"), "box size"},
+      {link_b("0.2", kGoodInertia, "0.1 -0.1 0.1"), "box size"},
+      {"<link name='b'><collision><geometry><sphere radius='-1'/></geometry></collision></link>", "sphere"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.link);
+    const std::string m = input_error([&] { ChainModel::from_urdf(two_links(c.link), "a", "b"); });
+    EXPECT_TRUE(contains(m, "b") && contains(m, c.what)) << m;
+  }
+  // The link is named (urdfdom's "Link [b]" or ours "link 'b'").
+  const std::string m = input_error([&] { ChainModel::from_urdf(two_links(link_b("0,2", kGoodInertia)), "a", "b"); });
+  EXPECT_TRUE(contains(m, "Link [b]") && contains(m, "0,2")) << m;
+  EXPECT_TRUE(contains(input_error([&] { ChainModel::from_urdf(two_links(link_b("-1", kGoodInertia)), "a", "b"); }),
+                       "link 'b' <inertial>"));
+  // Joint limits of the wrong sign.
+  const std::string bad_velocity = "<?xml version='1.0'?><robot name='r'><link name='a'/><link name='b'/>"
+                                   "<joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+                                   "<limit lower='-1' upper='1' effort='1' velocity='-3'/></joint></robot>";
+  EXPECT_TRUE(contains(input_error([&] { ChainModel::from_urdf(bad_velocity, "a", "b"); }), "velocity"));
+  // Sound data passes: a massless link, a point mass, a thin plate.
+  EXPECT_NO_THROW(ChainModel::from_urdf(two_links("<link name='b'/>"), "a", "b"));
+  EXPECT_NO_THROW(ChainModel::from_urdf(two_links(link_b("0.2", "ixx='0' ixy='0' ixz='0' iyy='0' iyz='0' izz='0'")),
+                                        "a", "b"));
+  EXPECT_NO_THROW(ChainModel::from_urdf(two_links(link_b("0.2", "ixx='1e-3' ixy='0' ixz='0' iyy='2e-3' iyz='0' izz='3e-3'")),
+                                        "a", "b"));
+}
+
+TEST(HostileUrdf, KinematicHashIsUnchangedAndTheBodiesHaveTheirOwn) {
+  // The shipped maps (python/snakehead/data/*.npz) record these kinematic hashes.
+  const ChainModel head = ChainModel::from_urdf(kSnake, "neck_end", "head_tip");
+  EXPECT_EQ(head.hash(), "9581ed36d7fff8a5");
+  EXPECT_EQ(ChainModel::from_urdf(kSnake, "link_10", "head_tip").hash(), "0f32da7f939f69c3");
+  // The default robot weighs 3.2 kg (0.2 kg per 0.0865 m of body, DESIGN.md).
+  const ChainModel body = ChainModel::from_urdf(kSnake, "link_0", "head_tip");
+  EXPECT_NEAR(body.total_mass(), 3.2, 1e-9);
+  // A mass changes the bodies' digest, not the kinematic one; a joint origin changes the kinematic one.
+  const std::string text = read_urdf_file(kSnake);
+  std::string heavier = text;
+  const auto at = heavier.find("<mass value=\"0.2\"");
+  ASSERT_NE(at, std::string::npos);
+  heavier.replace(at, 17, "<mass value=\"0.3\"");
+  const ChainModel heavy = ChainModel::from_urdf(heavier, "link_0", "head_tip");
+  EXPECT_EQ(heavy.hash(), body.hash());
+  EXPECT_NE(heavy.body_hash(), body.body_hash());
+  EXPECT_NEAR(heavy.total_mass(), 3.3, 1e-9);
+  EXPECT_EQ(ChainModel::from_urdf(kSnake, "link_0", "head_tip").body_hash(), body.body_hash());
+  EXPECT_EQ(ChainModel::from_urdf(two_links("<link name='b'/>"), "a", "b").total_mass(), 0.0);
 }
