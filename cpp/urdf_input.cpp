@@ -297,12 +297,14 @@ std::string joined(const std::vector<std::string>& messages) {
 }  // namespace
 
 std::string read_urdf_file(const std::string& path) {
+  if (path.find('\0') != std::string::npos)  // open() would read another file: the name up to the NUL
+    throw InputError("the URDF path contains a NUL character");
   const FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (fd.get() < 0)
-    throw InputError("cannot read the URDF file '" + path + "': " + std::strerror(errno));
+    throw InputError("cannot read URDF file '" + path + "': " + std::strerror(errno));
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0)
-    throw InputError("cannot read the URDF file '" + path + "': " + std::strerror(errno));
+    throw InputError("cannot read URDF file '" + path + "': " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw InputError("the URDF path '" + path + "' is " + file_kind(st.st_mode) + ", not a file");
   if (static_cast<unsigned long long>(st.st_size) > limits::kMaxUrdfBytes)
     throw InputError("the URDF file '" + path + "' is " + std::to_string(st.st_size) + " bytes; at most " +
@@ -314,7 +316,7 @@ std::string read_urdf_file(const std::string& path) {
     const ssize_t got = ::read(fd.get(), buf, sizeof buf);
     if (got < 0) {
       if (errno == EINTR) continue;
-      throw InputError("cannot read the URDF file '" + path + "': " + std::strerror(errno));
+      throw InputError("cannot read URDF file '" + path + "': " + std::strerror(errno));
     }
     if (got == 0) break;
     text.append(buf, static_cast<std::size_t>(got));

@@ -360,10 +360,7 @@ def _urdf_text(chain_or_robot, urdf) -> str:
         raise ValueError("urdf must be a path or an XML string")
     if source.lstrip().startswith("<"):
         return source
-    try:
-        return Path(source).read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
+    return _core.read_urdf_file(source)  # ValueError unless a regular file of bounded size, as Chain.from_urdf
 
 
 def _bar(progress: bool, total: int, unit: str):
@@ -446,10 +443,37 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
     if not path.endswith(".npz"):
         raise ValueError(f"a map file ends in .npz, got {path!r}")
     try:
-        with open(path, "wb") as f:
-            np.savez(f, **arrays)
+        _write_replacing(path, lambda f: np.savez(f, **arrays))
     except OSError as exc:
         raise ValueError(f"cannot write the map to {path!r}: {exc}") from None
+
+
+def _write_replacing(path: str, write) -> None:
+    """``write(f)`` into a new file beside ``path``, then rename it over ``path``: a failed write (disk full,
+    file-size limit) leaves an old file as it was and no partial one. As the C++ writer (npz.cpp) does."""
+    if os.path.exists(path) and not os.path.isfile(path):  # renaming would replace a device, a FIFO...
+        raise OSError(f"{path!r} exists and is not a regular file")
+    for attempt in range(100):
+        tmp = f"{path}.tmp-{os.getpid()}-{os.urandom(4).hex()}"
+        try:  # O_EXCL: the name is ours; 0o666: the umask decides the permissions, as for open(path, "w")
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+            break
+        except FileExistsError:
+            continue
+    else:
+        raise OSError(f"cannot create a temporary file beside {path!r}")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())  # a full disk may only say so here
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
 
 
 def load(path: str | os.PathLike) -> ReachabilityMap:

@@ -10,9 +10,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <dirent.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <dirent.h>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -383,4 +385,124 @@ TEST(HostileUrdf, KinematicHashIsUnchangedAndTheBodiesHaveTheirOwn) {
   EXPECT_NEAR(heavy.total_mass(), 3.3, 1e-9);
   EXPECT_EQ(ChainModel::from_urdf(kSnake, "link_0", "head_tip").body_hash(), body.body_hash());
   EXPECT_EQ(ChainModel::from_urdf(two_links("<link name='b'/>"), "a", "b").total_mass(), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Errors in worker threads reach the caller as the same exception.
+
+namespace {
+struct ThrowingSolver : PoseSolver {
+  bool solve(const Eigen::Isometry3d&, const Eigen::VectorXd&, std::uint64_t, Eigen::VectorXd&) override {
+    throw InputError("thrown in a worker thread");
+  }
+};
+}  // namespace
+
+TEST(HostileThreads, WorkerExceptionsReachTheCaller) {
+  WorkspaceOptions o;
+  o.voxel_size = 0.2;
+  o.directions = 2;
+  o.rolls = 1;
+  o.cloud_samples = 200;
+  o.threads = 4;
+  const PoseSolverFactory throwing = [](const ChainModel&, const WorkspaceOptions&) {
+    return std::make_unique<ThrowingSolver>();
+  };
+  const std::string m = input_error([&] { compute_reachability(*head7(), o, nullptr, throwing); });
+  EXPECT_EQ(m, "thrown in a worker thread");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Files: written under a temporary name and renamed, so a failed write keeps the old file and leaves no
+// partial one.
+
+namespace {
+
+std::vector<std::string> directory_entries(const std::string& dir) {
+  std::vector<std::string> names;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (dirent* e = readdir(d))
+      if (std::string(e->d_name) != "." && std::string(e->d_name) != "..") names.push_back(e->d_name);
+    closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A file-size limit (ulimit -f) for the scope, with SIGXFSZ ignored so that the write fails with EFBIG.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    old_handler_ = signal(SIGXFSZ, SIG_IGN);
+    rlimit r = saved_;
+    r.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &r);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    signal(SIGXFSZ, old_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*old_handler_)(int) = nullptr;
+};
+
+}  // namespace
+
+TEST(HostileFiles, FailedNpzWriteKeepsTheOldFile) {
+  const std::string dir = temp_path("npz_dir");
+  mkdir(dir.c_str(), 0700);
+  const std::string path = dir + "/map.npz";
+  {
+    std::ofstream f(path);
+    f << "the old map";
+  }
+  NpzWriter w;
+  w.add_f64("big", std::vector<double>(100000, 1.0), {100000});
+  {
+    FileSizeLimit limit(4096);
+    try {
+      w.write(path);
+      ADD_FAILURE() << "the write should fail beyond the file-size limit";
+    } catch (const std::runtime_error& e) {
+      EXPECT_TRUE(contains(e.what(), "File too large")) << e.what();
+    }
+  }
+  EXPECT_EQ(file_text(path), "the old map");
+  EXPECT_EQ(directory_entries(dir), std::vector<std::string>{"map.npz"});
+  w.write(path);  // and without the limit it replaces the file
+  EXPECT_EQ(file_text(path), w.bytes());
+  EXPECT_EQ(directory_entries(dir), std::vector<std::string>{"map.npz"});
+  std::remove(path.c_str());
+  rmdir(dir.c_str());
+}
+
+TEST(HostileFiles, OutputsThatAreNotFilesAreRefused) {
+  const std::string fifo = temp_path("out_fifo.npz");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  NpzWriter w;
+  w.add_scalar("x", 1.0);
+  EXPECT_THROW(check_output_path(fifo), std::runtime_error);  // used to block opening it
+  EXPECT_THROW(w.write(fifo), std::runtime_error);            // renaming would replace it
+  struct stat st {};
+  ASSERT_EQ(stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  std::remove(fifo.c_str());
+  EXPECT_THROW(check_output_path(::testing::TempDir()), std::runtime_error);
+  EXPECT_THROW(check_output_path("/no/such/dir/map.npz"), std::runtime_error);
+  const std::string dir = temp_path("check_dir");
+  mkdir(dir.c_str(), 0700);
+  EXPECT_NO_THROW(check_output_path(dir + "/map.npz"));
+  EXPECT_TRUE(directory_entries(dir).empty());  // the trial file is gone
+  rmdir(dir.c_str());
 }
