@@ -38,6 +38,8 @@ const char* type_name(JointType t) {
 void bind_model(py::module_& m) {
   m.def("read_urdf_file", &read_urdf_file, py::arg("path"),
         "The text of a URDF file: ValueError unless a readable regular file of at most 8 MiB");
+  m.def("urdf_root_link", &urdf_root_link, py::arg("urdf"),
+        "The root link of a URDF (an XML document or a file path)");
   py::class_<ChainModel>(m, "ChainModel", "Immutable serial chain between two links of a URDF.")
       .def_static("from_urdf", &ChainModel::from_urdf, py::arg("urdf"), py::arg("base"), py::arg("tip"),
                   "urdf: an XML document or a file path")

@@ -123,14 +123,30 @@ void append(std::ostringstream& os, const Eigen::Isometry3d& t) {
 
 }  // namespace
 
-ChainModel ChainModel::from_urdf(const std::string& urdf, const std::string& base, const std::string& tip) {
+namespace {
+
+// The text of a URDF given as an XML document (its first non-blank character is '<') or a file path.
+std::string document_text(const std::string& urdf) {
   const auto first = urdf.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && urdf[first] == '<') return from_urdf_string(urdf, base, tip);
-  return from_urdf_file(urdf, base, tip);
+  if (first != std::string::npos && urdf[first] == '<') return urdf;
+  return read_urdf_file(urdf);
+}
+
+}  // namespace
+
+ChainModel ChainModel::from_urdf(const std::string& urdf, const std::string& base, const std::string& tip) {
+  return from_urdf_string(document_text(urdf), base, tip);
 }
 
 ChainModel ChainModel::from_urdf_file(const std::string& path, const std::string& base, const std::string& tip) {
   return from_urdf_string(read_urdf_file(path), base, tip);
+}
+
+std::string urdf_root_link(const std::string& urdf) {
+  const auto robot = parse_urdf(document_text(urdf));  // checked, and urdfdom's complaints as InputError
+  const auto root = robot->getRoot();
+  if (!root) throw InputError("the URDF has no root link");
+  return root->name;
 }
 
 ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::string& base, const std::string& tip) {

@@ -19,9 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead import Chain, TracIK, _core
-from snakehead import workspace as ws
-from snakehead.robot import default_urdf_path
+from snakehead import Chain, TracIK, _core, default_urdf_path
+from snakehead.kinematics import workspace as ws
 
 URDF = default_urdf_path()
 MAX_TIMEOUT_S = 86400.0  # limits::kMaxTimeoutSeconds
@@ -207,7 +206,7 @@ def test_hash_covers_kinematics_and_bodies_separately():
     assert body.total_mass == pytest.approx(3.2)  # DESIGN.md: 0.2 kg per 0.0865 m of body
     # The shipped maps record the kinematic hash of their chains, unchanged.
     for name, (base, tip) in (("snake16_head7.npz", ("neck_end", "head_tip")), ("snake16_head6.npz", ("link_10", "head_tip"))):
-        with np.load(ws.DATA_DIR / name) as z:
+        with np.load(URDF.parent / name) as z:
             assert Chain.from_urdf(URDF, base, tip).hash == str(z["chain_hash"])
     heavier = Chain.from_urdf(URDF.read_text().replace('<mass value="0.2"/>', '<mass value="0.25"/>', 1),
                               "link_0", "head_tip")
@@ -275,8 +274,8 @@ def test_failed_map_writes_keep_the_old_file(tmp_path):
     # workspace.save (Python's writer): ValueError, the same guarantees.
     r = python(f"""
         import resource
-        from snakehead import workspace
-        m = workspace.default_map("head6")
+        from snakehead.kinematics import workspace
+        m = workspace.load({str(URDF.parent / "snake16_head6.npz")!r})
         resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
         try:
             workspace.save(m, {str(old)!r})
@@ -317,6 +316,6 @@ def test_outputs_that_are_not_files_are_refused(tmp_path):
         r = gen(out, timeout=60)
         assert r.returncode == 2 and "not a regular file" in one_error_line(r.stderr)
         with pytest.raises(ValueError, match="not a regular file"):
-            ws.save(ws.default_map("head6"), out)
+            ws.save(ws.load(URDF.parent / "snake16_head6.npz"), out)
         mode = out.stat().st_mode
         assert stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
