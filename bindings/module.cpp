@@ -14,14 +14,15 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
+  snakehead::bindings::bind_support(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");
 
   // Every C++ exception reaches Python as ValueError (bad input; also any other failure of the core, with
   // its message), TypeError (a value pybind11 could not convert), MemoryError, Cancelled, or the Python
-  // exception a callback raised; never RuntimeError, never an abort. (Tried before register_exception's.) This also covers exceptions
-  // raised in worker threads: the core carries them to the calling thread.
+  // exception a callback raised; never RuntimeError, never an abort (tried before register_exception's).
+  // This also covers exceptions raised in worker threads: the core carries them to the calling thread.
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
