@@ -103,15 +103,35 @@ def test_workspace_cli_and_workspace_gen_refuse_a_huge_timeout(tmp_path):
     assert not out.exists()
 
 
-def test_sizes_beyond_their_limits_name_the_field(head):
-    with pytest.raises(ValueError, match="directions must be between 1 and 4096"):
-        ws.compute(head, progress=False, **{**SMALL, "directions": 10**6})
-    with pytest.raises(ValueError, match=r"voxel size 1e-09 m is too small .* at most 256"):
-        ws.compute(head, progress=False, **{**SMALL, "voxel": 1e-9})
-    with pytest.raises(ValueError, match="cloud_samples must be between 100 and 10000000"):
-        ws.compute(head, progress=False, **{**SMALL, "cloud_samples": 2 * 10**9})
-    with pytest.raises(ValueError, match="between 1 and 4096"):
-        ws.fibonacci_directions(2 * 10**9)
+def test_sizes_beyond_their_limits_name_the_field():
+    """Sizes failed only at allocation (a voxel of 1e-9 m asked for 10^27 voxels), or ran for days. In a subprocess
+    with 4 GiB of address space and a timeout, so that neither can take the machine down."""
+    r = python("""
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
+        from snakehead import Chain, default_urdf_path
+        from snakehead.kinematics import workspace as ws
+        head = Chain.from_urdf(default_urdf_path(), "neck_end", "head_tip")
+        small = dict(voxel=0.2, directions=2, rolls=1, cloud_samples=200, timeout=1e-3)
+        for change in (dict(directions=10**6), dict(voxel=1e-9), dict(cloud_samples=2 * 10**9), dict(threads=10**5)):
+            try:
+                ws.compute(head, progress=False, **{**small, **change})
+                print("accepted", change)
+            except Exception as e:
+                print(type(e).__name__, e)
+        try:
+            ws.fibonacci_directions(2 * 10**9)
+        except Exception as e:
+            print(type(e).__name__, e)
+        """, timeout=120)
+    assert r.returncode == 0, r.stderr[-2000:]
+    lines = r.stdout.splitlines()
+    assert len(lines) == 5, r.stdout
+    assert lines[0].startswith("ValueError directions must be between 1 and 4096"), lines[0]
+    assert lines[1].startswith("ValueError voxel size 1e-09 m is too small") and "at most 256" in lines[1], lines[1]
+    assert lines[2].startswith("ValueError cloud_samples must be between 100 and 10000000"), lines[2]
+    assert lines[3].startswith("ValueError threads must be between 0 and 256"), lines[3]
+    assert lines[4].startswith("ValueError directions must be between 1 and 4096"), lines[4]
 
 
 # --- robot descriptions ---------------------------------------------------------------------------------
