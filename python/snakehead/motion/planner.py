@@ -41,6 +41,8 @@ DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straigh
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move
+ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
 BENDING_COMBINATIONS = 30000  # the grid coarsens so that it never holds more curls than this
@@ -127,10 +129,11 @@ class Plan:
         for tg in self.targets:
             if not tg.solved:
                 return f"target {tg.name!r} not solved: {tg.solution.message}"
-        if not self.stability.stable:
+        if self.min_zmp_margin_m < ZMP_MARGIN:
             k = self.stability.argmin
-            return (f"the ZMP leaves the support polygon (by {-1000 * self.min_zmp_margin_m:.1f} mm at "
-                    f"t = {self.t[k]:.2f} s)")
+            where = "leaves the support polygon by" if self.min_zmp_margin_m < 0 else "comes within"
+            return (f"the ZMP {where} {abs(1000 * self.min_zmp_margin_m):.1f} mm of its edge at t = {self.t[k]:.2f} s "
+                    f"(a plan keeps it {1000 * ZMP_MARGIN:.0f} mm inside)")
         if self.min_ground_clearance_m <= -coll.GROUND_TOLERANCE:
             k = int(np.argmin(self.ground_clearance))
             return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
@@ -143,6 +146,17 @@ class Plan:
     @property
     def success(self) -> bool:
         return self.failure is None
+
+
+def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
+    """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
+    (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
+    qs = np.asarray(qs, float)
+    s = np.arange(between + 1) / (between + 1)
+    a, b = qs[..., :-1, :], qs[..., 1:, :]
+    fine = a[..., None, :] + s[:, None] * (b - a)[..., None, :]  # (..., K-1, between+1, n)
+    fine = fine.reshape(qs.shape[:-2] + (-1, qs.shape[-1]))
+    return np.concatenate([fine, qs[..., -1:, :]], axis=-2)
 
 
 class _Waypoints:
@@ -184,7 +198,7 @@ class _Waypoints:
         """
         q = np.asarray(q, float)
         path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
-        if self._feasible(path.q).all():
+        if self._feasible(_densify(path.q)).all():
             qs, method = path.q, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
@@ -224,7 +238,7 @@ class _Waypoints:
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = qa + s * (qb - qa)
-        if self._feasible(straight).all():
+        if self._feasible(_densify(straight)).all():
             return straight, "joint space"
         movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -232,7 +246,7 @@ class _Waypoints:
         W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
         W = np.clip(W, self.robot.lower, self.robot.upper)
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
-        flat = paths.reshape(-1, qa.size)
+        flat = _densify(paths).reshape(-1, qa.size)
         ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
         if ok.any():
             length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
@@ -260,8 +274,9 @@ def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), sc
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
-    clearance = coll.ground_clearance(robot, traj.q, base)[:, robot.lifted_links].min(axis=1)
+    frames = robot.frames_many(traj.q, base)  # once, for every check below
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
+    clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
@@ -347,8 +362,8 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[BasePlacement, np.ndarray,
-                                                                           Relocation | None, list[str]]:
+def choose_base(controller: HeadController, targets, obstacles=(), allow_relocation: bool = True
+                ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -383,6 +398,8 @@ def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[Base
         return start, q0.copy(), None, []
     reason = ("the start state touches an obstacle" if first == "the start" else
               f"target {first.name!r} is not reached from the start ({why.reason})")
+    if not allow_relocation:
+        return start, q0.copy(), None, [f"the base is kept (no relocation allowed): {reason}"]
     order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
     for t in order:
         sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
@@ -442,7 +459,8 @@ def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Sce
 
 def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
          base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
-         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
+         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT,
+         allow_relocation: bool = True) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -453,8 +471,10 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     controller : a :class:`~snakehead.control.HeadController` to solve the head with (default: one for ``robot``
         with its head's map, ``method`` and ``seed``).
     obstacles : more obstacles (``geometry.BoxObstacle``, ``geometry.WallWithHole``) besides the scene's.
-    base : where the base lies at first (default: the scene's, else ``BasePlacement()``); the planner may choose
-        another placement that reaches every target (said in ``notes``).
+    base : where the base lies at first (default: the scene's, else ``BasePlacement()``); when a target cannot be
+        reached from there, the planner chooses another placement (and flat shape) that reaches every target: the
+        plan starts there and ``relocation`` says what locomotion must do first (unless ``allow_relocation`` is
+        False: then the base stays and the plan fails on the targets it cannot reach).
     method : the head IK: "rotated" (the paper's Fig. 9) or "free_roll".
     seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
     speed : the largest joint rate a segment is planned for (rad/s). min_segment : the shortest segment (s).
@@ -484,7 +504,7 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
-    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles)
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation)
     notes += base_notes
     way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
     way.start("bending state", bending_state(controller, q_shape))
