@@ -99,7 +99,7 @@ def test_virtual_chassis_of_simple_shapes():
     (lambda: make_gait("rolling", direction=True), ValueError, "direction must be"),
     (lambda: make_gait("rolling", speed=2), TypeError, "rolling"),
     (lambda: Wave(0.3, taper=1.5), ValueError, "taper"),
-    (lambda: Wave("big"), ValueError, "amplitude"),
+    (lambda: Wave("big"), TypeError, "amplitude must be a real number, got str"),
 ])
 def test_bad_gait_parameters(call, error, match):
     with pytest.raises(error, match=match):

@@ -1,6 +1,13 @@
-"""Input checks shared by every public function: numpy in, a clear ValueError out."""
+"""Input checks shared by every public function, one per kind of input: numpy in, a clear error out.
+
+A value of the wrong kind (a str, a bool, None where a number is needed) is a TypeError; a value of the right
+kind that is wrong (NaN, out of range, too large, the wrong shape) is a ValueError. Every message names the
+argument and says what was wrong. Durations and sizes have upper limits (:data:`MAX_DURATION_S`,
+:data:`MAX_SAMPLES`): a value that would run for days or allocate without bound is refused at once.
+"""
 from __future__ import annotations
 
+import numbers
 from typing import Any
 
 import numpy as np
@@ -9,12 +16,42 @@ import numpy.typing as npt
 
 ORTHONORMAL_TOLERANCE = 1e-6
 
+#: The longest duration (s) any argument may ask for: one day, the C++ core's limit on timeouts
+#: (``limits::kMaxTimeoutSeconds``). A plan, a simulation or a gait run of more than a day is a mistake.
+MAX_DURATION_S = 86400.0
+
+#: The most samples a trajectory, a simulation's record or a sampled curve may have: 2000 s at the 2 ms control
+#: period, ~130 MB for a 16-joint robot's joint angles in float64. Beyond it an allocation would exhaust memory.
+MAX_SAMPLES = 1_000_000
+
+
+def _shown(x: Any) -> str:
+    """``repr(x)`` cut short for messages (an int of 10**400 has 401 digits)."""
+    text = repr(x)
+    return text if len(text) <= 60 else text[:40] + "..." + text[-10:]
+
+
+def _not_a_number(x: Any) -> bool:
+    """Text, a bool or None: values that numpy would turn into numbers (or NaN) but that are not numbers."""
+    return x is None or isinstance(x, (str, bytes, bool, np.bool_))
+
 
 def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.ndarray:
-    """``x`` as a float64 array; ValueError unless finite and (when given) of ``shape`` (None = any size)."""
+    """``x`` as a float64 array; ValueError unless finite and (when given) of ``shape`` (None = any size).
+
+    TypeError for text, booleans or None (numpy would read ``"1"`` and True as 1.0, None as NaN)."""
+    if _not_a_number(x):
+        raise TypeError(f"{name} must be numbers, got {type(x).__name__} {_shown(x)}")
     try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
+        raw = x if isinstance(x, np.ndarray) else np.asarray(x)
+    except (TypeError, ValueError, OverflowError) as exc:  # e.g. ragged nested lists
+        raise ValueError(f"{name} must be an array of numbers: {exc}") from None
+    if raw.dtype.kind in "USb" or (raw.dtype.kind == "O" and any(_not_a_number(v) for v in raw.flat)):
+        what = "booleans" if raw.dtype.kind == "b" else "text" if raw.dtype.kind in "US" else "None or text"
+        raise TypeError(f"{name} must be numbers, got {what}")
+    try:
+        a = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:  # None, complex, objects, ints beyond a float
         raise ValueError(f"{name} must be an array of numbers: {exc}") from None
     if shape is not None:
         if a.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, a.shape)):
@@ -28,6 +65,24 @@ def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.
 def joint_vector(q: npt.ArrayLike, n: int, name: str = "q") -> np.ndarray:
     """A 1-D float64 vector of ``n`` finite joint values."""
     return finite_array(q, name, (n,))
+
+
+def within_limits(q: npt.ArrayLike, lower: npt.ArrayLike, upper: npt.ArrayLike, name: str = "q",
+                  tolerance: float = 1e-9) -> np.ndarray:
+    """Joint values ``q`` (n,) or (T, n), finite, within [lower - tolerance, upper + tolerance]; ValueError naming
+    the first value outside (a start or a state outside the limits would be carried into a result)."""
+    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
+    a = finite_array(q, name)
+    if a.ndim not in (1, 2) or a.shape[-1] != lo.shape[-1]:
+        raise ValueError(f"{name} has shape {a.shape}; expected ({lo.shape[-1]},)" +
+                         ("" if a.ndim == 1 else f" or (T, {lo.shape[-1]})"))
+    bad = np.argwhere((a < lo - tolerance) | (a > hi + tolerance))
+    if len(bad):
+        at = tuple(int(i) for i in bad[0])
+        j = at[-1]
+        where = f"{name}[{', '.join(map(str, at))}]"
+        raise ValueError(f"{where} = {a[at]:.6g} is outside the joint limits [{lo[j]:.6g}, {hi[j]:.6g}]")
+    return a
 
 
 def vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
@@ -59,20 +114,78 @@ def rotation_matrix(R: npt.ArrayLike, name: str = "rotation") -> np.ndarray:
     return a
 
 
-def positive(x: npt.ArrayLike, name: str) -> float:
-    """``x`` as a positive finite float; ValueError naming ``name`` otherwise."""
-    v = finite_float(x, name)
-    if v <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {x!r}")
-    return v
+def real_number(x: Any, name: str) -> float:
+    """``x`` as a float: an int, a float, a numpy number or a 0-d numeric array. TypeError for anything else
+    (bool, str, None, complex, a sequence); ValueError for an int too large for a float. NaN and inf pass
+    (see :func:`finite_float`)."""
+    if isinstance(x, np.ndarray) and x.ndim == 0 and x.dtype.kind in "iuf":
+        x = x[()]
+    if _not_a_number(x) or not isinstance(x, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {type(x).__name__} {_shown(x)}")
+    try:
+        return float(x)
+    except OverflowError:
+        raise ValueError(f"{name} is too large for a float, got {_shown(x)}") from None
 
 
 def finite_float(x: Any, name: str) -> float:
-    """``x`` as a finite float; ValueError naming ``name`` otherwise."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {x!r}") from None
+    """``x`` as a finite float (:func:`real_number`); ValueError naming ``name`` for NaN or inf."""
+    v = real_number(x, name)
     if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {x!r}")
+        raise ValueError(f"{name} must be finite, got {_shown(x)}")
     return v
+
+
+def positive(x: Any, name: str, *, maximum: float | None = None) -> float:
+    """``x`` as a positive finite float, at most ``maximum`` when given; ValueError naming ``name`` otherwise."""
+    v = finite_float(x, name)
+    if v <= 0:
+        raise ValueError(f"{name} must be a positive finite number, got {_shown(x)}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
+    return v
+
+
+def non_negative(x: Any, name: str, *, maximum: float | None = None) -> float:
+    """``x`` as a finite float >= 0, at most ``maximum`` when given; ValueError naming ``name`` otherwise."""
+    v = finite_float(x, name)
+    if v < 0:
+        raise ValueError(f"{name} must be >= 0, got {_shown(x)}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
+    return v
+
+
+def duration(x: Any, name: str, *, allow_zero: bool = False, maximum: float = MAX_DURATION_S) -> float:
+    """A duration in seconds: finite, > 0 (>= 0 with ``allow_zero``) and at most ``maximum`` (one day)."""
+    v = finite_float(x, name)
+    if v < 0 or (v == 0 and not allow_zero):
+        raise ValueError(f"{name} must be {'>= 0' if allow_zero else '> 0'} s, got {_shown(x)}")
+    if v > maximum:
+        raise ValueError(f"{name} must be at most {maximum:g} s, got {_shown(x)}")
+    return v
+
+
+def integer(n: Any, name: str, *, least: int | None = None, most: int | None = None) -> int:
+    """``n`` as an int within [least, most]: an int or a numpy integer (TypeError for bool, float, str...)."""
+    if isinstance(n, np.ndarray) and n.ndim == 0 and n.dtype.kind in "iu":
+        n = n[()]
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, got {type(n).__name__} {_shown(n)}")
+    v = int(n)
+    if (least is not None and v < least) or (most is not None and v > most):
+        bounds = (f"between {least} and {most}" if least is not None and most is not None else
+                  f">= {least}" if least is not None else f"<= {most}")
+        raise ValueError(f"{name} must be {bounds}, got {_shown(n)}")
+    return v
+
+
+def sample_count(span_s: float, step_s: float, name: str, *, maximum: int = MAX_SAMPLES) -> int:
+    """How many samples ``span_s`` seconds take at ``step_s`` steps (both ends included), ValueError when more than
+    ``maximum``: the check before an allocation (or a loop) whose size the caller's numbers decide."""
+    span, step = finite_float(span_s, f"{name} (s)"), positive(step_s, f"{name}'s step (s)")
+    steps = span / step
+    if not steps <= maximum - 1:  # also NaN
+        raise ValueError(f"{name}: {span:g} s in steps of {step:g} s is {steps + 1:.3g} samples; at most {maximum} "
+                         "(shorten it or take longer steps)")
+    return int(np.floor(max(steps, 0.0) + 1e-9)) + 1
