@@ -320,12 +320,21 @@ def test_bad_q_init(solver7, head7):
     (dict(epsilon=-1e-5), "epsilon"),
     (dict(solve_type="Fastest"), "solve_type"),
     (dict(seed=-1), "seed"),
-    (dict(seed=1.5), "seed"),
+    (dict(seed=1.5), "seed must be an integer, got float"),
     (dict(bounds=[0, 0, 0]), "bounds"),
     (dict(bounds=[0, 0, 0, -1, 0, 0]), "bounds"),
+    (dict(timeout=10**400), "timeout is too large for a float"),  # was OverflowError
+    (dict(timeout=1e10), "timeout must be at most 86400 s"),
+    (dict(timeout="1"), "timeout must be a real number, got str"),  # was accepted as 1 s
+    (dict(timeout=True), "timeout must be a real number, got bool"),  # was accepted as 1 s
+    (dict(epsilon=None), "epsilon must be a real number"),
+    (dict(seed=True), "seed must be an integer, got bool"),
+    (dict(solve_type=None), "solve_type"),
 ])
 def test_bad_options(head7, kwargs, match):
-    with pytest.raises(ValueError, match=match):
+    """Issue 14, finding 9: a number of the wrong kind is a TypeError, a wrong value a ValueError; both name it."""
+    kind = TypeError if "real number" in match or "an integer, got" in match else ValueError
+    with pytest.raises(kind, match=match):
         TracIK.from_chain(head7, **kwargs)
 
 

@@ -189,3 +189,28 @@ def sample_count(span_s: float, step_s: float, name: str, *, maximum: int = MAX_
         raise ValueError(f"{name}: {span:g} s in steps of {step:g} s is {steps + 1:.3g} samples; at most {maximum} "
                          "(shorten it or take longer steps)")
     return int(np.floor(max(steps, 0.0) + 1e-9)) + 1
+
+
+#: The longest name (UTF-8 bytes) that goes into a file name (a scene's: ``NAME_trajectory.csv``, ``NAME.html``...).
+MAX_NAME_BYTES = 100
+
+
+def file_name_part(name: Any, what: str) -> str:
+    """A name that becomes part of a file name (``out / f"{name}_trajectory.csv"``): a non-empty str without path
+    separators or control characters, not "." or "..", at most MAX_NAME_BYTES bytes in UTF-8. Anything else could
+    write outside the output folder or fail half-way through the outputs."""
+    if not isinstance(name, str):
+        raise TypeError(f"{what} must be a str, got {type(name).__name__} {_shown(name)}")
+    if not name or name in (".", ".."):
+        raise ValueError(f"{what} must be a name, got {name!r}")
+    bad = sorted({c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127})
+    if bad:
+        raise ValueError(f"{what} {_shown(name)} holds {', '.join(map(repr, bad))}: it names files, so it may not hold "
+                         "path separators or control characters")
+    try:
+        size = len(name.encode("utf-8"))
+    except UnicodeEncodeError as exc:
+        raise ValueError(f"{what} is not valid text: {exc.reason}") from None
+    if size > MAX_NAME_BYTES:
+        raise ValueError(f"{what} is {size} bytes long in UTF-8; at most {MAX_NAME_BYTES} (it names files)")
+    return name

@@ -21,9 +21,9 @@ import numpy as np
 from . import head as head_ik
 from . import neck as nk
 from ..dynamics import stability
-from .._validate import joint_vector, positive, unit_vector3, vector3
+from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
 from ..kinematics.ik import TracIK
-from ..model.robot import BasePlacement, SnakeRobot
+from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable
@@ -77,18 +77,20 @@ class HeadController:
                  base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
         from .. import backbone  # late: heavier imports, only needed here
 
-        self.robot = robot if robot is not None else SnakeRobot.default()
+        from ..kinematics import workspace
+
+        self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):
             raise ValueError(f"method must be 'rotated' or 'free_roll', got {method!r}")
-        if int(n_frames) != n_frames or n_frames < 1:
-            raise ValueError(f"n_frames must be a positive integer, got {n_frames!r}")
-        self.method, self.n_frames = method, int(n_frames)
+        self.method, self.n_frames = method, integer(n_frames, "n_frames", least=1, most=360)
+        timeout = duration(timeout, "timeout")
         if workspace_map is None:
-            from ..kinematics import workspace
-
             workspace_map = workspace.map_for(self.robot)
-        chain_hash = getattr(workspace_map, "chain_hash", None)
-        if chain_hash is not None and chain_hash != self.robot.head_chain.hash:
+        if not isinstance(workspace_map, workspace.ReachabilityMap):
+            raise TypeError(f"workspace_map must be a ReachabilityMap (snakehead.load_map), got "
+                            f"{type(workspace_map).__name__}")
+        chain_hash = workspace_map.chain_hash
+        if chain_hash != self.robot.head_chain.hash:
             raise ValueError("the workspace map was made for another head chain (hash "
                              f"{chain_hash} != {self.robot.head_chain.hash}); compute one for this robot's head")
         self.map = workspace_map
@@ -108,9 +110,10 @@ class HeadController:
         self.allow_base_move = bool(allow_base_move)
         if base_configuration is None:
             base_configuration = backbone.initial_configuration(self.robot)
-        self.q_initial = joint_vector(base_configuration, self.robot.n_joints, "base_configuration")
+        self.q_initial = within_limits(joint_vector(base_configuration, self.robot.n_joints, "base_configuration"),
+                                       self.robot.lower, self.robot.upper, "base_configuration")
         self._polygons: dict = {}  # (base placement, base joints) -> support polygon
-        self.ik = TracIK.from_chain(self.robot.head_chain, timeout=positive(timeout, "timeout"),
+        self.ik = TracIK.from_chain(self.robot.head_chain, timeout=timeout,
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 
     # --- the process ---------------------------------------------------------------------------
@@ -119,9 +122,10 @@ class HeadController:
               allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
-        ``q_prev`` (16,): the current joints; the base keeps its shape from it and the neck and head start
-        from it (and, with the rotated-frames method, the solution closest to it is kept). ``base``: the base
-        placement to start from (default: the controller's).
+        ``q_prev`` (16,): the current joints, within the joint limits (ValueError otherwise: the base would keep
+        them); the base keeps its shape from it and the neck and head start from it (and, with the rotated-frames
+        method, the solution closest to it is kept). ``base``: the base placement to start from (default: the
+        controller's).
 
         Step 3's accepted range decides where the base must be. Out of range, the base is moved (when
         ``allow_base_move``) by the planar move that brings the target in range; the accepted range is a
@@ -138,10 +142,16 @@ class HeadController:
         t_start = time.perf_counter()
         position = vector3(position, "position")
         direction = unit_vector3(direction, "direction")
-        q = self.q_initial.copy() if q_prev is None else joint_vector(q_prev, self.robot.n_joints, "q_prev").copy()
+        if q_prev is None:
+            q = self.q_initial.copy()
+        else:  # joints outside their limits would be returned as they are, with success=True
+            q = within_limits(joint_vector(q_prev, self.robot.n_joints, "q_prev"), self.robot.lower, self.robot.upper,
+                              "q_prev").copy()
         base = self.base if base is None else base
         if not isinstance(base, BasePlacement):
-            raise TypeError("base must be a BasePlacement")
+            raise TypeError(f"base must be a BasePlacement, got {type(base).__name__}")
+        if accept is not None and not callable(accept):
+            raise TypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
         desired = head_ik.frame_from_direction(position, direction)
         P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         check = nk.accepted_range(position, P0_frame[:3, 3], self.Lc, self.neck_length, self.slack)

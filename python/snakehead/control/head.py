@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, pose, unit_vector3, vector3
+from .._validate import finite_array, finite_float, integer, pose, unit_vector3, vector3
 from ..kinematics.ik import TracIK
 
 import numpy.typing as npt
@@ -46,9 +46,10 @@ def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: 
 
 def roll_about_x(T: npt.ArrayLike, angle: float) -> np.ndarray:
     """``T`` rotated by ``angle`` (rad) about its own x-axis (Fig. 9)."""
+    angle = finite_float(angle, "angle")
     c, s = np.cos(angle), np.sin(angle)
     R = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-    out = np.array(T, dtype=float, copy=True)
+    out = np.array(pose(T, "T"), dtype=float, copy=True)
     out[:3, :3] = out[:3, :3] @ R
     return out
 
@@ -99,6 +100,11 @@ def _finish(ik: TracIK, q: np.ndarray | None, target: Any, tried: int, solved: i
     return HeadIKResult(q, T, pe, de, _roll_between(T, target), tried, solved, time.perf_counter() - t0, candidates)
 
 
+def _check_solver(ik: Any) -> None:
+    if not isinstance(ik, TracIK):
+        raise TypeError(f"ik must be a snakehead TracIK, got {type(ik).__name__}")
+
+
 def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None = None,
                    q_prev: npt.ArrayLike | None = None, accept: Callable[..., bool] | None = None
                    ) -> HeadIKResult:
@@ -111,9 +117,11 @@ def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarr
     optional test ``accept(q) -> bool`` of a head solution; only accepted solutions are candidates (``solved``
     still counts every solution found).
     """
+    _check_solver(ik)
     target = pose(target, "target")
-    if int(n_frames) != n_frames or n_frames < 1:
-        raise ValueError(f"n_frames must be a positive integer, got {n_frames!r}")
+    n_frames = integer(n_frames, "n_frames", least=1, most=360)
+    if accept is not None and not callable(accept):
+        raise TypeError(f"accept must be a callable accept(q) -> bool or None, got {type(accept).__name__}")
     n = ik.n_joints
     if q_prev is not None:
         q_prev = finite_array(q_prev, "q_prev", (n,))
@@ -140,13 +148,15 @@ def select(candidates: list[Any], q_prev: np.ndarray | None = None) -> Any:
 
 def free_roll(ik: TracIK, target: Any, q_init: npt.ArrayLike | None = None, attempts: int = 1) -> HeadIKResult:
     """One TRAC-IK call (or ``attempts`` calls from random seeds) with the roll about x left free."""
+    _check_solver(ik)
     target = pose(target, "target")
+    attempts = integer(attempts, "attempts", least=1, most=1000)
     n = ik.n_joints
     q0 = np.zeros(n) if q_init is None else np.clip(finite_array(q_init, "q_init", (n,)), ik.lower, ik.upper)
     t0 = time.perf_counter()
     q = None
     tried = 0
-    for attempt in range(max(1, int(attempts))):
+    for attempt in range(attempts):
         tried += 1
         # Later attempts restart from fixed pseudo-random joints (a seeded solver given no start would
         # start every attempt from the same point, and an unseeded one would not be reproducible).

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, positive, vector3
+from .._validate import finite_array, finite_float, pose, positive, vector3
 from ..model.chain import Chain
 from .head import angle_between_deg
 from ..model.robot import BasePlacement
@@ -104,7 +104,11 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
     started from ``q_init`` and from the best point of a coarse grid (Eq. 22 is not convex); the minimum
     reached from ``q_init`` is kept unless the grid's is lower by more than ``CONTINUITY_TOLERANCE``.
     """
-    P0_frame = finite_array(P0_frame, "P0_frame", (4, 4))
+    if not isinstance(neck, Chain):
+        raise TypeError(f"neck must be a snakehead Chain, got {type(neck).__name__}")
+    if not isinstance(goal, NeckGoal):
+        raise TypeError(f"goal must be a NeckGoal (neck_goal()), got {type(goal).__name__}")
+    P0_frame = pose(P0_frame, "P0_frame")  # a rigid frame: a scaled or sheared one would distort Eq. 22
     h = positive(h, "h")
     if neck.n_joints == 0:  # nothing to move: the neck end is where the chain puts it
         T = P0_frame @ neck.fk(np.zeros(0))
@@ -196,7 +200,11 @@ def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: Bas
     (the target is too high for the neck and head to reach from the ground).
     """
     P_hd = vector3(P_hd, "P_hd")
-    P0_local = finite_array(P0_local, "P0_local", (4, 4))
+    P0_local = pose(P0_local, "P0_local")
+    if not isinstance(base, BasePlacement):
+        raise TypeError(f"base must be a BasePlacement, got {type(base).__name__}")
+    Lc, length, slack = positive(Lc, "Lc"), positive(length, "length"), positive(slack, "slack")
+    height = finite_float(height, "height")
     want = Lc + length - 0.5 * slack  # |P_hd - P0| in the middle of the accepted band
     dz = P_hd[2] - (base.matrix(height) @ P0_local)[2, 3]
     if want <= abs(dz):

@@ -18,7 +18,8 @@ import os
 import numpy as np
 
 from .. import _core
-from .._validate import ORTHONORMAL_TOLERANCE, finite_array, joint_vector, pose as check_pose, positive
+from .._validate import (ORTHONORMAL_TOLERANCE, duration, finite_array, integer, joint_vector, pose as check_pose,
+                         positive, within_limits)
 from ..model.chain import Chain
 
 import numpy.typing as npt
@@ -60,13 +61,7 @@ def _pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
 
 
 def _seed(seed: int | None) -> int | None:
-    if seed is None:
-        return None
-    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
-        raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}")
-    if not 0 <= int(seed) < 2**64:
-        raise ValueError(f"seed must be in [0, 2**64), got {seed}")
-    return int(seed)
+    return None if seed is None else integer(seed, "seed", least=0, most=2**64 - 1)
 
 
 class TracIK:
@@ -94,10 +89,10 @@ class TracIK:
 
     def _init(self, chain: Chain, timeout: float, epsilon: float, solve_type: str, seed: int | None, bounds: Any
               ) -> None:
-        if solve_type not in SOLVE_TYPES:
+        if not isinstance(solve_type, str) or solve_type not in SOLVE_TYPES:
             raise ValueError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
         self._chain = chain
-        self._solver = _core.TracIK(chain.model, positive(timeout, "timeout"), positive(epsilon, "epsilon"),
+        self._solver = _core.TracIK(chain.model, duration(timeout, "timeout"), positive(epsilon, "epsilon"),
                                     solve_type, _bounds(np.zeros(6) if bounds is None else bounds), _seed(seed))
         self._rng = np.random.default_rng(seed)
         self._lo, self._hi = self._solver.lower.tolist(), self._solver.upper.tolist()
@@ -149,13 +144,7 @@ class TracIK:
             # The common case in plain Python (faster than numpy's reductions for a few values).
             if all(lo - 1e-9 <= v <= hi + 1e-9 for v, lo, hi in zip(q_init.tolist(), self._lo, self._hi)):
                 return q_init  # NaN fails the comparisons and goes to the checks below
-        q = joint_vector(q_init, self.n_joints, name)
-        lo, hi = self.lower, self.upper
-        bad = np.flatnonzero((q < lo - 1e-9) | (q > hi + 1e-9))
-        if bad.size:
-            i = int(bad[0])
-            raise ValueError(f"{name}[{i}] = {q[i]:.6g} is outside the joint limits [{lo[i]:.6g}, {hi[i]:.6g}]")
-        return q
+        return within_limits(joint_vector(q_init, self.n_joints, name), self.lower, self.upper, name)
 
     def random_configuration(self) -> np.ndarray:
         """Uniform within the limits ([-pi, pi] for continuous joints), from the solver's own generator."""
@@ -183,8 +172,8 @@ class TracIK:
         T = _pose(pose)
         q = self._chain.random_configuration(self._start_generator()) if q_init is None else self._q_init(q_init)
         b = None if bounds is None else _bounds(bounds)
-        t = None if timeout is None else positive(timeout, "timeout")
-        if algorithm not in ("TRAC-IK", "KDL-RR", "SQP"):
+        t = None if timeout is None else duration(timeout, "timeout")
+        if not isinstance(algorithm, str) or algorithm not in ("TRAC-IK", "KDL-RR", "SQP"):
             raise ValueError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
         return self._solver.ik(T, q, b, t, algorithm)
 

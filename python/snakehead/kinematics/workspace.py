@@ -102,9 +102,11 @@ class ReachabilityMap:
 
     def histogram(self, bins: Sequence[float] = TABLE2_BINS) -> tuple[np.ndarray, np.ndarray]:
         """Voxel counts and percentages per bin, Table 2's bins by default; the last bin is closed ([80, 100])."""
-        edges = np.asarray(bins, dtype=float)
-        if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0):
-            raise ValueError("bins must be an increasing sequence of at least two edges")
+        from .._validate import finite_array
+
+        edges = finite_array(bins, "bins", (None,))  # NaN edges passed the test below and gave negative counts
+        if len(edges) < 2 or np.any(np.diff(edges) <= 0):
+            raise ValueError(f"bins must be an increasing sequence of at least two edges, got {edges.tolist()}")
         counts, _ = np.histogram(self.indices, bins=edges)  # numpy's last bin is closed
         pct = 100.0 * counts / max(len(self), 1)
         return counts, pct

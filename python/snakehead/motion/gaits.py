@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_float, positive
+from .._validate import duration, finite_array, finite_float, integer, positive, sample_count
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .interpolation import CONTROL_PERIOD
 
@@ -157,9 +157,9 @@ class Gait:
     def joint_angles(self, robot: SnakeRobot, t: npt.ArrayLike, cycles: float) -> np.ndarray:
         """Joint angles (T, n) rad at times t (T,) s from the start of a run of ``cycles`` cycles."""
         robot = as_robot(robot)
-        t = np.atleast_1d(np.asarray(t, float))
-        if not np.all(np.isfinite(t)):
-            raise ValueError("t contains NaN or inf")
+        t = np.atleast_1d(finite_array(t, "t"))
+        if t.ndim != 1:
+            raise ValueError(f"t must be a time or a 1-D array of times, got shape {t.shape}")
         self.check(robot)
         cycles = positive(cycles, "cycles")
         running = cycles / self.frequency
@@ -184,7 +184,8 @@ class Gait:
         corners across the plane of the body (along the virtual chassis' z-axis). Resting on that plane, no link
         rises higher than this; sidewinding and turning lift links by design, to about this height."""
         robot = as_robot(robot)
-        t = self.ramp_s + np.linspace(0.0, self.period_s, int(samples), endpoint=False)
+        samples = integer(samples, "samples", least=1, most=10_000)
+        t = self.ramp_s + np.linspace(0.0, self.period_s, samples, endpoint=False)
         F = robot.frames_many(self.joint_angles(robot, t, 1.0))
         corners = robot.box_corners(F)  # (T, k, 8, 3)
         centres = robot.box_poses(F)[..., :3, 3]  # (T, k, 3)
@@ -198,8 +199,9 @@ class Gait:
     def trajectory(self, robot: SnakeRobot, cycles: float, dt: float = CONTROL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
         """A run of ``cycles`` cycles sampled every ``dt`` s: t (T,) s from 0, q (T, n) rad; straight at both ends
         (unless the waves have offsets)."""
-        dt = positive(dt, "dt")
-        total = self.duration(cycles)
+        dt = duration(dt, "dt", maximum=1.0)
+        total = duration(self.duration(cycles), f"a run of {cycles!r} cycles of the {self.name} gait")
+        sample_count(total, dt, f"a run of {cycles!r} cycles of the {self.name} gait")
         t = np.arange(0.0, total + 0.5 * dt, dt)
         t[-1] = min(t[-1], total)
         return t, self.joint_angles(robot, t, cycles)

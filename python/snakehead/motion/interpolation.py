@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from .._validate import finite_array, joint_vector, positive
+from .._validate import finite_array, finite_float, joint_vector, positive, sample_count
 
 import numpy.typing as npt
 
@@ -102,8 +102,11 @@ class MonotoneQuintic:
 
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:
     """t0, t0 + dt, ... up to t1, with t1 itself as the last sample: (T,) s."""
+    t0, t1 = finite_float(t0, "t0"), finite_float(t1, "t1")
     dt = positive(dt, "dt")
-    steps = int(np.floor((t1 - t0) / dt + 1e-9))
+    if t1 < t0:
+        raise ValueError(f"t1 must be >= t0, got t0 = {t0:g} s and t1 = {t1:g} s")
+    steps = sample_count(t1 - t0, dt, "the trajectory (t1 - t0)") - 1  # at most MAX_SAMPLES: checked before allocating
     t = t0 + dt * np.arange(steps + 1)
     # A gap under a microsecond is round-off, not a sample: stretch the last step to t1 instead of adding a
     # sample a hair after it (two samples closer than any controller or file can tell apart).

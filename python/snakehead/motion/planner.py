@@ -427,10 +427,18 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     return start, q0.copy(), None, [f"no single base reaches every target: {reason}"]
 
 
+#: The most poses solved along one straight-line approach (approach = "line"; each is a whole-body solve).
+MAX_LINE_POSES = 2000
+
+
 def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     """Positions from target ``a`` to target ``b`` every ``b.step_m`` m (b included, a excluded)."""
     d = b.position - a.position
     length = float(np.linalg.norm(d))
+    if length / b.step_m > MAX_LINE_POSES:  # each pose is a whole-body solve
+        raise ValueError(f"target {b.name!r}: the line from {a.name!r} is {length:.4g} m long; at step_m = "
+                         f"{b.step_m:g} m that is {length / b.step_m:.3g} poses, at most {MAX_LINE_POSES}: take a "
+                         "larger step_m")
     n = int(np.ceil(length / b.step_m - 1e-9))
     steps = [min(k * b.step_m, length) for k in range(1, n + 1)]
     if length > 0 and steps and abs(steps[-1] - length) > 1e-12:

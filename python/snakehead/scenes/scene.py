@@ -43,7 +43,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import finite_float, unit_vector3, vector3
+from .._validate import duration, file_name_part, finite_float, unit_vector3, vector3
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, read_toml
@@ -77,11 +77,8 @@ class Target:
             raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
         object.__setattr__(self, "position", vector3(self.position, f"target {self.name!r} position"))
         object.__setattr__(self, "direction", unit_vector3(self.direction, f"target {self.name!r} direction"))
-        hold = finite_float(self.hold_s, f"target {self.name!r} hold_s")
-        if hold < 0:
-            raise ValueError(f"target {self.name!r}: hold_s must be >= 0, got {self.hold_s!r}")
-        object.__setattr__(self, "hold_s", hold)
-        if self.approach not in APPROACHES:
+        object.__setattr__(self, "hold_s", duration(self.hold_s, f"target {self.name!r} hold_s", allow_zero=True))
+        if not isinstance(self.approach, str) or self.approach not in APPROACHES:
             raise ValueError(f"target {self.name!r}: approach must be one of {APPROACHES}, got {self.approach!r}")
         step = finite_float(self.step_m, f"target {self.name!r} step_m")
         if step <= 0:
@@ -109,6 +106,9 @@ class Scene:
     path: Path | None = None
 
     def __post_init__(self) -> None:
+        file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
+        if not isinstance(self.description, str):
+            raise TypeError(f"a scene's description must be a str, got {type(self.description).__name__}")
         targets = tuple(self.targets)
         if not targets:
             raise ValueError(f"scene {self.name!r} has no targets")

@@ -55,7 +55,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .._validate import finite_array, positive
+from .._validate import duration, finite_array, non_negative, positive
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from .gains import default_torque_limits
@@ -69,6 +69,11 @@ GRAVITY = 9.80665
 #: Physics timestep (s) and control period (s) used by default.
 DEFAULT_TIMESTEP = 0.001
 DEFAULT_CONTROL_DT = 0.002
+#: Upper limits (s) on the physics timestep and the control period, and on the physics steps of one run (10^8: about
+#: an hour of computing, 28 hours of motion at 1 ms): beyond them a run would never end or not be a simulation.
+MAX_TIMESTEP = 0.1
+MAX_CONTROL_DT = 1.0
+MAX_PHYSICS_STEPS = 100_000_000
 
 _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
@@ -199,12 +204,12 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     """
     mj = _mujoco()
     robot = as_robot(robot)
-    timestep = positive(timestep, "timestep")
+    timestep = duration(timestep, "timestep", maximum=MAX_TIMESTEP)
     friction = positive(friction, "friction")
-    if not (np.isfinite(joint_damping) and joint_damping >= 0):
-        raise ValueError(f"joint_damping must be >= 0, got {joint_damping!r}")
-    if not (np.isfinite(armature) and armature >= 0):
-        raise ValueError(f"armature must be >= 0, got {armature!r}")
+    joint_damping = non_negative(joint_damping, "joint_damping")
+    armature = non_negative(armature, "armature")
+    if not isinstance(self_collision, (bool, np.bool_)):
+        raise TypeError(f"self_collision must be True or False, got {self_collision!r}")
     solref = finite_array(contact_solref, "contact_solref", (2,))
     if solref[0] < 2 * timestep or solref[1] <= 0:
         raise ValueError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")

@@ -9,10 +9,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import finite_array, positive
+from .._validate import duration, finite_array, non_negative, sample_count
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gains import default_gains
-from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco, build_model
+from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, MAX_CONTROL_DT,
+                   MAX_PHYSICS_STEPS, MAX_TIMESTEP, SimModel, _mujoco, build_model)
 
 import numpy.typing as npt
 
@@ -277,23 +278,24 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     base = as_base(base)
     t, q = check_trajectory(robot, t, q)
     n = robot.n_joints
-    timestep = positive(timestep, "timestep")
-    if not (np.isfinite(armature) and armature >= 0):
-        raise ValueError(f"armature must be >= 0, got {armature!r}")
+    timestep = duration(timestep, "timestep", maximum=MAX_TIMESTEP)
+    armature = non_negative(armature, "armature")
     if kp is None or kd is None:
         kp_load, kd_load = default_gains(robot, armature=armature)
         kp = kp_load if kp is None else kp
         kd = kd_load if kd is None else kd
     kp = _gains(kp, n, "kp", allow_zero=False)
     kd = _gains(kd, n, "kd", allow_zero=True)
-    control_dt = positive(control_dt, "control_dt")
+    control_dt = duration(control_dt, "control_dt", maximum=MAX_CONTROL_DT)
     sub = int(round(control_dt / timestep))
     if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
         raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
-    for name, val in (("settle", settle), ("hold", hold), ("drop", drop)):
-        v = finite_array(val, name, ())
-        if v < 0:
-            raise ValueError(f"{name} must be >= 0, got {val!r}")
+    settle, hold = duration(settle, "settle", allow_zero=True), duration(hold, "hold", allow_zero=True)
+    drop = non_negative(drop, "drop", maximum=1.0)
+    # What the run will record and step, checked before anything is allocated or stepped.
+    sample_count(t[-1] - t[0] + hold, control_dt, "the simulated motion (t[-1] - t[0] + hold)")
+    sample_count(settle + t[-1] - t[0] + hold, timestep, "the physics steps (settle + motion + hold)",
+                 maximum=MAX_PHYSICS_STEPS)
     mode = _compensated_mode(gravity_compensation)
 
     sim = build_model(robot, timestep=timestep, friction=friction, joint_damping=joint_damping,
