@@ -8,9 +8,13 @@ The command is snakehead (also python -m snakehead). Subcommands:
   workspace   compute a reachability map of a robot's head (Algorithm 1) into a .npz file
   view        the interactive 3-D viewer of the output of plan or demo, served to a web browser
 
-Exit status: 0 on success; 1 when a scenario or target was planned but not successfully (the outputs are
-written all the same); 2 for bad arguments or input files; 130 when interrupted.
-Set SNAKEHEAD_TRACEBACK=1 to see the Python traceback of an error.
+Exit status:
+  0    success
+  1    a scenario or target was planned but not successfully (the outputs are written all the same)
+  2    bad arguments, bad input files, or outputs that cannot be written (one line on stderr says which)
+  3    an internal error: a bug in snakehead (one line on stderr; please report it with its traceback)
+  130  interrupted (Ctrl-C)
+Errors are one line on stderr, never a traceback; set SNAKEHEAD_TRACEBACK=1 to see the Python traceback.
 """
 from __future__ import annotations
 
@@ -34,6 +38,17 @@ if TYPE_CHECKING:
 
 class UsageError(Exception):
     """A mistake in the command line or its input files: reported on stderr, exit status 2."""
+
+
+#: Exit statuses (the module's docstring says when).
+EXIT_OK, EXIT_UNSUCCESSFUL, EXIT_BAD_INPUT, EXIT_INTERNAL_ERROR, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors on one line (argparse prints the whole usage first): exit status 2."""
+
+    def error(self, message: str) -> Any:  # type: ignore[override]
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -311,7 +326,7 @@ def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: s
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="snakehead", description=__doc__.split("\n\n")[0],
+    parser = _Parser(prog="snakehead", description=__doc__.split("\n\n")[0],
                                      epilog=__doc__.split("\n\n", 1)[1],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -377,16 +392,34 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _traceback_wanted() -> bool:
+    return os.environ.get("SNAKEHEAD_TRACEBACK", "") not in ("", "0")
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+    return text or type(exc).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run the command line ``argv`` (default: ``sys.argv[1:]``); returns the exit status (see the module)."""
+    command = "snakehead"
     try:
-        return args.func(args)
+        parser = build_parser()
+        args = parser.parse_args(argv)  # bad arguments: one line and SystemExit(2)
+        command = f"snakehead {args.command}"
+        return int(args.func(args))
     except KeyboardInterrupt:
-        print("snakehead: interrupted", file=sys.stderr)
-        return 130
-    except (UsageError, ValueError, TypeError, OSError) as exc:
-        if os.environ.get("SNAKEHEAD_TRACEBACK"):
+        print(f"{command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (UsageError, ValueError, TypeError, OSError) as exc:  # what the user gave (or where outputs go) is wrong
+        if _traceback_wanted():
             raise
-        print(f"snakehead {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        print(f"{command}: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except Exception as exc:  # noqa: BLE001 -- anything else is a bug: one line, the traceback on request
+        if _traceback_wanted():
+            raise
+        print(f"{command}: internal error ({type(exc).__name__}: {_one_line(exc)}); this is a bug in snakehead: run "
+              "again with SNAKEHEAD_TRACEBACK=1 to see the traceback, and report it", file=sys.stderr)
+        return EXIT_INTERNAL_ERROR

@@ -181,9 +181,29 @@ def _check_names(robot: SnakeRobot) -> None:
         for name in names:
             if not isinstance(name, str) or not name:
                 raise ValueError(f"every {kind} of the robot needs a non-empty name, got {name!r}")
+    _check_moving_masses(robot)
     if FREE_JOINT in robot.body.joint_names:
         raise ValueError(f"a joint of the robot is named {FREE_JOINT!r}, the simulation's name for the free joint "
                          "of the root link; rename it in the URDF")
+
+
+def _check_moving_masses(robot: SnakeRobot) -> None:
+    """MuJoCo needs a mass and an inertia on every body that a joint moves (the root link's free joint included),
+    or on a link welded to it (the links up to the next joint); without them the model fails to compile with
+    MuJoCo's terse message (or, had urdfdom dropped a malformed ``<inertial>``, moves weightless). Say which link."""
+    child = [0] + [int(c) for c in robot.body.model.joint_child_links]
+    joints = [repr(FREE_JOINT) + " (the root link's free joint)"] + [repr(j) for j in robot.body.joint_names]
+    ends = child[1:] + [len(robot.link_names)]
+    for first, end, joint in zip(child, ends, joints):
+        if not any(robot.masses[k] > 0 and np.linalg.eigvalsh(robot.inertias[k]).min() > _MUJOCO_MINVAL
+                   for k in range(first, end)):
+            raise ValueError(f"link {robot.link_names[first]!r} is moved by joint {joint} but has no mass and "
+                             "inertia in the URDF (nor a link fixed to it): the simulation needs them on every moving "
+                             "link (give it an <inertial> with a positive definite inertia)")
+
+
+#: MuJoCo's smallest mass or principal moment of a moving body (mjMINVAL).
+_MUJOCO_MINVAL = 1e-15
 
 
 def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
