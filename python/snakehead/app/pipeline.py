@@ -137,11 +137,12 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
                   workspace_map: ReachabilityMap | None = None) -> list[str]:
     """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
     from ..viz import animation, body, save, viewer
+    from ..viz._common import literal
 
     robot = result.robot
     name = scene.name
     snap = rep.PAPER.get(name, {}).get("figures", (None, None, None))[0]
-    label = scene.description or name
+    label = literal(scene.description or name)  # shown as it is in the titles (a "$" is not math)
     files = []
     with progress.stage(f"{name}: figures"):
         if solution_figure and result.targets:
@@ -156,7 +157,7 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
     with progress.stage(f"{name}: animation"):
         files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
     with progress.stage(f"{name}: 3-D viewer page"):
-        data = viewer.viewer_scene(result, workspace_map=workspace_map, title=label)
+        data = viewer.viewer_scene(result, workspace_map=workspace_map, title=scene.description or name)
         files.append(viewer.save_viewer_scene(data, out / f"{name}{viewer.SCENE_SUFFIX}").name)
         files.append(viewer.write_html(data, out / f"{name}.html").name)
     return files
@@ -165,10 +166,11 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
 def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress) -> list[str]:
     """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
     from ..viz import dynamics, save
+    from ..viz._common import literal
 
     name = scene.name
     _, mom, zmp = rep.PAPER.get(name, {}).get("figures", (None, None, None))
-    label = scene.description or name
+    label = literal(scene.description or name)  # shown as it is in the titles (a "$" is not math)
     simulated = " and simulated" if sim_result is not None else ""
     with progress.stage(f"{name}: momenta and ZMP figures"):
         figures = {

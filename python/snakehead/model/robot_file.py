@@ -127,6 +127,18 @@ def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_e
 
 
 def _toml_string(s: str) -> str:
+    """``s`` as a TOML basic string: quotes, backslashes and control characters escaped (a name holding a newline
+    or a quote must read back as itself, never end the string early or add a key)."""
     if not isinstance(s, str):
         raise TypeError(f"expected a str, got {type(s).__name__}")
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    out = []
+    for c in s:
+        if c in '"\\':
+            out.append("\\" + c)
+        elif ord(c) < 32 or ord(c) == 127:
+            out.append(f"\\u{ord(c):04x}")
+        elif 0xD800 <= ord(c) <= 0xDFFF:
+            raise ValueError(f"{s!r} is not valid text (a lone surrogate)")
+        else:
+            out.append(c)
+    return '"' + "".join(out) + '"'

@@ -38,6 +38,12 @@ DEFAULT_DPI = 150
 PathLike = Union[str, "os.PathLike[str]"]
 
 
+def literal(text: str) -> str:
+    """``text`` (a name from the data: a scene's, a target's) shown as it is: matplotlib reads ``$...$`` as math and
+    fails to draw a figure whose text is not valid math (``$\\frac{$``)."""
+    return str(text).replace("$", r"\$")
+
+
 def new_figure(**kwargs: Any) -> Figure:
     """A matplotlib Figure outside pyplot (``kwargs`` go to :class:`~matplotlib.figure.Figure`)."""
     return Figure(**kwargs)

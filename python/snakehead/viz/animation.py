@@ -16,7 +16,7 @@ from typing import IO, TYPE_CHECKING, Iterator, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from ._common import new_figure, setup_axes3d
+from ._common import literal, new_figure, setup_axes3d
 from .body import Sphere, body_faces, draw_body, draw_scenery, plan_spheres, scene_bounds, view_angles
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ class BodyAnimation:
             body.set_verts(body_faces(robot, self._frames[k])[0])
             body.do_3d_projection()
             trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
-            clock.set_text(f"{plan.name}: t = {self.times[k]:5.1f} s  (x{self._speedup:.1f} speed)")
+            clock.set_text(f"{literal(plan.name)}: t = {self.times[k]:5.1f} s  (x{self._speedup:.1f} speed)")
             for artist in (body, *over):
                 ax.draw_artist(artist)
             fig.draw_artist(clock)
@@ -109,7 +109,7 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
     draw_scenery(ax, plan, spheres)
     body = draw_body(ax, robot, frames[0])
     (trace,) = ax.plot(tip[:1, 0], tip[:1, 1], tip[:1, 2], ":", color="k", lw=1.0)
-    clock = fig.text(0.5, 0.98, f"{plan.name}: t = {t[idx[0]]:5.1f} s  (x{speedup:.1f} speed)", ha="center", va="top",
+    clock = fig.text(0.5, 0.98, f"{literal(plan.name)}: t = {t[idx[0]]:5.1f} s  (x{speedup:.1f} speed)", ha="center", va="top",
              fontsize=9)
     fig.subplots_adjust(left=0.0, right=0.96, bottom=0.02, top=0.98)
     return BodyAnimation(figure=fig, times=t[idx], fps=fps, _frames=frames, _plan=plan,

@@ -24,7 +24,7 @@ from ..geometry import collision as coll
 from ..geometry.obstacles import WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot
 from ..motion.cartesian import cartesian_interpolation
-from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, new_figure,
+from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, literal, new_figure,
                       setup_axes3d)
 
 if TYPE_CHECKING:
@@ -226,9 +226,10 @@ def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_pan
         draw_body(ax, robot, robot.frames(q, plan.base))
         tip = robot.head_pose(q, plan.base)[:3, 3]
         ax.scatter(*tip, color="k", s=6)
-        ax.set_title(f"({chr(ord('a') + k)}) {label}\nt = {time:.1f} s", fontsize=8)
+        ax.set_title(f"({chr(ord('a') + k)}) {literal(label)}\nt = {time:.1f} s", fontsize=8)
     _part_legend(fig, plan, spheres)
-    fig.suptitle(title or f"{plan.name}: the body at the scenario's states (axes in m, equal scales)", fontsize=11)
+    fig.suptitle(title or f"{literal(plan.name)}: the body at the scenario's states (axes in m, equal scales)",
+                 fontsize=11)
     fig.subplots_adjust(left=0.0, right=0.97, bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(),
                         wspace=0.12, hspace=0.12)
     return fig
