@@ -475,15 +475,39 @@ def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None,
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 
-    The polygon is built once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
-    round-off in a still base does not split it): the base joints decide the base's contacts; with
-    contact="ground" also the joints before the last link on the ground (those after it move nothing that
-    touches).
+    The polygons are those of :func:`support_polygons`, built once per distinct contact configuration.
     """
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     xy = finite_array(xy, "xy", (q.shape[0], 2))
+    pts, idx, count, inv = _polygons_along(robot, q, base, contact, tolerance)
+    return _margins(pts[inv], idx[inv], count[inv], xy)
+
+
+def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *, contact: str = "endpoints",
+                     tolerance: float = CONTACT_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+    """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
+    ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
+
+    Row k holds its polygon's ``count[k]`` vertices counter-clockwise first (the rest is padding): 0 where no link
+    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per
+    distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's round-off in a still base does
+    not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
+    last link on the ground (those after it move nothing that touches).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q, _ = _joint_matrix(robot, q)
+    pts, idx, count, inv = _polygons_along(robot, q, base, contact, tolerance)
+    vertices = np.take_along_axis(pts, idx[..., None], axis=1)
+    return vertices[inv], count[inv]
+
+
+def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Hulls of the distinct contact configurations of q (T, n): contact points (U, N, 2), hull vertex indices
+    (U, N) and counts (U,) as :func:`_hull_vertices` gives them, and which of them each sample has (T,)."""
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
@@ -502,4 +526,4 @@ def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None,
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
     pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
     idx, count = _hull_vertices(pts, active)
-    return _margins(pts[inv], idx[inv], count[inv], xy)
+    return pts, idx, count, inv
