@@ -5,7 +5,8 @@ Everything is in the world frame (z up, ground at z = 0). Where the base lies is
 body along +x).
 
 * :func:`center_of_mass` -- Eq. 23, for one configuration (16,) or a trajectory (T, 16).
-* :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts.
+* :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts; :func:`support_polygons` the same
+  for every configuration of a trajectory at once.
 * :func:`static_margin`, :func:`is_statically_stable` -- signed distance of the CoM's ground
   projection to the polygon's edge (positive inside).
 * :func:`momenta_from_velocities`, :func:`momenta` -- Eqs. 25-31, linear and angular momentum about the

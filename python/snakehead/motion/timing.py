@@ -67,17 +67,18 @@ HOLD_S = 1.0
 #: rad: the largest step of the path (Euclidean length in joint space) between two TOPP-RA gridpoints.
 GRID_STEP = 0.01
 #: Gridpoints per segment between two waypoints, at least.
-MIN_GRID_PER_SEGMENT = 4
+MIN_GRID_PER_SEGMENT = 8
 #: rad: two waypoints closer than this (largest joint difference) are the same: a hold.
 SAME_WAYPOINT = 1e-9
+#: TOPP-RA is given this share of the velocity, acceleration, torque and friction limits, and the ZMP margin plus
+#: SOLVE_ZMP_EXTRA_M: the room that the path's curvature between gridpoints takes, so that the limits themselves hold
+#: at every sample without many refinement rounds.
+SOLVE_SHARE = 0.995
+SOLVE_ZMP_EXTRA_M = 2e-4
 #: Rounds of grid refinement: stages that break a limit between their gridpoints are halved and the path solved again.
 REFINE_ROUNDS = 4
 #: Points probed inside each stage for the refinement.
 PROBES = 5
-#: Share over a limit (velocity, acceleration, torque, friction) that makes a stage be halved.
-REFINE_TOLERANCE = 1e-3
-#: m: how far the ZMP may come inside its required margin before a stage is halved.
-REFINE_ZMP_M = 1e-4
 #: The paths :func:`retime` can join the waypoints with.
 INTERPOLATIONS = ("monotone", "spline")
 #: How close (share of the limit) a sample must come to a limit to count as binding in :class:`LimitCheck`.
@@ -186,13 +187,14 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits) 
     """The stability constraints at N configurations as F w <= g on w = (dP/dt, dL/dt) (N, 6):
     F (N, E + FRICTION_SIDES + 1, 6), g (N, E + FRICTION_SIDES + 1).
 
-    Rows: one per support-polygon edge (the ZMP at least the required margin inside it, multiplied through by
+    Rows: one per support-polygon edge (the ZMP at least the margin that ``limits.zmp_margin`` requires
+    (:func:`required_margins`) inside it, multiplied through by
     M g + dP_z/dt), the friction polygon inscribed in |dP_xy/dt| <= mu (M g + dP_z/dt), and
     M g + dP_z/dt >= MIN_NORMAL_SHARE M g.
     """
     Mg = robot.total_mass * stability.GRAVITY
     N, E = support.offset.shape
-    off = support.offset + support.required[:, None]
+    off = support.offset + required_margins(support.static, limits.zmp_margin)[:, None]
     normal = support.normal
     F_zmp = np.zeros((N, E, 6))
     F_zmp[..., 2] = off  # (d + m) dP_z/dt - n_y dL_x/dt + n_x dL_y/dt <= M g (n . c - d - m)
@@ -467,9 +469,11 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
     from . import _topp  # toppra imports pyplot: only when a path is retimed
 
     big = 1e6  # toppra needs finite limits; "none" is a limit no motion here comes near
-    vel_c = _topp.velocity_constraint(np.minimum(limits.velocity, big))
-    acc_c = _topp.acceleration_constraint(np.minimum(limits.acceleration, big))
-    tau_lim = np.minimum(limits.torque, big)
+    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big))
+    acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
+    tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
+    solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque,
+                                  limits.zmp_margin + SOLVE_ZMP_EXTRA_M, SOLVE_SHARE * limits.friction)
 
     def torque_coefficients(q, dq, ddq):  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
         zero = np.zeros_like(q)
@@ -484,7 +488,7 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
         support = supports.get(q.shape[0])
         if support is None or not np.array_equal(support[0], q):
             supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin))
-        F, g = stability_rows(robot, support[1], limits)
+        F, g = stability_rows(robot, support[1], solve_limits)
         return a, b, np.zeros_like(a), F, g
 
     tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
@@ -533,7 +537,7 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
             split = _stages_over(robot, base, limits, f, grid, sd, supports[len(grid)][1])
             if not split.any():
                 break
-            grid = np.sort(np.r_[grid, 0.5 * (grid[:-1] + grid[1:])[split]])
+            grid = _refined(grid, split)
         t_grid = timeline.add_piece(f, grid, sd)
         times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
@@ -542,6 +546,17 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
     check = check_limits(robot, q, qd, qdd, base, limits)
     return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
                              notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
+
+
+def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:
+    """The grid with each stage in ``split`` cut in four and its neighbours in two."""
+    ds = np.diff(grid)
+    near = split.copy()
+    near[1:] |= split[:-1]
+    near[:-1] |= split[1:]
+    new = [grid[:-1][near] + 0.5 * ds[near]]
+    new += [grid[:-1][split] + f * ds[split] for f in (0.25, 0.75)]
+    return np.unique(np.concatenate([grid] + new))
 
 
 def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f, grid: np.ndarray,
@@ -565,8 +580,8 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     r = _ratios(robot, base, limits, sub, q, qd, qdd)
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
-        over |= r[key] > 1.0 + REFINE_TOLERANCE
-    over |= r["zmp_slack"] < -REFINE_ZMP_M
+        over |= r[key] > 1.0
+    over |= r["zmp_slack"] < 0.0
     bad = np.zeros(len(ds), bool)
     bad[stage[over]] = True
     return bad
