@@ -10,8 +10,8 @@ of links that hangs from the joint, up to the first link resting on the ground. 
 * :func:`inverse_dynamics` -- joint torques tau (T, n) from q, qd, qdd (T, n): a forward pass of velocities and
   accelerations from the root, a backward pass of forces and moments to it, with gravity "carried" (the rule
   above; the default), "full" (every link's weight, as for an arm: pinocchio's RNEA) or "none";
-  ``full_output=True`` also returns the wrench that the root link exerts on the rest of the body (with
-  ``gravity="none"`` that is the momentum rate (dP/dt, dL/dt) of Eqs. 33-34).
+  ``full_output=True`` also returns the rates of the momenta (dP/dt, dL/dt) of Eqs. 33-34, exactly: the inertial
+  part of the wrench that the root link exerts on the rest of the body.
 * :func:`lift_shares`, :func:`carried_weights` -- the lifted shares; the same rule drives the gravity compensation
   of the MuJoCo controller (:mod:`snakehead.sim.tracking`).
 
@@ -82,13 +82,15 @@ def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RA
 class InverseDynamics:
     """What :func:`inverse_dynamics` computes with ``full_output=True``.
 
-    tau (T, n) N m: the joint torques. force (T, 3) N and moment (T, 3) N m (about the world origin, world axes):
-    the wrench the root link exerts on the rest of the body across the first joint.
+    tau (T, n) N m: the joint torques. Pdot (T, 3) N and Ldot (T, 3) N m: the rates of the linear momentum and of the
+    angular momentum about the world origin (world axes) of the body (Eqs. 33-34): the inertial part of the wrench
+    that the root link exerts on the rest of the body across the first joint (the rest of that wrench holds the
+    carried weight).
     """
 
     tau: np.ndarray
-    force: np.ndarray
-    moment: np.ndarray
+    Pdot: np.ndarray
+    Ldot: np.ndarray
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -118,7 +120,7 @@ def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None =
     the ground), "full" (every link's weight: the body as a fixed-base arm) or "none" (inertial terms only).
     Inertial terms (the links' accelerations, Coriolis and centrifugal terms) always count in full.
 
-    Returns tau (T, n), or an :class:`InverseDynamics` with the root's wrench when ``full_output``.
+    Returns tau (T, n), or an :class:`InverseDynamics` with the momentum rates too when ``full_output``.
     """
     robot = as_robot(robot)
     base = as_base(base)
@@ -199,13 +201,14 @@ def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None =
     tau = tau[0] if single else tau
     if not full_output:
         return tau
-    f_root, n_root = f_in + f_g, n_in + n_g  # about the origin of the first joint's frame, root axes
-    n_origin = n_root + _cross(G[first, :, 3], f_root)  # about the root frame's origin
-    force = (R0 @ f_root).T
-    moment = (R0 @ n_origin).T + np.cross(p0, force)  # about the world origin
+    # the inertial wrench across the first joint is the momentum rate (the root link does not move): moved from
+    # the first joint's frame origin to the root frame's, then to the world (about the world origin)
+    n_origin = n_in + _cross(G[first, :, 3], f_in)
+    Pdot = (R0 @ f_in).T
+    Ldot = (R0 @ n_origin).T + np.cross(p0, Pdot)
     if single:
-        force, moment = force[0], moment[0]
-    return InverseDynamics(tau, force, moment)
+        Pdot, Ldot = Pdot[0], Ldot[0]
+    return InverseDynamics(tau, Pdot, Ldot)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -223,8 +226,8 @@ def momentum_rates(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None = N
     linear in the joint velocities, P = A(q) qd, so dP/dt = A(q) qdd + (dA/dq . qd) qd: the first term is the
     momentum of the velocity qdd, the second the derivative of P(q, v) at fixed v = qd along qd, taken here by a
     central difference (step :data:`MOMENTUM_STEP` rad on the largest joint; the error is of its square).
-    :func:`inverse_dynamics` with ``gravity="none", full_output=True`` computes the same rates exactly by
-    Newton-Euler; this path uses the paper's equations.
+    :func:`inverse_dynamics` with ``full_output=True`` computes the same rates exactly by Newton-Euler; this path
+    uses the paper's equations.
     """
     from .stability import momenta_from_velocities
 

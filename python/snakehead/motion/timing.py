@@ -253,8 +253,8 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
             ) -> dict:
     """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
     used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
-    tau = inverse_dynamics(robot, q, qd, qdd, base)
-    Pdot, Ldot = momentum_rates(robot, q, qd, qdd, base)
+    dyn = inverse_dynamics(robot, q, qd, qdd, base, full_output=True)  # torques and exact momentum rates
+    tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
     Mg = robot.total_mass * stability.GRAVITY
     normal_force = Mg + Pdot[:, 2]
     lifting = normal_force > 0  # else the ground would have to pull: no ZMP
@@ -272,8 +272,9 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
 
 def check_limits(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None, limits: RetimingLimits) -> LimitCheck:
     """Measure samples q, qd, qdd (T, n) of a trajectory against ``limits``: joint velocities and accelerations, the
-    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the exact momentum rates in the ground support
-    polygon of each sample, and the base's friction."""
+    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler (exact; the
+    retiming's constraint takes them from the paper's momenta instead) in the ground support polygon of each sample,
+    and the base's friction."""
     robot = as_robot(robot)
     base = as_base(base)
     if not isinstance(limits, RetimingLimits):
