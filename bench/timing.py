@@ -8,6 +8,7 @@ run time, the simulated head errors against the paper's, momentum errors, ZMP, b
 
     python3 bench/timing.py                       # the sweep below, both scenarios, MuJoCo for each
     python3 bench/timing.py --accelerations 1 --velocity-shares 0.5 --no-sim
+    python3 bench/timing.py --accelerations 4 --velocity-shares 1 --zmp-margins 0.005 0.01 0.015 --interpolations
 """
 from __future__ import annotations
 
@@ -84,44 +85,52 @@ def main() -> None:
                     help="joint acceleration limits to sweep (rad/s^2)")
     ap.add_argument("--velocity-shares", nargs="+", type=float, default=[0.5, 1.0],
                     help="shares of the URDF's velocity limits to sweep")
-    ap.add_argument("--zmp-margin", type=float, default=timing.ZMP_MARGIN, help="m")
+    ap.add_argument("--zmp-margins", nargs="+", type=float, default=[timing.ZMP_MARGIN], help="m, swept")
     ap.add_argument("--friction", type=float, default=timing.FRICTION)
     ap.add_argument("--no-sim", action="store_true", help="skip MuJoCo")
-    ap.add_argument("--interpolations", nargs="+", default=["monotone", "spline"],
+    ap.add_argument("--interpolations", nargs="*", default=["monotone", "spline"],
                     help="paths compared at the default limits")
     args = ap.parse_args()
     print(f"{time.strftime('%Y-%m-%d %H:%M')}, {cpu_name()} ({os.cpu_count()} CPU), load average "
           f"{os.getloadavg()[0]:.1f}, Python {platform.python_version()}")
     scenarios = {name: scenario(name) for name in args.scenarios}
     for name, sc in scenarios.items():
-        print(f"\n{name}: {len(sc['q'])} states, fixed-speed plan {sc['plan'].duration_s:.1f} s "
-              f"(planned in {sc['plan_s']:.1f} s); the paper's {PAPER[name]['duration']:.0f} s, "
-              f"{PAPER[name]['position_mm']} mm / {PAPER[name]['direction_deg']} deg")
+        line = (f"\n{name}: {len(sc['q'])} states, fixed-speed plan {sc['plan'].duration_s:.1f} s "
+                f"(planned in {sc['plan_s']:.1f} s)")
+        if not args.no_sim:
+            fixed = snakehead.simulate(sc["plan"])
+            line += (f", simulated head error {1000 * fixed.position_error_m:.2f} mm / "
+                     f"{fixed.direction_error_deg:.3f} deg, ZMP inside {fixed.zmp_inside}")
+        print(line + f"; the paper's {PAPER[name]['duration']:.0f} s, {PAPER[name]['position_mm']} mm / "
+              f"{PAPER[name]['direction_deg']} deg", flush=True)
 
-    print("\n### Limits swept (monotone path; torque 0.8 x URDF effort; ZMP margin "
-          f"{1000 * args.zmp_margin:.0f} mm; friction {args.friction})\n")
-    head = ("| scenario | acc (rad/s^2) | vel (x URDF) | duration (s) | retime (s) | binds | planned ZMP (mm) |"
+    print(f"\n### Limits swept (monotone path; torque {timing.TORQUE_SHARE} x URDF effort; friction {args.friction})\n")
+    head = ("| scenario | acc (rad/s^2) | vel (x URDF) | ZMP margin (mm) | duration (s) | retime (s) | binds | planned ZMP (mm) |"
             + ("" if args.no_sim else " head error (mm / deg) | sim ZMP inside (min mm) | slide (mm) | "
                "dP / dL error | max torque (N m) | within the paper's |"))
     print(head)
     print("|" + "|".join("---" for _ in head.split("|")[1:-1]) + "|")
     for name, sc in scenarios.items():
-        for vs in args.velocity_shares:
-            for acc in args.accelerations:
-                row = run(name, sc, simulate=not args.no_sim, acceleration_limit=acc,
-                          velocity_limit=vs * sc["plan"].robot.velocity_limit, zmp_margin=args.zmp_margin,
-                          friction=args.friction)
-                line = (f"| {name} | {acc:g} | {vs:g} | {row['duration']:.2f} | {row['solve_s']:.1f} | "
-                        f"{binds(row['check'])} | {row['zmp_planned_mm']:.1f} |")
-                if not args.no_sim:
-                    p = PAPER[name]
-                    ok = (row["duration"] <= p["duration"] and row["position_mm"] <= p["position_mm"]
-                          and row["direction_deg"] <= p["direction_deg"] and row["zmp_inside"])
-                    line += (f" {row['position_mm']:.2f} / {row['direction_deg']:.3f} | {row['zmp_inside']} "
-                             f"({row['zmp_sim_mm']:.1f}) | {row['slide_mm']:.2f} | {row['dP']:.3f} / {row['dL']:.4f} | "
-                             f"{row['torque']:.2f} | {'yes' if ok else 'no'} |")
-                print(line, flush=True)
+        for zm in args.zmp_margins:
+            for vs in args.velocity_shares:
+                for acc in args.accelerations:
+                    row = run(name, sc, simulate=not args.no_sim, acceleration_limit=acc,
+                              velocity_limit=vs * sc["plan"].robot.velocity_limit, zmp_margin=zm,
+                              friction=args.friction)
+                    line = (f"| {name} | {acc:g} | {vs:g} | {1000 * zm:g} | {row['duration']:.2f} | "
+                            f"{row['solve_s']:.1f} | {binds(row['check'])} | {row['zmp_planned_mm']:.1f} |")
+                    if not args.no_sim:
+                        p = PAPER[name]
+                        ok = (row["duration"] <= p["duration"] and row["position_mm"] <= p["position_mm"]
+                              and row["direction_deg"] <= p["direction_deg"] and row["zmp_inside"])
+                        line += (f" {row['position_mm']:.2f} / {row['direction_deg']:.3f} | "
+                                 f"{'yes' if row['zmp_inside'] else 'no'} ({row['zmp_sim_mm']:.2f}) | "
+                                 f"{row['slide_mm']:.2f} | {row['dP']:.3f} / {row['dL']:.4f} | {row['torque']:.2f} | "
+                                 f"{'yes' if ok else 'no'} |")
+                    print(line, flush=True)
 
+    if not args.interpolations:
+        return
     print("\n### Path through the waypoints (default limits)\n")
     print("| scenario | path | duration (s) | retime (s) | worst velocity / acceleration / torque (x limit) |")
     print("|---|---|---|---|---|")

@@ -245,3 +245,24 @@ def test_bad_input():
     tipping[robot.lift_joints.start] = -1.2 * robot.joint_signs[robot.lift_joints.start]  # the whole front up
     with pytest.raises(ValueError, match="outside the support polygon"):
         timing.retime(robot, np.array([flat, tipping]), torque_limit=100.0)
+
+
+def test_spline_path_and_its_overshoot():
+    """The not-a-knot cubic (toppra's own path) keeps the limits too where it stays inside the joint limits, and is
+    refused with the reason where it overshoots one."""
+    robot = snakehead.SnakeRobot.default()
+    q0 = snakehead.HeadController(robot).q_initial
+    head = np.arange(robot.parts.head.start, robot.n_joints)
+    W = np.tile(q0, (4, 1))
+    W[1, head] -= 0.08
+    W[2, head] -= 0.05
+    W[3, head] -= 0.12
+    for interpolation in timing.INTERPOLATIONS:
+        traj = timing.retime(robot, W, interpolation=interpolation)
+        assert traj.check.within(LIMIT_TOLERANCE), (interpolation, traj.check)
+        assert np.abs(traj.spline(traj.waypoint_times) - W).max() < 1e-9
+    j = head[-1]  # the head link's joint: the CoM hardly moves
+    W[:, j] = [robot.upper[j] - 0.3, robot.upper[j], robot.upper[j] - 0.05, robot.upper[j] - 0.3]
+    with pytest.raises(ValueError, match="overshoots a joint limit"):
+        timing.retime(robot, W, interpolation="spline")
+    assert timing.retime(robot, W).q[:, j].max() <= robot.upper[j] + 1e-12  # the monotone path never does

@@ -77,6 +77,12 @@ SOLVE_SHARE = 0.995
 SOLVE_ZMP_EXTRA_M = 2e-4
 #: Rounds of grid refinement: stages that break a limit between their gridpoints are halved and the path solved again.
 REFINE_ROUNDS = 4
+#: m: how far the ZMP may come inside its required margin between gridpoints before the stage is halved (less is
+#: round-off of the path's curvature, not worth a finer grid).
+REFINE_ZMP_M = 1e-5
+#: The refinement stops when the grid would grow beyond this multiple of its first size plus REFINE_EXTRA_POINTS.
+REFINE_GROWTH = 3.0
+REFINE_EXTRA_POINTS = 1000
 #: Points probed inside each stage for the refinement.
 PROBES = 5
 #: The paths :func:`retime` can join the waypoints with.
@@ -183,18 +189,21 @@ def required_margins(static, zmp_margin: float) -> np.ndarray:
     return np.minimum(zmp_margin, 0.5 * np.asarray(static, float))
 
 
-def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits) -> tuple[np.ndarray, np.ndarray]:
+def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, extra_margin: float = 0.0
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """The stability constraints at N configurations as F w <= g on w = (dP/dt, dL/dt) (N, 6):
     F (N, E + FRICTION_SIDES + 1, 6), g (N, E + FRICTION_SIDES + 1).
 
     Rows: one per support-polygon edge (the ZMP at least the margin that ``limits.zmp_margin`` requires
-    (:func:`required_margins`) inside it, multiplied through by
+    (:func:`required_margins`), plus ``extra_margin`` m (at most 90 % of the CoM's own margin), inside it,
+    multiplied through by
     M g + dP_z/dt), the friction polygon inscribed in |dP_xy/dt| <= mu (M g + dP_z/dt), and
     M g + dP_z/dt >= MIN_NORMAL_SHARE M g.
     """
     Mg = robot.total_mass * stability.GRAVITY
     N, E = support.offset.shape
-    off = support.offset + required_margins(support.static, limits.zmp_margin)[:, None]
+    margin = np.minimum(required_margins(support.static, limits.zmp_margin) + extra_margin, 0.9 * support.static)
+    off = support.offset + margin[:, None]
     normal = support.normal
     F_zmp = np.zeros((N, E, 6))
     F_zmp[..., 2] = off  # (d + m) dP_z/dt - n_y dL_x/dt + n_x dL_y/dt <= M g (n . c - d - m)
@@ -473,8 +482,8 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
     vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big))
     acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
     tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
-    solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque,
-                                  limits.zmp_margin + SOLVE_ZMP_EXTRA_M, SOLVE_SHARE * limits.friction)
+    solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
+                                  SOLVE_SHARE * limits.friction)
 
     def torque_coefficients(q, dq, ddq):  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
         zero = np.zeros_like(q)
@@ -489,7 +498,7 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
         support = supports.get(q.shape[0])
         if support is None or not np.array_equal(support[0], q):
             supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin))
-        F, g = stability_rows(robot, support[1], solve_limits)
+        F, g = stability_rows(robot, support[1], solve_limits, SOLVE_ZMP_EXTRA_M)
         return a, b, np.zeros_like(a), F, g
 
     tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
@@ -526,6 +535,7 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
             notes.append(f"the CoM is only {1000 * support.static[k]:.1f} mm inside the support polygon near waypoint "
                          f"{near(k)}: the ZMP keeps half that there instead of {1000 * limits.zmp_margin:.1f} mm")
         path = _topp.GeometricPath(f, knots[-1], n)
+        first_size = len(grid)
         for refinement in range(REFINE_ROUNDS + 1):
             sd, K = _topp.solve(path, constraints, grid)
             if sd is None:
@@ -538,7 +548,12 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
             split = _stages_over(robot, base, limits, f, grid, sd, supports[len(grid)][1])
             if not split.any():
                 break
-            grid = _refined(grid, split)
+            refined = _refined(grid, split)
+            if len(refined) > REFINE_GROWTH * first_size + REFINE_EXTRA_POINTS:  # not a local defect: say so rather than grow on
+                notes.append(f"waypoints {i0}..{i1}: {split.sum()} of {len(split)} stages still break a limit between "
+                             "gridpoints after refining; see check")
+                break
+            grid = refined
         t_grid = timeline.add_piece(f, grid, sd)
         times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
@@ -582,7 +597,7 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
         over |= r[key] > 1.0
-    over |= r["zmp_slack"] < 0.0
+    over |= r["zmp_slack"] < -REFINE_ZMP_M
     bad = np.zeros(len(ds), bool)
     bad[stage[over]] = True
     return bad
