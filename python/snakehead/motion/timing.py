@@ -3,7 +3,8 @@
 :func:`retime` takes waypoints (K, n) -- the states of a plan, or the dense configurations of a Cartesian move --
 joins them by a smooth path q(s) through every one of them that never leaves the range of two neighbouring
 waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018, with the
-``toppra`` package's ``seidel`` solver) that keeps, at every gridpoint:
+``toppra`` package's ``seidel`` solver) that keeps, at every gridpoint (and, the grid refined where needed, between
+them: at every sample):
 
 * each joint's velocity within ``velocity_limit`` (default :data:`VELOCITY_SHARE` of the URDF's);
 * each joint's acceleration within ``acceleration_limit`` (URDFs have none: default :data:`ACCELERATION_LIMIT`);
@@ -46,8 +47,8 @@ from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sam
 
 #: Share of the URDF's joint velocity limits used by default.
 VELOCITY_SHARE = 0.5
-#: rad/s^2: joint acceleration limit by default (URDFs give none). A hobby servo's gearbox reaches a few rad/s^2
-#: under a snake's load; 1 rad/s^2 keeps the simulated head within the paper's errors (bench/timing.py).
+#: rad/s^2: joint acceleration limit by default (URDFs give none). Conservative: bench/timing.py measures the
+#: paper's scenarios from 0.5 to 4 rad/s^2 (durations, simulated errors, the simulated ZMP).
 ACCELERATION_LIMIT = 1.0
 #: Share of the URDF's joint effort limits used by default: room for the PD controller's corrections.
 TORQUE_SHARE = 0.8
@@ -75,7 +76,8 @@ SAME_WAYPOINT = 1e-9
 #: at every sample without many refinement rounds.
 SOLVE_SHARE = 0.995
 SOLVE_ZMP_EXTRA_M = 2e-4
-#: Rounds of grid refinement: stages that break a limit between their gridpoints are halved and the path solved again.
+#: Rounds of grid refinement: stages that break a limit between their gridpoints are cut in four (their neighbours
+#: in two) and the path is solved again.
 REFINE_ROUNDS = 4
 #: m: how far the ZMP may come inside its required margin between gridpoints before the stage is halved (less is
 #: round-off of the path's curvature, not worth a finer grid).
