@@ -81,6 +81,7 @@ def scenario_entry(result, sim_metrics: dict | None = None, *, extra: dict | Non
                      "direction_error_deg": float(tg.direction_error_deg),
                      "position_m": tg.position.tolist(), "direction": tg.direction.tolist(),
                      "time_s": float(tg.time_s), "solved": bool(tg.solution.success),
+                     "stage": getattr(tg.solution, "stage", None),
                      "message": tg.solution.message} for tg in result.targets],
         "min_zmp_margin_m": float(result.min_zmp_margin_m),
         "min_ground_clearance_m": float(result.min_ground_clearance_m),
@@ -95,6 +96,7 @@ def scenario_entry(result, sim_metrics: dict | None = None, *, extra: dict | Non
         "min_obstacle_distance_m": (None if result.obstacle_distance is None
                                     else float(np.min(result.obstacle_distance))),
         "segments": [{"segment": s, "interpolation": m} for s, m in result.segments],
+        "relocation": None if result.relocation is None else result.relocation.as_dict(),
         "notes": list(result.notes),
     }
     if result.name in PAPER:

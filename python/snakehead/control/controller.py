@@ -109,7 +109,7 @@ class HeadController:
 
     # --- the process ---------------------------------------------------------------------------
     def solve(self, position, direction, q_prev=None, base: BasePlacement | None = None,
-              accept=None) -> HeadSolution:
+              accept=None, allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
         ``q_prev`` (16,): the current joints; the base keeps its shape from it and the neck and head start
@@ -120,6 +120,9 @@ class HeadController:
         ``allow_base_move``) by the planar move that brings the target in range; the accepted range is a
         sufficient test, not a necessary one, so a target out of range is first tried from where the base is,
         and the move is made only when that fails or leaves the body statically unstable.
+
+        ``allow_base_move``: whether a target out of range may move the base (default: the controller's
+        ``allow_base_move``).
 
         ``accept``: an optional test ``accept(q (16,), base) -> bool`` of a whole-body solution (e.g. no
         collision with an obstacle). Only accepted solutions are kept: with free roll, when its solution is
@@ -138,7 +141,8 @@ class HeadController:
         solution = self._solve_from(base, q, desired, q_prev is not None, accept)
         if not check.accepted:
             note = f"the target is outside the accepted range from the given base ({check.reason})"
-            if not (solution.success and solution.static_stable) and self.allow_base_move:
+            move = self.allow_base_move if allow_base_move is None else bool(allow_base_move)
+            if not (solution.success and solution.static_stable) and move:
                 P0_local = np.linalg.inv(self.robot.root_pose(base)) @ P0_frame
                 moved = nk.base_move_into_range(position, P0_local, base, self.Lc, self.neck_length, self.slack,
                                                      self.robot.body_axis_height)
@@ -213,6 +217,15 @@ class HeadController:
                             position_error_m=pe, direction_error_deg=de, success=head.success, message=message,
                             static_stable=margin > 0, static_margin_m=margin, timings=timings, neck_goal=goal,
                             neck=neck, head=head)
+
+    @property
+    def body_problem(self):
+        """The geometry the whole-body solve needs for this robot (``control.whole_body.BodyProblem``), made once."""
+        if getattr(self, "_body_problem", None) is None:
+            from .whole_body import BodyProblem
+
+            self._body_problem = BodyProblem(self.robot)
+        return self._body_problem
 
     def _static_margin(self, q: np.ndarray, base: BasePlacement) -> float:
         """``stability.static_margin`` with the support polygon cached: it depends only on the base joints

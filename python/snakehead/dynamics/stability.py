@@ -18,9 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull
-from scipy.spatial import QhullError
 
+from .. import _core
 from .._validate import finite_array, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
@@ -94,84 +93,21 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     return pts, active
 
 
-def _hull_vertices(points: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Counter-clockwise convex hulls of many small 2-D point sets at once (gift wrapping, vectorised over U).
-
-    points (U, N, 2), active (U, N) -> vertex indices (U, N) (the first ``count`` of each row are valid) and
-    count (U,): 0 without active points, 1 for a single point, 2 for a segment (collinear points).
-    Each step picks, from the current vertex, the point at the smallest counter-clockwise turn from the last
-    edge's direction (the farthest one among ties, so collinear points on an edge are skipped). The loop runs
-    over hull vertices (at most N), never over the U samples.
-    """
-    U, N, _ = points.shape
-    scale = max(1.0, float(np.abs(points).max(initial=0.0)))
-    eps = 1e-12 * scale
-    rows = np.arange(U)
-    x, y = points[..., 0], points[..., 1]
-    ymin = np.where(active, y, np.inf).min(axis=1, keepdims=True)
-    start = np.argmin(np.where(active & (y <= ymin + eps), x, np.inf), axis=1)  # lowest, then leftmost
-    idx = np.zeros((U, N), int)
-    count = np.zeros(U, int)
-    done = ~active.any(axis=1)
-    cur = start.copy()
-    prev = np.tile([1.0, 0.0], (U, 1))  # the lowest point's hull edge turns left from +x
-    for step in range(N):
-        live = ~done
-        idx[live, step] = cur[live]
-        count[live] += 1
-        d = points - points[rows, cur][:, None, :]  # (U, N, 2)
-        dist = np.hypot(d[..., 0], d[..., 1])
-        turn = np.arctan2(prev[:, None, 0] * d[..., 1] - prev[:, None, 1] * d[..., 0],
-                          prev[:, None, 0] * d[..., 0] + prev[:, None, 1] * d[..., 1])
-        turn = np.mod(turn + 1e-9, 2 * np.pi) - 1e-9  # in [-1e-9, 2 pi): straight ahead is 0
-        ok = active & (dist > eps)
-        turn = np.where(ok, turn, np.inf)
-        best = turn.min(axis=1, keepdims=True)
-        nxt = np.argmax(np.where(ok & (turn <= best + 1e-9), dist, -1.0), axis=1)
-        alone = ~ok.any(axis=1)
-        prev = np.where(alone[:, None], prev, points[rows, nxt] - points[rows, cur])
-        done = done | alone | (nxt == start)
-        cur = np.where(alone, cur, nxt)
-        if done.all():
-            break
-    return idx, count
-
-
-def _margins(points: np.ndarray, idx: np.ndarray, count: np.ndarray, xy: np.ndarray) -> np.ndarray:
-    """Signed distance of xy (T, 2) to the hulls of ``_hull_vertices`` (given per sample); > 0 inside."""
-    T, N, _ = points.shape
-    h = np.arange(N)[None, :]
-    valid = h < count[:, None]
-    nxt = np.where(h + 1 < count[:, None], h + 1, 0)
-    a = np.take_along_axis(points, idx[..., None], axis=1)  # (T, N, 2)
-    b = np.take_along_axis(points, np.take_along_axis(idx, nxt, axis=1)[..., None], axis=1)
-    e = b - a
-    elen2 = (e * e).sum(-1)
-    w = xy[:, None, :] - a
-    u = np.clip((w * e).sum(-1) / np.where(elen2 > 0, elen2, 1.0), 0.0, 1.0)
-    seg = np.hypot(w[..., 0] - u * e[..., 0], w[..., 1] - u * e[..., 1])
-    line = e[..., 0] * w[..., 1] - e[..., 1] * w[..., 0]  # >= 0 on the left of the edge
-    dist = np.where(valid, seg, np.inf).min(axis=1)
-    inside = np.where(valid, line >= 0.0, True).all(axis=1) & (count >= 3)  # a segment has no interior
-    m = np.where(inside, dist, -dist)
-    return np.where(count > 0, m, -np.inf)
-
-
 def polygon_margin_many(points, active, xy) -> np.ndarray:
     """Signed distance (m) of ``xy`` to the convex hull of the active ``points``, positive inside.
 
     points (T, N, 2), active (T, N) bool, xy (T, 2) -> (T,). Inside a convex polygon the distance to its
     boundary is the smallest distance to its edges; outside, the distance to the polygon is also the smallest
     distance to its edges (as segments). A degenerate hull (collinear points) has no interior: the margin is
-    minus the distance to it (0 on it). Samples with no active point get -inf. Vectorised, no hull objects.
+    minus the distance to it (0 on it). Samples with no active point get -inf. One hull per sample (the C++
+    core's monotone chain), without the GIL.
     """
     points = finite_array(points, "points", (None, None, 2))
     active = np.asarray(active, bool)
     xy = finite_array(xy, "xy", (points.shape[0], 2))
     if active.shape != points.shape[:2]:
         raise ValueError(f"active has shape {active.shape}; expected {points.shape[:2]}")
-    idx, count = _hull_vertices(points, active)
-    return _margins(points, idx, count, xy)
+    return _core.hull_margins(np.ascontiguousarray(points), np.ascontiguousarray(active), np.ascontiguousarray(xy))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -201,26 +137,15 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
 # ------------------------------------------------------------------------------------------------
 # Eq. 24: support polygon
 # ------------------------------------------------------------------------------------------------
+def hull_indices(pts: np.ndarray) -> list[int]:
+    """Indices of the counter-clockwise convex hull vertices of 2-D points (N, 2), collinear points on edges left
+    out (the C++ core's monotone chain): one index for coincident points, the two extremes for collinear points."""
+    return list(_core.convex_hull(finite_array(pts, "points", (None, 2))))
+
+
 def _hull_ccw(pts: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull vertices of 2-D points; a 2-point segment or 1 point when degenerate."""
-    uniq = np.unique(pts, axis=0)
-    if len(uniq) == 1:
-        return uniq
-    centred = uniq - uniq.mean(axis=0)
-    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
-    if sv[-1] <= 1e-12 * max(1.0, sv[0]):  # collinear: the polygon degenerates to a segment
-        s = centred @ vt[0]
-        return uniq[[int(np.argmin(s)), int(np.argmax(s))]]
-    try:
-        hull = ConvexHull(uniq)
-    except QhullError as exc:  # pragma: no cover - guarded by the rank test above
-        raise ValueError(f"cannot build the support polygon: {exc}") from None
-    v = uniq[hull.vertices]  # scipy orders 2-D hull vertices counter-clockwise
-    # drop vertices lying on the line of their neighbours (collinear contact points along a straight edge)
-    prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)
-    a, b = v - prev, nxt - v
-    turn = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-    return v[turn > 1e-9]
+    return np.asarray(pts, float)[hull_indices(pts)]
 
 
 def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
@@ -482,8 +407,8 @@ def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None,
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     xy = finite_array(xy, "xy", (q.shape[0], 2))
-    pts, idx, count, inv = _polygons_along(robot, q, base, contact, tolerance)
-    return _margins(pts[inv], idx[inv], count[inv], xy)
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance)
+    return polygon_margin_many(pts[inv], active[inv], xy)
 
 
 def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *, contact: str = "endpoints",
@@ -500,15 +425,19 @@ def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
-    pts, idx, count, inv = _polygons_along(robot, q, base, contact, tolerance)
-    vertices = np.take_along_axis(pts, idx[..., None], axis=1)
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance)
+    hulls = [p[a][hull_indices(p[a])] if a.any() else np.zeros((0, 2)) for p, a in zip(pts, active)]
+    count = np.array([len(h) for h in hulls], int)
+    vertices = np.zeros((len(hulls), max(1, int(count.max())), 2))
+    for k, h in enumerate(hulls):
+        vertices[k, :len(h)] = h
     return vertices[inv], count[inv]
 
 
 def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Hulls of the distinct contact configurations of q (T, n): contact points (U, N, 2), hull vertex indices
-    (U, N) and counts (U,) as :func:`_hull_vertices` gives them, and which of them each sample has (T,)."""
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct contact configurations of q (T, n): their contact points (U, N, 2) and which touch (U, N), and
+    which of them each sample has (T,)."""
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
@@ -526,5 +455,4 @@ def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, conta
     first = np.zeros(len(uniq), int)
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
     pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
-    idx, count = _hull_vertices(pts, active)
-    return pts, idx, count, inv
+    return pts, active, inv

@@ -461,6 +461,38 @@ class SnakeRobot:
         return B[..., 2, 3] - np.einsum("tkj,kj->tk", np.abs(B[..., 2, :3]), half)
 
     # --- whole-body kinematics ---------------------------------------------------------------------------
+    def joint_axes_world(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World axes (n, 3) and origins (n, 3) of the joints, from the world frames (n_links, 4, 4) of one
+        configuration (:meth:`frames`)."""
+        child = np.asarray(self.body.model.joint_child_links)
+        local = np.asarray(self.body.model.joint_axes, float)
+        return np.einsum("jik,jk->ji", frames[child, :3, :3], local), frames[child, :3, 3]
+
+    def point_jacobians(self, frames: np.ndarray, points: np.ndarray, links) -> np.ndarray:
+        """d(point)/d(q, x, y, yaw) of world points rigidly attached to ``links`` (indices into link_names), for
+        the configuration of ``frames`` (n_links, 4, 4): (P, 3, n + 3). The last three columns are the base
+        placement's x, y and yaw.
+
+        A revolute joint j moves the points distal to it by a_j x (p - o_j) (a_j its world axis, o_j its origin);
+        the base's placement moves every point by (1, 0, 0), (0, 1, 0) and e_z x (p - root).
+        """
+        points = np.asarray(points, float).reshape(-1, 3)
+        a, o = self.joint_axes_world(frames)
+        n = len(a)
+        child = np.asarray(self.body.model.joint_child_links)
+        J = np.zeros((len(points), 3, n + 3))
+        moved = child[None, :] <= np.asarray(links).reshape(-1)[:, None]  # (P, n): joint j moves point's link
+        r = points[:, None, :] - o[None, :, :]  # (P, n, 3)
+        J[:, 0, :n] = (a[None, :, 1] * r[..., 2] - a[None, :, 2] * r[..., 1]) * moved
+        J[:, 1, :n] = (a[None, :, 2] * r[..., 0] - a[None, :, 0] * r[..., 2]) * moved
+        J[:, 2, :n] = (a[None, :, 0] * r[..., 1] - a[None, :, 1] * r[..., 0]) * moved
+        root = frames[0, :3, 3]
+        J[:, 0, n] = 1.0
+        J[:, 1, n + 1] = 1.0
+        J[:, 0, n + 2] = -(points[:, 1] - root[1])  # e_z x (p - root)
+        J[:, 1, n + 2] = points[:, 0] - root[0]
+        return J
+
     def root_pose(self, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of the root frame when the base lies on the ground at ``base`` (default placement)."""
         return as_base(base).matrix(self.body_axis_height)

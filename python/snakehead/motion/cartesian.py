@@ -179,3 +179,94 @@ def cartesian_trajectory(robot: SnakeRobot, q_start, q_end, duration: float, dt:
     qd[[0, -1]] = 0.0
     qdd[[0, -1]] = 0.0
     return JointTrajectory(t, q, qd, qdd, None)
+
+
+#: Damping (m) and iterations of the tracking interpolation's damped least squares at each sample.
+TRACKING_DAMPING = 0.01
+TRACKING_ITERATIONS = 12
+#: The tracking fit keeps the lifted boxes' lowest corners this high (m) when the interpolated points allow it,
+#: weighted this much against the points.
+TRACKING_CLEARANCE = 0.002
+TRACKING_GROUND_WEIGHT = 10.0
+#: Weight (m per rad) of each lifted joint's change from the previous sample in the tracking fit.
+TRACKING_CONTINUITY = 0.03
+
+
+@dataclass(frozen=True)
+class TrackingInterpolation:
+    """Result of :func:`tracking_interpolation`: q (n_samples, n) rad; s (n_samples,) Eq. 41's t_j; points
+    (n_samples, m, 3) the interpolated joint positions; actual (n_samples, m, 3) where the joints are; deviation
+    (n_samples,) the largest distance between the two (m) and max_deviation its maximum."""
+
+    q: np.ndarray
+    s: np.ndarray
+    points: np.ndarray
+    actual: np.ndarray
+    deviation: np.ndarray
+    max_deviation: float
+
+
+def tracked_points(robot: SnakeRobot) -> np.ndarray:
+    """Frame indices (link_names) whose origins Eq. 41 interpolates: the joints the neck lifts with and every joint
+    after them (their child links' frames), and the head tip."""
+    child = np.asarray(robot.body.model.joint_child_links)
+    return np.r_[child[robot.lift_joints.start:], robot.link_index(robot.parts.head_tip)]
+
+
+def tracking_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlacement | None = None
+                           ) -> TrackingInterpolation:
+    """Eq. 41 made to track: the lifted joints' positions (from the neck's first lifting joint to the head tip)
+    move on straight lines, p_ij = (1 - t_j) p_si + t_j p_fi, and at every sample the lifted joint angles are fitted
+    to all those points at once by damped least squares (Levenberg-Marquardt steps, warm-started from the previous
+    sample, within the joint limits), instead of Eqs. 42-44's link-by-link directions, which drift off the points
+    when they are closer together than the links are long. The ground enters the fit as a stiff one-sided term on
+    the lifted boxes' lowest corners (``TRACKING_CLEARANCE``, ``TRACKING_GROUND_WEIGHT``). The joints before the lift interpolate linearly in joint
+    space (the base stays on the ground). The first and last samples are q_start and q_end exactly.
+
+    Where the interpolated points cannot be met (a straight line between two poses shortens the chain, while links
+    keep their lengths), the fit is the closest in the least-squares sense; ``deviation`` says how far it is.
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    nj = robot.n_joints
+    q_start = joint_vector(q_start, nj, "q_start")
+    q_end = joint_vector(q_end, nj, "q_end")
+    s = _interpolation_parameters(n)
+    lift = np.arange(robot.lift_joints.start, nj)
+    pts_idx = tracked_points(robot)
+    ends = robot.frames_many(np.stack([q_start, q_end]), base)[:, pts_idx][..., :3, 3]  # (2, m, 3)
+    P = (1.0 - s)[:, None, None] * ends[0] + s[:, None, None] * ends[1]  # Eq. 41
+    q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # joints before the lift, and the starting guesses
+    lo, hi = robot.lower[lift], robot.upper[lift]
+    lifted = robot.lifted_links
+    lam2 = TRACKING_DAMPING ** 2
+    current = q_start[lift].copy()
+    for j in range(1, len(s) - 1):
+        qj = q[j].copy()
+        qj[lift] = current
+        for _ in range(TRACKING_ITERATIONS):
+            F = robot.frames(qj, base)
+            r = (F[pts_idx, :3, 3] - P[j]).reshape(-1)
+            J = robot.point_jacobians(F, F[pts_idx, :3, 3], pts_idx)[:, :, lift].reshape(-1, len(lift))
+            # the ground as a stiff one-sided spring on the lifted boxes' lowest corners: stay TRACKING_CLEARANCE up
+            corners = robot.box_corners(F[None], lifted)[0]  # (k, 8, 3)
+            low = corners[np.arange(len(lifted)), np.argmin(corners[..., 2], axis=1)]
+            below = low[:, 2] < TRACKING_CLEARANCE
+            if below.any():
+                Jz = robot.point_jacobians(F, low[below], lifted[below])[:, 2, lift]
+                r = np.concatenate([r, TRACKING_GROUND_WEIGHT * (low[below, 2] - TRACKING_CLEARANCE)])
+                J = np.vstack([J, TRACKING_GROUND_WEIGHT * Jz])
+            # continuity: every joint's change from the previous sample costs TRACKING_CONTINUITY m per rad, so
+            # the fit follows one branch instead of jumping between distant ones
+            r = np.concatenate([r, TRACKING_CONTINUITY * (qj[lift] - current)])
+            J = np.vstack([J, TRACKING_CONTINUITY * np.eye(len(lift))])
+            step = -np.linalg.solve(J.T @ J + lam2 * np.eye(len(lift)), J.T @ r)
+            qj[lift] = np.clip(qj[lift] + step, lo, hi)
+            if np.abs(step).max() < 1e-7:
+                break
+        q[j] = qj
+        current = qj[lift]
+    q[0], q[-1] = q_start, q_end
+    actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
+    dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
+    return TrackingInterpolation(q, s, P, actual, dev, float(dev.max()))

@@ -26,13 +26,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validate import positive
-from ..control.controller import HeadController, HeadSolution
+from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import interpolation as interp
-from .cartesian import cartesian_interpolation
+from .cartesian import tracking_interpolation
 
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
@@ -40,6 +40,9 @@ DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
 DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
+JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move
+ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
 BENDING_COMBINATIONS = 30000  # the grid coarsens so that it never holds more curls than this
@@ -59,7 +62,7 @@ class TargetResult:
     position: np.ndarray  # (3,) m
     direction: np.ndarray  # (3,) unit
     time_s: float  # when the plan arrives
-    solution: HeadSolution
+    solution: object  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
 
     @property
     def position_error_m(self) -> float:
@@ -101,6 +104,7 @@ class Plan:
     notes: list = field(default_factory=list)
     segments: list = field(default_factory=list)
     scene: Scene | None = None
+    relocation: "Relocation | None" = None  # the change of base the targets need, before the plan (locomotion)
 
     @property
     def min_zmp_margin_m(self) -> float:
@@ -125,10 +129,11 @@ class Plan:
         for tg in self.targets:
             if not tg.solved:
                 return f"target {tg.name!r} not solved: {tg.solution.message}"
-        if not self.stability.stable:
+        if self.min_zmp_margin_m < ZMP_MARGIN:
             k = self.stability.argmin
-            return (f"the ZMP leaves the support polygon (by {-1000 * self.min_zmp_margin_m:.1f} mm at "
-                    f"t = {self.t[k]:.2f} s)")
+            where = "leaves the support polygon by" if self.min_zmp_margin_m < 0 else "comes within"
+            return (f"the ZMP {where} {abs(1000 * self.min_zmp_margin_m):.1f} mm of its edge at t = {self.t[k]:.2f} s "
+                    f"(a plan keeps it {1000 * ZMP_MARGIN:.0f} mm inside)")
         if self.min_ground_clearance_m <= -coll.GROUND_TOLERANCE:
             k = int(np.argmin(self.ground_clearance))
             return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
@@ -143,11 +148,23 @@ class Plan:
         return self.failure is None
 
 
+def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
+    """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
+    (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
+    qs = np.asarray(qs, float)
+    s = np.arange(between + 1) / (between + 1)
+    a, b = qs[..., :-1, :], qs[..., 1:, :]
+    fine = a[..., None, :] + s[:, None] * (b - a)[..., None, :]  # (..., K-1, between+1, n)
+    fine = fine.reshape(qs.shape[:-2] + (-1, qs.shape[-1]))
+    return np.concatenate([fine, qs[..., -1:, :]], axis=-2)
+
+
 class _Waypoints:
     """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
 
-    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float):
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles=()):
         self.robot, self.base = robot, base
+        self.obstacles = list(obstacles)
         self.speed, self.min_segment = speed, min_segment
         self.labels: list[str] = []
         self.qs: list[np.ndarray] = []
@@ -158,8 +175,15 @@ class _Waypoints:
         self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
 
     def move_joint(self, label: str, q, duration: float | None = None):
+        """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
+        the straight step is not safe throughout."""
         q = np.asarray(q, float)
         step = np.abs(q - self.qs[-1]).max()
+        n = max(3, int(np.ceil(step / JOINT_STEP_CHECK)) + 1)
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        if duration is None and not self._feasible(self.qs[-1] + s * (q - self.qs[-1])).all():
+            self.move(label, q)
+            return
         self.qs.append(q)
         self.labels.append(label)
         self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
@@ -167,16 +191,15 @@ class _Waypoints:
     def move(self, label: str, q, n: int = 12) -> str:
         """A whole-body move from the last state to q (Section 3.2); returns the method used.
 
-        The Cartesian interpolation of Eqs. 41-44 (n configurations) is used when its configurations stay
-        within the joint limits without clipping, above the ground and statically stable; otherwise (the
-        interpolated joint points are closer than the links are long, so the links cannot follow them, and
-        clipped angles jump between limits) the move is a joint-space one, through a detour waypoint when the
-        straight joint path would leave the support polygon (see ``_joint_path``).
+        First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
+        ``motion.cartesian.tracking_interpolation``), kept when every configuration is safe (above the ground, clear
+        of itself and the obstacles, statically stable with DETOUR_MARGIN); else the straight joint-space path;
+        else a joint-space path through a safe detour waypoint (see ``_joint_path``).
         """
         q = np.asarray(q, float)
-        path = cartesian_interpolation(self.robot, self.qs[-1], q, n, self.base, aim="points", full_output=True)
-        if not path.clipped.any() and self._feasible(path.q).all():
-            qs, method = path.q, "cartesian (Eqs. 41-44)"
+        path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
+        if self._feasible(_densify(path.q)).all():
+            qs, method = path.q, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
         steps = np.abs(np.diff(qs, axis=0)).max(axis=1) / self.speed
@@ -189,19 +212,22 @@ class _Waypoints:
         return method
 
     def _margins(self, qs: np.ndarray) -> np.ndarray:
-        """Static margins (m) of configurations qs (m, 16): the CoM's distance inside the support polygon of
-        every link lying on the ground (``contact="ground"``; once the head is up, the base's footprint)."""
-        still = np.zeros_like(qs)
-        dyn = stability.dynamic_stability(self.robot, np.arange(len(qs), dtype=float), qs, self.base, still,
-                                          contact="ground")
-        return dyn.margin  # with no motion the ZMP is the CoM's ground projection
+        """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
+        link lying on the ground (``contact="ground"``; once the head is up, the base's footprint)."""
+        com = stability.center_of_mass(self.robot, qs, self.base)
+        return stability.support_margins(self.robot, qs, com[:, :2], self.base, contact="ground")
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
-        """(m,) bool: above the ground, no two non-neighbouring links overlapping, and statically stable with
-        DETOUR_MARGIN to spare."""
+        """(m,) bool: above the ground, no two non-neighbouring links overlapping, clear of the obstacles, and
+        statically stable with DETOUR_MARGIN to spare."""
         clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
-        return ((clearance >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(self.robot, qs, self.base) > 0.0)
-                & (self._margins(qs) >= DETOUR_MARGIN))
+        ok = ((clearance >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(self.robot, qs, self.base) > 0.0)
+              & (self._margins(qs) >= DETOUR_MARGIN))
+        if self.obstacles and ok.any():
+            rows = np.flatnonzero(ok)
+            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
+            ok[rows] = d > 0.0
+        return ok
 
     def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
         """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
@@ -212,7 +238,7 @@ class _Waypoints:
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = qa + s * (qb - qa)
-        if self._feasible(straight).all():
+        if self._feasible(_densify(straight)).all():
             return straight, "joint space"
         movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -220,7 +246,7 @@ class _Waypoints:
         W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
         W = np.clip(W, self.robot.lower, self.robot.upper)
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
-        flat = paths.reshape(-1, qa.size)
+        flat = _densify(paths).reshape(-1, qa.size)
         ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
         if ok.any():
             length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
@@ -260,7 +286,7 @@ def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), sc
                 planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene)
 
 
-def bending_state(controller: HeadController) -> np.ndarray:
+def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
     """The bending state (Figs. 17b, 22a): the base on its arc and the neck and head curled flat on the ground
     inside it, so that lifting them keeps their mass over the base (n,).
 
@@ -268,19 +294,25 @@ def bending_state(controller: HeadController) -> np.ndarray:
     beyond P0 they tip the body. Here the pitch joints are 0 (everything lies on the ground) and the neck and
     head's yaw joints are chosen on a grid (15 deg, coarser for many joints) for the largest static margin over the base's support polygon
     alone (the support left once they are lifted), among the curls in which no two non-neighbouring links
-    overlap. Deterministic."""
+    overlap. Deterministic. ``q_shape``: a configuration whose base (and the neck's links that stay on the ground)
+    give the shape on the ground (default: the controller's initial configuration)."""
     robot = controller.robot
+    shape = controller.q_initial if q_shape is None else np.asarray(q_shape, float)
+    key = shape[:robot.lift_joints.start].tobytes()
+    cache = controller.__dict__.setdefault("_bending_states", {})
+    if key in cache:
+        return cache[key].copy()
     q = np.zeros(robot.n_joints)
-    q[robot.parts.base] = controller.q_initial[robot.parts.base]
+    # the base, and the links before the first pitch joint of the neck, which cannot leave the ground: their yaw
+    # joints keep the shape's angles, or the lift would sweep those links across the ground and the friction would
+    # push the base
+    first_pitch = robot.lift_joints.start
+    q[:first_pitch] = shape[:first_pitch]
     up = np.arange(robot.parts.neck.start, robot.parts.head.stop)
-    # the links before the first pitch joint of the neck cannot leave the ground: their yaw joints keep the initial
-    # state's angles, or the lift would sweep those links across the ground and the friction would push the base
-    pitch = [j for j in up if robot.joint_kinds[j] == "pitch"]
-    first_pitch = pitch[0] if pitch else robot.n_joints
-    q[up[up < first_pitch]] = controller.q_initial[up[up < first_pitch]]
     yaw = np.array([j for j in up if robot.joint_kinds[j] == "yaw" and j > first_pitch], int)  # bend when flat
     if len(yaw) == 0:
-        return q
+        cache[key] = q
+        return q.copy()
     # the finest grid (at most BENDING_GRID_DEG) with at most BENDING_COMBINATIONS curls
     per_joint = max(3, min(int(round(180.0 / BENDING_GRID_DEG)) + 1,
                            int(np.floor(BENDING_COMBINATIONS ** (1.0 / len(yaw)) + 1e-9))))
@@ -297,50 +329,89 @@ def bending_state(controller: HeadController) -> np.ndarray:
     for chunk in np.array_split(order[margin[order] > 0], max(1, int(np.sum(margin > 0)) // 500 + 1)):
         ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
         if ok.any():
-            return qs[chunk[np.argmax(ok)]]
+            cache[key] = qs[chunk[np.argmax(ok)]]
+            return cache[key].copy()
     raise ValueError("no curl of the neck and head on the ground keeps their mass over the base")
 
 
 
-def choose_base(controller: HeadController, targets, accept=None) -> tuple[BasePlacement, list[str]]:
-    """One base placement for a whole scenario: the controller's when every target (position, direction) is
-    solved from it with the body statically stable (and passing ``accept(q, base)`` when given, as must the bending
-    and initial states the plan starts from); otherwise the
-    first that does among the planar moves that bring a target (or their mean) into the accepted range, and
-    those placements stepped back from the targets by BASE_STEP_SHARES of the body's length (room for the body in
-    front of an obstacle).
-    Returns the placement and notes."""
-    from ..control import neck as nk
+@dataclass(frozen=True)
+class Relocation:
+    """A change of base that the targets need, carried out before the plan by locomotion (the paper's rolling gait
+    or turning in place, Section 3.3 (3)): from placement ``start`` to ``base``, with the base's flat shape changed
+    when ``shape_changed``; ``reason`` says why (what failed from the start)."""
+
+    start: BasePlacement
+    base: BasePlacement
+    shape_changed: bool
+    reason: str
+
+    def as_dict(self) -> dict:
+        return {"from": {"x_m": self.start.x, "y_m": self.start.y, "yaw_rad": self.start.yaw},
+                "to": {"x_m": self.base.x, "y_m": self.base.y, "yaw_rad": self.base.yaw},
+                "distance_m": float(np.hypot(self.base.x - self.start.x, self.base.y - self.start.y)),
+                "shape_changed": self.shape_changed, "reason": self.reason}
+
+
+def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
+    """``q_rest`` with the joints of the links lying on the ground (the base's, and the neck's before it lifts)
+    taken from ``q_shape``."""
+    q = np.asarray(q_rest, float).copy()
+    q[:robot.lift_joints.start] = q_shape[:robot.lift_joints.start]
+    return q
+
+
+def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[BasePlacement, np.ndarray,
+                                                                           Relocation | None, list[str]]:
+    """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
+    (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
+    obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
+    one first) from which every target is solved. Returns the placement, a configuration with the base's shape
+    (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
+    from ..control.whole_body import solve_target
 
     robot = controller.robot
-    q = controller.q_initial
-    P0 = robot.frame(q, robot.lift_frame, controller.base)
-    P0_local = np.linalg.inv(robot.root_pose(controller.base)) @ P0
-    positions = [np.asarray(p, float) for p, _ in targets]
-    mean = np.mean(positions, axis=0)
-    steps = [share * robot.body_length for share in BASE_STEP_SHARES]
-    candidates = [controller.base]
-    for p in [mean] + positions:
-        moved = nk.base_move_into_range(p, P0_local, controller.base, controller.Lc, controller.neck_length,
-                                        controller.slack, robot.body_axis_height)
-        if moved is not None:
-            candidates.append(moved)
-    for base in list(candidates):
-        away = (robot.root_pose(base) @ P0_local)[:2, 3] - mean[:2]
-        if np.linalg.norm(away) > 1e-9:
-            away /= np.linalg.norm(away)
-            candidates += [BasePlacement(float(base.x + d * away[0]), float(base.y + d * away[1]), base.yaw)
-                           for d in steps]
-    start_states = [controller.q_initial, bending_state(controller)]
-    for k, base in enumerate(candidates):
-        if accept is not None and not all(accept(q, base) for q in start_states):
-            continue  # the body would start inside an obstacle
-        sols = [controller.solve(p, d, base=base, accept=accept) for p, d in targets]
-        if all(s.success and s.static_stable and not s.base_moved for s in sols):
-            note = [] if k == 0 else [f"the base was moved to {base} (rolling / turning in place) so that every "
-                                      "target is reached"]
-            return base, note
-    return controller.base, ["no single base placement reaches every target stably; kept the controller's"]
+    obstacles = list(obstacles)
+    targets = list(targets)
+
+    def clear(q, b) -> bool:
+        if not obstacles:
+            return True
+        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
+                    > OBSTACLE_CLEARANCE)
+
+    def failing(b, q_shape):
+        """The first target not solved from this base (None: all are), or the start state in an obstacle."""
+        if not clear(bending_state(controller, q_shape), b):
+            return "the start", None
+        for t in targets:
+            sol = solve_target(controller, t.position, t.direction, q_prev=q_shape, base=b, obstacles=obstacles,
+                               allow_base_move=False, problem=controller.body_problem)
+            if not sol.success:
+                return t, sol
+        return None, None
+
+    start, q0 = controller.base, controller.q_initial
+    first, why = failing(start, q0)
+    if first is None:
+        return start, q0.copy(), None, []
+    reason = ("the start state touches an obstacle" if first == "the start" else
+              f"target {first.name!r} is not reached from the start ({why.reason})")
+    order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
+    for t in order:
+        sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
+                           allow_base_move=True, problem=controller.body_problem)
+        if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
+                                                                   q0[:robot.lift_joints.start])):
+            continue
+        q_shape = _shape_of(robot, sol.q, q0)
+        if failing(sol.base, q_shape)[0] is None:
+            changed = not np.allclose(q_shape[:robot.lift_joints.start], q0[:robot.lift_joints.start])
+            reloc = Relocation(start, sol.base, changed, reason)
+            return sol.base, q_shape, reloc, [f"the base is relocated to {sol.base}"
+                                              + (" with another flat shape" if changed else "")
+                                              + f" (by locomotion, before the plan): {reason}"]
+    return start, q0.copy(), None, [f"no single base reaches every target: {reason}"]
 
 
 def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
@@ -354,11 +425,13 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
 
 
-def _solve(controller: HeadController, position, direction, q_prev, base, accept, name: str, notes: list
-           ) -> HeadSolution:
-    sol = controller.solve(position, direction, q_prev=q_prev, base=base, accept=accept)
-    if sol.base_moved:
-        notes.append(f"{name}: the base would have to move to {sol.base}; kept at {base}")
+def _solve(controller: HeadController, position, direction, q_prev, base, obstacles, name: str, notes: list,
+           near: bool = False):
+    """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
+    from ..control.whole_body import solve_target
+
+    sol = solve_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
+                       allow_base_move=False, problem=controller.body_problem, near=near)
     if not sol.success:
         notes.append(f"{name}: {sol.message}")
     return sol
@@ -422,22 +495,22 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
                                     seed=seed)
     robot = controller.robot
     obstacles = list(scene.obstacles)
-
-    def clear(q, b) -> bool:  # the solutions kept must leave every link clear of every obstacle
-        report = coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005)
-        return bool(report.distance[0] > OBSTACLE_CLEARANCE)
-
-    accept = clear if obstacles else None
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
-    chosen, base_notes = choose_base(controller, [(t.position, t.direction) for t in scene.reported], accept=accept)
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles)
     notes += base_notes
-    way = _Waypoints(robot, chosen, speed, min_segment)
-    way.start("bending state", bending_state(controller))
-    way.move("initial state (head lifted)", controller.q_initial, n=LIFT_STEPS)
+    way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
+    way.start("bending state", bending_state(controller, q_shape))
+    # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
+    # state there; else the lift goes straight to the first target
+    q = _shape_of(robot, q_shape, controller.q_initial)
+    if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
+            robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
+        way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+    else:
+        q = way.qs[-1]
     results: list[TargetResult] = []
-    q = controller.q_initial
     k = 0
     targets = scene.targets
     while k < len(targets):
@@ -447,7 +520,7 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
             end += 1
         if end == k:
             tg = targets[k]
-            sol = _solve(controller, tg.position, tg.direction, q, chosen, accept, tg.name, notes)
+            sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
             way.move(tg.name, sol.q)
             q = sol.q
             if not tg.via:
@@ -467,11 +540,11 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
                 last = m == len(line) - 1
                 label = targets[j].name if last else f"{targets[j].name} ({m + 1}/{len(line)})"
                 poses.append((label, p, targets[j].direction, targets[j] if last else None))
-        sols: list[HeadSolution | None] = [None] * len(poses)
+        sols: list = [None] * len(poses)
         q_back = q
         for m in range(len(poses) - 1, -1, -1):
             label, p, d, _ = poses[m]
-            sols[m] = _solve(controller, p, d, q_back, chosen, accept, label, notes)
+            sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
             if sols[m].success:
                 q_back = sols[m].q
         for m, (label, p, d, tg) in enumerate(poses):
@@ -486,4 +559,6 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
                     way.hold(tg.hold_s)
         q = sols[-1].q
         k = end + 1
-    return _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)
+    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)
+    plan.relocation = relocation
+    return plan
