@@ -254,8 +254,8 @@ def test_spline_path_and_its_overshoot():
     q0 = snakehead.HeadController(robot).q_initial
     head = np.arange(robot.parts.head.start, robot.n_joints)
     W = np.tile(q0, (4, 1))
-    W[1, head] -= 0.08
-    W[2, head] -= 0.05
+    W[1, head] -= 0.05
+    W[2, head] -= 0.08
     W[3, head] -= 0.12
     for interpolation in timing.INTERPOLATIONS:
         traj = timing.retime(robot, W, interpolation=interpolation)
@@ -266,3 +266,15 @@ def test_spline_path_and_its_overshoot():
     with pytest.raises(ValueError, match="overshoots a joint limit"):
         timing.retime(robot, W, interpolation="spline")
     assert timing.retime(robot, W).q[:, j].max() <= robot.upper[j] + 1e-12  # the monotone path never does
+
+
+def test_a_path_that_turns_back_rests_at_the_turn():
+    """Every joint reverses at the middle waypoint: the path stands still there (a cusp); the motion rests there."""
+    robot = snakehead.SnakeRobot.default()
+    q0 = snakehead.HeadController(robot).q_initial
+    q1 = q0.copy()
+    q1[robot.parts.head] -= 0.1
+    traj = timing.retime(robot, np.array([q0, q1, q0]))
+    k = int(np.argmin(np.abs(traj.t - traj.waypoint_times[1])))
+    assert np.abs(traj.qd[k]).max() < 1e-9 and np.abs(traj.q[k] - q1).max() < 1e-9
+    assert traj.check.within(LIMIT_TOLERANCE), traj.check

@@ -73,8 +73,23 @@ def box_constraint(limit: np.ndarray, coefficients, dof: int, name: str) -> Poin
     return PointwiseLinearConstraint(params, dof, identical=True, name=name)
 
 
-def velocity_constraint(limit: np.ndarray) -> JointVelocityConstraint:
-    return JointVelocityConstraint(np.column_stack([-limit, limit]))
+class CappedVelocityConstraint(JointVelocityConstraint):
+    """toppra's joint velocity constraint, with the squared path velocity also capped at ``x_cap``: where the path
+    stands still (q'(s) = 0, at a cusp of the path where every joint turns back or stops) the joint limits leave
+    the path velocity unbounded, and toppra's solver turns the unbounded set into NaN."""
+
+    def __init__(self, limit: np.ndarray, x_cap: float):
+        super().__init__(np.column_stack([-limit, limit]))
+        self.x_cap = float(x_cap)
+
+    def compute_constraint_params(self, path, gridpoints):
+        params = list(super().compute_constraint_params(path, gridpoints))
+        params[6] = np.column_stack([params[6][:, 0], np.minimum(params[6][:, 1], self.x_cap)])
+        return tuple(params)
+
+
+def velocity_constraint(limit: np.ndarray, x_cap: float) -> CappedVelocityConstraint:
+    return CappedVelocityConstraint(limit, x_cap)
 
 
 def acceleration_constraint(limit: np.ndarray) -> JointAccelerationConstraint:

@@ -26,7 +26,8 @@ exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count 
 Where the centre of mass itself is closer than twice ``zmp_margin`` to the polygon's edge (a barely stable path),
 the ZMP is asked to keep half the CoM's margin instead (at rest the ZMP is the CoM's projection, so no motion can
 do better there); the result's ``notes`` say where. A waypoint repeated (a zero-length segment) is a pause of
-``hold_s`` s; the motion comes to rest there, at ``stops`` and at both ends.
+``hold_s`` s; the motion comes to rest there, at ``stops``, at both ends and where the path turns back on itself
+(every joint reverses or stops at a waypoint).
 
 :func:`check_limits` measures any sampled trajectory against the same limits (the retimed one is checked at every
 2 ms sample); the result says what binds.
@@ -71,6 +72,11 @@ GRID_STEP = 0.01
 MIN_GRID_PER_SEGMENT = 8
 #: rad: two waypoints closer than this (largest joint difference) are the same: a hold.
 SAME_WAYPOINT = 1e-9
+#: Where the path stands still (a cusp: every joint turns back or stops at a waypoint) the joint velocity limits do
+#: not bound the path's speed s' (rad of joint-space path per s); it is capped at this multiple of the norm of the
+#: velocity limits (each taken at most MAX_JOINT_SPEED rad/s). Elsewhere |q'(s)| is about 1 and the limits bind.
+PATH_SPEED_FACTOR = 10.0
+MAX_JOINT_SPEED = 100.0
 #: TOPP-RA is given this share of the velocity, acceleration, torque and friction limits, and the ZMP margin plus
 #: SOLVE_ZMP_EXTRA_M: the room that the path's curvature between gridpoints takes, so that the limits themselves hold
 #: at every sample without many refinement rounds.
@@ -405,6 +411,11 @@ def _segments(waypoints: np.ndarray, stops, hold_s) -> tuple[list, np.ndarray]:
         raise ValueError("hold_s must be >= 0 s")
     rest = np.zeros(K, bool)
     rest[[0, -1]] = True
+    # a cusp: every joint turns back or stops at the waypoint, so the path stands still there (q'(s) = 0 on the
+    # monotone path): the motion comes to rest there anyway, and a piece ends there (TOPP-RA is ill-conditioned at
+    # a standstill inside a path)
+    step = np.diff(waypoints, axis=0)
+    rest[1:-1] |= np.all(step[:-1] * step[1:] <= 0.0, axis=1) & ~same[:-1] & ~same[1:]
     for k in stops:
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
             raise TypeError(f"stops must be waypoint indices (int), got {k!r}")
@@ -481,7 +492,10 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
     from . import _topp  # toppra imports pyplot: only when a path is retimed
 
     big = 1e6  # toppra needs finite limits; "none" is a limit no motion here comes near
-    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big))
+    # the path is parametrised by its length in joint space (rad): its speed s' is about the joints' speed, which
+    # their limits bound; where the path stands still they do not, and PATH_SPEED_FACTOR times their norm does
+    path_speed = PATH_SPEED_FACTOR * np.linalg.norm(np.minimum(limits.velocity, MAX_JOINT_SPEED))
+    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big), path_speed ** 2)
     acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
     tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
     solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
