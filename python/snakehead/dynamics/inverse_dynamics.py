@@ -51,10 +51,10 @@ def lift_shares(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) 
     ramp = positive(ramp, "ramp")
     L = len(robot.link_names)
     boxed = np.all(robot.box_sizes > 0, axis=1)
-    B = frames[:, boxed] @ robot.box_origins[boxed]
+    Bz = np.einsum("tkj,kjl->tkl", frames[:, boxed, 2, :], robot.box_origins[boxed])  # the boxes' poses' z rows
     half = 0.5 * robot.box_sizes[boxed]
-    low = (B[..., 2, 3] + B[..., 2, 0] * half[:, 0]
-           - np.abs(B[..., 2, 1]) * half[:, 1] - np.abs(B[..., 2, 2]) * half[:, 2])
+    low = (Bz[..., 3] + Bz[..., 0] * half[:, 0]
+           - np.abs(Bz[..., 1]) * half[:, 1] - np.abs(Bz[..., 2]) * half[:, 2])
     w = np.ones((frames.shape[0], L))
     w[:, boxed] = np.clip(low / ramp, 0.0, 1.0)
     return w

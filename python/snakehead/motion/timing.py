@@ -48,9 +48,10 @@ from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sam
 
 #: Share of the URDF's joint velocity limits used by default.
 VELOCITY_SHARE = 0.5
-#: rad/s^2: joint acceleration limit by default (URDFs give none). Conservative: bench/timing.py measures the
-#: paper's scenarios from 0.5 to 4 rad/s^2 (durations, simulated errors, the simulated ZMP).
-ACCELERATION_LIMIT = 1.0
+#: rad/s^2: joint acceleration limit by default (URDFs give none). bench/timing.py measures the paper's scenarios
+#: from 0.5 to 4 rad/s^2: at 2 both are within the paper's durations and simulated errors with the simulated ZMP
+#: inside by millimetres; at 4 the simulated ZMP comes within a millimetre of the base's edge.
+ACCELERATION_LIMIT = 2.0
 #: Share of the URDF's joint effort limits used by default: room for the PD controller's corrections.
 TORQUE_SHARE = 0.8
 #: m: how far inside the support polygon the ZMP stays by default.
