@@ -377,7 +377,8 @@ class DynamicStability:
 
 
 def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None, *,
-                      contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> DynamicStability:
+                      contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                      frames: np.ndarray | None = None) -> DynamicStability:
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
     The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
@@ -389,7 +390,8 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     p, P, L, com, q = _zmp(robot, t, q, base, qd)
     flying = ~np.all(np.isfinite(p), axis=1)
-    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance)
+    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance,
+                             frames=frames)
     margin[flying] = -np.inf  # no ZMP: the body would leave the ground
     inside = margin > 0.0
     k = int(np.argmin(margin))
@@ -397,22 +399,24 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
 
 
 def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None, *, contact: str = "endpoints",
-                    tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+                    tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None) -> np.ndarray:
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 
     The polygons are those of :func:`support_polygons`, built once per distinct contact configuration.
+    ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     xy = finite_array(xy, "xy", (q.shape[0], 2))
-    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance)
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
     return polygon_margin_many(pts[inv], active[inv], xy)
 
 
 def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *, contact: str = "endpoints",
-                     tolerance: float = CONTACT_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+                     tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
     """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
     ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
 
@@ -420,12 +424,13 @@ def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per
     distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's round-off in a still base does
     not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
-    last link on the ground (those after it move nothing that touches).
+    last link on the ground (those after it move nothing that touches). ``frames``: the world frames of ``q``
+    (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
-    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance)
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
     hulls = [p[a][hull_indices(p[a])] if a.any() else np.zeros((0, 2)) for p, a in zip(pts, active)]
     count = np.array([len(h) for h in hulls], int)
     vertices = np.zeros((len(hulls), max(1, int(count.max())), 2))
@@ -434,15 +439,18 @@ def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     return vertices[inv], count[inv]
 
 
-def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance,
+                    frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The distinct contact configurations of q (T, n): their contact points (U, N, 2) and which touch (U, N), and
-    which of them each sample has (T,)."""
+    which of them each sample has (T,). ``frames``: q's world frames when the caller has them."""
+    if frames is None or frames.shape != (q.shape[0], len(robot.link_names), 4, 4):
+        frames = None
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
         boxed = robot.boxed_links
-        lowest[:, boxed] = robot.lowest_box_z(robot.frames_many(q, base), boxed)
+        frames = robot.frames_many(q, base) if frames is None else frames
+        lowest[:, boxed] = robot.lowest_box_z(frames, boxed)
         touching = lowest <= tolerance
         last = np.where(touching.any(axis=1), len(robot.link_names) - 1 - np.argmax(touching[:, ::-1], axis=1), -1)
         child = np.asarray(robot.body.model.joint_child_links)
@@ -454,5 +462,6 @@ def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, conta
     inv = inv.reshape(-1)
     first = np.zeros(len(uniq), int)
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
-    pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
+    sample_frames = robot.frames_many(q[first], base) if frames is None else frames[first]
+    pts, active = _contact_points_many(robot, sample_frames, contact, tolerance)
     return pts, active, inv

@@ -274,8 +274,9 @@ def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), sc
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
-    clearance = coll.ground_clearance(robot, traj.q, base)[:, robot.lifted_links].min(axis=1)
+    frames = robot.frames_many(traj.q, base)  # once, for every check below
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
+    clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
@@ -361,8 +362,8 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[BasePlacement, np.ndarray,
-                                                                           Relocation | None, list[str]]:
+def choose_base(controller: HeadController, targets, obstacles=(), allow_relocation: bool = True
+                ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -397,6 +398,8 @@ def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[Base
         return start, q0.copy(), None, []
     reason = ("the start state touches an obstacle" if first == "the start" else
               f"target {first.name!r} is not reached from the start ({why.reason})")
+    if not allow_relocation:
+        return start, q0.copy(), None, [f"the base is kept (no relocation allowed): {reason}"]
     order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
     for t in order:
         sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
@@ -456,7 +459,8 @@ def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Sce
 
 def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
          base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
-         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
+         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT,
+         allow_relocation: bool = True) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -467,8 +471,10 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     controller : a :class:`~snakehead.control.HeadController` to solve the head with (default: one for ``robot``
         with its head's map, ``method`` and ``seed``).
     obstacles : more obstacles (``geometry.BoxObstacle``, ``geometry.WallWithHole``) besides the scene's.
-    base : where the base lies at first (default: the scene's, else ``BasePlacement()``); the planner may choose
-        another placement that reaches every target (said in ``notes``).
+    base : where the base lies at first (default: the scene's, else ``BasePlacement()``); when a target cannot be
+        reached from there, the planner chooses another placement (and flat shape) that reaches every target: the
+        plan starts there and ``relocation`` says what locomotion must do first (unless ``allow_relocation`` is
+        False: then the base stays and the plan fails on the targets it cannot reach).
     method : the head IK: "rotated" (the paper's Fig. 9) or "free_roll".
     seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
     speed : the largest joint rate a segment is planned for (rad/s). min_segment : the shortest segment (s).
@@ -498,7 +504,7 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
-    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles)
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation)
     notes += base_notes
     way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
     way.start("bending state", bending_state(controller, q_shape))

@@ -12,8 +12,8 @@ import numpy as np
 from .._validate import finite_array, positive
 from ..dynamics.inverse_dynamics import LIFT_RAMP, carried_weights  # noqa: F401  (the one rule; re-exported)
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_KD, DEFAULT_KP, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco,
-                   build_model)
+from .gains import default_gains
+from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco, build_model
 
 
 # ------------------------------------------------------------------------------------------------
@@ -215,7 +215,7 @@ def gravity_torques(sim: SimModel, data, weights: np.ndarray) -> np.ndarray:
     return -np.einsum("nl,nlk,nk->n", weights, torque, a)
 
 
-def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = None, kp=DEFAULT_KP, kd=DEFAULT_KD, *,
+def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = None, kp=None, kd=None, *,
              control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3,
              hold: float = 0.0, gravity_compensation: str = "supported", torque_limit=None, friction: float = 0.8,
              joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES,
@@ -224,14 +224,15 @@ def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = No
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
     at every control tick, qdot_ref from ``np.gradient(q, t)``). ``base``: where the tail lies.
-    kp (N m/rad, > 0) and kd (N m s/rad, >= 0): scalars or (n,). ``control_dt`` (s): the control period (2 ms,
+    kp (N m/rad, > 0) and kd (N m s/rad, >= 0): scalars or (n,); None (default): derived per joint from its load
+    (:func:`snakehead.sim.gains.default_gains`). ``control_dt`` (s): the control period (2 ms,
     the paper's), a whole multiple of the physics ``timestep`` (1 ms). ``settle`` s: the robot is first put at
     q[0], ``drop`` m above its resting height, and held there with the same controller before t[0]; ``hold`` s:
     after t[-1] the last configuration is held and recorded. ``gravity_compensation``: "supported" (default: each joint
     carries the lifted run of links hanging from it, judged from the planned configuration, see
     :func:`carried_weights`), "bias" (MuJoCo's ``qfrc_bias`` on every joint: gravity and Coriolis as if the tail
     were clamped) or "none". ``torque_limit`` N m: scalar or (n,), default the URDF
-    effort. Other keywords go to :func:`build_mjcf`.
+    effort (:func:`snakehead.sim.gains.default_torque_limits`). Other keywords go to :func:`snakehead.sim.build_spec`.
 
     Returns a :class:`SimResult` sampled at every control tick from t[0] to t[-1] + hold.
     """
@@ -240,9 +241,15 @@ def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = No
     base = as_base(base)
     t, q = check_trajectory(robot, t, q)
     n = robot.n_joints
+    timestep = positive(timestep, "timestep")
+    if not (np.isfinite(armature) and armature >= 0):
+        raise ValueError(f"armature must be >= 0, got {armature!r}")
+    if kp is None or kd is None:
+        kp_load, kd_load = default_gains(robot, armature=armature)
+        kp = kp_load if kp is None else kp
+        kd = kd_load if kd is None else kd
     kp = _gains(kp, n, "kp", allow_zero=False)
     kd = _gains(kd, n, "kd", allow_zero=True)
-    timestep = positive(timestep, "timestep")
     control_dt = positive(control_dt, "control_dt")
     sub = int(round(control_dt / timestep))
     if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
