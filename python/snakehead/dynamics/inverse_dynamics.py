@@ -10,8 +10,8 @@ of links that hangs from the joint, up to the first link resting on the ground. 
 * :func:`inverse_dynamics` -- joint torques tau (T, n) from q, qd, qdd (T, n): a forward pass of velocities and
   accelerations from the root, a backward pass of forces and moments to it, with gravity "carried" (the rule
   above; the default), "full" (every link's weight, as for an arm: pinocchio's RNEA) or "none";
-  ``full_output=True`` also returns the rates of the momenta (dP/dt, dL/dt) of Eqs. 33-34, exactly: the inertial
-  part of the wrench that the root link exerts on the rest of the body.
+  :func:`newton_euler` -- the same pass, returning also the rates of the momenta (dP/dt, dL/dt) of Eqs. 33-34,
+  exactly: the inertial part of the wrench that the root link exerts on the rest of the body.
 * :func:`lift_shares`, :func:`carried_weights` -- the lifted shares; the same rule drives the gravity compensation
   of the MuJoCo controller (:mod:`snakehead.sim.tracking`).
 
@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -80,7 +81,7 @@ def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RA
 # ------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class InverseDynamics:
-    """What :func:`inverse_dynamics` computes with ``full_output=True``.
+    """What :func:`newton_euler` computes.
 
     tau (T, n) N m: the joint torques. Pdot (T, 3) N and Ldot (T, 3) N m: the rates of the linear momentum and of the
     angular momentum about the world origin (world axes) of the body (Eqs. 33-34): the inertial part of the wrench
@@ -98,7 +99,7 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _samples(robot: SnakeRobot, x, name: str, n_samples: int | None) -> np.ndarray:
+def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | None) -> np.ndarray:
     a = finite_array(x, name)
     n = robot.n_joints
     if a.ndim == 1:
@@ -110,8 +111,9 @@ def _samples(robot: SnakeRobot, x, name: str, n_samples: int | None) -> np.ndarr
     return a
 
 
-def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None = None, *, gravity: str = "carried",
-                     ramp: float = LIFT_RAMP, full_output: bool = False):
+def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
+                     base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
+                     ) -> np.ndarray:
     """Joint torques (N m) that move the body along q, qd, qdd with the root link lying still on the ground.
 
     q (rad), qd (rad/s), qdd (rad/s^2): (T, n) each, or (n,) each (-> (n,)). ``base``: where the root lies (its
@@ -120,8 +122,16 @@ def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None =
     the ground), "full" (every link's weight: the body as a fixed-base arm) or "none" (inertial terms only).
     Inertial terms (the links' accelerations, Coriolis and centrifugal terms) always count in full.
 
-    Returns tau (T, n), or an :class:`InverseDynamics` with the momentum rates too when ``full_output``.
+    Returns tau (T, n) N m (or (n,)). :func:`newton_euler` returns the momentum rates too.
     """
+    return newton_euler(robot, q, qd, qdd, base, gravity=gravity, ramp=ramp).tau
+
+
+def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
+                 base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
+                 ) -> InverseDynamics:
+    """:func:`inverse_dynamics`'s pass, returning the joint torques and the momentum rates (Eqs. 33-34) of the
+    body: an :class:`InverseDynamics` (arrays of one sample when q, qd, qdd are (n,))."""
     robot = as_robot(robot)
     base = as_base(base)
     if gravity not in GRAVITY_MODELS:
@@ -199,8 +209,6 @@ def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None =
         if j >= 0:
             tau[:, j] = ((n_in + n_g) * z[link]).sum(axis=0)
     tau = tau[0] if single else tau
-    if not full_output:
-        return tau
     # the inertial wrench across the first joint is the momentum rate (the root link does not move): moved from
     # the first joint's frame origin to the root frame's, then to the world (about the world origin)
     n_origin = n_in + _cross(G[first, :, 3], f_in)
@@ -218,16 +226,15 @@ def inverse_dynamics(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None =
 MOMENTUM_STEP = 1e-5
 
 
-def momentum_rates(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None = None
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def momentum_rates(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
+                   base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Rates of the linear and angular momentum (about the world origin) of Eqs. 33-34: (dP/dt, dL/dt), (T, 3) each.
 
     q, qd, qdd (T, n) (or (n,) -> (3,)). The momenta of Eqs. 25-31 (:func:`stability.momenta_from_velocities`) are
     linear in the joint velocities, P = A(q) qd, so dP/dt = A(q) qdd + (dA/dq . qd) qd: the first term is the
     momentum of the velocity qdd, the second the derivative of P(q, v) at fixed v = qd along qd, taken here by a
     central difference (step :data:`MOMENTUM_STEP` rad on the largest joint; the error is of its square).
-    :func:`inverse_dynamics` with ``full_output=True`` computes the same rates exactly by Newton-Euler; this path
-    uses the paper's equations.
+    :func:`newton_euler` computes the same rates exactly; this path uses the paper's equations.
     """
     from .stability import momenta_from_velocities
 

@@ -419,7 +419,7 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     return polygon_margin_many(pts[inv], active[inv], xy)
 
 
-def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *, contact: str = "endpoints",
+def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *, contact: str = "endpoints",
                      tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None
                      ) -> tuple[np.ndarray, np.ndarray]:
     """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
@@ -444,7 +444,7 @@ def support_polygons(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     return vertices[inv], count[inv]
 
 
-def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance,
+def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
                     frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The distinct contact configurations of q (T, n): their contact points (U, N, 2) and which touch (U, N), and
     which of them each sample has (T,). ``frames``: q's world frames when the caller has them."""

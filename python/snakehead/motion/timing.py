@@ -36,15 +36,20 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
 
 import numpy as np
+import numpy.typing as npt
 from scipy.interpolate import CubicSpline
 
 from .._validate import finite_array, finite_float, positive
 from ..dynamics import stability
-from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates
+from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
+
+#: q(s) and its derivatives: f(s (N,), order 0, 1 or 2) -> (N, n).
+PathFunction = Callable[[np.ndarray, int], np.ndarray]
 
 #: Share of the URDF's joint velocity limits used by default.
 VELOCITY_SHARE = 0.5
@@ -117,9 +122,10 @@ class RetimingLimits:
     friction: float
 
 
-def _joint_limit(value, n: int, name: str, default: np.ndarray | None = None) -> np.ndarray:
+def _joint_limit(value: npt.ArrayLike | None, n: int, name: str, default: np.ndarray | None = None) -> np.ndarray:
     """A per-joint limit from a number or (n,) array; zeros in ``default`` (URDF gives none) become inf."""
     if value is None:
+        assert default is not None, name
         limit = np.where(default > 0, default, np.inf)
     else:
         try:
@@ -135,8 +141,9 @@ def _joint_limit(value, n: int, name: str, default: np.ndarray | None = None) ->
     return limit
 
 
-def resolve_limits(robot: SnakeRobot, *, velocity_limit=None, acceleration_limit=ACCELERATION_LIMIT,
-                   torque_limit=None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION) -> RetimingLimits:
+def resolve_limits(robot: SnakeRobot, *, velocity_limit: npt.ArrayLike | None = None,
+                   acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT, torque_limit: npt.ArrayLike | None = None,
+                   zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION) -> RetimingLimits:
     """The limits :func:`retime` uses, from its keywords (see there); ValueError/TypeError for bad ones."""
     robot = as_robot(robot)
     n = robot.n_joints
@@ -192,7 +199,7 @@ class Support:
         return ((self.normal * xy[:, None, :]).sum(-1) - self.offset).min(axis=1)
 
 
-def required_margins(static, zmp_margin: float) -> np.ndarray:
+def required_margins(static: npt.ArrayLike, zmp_margin: float) -> np.ndarray:
     """The margin (m) the ZMP must keep inside the support polygon where the CoM keeps ``static`` m:
     ``zmp_margin``, or half the CoM's own margin where that is less than twice it."""
     return np.minimum(zmp_margin, 0.5 * np.asarray(static, float))
@@ -230,11 +237,11 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, 
     return F, g
 
 
-def momentum_rate_coefficients(robot: SnakeRobot, q, dq, ddq, base: BasePlacement | None = None
-                               ) -> tuple[np.ndarray, np.ndarray]:
+def momentum_rate_coefficients(robot: SnakeRobot, q: npt.ArrayLike, dq: npt.ArrayLike, ddq: npt.ArrayLike,
+                               base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
     """w = (dP/dt, dL/dt) along a path q(s) as a s'' + b s'^2: a, b (N, 6) at points q, dq = q'(s), ddq = q''(s)
     (N, n) each. a = (P, L)(q, q'); b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (Eqs. 25-31, 33-34)."""
-    P, L = stability.momenta_from_velocities(robot, q, dq, base)
+    P, L = stability.momenta_from_velocities(robot, np.asarray(q, float), np.asarray(dq, float), base)
     Pb, Lb = momentum_rates(robot, q, dq, ddq, base)
     return np.hstack([P, L]), np.hstack([Pb, Lb])
 
@@ -267,11 +274,11 @@ class LimitCheck:
         return max(ratios) <= 1.0 + tolerance and self.zmp_slack_m >= -zmp_tolerance_m
 
 
-def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q, qd, qdd
-            ) -> dict:
+def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
+            qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
     """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
     used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
-    dyn = inverse_dynamics(robot, q, qd, qdd, base, full_output=True)  # torques and exact momentum rates
+    dyn = newton_euler(robot, q, qd, qdd, base)  # torques and exact momentum rates
     tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
     Mg = robot.total_mass * stability.GRAVITY
     normal_force = Mg + Pdot[:, 2]
@@ -288,7 +295,8 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
             "zmp_margin": margin, "zmp_slack": margin - support.required}
 
 
-def check_limits(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None, limits: RetimingLimits) -> LimitCheck:
+def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike, base: BasePlacement | None,
+                 limits: RetimingLimits) -> LimitCheck:
     """Measure samples q, qd, qdd (T, n) of a trajectory against ``limits``: joint velocities and accelerations, the
     torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler (exact; the
     retiming's constraint takes them from the paper's momenta instead) in the ground support polygon of each sample,
@@ -302,7 +310,10 @@ def check_limits(robot: SnakeRobot, q, qd, qdd, base: BasePlacement | None, limi
     qdd = finite_array(qdd, "qdd", q.shape)
     r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin), q, qd, qdd)
     moving = np.abs(qd).max(axis=1) > 0
-    share = (lambda hit: float(np.mean(hit[moving])) if moving.any() else 0.0)
+
+    def share(hit: np.ndarray) -> float:
+        return float(np.mean(hit[moving])) if moving.any() else 0.0
+
     binding = {key: share(r[key] >= BINDING_SHARE) for key in ("velocity", "acceleration", "torque", "friction")}
     binding["zmp"] = share(r["zmp_slack"] <= BINDING_ZMP_M)
     return LimitCheck(float(r["velocity"].max()), float(r["acceleration"].max()), float(r["torque"].max()),
@@ -322,10 +333,10 @@ class RetimedTrajectory(JointTrajectory):
     retiming had to relax; solve_time_s: the retiming's own run time.
     """
 
-    waypoint_times: np.ndarray = None
-    limits: RetimingLimits = None
-    check: LimitCheck = None
-    notes: tuple = ()
+    waypoint_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    limits: RetimingLimits | None = None
+    check: LimitCheck | None = None
+    notes: tuple[str, ...] = ()
     solve_time_s: float = 0.0
 
     @property
@@ -337,12 +348,12 @@ class RetimedTrajectory(JointTrajectory):
 class _Timeline:
     """The retimed motion as a function of time: rest-to-rest pieces along their paths, and pauses."""
 
-    def __init__(self, n: int):
+    def __init__(self, n: int) -> None:
         self.n = n
-        self.items: list[dict] = []
+        self.items: list[dict[str, Any]] = []
         self.end = 0.0
 
-    def add_piece(self, f, s: np.ndarray, sd: np.ndarray):
+    def add_piece(self, f: PathFunction, s: np.ndarray, sd: np.ndarray) -> np.ndarray:
         ds = np.diff(s)
         mean = 0.5 * (sd[:-1] + sd[1:])
         dt = ds / mean  # constant path acceleration over each stage
@@ -352,11 +363,11 @@ class _Timeline:
         self.end = float(t[-1])
         return t
 
-    def add_pause(self, q: np.ndarray, seconds: float):
+    def add_pause(self, q: np.ndarray, seconds: float) -> None:
         self.items.append(dict(kind="pause", t=np.array([self.end, self.end + seconds]), q=q))
         self.end += seconds
 
-    def __call__(self, t, nu: int = 0) -> np.ndarray:
+    def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t, float))
         out = np.zeros((len(t), self.n))
         for k, item in enumerate(self.items):
@@ -390,15 +401,20 @@ class _Timeline:
         return out
 
 
-def _path_function(s: np.ndarray, waypoints: np.ndarray, interpolation: str):
+def _path_function(s: np.ndarray, waypoints: np.ndarray, interpolation: str) -> PathFunction:
     """q(s) through the waypoints at path positions s (knots): f(s, order) -> (N, n)."""
     if interpolation == "monotone":
         return MonotoneQuintic(s, waypoints)
     spline = CubicSpline(s, waypoints, bc_type="not-a-knot", axis=0)  # as toppra's SplineInterpolator
-    return lambda x, order=0: spline(x, order)
+
+    def f(x: np.ndarray, order: int = 0) -> np.ndarray:
+        return np.asarray(spline(x, order))
+
+    return f
 
 
-def _segments(waypoints: np.ndarray, stops, hold_s) -> tuple[list, np.ndarray]:
+def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
+              ) -> tuple[list[tuple[str, int, int]], np.ndarray]:
     """The schedule: ("piece", i0, i1) runs of moving segments between rests, ("pause", k) holds; and the pause
     of each segment (K-1,)."""
     K = len(waypoints)
@@ -430,7 +446,7 @@ def _segments(waypoints: np.ndarray, stops, hold_s) -> tuple[list, np.ndarray]:
             if start is not None:
                 schedule.append(("piece", start, k))
                 start = None
-            schedule.append(("pause", k))
+            schedule.append(("pause", k, k + 1))
             continue
         if start is None:
             start = k
@@ -440,9 +456,10 @@ def _segments(waypoints: np.ndarray, stops, hold_s) -> tuple[list, np.ndarray]:
     return schedule, holds
 
 
-def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, velocity_limit=None,
-           acceleration_limit=ACCELERATION_LIMIT, torque_limit=None, zmp_margin: float = ZMP_MARGIN,
-           friction: float = FRICTION, dt: float = CONTROL_PERIOD, hold_s=HOLD_S, stops=(),
+def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | None = None, *,
+           velocity_limit: npt.ArrayLike | None = None, acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
+           torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION,
+           dt: float = CONTROL_PERIOD, hold_s: npt.ArrayLike = HOLD_S, stops: Sequence[int] = (),
            interpolation: str = "monotone", grid_step: float = GRID_STEP) -> RetimedTrajectory:
     """The fastest motion through ``waypoints`` that keeps the robot's limits and its balance.
 
@@ -496,21 +513,21 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
     # the path is parametrised by its length in joint space (rad): its speed s' is about the joints' speed, which
     # their limits bound; where the path stands still they do not, and PATH_SPEED_FACTOR times their norm does
     path_speed = PATH_SPEED_FACTOR * np.linalg.norm(np.minimum(limits.velocity, MAX_JOINT_SPEED))
-    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big), path_speed ** 2)
+    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big), float(path_speed) ** 2)
     acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
     tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
     solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
                                   SOLVE_SHARE * limits.friction)
 
-    def torque_coefficients(q, dq, ddq):  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
+    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
         zero = np.zeros_like(q)
         return (inverse_dynamics(robot, q, zero, dq, base, gravity="none"),
                 inverse_dynamics(robot, q, dq, ddq, base, gravity="none"),
                 inverse_dynamics(robot, q, zero, zero, base))
 
-    supports: dict = {}
+    supports: dict[int, tuple[np.ndarray, Support]] = {}
 
-    def stability_params(q, dq, ddq):
+    def stability_params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
         a, b = momentum_rate_coefficients(robot, q, dq, ddq, base)
         support = supports.get(q.shape[0])
         if support is None or not np.array_equal(support[0], q):
@@ -545,7 +562,10 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
                                  f"{np.degrees(over):.2f} deg; use interpolation='monotone'")
         support = Support.of(robot, qg, base, limits.zmp_margin)
         supports[len(grid)] = (qg, support)
-        near = (lambda k: i0 + int(np.searchsorted(knots, grid[k], side="right")) - 1)
+
+        def near(k: int) -> int:  # the waypoint at or before gridpoint k
+            return i0 + int(np.searchsorted(knots, grid[k], side="right")) - 1
+
         _precheck(robot, base, limits, qg, support, near)
         if np.any(support.required < limits.zmp_margin):
             k = int(np.argmin(support.static))
@@ -571,6 +591,7 @@ def retime(robot: SnakeRobot, waypoints, base: BasePlacement | None = None, *, v
                              "gridpoints after refining; see check")
                 break
             grid = refined
+        assert sd is not None  # the loop raised otherwise
         t_grid = timeline.add_piece(f, grid, sd)
         times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
@@ -592,7 +613,7 @@ def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:
     return np.unique(np.concatenate([grid] + new))
 
 
-def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f, grid: np.ndarray,
+def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f: PathFunction, grid: np.ndarray,
                  sd: np.ndarray, support: Support) -> np.ndarray:
     """(N-1,) bool: the stages of a solution that break a limit between their gridpoints (TOPP-RA keeps the limits
     at the gridpoints only). Probed at PROBES points inside each stage, with its constant path acceleration; the
@@ -621,7 +642,7 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
 
 
 def _precheck(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, q: np.ndarray, support: Support,
-              near) -> None:
+              near: Callable[[int], int]) -> None:
     """Clear errors for paths no timing can follow: holding still there already breaks a limit."""
     if np.any(support.static <= 0):
         k = int(np.argmin(support.static))
@@ -629,6 +650,6 @@ def _precheck(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, q:
                          f"waypoint {near(k)}: no motion along this path is stable there")
     hold = np.abs(inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base)) / limits.torque
     if hold.max() > 1.0:
-        k, j = np.unravel_index(int(np.argmax(hold)), hold.shape)
+        k, j = (int(i) for i in np.unravel_index(int(np.argmax(hold)), hold.shape))
         raise ValueError(f"joint {robot.joint_names[j]} needs {hold[k, j] * limits.torque[j]:.2f} N m to hold the body "
                          f"still near waypoint {near(k)}; its torque limit is {limits.torque[j]:.2f} N m")
