@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import sysconfig
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -27,9 +28,11 @@ def small(robot):
 
 
 def workspace_gen() -> str:
-    exe = shutil.which("workspace_gen")
-    assert exe, "workspace_gen is not on PATH (the wheel installs it)"
-    return exe
+    """The workspace_gen installed with this interpreter's snakehead (PATH may lead to another install)."""
+    exe = Path(sysconfig.get_path("scripts")) / "workspace_gen"
+    found = str(exe) if exe.exists() else shutil.which("workspace_gen")
+    assert found, "workspace_gen is not installed (the wheel installs it)"
+    return found
 
 
 def gen_args(robot, out, **kw):
