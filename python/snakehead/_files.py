@@ -1,11 +1,19 @@
-"""Writing files so that a failure never leaves a half-written file: write a temporary file in the same folder,
-flush it to disk, then rename it over the destination (an atomic step on POSIX file systems)."""
+"""Files, written so that a failure never leaves a half-written file (:func:`atomic_open`: a temporary file in the
+same folder, flushed to disk, then renamed over the destination, an atomic step on POSIX file systems), and read
+without trusting them (:func:`read_npz`: .npz archives checked before anything is unpacked or allocated)."""
 from __future__ import annotations
 
 import contextlib
+import math
 import os
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Any, IO, Iterator
+
+import numpy as np
+
+from ._validate import input_file
 
 
 
@@ -60,3 +68,70 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
     with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:
         f.write(text)
     return Path(path)
+
+
+def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str, np.ndarray]:
+    """The arrays of a ``.npz`` archive (what ``numpy.savez`` writes), read without trusting the file.
+
+    ``path`` must be a regular file of at most ``max_bytes`` bytes (:func:`snakehead._validate.input_file`); the
+    archive's members, as its directory declares them, must be ``.npy`` arrays of at most ``max_bytes`` bytes in
+    all, checked before anything is unpacked (a zip bomb of a few MB can declare gigabytes); each array's header
+    must agree with its member's size before its memory is allocated; arrays of Python objects (pickles) are
+    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is a ValueError naming
+    ``what``, the file and, where it applies, the array: never EOFError, zipfile.BadZipFile or zlib.error.
+    """
+    p = input_file(path, what, max_bytes)
+    where = f"{what} {os.fspath(p)!r}"
+    try:
+        archive = zipfile.ZipFile(p)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as exc:
+        raise ValueError(f"{where} is not a .npz archive (a zip of .npy arrays): {exc}") from None
+    arrays: dict[str, np.ndarray] = {}
+    with archive:
+        members = archive.infolist()
+        declared = sum(m.file_size for m in members)
+        if declared > max_bytes:
+            raise ValueError(f"{where} would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
+                             "damaged file or a zip bomb)")
+        for m in members:
+            if m.is_dir() or not m.filename.endswith(".npy"):
+                raise ValueError(f"{where} holds {m.filename!r}, which is not a .npy array")
+            key = m.filename[:-len(".npy")]
+            if key in arrays:
+                raise ValueError(f"{where} holds the array {key!r} twice")
+            try:
+                with archive.open(m) as f:
+                    arrays[key] = _read_npy(f, m.file_size)
+            except ValueError as exc:
+                raise ValueError(f"{where}, array {key!r}: {exc}") from None
+            except (zipfile.BadZipFile, zlib.error, OSError, EOFError, RuntimeError, NotImplementedError) as exc:
+                raise ValueError(f"{where}, array {key!r} is damaged: {type(exc).__name__}: {exc}") from None
+    return arrays
+
+
+def _read_npy(f: IO[bytes], size: int) -> np.ndarray:
+    """One .npy array from a stream that holds ``size`` bytes: its header checked against ``size`` first."""
+    from numpy.lib import format as npy
+
+    version = npy.read_magic(f)  # ValueError for anything but a .npy magic string
+    if version == (1, 0):
+        shape, fortran, dtype = npy.read_array_header_1_0(f)
+    elif version == (2, 0):
+        shape, fortran, dtype = npy.read_array_header_2_0(f)
+    else:
+        raise ValueError(f"unsupported .npy format version {version}")
+    if dtype.hasobject:
+        raise ValueError("holds Python objects (pickled), which are never read")
+    if any(not isinstance(d, int) or d < 0 for d in shape):
+        raise ValueError(f"has an invalid shape {shape}")
+    count = math.prod(shape)
+    nbytes = count * dtype.itemsize
+    if nbytes > size or count > size + 1:  # no more data than the member holds (itemsize 0: no more items)
+        raise ValueError(f"declares {shape} of {dtype} ({nbytes} bytes) but the archive holds {size} bytes for it")
+    data = f.read(nbytes)
+    if len(data) != nbytes:
+        raise ValueError(f"is truncated ({len(data)} of {nbytes} bytes)")
+    if f.read(1):  # reading to the member's end also makes zipfile check its CRC
+        raise ValueError(f"holds more bytes than its header declares ({shape} of {dtype})")
+    flat = np.frombuffer(data, dtype=dtype, count=count) if nbytes else np.zeros(count, dtype)
+    return flat.reshape(shape, order="F" if fortran else "C").copy()

@@ -8,6 +8,9 @@ argument and says what was wrong. Durations and sizes have upper limits (:data:`
 from __future__ import annotations
 
 import numbers
+import os
+import stat
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -180,14 +183,14 @@ def integer(n: Any, name: str, *, least: int | None = None, most: int | None = N
     return v
 
 
-def sample_count(span_s: float, step_s: float, name: str, *, maximum: int = MAX_SAMPLES) -> int:
-    """How many samples ``span_s`` seconds take at ``step_s`` steps (both ends included), ValueError when more than
-    ``maximum``: the check before an allocation (or a loop) whose size the caller's numbers decide."""
-    span, step = finite_float(span_s, f"{name} (s)"), positive(step_s, f"{name}'s step (s)")
+def sample_count(span: float, step: float, name: str, *, maximum: int = MAX_SAMPLES, unit: str = "s") -> int:
+    """How many samples a ``span`` takes at ``step`` (both ends included; both in ``unit``), ValueError when more
+    than ``maximum``: the check before an allocation (or a loop) whose size the caller's numbers decide."""
+    span, step = finite_float(span, f"{name} ({unit})"), positive(step, f"{name}'s step ({unit})")
     steps = span / step
     if not steps <= maximum - 1:  # also NaN
-        raise ValueError(f"{name}: {span:g} s in steps of {step:g} s is {steps + 1:.3g} samples; at most {maximum} "
-                         "(shorten it or take longer steps)")
+        raise ValueError(f"{name}: {span:g} {unit} in steps of {step:g} {unit} is {steps + 1:.3g} samples; at most "
+                         f"{maximum} (shorten it or take longer steps)")
     return int(np.floor(max(steps, 0.0) + 1e-9)) + 1
 
 
@@ -214,3 +217,30 @@ def file_name_part(name: Any, what: str) -> str:
     if size > MAX_NAME_BYTES:
         raise ValueError(f"{what} is {size} bytes long in UTF-8; at most {MAX_NAME_BYTES} (it names files)")
     return name
+
+
+def input_file(path: Any, what: str, max_bytes: int) -> Path:
+    """A file to read: a path (str or os.PathLike; TypeError otherwise) to an existing regular file of at most
+    ``max_bytes`` bytes. Checked without opening it: a FIFO would block, /dev/zero would be read forever, a
+    directory or a device is not a file. ValueError naming ``what`` and the path otherwise."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"{what} must be a path (str or os.PathLike), got {type(path).__name__}")
+    text = os.fspath(path)
+    if isinstance(text, bytes):
+        raise TypeError(f"{what} must be a str path, got bytes")
+    if "\0" in text:
+        raise ValueError(f"{what} {text!r} holds a NUL character")
+    try:
+        info = os.stat(text)
+    except FileNotFoundError:
+        raise ValueError(f"{what} {text!r} does not exist") from None
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"cannot read {what} {text!r}: {getattr(exc, 'strerror', None) or exc}") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = ("a directory" if stat.S_ISDIR(info.st_mode) else "a FIFO" if stat.S_ISFIFO(info.st_mode) else
+                "a character device" if stat.S_ISCHR(info.st_mode) else "a block device" if stat.S_ISBLK(info.st_mode)
+                else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a regular file")
+        raise ValueError(f"{what} {text!r} is {kind}, not a regular file")
+    if info.st_size > max_bytes:
+        raise ValueError(f"{what} {text!r} is {info.st_size} bytes; at most {max_bytes} are read")
+    return Path(text)

@@ -22,6 +22,8 @@ from pathlib import Path
 
 from typing import Sequence
 
+from .._validate import input_file
+
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
 OPTIONAL_KEYS = ("root", "map")
@@ -45,11 +47,7 @@ class RobotFile:
 
 def read_toml(path: str | os.PathLike, what: str) -> dict:
     """A small TOML file as a dict; ValueError naming the file for a missing, oversized or malformed one."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"a {what} path must be a str or os.PathLike, got {type(path).__name__}")
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"{what} {os.fspath(p)!r} does not exist or is not a regular file")
+    p = input_file(path, what, MAX_FILE_BYTES)
     try:
         with open(p, "rb") as f:
             raw = f.read(MAX_FILE_BYTES + 1)

@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.interpolate import CubicSpline
 
-from .._validate import finite_array, finite_float, positive
+from .._validate import finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
 from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -76,6 +76,8 @@ HOLD_S = 1.0
 GRID_STEP = 0.01
 #: Gridpoints per segment between two waypoints, at least.
 MIN_GRID_PER_SEGMENT = 8
+#: The most gridpoints of one retimed path (a path of 1000 rad at the default step): a larger grid is a mistake.
+MAX_GRID_POINTS = 100_000
 #: rad: two waypoints closer than this (largest joint difference) are the same: a hold.
 SAME_WAYPOINT = 1e-9
 #: Where the path stands still (a cusp: every joint turns back or stops at a waypoint) the joint velocity limits do
@@ -551,6 +553,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         pts = W[i0:i1 + 1]
         knots = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
         f = _path_function(knots, pts, interpolation)
+        sample_count(knots[-1], grid_step, "TOPP-RA's grid (the path's length over grid_step)", unit="rad",
+                     maximum=MAX_GRID_POINTS)  # before the grid is allocated and solved over
         steps = np.maximum(MIN_GRID_PER_SEGMENT, np.ceil(np.diff(knots) / grid_step).astype(int))
         grid = np.concatenate([np.linspace(knots[k], knots[k + 1], steps[k] + 1)[:-1] for k in range(len(steps))]
                               + [knots[-1:]])

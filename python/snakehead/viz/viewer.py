@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import threading
 import time
 from dataclasses import dataclass, fields
@@ -31,7 +32,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
 
-from .._files import atomic_open, write_text_atomic
+from .._files import atomic_open, read_npz, write_text_atomic
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
 
@@ -253,22 +254,66 @@ def save_viewer_scene(scene: ViewerScene, path: str | Path) -> Path:
     return path
 
 
+#: The largest viewer scene read (bytes, unpacked): a scene of 2000 frames of a 100-link robot is ~20 MB.
+MAX_SCENE_BYTES = 512 << 20
+
+#: Each array of a viewer scene: its dtype kind ("f" numbers, "i" integers, "U" text) and its shape, in symbols
+#: that must agree across arrays (F frames, K boxes, V voxels, Z ZMP samples, P polygons of M vertices, N targets,
+#: B obstacle boxes, W wall vertices, T wall triangles, H hole rims of R points).
+_SCENE_ARRAYS = {
+    "name": ("U", ()), "title": ("U", ()), "times": ("f", ("F",)), "box_positions": ("f", ("F", "K", 3)),
+    "box_wxyz": ("f", ("F", "K", 4)), "box_sizes": ("f", ("K", 3)), "box_colors": ("i", ("K", 3)),
+    "head_tip": ("f", ("F", 3)), "map_frame_positions": ("f", ("F", 3)), "map_frame_wxyz": ("f", ("F", 4)),
+    "voxel_centers": ("f", ("V", 3)), "voxel_indices": ("f", ("V",)), "voxel_size": ("f", ()),
+    "zmp": ("f", ("F", 2)), "com": ("f", ("F", 3)), "zmp_path": ("f", ("Z", 2)), "polygons": ("f", ("P", "M", 2)),
+    "polygon_of_frame": ("i", ("F",)), "target_positions": ("f", ("N", 3)), "target_directions": ("f", ("N", 3)),
+    "target_names": ("U", ("N",)), "target_diameters": ("f", ("N",)), "obstacle_centres": ("f", ("B", 3)),
+    "obstacle_sizes": ("f", ("B", 3)), "obstacle_wxyz": ("f", ("B", 4)), "wall_vertices": ("f", ("W", 3)),
+    "wall_triangles": ("i", ("T", 3)), "hole_rims": ("f", ("H", "R", 3)),
+}
+#: Arrays that may hold NaN (polygons are NaN-padded; a target without a diameter is an arrow).
+_SCENE_NAN_ALLOWED = ("polygons", "target_diameters")
+
+
+def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
+    """ValueError naming the array unless every array has its kind and a shape consistent with the others, numbers
+    are finite (where NaN means nothing) and indices point inside what they index."""
+    sizes: dict[str, int] = {}
+    for key, (kind, shape) in _SCENE_ARRAYS.items():
+        a = values[key]
+        if not (a.dtype.kind == kind or (kind == "f" and a.dtype.kind in "iu") or (kind == "i" and a.dtype.kind == "u")):
+            raise ValueError(f"{where}: {key} holds {a.dtype}, not {dict(f='numbers', i='integers', U='text')[kind]}")
+        if a.ndim != len(shape):
+            raise ValueError(f"{where}: {key} has shape {a.shape}, expected {len(shape)} dimensions")
+        for d, want in zip(a.shape, shape):
+            if isinstance(want, int) and d != want or isinstance(want, str) and sizes.setdefault(want, d) != d:
+                raise ValueError(f"{where}: {key} has shape {a.shape}, which disagrees with the other arrays")
+        if kind == "f" and key not in _SCENE_NAN_ALLOWED and not np.all(np.isfinite(a)):
+            raise ValueError(f"{where}: {key} holds NaN or inf")
+    if sizes["F"] < 1 or np.any(np.diff(values["times"]) < 0):
+        raise ValueError(f"{where}: times must be at least one time, in order")
+    for key, bound in (("polygon_of_frame", "P"), ("wall_triangles", "W")):
+        a = values[key]
+        if a.size and (a.min() < 0 or a.max() >= sizes[bound]):
+            raise ValueError(f"{where}: {key} points outside its {sizes[bound]} entries")
+    if np.any((values["voxel_indices"] < 0) | (values["voxel_indices"] > 100)) or not values["voxel_size"] >= 0:
+        raise ValueError(f"{where}: voxel_indices must be within [0, 100] and voxel_size >= 0")
+
+
 def load_viewer_scene(path: str | Path) -> ViewerScene:
-    """Read a scene written by :func:`save_viewer_scene` (ValueError if the file is not one)."""
-    path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            contents = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"{path}: not a viewer scene (.npz): {exc}") from None
+    """Read a scene written by :func:`save_viewer_scene`: ValueError if the file is not one, is damaged (see
+    :func:`snakehead._files.read_npz`) or its arrays disagree (shapes, kinds, indices)."""
+    where = f"{os.fspath(path)}"
+    contents = read_npz(path, "viewer scene", max_bytes=MAX_SCENE_BYTES)
     version = contents.pop("format", None)
-    if version is None or int(version) != SCENE_FORMAT:
-        raise ValueError(f"{path}: viewer scene format {version!r}, this snakehead reads {SCENE_FORMAT}")
+    if version is None or version.shape != () or version.dtype.kind not in "iu" or int(version) != SCENE_FORMAT:
+        raise ValueError(f"{where}: not a viewer scene of format {SCENE_FORMAT} (format {version!r})")
     names = {f.name for f in fields(ViewerScene)}
     missing = names - set(contents)
     if missing:
-        raise ValueError(f"{path}: viewer scene without {sorted(missing)}")
+        raise ValueError(f"{where}: viewer scene without {sorted(missing)}")
     values: dict[str, Any] = {k: contents[k] for k in names}
+    _check_scene_arrays(where, values)
     values["name"] = str(values["name"])
     values["title"] = str(values["title"])
     values["voxel_size"] = float(values["voxel_size"])
