@@ -77,35 +77,35 @@ def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str,
     archive's members, as its directory declares them, must be ``.npy`` arrays of at most ``max_bytes`` bytes in
     all, checked before anything is unpacked (a zip bomb of a few MB can declare gigabytes); each array's header
     must agree with its member's size before its memory is allocated; arrays of Python objects (pickles) are
-    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is a ValueError naming
-    ``what``, the file and, where it applies, the array: never EOFError, zipfile.BadZipFile or zlib.error.
+    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is a ValueError "cannot read
+    {what} {path}: ..." naming, where it applies, the array: never EOFError, zipfile.BadZipFile or zlib.error.
     """
     p = input_file(path, what, max_bytes)
-    where = f"{what} {os.fspath(p)!r}"
+    where = f"cannot read {what} {os.fspath(p)!r}"
     try:
         archive = zipfile.ZipFile(p)
     except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as exc:
-        raise ValueError(f"{where} is not a .npz archive (a zip of .npy arrays): {exc}") from None
+        raise ValueError(f"{where}: it is not a .npz archive (a zip of .npy arrays): {exc}") from None
     arrays: dict[str, np.ndarray] = {}
     with archive:
         members = archive.infolist()
         declared = sum(m.file_size for m in members)
         if declared > max_bytes:
-            raise ValueError(f"{where} would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
+            raise ValueError(f"{where}: it would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
                              "damaged file or a zip bomb)")
         for m in members:
             if m.is_dir() or not m.filename.endswith(".npy"):
-                raise ValueError(f"{where} holds {m.filename!r}, which is not a .npy array")
+                raise ValueError(f"{where}: it holds {m.filename!r}, which is not a .npy array")
             key = m.filename[:-len(".npy")]
             if key in arrays:
-                raise ValueError(f"{where} holds the array {key!r} twice")
+                raise ValueError(f"{where}: it holds the array {key!r} twice")
             try:
                 with archive.open(m) as f:
                     arrays[key] = _read_npy(f, m.file_size)
             except ValueError as exc:
-                raise ValueError(f"{where}, array {key!r}: {exc}") from None
+                raise ValueError(f"{where}: its array {key!r} {exc}") from None
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, RuntimeError, NotImplementedError) as exc:
-                raise ValueError(f"{where}, array {key!r} is damaged: {type(exc).__name__}: {exc}") from None
+                raise ValueError(f"{where}: its array {key!r} is damaged ({type(exc).__name__}: {exc})") from None
     return arrays
 
 
@@ -113,13 +113,17 @@ def _read_npy(f: IO[bytes], size: int) -> np.ndarray:
     """One .npy array from a stream that holds ``size`` bytes: its header checked against ``size`` first."""
     from numpy.lib import format as npy
 
-    version = npy.read_magic(f)  # ValueError for anything but a .npy magic string
-    if version == (1, 0):
-        shape, fortran, dtype = npy.read_array_header_1_0(f)
-    elif version == (2, 0):
-        shape, fortran, dtype = npy.read_array_header_2_0(f)
-    else:
-        raise ValueError(f"unsupported .npy format version {version}")
+    try:
+        version = npy.read_magic(f)
+    except ValueError as exc:
+        raise ValueError(f"is not a .npy array ({exc})") from None
+    if version not in ((1, 0), (2, 0)):
+        raise ValueError(f"has an unsupported .npy format version {version}")
+    try:
+        read_header = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+        shape, fortran, dtype = read_header(f)
+    except (ValueError, TypeError, SyntaxError, RecursionError, MemoryError) as exc:  # a Python literal, parsed safely
+        raise ValueError(f"has a damaged header ({exc})") from None
     if dtype.hasobject:
         raise ValueError("holds Python objects (pickled), which are never read")
     if any(not isinstance(d, int) or d < 0 for d in shape):

@@ -222,25 +222,25 @@ def file_name_part(name: Any, what: str) -> str:
 def input_file(path: Any, what: str, max_bytes: int) -> Path:
     """A file to read: a path (str or os.PathLike; TypeError otherwise) to an existing regular file of at most
     ``max_bytes`` bytes. Checked without opening it: a FIFO would block, /dev/zero would be read forever, a
-    directory or a device is not a file. ValueError naming ``what`` and the path otherwise."""
+    directory or a device is not a file. Otherwise ValueError "cannot read {what} {path}: {why}"."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"{what} must be a path (str or os.PathLike), got {type(path).__name__}")
     text = os.fspath(path)
     if isinstance(text, bytes):
         raise TypeError(f"{what} must be a str path, got bytes")
     if "\0" in text:
-        raise ValueError(f"{what} {text!r} holds a NUL character")
+        raise ValueError(f"cannot read {what} {text!r}: the path holds a NUL character")
     try:
         info = os.stat(text)
     except FileNotFoundError:
-        raise ValueError(f"{what} {text!r} does not exist") from None
+        raise ValueError(f"cannot read {what} {text!r}: it does not exist") from None
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read {what} {text!r}: {getattr(exc, 'strerror', None) or exc}") from None
     if not stat.S_ISREG(info.st_mode):
         kind = ("a directory" if stat.S_ISDIR(info.st_mode) else "a FIFO" if stat.S_ISFIFO(info.st_mode) else
                 "a character device" if stat.S_ISCHR(info.st_mode) else "a block device" if stat.S_ISBLK(info.st_mode)
                 else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a regular file")
-        raise ValueError(f"{what} {text!r} is {kind}, not a regular file")
+        raise ValueError(f"cannot read {what} {text!r}: it is {kind}, not a regular file")
     if info.st_size > max_bytes:
-        raise ValueError(f"{what} {text!r} is {info.st_size} bytes; at most {max_bytes} are read")
+        raise ValueError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
     return Path(text)

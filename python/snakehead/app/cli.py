@@ -13,7 +13,7 @@ Exit status:
   1    a scenario or target was planned but not successfully (the outputs are written all the same)
   2    bad arguments, bad input files, or outputs that cannot be written (one line on stderr says which)
   3    an internal error: a bug in snakehead (one line on stderr; please report it with its traceback)
-  130  interrupted (Ctrl-C)
+  130  interrupted (Ctrl-C; but view, which runs until Ctrl-C, then exits with 0)
 Errors are one line on stderr, never a traceback; set SNAKEHEAD_TRACEBACK=1 to see the Python traceback.
 """
 from __future__ import annotations

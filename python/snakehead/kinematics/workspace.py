@@ -34,6 +34,8 @@ if TYPE_CHECKING:
 import numpy.typing as npt
 
 FORMAT = "snakehead-reachability-1"
+#: Formats :func:`load` reads.
+FORMATS = (FORMAT,)
 #: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
 TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
 #: How many voxels the dexterous band must hold at least, as a share of the map's voxels (see
@@ -500,47 +502,154 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
         raise ValueError(f"cannot write the map to {path!r}: {exc}") from None
 
 
+#: The largest map file read (bytes, as its archive declares them unpacked). A full grid of 256^3 voxels -- the C++
+#: sweep's limit -- holds at most 16.8 million voxels of about 50 bytes each: 840 MB.
+MAX_MAP_BYTES = 1 << 30
+#: The C++ sweep's limits (include/snakehead/limits.hpp): voxels per grid axis, points per sphere, rolls.
+_MAX_VOXELS_PER_AXIS, _MAX_DIRECTIONS, _MAX_ROLLS = 256, 4096, 360
+
+# What each key of a map file holds: "text", "int", "bool" or "float" scalars; arrays by (kind, shape) with "M"
+# the voxel count. Keys of the second format (reached, sphere_directions, hull, shrink, alpha) are optional.
+_MAP_SCALARS = {
+    "format": "text", "chain_hash": "text", "base": "text", "tip": "text", "command": "text", "approach_axis": "text",
+    "tried": "int", "hull_voxels": "int", "directions": "int", "rolls": "int", "cloud_samples": "int", "seed": "int",
+    "any_roll": "bool", "free_roll": "bool", "grid_size": "float", "voxel_size": "float", "timeout": "float",
+    "epsilon": "float",
+}
+_MAP_OPTIONAL_SCALARS = {"hull": "text", "shrink": "float", "alpha": "float", "reach": "float", "seconds": "float",
+                         "ik_calls": "int", "cheap_exits": "int", "threads": "int", "hull_facets": "int"}
+_MAP_ARRAYS = {"centers": ("f", ("M", 3)), "indices": ("f", ("M",)), "solved": ("i", ("M",)),
+               "voxel_ids": ("i", ("M",)), "grid_origin": ("f", (3,)), "grid_shape": ("i", (3,)), "shard": ("i", (2,))}
+_KINDS = {"text": "U", "int": "iu", "bool": "b", "float": "fiu"}
+
+
+def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -> None:
+    """Check the arrays of a map file (as :func:`snakehead._files.read_npz` returns them) before a map is made of
+    them: ValueError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
+    outside [0, 100] or not 100 * solved / tried, solved counts outside [0, tried], NaN or non-positive sizes,
+    voxel ids duplicated, out of order or outside the grid, voxel centres that are not their voxels' centres,
+    per-direction results of the wrong shape, and parameters beyond the sweep's limits. Either format (1 or 2)."""
+    def fail(field: str, what: str) -> ValueError:
+        return ValueError(f"{where}: {field} {what}")
+
+    if "format" not in arrays or arrays["format"].dtype.kind != "U" or str(arrays["format"][()]) not in FORMATS:
+        raise ValueError(f"{where} is not a snakehead reachability map (its format is not one of "
+                         f"{', '.join(FORMATS)})")
+    scalars = dict(_MAP_SCALARS)
+    for key, kind in _MAP_OPTIONAL_SCALARS.items():
+        if key in arrays:
+            scalars[key] = kind
+    for key, kind in scalars.items():
+        if key not in arrays:
+            raise fail(key, "is missing")
+        a = arrays[key]
+        if a.shape != () or a.dtype.kind not in _KINDS[kind]:
+            raise fail(key, f"must be one {kind} value, got {a.dtype} of shape {a.shape}")
+    for key, (kind, shape) in _MAP_ARRAYS.items():
+        if key not in arrays:
+            raise fail(key, "is missing")
+        a = arrays[key]
+        if a.dtype.kind not in ("fiu" if kind == "f" else "iu") or a.ndim != len(shape):
+            raise fail(key, f"must be an array of {'numbers' if kind == 'f' else 'integers'} of shape "
+                            f"{tuple(shape)}, got {a.dtype} of shape {a.shape}")
+    value = {k: arrays[k][()] for k in scalars}
+    M = len(arrays["voxel_ids"])
+    for key, (kind, shape) in _MAP_ARRAYS.items():
+        want = tuple(M if d == "M" else d for d in shape)
+        if arrays[key].shape != want:
+            raise fail(key, f"has shape {arrays[key].shape}; the map's {M} voxels need {want}")
+    for key in ("grid_size", "voxel_size", "timeout", "epsilon"):
+        if not (math.isfinite(float(value[key])) and float(value[key]) > 0):
+            raise fail(key, f"must be a positive finite number, got {value[key]}")
+    for key in ("centers", "indices", "grid_origin"):
+        if not np.all(np.isfinite(arrays[key])):
+            raise fail(key, "holds NaN or inf")
+    if str(value["approach_axis"]) not in ("x", "z"):
+        raise fail("approach_axis", f"must be 'x' or 'z', got {str(value['approach_axis'])!r}")
+    if "hull" in value and str(value["hull"]) not in ("convex", "boundary"):
+        raise fail("hull", f"must be 'convex' or 'boundary', got {str(value['hull'])!r}")
+    directions, rolls, tried = int(value["directions"]), int(value["rolls"]), int(value["tried"])
+    if not 1 <= directions <= _MAX_DIRECTIONS or not 0 <= rolls <= _MAX_ROLLS:
+        raise fail("directions/rolls", f"must be within [1, {_MAX_DIRECTIONS}] / [0, {_MAX_ROLLS}], got {directions} "
+                                       f"/ {rolls}")
+    if tried not in (directions, directions * max(rolls, 1)):
+        raise fail("tried", f"must be the directions ({directions}) or directions x rolls, got {tried}")
+    n = arrays["grid_shape"]
+    if not (n[0] == n[1] == n[2] and 1 <= int(n[0]) <= _MAX_VOXELS_PER_AXIS):
+        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {_MAX_VOXELS_PER_AXIS}, got {n.tolist()}")
+    n = int(n[0])
+    voxel = float(value["voxel_size"])
+    if not math.isclose(float(value["grid_size"]), n * voxel, rel_tol=1e-9):
+        raise fail("grid_size", f"must be grid_shape x voxel_size ({n} x {voxel}), got {value['grid_size']}")
+    i, count = (int(x) for x in arrays["shard"])
+    if not 0 <= i < count:
+        raise fail("shard", f"must be (i, N) with 0 <= i < N, got {(i, count)}")
+    if not M <= int(value["hull_voxels"]) <= n ** 3:
+        raise fail("hull_voxels", f"must be within [{M} (the map's voxels), {n ** 3} (the grid's)], got "
+                                  f"{value['hull_voxels']}")
+    ids = arrays["voxel_ids"]
+    if M and (ids[0] < 0 or ids[-1] >= n ** 3 or np.any(np.diff(ids) <= 0)):
+        if M and np.any(np.diff(ids) == 0):
+            raise fail("voxel_ids", f"holds duplicates (voxel {int(ids[np.flatnonzero(np.diff(ids) == 0)[0]])})")
+        raise fail("voxel_ids", f"must increase strictly within [0, {n ** 3}) (the grid's {n}^3 voxels)")
+    ijk = np.stack([ids // (n * n), (ids // n) % n, ids % n], axis=1)
+    expected = np.asarray(arrays["grid_origin"], float) + (ijk + 0.5) * voxel
+    if M and not np.allclose(arrays["centers"], expected, rtol=0.0, atol=1e-6 * max(voxel, 1.0)):
+        raise fail("centers", "are not the centres of the voxels voxel_ids names (grid_origin + (ijk + 1/2) voxel)")
+    solved = arrays["solved"]
+    if M and (solved.min() < 0 or solved.max() > tried):
+        raise fail("solved", f"must be within [0, tried = {tried}]")
+    indices = np.asarray(arrays["indices"], float)
+    if M and (indices.min() < 0 or indices.max() > 100):
+        raise fail("indices", f"must be within [0, 100], got [{indices.min():g}, {indices.max():g}]")
+    if not np.allclose(indices, 100.0 * solved / tried, rtol=0.0, atol=1e-9):
+        raise fail("indices", "disagree with 100 * solved / tried")
+    if "reached" in arrays:
+        r = arrays["reached"]
+        if r.dtype != np.uint8 or r.shape != (M, (tried + 7) // 8):
+            raise fail("reached", f"must be uint8 of shape ({M}, {(tried + 7) // 8}), got {r.dtype} {r.shape}")
+    if "sphere_directions" in arrays:
+        d = arrays["sphere_directions"]
+        if d.dtype.kind != "f" or d.shape != (directions, 3) or not np.all(np.isfinite(d)):
+            raise fail("sphere_directions", f"must be ({directions}, 3) finite numbers, got {d.dtype} {d.shape}")
+
+
 def load(path: str | os.PathLike) -> ReachabilityMap:
-    """Read a map written by ``save`` or ``workspace_gen``. ValueError for a missing or foreign file."""
+    """Read a map written by ``save`` or ``workspace_gen``. ValueError for a missing, foreign, damaged or
+    inconsistent file (:func:`snakehead._files.read_npz`, :func:`validate_map_arrays`), naming what is wrong."""
+    from .._files import read_npz
+
+    z = read_npz(path, "the map", max_bytes=MAX_MAP_BYTES)  # a regular file; sizes checked before unpacking
     path = os.fspath(path)
-    try:
-        z = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"cannot read the map {path!r}: {exc}") from None
-    with z:
-        if "format" not in z.files or str(z["format"]) != FORMAT:
-            raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
+    validate_map_arrays(z, f"map {path!r}")  # every field, before a map is made of them
+    def scalar(k: str, cast: Callable[[Any], Any]) -> Any:
+        return cast(z[k][()])
 
-        def scalar(k: str, cast: Callable[[Any], Any]) -> Any:
-            return cast(z[k][()])
-
-        params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")
-                            else float if p in ("voxel_size", "timeout", "epsilon") else int) for p in _PARAMS}
-        stats = {}
-        for k, cast in (("ik_calls", int), ("cheap_exits", int), ("seconds", float), ("threads", int),
-                        ("hull_facets", int), ("reach", float)):
-            if k in z.files:
-                stats[k] = scalar(k, cast)
-        m = ReachabilityMap(
-            centers=np.array(z["centers"], dtype=float).reshape(-1, 3),
-            solved=np.array(z["solved"], dtype=np.int32),
-            voxel_ids=np.array(z["voxel_ids"], dtype=np.int64),
-            tried=scalar("tried", int),
-            grid_origin=np.array(z["grid_origin"], dtype=float),
-            grid_size=scalar("grid_size", float),
-            grid_shape=tuple(int(x) for x in z["grid_shape"]),
-            hull_voxels=scalar("hull_voxels", int),
-            chain_hash=scalar("chain_hash", str),
-            base=scalar("base", str),
-            tip=scalar("tip", str),
-            params=params,
-            shard=tuple(int(x) for x in z["shard"]),
-            command=scalar("command", str),
-            stats=stats,
-            path=Path(path),
-        )
-        if m.tried < 1 or not np.allclose(m.indices, np.asarray(z["indices"], dtype=float), atol=1e-9):
-            raise ValueError(f"{path!r}: the indices disagree with solved / tried")
+    params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")
+                        else float if p in ("voxel_size", "timeout", "epsilon") else int) for p in _PARAMS}
+    stats = {}
+    for k, cast in (("ik_calls", int), ("cheap_exits", int), ("seconds", float), ("threads", int),
+                    ("hull_facets", int), ("reach", float)):
+        if k in z:
+            stats[k] = scalar(k, cast)
+    m = ReachabilityMap(
+        centers=np.array(z["centers"], dtype=float).reshape(-1, 3),
+        solved=np.array(z["solved"], dtype=np.int32),
+        voxel_ids=np.array(z["voxel_ids"], dtype=np.int64),
+        tried=scalar("tried", int),
+        grid_origin=np.array(z["grid_origin"], dtype=float),
+        grid_size=scalar("grid_size", float),
+        grid_shape=tuple(int(x) for x in z["grid_shape"]),
+        hull_voxels=scalar("hull_voxels", int),
+        chain_hash=scalar("chain_hash", str),
+        base=scalar("base", str),
+        tip=scalar("tip", str),
+        params=params,
+        shard=tuple(int(x) for x in z["shard"]),
+        command=scalar("command", str),
+        stats=stats,
+        path=Path(path),
+    )
     return m
 
 

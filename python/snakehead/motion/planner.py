@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import positive
+from .._validate import duration, positive
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -503,7 +503,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     """
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
-    speed, min_segment = positive(speed, "speed"), positive(min_segment, "min_segment")
+    speed, min_segment = positive(speed, "speed"), duration(min_segment, "min_segment")
     if controller is not None:
         if not isinstance(controller, HeadController):
             raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
