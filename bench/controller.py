@@ -15,9 +15,10 @@ import time
 
 import numpy as np
 
-from snakehead import SnakeRobot, scenarios
-from snakehead.controller import HeadController
-from snakehead.report import cpu_name
+from snakehead import SnakeRobot
+from snakehead.app.report import cpu_name
+from snakehead.control.controller import HeadController
+from snakehead.scenes import paper_scene
 
 
 def run(controller: HeadController, targets) -> dict:
@@ -60,8 +61,8 @@ def main() -> None:
     args = ap.parse_args()
     robot = SnakeRobot.default()
     rng = np.random.default_rng(args.seed)
-    paper = [(scenarios.SPHERE_1, scenarios.SPHERE_DIRECTION), (scenarios.SPHERE_2, scenarios.SPHERE_DIRECTION),
-             (scenarios.HOLE_CENTRE, scenarios.HOLE_AXIS)]
+    spheres, hole = paper_scene("spheres"), paper_scene("hole")
+    paper = [(t.position, t.direction) for t in spheres.reported] + [(hole.obstacles[0].centre, hole.obstacles[0].normal)]
     print(f"# HeadController.solve, {cpu_name()}, {time.strftime('%Y-%m-%d')}")
     print("| method | targets | n | success % | statically stable % | median ms | mean ms | p95 ms "
           "| max position error mm | max direction error deg |")

@@ -184,7 +184,7 @@ def main(argv=None) -> int:
     robot = snakehead.SnakeRobot.default()
     urdf = snakehead.default_urdf_path()
     parts = robot.parts
-    chains = [(parts.head6_root, parts.head_tip), (parts.neck_end, parts.head_tip)]
+    chains = [("link_10", parts.head_tip), (parts.neck_end, parts.head_tip)]  # the 6- and 7-DOF heads
     lines = ["| chain | solver | solve rate (%) | paper (%) | mean (ms) | median (ms) | p95 (ms) | failed (parked) |",
              "|---|---|---:|---:|---:|---:|---:|---:|"]
     ratios = []

@@ -4,8 +4,8 @@ Plan (joint space, on the default robot, base at BasePlacement()): from a flat c
 joints at 0.879 rad, neck turned inwards, all pitch joints 0) the head part rises to a pose 0.42 m high (target A,
 hold), then moves its head to a second pose (target B, hold). Both lifted poses and the joint-space path between
 them keep the CoM inside the base's support polygon. The plan is interpolated by
-``snakehead.trajectory.joint_interpolation`` at 2 ms (quintic segments if that module is absent), then tracked by
-``snakehead.sim.simulate`` (PD + support-aware gravity compensation, 2 ms control, 1 ms physics), and compared
+``snakehead.motion.interpolation.joint_interpolation`` at 2 ms (quintic segments if that module is absent), then tracked by
+``snakehead.sim.simulate_trajectory`` (PD + support-aware gravity compensation, 2 ms control, 1 ms physics), and compared
 with ``snakehead.sim.compare``. Prints the table; writes the three figures with ``--out``.
 
     python3 bench/sim_demo.py [--out DIR] [--kp 200] [--kd 3] [--torque-limit 10]
@@ -18,7 +18,9 @@ import time
 
 import numpy as np
 
-from snakehead import BasePlacement, SnakeRobot, sim, stability
+from snakehead import BasePlacement, SnakeRobot, sim
+from snakehead.sim import tracking
+from snakehead.dynamics import stability
 
 Q_A = np.array([0.879, 0.0, 0.879, 0.0, 0.879, 0.0, 0.879, 0.0,
                 1.485, -1.208, 0.151, -0.2, 0.292, 0.977, -0.451, 0.599])
@@ -41,9 +43,9 @@ def plan(dt: float = 0.002):
     times = [0.0, 4.0, 5.0, 8.0, 9.0]
     waypoints = np.array([q0, Q_A, Q_A, Q_B, Q_B])
     try:
-        from snakehead.trajectory import joint_interpolation
+        from snakehead.motion.interpolation import joint_interpolation
         t, q = joint_interpolation(times, waypoints, dt=dt)
-        how = "snakehead.trajectory.joint_interpolation"
+        how = "snakehead.motion.interpolation.joint_interpolation"
     except (ImportError, AttributeError):
         ts, qs = [np.zeros(1)], [waypoints[:1]]
         for k in range(len(times) - 1):
@@ -61,11 +63,11 @@ def plan(dt: float = 0.002):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=None, help="directory for the figures (PNG)")
-    ap.add_argument("--kp", type=float, default=sim.DEFAULT_KP)
-    ap.add_argument("--kd", type=float, default=sim.DEFAULT_KD)
+    ap.add_argument("--kp", type=float, default=tracking.DEFAULT_KP)
+    ap.add_argument("--kd", type=float, default=tracking.DEFAULT_KD)
     ap.add_argument("--torque-limit", type=float, default=10.0,
                     help="N m; the URDF's 3 N m cannot lift the head part (see RESULTS.md)")
-    ap.add_argument("--gravity-compensation", default="supported", choices=sim.GRAVITY_COMPENSATION)
+    ap.add_argument("--gravity-compensation", default="supported", choices=tracking.GRAVITY_COMPENSATION)
     args = ap.parse_args()
 
     robot = SnakeRobot.default()
@@ -76,7 +78,7 @@ def main() -> None:
           f"(endpoints polygon), head A at {robot.head_pose(Q_A, base)[:3, 3].round(3)}, "
           f"B at {robot.head_pose(Q_B, base)[:3, 3].round(3)}")
     t0 = time.perf_counter()
-    res = sim.simulate(robot, t, q, base, kp=args.kp, kd=args.kd, torque_limit=args.torque_limit,
+    res = sim.simulate_trajectory(robot, t, q, base, kp=args.kp, kd=args.kd, torque_limit=args.torque_limit,
                        gravity_compensation=args.gravity_compensation)
     wall = time.perf_counter() - t0
     rep = sim.compare(robot, t, q, res, targets=[times[2], times[4]])
@@ -114,7 +116,7 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
           f"python {platform.python_version()}")
     if args.out:
-        from snakehead.sim_plots import plot_dynamics_check
+        from snakehead.viz.sim import plot_dynamics_check
 
         for p in plot_dynamics_check(robot, t, q, res, args.out, base):
             print("wrote", p)

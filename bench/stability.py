@@ -13,14 +13,17 @@ import time
 import numpy as np
 
 from snakehead import SnakeRobot
-from snakehead import stability as st
-from snakehead import trajectory as tr
-from snakehead.plots import stable_lift_motion
+from snakehead.dynamics import stability as st
+from snakehead.geometry import collision as coll
+from snakehead.geometry.obstacles import BoxObstacle
+from snakehead.motion import cartesian as cart
+from snakehead.motion import interpolation as interp
+from snakehead.viz.figures import stable_lift_motion
 
 
 def scenario(robot: SnakeRobot):
     """A 36 s, 5-waypoint joint-space motion like the paper's sphere scenario: curl the base tighter (the base
-    moves), lift the head (plots.stable_lift_motion), then turn and bend it twice."""
+    moves), lift the head (viz.figures.stable_lift_motion), then turn and bend it twice."""
     q0, q1 = stable_lift_motion(robot)
     qa = q0.copy()
     qa[0:7:2] = 0.8
@@ -31,7 +34,7 @@ def scenario(robot: SnakeRobot):
     q3[8] -= 0.2
     q3[[9, 11]] += 0.2
     times = np.array([0.0, 6.0, 18.0, 27.0, 36.0])
-    return tr.joint_trajectory(times, np.stack([qa, q0, q1, q2, q3]), dt=0.002)
+    return interp.joint_trajectory(times, np.stack([qa, q0, q1, q2, q3]), dt=0.002)
 
 
 def timeit(fn, repeat: int) -> tuple[float, float]:
@@ -55,7 +58,7 @@ def main() -> None:
     q_moving_base = q.copy()
     q_const_base = q.copy()
     q_const_base[:, robot.parts.base] = q[-1, robot.parts.base]
-    box = tr.BoxObstacle([0.3, 0.4, 0.3], [0.1, 0.1, 0.1])
+    box = BoxObstacle([0.3, 0.4, 0.3], [0.1, 0.1, 0.1])
     rows = [
         ("frames_many (C++ FK, all frames)", T, lambda: robot.frames_many(q)),
         ("center_of_mass (Eq. 23)", T, lambda: st.center_of_mass(robot, q)),
@@ -67,11 +70,11 @@ def main() -> None:
         ("dynamic_stability, moving base (footprint)", T,
          lambda: st.dynamic_stability(robot, t, q_moving_base, contact="footprint")),
         ("joint_trajectory (quintic spline, 2 ms)", T,
-         lambda: tr.joint_trajectory([0, 6, 18, 27, 36], q[[0, 3000, 9000, 13500, -1]])),
-        ("ground_clearance", T, lambda: tr.ground_clearance(robot, q)),
-        ("collision_check, one box obstacle", T, lambda: tr.collision_check(robot, q, box)),
+         lambda: interp.joint_trajectory([0, 6, 18, 27, 36], q[[0, 3000, 9000, 13500, -1]])),
+        ("ground_clearance", T, lambda: coll.ground_clearance(robot, q)),
+        ("collision_check, one box obstacle", T, lambda: coll.collision_check(robot, q, box)),
         ("cartesian_interpolation (Eqs. 41-44)", 1000,
-         lambda: tr.cartesian_interpolation(robot, q[9000], q[-1], 1000)),
+         lambda: cart.cartesian_interpolation(robot, q[9000], q[-1], 1000)),
     ]
     print(f"machine: {platform.machine()} {platform.processor() or ''} {os.cpu_count()} CPUs, "
           f"Python {platform.python_version()}, numpy {np.__version__}")
@@ -82,7 +85,7 @@ def main() -> None:
         best, med = timeit(fn, args.repeat)
         print(f"| {name:<50} | {n:>7} | {1000 * best:>9.1f} | {1000 * med:>11.1f} |")
     res = st.dynamic_stability(robot, t, q_moving_base)
-    low = tr.ground_clearance(robot, q)[:, tr.non_base_links(robot)].min(axis=1)
+    low = coll.ground_clearance(robot, q)[:, robot.lifted_links].min(axis=1)
     print(f"\nscenario: dynamically stable={res.stable}, min ZMP margin {res.min_margin * 1000:.1f} mm "
           f"at t = {t[res.argmin]:.2f} s; lowest neck/head box point {low.min() * 1000:.1f} mm "
           f"at t = {t[np.argmin(low)]:.2f} s (joint-space lift)")

@@ -19,10 +19,11 @@ import time
 
 import numpy as np
 
-from snakehead import SnakeRobot
-from snakehead import workspace as ws
-from snakehead.report import cpu_name
+from snakehead import SnakeRobot, default_robot_file
+from snakehead.app.report import cpu_name
+from snakehead.kinematics import workspace as ws
 
+ROBOT_FILES = {"head": "snake16.toml", "head6": "snake16_head6.toml"}  # beside the default robot
 PAPER = {  # Table 2 and Section 2.2 of the paper
     "head": {"bins": [8.22, 15.87, 16.96, 25.80, 33.15], "max": 100.0, "above90": 14.79, "at100": 3.69},
     "head6": {"bins": [29.82, 31.28, 28.14, 10.76, 0.0], "max": 76.0, "above90": 0.0, "at100": 0.0},
@@ -38,7 +39,7 @@ def table2() -> None:
     print("| head | voxels | [0,20) | [20,40) | [40,60) | [60,80) | [80,100] | max | > 90 | = 100 |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for part, label in (("head", "7 DOF"), ("head6", "6 DOF")):
-        m = ws.default_map(part)
+        m = ws.map_for(SnakeRobot.from_file(default_robot_file().with_name(ROBOT_FILES[part])))
         _, pct = m.histogram()
         d = m.indices
         print(f"| {label} (ours) | {len(m)} | " + " | ".join(f"{p:.2f} %" for p in pct)
@@ -46,7 +47,7 @@ def table2() -> None:
         p = PAPER[part]
         print(f"| {label} (paper) | | " + " | ".join(f"{x:.2f} %" for x in p["bins"])
               + f" | {p['max']:.0f} | {p['above90']:.2f} % | {p['at100']:.2f} % |")
-    m = ws.default_map("head")
+    m = ws.map_for(SnakeRobot.default())
     c = m.clusters(k=3)
     print(f"\nG0 of the 7-DOF head (rule '{c.rule}', neck_end frame): {np.round(c.center, 4).tolist()} m; "
           f"cluster sizes {c.sizes.tolist()}; centroids {np.round(c.centroids, 3).tolist()}")

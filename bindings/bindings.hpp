@@ -7,4 +7,5 @@ namespace snakehead::bindings {
 void bind_model(pybind11::module_& m);
 void bind_trac_ik(pybind11::module_& m);
 void bind_workspace(pybind11::module_& m);
+void bind_support(pybind11::module_& m);
 }  // namespace snakehead::bindings

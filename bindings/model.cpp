@@ -35,6 +35,8 @@ const char* type_name(JointType t) {
 }  // namespace
 
 void bind_model(py::module_& m) {
+  m.def("urdf_root_link", &urdf_root_link, py::arg("urdf"),
+        "The root link of a URDF (an XML document or a file path)");
   py::class_<ChainModel>(m, "ChainModel", "Immutable serial chain between two links of a URDF.")
       .def_static("from_urdf", &ChainModel::from_urdf, py::arg("urdf"), py::arg("base"), py::arg("tip"),
                   "urdf: an XML document or a file path")

@@ -5,4 +5,5 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
+  snakehead::bindings::bind_support(m);
 }

@@ -93,7 +93,9 @@ ChainModel ChainModel::from_urdf_file(const std::string& path, const std::string
   return from_urdf_string(buffer.str(), base, tip);
 }
 
-ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::string& base, const std::string& tip) {
+namespace {
+
+urdf::ModelInterfaceSharedPtr parse_document(const std::string& xml) {
   urdf::ModelInterfaceSharedPtr robot;
   try {
     robot = urdf::parseURDF(xml);
@@ -101,6 +103,30 @@ ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::strin
     throw InputError(std::string("malformed URDF: ") + e.what());
   }
   if (!robot) throw InputError("malformed URDF: urdfdom could not parse the document (not a valid <robot> description)");
+  return robot;
+}
+
+std::string read_document(const std::string& urdf) {
+  const auto first = urdf.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && urdf[first] == '<') return urdf;
+  std::ifstream in(urdf);
+  if (!in) throw InputError("cannot read URDF file '" + urdf + "': no such file or not readable");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+}  // namespace
+
+std::string urdf_root_link(const std::string& urdf) {
+  const auto robot = parse_document(read_document(urdf));
+  const auto root = robot->getRoot();
+  if (!root) throw InputError("the URDF has no root link");
+  return root->name;
+}
+
+ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::string& base, const std::string& tip) {
+  const urdf::ModelInterfaceSharedPtr robot = parse_document(xml);
   if (base == tip) throw InputError("base and tip are the same link '" + base + "': a chain needs two links");
   const auto base_link = robot->getLink(base);
   if (!base_link) throw InputError("unknown base link '" + base + "' in URDF robot '" + robot->getName() + "'");

@@ -10,7 +10,8 @@ import pytest
 from scipy import optimize
 from scipy.spatial import ConvexHull
 
-from snakehead import BasePlacement, SnakeRobot, stability
+from snakehead import BasePlacement, SnakeRobot
+from snakehead.dynamics import stability
 from snakehead import backbone as bb
 
 L_BASE = 0.646  # tail end to P0 on the default robot (m)
@@ -44,12 +45,12 @@ def point_index(robot, name):
 # layout and interval mapping
 # ------------------------------------------------------------------------------------------------
 def test_joint_layout_of_default_robot(robot):
-    lay = bb.joint_layout(robot)
     expected = 0.0405 + 0.0865 * np.arange(16)
-    np.testing.assert_allclose(lay.s, expected, atol=1e-12)
-    assert lay.kinds == tuple("yaw" if i % 2 == 0 else "pitch" for i in range(16))
-    assert lay.length == pytest.approx(1.384, abs=1e-12)
-    assert bb.base_length(robot) == pytest.approx(L_BASE, abs=1e-12)
+    np.testing.assert_allclose(robot.joint_arc_lengths, expected, atol=1e-12)
+    assert robot.joint_kinds == tuple("yaw" if i % 2 == 0 else "pitch" for i in range(16))
+    np.testing.assert_array_equal(robot.joint_signs, 1.0)
+    assert robot.body_length == pytest.approx(1.384, abs=1e-12)
+    assert robot.base_length == pytest.approx(L_BASE, abs=1e-12)
     assert bb.up_length(robot) == pytest.approx(0.738, abs=1e-12)
 
 
@@ -230,8 +231,7 @@ def test_helix_gives_yaw_and_pitch_and_fk_follows_it(robot):
         assert np.abs(q[0::2]).min() > 1e-3 and np.abs(q[1::2]).min() > 1e-3  # yaw and pitch both bend
         # closed form of every joint's angle (Eqs. 5-6 with the intervals of joint_intervals)
         kappa0, tau0 = a / (a * a + b * b), b / (a * a + b * b)
-        lay = bb.joint_layout(robot)
-        iv = bb.joint_intervals(lay.s, lay.kinds, lay.length)  # the curve is cut at the head tip
+        iv = bb.joint_intervals(robot.joint_arc_lengths, robot.joint_kinds, robot.body_length)  # cut at the tip
         p1, p2 = phi0 + tau0 * iv[:, 0], phi0 + tau0 * iv[:, 1]
         ty = kappa0 / tau0 * (np.sin(p2) - np.sin(p1))
         tp = -kappa0 / tau0 * (np.cos(p2) - np.cos(p1))
@@ -239,7 +239,7 @@ def test_helix_gives_yaw_and_pitch_and_fk_follows_it(robot):
         np.testing.assert_allclose(q[1::2], -tp[1::2], atol=1e-8)  # pitch joint = -theta_p (axis +y)
         # FK in the root frame against the helix expressed in the body frame at its start
         P = robot.body.fk_all(q)[:, :3, 3]
-        lay_s = np.concatenate([[0.0], lay.s, [lay.length]])
+        lay_s = np.concatenate([[0.0], robot.joint_arc_lengths, [robot.body_length]])
         names = ["link_0"] + [robot.link_names[i] for i in robot.body.model.joint_child_links] + ["head_tip"]
         Pj = np.array([P[point_index(robot, n)] for n in names])
         H = np.array([R0.T @ (c.point(c.t_at(s)) - c.point(0.0)) for s in lay_s])
@@ -459,7 +459,7 @@ def test_curve_that_starts_straight(robot):
 def test_figures(tmp_path, default_backbone):
     import matplotlib.pyplot as plt
 
-    from snakehead import backbone_plots as bp
+    from snakehead.viz import backbone as bp
 
     figs = [bp.plot_arc_discretisation(central_angle=2.0, path=tmp_path / "fig3.png"),
             bp.plot_initial_configuration(default_backbone, path=tmp_path / "fig14.png"),

@@ -7,6 +7,7 @@ import pytest
 
 import snakehead
 from snakehead import Chain, SnakeRobot
+from conftest import head6_robot
 
 SNAKE = str(snakehead.default_urdf_path())
 CHAINS = [
@@ -97,7 +98,7 @@ def test_default_robot_parts_and_frames():
     assert {"base_end", "neck_end"} <= set(names)
     assert [robot.body.joint_names[i] for i in range(16)[robot.parts.base]] == [f"joint_{i}" for i in range(1, 8)]
     assert [robot.body.joint_names[i] for i in range(16)[robot.parts.neck]] == ["joint_8", "joint_9"]
-    assert robot.head_chain.n_joints == 7 and robot.head6_chain.n_joints == 6
+    assert robot.head_chain.n_joints == 7 and head6_robot().head_chain.n_joints == 6
     np.testing.assert_allclose(robot.lower, -np.pi / 2)
     np.testing.assert_allclose(robot.upper, np.pi / 2)
     assert robot.total_mass == pytest.approx(3.2, abs=1e-9)

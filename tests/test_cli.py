@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead import BasePlacement, SnakeRobot
+from snakehead import BasePlacement, SnakeRobot, default_robot_file
 
 HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
 SCENARIO_FILES = ["{}_trajectory.csv", "{}_snapshots.png", "{}_momenta.png", "{}_zmp.png", "{}.gif"]
@@ -123,7 +123,7 @@ def test_hole_simulated_with_the_wall(demo):
     _, _, rep = demo
     if not HAVE_MUJOCO:
         pytest.skip("MuJoCo not installed")
-    assert any("boxes" in s["stage"] and "0 obstacle" not in s["stage"] and s["stage"].startswith("hole")
+    assert any("MuJoCo" in s["stage"] and "(1 obstacle)" in s["stage"] and s["stage"].startswith("hole")
                for s in rep["stages"])
 
 
@@ -192,14 +192,15 @@ def test_plan_writes_the_same_kinds_of_files(plan):
 # workspace, help, bad arguments
 # ------------------------------------------------------------------------------------------------
 def test_workspace_writes_a_map(tmp_path):
-    from snakehead import workspace
+    from snakehead.kinematics import workspace
 
     path = tmp_path / "map.npz"
-    proc = run("workspace", "--out", str(path), "--part", "head6", "--voxel", "0.2", "--directions", "2",
+    head6 = default_robot_file().with_name("snake16_head6.toml")
+    proc = run("workspace", "--out", str(path), "--robot", str(head6), "--voxel", "0.2", "--directions", "2",
                "--rolls", "1", "--quiet")
     assert proc.returncode == 0, proc.stderr
     m = workspace.load(path)
-    assert m.chain_hash == SnakeRobot.default().head6_chain.hash
+    assert m.chain_hash == SnakeRobot.from_file(head6).head_chain.hash
     assert m.voxel_size == 0.2 and m.params["directions"] == 2
     assert str(path) in proc.stdout
 
@@ -243,7 +244,11 @@ BAD = [
     (["workspace", "--out", "{tmp}/map.txt"], ".npz"),
     (["workspace", "--out", "{tmp}/nowhere/map.npz"], "does not exist"),
     (["workspace", "--out", "{tmp}/map.npz", "--voxel", "-0.1"], "positive"),
-    (["workspace", "--out", "{tmp}/map.npz", "--part", "tail"], "invalid choice"),
+    (["workspace", "--out", "{tmp}/map.npz", "--robot", "{tmp}/missing.toml"], "does not exist"),
+    (["info", "--robot", "{file}"], "not valid TOML"),
+    (["plan", "--scene", "{tmp}/missing.toml", "--out", "{tmp}/o"], "does not exist"),
+    (["plan", "--scene", "{file}", "--position", "0", "0.5", "0.3", "--out", "{tmp}/o"], "not both"),
+    (["plan", "--out", "{tmp}/o"], "--position"),
     (["workspace", "--out", "{tmp}/map.npz", "--shard", "3/2", "--quiet"], "shard"),
 ]
 

@@ -2,9 +2,11 @@
 import numpy as np
 import pytest
 
-from snakehead import SnakeRobot, stability
-from snakehead import scenarios as sc
-from snakehead.controller import HeadController
+from snakehead import SnakeRobot
+from snakehead.dynamics import stability
+from snakehead.scenes import paper_scene
+from snakehead.control.controller import HeadController
+from conftest import head6_robot
 
 
 @pytest.fixture(scope="module")
@@ -26,12 +28,18 @@ def check_solution(robot, sol, position, direction):
     np.testing.assert_allclose(T, sol.head_frame, atol=1e-12)
     assert np.all(sol.q >= robot.lower - 1e-12) and np.all(sol.q <= robot.upper + 1e-12)
     margin = stability.static_margin(robot, sol.q, sol.base)
-    assert sol.static_margin == pytest.approx(margin, abs=1e-12)
+    assert sol.static_margin_m == pytest.approx(margin, abs=1e-12)
     assert sol.static_stable == (margin > 0)
 
 
+SPHERES = paper_scene("spheres").targets
+SPHERE_1, SPHERE_2 = SPHERES[0].position, SPHERES[2].position
+SPHERE_DIRECTION = SPHERES[0].direction
+HOLE = paper_scene("hole").obstacles[0]
+
+
 @pytest.mark.parametrize("position,direction", [
-    (sc.SPHERE_1, sc.SPHERE_DIRECTION), (sc.SPHERE_2, sc.SPHERE_DIRECTION), (sc.HOLE_CENTRE, sc.HOLE_AXIS),
+    (SPHERE_1, SPHERE_DIRECTION), (SPHERE_2, SPHERE_DIRECTION), (HOLE.centre, HOLE.normal),
 ])
 def test_paper_targets(controller, robot, position, direction):
     sol = controller.solve(position, direction)
@@ -65,8 +73,8 @@ def test_random_reachable_targets_are_verified_by_fk(robot):
 
 def test_keeps_closest_to_previous_joints(robot):
     controller = HeadController(robot, method="rotated", n_frames=12, seed=1)
-    first = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION)
-    moved = controller.solve(sc.SPHERE_2 + [0.0, -0.01, 0.0], sc.SPHERE_DIRECTION, q_prev=first.q)
+    first = controller.solve(SPHERE_2, SPHERE_DIRECTION)
+    moved = controller.solve(SPHERE_2 + [0.0, -0.01, 0.0], SPHERE_DIRECTION, q_prev=first.q)
     assert moved.success
     cands = moved.head.candidates
     dists = [np.linalg.norm(q - first.q[robot.parts.head]) for _, q in cands]
@@ -82,9 +90,9 @@ def test_unreachable_target_fails_with_a_reason(robot):
 
 def test_accept_hook_filters_solutions(robot):
     controller = HeadController(robot, method="rotated", n_frames=6, seed=0)
-    sol = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION, accept=lambda q, base: False)
+    sol = controller.solve(SPHERE_2, SPHERE_DIRECTION, accept=lambda q, base: False)
     assert not sol.success and "acceptance" in sol.message
-    low = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION, accept=lambda q, base: q[12] > 0)
+    low = controller.solve(SPHERE_2, SPHERE_DIRECTION, accept=lambda q, base: q[12] > 0)
     if low.success:
         assert low.q[12] > 0
 
@@ -102,10 +110,10 @@ def test_bad_construction(robot, kwargs, message):
 
 
 def test_map_of_another_chain_is_rejected(robot):
-    from snakehead import workspace
+    from snakehead.kinematics import workspace
 
     with pytest.raises(ValueError, match="another head chain"):
-        HeadController(robot, workspace_map=workspace.default_map("head6"))
+        HeadController(robot, workspace_map=workspace.map_for(head6_robot()))
 
 
 @pytest.mark.parametrize("position,direction,message", [
@@ -123,10 +131,10 @@ def test_bad_solve_input(robot, position, direction, message):
 
 
 def test_solution_figure(robot, tmp_path):
-    from snakehead import scenario_plots
+    from snakehead.viz import scenario as scenario_plots
 
     controller = HeadController(robot, method="free_roll", seed=0)
-    sol = controller.solve(sc.SPHERE_2, sc.SPHERE_DIRECTION)
+    sol = controller.solve(SPHERE_2, SPHERE_DIRECTION)
     path = scenario_plots.plot_head_solution(robot, sol, tmp_path / "solution.png")
     assert path.exists() and path.stat().st_size > 20_000
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

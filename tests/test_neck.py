@@ -4,7 +4,7 @@ import pytest
 from scipy.optimize import minimize
 
 from snakehead import BasePlacement, SnakeRobot
-from snakehead import neck as nk
+from snakehead.control import neck as nk
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +36,7 @@ def test_dexterous_distance():
 
 
 def test_neck_length_is_two_modules(robot):
-    assert nk.neck_length(robot) == pytest.approx(2 * 0.0865)
+    assert robot.neck_length == pytest.approx(2 * 0.0865)
 
 
 def test_solve_neck_matches_a_general_minimiser(robot):
@@ -77,7 +77,7 @@ def test_solve_neck_exact_when_goal_is_reachable(robot):
     # P_d = B and r_d = x-axis of B only when B's x-axis points away from P0 along the line; build such a goal
     goal = nk.NeckGoal(P0=P0[:3, 3], G0=B[:3, 3] + 0.25 * B[:3, 0], Lc=0.25, r_d=B[:3, 0], P_d=B[:3, 3])
     sol = nk.solve_neck(neck, P0, goal)
-    assert sol.position_error < 1e-8
+    assert sol.position_error_m < 1e-8
     assert sol.direction_error_deg < 1e-5
     np.testing.assert_allclose(sol.q, qn, atol=1e-6)
 
@@ -94,11 +94,11 @@ def test_accepted_range():
 def test_base_move_brings_target_in_range(robot):
     q = curled_base(robot)
     base = BasePlacement(0.0, 0.0, 0.0)
-    P0_local = np.linalg.inv(base.matrix()) @ robot.frame(q, "base_end", base)
-    Lc, length, slack = 0.3, nk.neck_length(robot), 0.1
+    P0_local = np.linalg.inv(robot.root_pose(base)) @ robot.frame(q, "base_end", base)
+    Lc, length, slack = 0.3, robot.neck_length, 0.1
     for target in ([2.0, 1.0, 0.3], [-1.0, 0.5, 0.35], [-0.05, 0.42, 0.25]):
         assert not nk.accepted_range(target, robot.frame(q, "base_end", base)[:3, 3], Lc, length, slack).accepted
-        moved = nk.base_move_into_range(target, P0_local, base, Lc, length, slack)
+        moved = nk.base_move_into_range(target, P0_local, base, Lc, length, slack, robot.body_axis_height)
         P0 = robot.frame(q, "base_end", moved)
         check = nk.accepted_range(target, P0[:3, 3], Lc, length, slack)
         assert check.accepted, check.reason
@@ -112,8 +112,8 @@ def test_base_move_impossible_when_too_high(robot):
     q = curled_base(robot)
     base = BasePlacement()
     P0_local = robot.frame(q, "base_end", base)
-    P0_local = np.linalg.inv(base.matrix()) @ P0_local
-    assert nk.base_move_into_range([0.2, 0.2, 3.0], P0_local, base, 0.3, 0.173, 0.1) is None
+    P0_local = np.linalg.inv(robot.root_pose(base)) @ P0_local
+    assert nk.base_move_into_range([0.2, 0.2, 3.0], P0_local, base, 0.3, 0.173, 0.1, robot.body_axis_height) is None
 
 
 @pytest.mark.parametrize(

@@ -6,7 +6,9 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from snakehead import BasePlacement, SnakeRobot, sim, stability  # noqa: E402
+from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
+from snakehead.sim import tracking  # noqa: E402
+from snakehead.dynamics import stability  # noqa: E402
 
 #: A curled base (yaw joints 0.879 rad) with the neck turned inwards and the head part raised 0.42 m:
 #: statically stable with a ~3 cm margin (endpoints polygon) all along the joint-space path from flat.
@@ -82,8 +84,8 @@ def test_momenta_of_a_state_three_ways(robot):
     s.set_state(d, q, base)
     d.qvel[s.dof_adr] = qd
     mujoco.mj_forward(s.model, d)
-    P, L = sim.momenta_of_state(s, d)
-    P2, L2 = sim.momenta_per_body(s, d)
+    P, L = tracking.momenta_of_state(s, d)
+    P2, L2 = tracking.momenta_per_body(s, d)
     P3, L3 = stability.momenta_from_velocities(robot, q, qd, base)
     np.testing.assert_allclose(P, P2, atol=1e-9)
     np.testing.assert_allclose(L, L2, atol=1e-9)
@@ -103,12 +105,12 @@ def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(robot):
     W = np.ones((robot.n_joints, len(robot.link_names)))
     for j, c in enumerate(robot.body.model.joint_child_links):
         W[j, :c] = 0.0
-    np.testing.assert_allclose(sim.gravity_torques(s, d, W), d.qfrc_bias[s.dof_adr], atol=1e-10)
+    np.testing.assert_allclose(tracking.gravity_torques(s, d, W), d.qfrc_bias[s.dof_adr], atol=1e-10)
     # a flat robot on the ground carries nothing: every link rests on the ground
-    Wflat = sim.carried_weights(robot, robot.frames_many(np.zeros((1, robot.n_joints))))[0]
+    Wflat = tracking.carried_weights(robot, robot.frames_many(np.zeros((1, robot.n_joints))))[0]
     assert np.all(Wflat == 0.0)
     # the raised head part is carried by joint 10 (index 9), the base by nobody
-    Wl = sim.carried_weights(robot, robot.frames_many(Q_LIFTED[None]))[0]
+    Wl = tracking.carried_weights(robot, robot.frames_many(Q_LIFTED[None]))[0]
     head_links = [robot.link_names.index(f"link_{i}") for i in range(10, 17)]
     assert np.all(Wl[9, head_links] == 1.0)
     assert np.all(Wl[:7] == 0.0)
@@ -122,7 +124,7 @@ def held(robot):
     """Hold the raised, statically stable configuration for 1 s."""
     t = np.array([0.0, 1.0])
     q = np.array([Q_LIFTED, Q_LIFTED])
-    return t, q, sim.simulate(robot, t, q, base=BasePlacement(0.1, 0.2, 0.3))
+    return t, q, sim.simulate_trajectory(robot, t, q, base=BasePlacement(0.1, 0.2, 0.3))
 
 
 def test_holding_a_stable_configuration_stays_put(robot, held):
@@ -141,14 +143,14 @@ def test_holding_a_stable_configuration_stays_put(robot, held):
     assert np.linalg.norm(res.com[-1] - c) < 2e-3
     # the ground carries the whole weight
     fz = sum(f[:, 2].sum() for f in res.contact_forces[-10:]) / 10
-    assert fz == pytest.approx(robot.total_mass * sim.GRAVITY, rel=1e-3)
+    assert fz == pytest.approx(robot.total_mass * tracking.GRAVITY, rel=1e-3)
 
 
 @pytest.fixture(scope="module")
 def lift(robot):
     """A slow 3 s lift of the head part from the flat curled pose, then 0.5 s of holding."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 3.0)
-    res = sim.simulate(robot, t, q, torque_limit=10.0, hold=0.5)
+    res = sim.simulate_trajectory(robot, t, q, torque_limit=10.0, hold=0.5)
     return t, q, res
 
 
@@ -158,7 +160,7 @@ def test_contact_zmp_matches_the_momentum_zmp(robot, lift):
     edge = 2
     Pdot = np.gradient(res.P, res.t, axis=0, edge_order=edge)
     Ldot = np.gradient(res.L, res.t, axis=0, edge_order=edge)
-    M, g = robot.total_mass, sim.GRAVITY
+    M, g = robot.total_mass, tracking.GRAVITY
     den = M * g + Pdot[:, 2]
     px = (M * g * res.com[:, 0] - Ldot[:, 1]) / den
     py = (M * g * res.com[:, 1] + Ldot[:, 0]) / den
@@ -194,7 +196,7 @@ def test_weak_servos_cannot_lift_the_head_part(robot):
     """3 N m servos cannot raise the 1.3 kg head part from flat (joint 10 needs ~3.9 N m): the simulation
     shows it. This is why snake16.urdf declares 10 N m (our choice; the paper gives no effort)."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 1.5)
-    res = sim.simulate(robot, t, q, settle=0.1, torque_limit=3.0)
+    res = sim.simulate_trajectory(robot, t, q, settle=0.1, torque_limit=3.0)
     assert res.saturation_fraction > 0.0
     assert res.head_position[-1, 2] < 0.2
 
@@ -203,28 +205,37 @@ def test_weak_servos_cannot_lift_the_head_part(robot):
 # obstacles
 # ------------------------------------------------------------------------------------------------
 def _inside_box(p, ob):
-    c, s, yaw = np.array(ob.center), np.array(ob.size), ob.yaw
-    R = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
-    local = R.T @ (np.asarray(p) - c)
-    return np.all(np.abs(local) <= s / 2 + 1e-12)
+    local = ob.rotation.T @ (np.asarray(p) - ob.centre)
+    return np.all(np.abs(local) <= ob.size / 2 + 1e-12)
 
 
-def test_wall_with_hole(robot):
+def test_wall_with_hole_as_boxes(robot):
+    from snakehead.geometry.obstacles import WallWithHole
+
     centre = np.array([0.2, 0.5, 0.4])
-    boxes = sim.wall_with_hole(centre, hole_diameter=0.07, yaw=0.3)
-    u = np.array([np.cos(0.3), np.sin(0.3), 0.0])
+    normal = np.array([-np.sin(0.3), np.cos(0.3), 0.0])  # the wall turned 0.3 rad about z
+    wall = WallWithHole.standing(centre, normal, (0.7, 0.58, 0.01), 0.07)
+    boxes = sim.obstacle_boxes([wall], hole_slices=8)
+    u = wall.rotation[:, 0]  # across the wall, horizontal
+    assert abs(u[2]) < 1e-12
     assert not any(_inside_box(centre, b) for b in boxes)
     assert not any(_inside_box(centre + 0.03 * u, b) for b in boxes)
     assert any(_inside_box(centre + 0.036 * u, b) for b in boxes)
     assert any(_inside_box(centre + np.array([0, 0, 0.036]), b) for b in boxes)
     assert any(_inside_box(centre + 0.3 * u - np.array([0, 0, 0.35]), b) for b in boxes)  # near the ground
-    area = sum(b.size[0] * b.size[2] for b in boxes)
+    lows = [b.centre[2] - b.size[1] / 2 for b in boxes]
+    assert min(lows) == pytest.approx(0.0, abs=1e-12)  # the wall stands on the ground
+    area = sum(b.size[0] * b.size[1] for b in boxes)
     opening = 0.7 * 0.58 - area  # a staircase inscribed in the circle: smaller, but not by much
     assert 0.75 * np.pi * 0.035**2 < opening < np.pi * 0.035**2
-    s = sim.build_model(robot, obstacles=boxes)
+    s = sim.build_model(robot, obstacles=[wall], hole_slices=8)
     assert s.model.ngeom == 1 + len(boxes) + 17
     with pytest.raises(ValueError, match="hole"):
-        sim.wall_with_hole((0.2, 0.5, 0.01))
+        WallWithHole.standing((0.2, 0.5, 0.01), (0, 1, 0), (0.7, 0.58, 0.01), 0.07)
+    with pytest.raises(ValueError, match="hole_slices"):
+        sim.obstacle_boxes([wall], hole_slices=0)
+    with pytest.raises(TypeError, match="obstacles"):
+        sim.obstacle_boxes(["wall"])
 
 
 # ------------------------------------------------------------------------------------------------
@@ -243,7 +254,7 @@ def test_bad_trajectories(robot, mutate, match):
     q = np.zeros((4, robot.n_joints))
     tt, qq = mutate(t, q)
     with pytest.raises(ValueError, match=match):
-        sim.simulate(robot, tt, qq)
+        sim.simulate_trajectory(robot, tt, qq)
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -256,7 +267,7 @@ def test_bad_parameters(robot, kwargs, match):
     t = np.array([0.0, 0.1])
     q = np.zeros((2, robot.n_joints))
     with pytest.raises(ValueError, match=match):
-        sim.simulate(robot, t, q, **kwargs)
+        sim.simulate_trajectory(robot, t, q, **kwargs)
 
 
 def test_bad_compare_input(robot, held):
@@ -278,7 +289,7 @@ def test_missing_mujoco_names_the_extra(monkeypatch, robot):
 
 
 def test_plots_write_pngs(robot, lift, tmp_path):
-    from snakehead import sim_plots
+    from snakehead.viz import sim as sim_plots
 
     t, q, res = lift
     paths = sim_plots.plot_dynamics_check(robot, t, q, res, tmp_path)

@@ -7,7 +7,10 @@ from scipy.spatial import ConvexHull
 
 import snakehead
 from snakehead import BasePlacement, SnakeRobot
-from snakehead import stability as st
+from snakehead.dynamics import stability as st
+
+#: The default robot's body axis lies half its 0.043 m section above the ground.
+AXIS_HEIGHT = 0.0215
 
 SNAKE = str(snakehead.default_urdf_path())
 
@@ -23,8 +26,13 @@ def pin_model():
     return model, model.createData()
 
 
+def test_body_axis_height_from_the_boxes(robot):
+    assert robot.body_axis_height == pytest.approx(AXIS_HEIGHT, abs=1e-15)
+    np.testing.assert_allclose(robot.root_pose(BasePlacement(0.1, 0.2, 0.3)), BasePlacement(0.1, 0.2, 0.3).matrix(AXIS_HEIGHT))
+
+
 def to_world(base: BasePlacement) -> pin.SE3:
-    M = base.matrix()
+    M = base.matrix(AXIS_HEIGHT)
     return pin.SE3(M[:3, :3], M[:3, 3])
 
 
@@ -215,7 +223,7 @@ def pin_world_momenta(model, data, base, q, v):
     h = pin.computeCentroidalMomentum(model, data, q, v)  # about the moving bodies' CoM, root-frame axes
     c = data.com[0]
     P, L = h.linear, h.angular + np.cross(c, h.linear)
-    M = base.matrix()
+    M = base.matrix(AXIS_HEIGHT)
     Pw = M[:3, :3] @ P
     return Pw, M[:3, :3] @ L + np.cross(M[:3, 3], Pw)
 
@@ -279,7 +287,7 @@ def test_zmp_matches_pinocchio_momentum_rate(robot, pin_model):
     base = BasePlacement(0.1, 0.4, 0.3)
     t, q, qd, qdd = smooth_trajectory(robot, rng, T=300, dt=0.002)
     ours = st.zmp(robot, t, q, base, qd=qd)
-    M = base.matrix()
+    M = robot.root_pose(base)
     R0, p0 = M[:3, :3], M[:3, 3]
     mass = robot.total_mass
     com = st.center_of_mass(robot, q, base)

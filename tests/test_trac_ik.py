@@ -10,7 +10,8 @@ import pytest
 
 import snakehead
 from snakehead import TracIK
-from snakehead.ik import FREE_ROLL, pose_error
+from snakehead.kinematics.ik import FREE_ROLL, pose_error
+from conftest import head6_robot
 
 EPS = 1e-5
 
@@ -22,7 +23,7 @@ def robot():
 
 @pytest.fixture(scope="module", params=["head6", "head7"])
 def chain(request, robot):
-    return robot.head6_chain if request.param == "head6" else robot.head_chain
+    return head6_robot().head_chain if request.param == "head6" else robot.head_chain
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,10 @@ from scipy.optimize import lsq_linear
 from scipy.spatial.transform import Rotation
 
 from snakehead import BasePlacement, SnakeRobot
-from snakehead import trajectory as tr
+from snakehead.geometry import collision as coll
+from snakehead.geometry import obstacles as obs
+from snakehead.motion import cartesian as cart
+from snakehead.motion import interpolation as interp
 
 
 @pytest.fixture(scope="module")
@@ -32,8 +35,8 @@ def test_joint_interpolation_through_waypoints_smooth_and_at_rest():
     rng = np.random.default_rng(0)
     times = np.array([0.0, 1.3, 2.0, 4.1, 5.0])
     wps = rng.uniform(-1, 1, (5, 16))
-    traj = tr.joint_trajectory(times, wps, dt=0.002)
-    t, q = tr.joint_interpolation(times, wps, dt=0.002)
+    traj = interp.joint_trajectory(times, wps, dt=0.002)
+    t, q = interp.joint_interpolation(times, wps, dt=0.002)
     np.testing.assert_array_equal(t, traj.t)
     np.testing.assert_array_equal(q, traj.q)
     # 2 ms samples from the first to the last time
@@ -60,44 +63,44 @@ def test_joint_interpolation_through_waypoints_smooth_and_at_rest():
 
 
 def test_two_waypoints_give_minimum_jerk_quintic():
-    t, q = tr.joint_interpolation([0.0, 2.0], [np.zeros(3), np.array([1.0, -2.0, 0.5])], dt=0.01)
+    t, q = interp.joint_interpolation([0.0, 2.0], [np.zeros(3), np.array([1.0, -2.0, 0.5])], dt=0.01)
     s = t / 2.0
     ref = (10 * s**3 - 15 * s**4 + 6 * s**5)[:, None] * np.array([1.0, -2.0, 0.5])
     np.testing.assert_allclose(q, ref, atol=1e-12)
 
 
 def test_duration_not_a_multiple_of_dt_ends_exactly():
-    t, q = tr.joint_interpolation([0.0, 0.0105], [[0.0], [1.0]], dt=0.002)
+    t, q = interp.joint_interpolation([0.0, 0.0105], [[0.0], [1.0]], dt=0.002)
     assert t[-1] == 0.0105 and q[-1, 0] == 1.0 and np.all(np.diff(t) > 0)
 
 
 def test_joint_limits_overshoot_is_reported():
     wps = np.array([[0.0], [1.5], [1.5], [0.0]])
     with pytest.raises(ValueError, match="overshoots the upper limit"):
-        tr.joint_trajectory([0, 1, 1.2, 2.0], wps, lower=[-1.55], upper=[1.55])
+        interp.joint_trajectory([0, 1, 1.2, 2.0], wps, lower=[-1.55], upper=[1.55])
 
 
 def test_joint_interpolation_bad_input():
     wps = np.zeros((3, 16))
     with pytest.raises(ValueError, match="increase"):
-        tr.joint_interpolation([0, 2, 1], wps)
+        interp.joint_interpolation([0, 2, 1], wps)
     with pytest.raises(ValueError, match="increase"):
-        tr.joint_interpolation([0, 1, 1], wps)
+        interp.joint_interpolation([0, 1, 1], wps)
     with pytest.raises(ValueError, match="shape"):
-        tr.joint_interpolation([0, 1, 2], np.zeros((4, 16)))
+        interp.joint_interpolation([0, 1, 2], np.zeros((4, 16)))
     with pytest.raises(ValueError, match="shape"):
-        tr.joint_interpolation([[0, 1, 2]], wps)
+        interp.joint_interpolation([[0, 1, 2]], wps)
     with pytest.raises(ValueError, match="at least two"):
-        tr.joint_interpolation([0.0], wps[:1])
+        interp.joint_interpolation([0.0], wps[:1])
     with pytest.raises(ValueError, match="NaN"):
-        tr.joint_interpolation([0, np.nan, 2], wps)
+        interp.joint_interpolation([0, np.nan, 2], wps)
     bad = wps.copy()
     bad[1, 3] = np.inf
     with pytest.raises(ValueError, match="NaN or inf"):
-        tr.joint_interpolation([0, 1, 2], bad)
+        interp.joint_interpolation([0, 1, 2], bad)
     for dt in (0.0, -0.002, np.nan):
         with pytest.raises(ValueError, match="dt"):
-            tr.joint_interpolation([0, 1, 2], wps, dt=dt)
+            interp.joint_interpolation([0, 1, 2], wps, dt=dt)
 
 
 # ---------------------------------------------------------------- Eqs. 41-44
@@ -106,7 +109,7 @@ def test_cartesian_interpolation_ends_base_and_points(robot):
     q0 = q0.copy()
     q0[0:7:2] = 0.5  # the base moves too
     base = BasePlacement(0.2, -0.1, 0.4)
-    res = tr.cartesian_interpolation(robot, q0, q1, 50, base, full_output=True)
+    res = cart.cartesian_interpolation(robot, q0, q1, 50, base, full_output=True)
     q = res.q
     assert q.shape == (50, 16)
     np.testing.assert_array_equal(q[0], q0)
@@ -126,14 +129,14 @@ def test_cartesian_interpolation_ends_base_and_points(robot):
     assert res.deviation[17] == pytest.approx(np.linalg.norm(Fk[idx, :3, 3] - res.points[17], axis=1).max())
     assert res.deviation[0] < 1e-12 and res.deviation[-1] < 1e-12
     assert res.max_deviation == pytest.approx(res.deviation.max())
-    np.testing.assert_array_equal(tr.cartesian_interpolation(robot, q0, q1, 50, base), q)
+    np.testing.assert_array_equal(cart.cartesian_interpolation(robot, q0, q1, 50, base), q)
 
 
 def test_cartesian_interpolation_of_a_still_robot_is_still(robot):
     q0, _ = lift_motion(robot)
     q0 = q0.copy()
     q0[[7, 9]] = -0.4, 0.3  # raised a little, so that every link has a well-defined angle
-    res = tr.cartesian_interpolation(robot, q0, q0, 10, full_output=True)
+    res = cart.cartesian_interpolation(robot, q0, q0, 10, full_output=True)
     np.testing.assert_allclose(res.q, np.tile(q0, (10, 1)), atol=1e-12)
     assert res.max_deviation < 1e-12
 
@@ -143,7 +146,7 @@ def test_recovered_angles_reproduce_the_start_without_snapping(robot):
     q0, q1 = lift_motion(robot)
     steps = []
     for n in (50, 200, 800):
-        q = tr.cartesian_interpolation(robot, q0, q1, n)
+        q = cart.cartesian_interpolation(robot, q0, q1, n)
         steps.append(max(np.abs(q[1] - q[0]).max(), np.abs(q[-1] - q[-2]).max()))
     assert steps[0] > steps[1] > steps[2] and steps[2] < 0.005
 
@@ -157,7 +160,7 @@ def test_eq42_literal_and_brute_force_projection(robot):
     l /= np.linalg.norm(l, axis=1, keepdims=True)
     x = np.array([1.0, 0.0, 0.0])
     for axis in (np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])):
-        theta, ok = tr.joint_angle_towards(R0, axis, x, l)
+        theta, ok = cart.joint_angle_towards(R0, axis, x, l)
         assert ok.all()
         Tx, Ty, Tz = R0[:, :, 0], R0[:, :, 1], R0[:, :, 2]
         a = R0 @ axis
@@ -181,7 +184,7 @@ def test_recovered_links_point_along_the_segments(robot):
     q0, q1 = lift_motion(robot)
     q1 = q1.copy()
     q1[[9, 11, 13, 15]] = 0.2
-    res = tr.cartesian_interpolation(robot, q0, q1, 40, full_output=True)
+    res = cart.cartesian_interpolation(robot, q0, q1, 40, full_output=True)
     F = robot.frames_many(res.q)
     model = robot.body.model
     names = robot.link_names
@@ -206,7 +209,7 @@ def test_rigid_rotation_directions_exact_positions_shrink(robot):
     q0 = np.zeros(16)
     q1 = q0.copy()
     q1[7] = -1.0
-    res = tr.cartesian_interpolation(robot, q0, q1, 21, full_output=True)
+    res = cart.cartesian_interpolation(robot, q0, q1, 21, full_output=True)
     s = res.s
     # the straight line from joint 8 rotates rigidly about it; interpolated points lie on the chords
     np.testing.assert_allclose(res.q[:, 7], -np.arctan2(np.sin(1.0) * s, 1 - s + s * np.cos(1.0)), atol=1e-12)
@@ -219,8 +222,8 @@ def test_rigid_rotation_directions_exact_positions_shrink(robot):
 
 def test_aim_at_points_tracks_the_interpolated_points(robot):
     q0, q1 = lift_motion(robot)
-    seg = tr.cartesian_interpolation(robot, q0, q1, 60, full_output=True)
-    pts = tr.cartesian_interpolation(robot, q0, q1, 60, aim="points", full_output=True)
+    seg = cart.cartesian_interpolation(robot, q0, q1, 60, full_output=True)
+    pts = cart.cartesian_interpolation(robot, q0, q1, 60, aim="points", full_output=True)
     np.testing.assert_array_equal(pts.q[[0, -1]], np.stack([q0, q1]))
     assert pts.max_deviation < seg.max_deviation  # aiming at the points keeps closer to them
     # each unclipped link lies in the plane of its joint axis and the line from its actual joint to the next point
@@ -240,44 +243,44 @@ def test_cartesian_interpolation_clears_the_ground_where_joint_space_does_not(ro
     """Fig. 11 vs Fig. 13: the head hits the ground under joint interpolation, not under Eqs. 41-44."""
     q0, q1 = lift_motion(robot)
     n = 200
-    links = tr.non_base_links(robot)
+    links = robot.lifted_links
     # the ends themselves: lying on the ground (touching, clearance 0) and raised clear of it
-    c_end = tr.ground_clearance(robot, np.stack([q0, q1]))[:, links]
+    c_end = coll.ground_clearance(robot, np.stack([q0, q1]))[:, links]
     assert abs(c_end[0].min()) < 1e-12 and c_end[1].min() > 0.01
     q_joint = q0 + (q1 - q0) * np.linspace(0, 1, n)[:, None]
-    joint_clear = tr.ground_clearance(robot, q_joint)[:, links].min(axis=1)
+    joint_clear = coll.ground_clearance(robot, q_joint)[:, links].min(axis=1)
     assert joint_clear.min() < -0.04  # 4 cm into the ground
-    assert tr.below_ground(robot, q_joint).any()
+    assert coll.below_ground(robot, q_joint).any()
     # at the start the neck and head lie on the ground: touching, not below it
-    assert tr.touching_ground(robot, q0)[0, links].all() and not tr.below_ground(robot, q0).any()
-    assert not tr.touching_ground(robot, q1).any()
-    q_cart = tr.cartesian_interpolation(robot, q0, q1, n)
-    cart_clear = tr.ground_clearance(robot, q_cart)[:, links].min(axis=1)
-    assert cart_clear.min() > -tr.GROUND_TOLERANCE
-    assert not tr.below_ground(robot, q_cart).any()
+    assert coll.touching_ground(robot, q0)[0, links].all() and not coll.below_ground(robot, q0).any()
+    assert not coll.touching_ground(robot, q1).any()
+    q_cart = cart.cartesian_interpolation(robot, q0, q1, n)
+    cart_clear = coll.ground_clearance(robot, q_cart)[:, links].min(axis=1)
+    assert cart_clear.min() > -coll.GROUND_TOLERANCE
+    assert not coll.below_ground(robot, q_cart).any()
     # the base stays on the ground throughout
     base_links = [robot.link_names.index(f"link_{i}") for i in range(8)]
-    np.testing.assert_allclose(tr.ground_clearance(robot, q_cart)[:, base_links], 0.0, atol=1e-12)
+    np.testing.assert_allclose(coll.ground_clearance(robot, q_cart)[:, base_links], 0.0, atol=1e-12)
 
 
 def test_cartesian_interpolation_bad_input(robot):
     q = np.zeros(16)
     with pytest.raises(ValueError, match="n must be"):
-        tr.cartesian_interpolation(robot, q, q, 1)
+        cart.cartesian_interpolation(robot, q, q, 1)
     with pytest.raises(ValueError, match="n must be"):
-        tr.cartesian_interpolation(robot, q, q, 2.5)
+        cart.cartesian_interpolation(robot, q, q, 2.5)
     with pytest.raises(ValueError, match="shape"):
-        tr.cartesian_interpolation(robot, q[:15], q, 5)
+        cart.cartesian_interpolation(robot, q[:15], q, 5)
     with pytest.raises(ValueError, match="NaN"):
-        tr.cartesian_interpolation(robot, q, np.full(16, np.nan), 5)
+        cart.cartesian_interpolation(robot, q, np.full(16, np.nan), 5)
     with pytest.raises(ValueError, match="aim"):
-        tr.cartesian_interpolation(robot, q, q, 5, aim="sideways")
+        cart.cartesian_interpolation(robot, q, q, 5, aim="sideways")
 
 
 # ---------------------------------------------------------------- ground clearance
 def test_ground_clearance_closed_form(robot):
     q = np.zeros(16)
-    c = tr.ground_clearance(robot, q)
+    c = coll.ground_clearance(robot, q)
     boxed = np.all(robot.box_sizes > 0, axis=1)
     np.testing.assert_allclose(c[0, boxed], 0.0, atol=1e-15)
     assert np.all(np.isinf(c[0, ~boxed]))
@@ -286,28 +289,28 @@ def test_ground_clearance_closed_form(robot):
     # distal bottom corner higher, so the lowest point of link_8 is h/2 (1 - cos theta) above the ground
     th = 0.6
     q[7] = -th
-    c = tr.ground_clearance(robot, q)[0]
+    c = coll.ground_clearance(robot, q)[0]
     k = robot.link_names.index("link_8")
     assert c[k] == pytest.approx(0.0215 * (1 - np.cos(th)), abs=1e-12)
     # and the head, bent down by 2 theta at joint 10 after the 2-link neck, dips this far
     q[9] = 2 * th
-    c = tr.ground_clearance(robot, q)[0]
+    c = coll.ground_clearance(robot, q)[0]
     k10 = robot.link_names.index("link_10")
     z_joint = 0.0215 + 2 * 0.0865 * np.sin(th)  # height of joint 10 (link_8, link_9 both at angle theta)
     # link_10 points down at angle theta; its lowest corner is the distal bottom one
     ref = z_joint - 0.0865 * np.sin(th) - 0.0215 * np.cos(th)
     assert c[k10] == pytest.approx(ref, abs=1e-12)
     # a batch gives the same rows
-    np.testing.assert_allclose(tr.ground_clearance(robot, np.stack([q, q]))[1], c, atol=0)
+    np.testing.assert_allclose(coll.ground_clearance(robot, np.stack([q, q]))[1], c, atol=0)
 
 
 def test_ground_clearance_bad_input(robot):
     with pytest.raises(ValueError, match="shape"):
-        tr.ground_clearance(robot, np.zeros((3, 15)))
+        coll.ground_clearance(robot, np.zeros((3, 15)))
     with pytest.raises(ValueError, match="NaN"):
-        tr.ground_clearance(robot, np.full((3, 16), np.nan))
+        coll.ground_clearance(robot, np.full((3, 16), np.nan))
     with pytest.raises(TypeError):
-        tr.ground_clearance(robot, np.zeros(16), base="origin")
+        coll.ground_clearance(robot, np.zeros(16), base="origin")
 
 
 # ---------------------------------------------------------------- obstacles
@@ -329,8 +332,8 @@ def test_box_box_distance_against_optimisation():
     rng = np.random.default_rng(0)
     ca, Ra, ha = random_boxes(rng, 200)
     cb, Rb, hb = random_boxes(rng, 200)
-    d = tr.box_box_distance(ca, Ra, ha, cb, Rb, hb)
-    sat = tr.box_box_sat(ca, Ra, ha, cb, Rb, hb)
+    d = coll.box_box_distance(ca, Ra, ha, cb, Rb, hb)
+    sat = coll.box_box_sat(ca, Ra, ha, cb, Rb, hb)
     n_apart = 0
     for k in range(200):
         ref = brute_box_distance(ca[k], Ra[k], ha[k], cb[k], Rb[k], hb[k])
@@ -348,7 +351,7 @@ def test_box_box_sat_against_generic_projection():
     rng = np.random.default_rng(9)
     ca, Ra, ha = random_boxes(rng, 100)
     cb, Rb, hb = random_boxes(rng, 100)
-    got = tr.box_box_sat(ca, Ra, ha, cb, Rb, hb)
+    got = coll.box_box_sat(ca, Ra, ha, cb, Rb, hb)
     for k in range(100):
         axes = [Ra[k][:, i] for i in range(3)] + [Rb[k][:, j] for j in range(3)]
         axes += [np.cross(Ra[k][:, i], Rb[k][:, j]) for i in range(3) for j in range(3)]
@@ -357,8 +360,8 @@ def test_box_box_sat_against_generic_projection():
             if np.linalg.norm(L) < 1e-9:
                 continue
             L = L / np.linalg.norm(L)
-            va = ca[k] + (tr._SIGNS * ha[k]) @ Ra[k].T  # the 8 corners
-            vb = cb[k] + (tr._SIGNS * hb[k]) @ Rb[k].T
+            va = ca[k] + (coll._SIGNS * ha[k]) @ Ra[k].T  # the 8 corners
+            vb = cb[k] + (coll._SIGNS * hb[k]) @ Rb[k].T
             pa, pb = va @ L, vb @ L
             gaps.append(max(pb.min() - pa.max(), pa.min() - pb.max()))
         assert got[k] == pytest.approx(max(gaps), abs=1e-12)
@@ -368,10 +371,10 @@ def test_box_box_penetration_depth_closed_form():
     # two axis-aligned unit cubes overlapping by 0.1 along x: depth 0.1
     I = np.eye(3)
     h = np.full(3, 0.5)
-    assert tr.box_box_distance([0, 0, 0], I, h, [0.9, 0.2, 0], I, h) == pytest.approx(-0.1)
-    assert tr.box_box_distance([0, 0, 0], I, h, [1.3, 0.0, 0], I, h) == pytest.approx(0.3)
+    assert coll.box_box_distance([0, 0, 0], I, h, [0.9, 0.2, 0], I, h) == pytest.approx(-0.1)
+    assert coll.box_box_distance([0, 0, 0], I, h, [1.3, 0.0, 0], I, h) == pytest.approx(0.3)
     # corner to corner along the diagonal
-    assert tr.box_box_distance([0, 0, 0], I, h, [1.5, 1.5, 1.5], I, h) == pytest.approx(np.sqrt(3) * 0.5)
+    assert coll.box_box_distance([0, 0, 0], I, h, [1.5, 1.5, 1.5], I, h) == pytest.approx(np.sqrt(3) * 0.5)
 
 
 def wall_solid_contains(wall, p):
@@ -383,14 +386,14 @@ def wall_solid_contains(wall, p):
 
 def test_box_wall_collision_against_dense_sampling():
     rng = np.random.default_rng(1)
-    wall = tr.WallWithHole([0.2, 0.5, 0.4], [0, 1, 0], (0.7, 0.58, 0.01), 0.07)
+    wall = obs.WallWithHole([0.2, 0.5, 0.4], [0, 1, 0], (0.7, 0.58, 0.01), 0.07)
     n = 200
     # link-sized boxes near the hole, randomly placed and turned
     c = wall.centre + rng.normal(scale=[0.04, 0.05, 0.04], size=(n, 3))
     R = Rotation.random(n, random_state=rng).as_matrix()
     R[: n // 2] = Rotation.from_euler("z", rng.normal(90, 8, (n // 2, 1)), degrees=True).as_matrix()  # along the axis
     h = np.array([0.0865, 0.043, 0.043]) / 2
-    got = tr.box_wall_collision(c, R, np.broadcast_to(h, (n, 3)), wall)
+    got = coll.box_wall_collision(c, R, np.broadcast_to(h, (n, 3)), wall)
     g = np.linspace(-1, 1, 31)
     grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     n_hit = 0
@@ -406,13 +409,13 @@ def test_box_wall_collision_against_dense_sampling():
     assert 20 < n_hit < n - 20
     # boxes passing straight through the middle of the hole do not collide; one beside it does
     Rx = np.column_stack([[0, 1, 0], [-1, 0, 0], [0, 0, 1]])
-    assert not tr.box_wall_collision(wall.centre, Rx, h, wall)
-    assert tr.box_wall_collision(wall.centre + [0.03, 0, 0], Rx, h, wall)
-    assert not tr.box_wall_collision(wall.centre + [0.0, 0.2, 0], Rx, h, wall)  # in front of the wall
+    assert not coll.box_wall_collision(wall.centre, Rx, h, wall)
+    assert coll.box_wall_collision(wall.centre + [0.03, 0, 0], Rx, h, wall)
+    assert not coll.box_wall_collision(wall.centre + [0.0, 0.2, 0], Rx, h, wall)  # in front of the wall
 
 
 def test_wall_point_distance_closed_form():
-    wall = tr.WallWithHole([0, 0, 0.4], [1, 0, 0], (0.6, 0.5, 0.02), 0.1)
+    wall = obs.WallWithHole([0, 0, 0.4], [1, 0, 0], (0.6, 0.5, 0.02), 0.1)
     # wall axes: width along world -y or +y, height along z, normal along x
     assert wall.distance_to_points([0.0, 0.0, 0.4]) == pytest.approx(0.05)  # hole centre: to the rim
     assert wall.distance_to_points([0.11, 0.0, 0.4]) == pytest.approx(np.hypot(0.05, 0.1))  # in front of it
@@ -423,31 +426,31 @@ def test_wall_point_distance_closed_form():
 
 def test_collision_check_on_the_robot(robot):
     q0, q1 = lift_motion(robot)
-    qs = tr.cartesian_interpolation(robot, q0, q1, 30)
+    qs = cart.cartesian_interpolation(robot, q0, q1, 30)
     F = robot.frames(q1)
     tip = F[robot.link_names.index("head_tip"), :3, 3]
-    box = tr.BoxObstacle(tip + [0.0, 0.0, 0.1], [0.1, 0.1, 0.05])  # 10 cm over the final head tip
-    ground_box = tr.BoxObstacle([0, 0, -0.05], [5, 5, 0.1])  # the ground as a box: the base touches it
-    rep = tr.collision_check(robot, qs, [box, ground_box], exact_within=np.inf)
+    box = obs.BoxObstacle(tip + [0.0, 0.0, 0.1], [0.1, 0.1, 0.05])  # 10 cm over the final head tip
+    ground_box = obs.BoxObstacle([0, 0, -0.05], [5, 5, 0.1])  # the ground as a box: the base touches it
+    rep = coll.collision_check(robot, qs, [box, ground_box], exact_within=np.inf)
     assert rep.link_distance.shape == (30, 17, 2)
     assert rep.collides.all()  # the base lies on the ground box
     assert not rep.link_collides[..., 0].any()
     d_box = rep.link_distance[..., 0].min(1)
     assert d_box[-1] == pytest.approx(0.1 - 0.025 - 0.0, abs=0.05) and d_box.min() > 0
     # consistent with ground_clearance for the ground box (distance = clearance for boxes above it)
-    clear = tr.ground_clearance(robot, qs)[:, rep.links]
+    clear = coll.ground_clearance(robot, qs)[:, rep.links]
     np.testing.assert_allclose(np.maximum(rep.link_distance[..., 1], 0), np.maximum(clear, 0), atol=1e-12)
     # a wall: sampled distance is an upper bound within the spacing of the exact clearance to the slab
-    wall = tr.WallWithHole([0.6, 0.4, 0.2], [1, 0, 0], (0.4, 0.3, 0.01), 0.07)  # beyond the body (x < 0.23)
-    rep2 = tr.collision_check(robot, qs, wall, spacing=0.004, exact_within=1.0)
+    wall = obs.WallWithHole([0.6, 0.4, 0.2], [1, 0, 0], (0.4, 0.3, 0.01), 0.07)  # beyond the body (x < 0.23)
+    rep2 = coll.collision_check(robot, qs, wall, spacing=0.004, exact_within=1.0)
     assert not rep2.collides.any()
     slab = wall.slab()
-    links, c, R, h = tr._link_boxes(robot, qs, BasePlacement())
-    exact = tr.box_box_distance(c, R, h[None], slab.centre, slab.rotation, slab.size / 2)
+    links, c, R, h = coll._link_boxes(robot, qs, BasePlacement())
+    exact = coll.box_box_distance(c, R, h[None], slab.centre, slab.rotation, slab.size / 2)
     near = exact.min(1)
     assert np.all(rep2.distance >= near - 1e-12) and np.all(rep2.distance <= near + 0.004)
     # with the default band, distances beyond it are lower bounds above it; inside it they are exact
-    rep3 = tr.collision_check(robot, qs, [box, ground_box], exact_within=0.05)
+    rep3 = coll.collision_check(robot, qs, [box, ground_box], exact_within=0.05)
     exact3 = rep.link_distance
     band = exact3 <= 0.05
     np.testing.assert_array_equal(rep3.link_distance[band], exact3[band])
@@ -456,44 +459,44 @@ def test_collision_check_on_the_robot(robot):
 
 def test_obstacle_bad_input(robot):
     with pytest.raises(ValueError, match="size"):
-        tr.BoxObstacle([0, 0, 0], [1, -1, 1])
+        obs.BoxObstacle([0, 0, 0], [1, -1, 1])
     with pytest.raises(ValueError, match="rotation"):
-        tr.BoxObstacle([0, 0, 0], [1, 1, 1], np.ones((3, 3)))
+        obs.BoxObstacle([0, 0, 0], [1, 1, 1], np.ones((3, 3)))
     with pytest.raises(ValueError, match="NaN"):
-        tr.BoxObstacle([0, np.nan, 0], [1, 1, 1])
+        obs.BoxObstacle([0, np.nan, 0], [1, 1, 1])
     with pytest.raises(ValueError, match="zero length"):
-        tr.WallWithHole([0, 0, 0], [0, 0, 0], (1, 1, 0.01), 0.1)
+        obs.WallWithHole([0, 0, 0], [0, 0, 0], (1, 1, 0.01), 0.1)
     with pytest.raises(ValueError, match="inside the wall"):
-        tr.WallWithHole([0, 0, 0], [1, 0, 0], (0.1, 0.1, 0.01), 0.2)
+        obs.WallWithHole([0, 0, 0], [1, 0, 0], (0.1, 0.1, 0.01), 0.2)
     with pytest.raises(ValueError, match="hole_diameter"):
-        tr.WallWithHole([0, 0, 0], [1, 0, 0], (1, 1, 0.01), -0.1)
+        obs.WallWithHole([0, 0, 0], [1, 0, 0], (1, 1, 0.01), -0.1)
     with pytest.raises(ValueError, match="no obstacles"):
-        tr.collision_check(robot, np.zeros((2, 16)), [])
+        coll.collision_check(robot, np.zeros((2, 16)), [])
     with pytest.raises(TypeError):
-        tr.collision_check(robot, np.zeros((2, 16)), ["a wall"])
+        coll.collision_check(robot, np.zeros((2, 16)), ["a wall"])
     with pytest.raises(ValueError, match="shape"):
-        tr.collision_check(robot, np.zeros((2, 17)), tr.BoxObstacle([0, 0, 1], [1, 1, 1]))
+        coll.collision_check(robot, np.zeros((2, 17)), obs.BoxObstacle([0, 0, 1], [1, 1, 1]))
 
 
 def test_cartesian_trajectory_is_timed_min_jerk(robot):
     q0, q1 = lift_motion(robot)
-    traj = tr.cartesian_trajectory(robot, q0, q1, duration=2.0, dt=0.002)
+    traj = cart.cartesian_trajectory(robot, q0, q1, duration=2.0, dt=0.002)
     assert traj.t[0] == 0 and traj.t[-1] == 2.0 and len(traj.t) == 1001
-    s = tr.minimum_jerk(traj.t / 2.0)
-    np.testing.assert_allclose(traj.q, tr.cartesian_interpolation(robot, q0, q1, s), atol=1e-12)
+    s = interp.minimum_jerk(traj.t / 2.0)
+    np.testing.assert_allclose(traj.q, cart.cartesian_interpolation(robot, q0, q1, s), atol=1e-12)
     np.testing.assert_array_equal(traj.q[[0, -1]], np.stack([q0, q1]))
     assert np.abs(traj.qd[[0, 1, -2, -1]]).max() < 1e-3  # at rest at both ends
     # explicit parameters must run from 0 to 1
     with pytest.raises(ValueError, match="from exactly 0"):
-        tr.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.5, 0.9]))
+        cart.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.5, 0.9]))
     with pytest.raises(ValueError, match="non-decreasing"):
-        tr.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.6, 0.5, 1.0]))
+        cart.cartesian_interpolation(robot, q0, q1, np.array([0.0, 0.6, 0.5, 1.0]))
     with pytest.raises(ValueError, match="duration"):
-        tr.cartesian_trajectory(robot, q0, q1, duration=0.0)
+        cart.cartesian_trajectory(robot, q0, q1, duration=0.0)
 
 
 def test_figures_are_written(tmp_path):
-    from snakehead import plots
+    from snakehead.viz import figures as plots
 
     paths = plots.lift_head_figures(tmp_path, duration=2.0)
     assert [p.name for p in paths] == ["fig11_13_interpolation.png", "fig18_19_momenta.png", "fig20_zmp.png"]
@@ -506,7 +509,7 @@ def test_figures_are_written(tmp_path):
 # the monotone multi-segment quintic
 # ------------------------------------------------------------------------------------------------
 def test_monotone_quintic_passes_waypoints_without_overshoot():
-    from snakehead.trajectory import MonotoneQuintic
+    from snakehead.motion.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(11)
     times = np.cumsum(rng.uniform(0.2, 2.0, 12))
@@ -524,7 +527,7 @@ def test_monotone_quintic_passes_waypoints_without_overshoot():
 
 
 def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
-    from snakehead.trajectory import MonotoneQuintic
+    from snakehead.motion.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(12)
     times = np.cumsum(rng.uniform(0.5, 1.5, 8))
@@ -544,15 +547,15 @@ def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
 def test_joint_trajectory_monotone_method_and_bad_method():
     times = np.array([0.0, 1.0, 2.0])
     way = np.array([[0.0], [1.0], [1.0]])
-    traj = tr.joint_trajectory(times, way, method="monotone")
+    traj = interp.joint_trajectory(times, way, method="monotone")
     assert traj.q.max() <= 1.0 + 1e-12
     with pytest.raises(ValueError, match="method"):
-        tr.joint_trajectory(times, way, method="cubic")
+        interp.joint_trajectory(times, way, method="cubic")
 
 
 def test_sample_times_never_adds_a_sample_a_hair_after_the_last():
     for t1 in (1.0, 1.0 + 1e-9, 1.0 + 5e-7, 1.0 + 2e-6, 36.000000013):
-        t = tr.sample_times(0.0, t1)
+        t = interp.sample_times(0.0, t1)
         assert t[0] == 0.0 and t[-1] == t1
         d = np.diff(t)
         assert d.min() > 1e-6 and d.max() <= 0.002 + 1e-6

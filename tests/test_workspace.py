@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead import Chain, SnakeRobot
-from snakehead import workspace as ws
+from snakehead import Chain, SnakeRobot, default_robot_file
+from snakehead.kinematics import workspace as ws
+from conftest import head6_robot
 
 SMALL = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
 
@@ -145,7 +146,7 @@ def test_chain_with_executor_needs_its_urdf(robot, small):
         m = ws.compute(bare, progress=False, executor=ex, shards=2, urdf=robot.urdf, **SMALL)
         assert m.same_map_as(small)
         assert ws.compute(chain, progress=False, executor=ex, shards=2, **SMALL).same_map_as(small)
-        six = robot.head6_chain
+        six = head6_robot().head_chain
         with pytest.raises(ValueError, match="different kinematics"):
             ws.compute(six, progress=False, executor=ex, urdf=_other_urdf(robot), **SMALL)
 
@@ -305,21 +306,23 @@ def test_index_at(small):
 
 
 # --- the shipped maps -------------------------------------------------------------------------------------
-@pytest.mark.parametrize("part, chain", [("head", "head_chain"), ("head6", "head6_chain")])
-def test_shipped_maps(robot, part, chain):
-    path = ws.DATA_DIR / ws.DEFAULT_MAPS[part]
+@pytest.mark.parametrize("robot_file", ["snake16.toml", "snake16_head6.toml"])
+def test_shipped_maps(robot_file):
+    robot = SnakeRobot.from_file(default_robot_file().with_name(robot_file))
+    path = robot.map_path
     assert path.stat().st_size < 1_000_000
-    m = ws.default_map(part)
-    assert m.chain_hash == getattr(robot, chain).hash
+    m = ws.map_for(robot)
+    assert m.path == path
+    assert m.chain_hash == robot.head_chain.hash
     assert m.params["voxel_size"] == 0.05 and m.params["directions"] == 20 and m.params["rolls"] == 4
     assert m.command.startswith("workspace_gen ") and "--voxel 0.05" in m.command
     assert len(m) == m.hull_voxels > 1000 and m.indices.max() <= 100
-    readme = (ws.DATA_DIR / "README.md").read_text()
+    readme = (default_robot_file().with_name("README.md")).read_text()
     assert m.command in readme
 
 
 def test_shipped_head_map_g0(robot):
-    m = ws.default_map("head")
+    m = ws.map_for(robot)
     c = m.clusters(k=3)
     assert len(c.points) >= 3 and np.all(np.isfinite(c.center))
     # G0 lies within the head's reach, among the voxels of high index.
@@ -329,7 +332,7 @@ def test_shipped_head_map_g0(robot):
 
 # --- figures ------------------------------------------------------------------------------------------------
 def test_figures(small, tmp_path):
-    from snakehead import workspace_plots as wp
+    from snakehead.viz import workspace as wp
 
     paths = wp.save_figures(small, tmp_path, prefix="small", k=2)
     assert [p.name for p in paths] == ["small_map.png", "small_dexterous.png", "small_clusters.png"]
@@ -395,8 +398,8 @@ def test_bad_inputs_of_the_helpers(robot, small, tmp_path):
         ws.evaluate(robot, [[0.1, 0.0, 0.0]], voxel=-1.0)
     with pytest.raises(ValueError):
         small.index_at([[np.inf, 0.0, 0.0]])
-    with pytest.raises(ValueError):
-        ws.default_map("tail")
+    with pytest.raises(TypeError):
+        ws.map_for("snake16")
     with pytest.raises(ValueError, match="at least one"):
         ws.merge([])
     with pytest.raises(ValueError, match="ReachabilityMap"):

@@ -58,6 +58,9 @@ struct SegmentGeometry {
   bool prismatic;
 };
 
+// The name of the root link of a URDF (an XML document or a file path, as ChainModel::from_urdf).
+std::string urdf_root_link(const std::string& urdf);
+
 class ChainModel {
  public:
   // `urdf` is either an XML document (its first non-blank character is '<') or a file path.

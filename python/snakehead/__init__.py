@@ -1,11 +1,33 @@
 """snakehead: head control of snake robots by segmented kinematics.
 
-The C++ core (``snakehead._core``) does kinematics, TRAC-IK and the workspace sweep; the Python
-modules plan with it. Start with ``SnakeRobot.default()``.
-"""
-from .chain import Chain
-from .ik import TracIK
-from .robot import BasePlacement, RobotParts, SnakeRobot, default_urdf_path
+The C++ core (``snakehead._core``) does kinematics, TRAC-IK and the workspace sweep; the subpackages plan with it:
 
-__all__ = ["Chain", "TracIK", "SnakeRobot", "BasePlacement", "RobotParts", "default_urdf_path"]
-__version__ = "0.1.0"
+* :mod:`snakehead.model` -- the robot (:class:`SnakeRobot`, :class:`Chain`, robot files);
+* :mod:`snakehead.kinematics` -- :class:`TracIK` and the head's reachability maps;
+* :mod:`snakehead.backbone` -- backbone curves and the base arc (Eqs. 1-9), the initial configuration;
+* :mod:`snakehead.control` -- the neck (Eqs. 18-22), the head, the :class:`HeadController`;
+* :mod:`snakehead.dynamics` -- centre of mass, support polygon, momenta, ZMP (Eqs. 23-40);
+* :mod:`snakehead.motion` -- joint and Cartesian interpolation (Eqs. 41-44), the planner;
+* :mod:`snakehead.geometry` -- obstacles and collisions; :mod:`snakehead.scenes` -- scene files;
+* :mod:`snakehead.sim` -- the dynamics check in MuJoCo; :mod:`snakehead.viz` -- figures; :mod:`snakehead.app` --
+  the pipeline and the command line.
+
+Start with ``SnakeRobot.default()``.
+"""
+from .control.controller import HeadController, HeadSolution
+from .geometry.obstacles import BoxObstacle, WallWithHole
+from .kinematics.ik import TracIK
+from .kinematics.workspace import ReachabilityMap
+from .kinematics.workspace import compute as compute_map
+from .kinematics.workspace import load as load_map
+from .model.chain import Chain
+from .model.robot import BasePlacement, RobotParts, SnakeRobot, default_robot_file, default_urdf_path
+from .motion.planner import Plan, TargetResult, plan
+from .scenes.scene import Scene, Target, load_scene
+from .sim.plan import PlanSimulation, simulate
+
+__all__ = ["SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
+           "ReachabilityMap", "compute_map", "load_map", "plan", "Plan", "TargetResult", "simulate",
+           "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "WallWithHole", "default_robot_file",
+           "default_urdf_path"]
+__version__ = "0.2.0"

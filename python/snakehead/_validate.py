@@ -56,10 +56,19 @@ def rotation_matrix(R, name: str = "rotation") -> np.ndarray:
 
 
 def positive(x, name: str) -> float:
+    """``x`` as a positive finite float; ValueError naming ``name`` otherwise."""
+    v = finite_float(x, name)
+    if v <= 0:
+        raise ValueError(f"{name} must be a positive finite number, got {x!r}")
+    return v
+
+
+def finite_float(x, name: str) -> float:
+    """``x`` as a finite float; ValueError naming ``name`` otherwise."""
     try:
         v = float(x)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, got {x!r}") from None
-    if not np.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {x!r}")
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {x!r}")
     return v

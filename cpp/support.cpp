@@ -1,0 +1,100 @@
+#include "snakehead/support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "snakehead/model.hpp"
+
+namespace snakehead {
+namespace {
+
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
+
+double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+// Distance from p to segment [a, b].
+double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d e = b - a;
+  const double len2 = e.squaredNorm();
+  const double u = len2 > 0.0 ? std::clamp((p - a).dot(e) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + u * e)).norm();
+}
+
+}  // namespace
+
+std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
+  const int n = static_cast<int>(points.rows());
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int i, int j) {
+    return points(i, 0) < points(j, 0) || (points(i, 0) == points(j, 0) && points(i, 1) < points(j, 1));
+  });
+  double scale = 1.0;
+  for (int i = 0; i < n; ++i) scale = std::max({scale, std::abs(points(i, 0)), std::abs(points(i, 1))});
+  const double eps = 1e-12 * scale;
+  auto half = [&](auto begin, auto end) {
+    std::vector<int> out;
+    for (auto it = begin; it != end; ++it) {
+      const int i = *it;
+      const Eigen::Vector2d p = points.row(i).transpose();
+      // pop while the turn is not strictly left: a sine of the turn angle below 1e-9 counts as straight
+      while (out.size() >= 2) {
+        const Eigen::Vector2d o = points.row(out[out.size() - 2]).transpose(), a = points.row(out.back()).transpose();
+        if (cross(o, a, p) > 1e-9 * (a - o).norm() * (p - a).norm()) break;
+        out.pop_back();
+      }
+      if (!out.empty() && (points.row(out.back()).transpose() - p).cwiseAbs().maxCoeff() <= eps) continue;
+      out.push_back(i);
+    }
+    return out;
+  };
+  std::vector<int> lower = half(order.begin(), order.end());
+  std::vector<int> upper = half(order.rbegin(), order.rend());
+  if (lower.size() < 2) return lower;
+  std::vector<int> hull(lower.begin(), lower.end() - 1);
+  hull.insert(hull.end(), upper.begin(), upper.end() - 1);
+  if (hull.size() < 2) return std::vector<int>(lower.begin(), lower.begin() + std::min<std::size_t>(2, lower.size()));
+  return hull;
+}
+
+double hull_margin(const Eigen::Ref<const Points>& points, const Eigen::Vector2d& xy) {
+  if (points.rows() == 0) return -std::numeric_limits<double>::infinity();
+  if (!xy.allFinite() || !points.allFinite()) throw InputError("hull_margin: points and xy must be finite");
+  const std::vector<int> h = convex_hull(points);
+  const int k = static_cast<int>(h.size());
+  if (k == 1) return -(xy - points.row(h[0]).transpose()).norm();
+  if (k == 2) return -segment_distance(xy, points.row(h[0]).transpose(), points.row(h[1]).transpose());
+  bool inside = true;
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < k; ++i) {
+    const Eigen::Vector2d a = points.row(h[i]).transpose(), b = points.row(h[(i + 1) % k]).transpose();
+    const Eigen::Vector2d e = b - a;
+    if (e.x() * (xy.y() - a.y()) - e.y() * (xy.x() - a.x()) < 0.0) inside = false;  // right of a ccw edge
+    best = std::min(best, segment_distance(xy, a, b));
+  }
+  return inside ? best : -best;
+}
+
+std::vector<double> hull_margins(const double* points, const unsigned char* active, const double* xy, long T,
+                                 long N) {
+  if (T < 0 || N < 0) throw InputError("hull_margins: negative sizes");
+  std::vector<double> out(static_cast<std::size_t>(T));
+  Points buffer(N, 2);
+  for (long t = 0; t < T; ++t) {
+    long m = 0;
+    for (long i = 0; i < N; ++i) {
+      if (!active[t * N + i]) continue;
+      buffer(m, 0) = points[(t * N + i) * 2];
+      buffer(m, 1) = points[(t * N + i) * 2 + 1];
+      ++m;
+    }
+    out[static_cast<std::size_t>(t)] = hull_margin(buffer.topRows(m), Eigen::Vector2d(xy[2 * t], xy[2 * t + 1]));
+  }
+  return out;
+}
+
+}  // namespace snakehead

@@ -1,0 +1,27 @@
+// Support polygons (paper Eq. 24) and the signed distance of a point to them (the static and ZMP margins of
+// Section 3.1), for many samples at once: each sample has its own set of ground contact points.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace snakehead {
+
+// Counter-clockwise convex hull of 2-D points (Andrew's monotone chain), as indices into `points`; points on
+// an edge are left out. Two indices (the extremes) for collinear points, one for coincident points, none for
+// none.
+std::vector<int> convex_hull(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>& points);
+
+// Signed distance of `xy` to the convex hull of `points` (> 0 inside: the distance to the nearest edge; < 0
+// outside: minus the distance to the polygon). A hull of two points or one has no inside: minus the distance
+// to the segment or point. -infinity when there is no point.
+double hull_margin(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>& points,
+                   const Eigen::Vector2d& xy);
+
+// hull_margin for T samples: points (T x N x 2, row-major, sample-major), active (T x N) says which of each
+// sample's N points are contacts, xy (T x 2). Returns (T).
+std::vector<double> hull_margins(const double* points, const unsigned char* active, const double* xy, long T,
+                                 long N);
+
+}  // namespace snakehead

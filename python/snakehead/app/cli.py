@@ -1,0 +1,341 @@
+"""snakehead: plan how a snake robot raises its head to a position and direction while its body stays stable.
+
+The command is snakehead (also python -m snakehead). Subcommands:
+
+  info        describe a robot (default: the shipped one; --robot FILE for yours)
+  demo        the paper's two scenarios of Section 4 end to end, with figures, animations and a report
+  plan        head targets (--position/--direction, or --scene FILE) with the same outputs
+  workspace   compute a reachability map of a robot's head (Algorithm 1) into a .npz file
+
+Exit status: 0 on success; 1 when a scenario or target was planned but not successfully (the outputs are
+written all the same); 2 for bad arguments or input files; 130 when interrupted.
+Set SNAKEHEAD_TRACEBACK=1 to see the Python traceback of an error.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .pipeline import FAST, NORMAL
+
+
+class UsageError(Exception):
+    """A mistake in the command line or its input files: reported on stderr, exit status 2."""
+
+
+# ----------------------------------------------------------------------------------------------
+# argument types
+# ----------------------------------------------------------------------------------------------
+def _finite_float(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(x):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return x
+
+
+def _positive_float(text: str) -> float:
+    x = _finite_float(text)
+    if x <= 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
+    return x
+
+
+def _int(text: str, least: int) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if n < least:
+        raise argparse.ArgumentTypeError(f"must be >= {least}, got {text!r}")
+    return n
+
+
+def _positive_int(text: str) -> int:
+    return _int(text, 1)
+
+
+def _seed(text: str) -> int:
+    return _int(text, 0)
+
+
+def _writable_dir(path: str) -> Path:
+    """Create ``path`` (and its parents) if needed and check that files can be written in it."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {path!r} exists and is not a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=out, prefix=".snakehead-write-test-"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"cannot write to --out {path!r}: {exc.strerror or exc}") from None
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# the robot and its map
+# ----------------------------------------------------------------------------------------------
+def _robot(args: argparse.Namespace):
+    from ..model.robot import SnakeRobot
+
+    if getattr(args, "robot", None) is None:
+        return SnakeRobot.default()
+    return SnakeRobot.from_file(args.robot)
+
+
+def _map(args: argparse.Namespace, robot):
+    """The map given with --map (checked against the robot's head), else None (the pipeline finds one)."""
+    from ..kinematics import workspace
+
+    if args.map is None:
+        return None
+    m = workspace.load(args.map)
+    if m.chain_hash != robot.head_chain.hash:
+        raise UsageError(f"--map {args.map!r} was made for another head chain ({m.base} -> {m.tip}, hash "
+                         f"{m.chain_hash}); this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip} "
+                         f"(hash {robot.head_chain.hash})")
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+# info
+# ----------------------------------------------------------------------------------------------
+def _info(args: argparse.Namespace) -> int:
+    robot = _robot(args)
+    p = robot.parts
+    print(f"robot: {robot.source or robot.urdf}")
+    print(f"urdf: {robot.urdf}")
+    print(f"joints: {robot.n_joints} ({', '.join(k[0] for k in robot.joint_kinds)}: y = yaw, p = pitch), "
+          f"mass {robot.total_mass:.3f} kg, length {robot.body_length:.4f} m, body axis "
+          f"{1000 * robot.body_axis_height:.1f} mm above the ground")
+    for name, sl, a, b in (("base", p.base, p.root, p.base_end), ("neck", p.neck, p.base_end, p.neck_end),
+                           ("head", p.head, p.neck_end, p.head_tip)):
+        names = robot.joint_names[sl]
+        print(f"{name}: {a} -> {b}, {len(names)} joints ({names[0]} .. {names[-1]})")
+    print(f"head's map: {robot.map_path if robot.map_path is not None else 'none (plan computes and caches one)'}")
+    np.set_printoptions(precision=4, suppress=True)
+    print("head_tip at q = 0 (world):")
+    print(robot.head_pose(np.zeros(robot.n_joints)))
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# demo and plan
+# ----------------------------------------------------------------------------------------------
+def _settings(args):
+    from .pipeline import Settings
+
+    return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)
+
+
+def _done(command: str, out: Path, report: dict, progress) -> int:
+    entries = report["scenarios"]
+    ok = all(e["success"] for e in entries.values())
+    progress.say(f"done in {progress.elapsed():.1f} s")
+    print(f"snakehead {command}: wrote report.json, summary.md and "
+          f"{sum(len(e['files']) for e in entries.values())} other files to {out.resolve()}")
+    for name, e in entries.items():
+        print(f"  {name}: {'success' if e['success'] else 'NOT successful: ' + str(e.get('failure'))}")
+    return 0 if ok else 1
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from ..scenes import paper_scene
+    from .pipeline import Progress, run_scenes
+
+    out = _writable_dir(args.out)
+    robot = _robot(args)
+    progress = Progress()
+    progress.say(f"snakehead demo -> {out}{' (--fast)' if args.fast else ''}")
+    notes = ["the simulated wall is boxes: the round hole is a staircase of strips inscribed in it "
+             "(sim.obstacle_boxes), standing on the ground",
+             "planned errors are the head's by forward kinematics of the planned joints; the simulated ones are "
+             "MuJoCo's at the times the plan reaches each target; the paper's momentum errors are magnitude errors "
+             "(our max_*_momentum_magnitude_error), ours without 'magnitude' are of the vector difference"]
+    report = run_scenes([paper_scene("spheres"), paper_scene("hole")], out, robot=robot,
+                        workspace_map=_map(args, robot), settings=_settings(args), progress=progress,
+                        command="demo", notes=notes)
+    return _done("demo", out, report, progress)
+
+
+def _plan(args: argparse.Namespace) -> int:
+    from ..scenes import Scene, load_scene
+    from .pipeline import Progress, run_scenes
+
+    if args.scene is not None and (args.position is not None or args.direction is not None):
+        raise UsageError("give --scene or --position/--direction, not both")
+    if args.scene is None:
+        if args.position is None or args.direction is None:
+            raise UsageError("give --position X Y Z and --direction DX DY DZ, or --scene FILE")
+        direction = np.array(args.direction, float)
+        if float(np.linalg.norm(direction)) < 1e-9:
+            raise UsageError(f"--direction must not be zero, got {args.direction}")
+        scene = Scene.from_targets([(np.array(args.position, float), direction)], name="target")
+    else:
+        scene = load_scene(args.scene)
+    if args.robot is None and scene.robot_file is not None:
+        args.robot = scene.robot_file
+    out = _writable_dir(args.out)
+    robot = _robot(args)
+    progress = Progress()
+    what = (f"head to {np.round(scene.targets[0].position, 4).tolist()} m along "
+            f"{np.round(scene.targets[0].direction, 4).tolist()}" if args.scene is None else f"scene {scene.name!r}")
+    progress.say(f"snakehead plan: {what} -> {out}")
+    report = run_scenes([scene], out, robot=robot, workspace_map=_map(args, robot), settings=_settings(args),
+                        progress=progress, command="plan", solution_figure=True)
+    return _done("plan", out, report, progress)
+
+
+# ----------------------------------------------------------------------------------------------
+# workspace
+# ----------------------------------------------------------------------------------------------
+def _workspace(args: argparse.Namespace) -> int:
+    from ..kinematics import workspace
+
+    out = Path(args.out)
+    if out.suffix != ".npz":
+        raise UsageError(f"--out must end in .npz, got {args.out!r}")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"the directory of --out {args.out!r} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise UsageError(f"cannot write to the directory of --out {args.out!r}")
+    robot = _robot(args)
+    chain = robot.head_chain
+    defaults = workspace.default_map_options(chain)
+    voxel = args.voxel if args.voxel is not None else defaults["voxel"]
+    t0 = time.perf_counter()
+    print(f"snakehead workspace: head chain {chain.base} -> {chain.tip} ({chain.n_joints} joints), voxel {voxel} m, "
+          f"{args.directions} directions x {args.rolls} rolls", file=sys.stderr, flush=True)
+    m = workspace.compute(chain, voxel=voxel, directions=args.directions, rolls=args.rolls,
+                          free_roll=args.free_roll, timeout=args.timeout, seed=args.seed, threads=args.threads,
+                          shard=args.shard, progress=not args.quiet)
+    workspace.save(m, out)
+    print(f"snakehead workspace: {len(m)} voxels in {time.perf_counter() - t0:.1f} s; wrote {out.resolve()}")
+    if m.shard == (0, 1) and len(m):
+        print(m.summary())
+    return 0
+
+# ----------------------------------------------------------------------------------------------
+# the parser
+# ----------------------------------------------------------------------------------------------
+def _add_robot_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", default=None, metavar="ROBOT.toml",
+                   help="a robot file (TOML: urdf, base_end, neck_end, head_tip, optional root and map); "
+                        "default: the shipped 16-joint robot")
+
+
+def _add_planning_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if needed)")
+    _add_robot_option(p)
+    p.add_argument("--no-sim", action="store_true", help="skip the MuJoCo dynamics check")
+    p.add_argument("--seed", type=_seed, default=1, metavar="N",
+                   help="seed of the head's TRAC-IK (the plan is a function of it; default 1)")
+    p.add_argument("--method", choices=("rotated", "free_roll"), default="rotated",
+                   help="head IK: the paper's rotated frames (Fig. 9, default) or one call with the roll free")
+    p.add_argument("--map", default=None, metavar="MAP.npz",
+                   help="the head's reachability map (default: the robot file's; for a robot without one, a map "
+                        "computed on the first run and cached)")
+    p.add_argument("--fast", action="store_true",
+                   help=f"quicker run of the same pipeline: joints planned at {FAST['speed']} rad/s instead of "
+                        f"{NORMAL['speed']} with {FAST['min_segment']:g} s segments (shorter motions, so fewer 2 ms "
+                        f"samples to check and simulate) and {FAST['max_frames']}-frame animations")
+
+
+_OUTPUTS = """outputs (in DIR):
+  report.json               per scenario: success, targets (errors), min ZMP margin, min ground clearance,
+                            planning time, sim (null without MuJoCo or with --no-sim), the paper's figures
+  summary.md                the same, readable
+  NAME_trajectory.csv       time_s and the joint angles (rad) every 2 ms
+  NAME_snapshots.png        the body in 3-D at the scenario's states (Figs. 17 / 22)
+  NAME_momenta.png          planned (and simulated) angular and linear momenta (Figs. 18-19 / 23-24)
+  NAME_zmp.png              the ZMP in the support polygon (Figs. 20 / 25)
+  NAME.gif                  an animation of the motion
+"""
+
+
+def _planning_parser(sub, name: str, func, help_text: str, description: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(name, help=help_text, description=description, epilog=_OUTPUTS,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_planning_options(p)
+    p.set_defaults(func=func)
+    return p
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="snakehead", description=__doc__.split("\n\n")[0],
+                                     epilog=__doc__.split("\n\n", 1)[1],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = sub.add_parser("info", help="describe a robot and print its head pose at q = 0",
+                       description="Describe a robot (its parts, joints, mass, map) and print its head pose at q = 0.")
+    _add_robot_option(p)
+    p.set_defaults(func=_info)
+
+    _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",
+                     "Plan the paper's two scenarios (catching two spheres, Section 4.1; getting the head through a "
+                     "hole in a wall, Section 4.2; on the default robot unless --robot), check them in MuJoCo (the "
+                     "hole's wall included), and write a report, trajectories, figures and animations. NAME is "
+                     "spheres and hole.")
+    p = _planning_parser(sub, "plan", _plan, "head targets: --position/--direction, or a scene file",
+                         "Plan the head from the bending state on the ground to POSITION pointing along DIRECTION "
+                         "(world frame, z up, ground at z = 0), or through the targets of a scene file (--scene; "
+                         "TOML: targets and obstacles), check it, and write the same outputs as demo with NAME = "
+                         "target (or the scene's name).")
+    p.add_argument("--position", type=_finite_float, nargs=3, default=None, metavar=("X", "Y", "Z"),
+                   help="desired head position (m, world)")
+    p.add_argument("--direction", type=_finite_float, nargs=3, default=None, metavar=("DX", "DY", "DZ"),
+                   help="desired head direction (the head link's x-axis; any non-zero length)")
+    p.add_argument("--scene", default=None, metavar="SCENE.toml",
+                   help="a scene file: targets (name, position, direction, hold_s, ...) and obstacles; its robot "
+                        "file is used unless --robot is given")
+
+    p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
+                       description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "
+                                   "robot: its 7-DOF head; the 6-DOF variant is the robot file snake16_head6.toml "
+                                   "beside the default one) with snakehead.kinematics.workspace.compute and save it "
+                                   "as .npz. For shards over many machines or without Python, use the workspace_gen "
+                                   "executable installed with the package (workspace_gen --help).")
+    p.add_argument("--out", required=True, metavar="MAP.npz", help="output file (.npz)")
+    _add_robot_option(p)
+    p.add_argument("--voxel", type=_positive_float, default=None, metavar="M",
+                   help="voxel edge (m; default: a twelfth of the head's reach rounded to 5 mm, 0.05 on the default "
+                        "robot)")
+    p.add_argument("--directions", type=_positive_int, default=20, metavar="N",
+                   help="points per voxel sphere (default 20)")
+    p.add_argument("--rolls", type=_positive_int, default=4, metavar="R",
+                   help="frames about the approach axis per point (default 4)")
+    p.add_argument("--free-roll", action="store_true", help="one IK call per point with the roll left free")
+    p.add_argument("--timeout", type=_positive_float, default=3e-4, metavar="S",
+                   help="TRAC-IK budget per call (s, default 0.0003)")
+    p.add_argument("--seed", type=_seed, default=1, metavar="N", help="random seed (default 1)")
+    p.add_argument("--threads", type=_positive_int, default=None, metavar="N", help="worker threads (default all)")
+    p.add_argument("--shard", default=None, metavar="i/N", help="compute only shard i of N (merge them afterwards)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_workspace)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        print("snakehead: interrupted", file=sys.stderr)
+        return 130
+    except (UsageError, ValueError, TypeError, OSError) as exc:
+        if os.environ.get("SNAKEHEAD_TRACEBACK"):
+            raise
+        print(f"snakehead {args.command}: error: {exc}", file=sys.stderr)
+        return 2

@@ -1,0 +1,207 @@
+"""The pipeline behind ``snakehead demo`` and ``snakehead plan``, as a library function: for each scene,
+plan -> simulate (MuJoCo) -> compare -> figures -> animation, then one report (``report.json``, ``summary.md``).
+
+>>> from snakehead.app.pipeline import run_scenes
+>>> from snakehead.scenes import paper_scene
+>>> report = run_scenes([paper_scene("spheres")], "out")          # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+from . import report as rep
+
+#: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
+#: and simulate), and animations with fewer frames.
+FAST = {"speed": 0.24, "min_segment": 1.0, "max_frames": 30}
+NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
+
+
+class Progress:
+    """Stage lines on stderr (``[  12.3 s] what ...`` / ``... done in 1.2 s``) and a record of the stage times."""
+
+    def __init__(self, quiet: bool = False, stream=None):
+        self.t0 = time.perf_counter()
+        self.quiet = quiet
+        self.stream = stream
+        self.stages: list[dict] = []
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.t0
+
+    def say(self, text: str) -> None:
+        if not self.quiet:
+            print(f"[{self.elapsed():7.1f} s] {text}", file=self.stream or sys.stderr, flush=True)
+
+    @contextlib.contextmanager
+    def stage(self, what: str):
+        self.say(f"{what} ...")
+        start = time.perf_counter()
+        yield
+        dt = time.perf_counter() - start
+        self.stages.append({"stage": what, "seconds": dt})
+        self.say(f"{what}: done in {dt:.1f} s")
+
+
+def mujoco_available() -> bool:
+    return importlib.util.find_spec("mujoco") is not None
+
+
+@dataclass
+class Settings:
+    """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
+    figures: write figures and the animation."""
+
+    method: str = "rotated"
+    seed: int | None = 1
+    fast: bool = False
+    simulate: bool = True
+    figures: bool = True
+
+    def as_dict(self) -> dict:
+        s = FAST if self.fast else NORMAL
+        return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "speed_rad_s": s["speed"],
+                "min_segment_s": s["min_segment"], "simulation": bool(self.simulate and mujoco_available())}
+
+
+def run_scene(scene, controller, out: Path, settings: Settings, progress: Progress, *,
+              solution_figure: bool = False) -> dict:
+    """One scene through the pipeline; its report entry (``report.scenario_entry``) with the files written."""
+    from ..motion.planner import plan
+
+    s = FAST if settings.fast else NORMAL
+    robot = controller.robot
+    name = scene.name
+    label = scene.description or name
+    with progress.stage(f"{name}: planning {label}"):
+        result = plan(scene, controller=controller, speed=s["speed"], min_segment=s["min_segment"])
+    progress.say(f"{name}: {'success' if result.success else 'NOT successful: ' + str(result.failure)}, "
+                 f"{result.duration_s:.1f} s of motion, {len(result.t)} samples; targets: "
+                 + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
+                             for tg in result.targets))
+    files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
+
+    metrics, notes, sim_result = None, [], None
+    if not settings.simulate:
+        notes.append("dynamics check skipped (--no-sim)")
+    elif not mujoco_available():
+        notes.append("dynamics check skipped: MuJoCo is not installed (pip install snakehead[sim])")
+        progress.say(f"{name}: MuJoCo is not installed; no dynamics check")
+    else:
+        from ..sim import simulate
+
+        n_obstacles = len(result.obstacles)
+        with progress.stage(f"{name}: MuJoCo simulation of {result.duration_s:.1f} s "
+                            f"({n_obstacles} obstacle{'' if n_obstacles == 1 else 's'})"):
+            try:
+                checked = simulate(result)
+            except RuntimeError as exc:
+                notes.append(f"the simulation failed: {exc}")
+                progress.say(f"{name}: the simulation failed: {exc}")
+                checked = None
+        if checked is not None:
+            metrics, sim_result = checked.metrics, checked.result
+            progress.say(f"{name}: simulated head error {1000 * metrics['position_error_m']:.2f} mm / "
+                         f"{metrics['direction_error_deg']:.2f} deg; momentum errors "
+                         f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
+                         f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
+
+    if settings.figures:
+        files += _figures(scene, result, sim_result, out, s, progress, solution_figure)
+    entry = rep.scenario_entry(result, metrics, extra={"files": files})
+    entry["notes"] = list(entry["notes"]) + notes
+    return entry
+
+
+def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, solution_figure: bool) -> list[str]:
+    from ..viz import scenario as scenario_plots
+
+    robot = result.robot
+    name = scene.name
+    paper = rep.PAPER.get(name, {})
+    snap, mom, zmp = paper.get("figures", (None, None, None))
+    spheres = [(t.position, t.sphere_diameter) for t in scene.targets if t.sphere_diameter is not None]
+    label = scene.description or name
+    files = []
+    with progress.stage(f"{name}: figures"):
+        if solution_figure and result.targets:
+            files.append(scenario_plots.plot_head_solution(robot, result.targets[0].solution,
+                                                           out / f"{name}_solution.png").name)
+        cols = 4 if len(result.targets) + 2 > 9 or len(spheres) else 3
+        n_panels = 12 if cols == 4 else 9
+        paths = [
+            scenario_plots.plot_snapshots(robot, result, out / f"{name}_snapshots.png", spheres=spheres,
+                                          n_panels=n_panels, columns=cols,
+                                          title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                                "the body at its states (collision boxes; axes in m, equal scales)"),
+            scenario_plots.plot_momenta(result, out / f"{name}_momenta.png", sim_result=sim_result,
+                                        figures=mom or (None, None),
+                                        title=f"{label}: momenta about the world origin, planned"
+                                              + (" and simulated" if sim_result is not None else "")),
+            scenario_plots.plot_zmp(robot, result, out / f"{name}_zmp.png", sim_result=sim_result, figure=zmp,
+                                    title=f"{label}: zero-moment point"),
+        ]
+        files += [p.name for p in paths]
+    with progress.stage(f"{name}: animation"):
+        files.append(scenario_plots.animate(robot, result, out / f"{name}.gif", spheres=spheres,
+                                            max_frames=s["max_frames"]).name)
+    return files
+
+
+def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None, workspace_map=None,
+               settings: Settings | None = None, progress: Progress | None = None, command: str = "plan",
+               notes: Sequence[str] = (), solution_figure: bool = False,
+               on_controller: Callable | None = None) -> dict:
+    """Every scene through :func:`run_scene` with one controller; writes ``report.json`` and ``summary.md`` into
+    ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
+    file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed)."""
+    from ..control.controller import HeadController
+    from ..kinematics import workspace
+    from ..model.robot import SnakeRobot
+
+    settings = settings or Settings()
+    progress = progress or Progress()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if controller is None:
+        if robot is None:
+            first = scenes[0].robot_file
+            robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
+        with progress.stage("the head's reachability map and its dexterous centre G0"):
+            if workspace_map is None:
+                if robot.map_path is None:
+                    progress.say("this robot has no map: computing one (cached for the next run)")
+                workspace_map = workspace.map_for(robot, progress=not progress.quiet)
+                if workspace_map.path is not None:
+                    progress.say(f"the head's map: {workspace_map.path}")
+            controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
+        if controller.dexterous_threshold < 100.0:
+            progress.say(controller.dexterous_note)
+    if on_controller is not None:
+        on_controller(controller)
+    entries = {}
+    for scene in scenes:
+        entries[scene.name] = run_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+    robot = controller.robot
+    report = {"command": command, "scenarios": entries,
+              "settings": {**settings.as_dict(), "map": _map_label(controller.map)},
+              "robot": {"source": robot.source or "URDF", "joints": robot.n_joints,
+                        "parts": {"base": robot.parts.base.stop - robot.parts.base.start,
+                                  "neck": robot.parts.neck.stop - robot.parts.neck.start,
+                                  "head": robot.parts.head.stop - robot.parts.head.start},
+                        "dexterous_threshold": controller.dexterous_threshold},
+              "run_time_s": progress.elapsed(), "stages": progress.stages, "notes": list(notes),
+              "paper": rep.PAPER, **rep.environment()}
+    rep.write_json(report, out / "report.json")
+    rep.write_summary(report, out / "summary.md")
+    return report
+
+
+def _map_label(m) -> str:
+    return str(m.path) if getattr(m, "path", None) is not None else "computed in this run"

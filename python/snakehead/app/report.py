@@ -1,0 +1,242 @@
+"""What ``snakehead demo`` and ``snakehead plan`` write: ``report.json``, ``summary.md`` and trajectory CSVs.
+
+The JSON report holds, per scenario under ``scenarios.<name>`` (see :func:`scenario_entry`):
+
+* ``success`` (bool), ``targets`` (list of ``name``, ``position_error_m``, ``direction_error_deg``: the planned
+  head against the desired pose), ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``planning_time_s``;
+* ``sim``: null when the dynamics check did not run, else ``position_error_m``, ``direction_error_deg``,
+  ``max_linear_momentum_error`` (kg m/s), ``max_angular_momentum_error`` (kg m^2/s), ``zmp_inside`` and the
+  other numbers of :func:`snakehead.sim.compare`;
+* ``paper``: the paper's reported figures for the scenario, when it has them.
+
+Units are SI (m, s, kg) unless a key names them (``_deg``, ``_mm``). Non-finite floats are written as null, so
+the file is strict JSON.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from .._files import atomic_open, write_text_atomic
+
+#: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
+#: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
+PAPER = {
+    "spheres": {"section": "4.1 (Figs. 17-20)", "position_error_m": 1.8e-3, "direction_error_deg": 0.76,
+                "max_angular_momentum_magnitude_error": 0.0383, "max_linear_momentum_magnitude_error": 0.216,
+                "zmp_inside": True, "duration_s": 36.0, "figures": (17, (18, 19), 20)},
+    "hole": {"section": "4.2 (Figs. 22-25)", "position_error_m": 1.39e-3, "direction_error_deg": 0.95,
+             "max_angular_momentum_magnitude_error": 0.0416, "max_linear_momentum_magnitude_error": 0.195,
+             "zmp_inside": True, "duration_s": 23.0, "figures": (22, (23, 24), 25)},
+}
+
+#: The keys of a scenario's ``sim`` entry that every report has (more may follow).
+SIM_KEYS = ("position_error_m", "direction_error_deg", "max_linear_momentum_error", "max_angular_momentum_error",
+            "zmp_inside")
+
+
+def jsonable(x):
+    """``x`` with numpy scalars and arrays turned into Python numbers and lists, non-finite floats into None,
+    tuples into lists and dict keys into strings (recursively)."""
+    if isinstance(x, dict):
+        return {str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return jsonable(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        x = float(x)
+        return x if math.isfinite(x) else None
+    if x is None or isinstance(x, str):
+        return x
+    if isinstance(x, os.PathLike):
+        return os.fspath(x)
+    return str(x)
+
+
+def scenario_entry(result, sim_metrics: dict | None = None, *, extra: dict | None = None) -> dict:
+    """The report entry of one planned scenario (``snakehead.scenarios.ScenarioResult``).
+
+    ``sim_metrics``: the dict of :func:`snakehead.sim.compare` (None without a dynamics check). ``extra``: more
+    keys to add (e.g. timings, file names).
+    """
+    if sim_metrics is not None:
+        missing = [k for k in SIM_KEYS if k not in sim_metrics]
+        if missing:
+            raise ValueError(f"sim_metrics lacks {missing}")
+    entry = {
+        "success": bool(result.success),
+        "failure": result.failure,
+        "targets": [{"name": tg.name, "position_error_m": float(tg.position_error_m),
+                     "direction_error_deg": float(tg.direction_error_deg),
+                     "position_m": tg.position.tolist(), "direction": tg.direction.tolist(),
+                     "time_s": float(tg.time_s), "solved": bool(tg.solution.success),
+                     "stage": getattr(tg.solution, "stage", None),
+                     "message": tg.solution.message} for tg in result.targets],
+        "min_zmp_margin_m": float(result.min_zmp_margin_m),
+        "min_ground_clearance_m": float(result.min_ground_clearance_m),
+        "planning_time_s": float(result.planning_time_s),
+        "sim": None if sim_metrics is None else {**{k: sim_metrics[k] for k in SIM_KEYS}, **sim_metrics},
+        "duration_s": float(result.t[-1] - result.t[0]),
+        "samples": int(len(result.t)),
+        "control_period_s": float(np.median(np.diff(result.t))) if len(result.t) > 1 else None,
+        "base": {"x_m": result.base.x, "y_m": result.base.y, "yaw_rad": result.base.yaw},
+        "dynamically_stable": bool(result.stability.stable),
+        "touches_obstacle": bool(result.touches_obstacle),
+        "min_obstacle_distance_m": (None if result.obstacle_distance is None
+                                    else float(np.min(result.obstacle_distance))),
+        "segments": [{"segment": s, "interpolation": m} for s, m in result.segments],
+        "relocation": None if result.relocation is None else result.relocation.as_dict(),
+        "notes": list(result.notes),
+    }
+    if result.name in PAPER:
+        entry["paper"] = dict(PAPER[result.name])
+    if extra:
+        entry.update(extra)
+    return jsonable(entry)
+
+
+def environment() -> dict:
+    """The machine and the versions of snakehead and its main dependencies."""
+    from importlib import metadata
+
+    from .. import __version__
+
+    versions = {"snakehead": __version__, "python": platform.python_version()}
+    for dist in ("numpy", "scipy", "matplotlib", "mujoco", "scikit-learn", "pillow"):
+        try:
+            versions[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            versions[dist] = None
+    return {"machine": {"cpu": cpu_name(), "cores": os.cpu_count(), "system": platform.platform()},
+            "versions": versions}
+
+
+def cpu_name() -> str:
+    """The CPU's model name (Linux: /proc/cpuinfo), else what ``platform`` knows."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def write_json(report: dict, path: str | os.PathLike) -> Path:
+    """Write ``report`` as indented strict JSON (see :func:`jsonable`); returns the path."""
+    return write_text_atomic(path, json.dumps(jsonable(report), indent=2, allow_nan=False) + "\n")
+
+
+def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
+    """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
+    time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
+    t, q = np.asarray(result.t, float), np.asarray(result.q, float)
+    if q.ndim != 2 or q.shape[0] != t.shape[0]:
+        raise ValueError(f"t {t.shape} and q {q.shape} do not match")
+    names = joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])]
+    if len(names) != q.shape[1]:
+        raise ValueError(f"{len(names)} joint names for {q.shape[1]} joints")
+    path = Path(path)
+    with atomic_open(path, "w", newline="") as f:  # a failed write leaves no CSV cut mid-row
+        w = csv.writer(f)
+        w.writerow(["time_s"] + [f"{n}_rad" for n in names])
+        for row in np.column_stack([t, q]):
+            w.writerow([f"{row[0]:.6f}"] + [f"{v:.7f}" for v in row[1:]])
+    return path
+
+
+def _fmt(x, scale: float = 1.0, digits: int = 2) -> str:
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    return f"{x * scale:.{digits}f}"
+
+
+def summary_markdown(report: dict) -> str:
+    """A readable summary of ``report`` (the dict written to report.json), as Markdown."""
+    lines = [f"# snakehead {report.get('command', '')}", ""]
+    m, v = report.get("machine") or {}, report.get("versions") or {}
+    if m:
+        lines += [f"Run on {m.get('cpu')} ({m.get('cores')} cores), {m.get('system')}; snakehead "
+                  f"{v.get('snakehead')}, Python {v.get('python')}, MuJoCo {v.get('mujoco') or 'not installed'}. "
+                  f"Total run time {_fmt(report.get('run_time_s'), 1, 1)} s.", ""]
+    for key in ("settings",):
+        if report.get(key):
+            lines += ["Settings: " + ", ".join(f"{k} = {val}" for k, val in report[key].items()), ""]
+    for name, sc in report.get("scenarios", {}).items():
+        paper = sc.get("paper") or {}
+        sim = sc.get("sim")
+        lines += [f"## {name}: {'success' if sc['success'] else 'NOT successful'}", ""]
+        lines += [f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
+                  f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
+                  f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
+                  f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad.", ""]
+        lines += ["| target | planned position error (mm) | planned direction error (deg) | solved |",
+                  "|---|---|---|---|"]
+        for tg in sc["targets"]:
+            lines.append(f"| {tg['name']} | {_fmt(tg['position_error_m'], 1000, 4)} | "
+                         f"{_fmt(tg['direction_error_deg'], 1, 4)} | {_fmt(tg.get('solved'))} |")
+        lines += ["", "| check | ours (plan) | ours (MuJoCo) | paper |", "|---|---|---|---|"]
+        s = sim or {}
+        rows = [
+            ("head position error (mm, worst target)", max((t["position_error_m"] for t in sc["targets"]),
+                                                           default=None), s.get("position_error_m"),
+             paper.get("position_error_m"), 1000, 3),
+            ("head direction error (deg, worst target)", max((t["direction_error_deg"] for t in sc["targets"]),
+                                                             default=None), s.get("direction_error_deg"),
+             paper.get("direction_error_deg"), 1, 3),
+            ("max angular momentum error ‖L_sim − L_plan‖ (kg m²/s)", None, s.get("max_angular_momentum_error"),
+             None, 1, 4),
+            ("max angular momentum magnitude error (kg m²/s)", None,
+             s.get("max_angular_momentum_magnitude_error"), paper.get("max_angular_momentum_magnitude_error"), 1, 4),
+            ("max linear momentum error ‖P_sim − P_plan‖ (kg m/s)", None, s.get("max_linear_momentum_error"),
+             None, 1, 4),
+            ("max linear momentum magnitude error (kg m/s)", None, s.get("max_linear_momentum_magnitude_error"),
+             paper.get("max_linear_momentum_magnitude_error"), 1, 4),
+            ("ZMP inside the support polygon", sc.get("dynamically_stable"), s.get("zmp_inside"),
+             paper.get("zmp_inside"), 1, 0),
+            ("min ZMP margin (mm)", sc["min_zmp_margin_m"], s.get("zmp_min_margin_m"), None, 1000, 1),
+            ("min ground clearance of neck and head (mm)", sc["min_ground_clearance_m"], None, None, 1000, 1),
+            ("min distance to the obstacles (mm)", sc.get("min_obstacle_distance_m"), None, None, 1000, 1),
+            ("base slide in simulation (mm)", None, s.get("base_slide_m"), None, 1000, 2),
+            ("max joint torque in simulation (N m)", None, s.get("max_torque_nm"), None, 1, 2),
+            ("motion duration (s)", sc.get("duration_s"), None, paper.get("duration_s"), 1, 1),
+        ]
+        for label, ours, simv, pap, scale, digits in rows:
+            if ours is None and simv is None and pap is None:
+                continue
+            lines.append(f"| {label} | {_fmt(ours, scale, digits)} | {_fmt(simv, scale, digits)} | "
+                         f"{_fmt(pap, scale, digits)} |")
+        if sim is None:
+            lines += ["", "No dynamics check (MuJoCo not installed, --no-sim, or the simulation failed)."]
+        notes = list(sc.get("notes") or [])
+        if notes:
+            lines += ["", "Notes:", ""] + [f"- {n}" for n in notes]
+        files = sc.get("files") or []
+        if files:
+            lines += ["", "Files: " + ", ".join(f"`{f}`" for f in files)]
+        lines.append("")
+    if report.get("notes"):
+        lines += ["## Notes", ""] + [f"- {n}" for n in report["notes"]] + [""]
+    if report.get("stages"):
+        lines += ["## Where the time went", "", "| stage | s |", "|---|---|"]
+        lines += [f"| {st['stage']} | {st['seconds']:.1f} |" for st in report["stages"]] + [""]
+    return "\n".join(lines)
+
+
+def write_summary(report: dict, path: str | os.PathLike) -> Path:
+    """Write :func:`summary_markdown` of ``report`` to ``path``; returns the path."""
+    return write_text_atomic(path, summary_markdown(jsonable(report)))

@@ -1,0 +1,712 @@
+"""The stability-aware whole-body solve: every joint and the base's placement at once.
+
+The paper's segmented solve (:class:`~snakehead.control.controller.HeadController`: the base on its arc, the neck
+by Eqs. 18-22, the head by TRAC-IK) reaches many targets in milliseconds, but it checks stability instead of
+seeking it and keeps the base where it is. When it fails, leaves the centre of mass outside the support polygon,
+puts a link in the ground or into an obstacle, this module solves one optimisation problem:
+
+    maximise   the static margin of the centre of mass in the support polygon (Eqs. 23-24)
+    over       the base's yaw joints (its flat shape: pitch joints flat, the base lying on the ground), the
+               neck and head joints, and (optionally) the base placement (x, y, yaw)
+    such that  the head is at the position pointing along the direction (roll free, or fixed),
+               margin >= ``min_margin``, every lifted link above the ground, no two links closer than
+               ``self_clearance``, every link ``obstacle_clearance`` from every obstacle, joints within limits.
+
+It is solved by SciPy's SLSQP with analytic gradients (the Jacobians of world points of the body, the centre of
+mass and the polygon's active edge) from several starts: the segmented solution, the current configuration, and
+the segmented solutions from base placements that bring the target into the neck's accepted range and from
+other base arcs. Links are capsules in the optimisation (their collision boxes' axes, radius half the section;
+the boxes' corners stick out by at most 41 % of that radius, covered by the clearance); every solution is then
+checked exactly (boxes by separating axes, the support polygon of the boxes' ground footprint).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from .._validate import finite_float, unit_vector3, vector3
+from ..dynamics import stability
+from ..geometry import collision as coll
+from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
+
+#: Default required static margin of a solution (m).
+MIN_MARGIN = 0.005
+#: Default least gap between the boxes of two links that are not neighbours (m), and from obstacles.
+SELF_CLEARANCE = 0.002
+OBSTACLE_CLEARANCE = 0.002
+#: Tolerances of a solution: head position (m) and direction (rad).
+POSITION_TOLERANCE = 1e-4
+DIRECTION_TOLERANCE = np.radians(0.05)
+#: SLSQP's iteration budget per start.
+MAX_ITERATIONS = 40
+#: Capsule pairs farther apart than this at a start (m) are left out of that start's constraints (and checked
+#: exactly at the end like every pair).
+PAIR_RANGE = 0.25
+
+STAGES = ("segmented", "whole-body, base kept", "whole-body, base moved")
+REASONS = ("out of reach", "no stable pose", "no clear pose")
+
+
+@dataclass
+class WholeBodySolution:
+    """A whole-body solution (or the best attempt).
+
+    q (n,) rad and base: the configuration and the base placement. stage: which of ``STAGES`` solved it (None
+    when unsolved). reason: None when solved, else one of ``REASONS`` (what the best attempt lacked).
+    position_error_m, direction_error_deg: of the head; static_margin_m (support polygon of the links on the
+    ground), ground_clearance_m (lowest lifted box corner), self_clearance_m (separating-axis gap),
+    obstacle_clearance_m (None without obstacles). starts: how many starts were tried; seconds: solve time.
+    """
+
+    q: np.ndarray
+    base: BasePlacement
+    stage: str | None
+    reason: str | None
+    position_error_m: float
+    direction_error_deg: float
+    static_margin_m: float
+    ground_clearance_m: float
+    self_clearance_m: float
+    obstacle_clearance_m: float | None
+    starts: int = 0
+    seconds: float = 0.0
+    notes: list = field(default_factory=list)
+    #: the paper's segmented solution (a ``HeadSolution``) tried first, when there was one
+    segmented: object | None = None
+    #: the desired head frame (4, 4) (x-axis the direction)
+    desired_frame: np.ndarray | None = None
+
+    @property
+    def success(self) -> bool:
+        return self.reason is None
+
+    @property
+    def message(self) -> str:
+        if self.success:
+            return f"solved ({self.stage})"
+        return (f"{self.reason}: head {1000 * self.position_error_m:.1f} mm / {self.direction_error_deg:.2f} deg off, "
+                f"static margin {1000 * self.static_margin_m:.1f} mm, ground clearance "
+                f"{1000 * self.ground_clearance_m:.1f} mm, self clearance {1000 * self.self_clearance_m:.1f} mm")
+
+    @property
+    def neck_goal(self):
+        """Eqs. 18-20's goal of the segmented solve, when that solve is the solution (for Fig. 8)."""
+        return getattr(self.segmented, "neck_goal", None) if self.stage == STAGES[0] else None
+
+    @property
+    def neck(self):
+        return getattr(self.segmented, "neck", None) if self.stage == STAGES[0] else None
+
+
+class BodyProblem:
+    """The geometry of one robot that the whole-body solve needs, computed once: which joints are free, which
+    links lie on the ground, the links' capsules and the pairs that may collide."""
+
+    def __init__(self, robot: SnakeRobot):
+        self.robot = robot = as_robot(robot)
+        n = robot.n_joints
+        child = np.asarray(robot.body.model.joint_child_links)
+        self.child = child
+        first_lifted_link = int(child[robot.lift_joints.start]) if robot.lift_joints.start < n else len(child) + 10**6
+        ground_joint = np.arange(n) < robot.lift_joints.start
+        kinds = np.array(robot.joint_kinds)
+        #: joints held at zero: the pitch joints of the links lying on the ground (the base lies flat)
+        self.flat = ground_joint & (kinds == PITCH)
+        #: free joints: the ground links' yaw joints (the base's flat shape) and every lifted joint
+        self.free = ~self.flat
+        self.ground_yaw = ground_joint & ~self.flat
+        boxed = robot.boxed_links
+        self.ground_links = boxed[boxed < first_lifted_link]
+        self.lifted_links = boxed[boxed >= first_lifted_link]
+        self.boxed = boxed
+        half = 0.5 * robot.box_sizes[boxed]
+        # capsules along each box's x-axis (the body axis), radius the smaller half-section, inside the box's length
+        self.radius = np.minimum(half[:, 1], half[:, 2])
+        self.half_len = np.maximum(half[:, 0] - self.radius, 0.0)
+        #: how far the box's corners stick out of its capsule (sqrt(2) - 1 of the radius for a square section)
+        self.corner_excess = np.hypot(half[:, 1], half[:, 2]) - self.radius
+        i, j = np.triu_indices(len(boxed), k=2)  # links at least two apart in the chain (neighbours always touch)
+        both_ground = np.isin(boxed[i], self.ground_links) & np.isin(boxed[j], self.ground_links)
+        # links lying flat on the ground next to each other cannot meet by turning yaw joints only if far apart in
+        # the chain: keep every pair, except ground pairs of consecutive boxed links (a marker in between)
+        self.pairs = np.column_stack([i, j])[~(both_ground & (j - i < 2))]
+        self.axis_local = np.asarray(robot.body.model.joint_axes, float)
+        self.head_index = robot.link_index(robot.parts.head_tip)
+        self._iks: dict = {}
+
+    def lifted_ik(self, seed: int = 0):
+        """TRAC-IK of the lifted chain (lift_frame -> head_tip), seeded (made once per seed)."""
+        from ..kinematics.ik import TracIK
+
+        if seed not in self._iks:
+            chain = self.robot.sub_chain(self.robot.lift_frame, self.robot.parts.head_tip)
+            self._iks[seed] = TracIK.from_chain(chain, timeout=0.002, seed=seed)
+        return self._iks[seed]
+
+    # --- kinematics of world points ---------------------------------------------------------------------------
+    def frames(self, q: np.ndarray, base: BasePlacement) -> np.ndarray:
+        return self.robot.frames(q, base)
+
+    def point_jacobians(self, F: np.ndarray, base: BasePlacement, points: np.ndarray, links: np.ndarray
+                        ) -> np.ndarray:
+        return self.robot.point_jacobians(F, points, links)
+
+    def vector_jacobian(self, F: np.ndarray, v: np.ndarray, link: int) -> np.ndarray:
+        """d(v)/d(q, x, y, yaw) of a world direction v attached to ``link``: (3, n + 3)."""
+        a, _ = self.robot.joint_axes_world(F)
+        n = len(a)
+        J = np.zeros((3, n + 3))
+        J[:, :n] = (np.cross(a, v) * (self.child <= link)[:, None]).T
+        J[:, n + 2] = np.cross([0.0, 0.0, 1.0], v)
+        return J
+
+    def capsules(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World end points (k, 2, 3) of the links' capsule axes."""
+        B = self.robot.box_poses(F[None], self.boxed)[0]
+        c, x = B[:, :3, 3], B[:, :3, 0]
+        ends = np.stack([c - self.half_len[:, None] * x, c + self.half_len[:, None] * x], axis=1)
+        return ends
+
+    # --- the support polygon and the static margin ---------------------------------------------------------
+    def contact_points(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World (P, 3) bottom corners of the ground links' boxes and their links (P,)."""
+        corners = self.robot.box_corners(F[None], self.ground_links)[0]  # (k, 8, 3)
+        order = np.argsort(corners[..., 2], axis=1)[:, :4]
+        low = np.take_along_axis(corners, order[..., None], axis=1)  # (k, 4, 3)
+        return low.reshape(-1, 3), np.repeat(self.ground_links, 4)
+
+    def com_and_jacobian(self, F: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray]:
+        r = self.robot
+        m = r.masses
+        heavy = np.flatnonzero(m > 0)
+        c_i = F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
+        M = m[heavy].sum()
+        J = self.point_jacobians(F, base, c_i, heavy)
+        return (m[heavy, None] * c_i).sum(0) / M, np.einsum("l,lij->ij", m[heavy], J) / M
+
+    def margin_and_gradient(self, F: np.ndarray, base: BasePlacement) -> tuple[float, np.ndarray]:
+        """Signed distance of the CoM's ground projection to the support polygon's nearest edge (> 0 inside) and
+        its gradient (n + 3,) through the active edge."""
+        c, Jc = self.com_and_jacobian(F, base)
+        pts, links = self.contact_points(F)
+        idx = stability.hull_indices(pts[:, :2])
+        if len(idx) < 3:
+            return -np.inf, np.zeros(Jc.shape[1])
+        A = pts[idx, :2]
+        B = np.roll(A, -1, axis=0)
+        e = B - A
+        ell = np.linalg.norm(e, axis=1)
+        t = e / ell[:, None]
+        nrm = np.column_stack([-t[:, 1], t[:, 0]])  # inward for a counter-clockwise polygon
+        d = np.einsum("ki,ki->k", nrm, c[:2] - A)
+        # outside: the distance to the polygon (edge segments); inside: to the nearest edge line
+        if np.all(d >= 0):
+            k = int(np.argmin(d))
+            margin = float(d[k])
+        else:
+            u = np.clip(np.einsum("ki,ki->k", c[:2] - A, t), 0.0, ell)
+            closest = A + u[:, None] * t
+            dist = np.linalg.norm(c[:2] - closest, axis=1)
+            k = int(np.argmin(dist))
+            margin = -float(dist[k])
+        ka, kb = idx[k], idx[(k + 1) % len(idx)]
+        Jp = self.point_jacobians(F, base, pts[[ka, kb]], links[[ka, kb]])[:, :2, :]  # (2, 2, m)
+        if margin >= 0:
+            n_k, a_k, t_k, l_k = nrm[k], A[k], t[k], ell[k]
+            # d margin = n . (dc - da) + (c - a) . dn,  dn = R90 (I - t t^T)(db - da) / l
+            R90 = np.array([[0.0, -1.0], [1.0, 0.0]])
+            P = R90 @ (np.eye(2) - np.outer(t_k, t_k)) / l_k
+            g = n_k @ (Jc[:2] - Jp[0]) + (c[:2] - a_k) @ P @ (Jp[1] - Jp[0])
+        else:
+            diff = c[:2] - closest[k]
+            dn = diff / max(np.linalg.norm(diff), 1e-12)
+            s = u[k] / ell[k]
+            g = -(dn @ (Jc[:2] - ((1 - s) * Jp[0] + s * Jp[1])))
+        return margin, g
+
+
+def _segment_closest(p1, q1, p2, q2):
+    """Closest points of segments [p1, q1], [p2, q2] (arrays (..., 3)): (s, t) parameters (Ericson 5.1.9)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a = np.sum(d1 * d1, -1)
+    e = np.sum(d2 * d2, -1)
+    f = np.sum(d2 * r, -1)
+    c = np.sum(d1 * r, -1)
+    b = np.sum(d1 * d2, -1)
+    den = a * e - b * b
+    eps = 1e-18
+    s = np.where(den > eps, np.clip((b * f - c * e) / np.where(den > eps, den, 1.0), 0.0, 1.0), 0.0)
+    t = np.where(e > eps, (b * s + f) / np.where(e > eps, e, 1.0), 0.0)
+    t_c = np.clip(t, 0.0, 1.0)
+    s_c = np.where(a > eps, np.clip((t_c * b - c) / np.where(a > eps, a, 1.0), 0.0, 1.0), 0.0)
+    s = np.where((t < 0.0) | (t > 1.0), s_c, s)
+    return s, t_c
+
+
+def _direction_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors orthogonal to d and to each other."""
+    helper = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    e1 = np.cross(d, helper)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(d, e1)
+
+
+class _Objective:
+    """The optimisation problem for one target, variables z = (free joints, [x, y, yaw] when the base moves)."""
+
+    def __init__(self, prob: BodyProblem, q_template: np.ndarray, base0: BasePlacement, position, direction,
+                 move_base: bool, obstacles, min_margin: float, self_clearance: float, obstacle_clearance: float,
+                 regularise: np.ndarray | None):
+        self.prob, self.r = prob, prob.robot
+        self.q_template = q_template.copy()
+        self.q_template[prob.flat] = 0.0
+        self.base0 = base0
+        self.p_des, self.d_des = position, direction
+        self.e1, self.e2 = _direction_basis(direction)
+        self.move_base = move_base
+        self.obstacles = list(obstacles)
+        self.min_margin, self.self_gap, self.obs_gap = min_margin, self_clearance, obstacle_clearance
+        # the base kept: its placement and its flat shape (the ground links' yaw joints) stay as they are
+        self.free = np.flatnonzero(prob.free if move_base else prob.free & ~prob.ground_yaw)
+        self.n = self.r.n_joints
+        self.reg = regularise
+        self._cache_z = None
+        self._cache = None
+        # the capsule pairs that can come near: not two ground links when the base is kept (they do not move
+        # relative to each other), and not farther apart at the start than a few links can close in one solve
+        F = prob.frames(self.q_template, base0)
+        ends = prob.capsules(F)
+        i, j = prob.pairs[:, 0], prob.pairs[:, 1]
+        s_, t_ = _segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
+        gap = np.linalg.norm(ends[i, 0] + s_[:, None] * (ends[i, 1] - ends[i, 0])
+                             - ends[j, 0] - t_[:, None] * (ends[j, 1] - ends[j, 0]), axis=1)
+        ground = np.isin(prob.boxed[i], prob.ground_links) & np.isin(prob.boxed[j], prob.ground_links)
+        keep = gap < PAIR_RANGE
+        if not move_base:
+            keep &= ~ground
+        self.pairs = prob.pairs[keep]
+
+    def unpack(self, z: np.ndarray) -> tuple[np.ndarray, BasePlacement]:
+        q = self.q_template.copy()
+        q[self.free] = z[:len(self.free)]
+        if self.move_base:
+            x, y, yaw = z[len(self.free):]
+            return q, BasePlacement(float(x), float(y), float(yaw))
+        return q, self.base0
+
+    def pack(self, q: np.ndarray, base: BasePlacement) -> np.ndarray:
+        z = q[self.free]
+        return np.concatenate([z, [base.x, base.y, base.yaw]]) if self.move_base else z.copy()
+
+    def columns(self) -> np.ndarray:
+        """Indices into the (n + 3) gradient of the variables."""
+        cols = list(self.free)
+        if self.move_base:
+            cols += [self.n, self.n + 1, self.n + 2]
+        return np.array(cols)
+
+    def bounds(self) -> list:
+        lo, hi = self.r.lower[self.free], self.r.upper[self.free]
+        b = list(zip(lo, hi))
+        if self.move_base:
+            b += [(None, None)] * 3
+        return b
+
+    def evaluate(self, z: np.ndarray) -> dict:
+        if self._cache_z is not None and np.array_equal(z, self._cache_z):
+            return self._cache
+        prob, r = self.prob, self.r
+        cols = self.columns()
+        q, base = self.unpack(z)
+        F = prob.frames(q, base)
+        out: dict = {"q": q, "base": base, "F": F}
+        # head position and direction
+        H = F[prob.head_index]
+        p, x = H[:3, 3], H[:3, 0]
+        Jp = prob.point_jacobians(F, base, p[None], np.array([prob.head_index]))[0][:, cols]
+        Jx = prob.vector_jacobian(F, x, prob.head_index)[:, cols]
+        out["eq"] = np.concatenate([p - self.p_des, [x @ self.e1, x @ self.e2]])
+        out["eq_jac"] = np.vstack([Jp, self.e1 @ Jx, self.e2 @ Jx])
+        # static margin
+        margin, g = prob.margin_and_gradient(F, base)
+        out["margin"], out["margin_jac"] = margin, g[cols]
+        ineq, ineq_jac = [np.array([margin - self.min_margin])], [g[cols][None]]
+        # ground: the lowest corner of every lifted box above the ground
+        lifted = prob.lifted_links
+        if len(lifted):
+            corners = r.box_corners(F[None], lifted)[0]  # (k, 8, 3)
+            k_low = np.argmin(corners[..., 2], axis=1)
+            low = corners[np.arange(len(lifted)), k_low]
+            Jg = prob.point_jacobians(F, base, low, lifted)[:, 2, :][:, cols]
+            ineq.append(low[:, 2])
+            ineq_jac.append(Jg)
+            out["ground"] = float(low[:, 2].min())
+        # self: capsule distances of the pairs
+        ends = prob.capsules(F)
+        i, j = self.pairs[:, 0], self.pairs[:, 1]
+        s, t = _segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
+        pa = ends[i, 0] + s[:, None] * (ends[i, 1] - ends[i, 0])
+        pb = ends[j, 0] + t[:, None] * (ends[j, 1] - ends[j, 0])
+        diff = pa - pb
+        dist = np.linalg.norm(diff, axis=1)
+        u = diff / np.maximum(dist, 1e-12)[:, None]
+        need = prob.radius[i] + prob.radius[j] + prob.corner_excess[i] + prob.corner_excess[j] + self.self_gap
+        links = prob.boxed
+        JA = prob.point_jacobians(F, base, pa, links[i])
+        JB = prob.point_jacobians(F, base, pb, links[j])
+        ineq.append(dist - need)
+        ineq_jac.append(np.einsum("pi,pij->pj", u, JA - JB)[:, cols])
+        # obstacles: points along every capsule against each obstacle's distance field
+        if self.obstacles:
+            samples = np.linspace(0.0, 1.0, 4)
+            pts = (ends[:, None, 0] + samples[None, :, None] * (ends[:, None, 1] - ends[:, None, 0])).reshape(-1, 3)
+            plinks = np.repeat(links, len(samples))
+            prad = np.repeat(prob.radius + prob.corner_excess, len(samples))
+            Jpts = prob.point_jacobians(F, base, pts, plinks)[:, :, cols]
+            for ob in self.obstacles:
+                dist_o, grad_o = _distance_and_gradient(ob, pts)
+                ineq.append(dist_o - prad - self.obs_gap)
+                ineq_jac.append(np.einsum("pi,pij->pj", grad_o, Jpts))
+        out["ineq"] = np.concatenate(ineq)
+        out["ineq_jac"] = np.vstack(ineq_jac)
+        self._cache_z, self._cache = z.copy(), out
+        return out
+
+    def objective(self, z):
+        e = self.evaluate(z)
+        f = -e["margin"]
+        if self.reg is not None:
+            d = z - self.reg
+            f += 1e-3 * float(d @ d)
+        return f
+
+    def objective_jac(self, z):
+        e = self.evaluate(z)
+        g = -e["margin_jac"].copy()
+        if self.reg is not None:
+            g += 2e-3 * (z - self.reg)
+        return g
+
+
+def _distance_and_gradient(ob, pts: np.ndarray, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """An obstacle's distance at points (P, 3) and its gradient by central differences."""
+    from ..geometry.obstacles import BoxObstacle
+
+    def dist(x):
+        if isinstance(ob, BoxObstacle):
+            loc = (x - ob.centre) @ ob.rotation
+            q = np.abs(loc) - ob.size / 2
+            outside = np.linalg.norm(np.maximum(q, 0.0), axis=-1)
+            inside = np.minimum(q.max(axis=-1), 0.0)
+            return outside + inside
+        return ob.distance_to_points(x)
+
+    d0 = dist(pts)
+    g = np.empty_like(pts)
+    for k in range(3):
+        dx = np.zeros(3)
+        dx[k] = h
+        g[:, k] = (dist(pts + dx) - dist(pts - dx)) / (2 * h)
+    return d0, g
+
+
+def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position, direction, obstacles=(),
+                   *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
+                   obstacle_clearance: float = OBSTACLE_CLEARANCE) -> dict:
+    """Exact checks of a configuration: head errors, static margin (support polygon of the boxes lying on the
+    ground), lowest lifted box corner, separating-axis self clearance, obstacle clearance, and the verdict
+    (None or one of ``REASONS``)."""
+    robot = as_robot(robot)
+    H = robot.head_pose(q, base)
+    pe = float(np.linalg.norm(H[:3, 3] - position))
+    de = float(np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1.0, 1.0))))
+    margin = float(stability.static_margin(robot, q, base, contact="ground"))
+    ground = float(coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min())
+    selfc = float(coll.self_clearance(robot, q, base)[0])
+    obst = None
+    if obstacles:
+        obst = float(coll.collision_check(robot, q[None], list(obstacles), base, exact_within=0.01).distance[0])
+    if pe > POSITION_TOLERANCE or np.radians(de) > DIRECTION_TOLERANCE:
+        reason = "out of reach"
+    elif margin < min_margin:
+        reason = "no stable pose"
+    elif ground < -coll.GROUND_TOLERANCE or selfc <= self_clearance or (obst is not None and obst <= obstacle_clearance):
+        reason = "no clear pose"
+    else:
+        reason = None
+    return {"position_error_m": pe, "direction_error_deg": de, "static_margin_m": margin,
+            "ground_clearance_m": ground, "self_clearance_m": selfc, "obstacle_clearance_m": obst, "reason": reason}
+
+
+def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position, direction, *, move_base: bool,
+           obstacles=(), min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
+           obstacle_clearance: float = OBSTACLE_CLEARANCE, max_iterations: int = MAX_ITERATIONS
+           ) -> tuple[np.ndarray, BasePlacement]:
+    """One SLSQP run from (q0, base0): the configuration and placement it ends at."""
+    obj = _Objective(prob, q0, base0, position, direction, move_base, obstacles, min_margin, self_clearance,
+                     obstacle_clearance, None)
+    z0 = np.clip(obj.pack(q0, base0), [b[0] if b[0] is not None else -np.inf for b in obj.bounds()],
+                 [b[1] if b[1] is not None else np.inf for b in obj.bounds()])
+    obj.reg = z0.copy()
+    cons = [{"type": "eq", "fun": lambda z: obj.evaluate(z)["eq"], "jac": lambda z: obj.evaluate(z)["eq_jac"]},
+            {"type": "ineq", "fun": lambda z: obj.evaluate(z)["ineq"], "jac": lambda z: obj.evaluate(z)["ineq_jac"]}]
+    res = optimize.minimize(obj.objective, z0, jac=obj.objective_jac, bounds=obj.bounds(), constraints=cons,
+                            method="SLSQP", options={"maxiter": int(max_iterations), "ftol": 1e-9})
+    return obj.unpack(res.x)
+
+
+def solve_whole_body(robot: SnakeRobot, position, direction, starts, *, move_base: bool = True, obstacles=(),
+                     min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
+                     obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None,
+                     time_budget: float = 3.0) -> WholeBodySolution:
+    """The whole-body solve from ``starts``, a sequence of (q (n,), BasePlacement) in the order to try; the first
+    whose refined solution passes every exact check is returned (stage "whole-body, base kept" when its base is
+    the first start's, else "whole-body, base moved"), else the best attempt with the reason it fails.
+    ``time_budget`` (s) stops trying more starts."""
+    t0 = time.perf_counter()
+    robot = as_robot(robot)
+    position, direction = vector3(position, "position"), unit_vector3(direction, "direction")
+    prob = problem if problem is not None else BodyProblem(robot)
+    min_margin = finite_float(min_margin, "min_margin")
+    starts = list(starts)
+    if not starts:
+        raise ValueError("the whole-body solve needs at least one start (q, base)")
+    base_first = starts[0][1]
+    best, best_key = None, None
+    rank = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
+    tried = 0
+    for q0, b0 in starts:
+        if tried and time.perf_counter() - t0 > time_budget:
+            break
+        tried += 1
+        q, b = refine(prob, np.asarray(q0, float), b0, position, direction, move_base=move_base, obstacles=obstacles,
+                      min_margin=min_margin, self_clearance=self_clearance, obstacle_clearance=obstacle_clearance)
+        q = np.clip(q, robot.lower, robot.upper)
+        chk = check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin,
+                             obstacle_clearance=obstacle_clearance)
+        key = (rank[chk["reason"]], chk["static_margin_m"] if chk["reason"] != "out of reach" else -chk["position_error_m"])
+        if best is None or key > best_key:
+            best, best_key = (q, b, chk), key
+        if chk["reason"] is None:
+            break
+    q, b, chk = best
+    same = b == base_first
+    stage = None if chk["reason"] else (STAGES[1] if same else STAGES[2])
+    return WholeBodySolution(q=q, base=b, stage=stage, reason=chk["reason"], position_error_m=chk["position_error_m"],
+                             direction_error_deg=chk["direction_error_deg"], static_margin_m=chk["static_margin_m"],
+                             ground_clearance_m=chk["ground_clearance_m"], self_clearance_m=chk["self_clearance_m"],
+                             obstacle_clearance_m=chk["obstacle_clearance_m"], starts=tried,
+                             seconds=time.perf_counter() - t0)
+
+
+def _base_shapes(controller) -> list[np.ndarray]:
+    """Base joint vectors to start from besides the controller's: its arc turned the other way, a straight base,
+    and arcs of a half and of one and a half times its central angle."""
+    robot = controller.robot
+    qb = controller.q_initial[robot.parts.base]
+    lo, hi = robot.lower[robot.parts.base], robot.upper[robot.parts.base]
+    return [-qb, np.zeros_like(qb), 0.5 * qb, np.clip(1.5 * qb, lo, hi)]
+
+
+#: Rolled frames (Fig. 9) and starts per roll of the lifted chain's IK that give the whole-body solve its
+#: candidates.
+CANDIDATE_ROLLS = 8
+CANDIDATE_SEEDS = 2
+
+
+def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position, direction,
+                      seed: int = 0) -> list[np.ndarray]:
+    """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
+    chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
+    frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
+    from .head import frame_from_direction, roll_about_x
+
+    robot = prob.robot
+    ik = prob.lifted_ik(seed)
+    start = robot.lift_joints.start
+    T0 = robot.frame(q_now, robot.lift_frame, base)
+    target = np.linalg.inv(T0) @ frame_from_direction(position, direction)
+    angles = 2 * np.pi * np.arange(CANDIDATE_ROLLS) / CANDIDATE_ROLLS
+    poses = np.stack([roll_about_x(target, a) for a in angles] * CANDIDATE_SEEDS)
+    rng = np.random.default_rng(seed)
+    inits = np.vstack([np.tile(q_now[start:], (CANDIDATE_ROLLS, 1))]
+                      + [rng.uniform(ik.lower, ik.upper, (CANDIDATE_ROLLS, ik.n_joints))
+                         for _ in range(CANDIDATE_SEEDS - 1)])
+    qs, ok = ik.ik_many(poses, inits)
+    out = []
+    for qk in qs[ok]:
+        q = q_now.copy()
+        q[start:] = qk
+        out.append(q)
+    return out
+
+
+def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position, direction, seed: int
+                   ) -> np.ndarray | None:
+    """The lifted chain's IK from the current joints, the roll about the direction free: the nearest solution."""
+    from ..kinematics.ik import FREE_ROLL
+    from .head import frame_from_direction
+
+    robot = prob.robot
+    start = robot.lift_joints.start
+    T0 = robot.frame(q_now, robot.lift_frame, base)
+    target = np.linalg.inv(T0) @ frame_from_direction(position, direction)
+    qk = prob.lifted_ik(seed).ik(target, q_init=np.clip(q_now[start:], robot.lower[start:], robot.upper[start:]),
+                                 bounds=FREE_ROLL)
+    if qk is None:
+        return None
+    q = q_now.copy()
+    q[start:] = qk
+    return q
+
+
+def solve_target(controller, position, direction, *, q_prev=None, base: BasePlacement | None = None, obstacles=(),
+                 allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
+                 problem: BodyProblem | None = None, seed: int = 0, near: bool = False) -> WholeBodySolution:
+    """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
+
+    Stages, the first that passes every exact check wins:
+
+    1. the paper's segmented solve (:meth:`HeadController.solve`) from the base as it is;
+    2. the base kept: the lifted chain's IK candidates (:func:`lifted_candidates`), then the whole-body
+       optimisation over the lifted joints from the best of them and from the segmented solution;
+    3. the base moved (when ``allow_base_move``): for the base's shape and other flat shapes (:func:`_base_shapes`),
+       the placement that brings the target into the neck's accepted range (Section 3.3 (3)), the segmented
+       solution and the IK candidates from there, then the whole-body optimisation over the base's yaw joints,
+       its placement and the lifted joints.
+
+    With ``near`` (for poses close to the previous one, e.g. along a line), a first attempt continues from
+    ``q_prev``: the lifted chain's IK started from its joints with the roll free, kept when it passes every check
+    (stage "whole-body, base kept"), so that consecutive poses stay on one branch of solutions.
+
+    The result says which stage solved it, or why the best attempt fails (``REASONS``).
+    """
+    from . import neck as nk
+
+    t0 = time.perf_counter()
+    robot = controller.robot
+    position, direction = vector3(position, "position"), unit_vector3(direction, "direction")
+    base = controller.base if base is None else base
+    q_now = controller.q_initial.copy() if q_prev is None else np.asarray(q_prev, float).copy()
+    prob = problem if problem is not None else BodyProblem(robot)
+    obstacles = list(obstacles)
+
+    def check(q, b):
+        return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin)
+
+    def solution(q, b, chk, stage, starts):
+        return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
+                                 position_error_m=chk["position_error_m"],
+                                 direction_error_deg=chk["direction_error_deg"],
+                                 static_margin_m=chk["static_margin_m"], ground_clearance_m=chk["ground_clearance_m"],
+                                 self_clearance_m=chk["self_clearance_m"],
+                                 obstacle_clearance_m=chk["obstacle_clearance_m"], starts=starts,
+                                 seconds=time.perf_counter() - t0)
+
+    def accept(q, b):
+        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
+                    > OBSTACLE_CLEARANCE)
+
+    best = None
+    seg_holder = [None]
+
+    def consider(q, b, stage, starts):
+        """Check a configuration; keep the best attempt; return the solution when it passes."""
+        nonlocal best
+        chk = check(q, b)
+        sol = solution(q, b, chk, stage, starts)
+        sol.segmented = seg_holder[0]
+        sol.desired_frame = None if seg_holder[0] is None else seg_holder[0].desired_frame
+        if best is None or _rank(sol) > _rank(best):
+            best = sol
+        return sol if sol.success else None
+
+    if near and q_prev is not None:
+        q = _continue_from(prob, q_now, base, position, direction, seed)
+        if q is not None and (found := consider(q, base, STAGES[1], 1)):
+            return found
+    # 1. the paper's segmented solve
+    seg = controller.solve(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
+                           allow_base_move=False)
+    seg_holder[0] = seg
+    if found := consider(seg.q, seg.base, STAGES[0], 0):
+        return found
+    # 2. the base kept
+    for k, q in enumerate(lifted_candidates(prob, q_now, base, position, direction, seed)):
+        if found := consider(q, base, STAGES[1], k + 1):
+            return found
+    # refine only what reached the head but failed stability or clearance: from there a local optimisation can
+    # move the body; a target out of reach from this base is the placement's problem (stage 3)
+    starts = [best.q] if best is not None and best.reason != "out of reach" else []
+    for q0 in starts:
+        if time.perf_counter() - t0 > time_budget:
+            break
+        q, b = refine(prob, q0, base, position, direction, move_base=False, obstacles=obstacles,
+                      min_margin=min_margin)
+        if found := consider(np.clip(q, robot.lower, robot.upper), b, STAGES[1], len(starts)):
+            return found
+    if not allow_base_move:
+        return best
+    # 3. the base moved
+    moved_starts = []
+    for qb in [q_now[robot.parts.base]] + _base_shapes(controller):
+        q = q_now.copy()
+        q[robot.parts.base] = qb
+        P0_local = np.linalg.inv(robot.root_pose(base)) @ robot.frame(q, robot.lift_frame, base)
+        placed = nk.base_move_into_range(position, P0_local, base, controller.Lc, controller.neck_length,
+                                         controller.slack, robot.body_axis_height)
+        if placed is not None:
+            s = controller.solve(position, direction, q_prev=q, base=placed, allow_base_move=False)
+            if s.success and (found := consider(s.q, placed, STAGES[2], 0)):
+                return found
+            moved_starts.append((s.q, placed))
+        for b in [placed] * (placed is not None) + placements(prob, P0_local, position, direction):
+            for qc in lifted_candidates(prob, q, b, position, direction, seed):
+                if found := consider(qc, b, STAGES[2], 0):
+                    return found
+            if time.perf_counter() - t0 > time_budget:
+                break
+        if time.perf_counter() - t0 > time_budget:
+            break
+    for q0, b0 in moved_starts:
+        if time.perf_counter() - t0 > time_budget:
+            break
+        q, b = refine(prob, q0, b0, position, direction, move_base=True, obstacles=obstacles, min_margin=min_margin)
+        if found := consider(np.clip(q, robot.lower, robot.upper), b, STAGES[2], len(moved_starts)):
+            return found
+    return best
+
+
+def placements(prob: BodyProblem, P0_local: np.ndarray, position, direction) -> list[BasePlacement]:
+    """Base placements that put the frame the neck lifts from (``P0_local``: its pose in the root frame, for the
+    base's shape) a few horizontal distances short of the target, its body axis pointing at the target along the
+    head's direction or its opposite's horizontal part: where the lifted chain can reach the target whatever its
+    height (the accepted range of Section 3.3 (3) has none for targets higher than the neck and the dexterous
+    centre reach)."""
+    robot = prob.robot
+    reach = robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach
+    dz = position[2] - (robot.body_axis_height + P0_local[2, 3])
+    span = np.sqrt(max(reach * reach - dz * dz, 0.0))
+    if span <= 0:
+        return []
+    axis_heading = np.arctan2(P0_local[1, 0], P0_local[0, 0])
+    dxy = np.asarray(direction[:2], float)
+    headings = [np.arctan2(dxy[1], dxy[0])] if np.linalg.norm(dxy) > 1e-6 else [0.0]
+    headings += [headings[0] + np.pi / 2, headings[0] - np.pi / 2]
+    out = []
+    for h in (0.5 * span, 0.25 * span, 0.75 * span):
+        for heading in headings:
+            yaw = heading - axis_heading
+            c, s = np.cos(yaw), np.sin(yaw)
+            P0_xy = position[:2] - h * np.array([np.cos(heading), np.sin(heading)])
+            x, y = P0_xy - np.array([[c, -s], [s, c]]) @ P0_local[:2, 3]
+            out.append(BasePlacement(float(x), float(y), float(np.arctan2(s, c))))
+    return out
+
+
+def _rank(s: WholeBodySolution) -> tuple:
+    order = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
+    return order[s.reason], s.static_margin_m if s.reason != "out of reach" else -s.position_error_m

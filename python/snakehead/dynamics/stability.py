@@ -1,0 +1,429 @@
+"""Stability of the snake's whole-body motion: paper Section 3.1, Eqs. 23-40.
+
+Everything is in the world frame (z up, ground at z = 0). Where the base lies is a parameter
+``base`` (a :class:`~snakehead.robot.BasePlacement`, default ``BasePlacement()``: tail at the origin,
+body along +x).
+
+* :func:`center_of_mass` -- Eq. 23, for one configuration (16,) or a trajectory (T, 16).
+* :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts.
+* :func:`static_margin`, :func:`is_statically_stable` -- signed distance of the CoM's ground
+  projection to the polygon's edge (positive inside).
+* :func:`momenta_from_velocities`, :func:`momenta` -- Eqs. 25-31, linear and angular momentum about the
+  world origin along a trajectory.
+* :func:`zmp`, :func:`dynamic_stability` -- Eqs. 36-40 with p_z = 0 and the ZMP's margin in the polygon.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from .._validate import finite_array, joint_vector
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+
+#: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
+GRAVITY = 9.80665
+
+#: A base link counts as lying on the ground when the lowest corner of its collision box is below this
+#: height (m). The default robot's flat base links sit at exactly 0.
+CONTACT_TOLERANCE = 1e-3
+
+#: Contact models of :func:`support_polygon`.
+CONTACT_MODELS = ("endpoints", "footprint", "ground")
+
+
+# ------------------------------------------------------------------------------------------------
+# helpers
+# ------------------------------------------------------------------------------------------------
+
+
+def _joint_matrix(robot: SnakeRobot, q, name: str = "q") -> tuple[np.ndarray, bool]:
+    """q as (T, n) and whether it was a single vector (n,)."""
+    a = finite_array(q, name)
+    n = robot.n_joints
+    if a.ndim == 1:
+        if a.shape != (n,):
+            raise ValueError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
+        return a[None, :], True
+    if a.ndim != 2 or a.shape[1] != n:
+        raise ValueError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
+    if a.shape[0] < 1:
+        raise ValueError(f"{name} has no samples")
+    return a, False
+
+
+def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
+                         tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """Ground contact points of the base part along a trajectory.
+
+    Returns points (T, N, 2) (world x, y) and active (T, N) bool: which points touch the ground.
+    """
+    if contact not in CONTACT_MODELS:
+        raise ValueError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
+    end = robot.link_index(robot.parts.base_end) + 1  # base links: link_names[:end - 1]; their ends: [:end]
+    links = np.arange(0, end - 1) if contact != "ground" else np.arange(len(robot.link_names))
+    links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
+    if links.size == 0:
+        raise ValueError("the base part has no links with a collision box; no support polygon")
+    on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
+    if contact == "endpoints":
+        # Eq. 24: p_i are the endpoints of the base links, i.e. the origins of consecutive frames (each
+        # link's frame is at its proximal joint; the next frame in chain order is at its distal end). A point
+        # touches the ground when a link it ends lies on the ground.
+        idx = np.unique(np.r_[links, links + 1])
+        pts = frames[:, idx][..., :2, 3]  # (T, N, 2)
+        active = np.zeros((frames.shape[0], len(idx)), bool)
+        active[:, np.searchsorted(idx, links)] |= on_ground
+        active[:, np.searchsorted(idx, links + 1)] |= on_ground
+        return pts, active
+    # footprint / ground: the four bottom corners of each box (its face nearest the ground).
+    B = frames[:, links] @ robot.box_origins[links]  # (T, k, 4, 4)
+    half = 0.5 * robot.box_sizes[links]  # (k, 3)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
+    local = signs[None, :, :] * half[:, None, :]  # (k, 8, 3)
+    world = np.einsum("tkij,kcj->tkci", B[..., :3, :3], local) + B[..., None, :3, 3]  # (T, k, 8, 3)
+    # keep the 4 lowest corners of each box (its bottom face when the link lies flat)
+    order = np.argsort(world[..., 2], axis=2, kind="stable")[..., :4]
+    low = np.take_along_axis(world, order[..., None], axis=2)  # (T, k, 4, 3)
+    T = frames.shape[0]
+    pts = low[..., :2].reshape(T, -1, 2)
+    active = np.repeat(on_ground, 4, axis=1)
+    return pts, active
+
+
+def polygon_margin_many(points, active, xy) -> np.ndarray:
+    """Signed distance (m) of ``xy`` to the convex hull of the active ``points``, positive inside.
+
+    points (T, N, 2), active (T, N) bool, xy (T, 2) -> (T,). Inside a convex polygon the distance to its
+    boundary is the smallest distance to its edges; outside, the distance to the polygon is also the smallest
+    distance to its edges (as segments). A degenerate hull (collinear points) has no interior: the margin is
+    minus the distance to it (0 on it). Samples with no active point get -inf. One hull per sample (the C++
+    core's monotone chain), without the GIL.
+    """
+    points = finite_array(points, "points", (None, None, 2))
+    active = np.asarray(active, bool)
+    xy = finite_array(xy, "xy", (points.shape[0], 2))
+    if active.shape != points.shape[:2]:
+        raise ValueError(f"active has shape {active.shape}; expected {points.shape[:2]}")
+    return _core.hull_margins(np.ascontiguousarray(points), np.ascontiguousarray(active), np.ascontiguousarray(xy))
+
+
+# ------------------------------------------------------------------------------------------------
+# Eq. 23: centre of mass
+# ------------------------------------------------------------------------------------------------
+def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> np.ndarray:
+    """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
+
+    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    qs, single = _joint_matrix(robot, q)
+    frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
+    m = robot.masses
+    # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product
+    W = np.zeros((len(m), 3, 4, 3))
+    for i in range(3):
+        W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
+        W[:, i, 3, i] = m  # coefficient of p_l[i]
+    c = (frames[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
+    W = robot.root_pose(base)
+    c = c @ W[:3, :3].T + W[:3, 3]
+    return c[0] if single else c
+
+
+# ------------------------------------------------------------------------------------------------
+# Eq. 24: support polygon
+# ------------------------------------------------------------------------------------------------
+def hull_indices(pts: np.ndarray) -> list[int]:
+    """Indices of the counter-clockwise convex hull vertices of 2-D points (N, 2), collinear points on edges left
+    out (the C++ core's monotone chain): one index for coincident points, the two extremes for collinear points."""
+    return list(_core.convex_hull(finite_array(pts, "points", (None, 2))))
+
+
+def _hull_ccw(pts: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull vertices of 2-D points; a 2-point segment or 1 point when degenerate."""
+    return np.asarray(pts, float)[hull_indices(pts)]
+
+
+def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+                    contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+    """Support polygon of the base part on the ground, Eq. 24: (k, 2) world (x, y) vertices, counter-clockwise.
+
+    ``contact`` selects the contact points p_i of Eq. 24:
+
+    * ``"endpoints"`` (default, the paper): both endpoints of every base link (link_0 .. link_7 on the default
+      robot: the origins of link_0 .. link_7 and of the ``base_end`` marker), projected on the ground.
+      This is conservative: the true footprint of the 0.043 m wide modules is larger.
+    * ``"footprint"``: the four bottom corners of every base link's collision box -- the physical contact
+      footprint of the modules; use it for an (almost) straight base, whose endpoints are collinear.
+    * ``"ground"``: the four bottom corners of every link's box that lies on the ground, the neck's and head's
+      included -- the physical support of a robot that still lies (partly) flat, e.g. before the head is lifted.
+
+    Only links lying on the ground count (the lowest corner of their box below ``tolerance`` m). In the paper's
+    model (the first two) only the base supports the body, even when the neck and head touch the ground.
+    If the contact points are collinear the "polygon" is the segment between the extreme points (2, 2): it
+    has no interior, so :func:`static_margin` is <= 0 for it.
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q = joint_vector(q, robot.n_joints)
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    frames = robot.frames_many(q[None, :], base)
+    pts, active = _contact_points_many(robot, frames, contact, tolerance)
+    pts = pts[0][active[0]]
+    if len(pts) == 0:
+        raise ValueError("no base link touches the ground: there is no support polygon")
+    return _hull_ccw(pts)
+
+
+def static_margin(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+                  contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> float:
+    """Signed distance (m) from the CoM's ground projection to the support polygon's edge; > 0 inside.
+
+    Static stability (Section 3.1): the robot is statically stable if c is in C (Eq. 23, 24).
+    Outside the polygon the value is minus the distance to the polygon.
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q = joint_vector(q, robot.n_joints)
+    poly = support_polygon(robot, q, base, contact=contact, tolerance=tolerance)
+    c = center_of_mass(robot, q, base)
+    return float(polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), c[None, :2])[0])
+
+
+def is_statically_stable(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+                         contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                         margin: float = 0.0) -> bool:
+    """True when the CoM's ground projection lies inside the support polygon by more than ``margin`` m."""
+    return static_margin(robot, q, base, contact=contact, tolerance=tolerance) > float(margin)
+
+
+# ------------------------------------------------------------------------------------------------
+# Eqs. 25-31: momenta
+# ------------------------------------------------------------------------------------------------
+def _check_times(t, name: str = "t") -> np.ndarray:
+    t = finite_array(t, name, (None,))
+    if t.shape[0] < 2:
+        raise ValueError(f"{name} needs at least two samples, got {t.shape[0]}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError(f"{name} must increase strictly")
+    return t
+
+
+def _check_trajectory(robot: SnakeRobot, t, q) -> tuple[np.ndarray, np.ndarray]:
+    t = _check_times(t)
+    q = finite_array(q, "q", (None, robot.n_joints))
+    if q.shape[0] != t.shape[0]:
+        raise ValueError(f"q has {q.shape[0]} samples but t has {t.shape[0]}")
+    return t, q
+
+
+def joint_velocities(t, q) -> np.ndarray:
+    """Joint velocities (rad/s) of a sampled trajectory by finite differences: (T,) and (T, n) -> (T, n).
+
+    ``np.gradient``: central differences inside (second order on non-uniform steps too), second-order
+    one-sided differences at the ends (first order with only two samples).
+    """
+    t = _check_times(t)
+    q = finite_array(q, "q", (t.shape[0], None))
+    return np.gradient(q, t, axis=0, edge_order=2 if len(t) > 2 else 1)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of (3, T) arrays (component-major: contiguous and fast)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eqs. 25-31 for q, qd (T, n): P (T, 3), L about the world origin (T, 3) and the CoM (T, 3), world.
+
+    Computed in the root link's frame and moved to the world at the end (the root is fixed, so only a
+    rigid change of frame: P_w = R0 P, L_w = R0 L + p0 x P_w, c_w = R0 c + p0). The arrays are laid out
+    component-major, (3, T), so each step is a contiguous vector operation over all samples; the Python
+    loop runs over the links (20), never over time.
+    """
+    model = robot.body.model
+    child = np.asarray(model.joint_child_links)  # joint j's frame is link_names[child[j]] (chain order)
+    axes = np.asarray(model.joint_axes, float)  # (n, 3), joint axis in that frame
+    masses, coms, inertias = robot.masses, robot.coms, robot.inertias
+    T = q.shape[0]
+    F = robot.body.fk_all_many(q)  # (T, L, 4, 4) in the root frame
+    G = np.ascontiguousarray(F[:, :, :3, :].transpose(1, 2, 3, 0))  # (L, 3, 4, T)
+    qdT = np.ascontiguousarray(qd.T)  # (n, T)
+    omega = np.zeros((3, T))  # sum of z_i qdot_i over the joints passed so far (Eq. 26 unrolled)
+    wxo = np.zeros((3, T))  # sum of (z_i qdot_i) x o_i over the same joints
+    P = np.zeros((3, T))
+    L = np.zeros((3, T))
+    mc = np.zeros((3, T))
+    j = 0
+    for link in range(G.shape[0]):
+        while j < len(child) and child[j] <= link:  # joint j moves this link and every later one
+            Rj, oj = G[child[j], :, :3], G[child[j], :, 3]
+            w = (Rj * axes[j][None, :, None]).sum(axis=1) * qdT[j]  # 0z_j qdot_j
+            omega += w
+            wxo += _cross(w, oj)
+            j += 1
+        if masses[link] <= 0.0:
+            continue  # marker frames carry no mass
+        R, o = G[link, :, :3], G[link, :, 3]
+        c = o + (R * coms[link][None, :, None]).sum(axis=1)  # 0c_j = 0p_j + 0R_j cbar_j
+        # Eqs. 25, 27: velocity of c_j = sum_i z_i qdot_i x (c_j - o_i) = omega_j x c_j - sum_i (z_i qdot_i) x o_i
+        cdot = _cross(omega, c) - wxo
+        Pj = masses[link] * cdot  # Eq. 28
+        P += Pj  # Eq. 29
+        local = (R * omega[:, None, :]).sum(axis=0)  # R_j^T omega_j
+        Iw = (R * (inertias[link] @ local)[None, :, :]).sum(axis=1)  # R_j Ibar_j R_j^T omega_j
+        L += _cross(c, Pj) + Iw  # Eqs. 30, 31
+        mc += masses[link] * c
+    com = mc / masses.sum()
+    W = robot.root_pose(base)
+    R0, p0 = W[:3, :3], W[:3, 3]
+    Pw = (R0 @ P).T
+    Lw = (R0 @ L).T + np.cross(p0, Pw)
+    cw = (R0 @ com).T + p0
+    return Pw, Lw, cw
+
+
+def momenta_from_velocities(robot: SnakeRobot, q, qd, base: BasePlacement | None = None
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Linear momentum P (kg m/s) and angular momentum L about the world origin (kg m^2/s), Eqs. 25-31.
+
+    q, qd: joint positions (rad) and velocities (rad/s), (T, 16) each (or (16,) each -> (3,), (3,)).
+    The root link is fixed to the ground at ``base`` (it does not move).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    qs, single = _joint_matrix(robot, q)
+    qds, _ = _joint_matrix(robot, qd, "qd")
+    if qds.shape != qs.shape:
+        raise ValueError(f"qd has shape {np.shape(qd)}; expected that of q, {np.shape(q)}")
+    P, L, _ = _momenta(robot, qs, qds, base)
+    return (P[0], L[0]) if single else (P, L)
+
+
+def momenta(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Momenta along a sampled trajectory, Eqs. 25-31: t (T,) s, q (T, 16) rad -> P (T, 3), L (T, 3).
+
+    P in kg m/s; L in kg m^2/s about the world origin. The joint velocities are ``qd`` when given (e.g. a
+    spline's exact derivative), otherwise :func:`joint_velocities` of the samples (np.gradient).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    t, q = _check_trajectory(robot, t, q)
+    qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
+    P, L, _ = _momenta(robot, q, qd, base)
+    return P, L
+
+
+# ------------------------------------------------------------------------------------------------
+# Eqs. 32-40: zero-moment point
+# ------------------------------------------------------------------------------------------------
+def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz: float = 0.0) -> np.ndarray:
+    """Eqs. 39-40: (T, 2) ZMP on the plane z = pz from the CoM (T, 3) and the momentum rates (T, 3)."""
+    den = M * GRAVITY + Pdot[:, 2]
+    # the ground cannot pull: where M g + dP_z/dt <= 0 the robot leaves the ground and there is no ZMP (NaN)
+    den = np.where(den > 0.0, den, np.nan)
+    px = (M * GRAVITY * com[:, 0] + pz * Pdot[:, 0] - Ldot[:, 1]) / den  # Eq. 39
+    py = (M * GRAVITY * com[:, 1] + pz * Pdot[:, 1] + Ldot[:, 0]) / den  # Eq. 40
+    return np.stack([px, py], axis=1)
+
+
+def _zmp(robot: SnakeRobot, t, q, base, qd) -> tuple[np.ndarray, ...]:
+    t, q = _check_trajectory(robot, t, q)
+    qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
+    P, L, com = _momenta(robot, q, qd, base)
+    edge = 2 if len(t) > 2 else 1
+    Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
+    Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
+    return _zmp_from(com, Pdot, Ldot, robot.total_mass), P, L, com, q
+
+
+def zmp(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None) -> np.ndarray:
+    """Zero-moment point on the ground along a trajectory, Eqs. 36-40 with p_z = 0: (T, 2) world (x, y), m.
+
+    The time derivatives of P and L (Eqs. 33, 34) are taken numerically along the samples (np.gradient);
+    the joint velocities are ``qd`` when given, else finite differences of q (see :func:`momenta`).
+    At rest the ZMP is the ground projection of the centre of mass. Samples where the ground would have to
+    pull (M g + dP_z/dt <= 0: the body would take off) have no ZMP: NaN.
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    return _zmp(robot, t, q, base, qd)[0]
+
+
+@dataclass(frozen=True)
+class DynamicStability:
+    """Verdict of :func:`dynamic_stability` along a trajectory of T samples.
+
+    zmp (T, 2) m; margin (T,) signed distance of the ZMP to its sample's support polygon edge (m, > 0 inside);
+    inside (T,) bool; min_margin (m) and the index where it occurs; stable: inside everywhere; P, L the momenta;
+    com (T, 3).
+    """
+
+    zmp: np.ndarray
+    margin: np.ndarray
+    inside: np.ndarray
+    min_margin: float
+    argmin: int
+    stable: bool
+    P: np.ndarray
+    L: np.ndarray
+    com: np.ndarray
+
+
+def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None, *,
+                      contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> DynamicStability:
+    """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
+
+    The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
+    distinct contact configuration along the trajectory (the base joints may move, e.g. into the initial arc;
+    with ``contact="ground"`` the neck and head may lie down or lift off).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    p, P, L, com, q = _zmp(robot, t, q, base, qd)
+    flying = ~np.all(np.isfinite(p), axis=1)
+    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance)
+    margin[flying] = -np.inf  # no ZMP: the body would leave the ground
+    inside = margin > 0.0
+    k = int(np.argmin(margin))
+    return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
+
+
+def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None, *, contact: str = "endpoints",
+                    tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+    """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
+    (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
+
+    The polygon is built once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    round-off in a still base does not split it): the base joints decide the base's contacts; with
+    contact="ground" also the joints before the last link on the ground (those after it move nothing that
+    touches).
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q, _ = _joint_matrix(robot, q)
+    xy = finite_array(xy, "xy", (q.shape[0], 2))
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    if contact == "ground":
+        lowest = np.full((len(q), len(robot.link_names)), np.inf)
+        boxed = robot.boxed_links
+        lowest[:, boxed] = robot.lowest_box_z(robot.frames_many(q, base), boxed)
+        touching = lowest <= tolerance
+        last = np.where(touching.any(axis=1), len(robot.link_names) - 1 - np.argmax(touching[:, ::-1], axis=1), -1)
+        child = np.asarray(robot.body.model.joint_child_links)
+        key = np.where(child[None, :] <= last[:, None], np.round(q, 12), 0.0)
+        key = np.column_stack([key, last])
+    else:
+        key = np.round(q[:, robot.parts.base], 12)
+    uniq, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    first = np.zeros(len(uniq), int)
+    first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
+    pts, active = _contact_points_many(robot, robot.frames_many(q[first], base), contact, tolerance)
+    return polygon_margin_many(pts[inv], active[inv], xy)

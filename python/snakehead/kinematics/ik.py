@@ -1,0 +1,212 @@
+"""`TracIK`: inverse kinematics of a chain with TRAC-IK (C++ core, Beeson and Ames 2015).
+
+KDL-RR (Newton-Raphson with joint limits and random restarts) and SQP (NLopt's SLSQP) search at the same
+time; with ``solve_type="Speed"`` the first solution wins. ``Distance``, ``Manip1`` and ``Manip2`` search
+until the timeout and return the solution closest to ``q_init``, with the largest sqrt(det(J J^T)), or with
+the largest smallest-to-largest singular value ratio.
+
+Tolerances: a solution puts the tip at ``pose`` within ``epsilon`` on each of the six axes of the pose
+error (position and rotation vector of the tip relative to the target, in the target's frame), plus the
+per-axis ``bounds`` (vx vy vz wx wy wz): ``bounds=[0, 0, 0, inf, 0, 0]`` leaves the roll about the target's
+x-axis free. The GIL is released while solving, and one solver may be shared by many threads.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from .. import _core
+from .._validate import ORTHONORMAL_TOLERANCE, finite_array, joint_vector, pose as check_pose, positive
+from ..model.chain import Chain
+
+SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
+#: Bounds that leave the roll about the target's x-axis free.
+FREE_ROLL = (0.0, 0.0, 0.0, np.inf, 0.0, 0.0)
+
+
+def _bounds(bounds) -> np.ndarray:
+    try:
+        b = np.asarray(bounds, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"bounds must be 6 numbers: {exc}") from None
+    if b.shape != (6,):
+        raise ValueError(f"bounds must have 6 entries (vx vy vz wx wy wz), got shape {b.shape}")
+    if np.any(np.isnan(b)) or np.any(b < 0):
+        raise ValueError(f"bounds must be >= 0 (inf leaves an axis free), got {b.tolist()}")
+    return b
+
+
+def _pose(T, name: str = "pose") -> np.ndarray:
+    """``T`` as a valid 4x4 pose. The common case (a valid float64 array) is checked in plain Python, several
+    times faster than the numpy checks of ``_validate.pose`` for one small matrix; anything that fails here
+    goes to ``_validate.pose``, whose message says what is wrong (same tolerances)."""
+    a = np.asarray(T, dtype=np.float64) if isinstance(T, np.ndarray) else None
+    if a is not None and a.shape == (4, 4):
+        m = a.tolist()
+        r0, r1, r2, last = m
+        if (all(math.isfinite(v) for row in m for v in row) and last == [0.0, 0.0, 0.0, 1.0]):
+            c = [[r0[i] * r0[j] + r1[i] * r1[j] + r2[i] * r2[j] for j in range(3)] for i in range(3)]
+            err = max(abs(c[i][j] - (1.0 if i == j else 0.0)) for i in range(3) for j in range(3))
+            det = (r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
+                   + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]))
+            if err <= ORTHONORMAL_TOLERANCE and det > 0:
+                return a
+    return check_pose(T, name)
+
+
+def _seed(seed) -> int | None:
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
+        raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}")
+    if not 0 <= int(seed) < 2**64:
+        raise ValueError(f"seed must be in [0, 2**64), got {seed}")
+    return int(seed)
+
+
+class TracIK:
+    """TRAC-IK for the chain ``base`` -> ``tip`` of a URDF (a path or an XML string).
+
+    ``timeout`` (s) bounds each call; ``epsilon`` is the per-axis tolerance (m, rad); ``solve_type`` is one of
+    Speed, Distance, Manip1, Manip2; ``bounds`` the default per-axis tolerances; ``seed`` an integer makes
+    every call reproducible (a seeded call is a pure function of its inputs: both solvers run interleaved in
+    the calling thread, bounded by an evaluation budget derived from the timeout rather than the clock).
+    """
+
+    def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = 0.005,
+                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds=None):
+        self._init(Chain.from_urdf(urdf, base, tip), timeout, epsilon, solve_type, seed, bounds)
+
+    @classmethod
+    def from_chain(cls, chain: Chain, timeout: float = 0.005, epsilon: float = 1e-5, solve_type: str = "Speed",
+                   seed: int | None = None, bounds=None) -> "TracIK":
+        """A solver for an existing :class:`Chain` (its model is copied into the solver)."""
+        if not isinstance(chain, Chain):
+            raise TypeError(f"chain must be a snakehead.Chain, got {type(chain).__name__}")
+        self = cls.__new__(cls)
+        self._init(chain, timeout, epsilon, solve_type, seed, bounds)
+        return self
+
+    def _init(self, chain, timeout, epsilon, solve_type, seed, bounds):
+        if solve_type not in SOLVE_TYPES:
+            raise ValueError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
+        self._chain = chain
+        self._solver = _core.TracIK(chain.model, positive(timeout, "timeout"), positive(epsilon, "epsilon"),
+                                    solve_type, _bounds(np.zeros(6) if bounds is None else bounds), _seed(seed))
+        self._rng = np.random.default_rng(seed)
+        self._lo, self._hi = self._solver.lower.tolist(), self._solver.upper.tolist()
+
+    # --- description -------------------------------------------------------------------------
+    @property
+    def chain(self) -> Chain:
+        return self._chain
+
+    @property
+    def n_joints(self) -> int:
+        return self._solver.n_joints
+
+    @property
+    def lower(self) -> np.ndarray:
+        return self._solver.lower
+
+    @property
+    def upper(self) -> np.ndarray:
+        return self._solver.upper
+
+    @property
+    def timeout(self) -> float:
+        return self._solver.timeout
+
+    @property
+    def epsilon(self) -> float:
+        return self._solver.epsilon
+
+    @property
+    def solve_type(self) -> str:
+        return self._solver.solve_type
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return self._solver.bounds
+
+    @property
+    def seed(self) -> int | None:
+        return self._solver.seed
+
+    # --- solving -----------------------------------------------------------------------------
+    def fk(self, q) -> np.ndarray:
+        """Pose of the tip in the base frame, (4, 4)."""
+        return self._solver.fk(joint_vector(q, self.n_joints))
+
+    def _q_init(self, q_init, name="q_init") -> np.ndarray:
+        if isinstance(q_init, np.ndarray) and q_init.shape == (self.n_joints,) and q_init.dtype == np.float64:
+            # The common case in plain Python (faster than numpy's reductions for a few values).
+            if all(lo - 1e-9 <= v <= hi + 1e-9 for v, lo, hi in zip(q_init.tolist(), self._lo, self._hi)):
+                return q_init  # NaN fails the comparisons and goes to the checks below
+        q = joint_vector(q_init, self.n_joints, name)
+        lo, hi = self.lower, self.upper
+        bad = np.flatnonzero((q < lo - 1e-9) | (q > hi + 1e-9))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"{name}[{i}] = {q[i]:.6g} is outside the joint limits [{lo[i]:.6g}, {hi[i]:.6g}]")
+        return q
+
+    def random_configuration(self) -> np.ndarray:
+        """Uniform within the limits ([-pi, pi] for continuous joints), from the solver's own generator."""
+        return self._chain.random_configuration(self._rng)
+
+    def _start_generator(self) -> np.random.Generator:
+        # Starts drawn when q_init is omitted: with a seed, a fresh generator from the seed alone, so that
+        # identical calls get identical starts (and results); without one, the solver's running generator.
+        return self._rng if self.seed is None else np.random.default_rng(self.seed)
+
+    def ik(self, pose, q_init=None, bounds=None) -> np.ndarray | None:
+        """Joint angles putting the tip at ``pose`` (4x4, base frame), or None if none was found in time.
+
+        ``q_init``: the start (and the reference of ``Distance``); random within the limits when omitted (with a
+        seed, the same start on every call, so identical calls return identical results).
+        ``bounds``: per-axis tolerances (vx vy vz wx wy wz, target frame) for this call.
+        """
+        found, q, _ = self.ik_ex(pose, q_init, bounds)
+        return q if found else None
+
+    def ik_ex(self, pose, q_init=None, bounds=None, algorithm: str = "TRAC-IK", timeout: float | None = None):
+        """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
+        and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
+        T = _pose(pose)
+        q = self._chain.random_configuration(self._start_generator()) if q_init is None else self._q_init(q_init)
+        b = None if bounds is None else _bounds(bounds)
+        t = None if timeout is None else positive(timeout, "timeout")
+        if algorithm not in ("TRAC-IK", "KDL-RR", "SQP"):
+            raise ValueError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
+        return self._solver.ik(T, q, b, t, algorithm)
+
+    def ik_many(self, poses, q_inits=None) -> tuple[np.ndarray, np.ndarray]:
+        """Solve many targets across all cores: poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
+
+        Rows of ``q`` where ``ok`` is False hold the start configuration. With a seed, target k's search
+        depends only on (seed, k), so results do not depend on which thread solved it.
+        """
+        P = finite_array(poses, "poses", (None, 4, 4))
+        for k in range(P.shape[0]):
+            _pose(P[k], f"poses[{k}]")
+        if q_inits is None:
+            rng = self._start_generator()
+            Q = np.array([self._chain.random_configuration(rng) for _ in range(P.shape[0])]).reshape(
+                P.shape[0], self.n_joints)
+        else:
+            Q = finite_array(q_inits, "q_inits", (P.shape[0], self.n_joints))
+            for k in range(Q.shape[0]):
+                self._q_init(Q[k], f"q_inits[{k}]")
+        return self._solver.ik_many(np.ascontiguousarray(P), np.ascontiguousarray(Q))
+
+    def __repr__(self) -> str:
+        return (f"TracIK({self._chain.base!r} -> {self._chain.tip!r}, {self.n_joints} joints, "
+                f"{self.solve_type}, timeout={self.timeout:g} s, epsilon={self.epsilon:g})")
+
+
+def pose_error(target, current) -> np.ndarray:
+    """The IK pose error (vx vy vz wx wy wz) of ``current`` relative to ``target``, in the target's frame."""
+    return _core.pose_error(check_pose(target, "target"), check_pose(current, "current"))

@@ -1,0 +1,652 @@
+"""Reachability maps: the paper's Algorithm 1 (Section 2.2), the dexterous workspace and its centre (2.3).
+
+The sweep runs in the C++ core (``workspace.hpp``; also the standalone ``workspace_gen``): random
+configurations give a cloud of tip positions; voxels of a cube of side 2 * reach centred on the chain's
+base that lie inside the cloud's convex hull get the reachability index
+
+    D = 100 * (points reached) / (points tried)
+
+over N points spread evenly (a Fibonacci lattice) on the voxel's inscribed sphere. At each point a frame's
+approach axis (the head's x-axis by default, or z as in the paper's Table 1) runs from the sphere's centre
+to the point; the frame is rolled R times about it, and the point is reached when TRAC-IK solves one of the
+rolled frames (the paper's rule; ``any_roll=False`` counts every frame instead), or with ``free_roll`` one
+IK call leaves the roll free. Everything is in the chain's base frame (for the head, ``neck_end``: B0).
+
+A map file is an ``.npz`` that ``numpy.load`` reads (``allow_pickle=False``); see ``save`` for its keys.
+"""
+from __future__ import annotations
+
+import math
+import os
+from concurrent.futures import Executor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..model.chain import Chain
+
+FORMAT = "snakehead-reachability-1"
+#: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
+TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
+#: How many voxels the dexterous band must hold at least, as a share of the map's voxels (see
+#: :meth:`ReachabilityMap.dexterous_threshold`): the paper's dexterous workspace holds 3.69 % of its map's voxels.
+DEXTEROUS_MIN_SHARE = 0.01
+
+# Parameters that define a map (two maps, or shards, with the same values are parts of one computation).
+_PARAMS = ("voxel_size", "directions", "rolls", "any_roll", "free_roll", "approach_axis", "timeout", "epsilon",
+           "cloud_samples", "seed")
+_STATS = ("ik_calls", "cheap_exits", "seconds", "threads")
+
+
+@dataclass
+class Clusters:
+    """k-means++ clusters of the dexterous voxels and the chosen centre G0 (Section 2.3)."""
+
+    points: np.ndarray  # (m, 3) the dexterous voxel centres (m)
+    labels: np.ndarray  # (m,) cluster of each point, 0..k-1, ordered by decreasing size
+    centroids: np.ndarray  # (k, 3) (m, chain base frame)
+    sizes: np.ndarray  # (k,) voxels per cluster
+    chosen: int  # the cluster whose centroid is G0
+    rule: str
+
+    @property
+    def center(self) -> np.ndarray:
+        """G0: the chosen centroid, (3,) in the chain's base frame."""
+        return self.centroids[self.chosen].copy()
+
+
+@dataclass
+class ReachabilityMap:
+    """A reachability map (or one shard of it): the in-hull voxels, their centres and indices.
+
+    Arrays are ordered by ``voxel_ids`` (the grid's linear index (i * n + j) * n + l, i along x).
+    """
+
+    centers: np.ndarray  # (M, 3) voxel centres in the chain base frame (m)
+    solved: np.ndarray  # (M,) int: points reached per voxel
+    voxel_ids: np.ndarray  # (M,) int64
+    tried: int  # points (or frames) per voxel
+    grid_origin: np.ndarray  # (3,) the grid's minimum corner (m)
+    grid_size: float  # the grid's side (m)
+    grid_shape: tuple  # (n, n, n)
+    hull_voxels: int  # in-hull voxels of the whole map (all shards)
+    chain_hash: str
+    base: str
+    tip: str
+    params: dict  # voxel_size, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, ...
+    shard: tuple = (0, 1)  # (i, N)
+    command: str = ""  # how the map was made
+    stats: dict = field(default_factory=dict)  # ik_calls, cheap_exits, seconds, threads, hull_facets, reach
+    path: Path | None = None  # the file it was loaded from or saved to, when there is one
+
+    # --- the index --------------------------------------------------------------------------------
+    @property
+    def indices(self) -> np.ndarray:
+        """(M,) reachability index D in [0, 100]."""
+        return 100.0 * self.solved / self.tried
+
+    @property
+    def voxel_size(self) -> float:
+        return float(self.params["voxel_size"])
+
+    def __len__(self) -> int:
+        return len(self.voxel_ids)
+
+    def histogram(self, bins: Sequence[float] = TABLE2_BINS) -> tuple[np.ndarray, np.ndarray]:
+        """Voxel counts and percentages per bin, Table 2's bins by default; the last bin is closed ([80, 100])."""
+        edges = np.asarray(bins, dtype=float)
+        if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0):
+            raise ValueError("bins must be an increasing sequence of at least two edges")
+        counts, _ = np.histogram(self.indices, bins=edges)  # numpy's last bin is closed
+        pct = 100.0 * counts / max(len(self), 1)
+        return counts, pct
+
+    def index_at(self, points) -> np.ndarray:
+        """Index of the voxel containing each point (0 outside the map's voxels), (k,) for (k, 3) points."""
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        if p.shape[-1] != 3 or not np.all(np.isfinite(p)):
+            raise ValueError("points must be finite, shape (3,) or (k, 3)")
+        n = self.grid_shape[0]
+        ijk = np.floor((p - self.grid_origin) / self.voxel_size).astype(np.int64)
+        inside = np.all((ijk >= 0) & (ijk < n), axis=1)
+        ids = (ijk[:, 0] * n + ijk[:, 1]) * n + ijk[:, 2]
+        pos = np.searchsorted(self.voxel_ids, ids)
+        pos = np.clip(pos, 0, max(len(self) - 1, 0))
+        found = inside & (len(self) > 0) & (self.voxel_ids[pos] == ids) if len(self) else np.zeros(len(p), bool)
+        out = np.zeros(len(p))
+        out[found] = self.indices[pos[found]]
+        return out
+
+    # --- Section 2.3 ---------------------------------------------------------------------------------
+    def dexterous_threshold(self, min_voxels: int | None = None) -> float:
+        """The index that bounds the dexterous workspace from below: 100 (the paper, Section 2.3) when enough
+        voxels reach it, else the best band the map has.
+
+        Returns the highest index level t such that at least ``min_voxels`` voxels have an index >= t (default:
+        3, the paper's clusters, or 1 % of the map's voxels if more). A head that reaches no voxel at 100 (most
+        6-DOF heads) thus still gets a dexterous workspace and a centre G0, in its most reachable band.
+        """
+        if len(self) == 0:
+            raise ValueError("the map has no voxels: it has no dexterous workspace")
+        need = max(3, int(np.ceil(DEXTEROUS_MIN_SHARE * len(self)))) if min_voxels is None else int(min_voxels)
+        if need < 1:
+            raise ValueError(f"min_voxels must be >= 1, got {min_voxels!r}")
+        need = min(need, len(self))
+        levels = np.sort(self.indices)[::-1]  # descending
+        return float(min(100.0, levels[need - 1]))
+
+    def summary(self) -> str:
+        """A few lines: the chain, the grid, Table 2's bands, the dexterous band and its centre G0."""
+        _, pct = self.histogram()
+        t = self.dexterous_threshold() if len(self) else float("nan")
+        lines = [repr(self),
+                 "Table 2 bands [0,20) [20,40) [40,60) [60,80) [80,100]: " + " ".join(f"{p:.2f} %" for p in pct),
+                 f"max index {self.indices.max() if len(self) else 0:.1f}; dexterous workspace: "
+                 + ("index 100 (the paper's)" if t >= 100.0 else
+                    f"no voxel reaches 100 in enough number, so the best band, index >= {t:.1f}")
+                 + f" ({int(np.sum(self.indices >= t - 1e-9))} voxels)"]
+        try:
+            lines.append(f"G0 = {np.round(self.center(), 4).tolist()} m in the {self.base!r} frame")
+        except ValueError as exc:
+            lines.append(f"G0: {exc}")
+        return "\n".join(lines)
+
+    def dexterous(self, threshold: float | None = 100.0) -> np.ndarray:
+        """Centres of the voxels whose index is at least ``threshold`` (100: the dexterous workspace; None: the
+        best band, :meth:`dexterous_threshold`), (m, 3)."""
+        t = self.dexterous_threshold() if threshold is None else float(threshold)
+        if not 0.0 <= t <= 100.0:
+            raise ValueError(f"threshold must be within [0, 100], got {threshold}")
+        return self.centers[self.indices >= t - 1e-9]
+
+    def clusters(self, k: int = 3, threshold: float | None = None, rule: str = "largest",
+                 random_state: int = 0) -> Clusters:
+        """k-means++ clusters of the dexterous voxels (Eqs. 16-17) and the centre G0.
+
+        ``threshold``: the dexterous workspace's lower index (default None: :meth:`dexterous_threshold`, 100
+        whenever enough voxels reach it).
+
+        The paper splits its dexterous workspace into three clusters and picks the centroid of one of
+        them by eye. The rule here (``rule="largest"``) takes the centroid of the largest cluster: the
+        most voxels of full reachability lie around it, so the head keeps the most room to reach
+        targets in every direction when the neck puts a target there, and the choice is stable under
+        small changes of the map. ``rule="index"`` takes the cluster whose centroid falls in the voxel
+        of highest index (a centroid can fall between the voxels of a curved cluster), ties broken by size.
+        """
+        from sklearn.cluster import KMeans
+
+        if not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"k must be a positive integer, got {k!r}")
+        if rule not in ("largest", "index"):
+            raise ValueError(f"rule must be 'largest' or 'index', got {rule!r}")
+        threshold = self.dexterous_threshold() if threshold is None else float(threshold)
+        pts = self.dexterous(threshold)
+        if len(pts) < k:
+            raise ValueError(f"{len(pts)} voxels have an index >= {threshold}; {k} clusters need at least {k}")
+        km = KMeans(n_clusters=int(k), init="k-means++", n_init=10, random_state=random_state).fit(pts)
+        sizes = np.bincount(km.labels_, minlength=k)
+        # Order clusters by decreasing size (then by centroid coordinates) so that labels are stable.
+        order = sorted(range(k), key=lambda c: (-sizes[c], *km.cluster_centers_[c]))
+        relabel = np.empty(k, dtype=int)
+        relabel[order] = np.arange(k)
+        centroids = km.cluster_centers_[order]
+        sizes = sizes[order]
+        if rule == "largest":
+            chosen = 0
+        else:
+            at = self.index_at(centroids)
+            chosen = int(max(range(k), key=lambda c: (at[c], sizes[c])))
+        return Clusters(pts, relabel[km.labels_], centroids, sizes, chosen, rule)
+
+    def center(self, k: int = 3, threshold: float | None = None, rule: str = "largest",
+               random_state: int = 0) -> np.ndarray:
+        """G0, the centre of the dexterous workspace (see ``clusters``), (3,) in the chain's base frame."""
+        return self.clusters(k, threshold, rule, random_state).center
+
+    # --- files -------------------------------------------------------------------------------------------
+    def save(self, path: str | os.PathLike) -> None:
+        save(self, path)
+
+    def same_map_as(self, other: "ReachabilityMap") -> bool:
+        """Same chain, parameters, grid and per-voxel results (statistics and command aside)."""
+        return (
+            self.chain_hash == other.chain_hash
+            and all(_param_equal(self.params[p], other.params[p]) for p in _PARAMS)
+            and self.tried == other.tried
+            and self.grid_shape == other.grid_shape
+            and np.array_equal(self.voxel_ids, other.voxel_ids)
+            and np.array_equal(self.solved, other.solved)
+            and np.allclose(self.centers, other.centers, rtol=0, atol=1e-12)
+        )
+
+    def __repr__(self) -> str:
+        s = "" if self.shard == (0, 1) else f", shard {self.shard[0]}/{self.shard[1]}"
+        return (f"ReachabilityMap({self.base!r} -> {self.tip!r}, {len(self)} voxels of {self.voxel_size} m, "
+                f"{self.params['directions']} directions{s}, mean index {self.indices.mean() if len(self) else 0:.1f})")
+
+
+def _param_equal(a, b) -> bool:
+    if isinstance(a, float) or isinstance(b, float):
+        return float(a) == float(b)
+    return a == b
+
+
+# --- computing -------------------------------------------------------------------------------------------
+def _options(voxel, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, cloud_samples, seed,
+             threads, shard) -> _core.WorkspaceOptions:
+    o = _core.WorkspaceOptions()
+    for name, value in (("directions", directions), ("rolls", rolls), ("cloud_samples", cloud_samples),
+                        ("seed", seed)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise ValueError(f"{name} must be an integer, got {value!r}")
+    if isinstance(seed, (int, np.integer)) and seed < 0:
+        raise ValueError(f"seed must be >= 0, got {seed}")
+    for name, value in (("voxel", voxel), ("timeout", timeout), ("epsilon", epsilon)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+    if not isinstance(approach_axis, str):
+        raise ValueError(f"approach_axis must be 'x' or 'z', got {approach_axis!r}")
+    o.voxel_size = float(voxel)
+    o.directions = int(directions)
+    o.rolls = int(rolls)
+    o.any_roll = bool(any_roll)
+    o.free_roll = bool(free_roll)
+    o.approach_axis = approach_axis  # ValueError unless 'x' or 'z'
+    o.timeout = float(timeout)
+    o.epsilon = float(epsilon)
+    o.cloud_samples = int(cloud_samples)
+    o.seed = int(seed)
+    o.threads = 0 if threads is None else int(threads)
+    o.shard_index, o.shard_count = _parse_shard(shard)
+    o.validate()  # ValueError naming the first bad field
+    return o
+
+
+def _parse_shard(shard) -> tuple[int, int]:
+    if shard is None:
+        return 0, 1
+    if isinstance(shard, str):
+        try:
+            i, n = (int(x) for x in shard.split("/"))
+        except ValueError:
+            raise ValueError(f"shard must be 'i/N' or (i, N), got {shard!r}") from None
+    else:
+        try:
+            i, n = (int(x) for x in shard)
+        except (TypeError, ValueError):
+            raise ValueError(f"shard must be 'i/N' or (i, N), got {shard!r}") from None
+    if n < 1 or not 0 <= i < n:
+        raise ValueError(f"shard must satisfy 0 <= i < N, got {i}/{n}")
+    return i, n
+
+
+def _resolve_chain(chain_or_robot) -> Chain:
+    from ..model.robot import SnakeRobot
+
+    if isinstance(chain_or_robot, SnakeRobot):
+        return chain_or_robot.head_chain
+    if isinstance(chain_or_robot, Chain):
+        return chain_or_robot
+    if isinstance(chain_or_robot, _core.ChainModel):
+        return Chain(chain_or_robot)
+    raise ValueError(f"expected a Chain or a SnakeRobot (whose head chain is mapped), got {type(chain_or_robot).__name__}")
+
+
+def _from_result(d: dict, o: _core.WorkspaceOptions, command: str) -> ReachabilityMap:
+    params = {p: getattr(o, "voxel_size" if p == "voxel_size" else p) for p in _PARAMS}
+    params["rolls"] = 0 if o.free_roll else o.rolls
+    return ReachabilityMap(
+        centers=np.asarray(d["centers"], dtype=float).reshape(-1, 3),
+        solved=np.asarray(d["solved"], dtype=np.int32),
+        voxel_ids=np.asarray(d["voxel_ids"], dtype=np.int64),
+        tried=int(d["tried"]),
+        grid_origin=np.asarray(d["grid_origin"], dtype=float),
+        grid_size=float(d["grid_size"]),
+        grid_shape=tuple(int(x) for x in d["grid_shape"]),
+        hull_voxels=int(d["hull_voxels"]),
+        chain_hash=str(d["chain_hash"]),
+        base=str(d["base"]),
+        tip=str(d["tip"]),
+        params=params,
+        shard=(o.shard_index, o.shard_count),
+        command=command,
+        stats={"ik_calls": int(d["ik_calls"]), "cheap_exits": int(d["cheap_exits"]), "seconds": float(d["seconds"]),
+               "threads": int(d["threads"]), "hull_facets": int(d["hull_facets"]), "reach": float(d["reach"])},
+    )
+
+
+def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, count: int) -> ReachabilityMap:
+    """One shard in a worker (module level, so that executors can pickle it)."""
+    chain = Chain.from_urdf(urdf, base, tip)
+    o = _options(shard=(index, count), **kwargs)
+    d = _core.compute_reachability(chain.model, o)
+    return _from_result(d, o, f"snakehead.workspace.compute(shard={index}/{count})")
+
+
+def compute(chain_or_robot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4, any_roll: bool = True,
+            free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4, epsilon: float = 1e-5,
+            cloud_samples: int = 50000, seed: int = 1, threads: int | None = None, shard=None,
+            executor: Executor | None = None, shards: int | None = None, urdf: str | os.PathLike | None = None,
+            progress: bool = True) -> ReachabilityMap:
+    """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
+
+    voxel: voxel edge (m); directions: points per voxel sphere; rolls: frames about the approach axis per
+    point; any_roll: a point counts when one of its rolls is solved (the paper) rather than each frame on its
+    own; free_roll: one IK call per point with the roll free; approach_axis: 'x' (the head's direction) or
+    'z'; timeout: TRAC-IK budget per call (s; seeded, so an evaluation budget: the map does not depend on
+    the machine's load); seed: the map is a function of it; threads: worker threads (None: all cores; the
+    map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th run of voxels.
+
+    executor: any ``concurrent.futures.Executor`` (a process pool, Dask's ``client.get_executor()``...):
+    the map is split into ``shards`` shards (default 4 per worker thread the executor reports, else 8),
+    each computed in a worker with ``threads`` threads (default 1) and merged; the result equals the
+    one-process map. Workers rebuild the chain from the URDF: a SnakeRobot carries it; for a Chain pass
+    ``urdf=``.
+    progress: a tqdm progress bar on stderr. The sweep runs without the GIL; Ctrl-C stops it.
+    """
+    chain = _resolve_chain(chain_or_robot)
+    kwargs = dict(voxel=voxel, directions=directions, rolls=rolls, any_roll=any_roll, free_roll=free_roll,
+                  approach_axis=approach_axis, timeout=timeout, epsilon=epsilon, cloud_samples=cloud_samples,
+                  seed=seed, threads=threads)
+    options = _options(shard=shard, **kwargs)  # validates everything before any work
+    if executor is None:
+        if shards is not None:
+            raise ValueError("shards= needs an executor; use shard=(i, N) to compute one shard here")
+        return _compute_local(chain, options, progress)
+    if shard is not None:
+        raise ValueError("give either shard= (one shard here) or executor= (all shards there), not both")
+    if not isinstance(executor, Executor):
+        raise ValueError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
+    text = _urdf_text(chain_or_robot, urdf)
+    if Chain.from_urdf(text, chain.base, chain.tip).hash != chain.hash:
+        raise ValueError("the URDF given does not describe this chain (different kinematics hash)")
+    n = _default_shards(executor) if shards is None else shards
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"shards must be a positive integer, got {shards!r}")
+    if threads is None:
+        kwargs["threads"] = 1  # each shard is one task; the executor provides the parallelism
+    futures = [executor.submit(_compute_shard, text, chain.base, chain.tip, kwargs, i, int(n)) for i in range(int(n))]
+    parts = []
+    bar = _bar(progress, int(n), "shards")
+    try:
+        for f in as_completed(futures):
+            parts.append(f.result())
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+        for f in futures:
+            f.cancel()
+    merged = merge(parts)
+    merged.command = f"snakehead.workspace.compute(executor={type(executor).__name__}, shards={n})"
+    return merged
+
+
+def _default_shards(executor) -> int:
+    workers = getattr(executor, "_max_workers", None)
+    return 4 * int(workers) if isinstance(workers, int) and workers > 0 else 8
+
+
+def _urdf_text(chain_or_robot, urdf) -> str:
+    source = urdf if urdf is not None else getattr(chain_or_robot, "urdf", None)
+    if source is None:
+        raise ValueError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
+                         "pass a SnakeRobot or a Chain made by Chain.from_urdf, or urdf= (a path or the XML)")
+    source = os.fspath(source) if isinstance(source, os.PathLike) else source
+    if not isinstance(source, str):
+        raise ValueError("urdf must be a path or an XML string")
+    if source.lstrip().startswith("<"):
+        return source
+    try:
+        return Path(source).read_text()
+    except OSError as exc:
+        raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
+
+
+def _bar(progress: bool, total: int, unit: str):
+    if not progress:
+        return None
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, unit=unit, desc="reachability", leave=False)
+
+
+def _compute_local(chain: Chain, options, progress: bool) -> ReachabilityMap:
+    bar = _bar(progress, 0, "voxel")
+
+    def callback(done, total):  # called about every 0.1 s; the binding checks for Ctrl-C before each call
+        return True
+
+    if bar is not None:
+        def callback(done, total):
+            if bar.total != total:
+                bar.total = total
+                bar.refresh()
+            bar.update(done - bar.n)
+            return True
+    try:
+        d = _core.compute_reachability(chain.model, options, callback)
+    finally:
+        if bar is not None:
+            bar.close()
+    return _from_result(d, options, "snakehead.workspace.compute")
+
+
+def evaluate(chain_or_robot, centers, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
+             any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
+             epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
+    """Reachability index of voxels at arbitrary centres, each on its own (random initial guesses only).
+
+    An independent check of a map (e.g. with a long timeout on a sample of its voxels), (k,) for (k, 3).
+    """
+    chain = _resolve_chain(chain_or_robot)
+    c = np.ascontiguousarray(np.atleast_2d(np.asarray(centers, dtype=float)))
+    if c.ndim != 2 or c.shape[1] != 3 or not np.all(np.isfinite(c)):
+        raise ValueError("centers must be finite, shape (k, 3)")
+    o = _options(voxel, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, 100, seed, threads,
+                 None)
+    d = _core.evaluate_voxels(chain.model, o, c, list(range(len(c))))
+    return 100.0 * np.asarray(d["solved"]) / d["tried"]
+
+
+# --- files -----------------------------------------------------------------------------------------------
+def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
+    """Write ``m`` as an uncompressed .npz with the keys ``workspace_gen`` writes.
+
+    centers (M,3), indices (M,), solved (M,), voxel_ids (M,), tried, grid_origin (3,), grid_size,
+    grid_shape (3,), hull_voxels, the parameters (voxel_size, directions, rolls, any_roll, free_roll,
+    approach_axis, timeout, epsilon, cloud_samples, seed), shard (2,), chain_hash, base, tip, command,
+    format, and the run's statistics (ik_calls, cheap_exits, seconds, threads, hull_facets, reach).
+    """
+    if not isinstance(m, ReachabilityMap):
+        raise ValueError(f"expected a ReachabilityMap, got {type(m).__name__}")
+    arrays = {
+        "format": np.array(FORMAT), "centers": m.centers, "indices": m.indices, "solved": m.solved.astype(np.int32),
+        "voxel_ids": m.voxel_ids.astype(np.int64), "tried": np.int64(m.tried), "grid_origin": m.grid_origin,
+        "grid_size": np.float64(m.grid_size), "grid_shape": np.array(m.grid_shape, dtype=np.int64),
+        "hull_voxels": np.int64(m.hull_voxels), "shard": np.array(m.shard, dtype=np.int64),
+        "chain_hash": np.array(m.chain_hash), "base": np.array(m.base), "tip": np.array(m.tip),
+        "command": np.array(m.command),
+    }
+    for p in _PARAMS:
+        v = m.params[p]
+        arrays[p] = np.array(v) if isinstance(v, str) else np.bool_(v) if isinstance(v, (bool, np.bool_)) else (
+            np.float64(v) if isinstance(v, float) else np.int64(v))
+    arrays["seed"] = np.uint64(m.params["seed"])
+    for k in ("ik_calls", "cheap_exits", "threads", "hull_facets"):
+        if k in m.stats:
+            arrays[k] = np.int64(m.stats[k])
+    for k in ("seconds", "reach"):
+        if k in m.stats:
+            arrays[k] = np.float64(m.stats[k])
+    path = os.fspath(path)
+    if not path.endswith(".npz"):
+        raise ValueError(f"a map file ends in .npz, got {path!r}")
+    from .._files import atomic_open
+
+    try:
+        with atomic_open(path, "wb") as f:  # a failed write leaves an existing map as it was
+            np.savez(f, **arrays)
+    except OSError as exc:
+        raise ValueError(f"cannot write the map to {path!r}: {exc}") from None
+
+
+def load(path: str | os.PathLike) -> ReachabilityMap:
+    """Read a map written by ``save`` or ``workspace_gen``. ValueError for a missing or foreign file."""
+    path = os.fspath(path)
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"cannot read the map {path!r}: {exc}") from None
+    with z:
+        if "format" not in z.files or str(z["format"]) != FORMAT:
+            raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
+
+        def scalar(k, cast):
+            return cast(z[k][()])
+
+        params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")
+                            else float if p in ("voxel_size", "timeout", "epsilon") else int) for p in _PARAMS}
+        stats = {}
+        for k, cast in (("ik_calls", int), ("cheap_exits", int), ("seconds", float), ("threads", int),
+                        ("hull_facets", int), ("reach", float)):
+            if k in z.files:
+                stats[k] = scalar(k, cast)
+        m = ReachabilityMap(
+            centers=np.array(z["centers"], dtype=float).reshape(-1, 3),
+            solved=np.array(z["solved"], dtype=np.int32),
+            voxel_ids=np.array(z["voxel_ids"], dtype=np.int64),
+            tried=scalar("tried", int),
+            grid_origin=np.array(z["grid_origin"], dtype=float),
+            grid_size=scalar("grid_size", float),
+            grid_shape=tuple(int(x) for x in z["grid_shape"]),
+            hull_voxels=scalar("hull_voxels", int),
+            chain_hash=scalar("chain_hash", str),
+            base=scalar("base", str),
+            tip=scalar("tip", str),
+            params=params,
+            shard=tuple(int(x) for x in z["shard"]),
+            command=scalar("command", str),
+            stats=stats,
+            path=Path(path),
+        )
+        if m.tried < 1 or not np.allclose(m.indices, np.asarray(z["indices"], dtype=float), atol=1e-9):
+            raise ValueError(f"{path!r}: the indices disagree with solved / tried")
+    return m
+
+
+def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
+    """The exact union of the shards 0..N-1 of one map (any order). ValueError when they do not fit together."""
+    parts = list(shards)
+    if not parts:
+        raise ValueError("merge needs at least one shard")
+    for p in parts:
+        if not isinstance(p, ReachabilityMap):
+            raise ValueError(f"merge takes ReachabilityMaps, got {type(p).__name__}")
+    first = parts[0]
+    n = first.shard[1]
+    if len(parts) != n:
+        raise ValueError(f"the map was split into {n} shards; got {len(parts)}")
+    seen = set()
+    for p in parts:
+        if (p.chain_hash != first.chain_hash or p.shard[1] != n or p.tried != first.tried
+                or p.grid_shape != first.grid_shape or p.hull_voxels != first.hull_voxels
+                or not all(_param_equal(p.params[k], first.params[k]) for k in _PARAMS)):
+            raise ValueError("shards of different maps (chain, parameters or grid differ) cannot be merged")
+        if p.shard[0] in seen:
+            raise ValueError(f"shard {p.shard[0]}/{n} given twice")
+        seen.add(p.shard[0])
+    ids = np.concatenate([p.voxel_ids for p in parts])
+    if len(np.unique(ids)) != len(ids):
+        raise ValueError("a voxel appears in two shards")
+    if len(ids) != first.hull_voxels:
+        raise ValueError(f"the shards hold {len(ids)} voxels; the map has {first.hull_voxels}")
+    order = np.argsort(ids, kind="stable")
+    stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in ("ik_calls", "cheap_exits", "seconds")}
+    stats.update({k: first.stats[k] for k in ("hull_facets", "reach") if k in first.stats})
+    return ReachabilityMap(
+        centers=np.concatenate([p.centers for p in parts])[order],
+        solved=np.concatenate([p.solved for p in parts])[order],
+        voxel_ids=ids[order],
+        tried=first.tried, grid_origin=first.grid_origin.copy(), grid_size=first.grid_size,
+        grid_shape=first.grid_shape, hull_voxels=first.hull_voxels, chain_hash=first.chain_hash,
+        base=first.base, tip=first.tip, params=dict(first.params), shard=(0, 1),
+        command=f"snakehead.workspace.merge({n} shards)", stats=stats,
+    )
+
+
+def default_map_options(chain_or_robot) -> dict:
+    """Options of :func:`compute` for a robot's head that has no map yet: the shipped maps' parameters (20
+    directions x 4 rolls, 0.3 ms per IK call), with voxels scaled to the head (a twelfth of its reach, 0.05 m on
+    the default robot's 7-DOF head, rounded to 5 mm) so that every head gets a grid of about the same size."""
+    chain = _resolve_chain(chain_or_robot)
+    voxel = max(0.005, round(chain.reach / 12 / 0.005) * 0.005)
+    return dict(voxel=voxel, directions=20, rolls=4, timeout=3e-4, seed=1)
+
+
+def cache_dir() -> Path:
+    """Where computed maps are cached: ``$SNAKEHEAD_CACHE`` or ``$XDG_CACHE_HOME/snakehead`` (``~/.cache``)."""
+    env = os.environ.get("SNAKEHEAD_CACHE")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "snakehead"
+
+
+def map_for(robot, *, progress: bool = True, cache: bool = True, **options) -> ReachabilityMap:
+    """The reachability map of a robot's head: the robot file's map when it has one; else a map computed earlier
+    for this head chain and these options (cached under :func:`cache_dir`); else one computed now (with a
+    progress bar; :func:`default_map_options` unless ``options`` say otherwise) and cached. The map's ``path``
+    says which file it is."""
+    from ..model.robot import SnakeRobot
+
+    if not isinstance(robot, SnakeRobot):
+        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+    chain = robot.head_chain
+    if robot.map_path is not None and not options:
+        m = load(robot.map_path)
+        if m.chain_hash != chain.hash:
+            raise ValueError(f"the map {os.fspath(robot.map_path)!r} of the robot file was made for another head chain "
+                             f"(hash {m.chain_hash} != {chain.hash}); recompute it")
+        return m
+    opts = {**default_map_options(chain), **options}
+    key = ",".join(f"{k}={opts[k]!r}" for k in sorted(opts))
+    import hashlib
+
+    digest = hashlib.sha1(f"{chain.hash}|{key}".encode()).hexdigest()[:16]
+    path = cache_dir() / f"map-{chain.base}-{chain.tip}-{digest}.npz"
+    if cache and path.is_file():
+        try:
+            m = load(path)
+            if m.chain_hash == chain.hash:
+                return m
+        except ValueError:
+            pass  # a damaged cache entry is recomputed
+    m = compute(chain, progress=progress, **opts)
+    if cache:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save(m, path)
+        m.path = path
+    return m
+
+
+def fibonacci_directions(n: int) -> np.ndarray:
+    """n unit vectors spread evenly over the sphere (the sweep's Fibonacci lattice), (n, 3)."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+        raise ValueError(f"n must be an integer, got {n!r}")
+    return _core.fibonacci_directions(int(n))
+
+
+def approach_frame(point, direction, roll: float = 0.0, axis: str = "x") -> np.ndarray:
+    """The sweep's frame at ``point`` whose ``axis`` ('x' or 'z') is ``direction``, rolled by ``roll`` rad, (4, 4)."""
+    from .._validate import finite_array
+
+    p = finite_array(point, "point", (3,))
+    d = finite_array(direction, "direction", (3,))
+    if not math.isfinite(float(roll)):
+        raise ValueError("roll must be finite")
+    return _core.approach_frame(p, d, float(roll), axis)

@@ -1,0 +1,6 @@
+"""The robot: a kinematic :class:`Chain` over the C++ model, and the :class:`SnakeRobot` that knows the body's
+parts (base, neck, head) and everything derived from its URDF; robot files (TOML)."""
+from .chain import Chain
+from .robot import BasePlacement, RobotParts, SnakeRobot, default_urdf_path
+
+__all__ = ["Chain", "SnakeRobot", "BasePlacement", "RobotParts", "default_urdf_path"]

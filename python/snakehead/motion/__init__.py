@@ -1,0 +1,7 @@
+"""Whole-body motion (paper Section 3.2): joint-space interpolation at the 2 ms control period, the Cartesian
+interpolation of Eqs. 41-44, and the planner that strings states, paths and checks together."""
+from .cartesian import CartesianInterpolation, cartesian_interpolation, cartesian_trajectory
+from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, joint_interpolation, joint_trajectory
+
+__all__ = ["CONTROL_PERIOD", "JointTrajectory", "MonotoneQuintic", "joint_interpolation", "joint_trajectory",
+           "CartesianInterpolation", "cartesian_interpolation", "cartesian_trajectory"]

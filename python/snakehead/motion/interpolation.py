@@ -1,0 +1,164 @@
+"""Multi-segment joint-space interpolation sampled at the 2 ms control period (paper Section 3.2, Section 4).
+
+* :func:`joint_trajectory` / :func:`joint_interpolation` -- through waypoints: the C4 quintic spline, or the
+  piecewise quintic that never overshoots (:class:`MonotoneQuintic`).
+* :func:`sample_times`, :func:`minimum_jerk` -- the sample grid and the rest-to-rest time scaling.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import BSpline, make_interp_spline
+
+from .._validate import finite_array, joint_vector, positive
+
+#: The joint controller's period (s), Section 4.
+CONTROL_PERIOD = 0.002
+
+
+@dataclass(frozen=True)
+class JointTrajectory:
+    """A sampled joint trajectory: t (T,) s, q (T, n) rad, qd (T, n) rad/s, qdd (T, n) rad/s^2, and the
+    spline it samples (``spline(t, nu)`` evaluates the nu-th derivative anywhere; None for
+    :func:`cartesian_trajectory`)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    spline: BSpline | None
+
+
+def _check_waypoints(times, waypoints) -> tuple[np.ndarray, np.ndarray]:
+    times = finite_array(times, "times", (None,))
+    if times.shape[0] < 2:
+        raise ValueError(f"times needs at least two waypoints, got {times.shape[0]}")
+    if np.any(np.diff(times) <= 0):
+        raise ValueError("times must increase strictly")
+    waypoints = finite_array(waypoints, "waypoints", (times.shape[0], None))
+    if waypoints.shape[1] < 1:
+        raise ValueError("waypoints have no joints")
+    return times, waypoints
+
+
+def joint_spline(times, waypoints) -> BSpline:
+    """The interpolating spline of :func:`joint_trajectory`: times (K,) s, waypoints (K, n) rad -> BSpline.
+
+    A quintic spline (degree 5, scipy ``make_interp_spline``) through every waypoint with zero velocity and
+    zero acceleration at both ends: C4 inside (position, velocity, acceleration, jerk and snap continuous),
+    at rest at the ends. With two waypoints it is the minimum-jerk quintic 10 s^3 - 15 s^4 + 6 s^5.
+    Like every interpolating spline it may overshoot between waypoints (see ``lower``/``upper`` of
+    :func:`joint_trajectory`).
+    """
+    times, waypoints = _check_waypoints(times, waypoints)
+    zero = np.zeros(waypoints.shape[1])
+    ends = [(1, zero), (2, zero)]
+    return make_interp_spline(times, waypoints, k=5, bc_type=(ends, ends), axis=0)
+
+
+class MonotoneQuintic:
+    """Piecewise quintic Hermite interpolation that does not overshoot: times (K,) s, waypoints (K, n).
+
+    Each segment is the quintic with the waypoints' positions, zero accelerations and velocities chosen like
+    PCHIP's (Fritsch-Carlson): zero where the neighbouring slopes differ in sign or at either end, else their
+    harmonic mean. Position, velocity and acceleration are continuous (the acceleration is zero at every
+    waypoint), and a joint never leaves the range of the two waypoints around it: safe for waypoints that
+    sit on a joint limit, where the C4 spline of :func:`joint_spline` can overshoot. Call as ``f(t, nu)``.
+    """
+
+    def __init__(self, times, waypoints):
+        self.times, self.q = _check_waypoints(times, waypoints)
+        h = np.diff(self.times)[:, None]
+        d = np.diff(self.q, axis=0) / h  # secant slopes (K-1, n)
+        v = np.zeros_like(self.q)
+        a, b = d[:-1], d[1:]
+        same = a * b > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            hm = np.where(same, 2 * a * b / (a + b), 0.0)
+        v[1:-1] = hm
+        self.v = v
+
+    def __call__(self, t, nu: int = 0) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, float))
+        k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
+        h = (self.times[k + 1] - self.times[k])[:, None]
+        s = ((t - self.times[k])[:, None]) / h
+        p0, p1, v0, v1 = self.q[k], self.q[k + 1], self.v[k], self.v[k + 1]
+        s2, s3, s4, s5 = s * s, s**3, s**4, s**5
+        if nu == 0:
+            return ((1 - 10 * s3 + 15 * s4 - 6 * s5) * p0 + h * (s - 6 * s3 + 8 * s4 - 3 * s5) * v0
+                    + (10 * s3 - 15 * s4 + 6 * s5) * p1 + h * (-4 * s3 + 7 * s4 - 3 * s5) * v1)
+        if nu == 1:
+            return ((-30 * s2 + 60 * s3 - 30 * s4) * (p0 - p1) / h + (1 - 18 * s2 + 32 * s3 - 15 * s4) * v0
+                    + (-12 * s2 + 28 * s3 - 15 * s4) * v1)
+        if nu == 2:
+            return ((-60 * s + 180 * s2 - 120 * s3) * (p0 - p1) / h**2 + (-36 * s + 96 * s2 - 60 * s3) * v0 / h
+                    + (-24 * s + 84 * s2 - 60 * s3) * v1 / h)
+        raise ValueError("nu must be 0, 1 or 2")
+
+
+def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:
+    """t0, t0 + dt, ... up to t1, with t1 itself as the last sample: (T,) s."""
+    dt = positive(dt, "dt")
+    steps = int(np.floor((t1 - t0) / dt + 1e-9))
+    t = t0 + dt * np.arange(steps + 1)
+    # A gap under a microsecond is round-off, not a sample: stretch the last step to t1 instead of adding a
+    # sample a hair after it (two samples closer than any controller or file can tell apart).
+    if t1 - t[-1] > min(1e-6, 1e-3 * dt):
+        t = np.append(t, t1)
+    t[-1] = t1
+    return t
+
+
+def joint_trajectory(times, waypoints, dt: float = CONTROL_PERIOD, *, lower=None, upper=None,
+                     method: str = "spline") -> JointTrajectory:
+    """Multi-segment joint-space interpolation through waypoints, sampled every ``dt`` s.
+
+    times (K,) strictly increasing (s); waypoints (K, n) joint vectors (rad), the first at rest and the last at
+    rest. ``method``: "spline", the C4 quintic spline of :func:`joint_spline`, or "monotone", the piecewise
+    quintic of :class:`MonotoneQuintic` that never overshoots the waypoints (use it for dense waypoints or
+    waypoints on joint limits). The samples are t0, t0 + dt, ... and the last time;
+    the first and last samples equal the first and last waypoints exactly. With ``lower``/``upper`` ((n,), rad)
+    a trajectory that overshoots the joint limits raises ValueError.
+    """
+    dt = positive(dt, "dt")
+    times, waypoints = _check_waypoints(times, waypoints)
+    if method == "spline":
+        spline = joint_spline(times, waypoints)
+    elif method == "monotone":
+        spline = MonotoneQuintic(times, waypoints)
+    else:
+        raise ValueError(f"method must be 'spline' or 'monotone', got {method!r}")
+    t = sample_times(times[0], times[-1], dt)
+    q, qd, qdd = spline(t), spline(t, 1), spline(t, 2)
+    q[0], q[-1] = waypoints[0], waypoints[-1]
+    qd[[0, -1]] = 0.0
+    qdd[[0, -1]] = 0.0
+    n = waypoints.shape[1]
+    for bound, name, bad in ((lower, "lower", lambda a, b: a < b), (upper, "upper", lambda a, b: a > b)):
+        if bound is None:
+            continue
+        b = joint_vector(bound, n, name)
+        over = bad(q, b + (1e-9 if name == "upper" else -1e-9))
+        if over.any():
+            k, j = np.argwhere(over)[0]
+            raise ValueError(f"the interpolation overshoots the {name} limit of joint {j} "
+                             f"({q[k, j]:.4f} rad at t = {t[k]:.3f} s; limit {b[j]:.4f} rad)")
+    return JointTrajectory(t, q, qd, qdd, spline)
+
+
+def joint_interpolation(times, waypoints, dt: float = CONTROL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
+    """Multi-segment joint-space interpolation (Section 3.2): -> (t (T,) s, q (T, n) rad) at the control period.
+
+    Continuous in velocity and acceleration, at rest at both ends; see :func:`joint_trajectory` for the
+    velocities and accelerations.
+    """
+    traj = joint_trajectory(times, waypoints, dt)
+    return traj.t, traj.q
+
+
+def minimum_jerk(tau: np.ndarray) -> np.ndarray:
+    """The rest-to-rest time scaling 10 tau^3 - 15 tau^4 + 6 tau^5 of tau in [0, 1]."""
+    tau = np.asarray(tau, float)
+    return tau ** 3 * (10.0 - 15.0 * tau + 6.0 * tau ** 2)

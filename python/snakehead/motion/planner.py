@@ -1,0 +1,564 @@
+"""The planner: head targets (a scene) -> a checked whole-body motion sampled at the 2 ms control period.
+
+It strings the control process of Section 3.3 together on any snake robot. The body starts in the bending state
+(Figs. 17b, 22a: the base on its optimised arc, the neck and head curled flat on the ground inside it:
+:func:`bending_state`) and lifts the head to the initial state of Section 3.3 (1) (the base arc joined to the
+neck-and-head Bezier: ``backbone.initial_configuration``). Each target is solved by the
+:class:`~snakehead.control.HeadController` and reached by a whole-body move (Section 3.2: the Cartesian
+interpolation of Eqs. 41-44 where it is valid, else joint space through a stable detour when needed; see
+``_Waypoints.move``), or, for targets approached along a line, by the head's poses solved every few millimetres
+along it. The waypoints are joined by the multi-segment interpolation at 2 ms, and the result is checked at every
+sample: the ZMP inside the support polygon (Eqs. 36-40), every neck and head link above the ground, no link
+touching an obstacle.
+
+Why the bending state: on the default robot the neck and head (1.7 kg) outweigh the base (1.5 kg); lifted as a
+cantilever beyond P0 they would tip the body, so they are curled over the base before they rise. Getting from an
+arbitrary lying state into the bending state is a reconfiguration on the ground (the paper's rolling gait or
+turning in place) that is not part of these plans.
+
+Segment durations grow with the largest joint change (``speed``), with a floor (``min_segment``).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._validate import positive
+from ..control.controller import HeadController
+from ..dynamics import stability
+from ..geometry import collision as coll
+from ..model.robot import BasePlacement, SnakeRobot
+from ..scenes.scene import Scene, Target
+from . import interpolation as interp
+from .cartesian import tracking_interpolation
+
+#: m: the least distance a solved configuration keeps from every obstacle.
+OBSTACLE_CLEARANCE = 0.002
+DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
+DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
+DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
+DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
+JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move
+ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
+LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
+BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
+BENDING_COMBINATIONS = 30000  # the grid coarsens so that it never holds more curls than this
+BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the bending state
+#: How far choose_base tries stepping the base back from the targets, as shares of the body's length
+#: (0.05, 0.1, 0.15, 0.2 m on the default robot, 1.384 m long).
+BASE_STEP_SHARES = tuple(k * 0.05 / 1.384 for k in (1, 2, 3, 4))
+DEFAULT_SPEED = 0.12  # rad/s: the largest joint rate a segment is planned for
+DEFAULT_MIN_SEGMENT = 2.0  # s: the shortest segment
+
+
+@dataclass
+class TargetResult:
+    """One head target of a plan and how well the plan reaches it (planned, by forward kinematics)."""
+
+    name: str
+    position: np.ndarray  # (3,) m
+    direction: np.ndarray  # (3,) unit
+    time_s: float  # when the plan arrives
+    solution: object  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
+
+    @property
+    def position_error_m(self) -> float:
+        return self.solution.position_error_m
+
+    @property
+    def direction_error_deg(self) -> float:
+        return self.solution.direction_error_deg
+
+    @property
+    def solved(self) -> bool:
+        return bool(self.solution.success)
+
+
+@dataclass
+class Plan:
+    """A planned motion: the 2 ms joint trajectory, its states and targets, and its checks.
+
+    name: the scene's. robot, base: the robot and where its base lies. t (T,) s, q (T, n) rad, qd (T, n) rad/s.
+    states: (label, time s, q (n,)) of every waypoint. targets: :class:`TargetResult` per reported target.
+    stability: ``dynamics.DynamicStability`` (ZMP and its margin at every sample). ground_clearance (T,) m: the
+    lowest neck or head box corner above the ground. obstacles and obstacle_distance (T,) m (None without
+    obstacles). segments: (segment, interpolation used). notes: what the planner had to do or could not.
+    """
+
+    name: str
+    robot: SnakeRobot
+    base: BasePlacement
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    states: list
+    targets: list
+    stability: stability.DynamicStability
+    ground_clearance: np.ndarray
+    obstacles: list = field(default_factory=list)
+    obstacle_distance: np.ndarray | None = None
+    planning_time_s: float = 0.0
+    notes: list = field(default_factory=list)
+    segments: list = field(default_factory=list)
+    scene: Scene | None = None
+    relocation: "Relocation | None" = None  # the change of base the targets need, before the plan (locomotion)
+
+    @property
+    def min_zmp_margin_m(self) -> float:
+        return float(self.stability.min_margin)
+
+    @property
+    def min_ground_clearance_m(self) -> float:
+        return float(self.ground_clearance.min())
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def touches_obstacle(self) -> bool:
+        return self.obstacle_distance is not None and bool((self.obstacle_distance <= 0).any())
+
+    @property
+    def failure(self) -> str | None:
+        """None when the plan succeeds, else the first reason it does not (a target not solved, the ZMP leaving the
+        support polygon, a link in the ground, a link touching an obstacle)."""
+        for tg in self.targets:
+            if not tg.solved:
+                return f"target {tg.name!r} not solved: {tg.solution.message}"
+        if self.min_zmp_margin_m < ZMP_MARGIN:
+            k = self.stability.argmin
+            where = "leaves the support polygon by" if self.min_zmp_margin_m < 0 else "comes within"
+            return (f"the ZMP {where} {abs(1000 * self.min_zmp_margin_m):.1f} mm of its edge at t = {self.t[k]:.2f} s "
+                    f"(a plan keeps it {1000 * ZMP_MARGIN:.0f} mm inside)")
+        if self.min_ground_clearance_m <= -coll.GROUND_TOLERANCE:
+            k = int(np.argmin(self.ground_clearance))
+            return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
+                    f"t = {self.t[k]:.2f} s")
+        if self.touches_obstacle:
+            k = int(np.argmax(self.obstacle_distance <= 0))
+            return f"a link touches an obstacle at t = {self.t[k]:.2f} s"
+        return None
+
+    @property
+    def success(self) -> bool:
+        return self.failure is None
+
+
+def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
+    """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
+    (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
+    qs = np.asarray(qs, float)
+    s = np.arange(between + 1) / (between + 1)
+    a, b = qs[..., :-1, :], qs[..., 1:, :]
+    fine = a[..., None, :] + s[:, None] * (b - a)[..., None, :]  # (..., K-1, between+1, n)
+    fine = fine.reshape(qs.shape[:-2] + (-1, qs.shape[-1]))
+    return np.concatenate([fine, qs[..., -1:, :]], axis=-2)
+
+
+class _Waypoints:
+    """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
+
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles=()):
+        self.robot, self.base = robot, base
+        self.obstacles = list(obstacles)
+        self.speed, self.min_segment = speed, min_segment
+        self.labels: list[str] = []
+        self.qs: list[np.ndarray] = []
+        self.times: list[float] = []
+        self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
+
+    def start(self, label: str, q):
+        self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
+
+    def move_joint(self, label: str, q, duration: float | None = None):
+        """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
+        the straight step is not safe throughout."""
+        q = np.asarray(q, float)
+        step = np.abs(q - self.qs[-1]).max()
+        n = max(3, int(np.ceil(step / JOINT_STEP_CHECK)) + 1)
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        if duration is None and not self._feasible(self.qs[-1] + s * (q - self.qs[-1])).all():
+            self.move(label, q)
+            return
+        self.qs.append(q)
+        self.labels.append(label)
+        self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
+
+    def move(self, label: str, q, n: int = 12) -> str:
+        """A whole-body move from the last state to q (Section 3.2); returns the method used.
+
+        First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
+        ``motion.cartesian.tracking_interpolation``), kept when every configuration is safe (above the ground, clear
+        of itself and the obstacles, statically stable with DETOUR_MARGIN); else the straight joint-space path;
+        else a joint-space path through a safe detour waypoint (see ``_joint_path``).
+        """
+        q = np.asarray(q, float)
+        path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
+        if self._feasible(_densify(path.q)).all():
+            qs, method = path.q, "cartesian (Eq. 41, tracked)"
+        else:
+            qs, method = self._joint_path(self.qs[-1], q, n)
+        steps = np.abs(np.diff(qs, axis=0)).max(axis=1) / self.speed
+        floor = self.min_segment / (len(qs) - 1)
+        for k in range(1, len(qs)):
+            self.qs.append(qs[k])
+            self.labels.append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})")
+            self.times.append(self.times[-1] + max(floor, steps[k - 1]))
+        self.methods.append((label, method))
+        return method
+
+    def _margins(self, qs: np.ndarray) -> np.ndarray:
+        """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
+        link lying on the ground (``contact="ground"``; once the head is up, the base's footprint)."""
+        com = stability.center_of_mass(self.robot, qs, self.base)
+        return stability.support_margins(self.robot, qs, com[:, :2], self.base, contact="ground")
+
+    def _feasible(self, qs: np.ndarray) -> np.ndarray:
+        """(m,) bool: above the ground, no two non-neighbouring links overlapping, clear of the obstacles, and
+        statically stable with DETOUR_MARGIN to spare."""
+        clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
+        ok = ((clearance >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(self.robot, qs, self.base) > 0.0)
+              & (self._margins(qs) >= DETOUR_MARGIN))
+        if self.obstacles and ok.any():
+            rows = np.flatnonzero(ok)
+            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
+            ok[rows] = d > 0.0
+        return ok
+
+    def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
+        """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
+
+        The straight path when it does; else the shortest of DETOUR_TRIALS two-piece paths through a waypoint
+        drawn around the midpoint (neck and head joints perturbed, seeded: plans are reproducible) whose every
+        configuration passes; else the one with the largest worst margin (the scenario's checks report it).
+        """
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        straight = qa + s * (qb - qa)
+        if self._feasible(_densify(straight)).all():
+            return straight, "joint space"
+        movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
+        rng = np.random.default_rng(DETOUR_SEED)
+        W = np.tile(0.5 * (qa + qb), (DETOUR_TRIALS, 1))
+        W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
+        W = np.clip(W, self.robot.lower, self.robot.upper)
+        paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
+        flat = _densify(paths).reshape(-1, qa.size)
+        ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
+        if ok.any():
+            length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
+            k = int(np.argmin(np.where(ok, length, np.inf)))
+            return paths[k], "joint space via a stable detour"
+        worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
+        return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
+
+    def hold(self, seconds: float):
+        self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
+
+    def sample(self, notes: list) -> interp.JointTrajectory:
+        """The multi-segment interpolation through the waypoints at 2 ms (``trajectory.MonotoneQuintic``:
+        dense Cartesian waypoints often sit on joint limits, and it never overshoots them)."""
+        traj = interp.joint_trajectory(np.array(self.times), np.array(self.qs), method="monotone")
+        lo, hi = self.robot.lower, self.robot.upper
+        over = float(max((lo - traj.q).max(), (traj.q - hi).max(), 0.0))
+        if over > 1e-9:
+            notes.append(f"the spline overshot a joint limit by up to {np.degrees(over):.3f} deg; clipped")
+            np.clip(traj.q, lo, hi, out=traj.q)
+        return traj
+
+
+def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), scene=None) -> Plan:
+    robot, base = plan.robot, plan.base
+    notes = list(notes)
+    traj = plan.sample(notes)
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground")
+    clearance = coll.ground_clearance(robot, traj.q, base)[:, robot.lifted_links].min(axis=1)
+    distance = None
+    if obstacles:
+        # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
+        distance = coll.collision_check(robot, traj.q, list(obstacles), base, exact_within=0.005).distance
+    states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
+    return Plan(name=name, robot=robot, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
+                stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
+                planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene)
+
+
+def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
+    """The bending state (Figs. 17b, 22a): the base on its arc and the neck and head curled flat on the ground
+    inside it, so that lifting them keeps their mass over the base (n,).
+
+    On the default robot the neck and head (1.7 kg) outweigh the base (1.5 kg): lifted from a straight line
+    beyond P0 they tip the body. Here the pitch joints are 0 (everything lies on the ground) and the neck and
+    head's yaw joints are chosen on a grid (15 deg, coarser for many joints) for the largest static margin over the base's support polygon
+    alone (the support left once they are lifted), among the curls in which no two non-neighbouring links
+    overlap. Deterministic. ``q_shape``: a configuration whose base (and the neck's links that stay on the ground)
+    give the shape on the ground (default: the controller's initial configuration)."""
+    robot = controller.robot
+    shape = controller.q_initial if q_shape is None else np.asarray(q_shape, float)
+    key = shape[:robot.lift_joints.start].tobytes()
+    cache = controller.__dict__.setdefault("_bending_states", {})
+    if key in cache:
+        return cache[key].copy()
+    q = np.zeros(robot.n_joints)
+    # the base, and the links before the first pitch joint of the neck, which cannot leave the ground: their yaw
+    # joints keep the shape's angles, or the lift would sweep those links across the ground and the friction would
+    # push the base
+    first_pitch = robot.lift_joints.start
+    q[:first_pitch] = shape[:first_pitch]
+    up = np.arange(robot.parts.neck.start, robot.parts.head.stop)
+    yaw = np.array([j for j in up if robot.joint_kinds[j] == "yaw" and j > first_pitch], int)  # bend when flat
+    if len(yaw) == 0:
+        cache[key] = q
+        return q.copy()
+    # the finest grid (at most BENDING_GRID_DEG) with at most BENDING_COMBINATIONS curls
+    per_joint = max(3, min(int(round(180.0 / BENDING_GRID_DEG)) + 1,
+                           int(np.floor(BENDING_COMBINATIONS ** (1.0 / len(yaw)) + 1e-9))))
+    combos = np.stack(np.meshgrid(*[np.linspace(0.0, 1.0, per_joint)] * len(yaw), indexing="ij"), -1)
+    combos = combos.reshape(-1, len(yaw))
+    lo, hi = np.maximum(robot.lower[yaw], -np.pi / 2), np.minimum(robot.upper[yaw], np.pi / 2)
+    qs = np.tile(q, (len(combos), 1))
+    qs[:, yaw] = lo + combos * (hi - lo)
+    poly = stability.support_polygon(robot, q)  # the base's, placement-independent in its own frame
+    com = stability.center_of_mass(robot, qs)
+    pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
+    margin = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
+    order = np.argsort(-margin)
+    for chunk in np.array_split(order[margin[order] > 0], max(1, int(np.sum(margin > 0)) // 500 + 1)):
+        ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
+        if ok.any():
+            cache[key] = qs[chunk[np.argmax(ok)]]
+            return cache[key].copy()
+    raise ValueError("no curl of the neck and head on the ground keeps their mass over the base")
+
+
+
+@dataclass(frozen=True)
+class Relocation:
+    """A change of base that the targets need, carried out before the plan by locomotion (the paper's rolling gait
+    or turning in place, Section 3.3 (3)): from placement ``start`` to ``base``, with the base's flat shape changed
+    when ``shape_changed``; ``reason`` says why (what failed from the start)."""
+
+    start: BasePlacement
+    base: BasePlacement
+    shape_changed: bool
+    reason: str
+
+    def as_dict(self) -> dict:
+        return {"from": {"x_m": self.start.x, "y_m": self.start.y, "yaw_rad": self.start.yaw},
+                "to": {"x_m": self.base.x, "y_m": self.base.y, "yaw_rad": self.base.yaw},
+                "distance_m": float(np.hypot(self.base.x - self.start.x, self.base.y - self.start.y)),
+                "shape_changed": self.shape_changed, "reason": self.reason}
+
+
+def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
+    """``q_rest`` with the joints of the links lying on the ground (the base's, and the neck's before it lifts)
+    taken from ``q_shape``."""
+    q = np.asarray(q_rest, float).copy()
+    q[:robot.lift_joints.start] = q_shape[:robot.lift_joints.start]
+    return q
+
+
+def choose_base(controller: HeadController, targets, obstacles=()) -> tuple[BasePlacement, np.ndarray,
+                                                                           Relocation | None, list[str]]:
+    """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
+    (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
+    obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
+    one first) from which every target is solved. Returns the placement, a configuration with the base's shape
+    (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
+    from ..control.whole_body import solve_target
+
+    robot = controller.robot
+    obstacles = list(obstacles)
+    targets = list(targets)
+
+    def clear(q, b) -> bool:
+        if not obstacles:
+            return True
+        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
+                    > OBSTACLE_CLEARANCE)
+
+    def failing(b, q_shape):
+        """The first target not solved from this base (None: all are), or the start state in an obstacle."""
+        if not clear(bending_state(controller, q_shape), b):
+            return "the start", None
+        for t in targets:
+            sol = solve_target(controller, t.position, t.direction, q_prev=q_shape, base=b, obstacles=obstacles,
+                               allow_base_move=False, problem=controller.body_problem)
+            if not sol.success:
+                return t, sol
+        return None, None
+
+    start, q0 = controller.base, controller.q_initial
+    first, why = failing(start, q0)
+    if first is None:
+        return start, q0.copy(), None, []
+    reason = ("the start state touches an obstacle" if first == "the start" else
+              f"target {first.name!r} is not reached from the start ({why.reason})")
+    order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
+    for t in order:
+        sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
+                           allow_base_move=True, problem=controller.body_problem)
+        if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
+                                                                   q0[:robot.lift_joints.start])):
+            continue
+        q_shape = _shape_of(robot, sol.q, q0)
+        if failing(sol.base, q_shape)[0] is None:
+            changed = not np.allclose(q_shape[:robot.lift_joints.start], q0[:robot.lift_joints.start])
+            reloc = Relocation(start, sol.base, changed, reason)
+            return sol.base, q_shape, reloc, [f"the base is relocated to {sol.base}"
+                                              + (" with another flat shape" if changed else "")
+                                              + f" (by locomotion, before the plan): {reason}"]
+    return start, q0.copy(), None, [f"no single base reaches every target: {reason}"]
+
+
+def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
+    """Positions from target ``a`` to target ``b`` every ``b.step_m`` m (b included, a excluded)."""
+    d = b.position - a.position
+    length = float(np.linalg.norm(d))
+    n = int(np.ceil(length / b.step_m - 1e-9))
+    steps = [min(k * b.step_m, length) for k in range(1, n + 1)]
+    if length > 0 and steps and abs(steps[-1] - length) > 1e-12:
+        steps.append(length)
+    return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
+
+
+def _solve(controller: HeadController, position, direction, q_prev, base, obstacles, name: str, notes: list,
+           near: bool = False):
+    """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
+    from ..control.whole_body import solve_target
+
+    sol = solve_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
+                       allow_base_move=False, problem=controller.body_problem, near=near)
+    if not sol.success:
+        notes.append(f"{name}: {sol.message}")
+    return sol
+
+
+def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Scene:
+    """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
+    import os
+
+    from ..scenes.scene import load_scene
+
+    if isinstance(targets, Scene):
+        scene = targets
+        if obstacles:
+            scene = Scene(name=scene.name, targets=scene.targets, obstacles=tuple(scene.obstacles) + tuple(obstacles),
+                          robot_file=scene.robot_file, base=scene.base, description=scene.description, path=scene.path)
+        return scene
+    if isinstance(targets, (str, os.PathLike)):
+        return as_scene(load_scene(targets), obstacles=obstacles, base=base)
+    return Scene.from_targets(targets, obstacles=obstacles, base=base)
+
+
+def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
+         base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
+         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT) -> Plan:
+    """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
+
+    Parameters
+    ----------
+    targets : a :class:`~snakehead.scenes.Scene`, a scene file's path, or (position, direction) pairs (m, world;
+        the direction is the head's x-axis), each then held 1 s.
+    robot : the snake (default: the scene's robot file, else ``SnakeRobot.default()``).
+    controller : a :class:`~snakehead.control.HeadController` to solve the head with (default: one for ``robot``
+        with its head's map, ``method`` and ``seed``).
+    obstacles : more obstacles (``geometry.BoxObstacle``, ``geometry.WallWithHole``) besides the scene's.
+    base : where the base lies at first (default: the scene's, else ``BasePlacement()``); the planner may choose
+        another placement that reaches every target (said in ``notes``).
+    method : the head IK: "rotated" (the paper's Fig. 9) or "free_roll".
+    seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
+    speed : the largest joint rate a segment is planned for (rad/s). min_segment : the shortest segment (s).
+
+    Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
+    ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
+    """
+    t_start = time.perf_counter()
+    scene = as_scene(targets, obstacles=obstacles, base=base)
+    speed, min_segment = positive(speed, "speed"), positive(min_segment, "min_segment")
+    if controller is not None:
+        if not isinstance(controller, HeadController):
+            raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
+        if robot is not None and robot is not controller.robot:
+            raise ValueError("give a robot or a controller (whose robot is used), not both")
+        if base is not None or scene.base is not None:
+            controller.base = base if base is not None else scene.base
+    else:
+        if robot is None:
+            robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
+        elif not isinstance(robot, SnakeRobot):
+            raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+        controller = HeadController(robot, base_pose=base if base is not None else scene.base, method=method,
+                                    seed=seed)
+    robot = controller.robot
+    obstacles = list(scene.obstacles)
+    notes: list[str] = []
+    if controller.dexterous_threshold < 100.0:
+        notes.append(controller.dexterous_note)
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles)
+    notes += base_notes
+    way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
+    way.start("bending state", bending_state(controller, q_shape))
+    # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
+    # state there; else the lift goes straight to the first target
+    q = _shape_of(robot, q_shape, controller.q_initial)
+    if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
+            robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
+        way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+    else:
+        q = way.qs[-1]
+    results: list[TargetResult] = []
+    k = 0
+    targets = scene.targets
+    while k < len(targets):
+        # a run: this target and the following ones approached along a line from it
+        end = k
+        while end + 1 < len(targets) and targets[end + 1].approach == "line":
+            end += 1
+        if end == k:
+            tg = targets[k]
+            sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
+            way.move(tg.name, sol.q)
+            q = sol.q
+            if not tg.via:
+                results.append(TargetResult(tg.name, tg.position, tg.direction, way.times[-1], sol))
+            if tg.hold_s > 0:
+                way.hold(tg.hold_s)
+            k += 1
+            continue
+        # poses along the lines, solved backwards from the deepest (the most constrained, e.g. only the head link in
+        # a hole) out to the run's first target, each from the previous joints: a branch of solutions that clears
+        # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
+        poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
+            (targets[k].name, targets[k].position, targets[k].direction, targets[k])]
+        for j in range(k + 1, end + 1):
+            line = _line_poses(targets[j - 1], targets[j])
+            for m, p in enumerate(line):
+                last = m == len(line) - 1
+                label = targets[j].name if last else f"{targets[j].name} ({m + 1}/{len(line)})"
+                poses.append((label, p, targets[j].direction, targets[j] if last else None))
+        sols: list = [None] * len(poses)
+        q_back = q
+        for m in range(len(poses) - 1, -1, -1):
+            label, p, d, _ = poses[m]
+            sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
+            if sols[m].success:
+                q_back = sols[m].q
+        for m, (label, p, d, tg) in enumerate(poses):
+            if m == 0:
+                way.move(label, sols[m].q)
+            else:
+                way.move_joint(label, sols[m].q)
+            if tg is not None:
+                if not tg.via:
+                    results.append(TargetResult(tg.name, tg.position, tg.direction, way.times[-1], sols[m]))
+                if tg.hold_s > 0:
+                    way.hold(tg.hold_s)
+        q = sols[-1].q
+        k = end + 1
+    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)
+    plan.relocation = relocation
+    return plan

@@ -1,0 +1,91 @@
+"""Head targets for measuring a planner: reachable by construction, or random around the robot.
+
+A target is *reachable by construction* when it is the head pose of a whole-body configuration that the robot
+can hold: statically stable (the centre of mass inside the support polygon of the links on the ground by
+``min_margin``), every neck and head link above the ground, no two links touching. Three kinds (``KINDS``):
+
+* ``"same"`` -- the base keeps the planner's initial configuration (its optimised arc) at the planner's
+  placement; the neck and head joints are drawn uniformly within their limits;
+* ``"shape"`` -- the base lies in another flat shape (its yaw joints drawn uniformly, its pitch joints flat);
+* ``"place"`` -- the base as in ``"same"`` but placed elsewhere (x, y uniform in +-``reach`` m, any yaw).
+
+``random_targets`` draws positions uniformly in a box around the robot and directions uniformly on the sphere:
+some are out of reach, which is what they are for (the planner must say why it fails).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..dynamics import stability
+from ..geometry import collision as coll
+from ..model.robot import BasePlacement
+
+KINDS = ("same", "shape", "place")
+
+
+@dataclass(frozen=True)
+class ReachableTarget:
+    """A head target (position (3,) m, unit direction (3,)) and the configuration and placement it comes from."""
+
+    position: np.ndarray
+    direction: np.ndarray
+    q: np.ndarray
+    base: BasePlacement
+    kind: str
+
+
+def reachable_targets(controller, kind: str, count: int, rng: np.random.Generator | None = None, *,
+                      min_margin: float = 0.005, reach: float = 1.0, max_draws: int = 200000) -> list[ReachableTarget]:
+    """``count`` targets reachable by construction of the given ``kind`` (see the module's docstring) for the
+    controller's robot, from its initial configuration and placement."""
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0:
+        raise ValueError(f"count must be an integer >= 0, got {count!r}")
+    robot = controller.robot
+    rng = np.random.default_rng() if rng is None else rng
+    lift = np.arange(robot.lift_joints.start, robot.n_joints)
+    ground_yaw = np.array([j for j in range(robot.lift_joints.start) if robot.joint_kinds[j] == "yaw"], int)
+    out: list[ReachableTarget] = []
+    for _ in range(int(max_draws)):
+        if len(out) >= count:
+            break
+        q = controller.q_initial.copy()
+        q[lift] = rng.uniform(robot.lower[lift], robot.upper[lift])
+        base = controller.base
+        if kind == "shape" and len(ground_yaw):
+            q[ground_yaw] = rng.uniform(robot.lower[ground_yaw], robot.upper[ground_yaw])
+        if kind == "place":
+            x, y = rng.uniform(-reach, reach, 2)
+            base = BasePlacement(float(controller.base.x + x), float(controller.base.y + y),
+                                 float(rng.uniform(-np.pi, np.pi)))
+        if stability.static_margin(robot, q, base, contact="ground") <= min_margin:
+            continue
+        if coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min() < 0.0:
+            continue
+        if coll.self_clearance(robot, q, base)[0] <= 0.0:
+            continue
+        H = robot.head_pose(q, base)
+        out.append(ReachableTarget(H[:3, 3].copy(), H[:3, 0].copy(), q, base, kind))
+    if len(out) < count:
+        raise ValueError(f"only {len(out)} of {count} reachable targets in {max_draws} draws")
+    return out
+
+
+def random_targets(controller, count: int, rng: np.random.Generator | None = None, *, half_width: float | None = None,
+                   height: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``count`` (position, direction) pairs: positions uniform in the box of +-``half_width`` m around the base's
+    placement (default: the body's length) and 0 .. ``height`` m high (default: the neck and head's length),
+    directions uniform on the sphere."""
+    robot = controller.robot
+    rng = np.random.default_rng() if rng is None else rng
+    w = robot.body_length if half_width is None else float(half_width)
+    h = robot.neck_length + robot.head_length if height is None else float(height)
+    out = []
+    for _ in range(int(count)):
+        p = np.array([controller.base.x, controller.base.y, 0.0]) + rng.uniform([-w, -w, 0.0], [w, w, h])
+        d = rng.normal(size=3)
+        out.append((p, d / np.linalg.norm(d)))
+    return out

@@ -1,0 +1,322 @@
+"""Optional dynamics check in MuJoCo: the paper's "dynamics software" (Section 4).
+
+The planned joint trajectory is tracked by a PD controller with gravity compensation on a free-floating
+model of the robot lying on a ground plane with friction, so the body can really slide or tip. What the
+paper compares (Figs. 18-20, 23-25) is recorded: the head frame, the linear and angular momentum about the
+world origin, the zero-moment point (centre of pressure of the ground contact forces), and whether the base
+moved.
+
+MuJoCo is an optional extra (``pip install snakehead[sim]``); it is imported only when a function here needs
+it, so ``import snakehead`` works without it.
+
+Model (:func:`build_mjcf`), generated from the robot's own data, not from the URDF importer:
+
+* one MuJoCo body per frame of ``robot.link_names`` (marker frames are massless bodies welded to their parent),
+  nested in chain order, placed with the relative poses of ``robot.body.fk_all(0)``; a free joint on the root
+  link (``link_0``), a hinge per revolute joint with the robot's axis and limits;
+* each link's mass, centre of mass and full inertia tensor (``robot.masses/coms/inertias``), and its collision
+  box (``robot.box_sizes/box_origins``);
+* a ground plane at z = 0 (Coulomb friction ``friction``, default 0.8) and the scene's obstacles
+  (:mod:`snakehead.geometry.obstacles`; a wall's round hole becomes a staircase of boxes inscribed in it,
+  :func:`obstacle_boxes`). Robot boxes collide with the ground and the
+  obstacles; not with each other unless ``self_collision=True`` (parent/child pairs never);
+* timestep 1 ms (physics) under the 2 ms control period of the paper; integrator ``implicitfast``;
+  contact ``solref = (0.005 s, 1)`` (stiff: the resting body sinks ~1 um into the ground);
+* servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
+  0.02 N m s/rad -- our choice, not the paper's.
+
+Controller (:func:`simulate`): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
+updated (zero-order hold); the joint torque is
+
+    tau = kp (q_ref - q) + kd (qdot_ref - qdot) + g_mj(q, qdot)     clipped to +-torque_limit
+
+where g_mj is a gravity term on the joints. The PD part is a MuJoCo affine actuator, i.e. evaluated at every
+physics step as in a servo's inner loop, with the velocity gain integrated implicitly (stable for the light
+distal links). Gravity compensation (``gravity_compensation``):
+
+* "supported" (default): each joint holds the weight of the run of lifted links hanging from it, up to the
+  first link that rests on the ground in the plan (:func:`carried_weights`, :func:`gravity_torques`); links
+  on the ground are carried by the ground;
+* "bias": MuJoCo's ``qfrc_bias`` (gravity + Coriolis) on every joint, the textbook term for a fixed-base arm.
+  For a snake lying on the ground it is wrong at the base joints: it is the torque that would hold the whole
+  distal body as a cantilever from the tail, so the base pitch joints push against the ground;
+* "none": PD only.
+
+Default gains kp = 200 N m/rad, kd = 3 N m s/rad. The URDF's 3 N m effort cannot lift the head part from flat
+(joint 10 needs ~3.9 N m); pass ``torque_limit`` to raise it (bench/RESULTS.md).
+"""
+from __future__ import annotations
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from .._validate import finite_array, positive
+from ..geometry.obstacles import BoxObstacle, WallWithHole
+from ..model.robot import BasePlacement, SnakeRobot, as_robot
+
+#: Standard gravity (m/s^2), the same as snakehead.stability.
+GRAVITY = 9.80665
+
+#: Physics timestep (s) and control period (s) used by default.
+DEFAULT_TIMESTEP = 0.001
+DEFAULT_CONTROL_DT = 0.002
+
+#: Default PD gains (N m/rad, N m s/rad) for every joint.
+DEFAULT_KP = 200.0
+DEFAULT_KD = 3.0
+
+_MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
+            "pip install 'snakehead[sim]' (or pip install mujoco)")
+
+
+def _mujoco():
+    """Import MuJoCo lazily; ImportError naming the extra when it is missing."""
+    try:
+        import mujoco
+    except ImportError as exc:  # pragma: no cover - mujoco is installed where the tests run
+        raise ImportError(_MISSING) from exc
+    return mujoco
+
+#: Horizontal strips of the staircase that stands for a wall's round hole in the simulation.
+DEFAULT_HOLE_SLICES = 32
+
+
+def obstacle_boxes(obstacles, hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
+    """The scene's obstacles as MuJoCo can collide them: boxes.
+
+    A :class:`~snakehead.geometry.obstacles.WallWithHole` becomes the boxes of the wall around its hole, the round
+    hole approximated by ``hole_slices`` strips across it, each leaving the narrowest chord of the circle in its
+    height open: a staircase inscribed in the circle (never wider than the hole; 32 strips stay within 0.3 mm of
+    the circle where a head's corners pass).
+    """
+    if not (isinstance(hole_slices, (int, np.integer)) and not isinstance(hole_slices, bool) and hole_slices >= 1):
+        raise ValueError(f"hole_slices must be a positive integer, got {hole_slices!r}")
+    out: list[BoxObstacle] = []
+    for ob in obstacles:
+        if isinstance(ob, BoxObstacle):
+            out.append(ob)
+        elif isinstance(ob, WallWithHole):
+            out += _wall_boxes(ob, int(hole_slices))
+        else:
+            raise TypeError(f"obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
+    return out
+
+
+def _wall_boxes(wall: WallWithHole, slices: int) -> list[BoxObstacle]:
+    R = wall.rotation  # columns: width axis u, height axis v, normal
+    r = wall.hole_diameter / 2
+    w, h, thickness = wall.size
+    u0, v0 = wall.hole_offset - np.array([w, h]) / 2  # the wall's corner, from the hole's centre
+    u1, v1 = u0 + w, v0 + h
+    rects = [(u0, -r, v0, v1), (r, u1, v0, v1), (-r, r, v0, -r), (-r, r, r, v1)]  # around the hole's square
+    step = 2 * r / slices
+    for k in range(slices):
+        a, b = -r + k * step, -r + (k + 1) * step
+        far = max(a * a, b * b)  # the chord is narrowest at the strip's edge farthest from the centre
+        g = math.sqrt(max(r * r - far, 0.0))
+        if g < r - 1e-12:
+            rects += [(-r, -g, a, b), (g, r, a, b)]
+    boxes = []
+    for ua, ub, va, vb in rects:
+        if ub - ua <= 1e-12 or vb - va <= 1e-12:
+            continue
+        centre = wall.centre + R @ np.array([(ua + ub) / 2, (va + vb) / 2, 0.0])
+        boxes.append(BoxObstacle(centre, (ub - ua, vb - va, thickness), R))
+    return boxes
+
+
+# ------------------------------------------------------------------------------------------------
+# model
+# ------------------------------------------------------------------------------------------------
+def _f(x: float) -> str:
+    return repr(float(x))
+
+
+def _vec(v) -> str:
+    return " ".join(_f(x) for x in np.asarray(v, float).ravel())
+
+
+def _quat(R: np.ndarray) -> str:
+    """MJCF text of the unit quaternion (w, x, y, z) of a rotation matrix."""
+    return _vec(_quat_array(R))
+
+
+def _quat_array(R: np.ndarray) -> np.ndarray:
+    """(w, x, y, z) of a rotation matrix (Shepperd's method), (4,)."""
+    R = np.asarray(R, float)
+    tr = np.trace(R)
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = (0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s)
+    else:
+        i = int(np.argmax(np.diag(R)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
+        q = [0.0] * 4
+        q[0] = (R[k, j] - R[j, k]) / s
+        q[1 + i] = 0.25 * s
+        q[1 + j] = (R[j, i] + R[i, j]) / s
+        q[1 + k] = (R[k, i] + R[i, k]) / s
+    return np.asarray(q, float)
+
+
+
+
+def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
+    n = robot.n_joints
+    if torque_limit is None:
+        lim = np.asarray(robot.body.model.effort, float)
+    else:
+        lim = np.broadcast_to(finite_array(torque_limit, "torque_limit"), (n,)).astype(float) \
+            if np.ndim(torque_limit) == 0 else finite_array(torque_limit, "torque_limit", (n,))
+    if np.any(lim <= 0):
+        raise ValueError(f"torque limits must be positive (N m), got {np.asarray(lim).tolist()}")
+    return np.array(lim, float)
+
+
+def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
+               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit=None,
+               obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
+               contact_solref: tuple = (0.005, 1.0)) -> str:
+    """MJCF text of the robot (free-floating root) on a ground plane, with optional obstacle boxes.
+
+    Names: bodies are ``robot.link_names``; hinges ``robot.body.joint_names``; the free joint ``root``;
+    a site ``site_<frame>`` at every frame's origin (axes of the frame); actuators ``act_<joint>`` (affine:
+    force = ctrl - kp q - kd qdot, gains set by :func:`simulate`); the floor geom ``floor``; obstacle geoms
+    ``obstacle_<k>``. Units SI; ``timestep`` s, ``friction`` the sliding coefficient, ``joint_damping``
+    N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default the URDF effort).
+    """
+    robot = as_robot(robot)
+    timestep = positive(timestep, "timestep")
+    friction = positive(friction, "friction")
+    if not (np.isfinite(joint_damping) and joint_damping >= 0):
+        raise ValueError(f"joint_damping must be >= 0, got {joint_damping!r}")
+    if not (np.isfinite(armature) and armature >= 0):
+        raise ValueError(f"armature must be >= 0, got {armature!r}")
+    solref = finite_array(contact_solref, "contact_solref", (2,))
+    if solref[0] < 2 * timestep or solref[1] <= 0:
+        raise ValueError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")
+    boxes = obstacle_boxes(obstacles, hole_slices)
+    lim = _torque_limits(robot, torque_limit)
+    n = robot.n_joints
+    model = robot.body.model
+    names = robot.link_names
+    F0 = robot.body.fk_all(np.zeros(n))  # frames at q = 0 in the root frame
+    child_of = {int(c): j for j, c in enumerate(model.joint_child_links)}
+    axes = np.asarray(model.joint_axes, float)
+    jnames = robot.body.joint_names
+    lower, upper = robot.lower, robot.upper
+    conaff = 1 if self_collision else 0
+
+    lines = ['<mujoco model="snakehead">',
+             '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
+             f'  <option timestep="{_f(timestep)}" gravity="0 0 {_f(-GRAVITY)}" integrator="implicitfast"/>',
+             '  <default>',
+             f'    <geom solref="{_vec(solref)}" friction="{_f(friction)} 0.005 0.0001"/>',
+             '  </default>',
+             '  <worldbody>',
+             '    <geom name="floor" type="plane" size="0 0 0.05" contype="0" conaffinity="1"/>']
+    for k, ob in enumerate(boxes):
+        lines.append(f'    <geom name="obstacle_{k}" type="box" pos="{_vec(ob.centre)}" quat="{_quat(ob.rotation)}" '
+                     f'size="{_vec(0.5 * ob.size)}" contype="0" conaffinity="1"/>')
+    depth = 0
+    for i, name in enumerate(names):
+        ind = "    " + "  " * depth
+        if i == 0:
+            lines.append(f'{ind}<body name="{name}">')
+            lines.append(f'{ind}  <freejoint name="root"/>')
+        else:
+            rel = np.linalg.solve(F0[i - 1], F0[i])
+            lines.append(f'{ind}<body name="{name}" pos="{_vec(rel[:3, 3])}" quat="{_quat(rel[:3, :3])}">')
+            if i in child_of:
+                j = child_of[i]
+                if robot.body.joint_types[j] not in ("revolute", "continuous"):
+                    raise ValueError(f"joint {jnames[j]} is {robot.body.joint_types[j]}; only revolute joints are simulated")
+                rng = f' range="{_f(lower[j])} {_f(upper[j])}"' if np.isfinite(lower[j]) else ""
+                lines.append(f'{ind}  <joint name="{jnames[j]}" type="hinge" axis="{_vec(axes[j])}"{rng} '
+                             f'damping="{_f(joint_damping)}" armature="{_f(armature)}"/>')
+        m = float(robot.masses[i])
+        if m > 0:
+            I = robot.inertias[i]
+            lines.append(f'{ind}  <inertial pos="{_vec(robot.coms[i])}" mass="{_f(m)}" fullinertia="'
+                         f'{_vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>')
+        if np.all(robot.box_sizes[i] > 0):
+            B = robot.box_origins[i]
+            lines.append(f'{ind}  <geom name="box_{name}" type="box" size="{_vec(0.5 * robot.box_sizes[i])}" '
+                         f'pos="{_vec(B[:3, 3])}" quat="{_quat(B[:3, :3])}" contype="1" conaffinity="{conaff}"/>')
+        lines.append(f'{ind}  <site name="site_{name}"/>')
+        depth += 1
+    for d in range(depth - 1, -1, -1):
+        lines.append("    " + "  " * d + "</body>")
+    lines.append('  </worldbody>')
+    lines.append('  <actuator>')
+    for j in range(n):
+        lines.append(f'    <general name="act_{jnames[j]}" joint="{jnames[j]}" gainprm="1" biastype="affine" '
+                     f'biasprm="0 0 0" forcerange="{_f(-lim[j])} {_f(lim[j])}"/>')
+    lines.append('  </actuator>')
+    lines.append('</mujoco>')
+    return "\n".join(lines)
+
+
+@dataclass
+class SimModel:
+    """A compiled MuJoCo model of a robot and the indices that map it back to the robot.
+
+    ``body_ids[i]`` is the MuJoCo body of ``robot.link_names[i]``; ``qpos_adr`` / ``dof_adr`` (n,) the joint
+    addresses; ``root_body`` the free-floating link; ``robot_geoms`` the ids of the robot's boxes.
+    """
+
+    robot: SnakeRobot
+    model: object
+    body_ids: np.ndarray
+    site_ids: np.ndarray
+    qpos_adr: np.ndarray
+    dof_adr: np.ndarray
+    root_body: int
+    floor_geom: int
+    robot_geoms: np.ndarray
+    torque_limit: np.ndarray
+
+    def set_state(self, data, q, base: BasePlacement | None = None, lift: float = 0.0) -> None:
+        """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
+        mj = _mujoco()
+        T = self.robot.root_pose(base)
+        data.qpos[:] = 0.0
+        data.qvel[:] = 0.0
+        data.qpos[0:3] = T[:3, 3] + (0.0, 0.0, lift)
+        data.qpos[3:7] = _quat_array(T[:3, :3])
+        data.qpos[self.qpos_adr] = q
+        mj.mj_forward(self.model, data)
+
+    def frames(self, data) -> np.ndarray:
+        """World poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics)."""
+        out = np.zeros((len(self.body_ids), 4, 4))
+        out[:, :3, :3] = data.xmat[self.body_ids].reshape(-1, 3, 3)
+        out[:, :3, 3] = data.xpos[self.body_ids]
+        out[:, 3, 3] = 1.0
+        return out
+
+
+def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
+    """Compile :func:`build_mjcf` (same keyword arguments) into a :class:`SimModel`."""
+    mj = _mujoco()
+    robot = as_robot(robot)
+    xml = build_mjcf(robot, **kwargs)
+    model = mj.MjModel.from_xml_string(xml)
+    names = robot.link_names
+    body_ids = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, nm) for nm in names])
+    site_ids = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "site_" + nm) for nm in names])
+    jids = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT, nm) for nm in robot.body.joint_names]
+    robot_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] != 0])
+    return SimModel(robot=robot, model=model, body_ids=body_ids, site_ids=site_ids,
+                    qpos_adr=np.array([model.jnt_qposadr[j] for j in jids]),
+                    dof_adr=np.array([model.jnt_dofadr[j] for j in jids]),
+                    root_body=int(body_ids[0]),
+                    floor_geom=mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, "floor"),
+                    robot_geoms=robot_geoms,
+                    torque_limit=_torque_limits(robot, kwargs.get("torque_limit")))

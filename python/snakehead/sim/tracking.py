@@ -1,0 +1,363 @@
+"""Track a planned joint trajectory in MuJoCo: PD control with gravity compensation at the 2 ms control period,
+and what the paper compares (Section 4): the head frame, the momenta, the zero-moment point.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from .._validate import finite_array, positive
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_KD, DEFAULT_KP, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco,
+                   build_model)
+
+
+# ------------------------------------------------------------------------------------------------
+# measurements on a MuJoCo state
+# ------------------------------------------------------------------------------------------------
+def momenta_of_state(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+    """Linear (kg m/s) and angular (kg m^2/s) momentum of the robot about the world origin, (3,) each.
+
+    From MuJoCo's subtree quantities of the root link (``mj_subtreeVel``): P = M v_c,
+    L_O = L_c + c x P, with L_c the angular momentum about the subtree's centre of mass c.
+    Needs positions and velocities computed (mj_forward or mj_step1).
+    """
+    mj = _mujoco()
+    mj.mj_subtreeVel(sim.model, data)
+    b = sim.root_body
+    P = sim.model.body_subtreemass[b] * data.subtree_linvel[b]
+    c = data.subtree_com[b]
+    L = data.subtree_angmom[b] + np.cross(c, P)
+    return P.copy(), L.copy()
+
+
+def momenta_per_body(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+    """The same momenta summed link by link (paper Eqs. 27-31) from ``mj_objectVelocity`` at each body's CoM.
+
+    An independent path to :func:`momenta_of_state`, used to check it.
+    """
+    mj = _mujoco()
+    m = sim.model
+    P, L = np.zeros(3), np.zeros(3)
+    v6 = np.zeros(6)
+    for b in range(1, m.nbody):
+        mass = m.body_mass[b]
+        if mass <= 0:
+            continue
+        mj.mj_objectVelocity(m, data, mj.mjtObj.mjOBJ_BODY, b, v6, 0)  # (omega, v) at xipos, world axes
+        w, v = v6[:3], v6[3:]
+        R = data.ximat[b].reshape(3, 3)
+        Iw = R @ np.diag(m.body_inertia[b]) @ R.T
+        p = mass * v
+        P += p
+        L += np.cross(data.xipos[b], p) + Iw @ w
+    return P, L
+
+
+def ground_contacts(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+    """Contact points (k, 3) m and forces on the robot (k, 3) N, world frame, of every robot-floor contact."""
+    mj = _mujoco()
+    pts, frc = [], []
+    f6 = np.zeros(6)
+    for i in range(data.ncon):
+        c = data.contact[i]
+        g1, g2 = int(c.geom1), int(c.geom2)
+        if sim.floor_geom not in (g1, g2):
+            continue
+        mj.mj_contactForce(sim.model, data, i, f6)
+        frame = np.asarray(c.frame).reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
+        f = frame.T @ f6[:3]  # force of geom1 on geom2, world
+        if g1 != sim.floor_geom:
+            f = -f
+        pts.append(np.array(c.pos))
+        frc.append(f)
+    if not pts:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    return np.array(pts), np.array(frc)
+
+
+def center_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray:
+    """The ZMP / centre of pressure on the ground plane z = 0 of contact forces, (2,) m; NaN without load.
+
+    The point p on z = 0 about which the contact forces have no horizontal moment:
+    p_x = sum(x_i f_zi - z_i f_xi) / sum f_zi,  p_y = sum(y_i f_zi - z_i f_yi) / sum f_zi.
+    The z_i terms correct for contact points off the plane (MuJoCo puts them mid-penetration, ~1e-4 m) carrying
+    friction; with z_i = 0 this is the plain p = sum f_z p_i / sum f_z.
+    """
+    points = np.asarray(points, float).reshape(-1, 3)
+    forces = np.asarray(forces, float).reshape(-1, 3)
+    fz = forces[:, 2].sum()
+    if points.shape[0] == 0 or fz <= 1e-9:
+        return np.array([np.nan, np.nan])
+    px = (points[:, 0] * forces[:, 2] - points[:, 2] * forces[:, 0]).sum() / fz
+    py = (points[:, 1] * forces[:, 2] - points[:, 2] * forces[:, 1]).sum() / fz
+    return np.array([px, py])
+
+
+# ------------------------------------------------------------------------------------------------
+# simulation
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class SimResult:
+    """What :func:`simulate` recorded, one row per control tick (``control_dt`` apart), after settling.
+
+    t (N,) s, starting at the planned t[0]; q, qdot, q_ref (N, n) rad, rad/s; tau (N, n) N m applied joint
+    torques; head_pose (N, 4, 4) world pose of ``head_tip``; P (N, 3) kg m/s and L (N, 3) kg m^2/s momenta about
+    the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground forces (NaN if airborne);
+    contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the robot-floor contacts;
+    base_positions (N, nb, 3) world origins of the base-part frames; base_slide_m / base_lift_m the largest
+    horizontal / upward displacement of any of them from the first tick (m).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    q_ref: np.ndarray
+    tau: np.ndarray
+    head_pose: np.ndarray
+    P: np.ndarray
+    L: np.ndarray
+    com: np.ndarray
+    zmp: np.ndarray
+    contact_points: list
+    contact_forces: list
+    base_positions: np.ndarray
+    base: BasePlacement
+    torque_limit: np.ndarray
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def head_position(self) -> np.ndarray:
+        """(N, 3) m."""
+        return self.head_pose[:, :3, 3]
+
+    @property
+    def head_direction(self) -> np.ndarray:
+        """(N, 3) unit x-axis of head_tip."""
+        return self.head_pose[:, :3, 0]
+
+    @property
+    def base_slide_m(self) -> float:
+        d = self.base_positions[:, :, :2] - self.base_positions[:1, :, :2]
+        return float(np.linalg.norm(d, axis=2).max())
+
+    @property
+    def base_lift_m(self) -> float:
+        return float(max((self.base_positions[:, :, 2] - self.base_positions[:1, :, 2]).max(), 0.0))
+
+    @property
+    def saturation_fraction(self) -> float:
+        """Fraction of (tick, joint) samples whose torque was at the limit."""
+        return float(np.mean(np.abs(self.tau) >= self.torque_limit * (1 - 1e-9)))
+
+
+def _gains(x, n: int, name: str, allow_zero: bool) -> np.ndarray:
+    a = finite_array(x, name)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    elif a.shape != (n,):
+        raise ValueError(f"{name} must be a number or shape ({n},), got shape {a.shape}")
+    if np.any(a < 0) or (not allow_zero and np.any(a <= 0)):
+        raise ValueError(f"{name} must be {'>= 0' if allow_zero else '> 0'}, got {a.tolist()}")
+    return a
+
+
+def check_trajectory(robot: SnakeRobot, t, q) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a planned trajectory: t (T,) strictly increasing, q (T, n) finite within the joint limits."""
+    n = robot.n_joints
+    t = finite_array(t, "t")
+    if t.ndim != 1 or t.size < 2:
+        raise ValueError(f"t must be a 1-D array of at least 2 times, got shape {t.shape}")
+    q = finite_array(q, "q")
+    if q.ndim != 2 or q.shape[1] != n:
+        raise ValueError(f"q must have shape (T, {n}), got {q.shape}")
+    if q.shape[0] != t.size:
+        raise ValueError(f"t and q have different lengths ({t.size} and {q.shape[0]})")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing")
+    tol = 1e-9
+    bad = (q < robot.lower - tol) | (q > robot.upper + tol)
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ValueError(f"q[{k}, {j}] = {q[k, j]:.6g} rad is outside the joint limits "
+                         f"[{robot.lower[j]:.6g}, {robot.upper[j]:.6g}]")
+    return t, q
+
+
+#: Modes of gravity compensation in :func:`simulate`.
+GRAVITY_COMPENSATION = ("supported", "bias", "none")
+
+#: Ramp (m) of the support-aware compensation: a link whose lowest box corner is this high in the plan is
+#: fully carried by the joints; on the ground (height 0) not at all; linear in between.
+LIFT_RAMP = 0.005
+
+
+def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) -> np.ndarray:
+    """How much of each joint's distal links' weight the joint carries: W (T, n, n_links) in [0, 1].
+
+    frames (T, n_links, 4, 4): planned world poses. A link with a box is lifted by w = clip(h / ramp, 0, 1),
+    h the height of the lowest corner of its box's distal face (+x end; massless marker frames: w = 1). The
+    distal face, not the whole box: a link pitched up about its proximal joint still touches the ground with
+    its proximal edge, right under the joint's axis, where the ground's reaction has no moment about the
+    joint, so the joint carries the link from the first degrees of lift. Joint j carries link i (i at or after
+    j's child link in chain order) by the product of w over the links from j's child to i: the weight of the
+    lifted run of links that hangs from the joint, up to the first link resting on the ground, which the
+    ground carries instead.
+    """
+    L = len(robot.link_names)
+    boxed = np.all(robot.box_sizes > 0, axis=1)
+    B = frames[:, boxed] @ robot.box_origins[boxed]
+    half = 0.5 * robot.box_sizes[boxed]
+    low = (B[..., 2, 3] + B[..., 2, 0] * half[:, 0]
+           - np.abs(B[..., 2, 1]) * half[:, 1] - np.abs(B[..., 2, 2]) * half[:, 2])
+    w = np.ones((frames.shape[0], L))
+    w[:, boxed] = np.clip(low / ramp, 0.0, 1.0)
+    child = np.asarray(robot.body.model.joint_child_links, int)
+    W = np.zeros((frames.shape[0], robot.n_joints, L))
+    for j, c in enumerate(child):
+        W[:, j, c:] = np.cumprod(w[:, c:], axis=1)
+    return W
+
+
+def _compensated_mode(gravity_compensation) -> str:
+    if gravity_compensation not in GRAVITY_COMPENSATION:
+        raise ValueError(f"gravity_compensation must be one of {GRAVITY_COMPENSATION}, got {gravity_compensation!r}")
+    return gravity_compensation
+
+
+def gravity_torques(sim: SimModel, data, weights: np.ndarray) -> np.ndarray:
+    """Joint torques (n,) N m holding the weighted link weights against gravity in the state ``data``.
+
+    tau_j = -a_j . sum_i W_ji (c_i - p_j) x (m_i g): a_j, p_j the joint's world axis and anchor, c_i, m_i each
+    link's centre of mass and mass, W (n, n_links) from :func:`carried_weights`. With every W = 1 on the
+    distal links this is the gravity part of MuJoCo's ``qfrc_bias`` on the joints (tested).
+    """
+    m = sim.model
+    jid = m.dof_jntid[sim.dof_adr]
+    a = data.xaxis[jid]  # (n, 3)
+    p = data.xanchor[jid]  # (n, 3)
+    c = data.xipos[sim.body_ids]  # (L, 3)
+    mg = m.body_mass[sim.body_ids][:, None] * np.array([0.0, 0.0, -GRAVITY])  # (L, 3)
+    r = c[None, :, :] - p[:, None, :]  # (n, L, 3)
+    torque = np.cross(r, mg[None, :, :])  # (n, L, 3)
+    return -np.einsum("nl,nlk,nk->n", weights, torque, a)
+
+
+def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = None, kp=DEFAULT_KP, kd=DEFAULT_KD, *,
+             control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3,
+             hold: float = 0.0, gravity_compensation: str = "supported", torque_limit=None, friction: float = 0.8,
+             joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES,
+             self_collision: bool = False, drop: float = 2e-4) -> SimResult:
+    """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
+
+    t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
+    at every control tick, qdot_ref from ``np.gradient(q, t)``). ``base``: where the tail lies.
+    kp (N m/rad, > 0) and kd (N m s/rad, >= 0): scalars or (n,). ``control_dt`` (s): the control period (2 ms,
+    the paper's), a whole multiple of the physics ``timestep`` (1 ms). ``settle`` s: the robot is first put at
+    q[0], ``drop`` m above its resting height, and held there with the same controller before t[0]; ``hold`` s:
+    after t[-1] the last configuration is held and recorded. ``gravity_compensation``: "supported" (default: each joint
+    carries the lifted run of links hanging from it, judged from the planned configuration, see
+    :func:`carried_weights`), "bias" (MuJoCo's ``qfrc_bias`` on every joint: gravity and Coriolis as if the tail
+    were clamped) or "none". ``torque_limit`` N m: scalar or (n,), default the URDF
+    effort. Other keywords go to :func:`build_mjcf`.
+
+    Returns a :class:`SimResult` sampled at every control tick from t[0] to t[-1] + hold.
+    """
+    mj = _mujoco()
+    robot = as_robot(robot)
+    base = as_base(base)
+    t, q = check_trajectory(robot, t, q)
+    n = robot.n_joints
+    kp = _gains(kp, n, "kp", allow_zero=False)
+    kd = _gains(kd, n, "kd", allow_zero=True)
+    timestep = positive(timestep, "timestep")
+    control_dt = positive(control_dt, "control_dt")
+    sub = int(round(control_dt / timestep))
+    if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
+        raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
+    for name, val in (("settle", settle), ("hold", hold), ("drop", drop)):
+        v = finite_array(val, name, ())
+        if v < 0:
+            raise ValueError(f"{name} must be >= 0, got {val!r}")
+    mode = _compensated_mode(gravity_compensation)
+
+    sim = build_model(robot, timestep=timestep, friction=friction, joint_damping=joint_damping,
+                      armature=armature, torque_limit=torque_limit, obstacles=obstacles, hole_slices=hole_slices,
+                      self_collision=self_collision)
+    m = sim.model
+    m.actuator_biasprm[:, 1] = -kp
+    m.actuator_biasprm[:, 2] = -kd
+    d = mj.MjData(m)
+    sim.set_state(d, q[0], base, lift=float(drop))
+
+    qdot_plan = np.gradient(q, t, axis=0)
+    qa, da = sim.qpos_adr, sim.dof_adr
+
+    def control(qr, qdr, W):
+        if mode == "supported":
+            tau_g = gravity_torques(sim, d, W)
+        elif mode == "bias":
+            tau_g = d.qfrc_bias[da]
+        else:
+            tau_g = 0.0
+        d.ctrl[:] = kp * qr + kd * qdr + tau_g
+
+    # settle at q[0]
+    zero = np.zeros(n)
+    W0 = carried_weights(robot, robot.frames_many(q[:1], base))[0]
+    for _ in range(int(round(float(settle) / control_dt))):
+        mj.mj_step1(m, d)
+        control(q[0], zero, W0)
+        mj.mj_step2(m, d)
+        for _ in range(sub - 1):
+            mj.mj_step(m, d)
+
+    N = int(math.floor((t[-1] - t[0] + float(hold)) / control_dt + 1e-9)) + 1
+    ts = t[0] + control_dt * np.arange(N)
+    q_ref = np.column_stack([np.interp(ts, t, q[:, j]) for j in range(n)])
+    qd_ref = np.column_stack([np.interp(ts, t, qdot_plan[:, j]) for j in range(n)])
+    qd_ref[ts > t[-1]] = 0.0
+    Wref = carried_weights(robot, robot.frames_many(q_ref, base)) if mode == "supported" else None
+
+    head_k = robot.body.link_index(robot.parts.head_tip)
+    base_last = int(robot.body.model.joint_child_links[robot.parts.base.stop - 1])
+    base_frames = sim.body_ids[:base_last + 2]  # base links and the base_end marker (distal end of the last)
+    rec = {k: np.zeros((N, 3)) for k in ("P", "L", "com")}
+    qs, qds, taus = np.zeros((N, n)), np.zeros((N, n)), np.zeros((N, n))
+    head = np.zeros((N, 4, 4))
+    basepos = np.zeros((N, len(base_frames), 3))
+    zmp = np.zeros((N, 2))
+    cpts, cfrc = [], []
+    hb = sim.body_ids[head_k]
+    for k in range(N):
+        mj.mj_step1(m, d)  # positions, velocities, collisions, bias forces at this tick
+        qs[k] = d.qpos[qa]
+        qds[k] = d.qvel[da]
+        head[k, :3, :3] = d.xmat[hb].reshape(3, 3)
+        head[k, :3, 3] = d.xpos[hb]
+        head[k, 3, 3] = 1.0
+        basepos[k] = d.xpos[base_frames]
+        rec["P"][k], rec["L"][k] = momenta_of_state(sim, d)
+        rec["com"][k] = d.subtree_com[sim.root_body]
+        control(q_ref[k], qd_ref[k], None if Wref is None else Wref[k])
+        mj.mj_step2(m, d)  # constraint (contact) forces of this tick's state, then integration
+        taus[k] = d.actuator_force
+        p, f = ground_contacts(sim, d)
+        cpts.append(p)
+        cfrc.append(f)
+        zmp[k] = center_of_pressure(p, f)
+        for _ in range(sub - 1):
+            mj.mj_step(m, d)
+        if not np.all(np.isfinite(d.qpos)):
+            raise RuntimeError(f"the simulation diverged at t = {ts[k]:.3f} s; lower the gains or the timestep")
+
+    settings = dict(kp=kp.tolist(), kd=kd.tolist(), control_dt=control_dt, timestep=timestep,
+                    settle=float(settle), hold=float(hold), gravity_compensation=mode,
+                    friction=float(friction), joint_damping=float(joint_damping), armature=float(armature),
+                    n_obstacles=len(obstacles), self_collision=bool(self_collision))
+    return SimResult(t=ts, q=qs, qdot=qds, q_ref=q_ref, tau=taus, head_pose=head, P=rec["P"], L=rec["L"],
+                     com=rec["com"], zmp=zmp, contact_points=cpts, contact_forces=cfrc, base_positions=basepos,
+                     base=base, torque_limit=sim.torque_limit, settings=settings)

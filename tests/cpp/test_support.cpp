@@ -1,0 +1,70 @@
+// Support polygons: the convex hull and the signed margin of a point, against closed forms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "snakehead/support.hpp"
+
+namespace {
+
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
+
+Points square_with_inside_and_edge_points() {
+  Points p(7, 2);
+  p << 0, 0, 2, 0, 2, 2, 0, 2,  // the square's corners
+      1, 1,                     // inside
+      1, 0,                     // on an edge
+      0.5, 1.5;                 // inside
+  return p;
+}
+
+TEST(ConvexHull, SquareKeepsItsCornersCounterClockwise) {
+  const Points p = square_with_inside_and_edge_points();
+  const std::vector<int> h = snakehead::convex_hull(p);
+  ASSERT_EQ(h.size(), 4u);
+  double area2 = 0.0;  // twice the shoelace area: positive for counter-clockwise
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const auto& a = p.row(h[i]);
+    const auto& b = p.row(h[(i + 1) % h.size()]);
+    area2 += a(0) * b(1) - a(1) * b(0);
+  }
+  EXPECT_DOUBLE_EQ(area2, 8.0);
+}
+
+TEST(ConvexHull, DegenerateSets) {
+  Points line(3, 2);
+  line << 0, 0, 1, 1, 3, 3;
+  EXPECT_EQ(snakehead::convex_hull(line).size(), 2u);
+  Points same(2, 2);
+  same << 1, 1, 1, 1;
+  EXPECT_EQ(snakehead::convex_hull(same).size(), 1u);
+  EXPECT_TRUE(snakehead::convex_hull(Points(0, 2)).empty());
+}
+
+TEST(HullMargin, InsideOutsideAndDegenerate) {
+  const Points p = square_with_inside_and_edge_points();
+  EXPECT_DOUBLE_EQ(snakehead::hull_margin(p, Eigen::Vector2d(1.0, 1.0)), 1.0);   // centre: 1 from each edge
+  EXPECT_DOUBLE_EQ(snakehead::hull_margin(p, Eigen::Vector2d(0.5, 1.0)), 0.5);
+  EXPECT_DOUBLE_EQ(snakehead::hull_margin(p, Eigen::Vector2d(3.0, 1.0)), -1.0);  // outside, beside an edge
+  EXPECT_NEAR(snakehead::hull_margin(p, Eigen::Vector2d(3.0, 3.0)), -std::sqrt(2.0), 1e-15);  // off a corner
+  Points seg(2, 2);
+  seg << 0, 0, 2, 0;
+  EXPECT_DOUBLE_EQ(snakehead::hull_margin(seg, Eigen::Vector2d(1.0, 0.5)), -0.5);  // a segment has no inside
+  EXPECT_EQ(snakehead::hull_margin(Points(0, 2), Eigen::Vector2d(0, 0)), -std::numeric_limits<double>::infinity());
+}
+
+TEST(HullMargins, ManySamplesWithActiveMasks) {
+  const Points p = square_with_inside_and_edge_points();
+  std::vector<double> pts;
+  for (int s = 0; s < 2; ++s)
+    for (int i = 0; i < 7; ++i) pts.insert(pts.end(), {p(i, 0), p(i, 1)});
+  std::vector<unsigned char> active(14, 1);
+  for (int i = 7; i < 14; ++i) active[i] = (i - 7 == 0 || i - 7 == 1) ? 1 : 0;  // sample 1: a segment
+  const double xy[4] = {1.0, 1.0, 1.0, 0.5};
+  const auto m = snakehead::hull_margins(pts.data(), active.data(), xy, 2, 7);
+  EXPECT_DOUBLE_EQ(m[0], 1.0);
+  EXPECT_DOUBLE_EQ(m[1], -0.5);
+}
+
+}  // namespace

@@ -1,0 +1,126 @@
+"""The paper's scenarios (Section 4) from their scene files, planned by snakehead.plan on the default robot:
+kinematic success and every check by independent computations."""
+import numpy as np
+import pytest
+
+import snakehead
+from snakehead import SnakeRobot
+from snakehead.control.controller import HeadController
+from snakehead.geometry import collision as coll
+from snakehead.motion import planner
+from snakehead.scenes import paper_scene
+
+HOLE = paper_scene("hole")
+WALL = HOLE.obstacles[0]
+HOLE_CENTRE = WALL.centre
+WALL_SIZE = WALL.size
+
+
+@pytest.fixture(scope="module")
+def controller():
+    return HeadController(SnakeRobot.default(), method="free_roll", seed=0)
+
+
+@pytest.fixture(scope="module")
+def spheres(controller):
+    return snakehead.plan(paper_scene("spheres"), controller=controller)
+
+
+@pytest.fixture(scope="module")
+def hole(controller):
+    return snakehead.plan(HOLE, controller=controller)
+
+
+def check(result, robot):
+    assert result.targets, "no targets"
+    for tg in result.targets:
+        assert tg.solution.success, tg.solution.message
+        # independent: whole-body FK of the planned joints at the target's time
+        k = int(np.argmin(np.abs(result.t - tg.time_s)))
+        T = robot.head_pose(result.q[k], result.base)
+        assert np.linalg.norm(T[:3, 3] - tg.position) <= 1e-4
+        assert np.degrees(np.arccos(np.clip(T[:3, 0] @ tg.direction, -1, 1))) <= 0.05
+    assert result.stability.inside.all(), f"ZMP outside at t = {result.t[result.stability.argmin]:.3f} s"
+    below = coll.below_ground(robot, result.q, result.base)
+    assert not below.any()
+    assert coll.self_clearance(robot, result.q[::5], result.base).min() > 0  # no two links overlap
+    assert np.all(np.diff(result.t) > 0) and result.q.shape == (len(result.t), 16)
+    assert np.all(result.q >= robot.lower - 1e-9) and np.all(result.q <= robot.upper + 1e-9)
+    assert result.success
+
+
+def test_spheres(spheres, controller):
+    check(spheres, controller.robot)
+    # the paper's phases: the bending state (on the ground), lifting the head, then the targets
+    labels = [lab for lab, _, _ in spheres.states]
+    assert labels[0] == "bending state" and "initial state (head lifted)" in labels
+    np.testing.assert_array_equal(spheres.states[0][2], planner.bending_state(controller))
+    names = [t.name for t in spheres.targets]
+    assert names == ["sphere 1", "sphere 2"]
+
+
+def test_hole(hole, controller):
+    check(hole, controller.robot)
+    assert hole.obstacle_distance is not None and hole.obstacle_distance.min() > 0  # no link touches the wall
+    # The head link is through: the head tip beyond the wall's far face, on the hole's axis.
+    last = controller.robot.head_pose(hole.q[-1], hole.base)
+    assert last[1, 3] > HOLE_CENTRE[1] + WALL_SIZE[2] / 2
+    assert np.linalg.norm(last[[0, 2], 3] - HOLE_CENTRE[[0, 2]]) < 1e-4
+    # nothing but the head link crosses the wall's near face
+    F = controller.robot.frames_many(hole.q, hole.base)
+    head_link = controller.robot.body.model.joint_child_links[-1]
+    near = HOLE_CENTRE[1] - WALL_SIZE[2] / 2
+    assert F[:, :head_link + 1, 1, 3].max() < near  # every joint up to the head link's stays in front
+
+
+def test_bad_parameters(controller):
+    with pytest.raises(ValueError, match="speed"):
+        snakehead.plan(paper_scene("spheres"), controller=controller, speed=0.0)
+    with pytest.raises(ValueError, match="min_segment"):
+        snakehead.plan(paper_scene("spheres"), controller=controller, min_segment=-1.0)
+    with pytest.raises(TypeError, match="controller"):
+        snakehead.plan(paper_scene("spheres"), controller="no")
+
+
+def test_wall_stands_on_the_ground():
+    wall = WALL
+    R = wall.rotation
+    centre = wall.centre + R[:, :2] @ wall.hole_offset  # the wall's own centre
+    corners = np.array([centre + R @ (np.array([sx, sy, sz]) * wall.size / 2)
+                        for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    assert corners[:, 2].min() == pytest.approx(0.0, abs=1e-12)
+    assert corners[:, 2].max() == pytest.approx(WALL_SIZE[1])
+    # the hole's centre is in the wall and free; a point of the wall just outside the hole's rim is solid
+    assert wall.distance_to_points(HOLE_CENTRE[None])[0] == pytest.approx(wall.hole_diameter / 2)
+    assert wall.distance_to_points((HOLE_CENTRE + [0, 0, -0.05])[None])[0] == 0.0
+
+
+def test_bending_state(controller):
+    robot = controller.robot
+    q = planner.bending_state(controller)
+    np.testing.assert_array_equal(q[robot.parts.base], controller.q_initial[robot.parts.base])
+    pitch = np.abs(np.asarray(robot.body.model.joint_axes)[:, 1]) > 0.5
+    np.testing.assert_array_equal(q[pitch], 0.0)  # everything lies flat on the ground
+    clearance = coll.ground_clearance(robot, q)[0]
+    boxed = np.isfinite(clearance)
+    np.testing.assert_allclose(clearance[boxed], 0.0, atol=1e-12)
+    assert coll.self_clearance(robot, q)[0] > planner.BENDING_CLEARANCE
+    # once lifted, only the base supports: the curl keeps the whole body's CoM over the base's polygon
+    from snakehead.dynamics import stability
+
+    assert stability.static_margin(robot, q) > 0.02
+
+
+def test_self_clearance_detects_overlap(controller):
+    robot = controller.robot
+    assert coll.self_clearance(robot, np.zeros(16))[0] == pytest.approx(0.0865)  # straight: a module apart
+    q = planner.bending_state(controller)
+    yaw_up = [8, 10, 12, 14]
+    q[yaw_up] = np.radians([90, 90, 0, 0])  # curls the head across the base: link_14 lies on link_4
+    assert coll.self_clearance(robot, q)[0] < 0
+
+
+@pytest.mark.parametrize("qs", [np.zeros(15), np.zeros((3, 4)), np.full(16, np.nan)])
+def test_self_clearance_bad_input(controller, qs):
+    with pytest.raises(ValueError):
+        coll.self_clearance(controller.robot, qs)

@@ -1,0 +1,158 @@
+"""The stability-aware whole-body solve (control.whole_body): gradients against finite differences, and solutions
+for targets reachable by construction checked by independent computations (FK, support polygon, clearances)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import snakehead
+from snakehead import BasePlacement, SnakeRobot
+from snakehead.control import whole_body as wb
+from snakehead.dynamics import stability
+from snakehead.geometry import collision as coll
+from snakehead.kinematics import workspace as ws
+from snakehead.model.generate import SnakeSpec, snake_urdf
+
+
+@pytest.fixture(scope="module")
+def default():
+    robot = SnakeRobot.default()
+    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
+    return robot, controller, wb.BodyProblem(robot)
+
+
+@pytest.fixture(scope="module")
+def generated():
+    spec = SnakeSpec(n_joints=20, module_length=0.07, section=0.05, mass_per_module=0.15,
+                     markers={"p0": 10, "b0": 12}, tip_name="tip")
+    robot = SnakeRobot.from_urdf(snake_urdf(spec), base_end="p0", neck_end="b0", head_tip="tip")
+    m = ws.compute(robot, voxel=0.07, directions=12, rolls=2, progress=False)
+    controller = snakehead.HeadController(robot, m, method="free_roll", seed=1)
+    return robot, controller, wb.BodyProblem(robot)
+
+
+def reachable(robot, controller, prob, rng, kind: str):
+    """A target reachable by construction: the head pose of a random configuration (neck and head joints uniform
+    within their limits; for kind "shape" the base's yaw joints too, for "place" another placement) that is
+    statically stable, keeps the neck and head above the ground and does not touch itself."""
+    for _ in range(5000):
+        q = controller.q_initial.copy()
+        lift = np.arange(robot.lift_joints.start, robot.n_joints)
+        q[lift] = rng.uniform(robot.lower[lift], robot.upper[lift])
+        base = BasePlacement()
+        if kind == "shape":
+            yaw = np.flatnonzero(prob.ground_yaw)
+            q[yaw] = rng.uniform(robot.lower[yaw], robot.upper[yaw])
+        if kind == "place":
+            base = BasePlacement(*rng.uniform([-1, -1, -np.pi], [1, 1, np.pi]))
+        if (stability.static_margin(robot, q, base, contact="ground") > 0.005
+                and coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min() >= 0
+                and coll.self_clearance(robot, q, base)[0] > 0):
+            H = robot.head_pose(q, base)
+            return H[:3, 3], H[:3, 0]
+    raise AssertionError("no reachable target drawn")
+
+
+def independent_checks(robot, sol, position, direction, base_start, q_start):
+    assert sol.success, (sol.reason, sol)
+    H = robot.head_pose(sol.q, sol.base)  # FK of the whole body
+    assert np.linalg.norm(H[:3, 3] - position) <= 1e-4
+    assert np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1, 1))) <= 0.05
+    assert stability.static_margin(robot, sol.q, sol.base, contact="ground") >= wb.MIN_MARGIN - 1e-12
+    assert coll.ground_clearance(robot, sol.q, sol.base)[0, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
+    assert coll.self_clearance(robot, sol.q, sol.base)[0] > 0
+    assert np.all(sol.q >= robot.lower - 1e-12) and np.all(sol.q <= robot.upper + 1e-12)
+    # the base lies flat on the ground: its pitch joints at zero, its boxes resting on the ground
+    flat = wb.BodyProblem(robot).flat
+    np.testing.assert_array_equal(sol.q[flat], 0.0)
+    F = robot.frames(sol.q, sol.base)
+    assert np.abs(robot.lowest_box_z(F[None], robot.base_links)).max() < 1e-9
+    if sol.stage in ("segmented", "whole-body, base kept"):
+        assert sol.base == base_start
+        np.testing.assert_array_equal(sol.q[robot.parts.base], q_start[robot.parts.base])
+
+
+def test_gradients_match_finite_differences(default):
+    robot, controller, prob = default
+    rng = np.random.default_rng(0)
+    q0 = controller.q_initial.copy()
+    q0[prob.free] += rng.normal(0, 0.05, prob.free.sum())
+    base = BasePlacement(0.1, -0.2, 0.3)
+    box = snakehead.BoxObstacle([0.3, 0.5, 0.2], [0.1, 0.1, 0.1])
+    obj = wb._Objective(prob, q0, base, np.array([0.1, 0.5, 0.3]), np.array([0.0, 1.0, 0.0]), True, [box],
+                        0.005, 0.002, 0.002, None)
+    z = obj.pack(q0, base)
+    e = obj.evaluate(z)
+    h = 1e-7
+    for value, jac in (("eq", "eq_jac"), ("ineq", "ineq_jac"), ("margin", "margin_jac")):
+        fd = np.array([(np.atleast_1d(obj.evaluate(z + h * u)[value]) - np.atleast_1d(obj.evaluate(z - h * u)[value]))
+                       / (2 * h) for u in np.eye(len(z))]).T
+        np.testing.assert_allclose(np.atleast_2d(e[jac]), fd, atol=1e-6)
+
+
+def test_hull_indices_match_qhull():
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(1)
+    for k in range(300):
+        p = rng.normal(size=(int(rng.integers(3, 50)), 2))
+        if k % 3 == 0:
+            p = np.round(p, 1)  # duplicates and collinear points
+        h = stability.hull_indices(p)
+        assert ConvexHull(p[h]).volume == pytest.approx(ConvexHull(p).volume, abs=1e-12)
+    assert len(stability.hull_indices(np.array([[0, 0], [1, 1], [2, 2.0]]))) == 2  # collinear: the extremes
+
+
+@pytest.mark.parametrize("kind, count", [("same", 12), ("shape", 6), ("place", 6)])
+def test_reachable_targets_default_robot(default, kind, count):
+    robot, controller, prob = default
+    rng = np.random.default_rng({"same": 10, "shape": 11, "place": 12}[kind])
+    stages = []
+    for _ in range(count):
+        p, d = reachable(robot, controller, prob, rng, kind)
+        sol = wb.solve_target(controller, p, d, problem=prob)
+        independent_checks(robot, sol, p, d, controller.base, controller.q_initial)
+        stages.append(sol.stage)
+    assert set(stages) <= set(wb.STAGES)
+
+
+def test_reachable_targets_generated_robot(generated):
+    robot, controller, prob = generated
+    rng = np.random.default_rng(5)
+    for kind in ("same", "shape", "place"):
+        for _ in range(3):
+            p, d = reachable(robot, controller, prob, rng, kind)
+            sol = wb.solve_target(controller, p, d, problem=prob)
+            independent_checks(robot, sol, p, d, controller.base, controller.q_initial)
+
+
+def test_base_kept_when_not_allowed_to_move(default):
+    robot, controller, prob = default
+    far = np.array([2.0, 2.0, 0.3])
+    sol = wb.solve_target(controller, far, [1.0, 0.0, 0.0], problem=prob, allow_base_move=False)
+    assert not sol.success and sol.reason == "out of reach" and sol.base == controller.base
+    moved = wb.solve_target(controller, far, [1.0, 0.0, 0.0], problem=prob)
+    independent_checks(robot, moved, far, np.array([1.0, 0.0, 0.0]), controller.base, controller.q_initial)
+    assert moved.stage == "whole-body, base moved"
+
+
+def test_failure_reasons(default):
+    robot, controller, prob = default
+    high = wb.solve_target(controller, [0.3, 0.3, 3.0], [0, 0, 1], problem=prob, time_budget=0.5)
+    assert high.reason == "out of reach" and high.stage is None
+    # a box over the only region the head can reach from here: no clear pose with the base kept
+    sol = wb.solve_target(controller, [0.15, 0.5, 0.4], [0, 1, 0], problem=prob, allow_base_move=False,
+                          obstacles=[snakehead.BoxObstacle([0.15, 0.3, 0.3], [1.5, 0.3, 0.6])], time_budget=0.5)
+    assert sol.reason in ("no clear pose", "out of reach")
+
+
+def test_bad_input(default):
+    robot, controller, prob = default
+    with pytest.raises(ValueError, match="position"):
+        wb.solve_target(controller, [0.1, np.nan, 0.3], [0, 1, 0], problem=prob)
+    with pytest.raises(ValueError, match="direction"):
+        wb.solve_target(controller, [0.1, 0.5, 0.3], [0, 0, 0], problem=prob)
+    with pytest.raises(ValueError, match="start"):
+        wb.solve_whole_body(robot, [0.1, 0.5, 0.3], [0, 1, 0], [])
+    with pytest.raises(TypeError):
+        wb.BodyProblem("robot")
