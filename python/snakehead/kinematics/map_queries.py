@@ -39,15 +39,61 @@ def direction_bits(m) -> np.ndarray:
     return m._cache["direction_bits"]
 
 
-def _rows(m, ijk: np.ndarray) -> np.ndarray:
-    """Row of the map holding each grid voxel (i, j, l), -1 where the map has none, for (..., 3) indices."""
+def _table(m) -> np.ndarray:
+    """The direction bits of every grid voxel, in a dense flat table over the grid padded by one voxel on each
+    side (False there and outside the map's voxels): a lookup is one array access (cached on the map)."""
+    if "table" not in m._cache:
+        n = int(m.grid_shape[0])
+        bits = direction_bits(m)
+        table = np.zeros((n + 2, n + 2, n + 2, bits.shape[1]), dtype=bool)
+        i, j, l = m.voxel_ids // (n * n), (m.voxel_ids // n) % n, m.voxel_ids % n
+        table[i + 1, j + 1, l + 1] = bits
+        m._cache["table"] = table.reshape(-1)
+    return m._cache["table"]
+
+
+#: Cells per cube face edge, and candidate directions per cell, of the directions' lookup table.
+_CUBE_CELLS, _CANDIDATES = 32, 7
+
+
+def _cube_cell(d: np.ndarray) -> np.ndarray:
+    """The cube-map cell (face, u, v) of each unit direction (K, 3), as a flat index."""
+    major = np.argmax(np.abs(d), axis=1)
+    rows = np.arange(len(d))
+    face = 2 * major + (d[rows, major] < 0)
+    big = np.abs(d[rows, major])
+    u = d[rows, (major + 1) % 3] / big
+    v = d[rows, (major + 2) % 3] / big
+    cell = lambda x: np.clip(((x + 1.0) * 0.5 * _CUBE_CELLS).astype(np.int64), 0, _CUBE_CELLS - 1)  # noqa: E731
+    return (face * _CUBE_CELLS + cell(u)) * _CUBE_CELLS + cell(v)
+
+
+def _direction_candidates(m) -> np.ndarray:
+    """(6 * cells^2, C): for each cube-map cell, the map's directions nearest its centre (cached on the map). A
+    cell spans under 3 degrees; the map's directions are tens of degrees apart, so the few nearest to any
+    direction in the cell are among them."""
+    if "candidates" not in m._cache:
+        dirs = m.sphere_directions
+        g = (np.arange(_CUBE_CELLS) + 0.5) / _CUBE_CELLS * 2.0 - 1.0
+        u, v = np.meshgrid(g, g, indexing="ij")
+        centres = []
+        for face in range(6):
+            major, sign = face // 2, -1.0 if face % 2 else 1.0
+            c = np.zeros((_CUBE_CELLS, _CUBE_CELLS, 3))
+            c[..., major], c[..., (major + 1) % 3], c[..., (major + 2) % 3] = sign, u, v
+            centres.append(c.reshape(-1, 3))
+        centres = np.concatenate(centres)
+        centres /= np.linalg.norm(centres, axis=1, keepdims=True)
+        keep = min(_CANDIDATES, len(dirs))
+        m._cache["candidates"] = np.argsort(-(centres @ dirs.T), axis=1)[:, :keep]
+    return m._cache["candidates"]
+
+
+def _padded(m, ijk: np.ndarray) -> np.ndarray:
+    """Grid indices (..., 3) to the padded table's voxel number; anything off the grid lands on the padding."""
     n = int(m.grid_shape[0])
-    inside = np.all((ijk >= 0) & (ijk < n), axis=-1)
-    ids = (ijk[..., 0] * n + ijk[..., 1]) * n + ijk[..., 2]
-    if len(m) == 0:
-        return np.full(ids.shape, -1)
-    pos = np.clip(np.searchsorted(m.voxel_ids, ids), 0, len(m) - 1)
-    return np.where(inside & (m.voxel_ids[pos] == ids), pos, -1)
+    a = np.clip(ijk, -1, n) + 1
+    return (a[..., 0] * (n + 2) + a[..., 1]) * (n + 2) + a[..., 2]
 
 
 def reachable(m, positions, directions, *, interpolate: bool = False):
@@ -58,15 +104,13 @@ def reachable(m, positions, directions, *, interpolate: bool = False):
     if interpolate:
         out = _reachability(m, p, d) >= 0.5
     else:
-        bits = direction_bits(m)
         dirs = m.sphere_directions
-        k = np.argmax(d @ dirs.T, axis=1)
+        candidates = _direction_candidates(m)[_cube_cell(d)]  # the nearest direction is among them
+        k = np.take_along_axis(candidates, np.argmax(np.einsum("kcj,kj->kc", dirs[candidates], d), axis=1)[:, None],
+                               axis=1)[:, 0]
         r = 0.5 * m.voxel_size
-        ijk = np.floor((p - r * dirs[k] - m.grid_origin) / m.voxel_size).astype(np.int64)
-        rows = _rows(m, ijk)
-        out = np.zeros(len(p), dtype=bool)
-        found = rows >= 0
-        out[found] = bits[rows[found], k[found]]
+        voxel = _padded(m, np.floor((p - r * dirs[k] - m.grid_origin) / m.voxel_size).astype(np.int64))
+        out = _table(m)[voxel * len(dirs) + k]
     return bool(out[0]) if single else out
 
 
@@ -80,30 +124,36 @@ def reachability(m, positions, directions) -> np.ndarray:
 
 
 def _reachability(m, p: np.ndarray, d: np.ndarray) -> np.ndarray:
-    bits = direction_bits(m)
     dirs = m.sphere_directions
     h, r = m.voxel_size, 0.5 * m.voxel_size
-    cos = np.clip(d @ dirs.T, -1.0, 1.0)
-    nearest = np.argsort(-cos, axis=1)[:, :BLENDED_DIRECTIONS + 1]
-    angles = np.arccos(np.take_along_axis(cos, nearest, axis=1))
+    n = int(m.grid_shape[0])
+    # The BLENDED_DIRECTIONS + 1 nearest directions, nearest first: among a few candidates looked up by the
+    # direction's cell on a cube map (the nearest ones of the cell's centre, and then some).
+    candidates = _direction_candidates(m)[_cube_cell(d)]  # (K, C)
+    cos = np.einsum("kcj,kj->kc", dirs[candidates], d)
+    order = np.argsort(-cos, axis=1)[:, :BLENDED_DIRECTIONS + 1]
+    nearest = np.take_along_axis(candidates, order, axis=1)
+    near_cos = np.take_along_axis(cos, order, axis=1)
+    angles = np.arccos(np.clip(near_cos, -1.0, 1.0))
     # Weights: 1 - angle / (angle of the first direction left out), so a direction as far as that one gets 0.
     weights = np.clip(1.0 - angles[:, :-1] / np.maximum(angles[:, -1:], 1e-12), 0.0, None)
     weights /= np.maximum(weights.sum(axis=1, keepdims=True), 1e-12)
-    score = np.zeros(len(p))
-    corners = np.array([[a, b, c] for a in (0, 1) for b in (0, 1) for c in (0, 1)])
-    for j in range(nearest.shape[1] - 1):
-        k = nearest[:, j]
-        f = (p - r * dirs[k] - m.grid_origin) / h - 0.5  # fractional index of the sphere points' lattice
-        base = np.floor(f).astype(np.int64)
-        t = f - base
-        ijk = base[:, None, :] + corners[None]  # (K, 8, 3)
-        w = np.prod(np.where(corners[None] == 1, t[:, None, :], 1.0 - t[:, None, :]), axis=2)  # (K, 8)
-        rows = _rows(m, ijk)
-        hit = np.zeros(rows.shape, dtype=bool)
-        ok = rows >= 0
-        hit[ok] = bits[rows[ok], np.broadcast_to(k[:, None], rows.shape)[ok]]
-        score += weights[:, j] * np.sum(w * hit, axis=1)
-    return score
+    k = nearest[:, :-1]  # (K, B)
+    # Trilinear over the 8 points of each direction's lattice of sphere points around the position.
+    f = (p[:, None, :] - r * dirs[k] - m.grid_origin) / h - 0.5  # (K, B, 3) fractional lattice index
+    base = np.floor(f).astype(np.int64)
+    t = f - base
+    axis = [(np.clip(base[..., a], -1, n) + 1, np.clip(base[..., a] + 1, -1, n) + 1) for a in range(3)]
+    frac = [(1.0 - t[..., a], t[..., a]) for a in range(3)]
+    table = _table(m)
+    blend = np.zeros(k.shape)
+    for cx in (0, 1):
+        for cy in (0, 1):
+            for cz in (0, 1):
+                voxel = (axis[0][cx] * (n + 2) + axis[1][cy]) * (n + 2) + axis[2][cz]
+                blend += frac[0][cx] * frac[1][cy] * frac[2][cz] * table[voxel * len(dirs) + k]
+    score = np.sum(weights * blend, axis=1)
+    return np.clip(score, 0.0, 1.0)  # rounding can leave a hair above 1
 
 
 @dataclass
