@@ -8,7 +8,7 @@ them keep the CoM inside the base's support polygon. The plan is interpolated by
 ``snakehead.sim.simulate_trajectory`` (PD + support-aware gravity compensation, 2 ms control, 1 ms physics), and compared
 with ``snakehead.sim.compare``. Prints the table; writes the three figures with ``--out``.
 
-    python3 bench/sim_demo.py [--out DIR] [--kp 200] [--kd 3] [--torque-limit 10]
+    python3 bench/sim_demo.py [--out DIR] [--kp 200 --kd 3] [--torque-limit 10]   # gains default: per joint
 """
 from __future__ import annotations
 
@@ -60,11 +60,16 @@ def plan(dt: float = 0.002):
     return t, q, times, how
 
 
+def gain_text(values) -> str:
+    values = np.asarray(values, float)
+    return f"{values[0]:g}" if np.all(values == values[0]) else f"{values.min():.3g}..{values.max():.3g} (per joint)"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=None, help="directory for the figures (PNG)")
-    ap.add_argument("--kp", type=float, default=tracking.DEFAULT_KP)
-    ap.add_argument("--kd", type=float, default=tracking.DEFAULT_KD)
+    ap.add_argument("--kp", type=float, default=None, help="N m/rad, every joint (default: per joint, sim.gains)")
+    ap.add_argument("--kd", type=float, default=None, help="N m s/rad, every joint (default: per joint, sim.gains)")
     ap.add_argument("--torque-limit", type=float, default=10.0,
                     help="N m; the URDF's 3 N m cannot lift the head part (see RESULTS.md)")
     ap.add_argument("--gravity-compensation", default="supported", choices=tracking.GRAVITY_COMPENSATION)
@@ -84,7 +89,7 @@ def main() -> None:
     rep = sim.compare(robot, t, q, res, targets=[times[2], times[4]])
     print(f"simulated {res.t[-1] - res.t[0]:.1f} s in {wall:.2f} s wall "
           f"({len(res.t)} control ticks of {res.settings['control_dt'] * 1e3:.0f} ms, "
-          f"physics {res.settings['timestep'] * 1e3:.0f} ms); kp {args.kp} N m/rad, kd {args.kd} N m s/rad, "
+          f"physics {res.settings['timestep'] * 1e3:.0f} ms); kp {gain_text(res.settings['kp'])} N m/rad, kd {gain_text(res.settings['kd'])} N m s/rad, "
           f"torque limit {args.torque_limit} N m, gravity compensation {args.gravity_compensation}")
     print()
     print(f"| {'quantity':<40} | {'ours':>12} | {'paper spheres':>13} | {'paper hole':>10} |")
@@ -116,10 +121,14 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
           f"python {platform.python_version()}")
     if args.out:
-        from snakehead.viz.sim import plot_dynamics_check
+        from pathlib import Path
 
-        for p in plot_dynamics_check(robot, t, q, res, args.out, base):
-            print("wrote", p)
+        from snakehead.viz import dynamics, save
+
+        P, L = stability.momenta(robot, t, q, base)
+        for name, fig in (("sim_momenta", dynamics.plot_momenta(t, P, L, simulated=res)),
+                          ("sim_zmp", dynamics.plot_zmp(robot, t, q, base=base, simulated=res, contact="footprint"))):
+            print("wrote", save(fig, Path(args.out) / f"{name}.png"))
 
 
 if __name__ == "__main__":

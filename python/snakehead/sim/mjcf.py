@@ -9,7 +9,8 @@ moved.
 MuJoCo is an optional extra (``pip install snakehead[sim]``); it is imported only when a function here needs
 it, so ``import snakehead`` works without it.
 
-Model (:func:`build_mjcf`), generated from the robot's own data, not from the URDF importer:
+Model (:func:`build_spec`, a ``mujoco.MjSpec`` built element by element, never XML text; :func:`build_model` compiles
+it), generated from the robot's own data, not from the URDF importer:
 
 * one MuJoCo body per frame of ``robot.link_names`` (marker frames are massless bodies welded to their parent),
   nested in chain order, placed with the relative poses of ``robot.body.fk_all(0)``; a free joint on the root
@@ -25,7 +26,7 @@ Model (:func:`build_mjcf`), generated from the robot's own data, not from the UR
 * servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
   0.02 N m s/rad -- our choice, not the paper's.
 
-Controller (:func:`simulate`): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
+Controller (:func:`snakehead.sim.simulate_trajectory`, in ``tracking.py``): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
 updated (zero-order hold); the joint torque is
 
     tau = kp (q_ref - q) + kd (qdot_ref - qdot) + g_mj(q, qdot)     clipped to +-torque_limit
@@ -42,11 +43,10 @@ distal links). Gravity compensation (``gravity_compensation``):
   distal body as a cantilever from the tail, so the base pitch joints push against the ground;
 * "none": PD only.
 
-Default gains kp = 200 N m/rad, kd = 3 N m s/rad. The URDF's 3 N m effort cannot lift the head part from flat
-(joint 10 needs ~3.9 N m); pass ``torque_limit`` to raise it (bench/RESULTS.md).
+Default gains and torque limits come from each joint's load (:mod:`snakehead.sim.gains`), so they suit any robot's
+masses; the torque limit is the URDF's effort (a 3 N m servo cannot lift the default robot's head part from flat:
+joint 10 needs ~3.9 N m).
 """
-from __future__ import annotations
-
 from __future__ import annotations
 
 import math
@@ -58,6 +58,10 @@ import numpy as np
 from .._validate import finite_array, positive
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from .gains import default_torque_limits
+
+import numpy.typing as npt
+from typing import Any
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
@@ -66,15 +70,11 @@ GRAVITY = 9.80665
 DEFAULT_TIMESTEP = 0.001
 DEFAULT_CONTROL_DT = 0.002
 
-#: Default PD gains (N m/rad, N m s/rad) for every joint.
-DEFAULT_KP = 200.0
-DEFAULT_KD = 3.0
-
 _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
 
 
-def _mujoco():
+def _mujoco() -> Any:
     """Import MuJoCo lazily; ImportError naming the extra when it is missing."""
     try:
         import mujoco
@@ -86,7 +86,7 @@ def _mujoco():
 DEFAULT_HOLE_SLICES = 32
 
 
-def obstacle_boxes(obstacles, hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
+def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
     """The scene's obstacles as MuJoCo can collide them: boxes.
 
     A :class:`~snakehead.geometry.obstacles.WallWithHole` becomes the boxes of the wall around its hole, the round
@@ -133,19 +133,6 @@ def _wall_boxes(wall: WallWithHole, slices: int) -> list[BoxObstacle]:
 # ------------------------------------------------------------------------------------------------
 # model
 # ------------------------------------------------------------------------------------------------
-def _f(x: float) -> str:
-    return repr(float(x))
-
-
-def _vec(v) -> str:
-    return " ".join(_f(x) for x in np.asarray(v, float).ravel())
-
-
-def _quat(R: np.ndarray) -> str:
-    """MJCF text of the unit quaternion (w, x, y, z) of a rotation matrix."""
-    return _vec(_quat_array(R))
-
-
 def _quat_array(R: np.ndarray) -> np.ndarray:
     """(w, x, y, z) of a rotation matrix (Shepperd's method), (4,)."""
     R = np.asarray(R, float)
@@ -165,12 +152,10 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     return np.asarray(q, float)
 
 
-
-
-def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
+def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
-        lim = np.asarray(robot.body.model.effort, float)
+        lim = default_torque_limits(robot)
     else:
         lim = np.broadcast_to(finite_array(torque_limit, "torque_limit"), (n,)).astype(float) \
             if np.ndim(torque_limit) == 0 else finite_array(torque_limit, "torque_limit", (n,))
@@ -179,18 +164,40 @@ def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
     return np.array(lim, float)
 
 
-def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
-               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit=None,
+#: Names the model gives its own elements; a robot's frames and joints are checked against them.
+FREE_JOINT = "root"
+FLOOR = "floor"
+
+
+def _check_names(robot: SnakeRobot) -> None:
+    """Names go into the model as data (MjSpec attributes, never parsed), so any text is harmless; only clashes
+    with the model's own names would make a different model, and MuJoCo needs non-empty names."""
+    for kind, names in (("frame", robot.link_names), ("joint", robot.body.joint_names)):
+        for name in names:
+            if not isinstance(name, str) or not name:
+                raise ValueError(f"every {kind} of the robot needs a non-empty name, got {name!r}")
+    if FREE_JOINT in robot.body.joint_names:
+        raise ValueError(f"a joint of the robot is named {FREE_JOINT!r}, the simulation's name for the free joint "
+                         "of the root link; rename it in the URDF")
+
+
+def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
+               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
-               contact_solref: tuple = (0.005, 1.0)) -> str:
-    """MJCF text of the robot (free-floating root) on a ground plane, with optional obstacle boxes.
+               contact_solref: tuple = (0.005, 1.0)) -> Any:
+    """The MuJoCo model of the robot (free-floating root) on a ground plane with the scene's obstacles, as a
+    ``mujoco.MjSpec`` built element by element from the robot's own data (``spec.compile()`` gives the
+    ``MjModel``; ``spec.to_xml()`` its MJCF text, for reading only).
 
     Names: bodies are ``robot.link_names``; hinges ``robot.body.joint_names``; the free joint ``root``;
-    a site ``site_<frame>`` at every frame's origin (axes of the frame); actuators ``act_<joint>`` (affine:
-    force = ctrl - kp q - kd qdot, gains set by :func:`simulate`); the floor geom ``floor``; obstacle geoms
-    ``obstacle_<k>``. Units SI; ``timestep`` s, ``friction`` the sliding coefficient, ``joint_damping``
-    N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default the URDF effort).
+    a site ``site_<frame>`` at every frame's origin (axes of the frame); a geom ``box_<frame>`` per collision box;
+    actuators ``act_<joint>`` (affine: force = ctrl - kp q - kd qdot, gains set by the caller); the floor geom
+    ``floor``; obstacle geoms ``obstacle_<k>``. Names are data: characters that mean something in XML are kept
+    as they are and cannot add elements. Units SI; ``timestep`` s, ``friction`` the sliding coefficient,
+    ``joint_damping`` N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default
+    :func:`snakehead.sim.gains.default_torque_limits`: the URDF effort), ``contact_solref`` (time constant s, damping ratio) of every contact.
     """
+    mj = _mujoco()
     robot = as_robot(robot)
     timestep = positive(timestep, "timestep")
     friction = positive(friction, "friction")
@@ -203,6 +210,7 @@ def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
         raise ValueError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")
     boxes = obstacle_boxes(obstacles, hole_slices)
     lim = _torque_limits(robot, torque_limit)
+    _check_names(robot)
     n = robot.n_joints
     model = robot.body.model
     names = robot.link_names
@@ -211,56 +219,60 @@ def build_mjcf(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     axes = np.asarray(model.joint_axes, float)
     jnames = robot.body.joint_names
     lower, upper = robot.lower, robot.upper
-    conaff = 1 if self_collision else 0
+    surface = dict(solref=solref, friction=[friction, 0.005, 0.0001])  # sliding, torsional, rolling
 
-    lines = ['<mujoco model="snakehead">',
-             '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-             f'  <option timestep="{_f(timestep)}" gravity="0 0 {_f(-GRAVITY)}" integrator="implicitfast"/>',
-             '  <default>',
-             f'    <geom solref="{_vec(solref)}" friction="{_f(friction)} 0.005 0.0001"/>',
-             '  </default>',
-             '  <worldbody>',
-             '    <geom name="floor" type="plane" size="0 0 0.05" contype="0" conaffinity="1"/>']
+    spec = mj.MjSpec()
+    spec.modelname = "snakehead"
+    spec.compiler.degree = False
+    spec.compiler.inertiafromgeom = mj.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    spec.compiler.autolimits = True
+    spec.option.timestep = timestep
+    spec.option.gravity = [0.0, 0.0, -GRAVITY]
+    spec.option.integrator = mj.mjtIntegrator.mjINT_IMPLICITFAST
+    world = spec.worldbody
+    world.add_geom(name=FLOOR, type=mj.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], contype=0, conaffinity=1,
+                   **surface)
     for k, ob in enumerate(boxes):
-        lines.append(f'    <geom name="obstacle_{k}" type="box" pos="{_vec(ob.centre)}" quat="{_quat(ob.rotation)}" '
-                     f'size="{_vec(0.5 * ob.size)}" contype="0" conaffinity="1"/>')
-    depth = 0
+        world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
+                       quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
+                       conaffinity=1, **surface)
+    parent = world
     for i, name in enumerate(names):
-        ind = "    " + "  " * depth
         if i == 0:
-            lines.append(f'{ind}<body name="{name}">')
-            lines.append(f'{ind}  <freejoint name="root"/>')
+            body = parent.add_body(name=name)
+            body.add_freejoint(name=FREE_JOINT)
         else:
             rel = np.linalg.solve(F0[i - 1], F0[i])
-            lines.append(f'{ind}<body name="{name}" pos="{_vec(rel[:3, 3])}" quat="{_quat(rel[:3, :3])}">')
+            body = parent.add_body(name=name, pos=rel[:3, 3], quat=_quat_array(rel[:3, :3]))
             if i in child_of:
                 j = child_of[i]
                 if robot.body.joint_types[j] not in ("revolute", "continuous"):
-                    raise ValueError(f"joint {jnames[j]} is {robot.body.joint_types[j]}; only revolute joints are simulated")
-                rng = f' range="{_f(lower[j])} {_f(upper[j])}"' if np.isfinite(lower[j]) else ""
-                lines.append(f'{ind}  <joint name="{jnames[j]}" type="hinge" axis="{_vec(axes[j])}"{rng} '
-                             f'damping="{_f(joint_damping)}" armature="{_f(armature)}"/>')
+                    raise ValueError(f"joint {jnames[j]!r} is {robot.body.joint_types[j]}; only revolute joints "
+                                     "are simulated")
+                hinge = body.add_joint(name=jnames[j], type=mj.mjtJoint.mjJNT_HINGE, axis=axes[j],
+                                       damping=joint_damping, armature=armature)
+                if np.isfinite(lower[j]):
+                    hinge.range = [lower[j], upper[j]]
         m = float(robot.masses[i])
         if m > 0:
             I = robot.inertias[i]
-            lines.append(f'{ind}  <inertial pos="{_vec(robot.coms[i])}" mass="{_f(m)}" fullinertia="'
-                         f'{_vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>')
+            body.mass = m
+            body.ipos = robot.coms[i]
+            body.fullinertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+            body.explicitinertial = True
         if np.all(robot.box_sizes[i] > 0):
             B = robot.box_origins[i]
-            lines.append(f'{ind}  <geom name="box_{name}" type="box" size="{_vec(0.5 * robot.box_sizes[i])}" '
-                         f'pos="{_vec(B[:3, 3])}" quat="{_quat(B[:3, :3])}" contype="1" conaffinity="{conaff}"/>')
-        lines.append(f'{ind}  <site name="site_{name}"/>')
-        depth += 1
-    for d in range(depth - 1, -1, -1):
-        lines.append("    " + "  " * d + "</body>")
-    lines.append('  </worldbody>')
-    lines.append('  <actuator>')
+            body.add_geom(name=f"box_{name}", type=mj.mjtGeom.mjGEOM_BOX, size=0.5 * robot.box_sizes[i],
+                          pos=B[:3, 3], quat=_quat_array(B[:3, :3]), contype=1,
+                          conaffinity=1 if self_collision else 0, **surface)
+        body.add_site(name=f"site_{name}")
+        parent = body
     for j in range(n):
-        lines.append(f'    <general name="act_{jnames[j]}" joint="{jnames[j]}" gainprm="1" biastype="affine" '
-                     f'biasprm="0 0 0" forcerange="{_f(-lim[j])} {_f(lim[j])}"/>')
-    lines.append('  </actuator>')
-    lines.append('</mujoco>')
-    return "\n".join(lines)
+        act = spec.add_actuator(name=f"act_{jnames[j]}", target=jnames[j], trntype=mj.mjtTrn.mjTRN_JOINT)
+        act.gainprm[0] = 1.0
+        act.biastype = mj.mjtBias.mjBIAS_AFFINE
+        act.forcerange = [-lim[j], lim[j]]
+    return spec
 
 
 @dataclass
@@ -272,7 +284,7 @@ class SimModel:
     """
 
     robot: SnakeRobot
-    model: object
+    model: Any  # mujoco.MjModel
     body_ids: np.ndarray
     site_ids: np.ndarray
     qpos_adr: np.ndarray
@@ -281,8 +293,9 @@ class SimModel:
     floor_geom: int
     robot_geoms: np.ndarray
     torque_limit: np.ndarray
+    spec: object = None  #: the mujoco.MjSpec it was compiled from (``spec.to_xml()`` to read it)
 
-    def set_state(self, data, q, base: BasePlacement | None = None, lift: float = 0.0) -> None:
+    def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
         """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
         mj = _mujoco()
         T = self.robot.root_pose(base)
@@ -293,7 +306,7 @@ class SimModel:
         data.qpos[self.qpos_adr] = q
         mj.mj_forward(self.model, data)
 
-    def frames(self, data) -> np.ndarray:
+    def frames(self, data: Any) -> np.ndarray:
         """World poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics)."""
         out = np.zeros((len(self.body_ids), 4, 4))
         out[:, :3, :3] = data.xmat[self.body_ids].reshape(-1, 3, 3)
@@ -302,21 +315,27 @@ class SimModel:
         return out
 
 
-def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
-    """Compile :func:`build_mjcf` (same keyword arguments) into a :class:`SimModel`."""
+def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
+    """Compile :func:`build_spec` (same keyword arguments) into a :class:`SimModel`."""
     mj = _mujoco()
     robot = as_robot(robot)
-    xml = build_mjcf(robot, **kwargs)
-    model = mj.MjModel.from_xml_string(xml)
+    spec = build_spec(robot, **kwargs)
+    try:
+        model = spec.compile()
+    except ValueError as exc:
+        raise ValueError(f"MuJoCo could not compile the robot's model: {exc}") from None
     names = robot.link_names
-    body_ids = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, nm) for nm in names])
-    site_ids = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "site_" + nm) for nm in names])
-    jids = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT, nm) for nm in robot.body.joint_names]
+
+    def ids(kind: str, keys: Any) -> np.ndarray:
+        return np.array([mj.mj_name2id(model, kind, k) for k in keys], int)
+
+    body_ids = ids(mj.mjtObj.mjOBJ_BODY, names)
+    site_ids = ids(mj.mjtObj.mjOBJ_SITE, ["site_" + nm for nm in names])
+    jids = ids(mj.mjtObj.mjOBJ_JOINT, robot.body.joint_names)
     robot_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] != 0])
     return SimModel(robot=robot, model=model, body_ids=body_ids, site_ids=site_ids,
-                    qpos_adr=np.array([model.jnt_qposadr[j] for j in jids]),
-                    dof_adr=np.array([model.jnt_dofadr[j] for j in jids]),
+                    qpos_adr=model.jnt_qposadr[jids].copy(), dof_adr=model.jnt_dofadr[jids].copy(),
                     root_body=int(body_ids[0]),
-                    floor_geom=mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, "floor"),
+                    floor_geom=mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, FLOOR),
                     robot_geoms=robot_geoms,
-                    torque_limit=_torque_limits(robot, kwargs.get("torque_limit")))
+                    torque_limit=_torque_limits(robot, kwargs.get("torque_limit")), spec=spec)

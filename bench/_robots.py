@@ -1,0 +1,24 @@
+"""The robots the simulation benchmarks run (bench/sim_gains.py, bench/gaits.py): the default one and generated
+snakes from light and short to heavy and long, their parts marked by fixed frames p0 (base end) and b0 (neck end)."""
+from __future__ import annotations
+
+from snakehead import SnakeRobot
+from snakehead.model.generate import SnakeSpec, snake_urdf
+
+
+def generated(n_joints, module, section, mass, first_axis="yaw", head=7, neck=2) -> SnakeRobot:
+    base = n_joints - head - neck
+    urdf = snake_urdf(SnakeSpec(n_joints=n_joints, module_length=module, section=section, mass_per_module=mass,
+                                first_axis=first_axis, markers={"p0": base, "b0": base + neck}))
+    return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
+
+
+#: name: (description, builder)
+ROBOTS = {
+    "default": ("16 joints, 8.65 cm, 0.2 kg", SnakeRobot.default),
+    "twenty": ("20 joints, 7 cm, 5 cm section, 0.2 kg", lambda: generated(20, 0.07, 0.05, 0.2)),
+    "pitch_first": ("13 joints (pitch first), 10 cm, 6 cm, 0.3 kg",
+                    lambda: generated(13, 0.10, 0.06, 0.3, "pitch", head=6, neck=1)),
+    "heavy": ("30 joints, 15 cm, 8 cm, 0.5 kg", lambda: generated(30, 0.15, 0.08, 0.5)),
+    "light": ("8 joints, 5 cm, 3 cm, 0.1 kg", lambda: generated(8, 0.05, 0.03, 0.1, head=6, neck=1)),
+}

@@ -1,0 +1,283 @@
+"""Gaits in MuJoCo: run a gait (:mod:`snakehead.motion.gaits`) on the friction ground from a simulated state, and
+say where the body went, as the robot estimates it (:mod:`snakehead.sim.estimate`) and as it truly is.
+
+The building block of a closed loop: a :class:`GaitSimulator` holds one robot's MuJoCo model;
+``run(state, gait, cycles)`` continues the simulation from ``state`` for the whole run (ramp up, ``cycles`` cycles,
+ramp down, then ``rest_s`` holding the last configuration), and returns a :class:`GaitRun` whose ``state`` is where
+the next phase starts and whose ``estimate`` is the body's pose as the robot knows it (its ``base`` the
+:class:`~snakehead.model.robot.BasePlacement` a planner needs); ``truth`` is MuJoCo's, for measuring only.
+
+    simulator = GaitSimulator(robot)
+    state = simulator.lying(BasePlacement(0.0, 0.0, 0.0))
+    run = simulator.run(state, make_gait("sidewinding", direction=+1), cycles=2)
+    run.estimate.base, run.estimate_error, run.state
+
+Control: the same PD servos as :func:`snakehead.sim.simulate_trajectory` (gains derived per joint,
+:mod:`snakehead.sim.gains`), without gravity compensation (the body lies on the ground); the reference is the gait's
+joint trajectory at the 2 ms control period.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._validate import finite_float, joint_vector
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from ..motion.gaits import Gait, virtual_chassis
+from .estimate import BodyPose, BodyPoseEstimator, pose_error
+from .gains import default_gains
+from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
+from .tracking import _gains
+
+import numpy.typing as npt
+from typing import Any
+
+
+@dataclass
+class SimState:
+    """A snapshot of the simulated robot: MuJoCo's qpos and qvel, and the simulated time (s)."""
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    time: float = 0.0
+
+    def copy(self) -> "SimState":
+        return SimState(self.qpos.copy(), self.qvel.copy(), float(self.time))
+
+
+@dataclass
+class GaitRun:
+    """What a gait run did.
+
+    state: the simulated state at its end (start the next phase here); estimate / truth: the body's pose at the end
+    (:class:`~snakehead.sim.estimate.BodyPose`), estimated and true; start_truth: the true pose at the start.
+    t (T,) s, q / q_ref (T, n) rad: recorded every ``record_every`` control ticks; chassis_truth / chassis_estimate
+    (T, 3) m: the virtual chassis' origin; heading_truth / heading_estimate (T,) rad; height (T,) m: the highest
+    point of any box above the ground; contact_fraction (T,): the share of the boxes touching the ground.
+    """
+
+    gait: Gait
+    cycles: float
+    state: SimState
+    estimate: BodyPose
+    truth: BodyPose
+    start_truth: BodyPose
+    t: np.ndarray
+    q: np.ndarray
+    q_ref: np.ndarray
+    chassis_truth: np.ndarray
+    chassis_estimate: np.ndarray
+    heading_truth: np.ndarray
+    heading_estimate: np.ndarray
+    height: np.ndarray
+    contact_fraction: np.ndarray
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def estimate_error(self) -> dict:
+        """:func:`~snakehead.sim.estimate.pose_error` of the final estimate against the truth."""
+        return pose_error(self.estimate, self.truth)
+
+    @property
+    def travel(self) -> np.ndarray:
+        """The virtual chassis' true displacement (2,) m over the run, in the body's frame at the start (x along
+        the body towards the head, y to its left)."""
+        d = self.truth.chassis[:2, 3] - self.start_truth.chassis[:2, 3]
+        h = self.start_truth.heading
+        c, s = math.cos(h), math.sin(h)
+        return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+
+    @property
+    def travel_direction_deg(self) -> float:
+        """Direction of :attr:`travel` in the start body frame (deg; +90 = to the left)."""
+        return math.degrees(math.atan2(self.travel[1], self.travel[0]))
+
+    @property
+    def turn_deg(self) -> float:
+        """The true change of the body's heading over the run (deg, counter-clockwise positive; followed through
+        the run, so a turn of more than half a revolution counts in full)."""
+        return math.degrees(self.heading_truth[-1] - self.start_truth.heading)
+
+    def body_lengths_per_cycle(self, robot: SnakeRobot) -> float:
+        return float(np.linalg.norm(self.travel)) / robot.body_length / self.cycles
+
+    @property
+    def turn_deg_per_cycle(self) -> float:
+        return self.turn_deg / self.cycles
+
+
+class GaitSimulator:
+    """One robot on the friction ground in MuJoCo, ready to run gaits from any state.
+
+    kp, kd: PD gains (default: derived per joint, :func:`snakehead.sim.gains.default_gains`); imu_link: the frame
+    carrying the IMU of the pose estimate (default: mid-body); imu_yaw_drift_deg_per_s: a gyro's heading drift
+    (deg/s; the IMU reads the link's true orientation turned by drift x time about the vertical; default 0, a
+    perfect attitude); other keywords (friction, torque_limit, obstacles,
+    armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
+    """
+
+    def __init__(self, robot: SnakeRobot, *, kp: float | None = None, kd: float | None = None, imu_link: str | None = None,
+                 imu_yaw_drift_deg_per_s: float = 0.0, control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, **model_options: Any) -> None:
+        self._mj = _mujoco()
+        self.robot = as_robot(robot)
+        n = self.robot.n_joints
+        armature = model_options.get("armature", 1e-3)
+        self.sim = build_model(self.robot, timestep=timestep, **model_options)
+        if kp is None or kd is None:
+            kp_load, kd_load = default_gains(self.robot, armature=armature)
+            kp = kp_load if kp is None else kp
+            kd = kd_load if kd is None else kd
+        self.kp = _gains(kp, n, "kp", allow_zero=False)
+        self.kd = _gains(kd, n, "kd", allow_zero=True)
+        m = self.sim.model
+        m.actuator_biasprm[:, 1] = -self.kp
+        m.actuator_biasprm[:, 2] = -self.kd
+        self.substeps = int(round(control_dt / timestep))
+        if self.substeps < 1 or abs(self.substeps * timestep - control_dt) > 1e-9 * control_dt:
+            raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
+        self.control_dt = float(control_dt)
+        self.data = self._mj.MjData(m)
+        self.estimator = BodyPoseEstimator(self.robot, imu_link)
+        self.imu_yaw_drift = math.radians(finite_float(imu_yaw_drift_deg_per_s, "imu_yaw_drift_deg_per_s"))
+        self.time = 0.0  # simulated time (s) of the state in ``data``
+        self._imu_body = int(self.sim.body_ids[self.estimator.imu_index])
+        self._box_bodies = self.sim.body_ids[self.robot.boxed_links]
+
+    # --- states -------------------------------------------------------------------------------------
+    def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
+        """The robot lying at ``base`` (default placement) with joints ``q`` (default straight), settled on the
+        ground for ``settle_s`` s while its servos hold q."""
+        base = as_base(base)
+        q = np.zeros(self.robot.n_joints) if q is None else joint_vector(q, self.robot.n_joints)
+        settle_s = finite_float(settle_s, "settle_s")
+        if settle_s < 0:
+            raise ValueError(f"settle_s must be >= 0, got {settle_s!r}")
+        d = self.data
+        self.sim.set_state(d, q, base, lift=2e-4)
+        for _ in range(int(round(settle_s / self.control_dt))):
+            self._step(q, np.zeros_like(q))
+        self.time = 0.0
+        return self._snapshot(0.0)
+
+    def _snapshot(self, time: float) -> SimState:
+        return SimState(self.data.qpos.copy(), self.data.qvel.copy(), time)
+
+    def restore(self, state: SimState) -> None:
+        """Put the simulation in ``state``."""
+        if not isinstance(state, SimState):
+            raise TypeError(f"state must be a SimState (from GaitSimulator.lying or a GaitRun), got "
+                            f"{type(state).__name__}")
+        d = self.data
+        if state.qpos.shape != d.qpos.shape or state.qvel.shape != d.qvel.shape:
+            raise ValueError("state belongs to another robot's model")
+        d.qpos[:] = state.qpos
+        d.qvel[:] = state.qvel
+        self.time = float(state.time)
+        self._mj.mj_forward(self.sim.model, d)
+
+    def _step(self, q_ref: np.ndarray, qd_ref: np.ndarray) -> None:
+        """One control period; then the positions of everything (what the sensors read) for the new state."""
+        self.data.ctrl[:] = self.kp * q_ref + self.kd * qd_ref
+        self._mj.mj_step(self.sim.model, self.data, self.substeps)
+        self._mj.mj_kinematics(self.sim.model, self.data)
+
+    # --- measurements ---------------------------------------------------------------------------------
+    def joint_angles(self) -> np.ndarray:
+        """The joint angles now (the encoders)."""
+        return self.data.qpos[self.sim.qpos_adr].copy()
+
+    def imu_orientation(self) -> np.ndarray:
+        """What the IMU reads now: its link's world orientation (3, 3), turned about the vertical by the drift."""
+        R = self.data.xmat[self._imu_body].reshape(3, 3).copy()
+        if self.imu_yaw_drift:
+            a = self.imu_yaw_drift * self.time
+            c, s = math.cos(a), math.sin(a)
+            R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R
+        return R
+
+    def true_pose(self, previous: BodyPose | None = None) -> BodyPose:
+        """MuJoCo's pose of the body now (ground truth); the chassis' x-axis kept close to ``previous``'s."""
+        d = self.data
+        root = np.eye(4)
+        rb = self.sim.root_body
+        root[:3, :3] = d.xmat[rb].reshape(3, 3)
+        root[:3, 3] = d.xpos[rb]
+        points = d.xpos[self._box_bodies] + np.einsum(
+            "kij,kj->ki", d.xmat[self._box_bodies].reshape(-1, 3, 3),
+            self.robot.box_origins[self.robot.boxed_links][:, :3, 3])
+        chassis = virtual_chassis(points, None if previous is None else previous.chassis, points[-1] - points[0])
+        return BodyPose(root=root, chassis=chassis)
+
+    def _box_heights(self) -> tuple[float, float]:
+        """(highest point of any box above the ground (m), share of boxes within 3 mm of it)."""
+        d = self.data
+        R = d.geom_xmat[self.sim.robot_geoms].reshape(-1, 3, 3)
+        half = self.sim.model.geom_size[self.sim.robot_geoms]
+        reach = np.einsum("kj,kj->k", np.abs(R[:, 2, :]), half)
+        z = d.geom_xpos[self.sim.robot_geoms, 2]
+        return float((z + reach).max()), float(np.mean(z - reach < 0.003))
+
+    # --- running a gait -----------------------------------------------------------------------------------
+    def run(self, state: SimState, gait: Gait, cycles: float, *, rest_s: float = 0.5, record_every: int = 5,
+            start_estimate: BodyPose | None = None) -> GaitRun:
+        """Run ``gait`` for ``cycles`` cycles from ``state`` (see the module). The estimate starts from
+        ``start_estimate`` (default: the true pose at the start: the robot knows where it starts) and follows the
+        joint angles and the IMU from there."""
+        if not isinstance(gait, Gait):
+            raise TypeError(f"gait must be a snakehead.motion.gaits.Gait (make_gait), got {type(gait).__name__}")
+        cycles = finite_float(cycles, "cycles")
+        if cycles <= 0:
+            raise ValueError(f"cycles must be > 0, got {cycles!r}")
+        rest_s = finite_float(rest_s, "rest_s")
+        if rest_s < 0:
+            raise ValueError(f"rest_s must be >= 0, got {rest_s!r}")
+        if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
+            raise ValueError(f"record_every must be a positive integer, got {record_every!r}")
+        gait.check(self.robot)
+        self.restore(state)
+        t, q_plan = gait.trajectory(self.robot, cycles, self.control_dt)
+        n_rest = int(round(rest_s / self.control_dt))
+        q_plan = np.vstack([q_plan, np.repeat(q_plan[-1:], n_rest, axis=0)])
+        t = self.control_dt * np.arange(len(q_plan))
+        qd_plan = np.gradient(q_plan, self.control_dt, axis=0)
+        qd_plan[len(q_plan) - n_rest:] = 0.0
+
+        start_truth = truth = self.true_pose()
+        est0 = start_truth if start_estimate is None else start_estimate
+        if not isinstance(est0, BodyPose):
+            raise TypeError(f"start_estimate must be a BodyPose, got {type(est0).__name__}")
+        self.estimator.reset(self.joint_angles(), self.imu_orientation(), est0.root[:2, 3], est0.base.yaw)
+        rec = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact")}
+        for k in range(len(q_plan)):
+            self._step(q_plan[k], qd_plan[k])
+            self.time = state.time + (k + 1) * self.control_dt
+            self.estimator.update(self.joint_angles(), self.imu_orientation())
+            if k % record_every == 0 or k == len(q_plan) - 1:
+                estimate = self.estimator.pose()
+                truth = self.true_pose(truth)
+                h, c = self._box_heights()
+                rec["t"].append(self.time)
+                rec["q"].append(self.joint_angles())
+                rec["q_ref"].append(q_plan[k])
+                rec["ct"].append(truth.chassis[:3, 3])
+                rec["ce"].append(estimate.chassis[:3, 3])
+                rec["ht"].append(truth.heading)
+                rec["he"].append(estimate.heading)
+                rec["height"].append(h)
+                rec["contact"].append(c)
+            if not np.all(np.isfinite(self.data.qpos)):
+                raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {gait.name} gait")
+        end = self._snapshot(self.time)
+        arr = {k: np.asarray(v) for k, v in rec.items()}
+        # headings unwrapped from the start's, so that turns beyond half a revolution count in full
+        heading_truth = np.unwrap(np.concatenate([[start_truth.heading], arr["ht"]]))[1:]
+        heading_estimate = np.unwrap(np.concatenate([[est0.heading], arr["he"]]))[1:]
+        return GaitRun(gait=gait, cycles=float(cycles), state=end, estimate=estimate, truth=truth,
+                       start_truth=start_truth, t=arr["t"], q=arr["q"], q_ref=arr["q_ref"],
+                       chassis_truth=arr["ct"], chassis_estimate=arr["ce"], heading_truth=heading_truth,
+                       heading_estimate=heading_estimate, height=arr["height"], contact_fraction=arr["contact"],
+                       settings=dict(imu_link=self.estimator.imu_link, control_dt=self.control_dt,
+                                     imu_yaw_drift_deg_per_s=math.degrees(self.imu_yaw_drift),
+                                     rest_s=float(rest_s), kp=self.kp.tolist(), kd=self.kd.tolist()))
