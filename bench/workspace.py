@@ -37,7 +37,6 @@ import numpy as np
 from snakehead import SnakeRobot, TracIK, default_robot_file
 from snakehead.app.report import cpu_name
 from snakehead.kinematics import base_placement as bp
-from snakehead.kinematics import map_queries as mq
 from snakehead.kinematics import workspace as ws
 
 ROBOT_FILES = {"head": "snake16.toml", "head6": "snake16_head6.toml"}  # beside the default robot

@@ -19,11 +19,17 @@ So any robot whose model gives B0 for a neck configuration works here; nothing e
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import joint_vector, position_direction_pairs
 from .map_queries import direction_bits
+
+if TYPE_CHECKING:
+    from ..model.robot import BasePlacement, SnakeRobot
+    from .workspace import ReachabilityMap
 
 
 @dataclass
@@ -41,14 +47,15 @@ class PlacementCandidates:
     def __len__(self) -> int:
         return len(self.index)
 
-    def placements(self):
+    def placements(self) -> list[BasePlacement]:
         """The candidates as :class:`~snakehead.model.robot.BasePlacement` objects."""
         from ..model.robot import BasePlacement
 
         return [BasePlacement(float(a), float(b), float(c)) for a, b, c in zip(self.x, self.y, self.yaw)]
 
 
-def neck_frames(robot, base_configuration=None, samples: int = 7) -> tuple[np.ndarray, np.ndarray]:
+def neck_frames(robot: SnakeRobot, base_configuration: npt.ArrayLike | None = None, samples: int = 7
+                ) -> tuple[np.ndarray, np.ndarray]:
     """B0's world poses (J, 4, 4) with the base at the origin placement (x = y = yaw = 0), for a grid of
     ``samples`` values per neck joint within its limits, and those neck joint values (J, n_neck).
 
@@ -73,7 +80,8 @@ def neck_frames(robot, base_configuration=None, samples: int = 7) -> tuple[np.nd
     return frames, grid
 
 
-def placements_from_frames(workspace_map, frames, neck_q, position, direction, *, yaw_samples: int = 72,
+def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike, neck_q: npt.ArrayLike,
+                           position: npt.ArrayLike, direction: npt.ArrayLike, *, yaw_samples: int = 72,
                            min_index: float = 0.0, limit: int = 20) -> PlacementCandidates:
     """Base placements (planar moves of the origin placement) that put one of ``frames`` (J, 4, 4), B0's poses at
     the origin placement, where the map (in B0's frame) reaches the target ``position``, ``direction`` (world).
@@ -89,6 +97,7 @@ def placements_from_frames(workspace_map, frames, neck_q, position, direction, *
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
     frames = np.asarray(frames, dtype=float)
+    neck_q = np.asarray(neck_q, dtype=float)
     if frames.ndim != 3 or frames.shape[1:] != (4, 4) or len(frames) != len(neck_q):
         raise ValueError("frames must be (J, 4, 4), one per row of neck_q")
     p, d = p[0], d[0]
@@ -96,7 +105,7 @@ def placements_from_frames(workspace_map, frames, neck_q, position, direction, *
     bits = direction_bits(m)
     index = np.where(m.indices >= float(min_index) - 1e-9, m.indices, -1.0)
     dirs = m.sphere_directions
-    h, r = m.voxel_size, 0.5 * m.voxel_size
+    r = 0.5 * m.voxel_size
     yaws = 2.0 * np.pi * np.arange(int(yaw_samples)) / int(yaw_samples)
     c, s = np.cos(yaws), np.sin(yaws)
     # The target direction with the placement's yaw undone: Rz(-yaw) d, (Y, 3).
@@ -121,7 +130,7 @@ def placements_from_frames(workspace_map, frames, neck_q, position, direction, *
                 best.append((index[v], -abs(offset[v]), j, y, v, a))
     if not best:
         empty = np.zeros((0, 3))
-        return PlacementCandidates(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros((0, np.shape(neck_q)[1])),
+        return PlacementCandidates(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros((0, neck_q.shape[1])),
                                    np.zeros(0), empty, empty)
     best.sort(key=lambda e: (-e[0], -e[1], e[2], e[3]))
     best = best[:int(limit)]
@@ -133,12 +142,14 @@ def placements_from_frames(workspace_map, frames, neck_q, position, direction, *
     x = p[0] - (cy * world_a[:, 0] - sy * world_a[:, 1])
     y = p[1] - (sy * world_a[:, 0] + cy * world_a[:, 1])
     return PlacementCandidates(x=x, y=y, yaw=np.remainder(yaws[ys] + np.pi, 2 * np.pi) - np.pi,
-                               neck_q=np.asarray(neck_q)[js], index=np.array([e[0] for e in best]),
+                               neck_q=neck_q[js], index=np.array([e[0] for e in best]),
                                target_in_b0=a, direction_in_b0=np.einsum("nji,nj->ni", frames[js, :3, :3], d_unyawed[ys]))
 
 
-def base_placements(robot, workspace_map, position, direction, *, base_configuration=None, neck_samples: int = 7,
-                    yaw_samples: int = 72, min_index: float = 0.0, limit: int = 20) -> PlacementCandidates:
+def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position: npt.ArrayLike,
+                    direction: npt.ArrayLike, *, base_configuration: npt.ArrayLike | None = None,
+                    neck_samples: int = 7, yaw_samples: int = 72, min_index: float = 0.0, limit: int = 20
+                    ) -> PlacementCandidates:
     """Candidate placements of ``robot``'s base on the ground from which its head reaches ``position`` (3,) m,
     pointing along ``direction`` (3,) (world), by the head's reachability map: best index first.
 

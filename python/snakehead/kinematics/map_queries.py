@@ -18,28 +18,33 @@ Everything is numpy; the map's frame is the chain's base frame. Placing a robot'
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import finite_float, position_direction_pairs as _poses
+
+if TYPE_CHECKING:
+    from .workspace import ReachabilityMap
 
 #: Directions blended by :func:`reachability`.
 BLENDED_DIRECTIONS = 3
 
 
-def direction_bits(m) -> np.ndarray:
+def direction_bits(m: ReachabilityMap) -> np.ndarray:
     """(M, N) bool: direction k of voxel v was reached with some roll (its units OR-ed over the rolls when
     every roll counted on its own). Cached on the map."""
     if "direction_bits" not in m._cache:
         units = m.reached_units()
         n = int(m.params["directions"])
         if units.shape[1] != n:  # each roll counted: units are (direction, roll) frames, direction-major
-            units = units.reshape(len(m), n, -1).any(axis=2)
+            units = np.asarray(units.reshape(len(m), n, -1).any(axis=2))
         m._cache["direction_bits"] = units
     return m._cache["direction_bits"]
 
 
-def _table(m) -> np.ndarray:
+def _table(m: ReachabilityMap) -> np.ndarray:
     """The direction bits of every grid voxel, in a dense flat table over the grid padded by one voxel on each
     side (False there and outside the map's voxels): a lookup is one array access (cached on the map)."""
     if "table" not in m._cache:
@@ -64,11 +69,15 @@ def _cube_cell(d: np.ndarray) -> np.ndarray:
     big = np.abs(d[rows, major])
     u = d[rows, (major + 1) % 3] / big
     v = d[rows, (major + 2) % 3] / big
-    cell = lambda x: np.clip(((x + 1.0) * 0.5 * _CUBE_CELLS).astype(np.int64), 0, _CUBE_CELLS - 1)  # noqa: E731
-    return (face * _CUBE_CELLS + cell(u)) * _CUBE_CELLS + cell(v)
+    return (face * _CUBE_CELLS + _cell(u)) * _CUBE_CELLS + _cell(v)
 
 
-def _direction_candidates(m) -> np.ndarray:
+def _cell(x: np.ndarray) -> np.ndarray:
+    """The cell of each coordinate in [-1, 1] along a cube face's edge."""
+    return np.clip(((x + 1.0) * 0.5 * _CUBE_CELLS).astype(np.int64), 0, _CUBE_CELLS - 1)
+
+
+def _direction_candidates(m: ReachabilityMap) -> np.ndarray:
     """(6 * cells^2, C): for each cube-map cell, the map's directions nearest its centre (cached on the map). A
     cell spans under 3 degrees; the map's directions are tens of degrees apart, so the few nearest to any
     direction in the cell are among them."""
@@ -76,27 +85,28 @@ def _direction_candidates(m) -> np.ndarray:
         dirs = m.sphere_directions
         g = (np.arange(_CUBE_CELLS) + 0.5) / _CUBE_CELLS * 2.0 - 1.0
         u, v = np.meshgrid(g, g, indexing="ij")
-        centres = []
+        faces = []
         for face in range(6):
             major, sign = face // 2, -1.0 if face % 2 else 1.0
             c = np.zeros((_CUBE_CELLS, _CUBE_CELLS, 3))
             c[..., major], c[..., (major + 1) % 3], c[..., (major + 2) % 3] = sign, u, v
-            centres.append(c.reshape(-1, 3))
-        centres = np.concatenate(centres)
+            faces.append(c.reshape(-1, 3))
+        centres = np.concatenate(faces)
         centres /= np.linalg.norm(centres, axis=1, keepdims=True)
         keep = min(_CANDIDATES, len(dirs))
         m._cache["candidates"] = np.argsort(-(centres @ dirs.T), axis=1)[:, :keep]
     return m._cache["candidates"]
 
 
-def _padded(m, ijk: np.ndarray) -> np.ndarray:
+def _padded(m: ReachabilityMap, ijk: np.ndarray) -> np.ndarray:
     """Grid indices (..., 3) to the padded table's voxel number; anything off the grid lands on the padding."""
     n = int(m.grid_shape[0])
     a = np.clip(ijk, -1, n) + 1
     return (a[..., 0] * (n + 2) + a[..., 1]) * (n + 2) + a[..., 2]
 
 
-def reachable(m, positions, directions, *, interpolate: bool = False):
+def reachable(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.ArrayLike, *,
+              interpolate: bool = False) -> np.ndarray | bool:
     """Whether each pose is reachable by the map (see the module's doc). positions, directions: (3,) or (K, 3);
     a bool for one pose, else (K,) bools. ``interpolate``: :func:`reachability` >= 1/2 instead of the nearest
     sample."""
@@ -114,7 +124,7 @@ def reachable(m, positions, directions, *, interpolate: bool = False):
     return bool(out[0]) if single else out
 
 
-def reachability(m, positions, directions) -> np.ndarray:
+def reachability(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.ArrayLike) -> np.ndarray | float:
     """A score in [0, 1] per pose: the map's reached/not-reached samples around it, blended trilinearly over the
     8 voxels whose sphere points surround the position, and over the BLENDED_DIRECTIONS nearest directions
     (weights falling linearly with the angle to zero at the next direction's). Voxels outside the map count 0."""
@@ -123,7 +133,7 @@ def reachability(m, positions, directions) -> np.ndarray:
     return float(s[0]) if single else s
 
 
-def _reachability(m, p: np.ndarray, d: np.ndarray) -> np.ndarray:
+def _reachability(m: ReachabilityMap, p: np.ndarray, d: np.ndarray) -> np.ndarray:
     dirs = m.sphere_directions
     h, r = m.voxel_size, 0.5 * m.voxel_size
     n = int(m.grid_shape[0])
@@ -193,8 +203,8 @@ def _turn_about(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
-def inverse(m, position, direction, *, rolls: int = 8, min_index: float = 0.0, limit: int | None = 200
-            ) -> BaseFrameCandidates:
+def inverse(m: ReachabilityMap, position: npt.ArrayLike, direction: npt.ArrayLike, *, rolls: int = 8,
+            min_index: float = 0.0, limit: int | None = 200) -> BaseFrameCandidates:
     """Inverse reachability: poses of the map's base frame in the world from which the head reaches the target
     (``position`` (3,) m, ``direction`` (3,), world), ranked by the index of the voxel holding the target.
 

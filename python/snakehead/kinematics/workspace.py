@@ -36,6 +36,7 @@ from ..model.chain import Chain
 
 if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
+    from .map_queries import BaseFrameCandidates
 
 import numpy.typing as npt
 
@@ -148,7 +149,7 @@ class ReachabilityMap:
 
         return reachable(self, positions, directions, interpolate=interpolate)
 
-    def inverse(self, position: npt.ArrayLike, direction: npt.ArrayLike, **options: Any):
+    def inverse(self, position: npt.ArrayLike, direction: npt.ArrayLike, **options: Any) -> BaseFrameCandidates:
         """Candidate poses of the map's base frame (B0) from which the head reaches a target; see
         ``map_queries.inverse``."""
         from .map_queries import inverse
