@@ -249,8 +249,11 @@ def test_old_map_loads_and_says_what_it_lacks(robot, tmp_path):
 
 def test_boundary_holds_the_deep_interior_and_leaves_empty_space_out(robot):
     # The paper's boundary(P) against the convex hull of the same cloud: fewer voxels, all among the hull's; every
-    # voxel 0.1 m or more inside the hull is kept; none is kept that no sample comes near (a point inside a
-    # tetrahedron of circumradius <= alpha is within 2 alpha of one of its vertices, which are samples).
+    # voxel 0.1 m or more inside the hull where the cloud is dense is kept (the hull's interior also holds a few
+    # voxels near the head's own base that the tip hardly reaches, which the boundary leaves out); none is kept that
+    # no sample comes near: a point x of a tetrahedron (vertices v_i, samples) whose circumsphere (centre c,
+    # radius rho <= alpha) holds it is within rho of a vertex, since x - c = sum l_i (v_i - c) with l_i >= 0 summing
+    # to 1 gives (x - c).(v_i - c) >= |x - c|^2 for some i, so |x - v_i|^2 <= rho^2 - |x - c|^2.
     from scipy.spatial import cKDTree
 
     from snakehead import _core
@@ -263,12 +266,14 @@ def test_boundary_holds_the_deep_interior_and_leaves_empty_space_out(robot):
     cloud = _core.sample_tip_positions(robot.head_chain.model, kw["cloud_samples"], kw["seed"])
     hull = _core.convex_hull(cloud)
     depth = -(convex.centers @ hull["normals"].T + hull["offsets"]).max(axis=1)  # distance inside the hull
-    deep = convex.voxel_ids[depth >= 0.1]
-    assert len(deep) > 100 and set(deep) <= set(boundary.voxel_ids)
+    tree = cKDTree(cloud)
+    dense = np.array([len(near) >= 10 for near in tree.query_ball_point(convex.centers, kw["voxel"])])
+    deep = convex.voxel_ids[(depth >= 0.1) & dense]
+    assert len(deep) > 1000 and set(deep) <= set(boundary.voxel_ids)
     alpha = boundary.stats["alpha"]
     assert 0 < alpha < 0.2 and convex.stats["alpha"] == np.inf
-    gap = cKDTree(cloud).query(convex.centers)[0]
-    lonely = convex.voxel_ids[gap > 2 * alpha]
+    gap = tree.query(convex.centers)[0]
+    lonely = convex.voxel_ids[gap > alpha]
     assert len(lonely) > 0 and not set(lonely) & set(boundary.voxel_ids)
     # MATLAB's shrink factor: 1 is the tightest one-region boundary, 0 the hull of all tetrahedra.
     tight = _core.boundary(cloud, 1.0)
