@@ -43,19 +43,22 @@ def frames_at(points, directions):
 def test_reachable_answers_the_maps_own_samples(small):
     points, dirs, bits = samples(small)
     assert 0.2 < bits.mean() < 0.8
-    np.testing.assert_array_equal(small.reachable(points, dirs), bits)
+    np.testing.assert_array_equal(small.reachable(points, dirs, interpolate=False), bits)
     # Slightly off the samples (less than half the spacing of positions and directions): the same answers.
     rng = np.random.default_rng(1)
     jitter = rng.uniform(-0.2, 0.2, points.shape) * small.voxel_size
     tilt = dirs + 0.1 * rng.normal(size=dirs.shape)
     near = np.argmax((tilt / np.linalg.norm(tilt, axis=1, keepdims=True)) @ small.sphere_directions.T, axis=1)
     same = near == np.tile(np.arange(len(small.sphere_directions)), len(small))
-    np.testing.assert_array_equal(small.reachable(points + jitter, tilt * 3.0)[same], bits[same])
+    np.testing.assert_array_equal(small.reachable(points + jitter, tilt * 3.0, interpolate=False)[same], bits[same])
     # One pose in, one bool out; directions need not be unit.
     k = int(np.argmax(bits))
-    assert small.reachable(points[k], 2.5 * dirs[k]) is True
+    assert small.reachable(points[k], 2.5 * dirs[k], interpolate=False) is True
+    assert isinstance(small.reachable(points[k], dirs[k]), bool)
     # Outside the map's voxels nothing is reachable.
-    assert not small.reachable([[5.0, 0.0, 0.0], [0.0, -3.0, 1.0]], [[1.0, 0, 0], [0, 0, 1.0]]).any()
+    for interpolate in (False, True):
+        assert not small.reachable([[5.0, 0.0, 0.0], [0.0, -3.0, 1.0]], [[1.0, 0, 0], [0, 0, 1.0]],
+                                   interpolate=interpolate).any()
 
 
 def test_interpolated_reachability(small):
@@ -63,7 +66,7 @@ def test_interpolated_reachability(small):
     score = mq.reachability(small, points, dirs)
     assert score.shape == bits.shape and score.min() >= 0.0 and score.max() <= 1.0
     # At the samples the blend leans on the sample itself: it mostly agrees with it.
-    agree = np.mean(small.reachable(points, dirs, interpolate=True) == bits)
+    agree = np.mean(small.reachable(points, dirs) == bits)
     assert agree > 0.85
     assert np.mean(score[bits]) > 0.6 > 0.4 > np.mean(score[~bits])
 
@@ -156,7 +159,7 @@ def check_placements(robot, m, position, direction, c, q_base):
         np.testing.assert_allclose(np.linalg.solve(B0, np.r_[position, 1.0])[:3], a, atol=1e-9)
         np.testing.assert_allclose(B0[:3, :3].T @ direction, d, atol=1e-9)
         local.append(np.linalg.solve(B0, ws.approach_frame(position, direction)))
-    assert np.all(m.reachable(c.target_in_b0, c.direction_in_b0))
+    assert np.all(m.reachable(c.target_in_b0, c.direction_in_b0, interpolate=False))  # the samples they come from
     _, ok = ik.ik_many(np.array(local))
     return ok.mean()
 

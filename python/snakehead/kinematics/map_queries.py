@@ -3,10 +3,11 @@
 * :func:`reachable`: can the head's tip be at a position, pointing along a direction (its roll free)?
   The map tried, for each voxel, N directions at the points of its inscribed sphere: the pose
   (``c_v + r d_k``, ``d_k``) for voxel centre ``c_v``, sphere radius ``r`` (half a voxel) and direction ``d_k``.
-  A query (p, d) is answered by the nearest of those poses: the direction ``d_k`` nearest d, and the voxel
-  whose sphere point in that direction is nearest p (the voxel holding ``p - r d_k``). :func:`reachability`
-  blends the neighbouring poses instead (trilinear over the voxels, weighted over the nearest directions), a
-  score in [0, 1]; ``reachable(..., interpolate=True)`` thresholds it at 1/2.
+  :func:`reachability` blends the map's samples around a query (p, d): trilinearly over the 8 voxels whose sphere
+  points in a direction surround p, weighted over the directions nearest d; a score in [0, 1], which
+  :func:`reachable` thresholds at 1/2 (the default: it agrees best with TRAC-IK, ``bench/RESULTS.md``). With
+  ``interpolate=False`` the nearest sample answers: the direction ``d_k`` nearest d, and the voxel whose sphere
+  point in that direction is nearest p (the voxel holding ``p - r d_k``).
 * :func:`inverse`: inverse reachability. For a target (position, direction) of the head in the world, the
   poses of the map's base frame (for the head, B0 = ``neck_end``) from which one of the map's reached poses is
   the target, ranked by the map's index of their voxel. Each reached (voxel, direction) gives one such pose up
@@ -106,10 +107,10 @@ def _padded(m: ReachabilityMap, ijk: np.ndarray) -> np.ndarray:
 
 
 def reachable(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.ArrayLike, *,
-              interpolate: bool = False) -> np.ndarray | bool:
+              interpolate: bool = True) -> np.ndarray | bool:
     """Whether each pose is reachable by the map (see the module's doc). positions, directions: (3,) or (K, 3);
-    a bool for one pose, else (K,) bools. ``interpolate``: :func:`reachability` >= 1/2 instead of the nearest
-    sample."""
+    a bool for one pose, else (K,) bools. ``interpolate``: :func:`reachability` >= 1/2 (default), else the
+    nearest sample."""
     p, d, single = _poses(positions, directions)
     if interpolate:
         out = _reachability(m, p, d) >= 0.5

@@ -139,12 +139,13 @@ class ReachabilityMap:
         return np.unpackbits(self.reached, axis=1, count=self.tried, bitorder="little").astype(bool)
 
     def reachable(self, positions: npt.ArrayLike, directions: npt.ArrayLike, *,
-                  interpolate: bool = False) -> np.ndarray | bool:
+                  interpolate: bool = True) -> np.ndarray | bool:
         """Whether the head's tip can be at each position pointing along each direction (any roll), by the map.
 
         positions, directions: (3,) or (K, 3) in the map's base frame (directions need not be unit); returns a
-        bool, or (K,) bools. Nearest voxel and direction by default; ``interpolate`` blends the neighbouring
-        voxels and directions (``map_queries.reachability``). See ``map_queries.py``."""
+        bool, or (K,) bools. By default the neighbouring voxels and directions are blended
+        (``map_queries.reachability``); ``interpolate=False``: the nearest voxel and direction. See
+        ``map_queries.py``."""
         from .map_queries import reachable
 
         return reachable(self, positions, directions, interpolate=interpolate)
