@@ -184,6 +184,8 @@ class _Waypoints:
         self.stops: list[int] = []  # waypoints where the motion comes to rest
         self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
         self.timing_failure: str | None = None  # why the path could not be timed, when it could not
+        self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
+        self.lift_cache: dict | None = None  # timed lifts, kept by the controller
 
     def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs = [label], [np.asarray(q, float)]
@@ -294,9 +296,25 @@ class _Waypoints:
         hold_s = np.zeros(len(self.qs) - 1)
         for k, seconds in self.holds.items():
             hold_s[k] = seconds
+        Q = np.array(self.qs)
+        stops = sorted(set(self.stops))
         try:
-            traj = retime(self.robot, np.array(self.qs), self.base, hold_s=hold_s, stops=sorted(set(self.stops)),
-                          **timing)
+            k = self.lift_index if self.lift_index is not None else -1
+            if 0 < k < len(Q) - 1 and self.lift_cache is not None:
+                # the lift from the bending state is the same for every target from this base: time it once
+                key = (self.base, Q[:k + 1].tobytes(), repr(sorted(timing.items())))
+                lift = self.lift_cache.get(key)
+                if lift is None:
+                    lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
+                                  stops=[i for i in stops if i <= k], **timing)
+                    if len(self.lift_cache) > 16:
+                        self.lift_cache.clear()
+                    self.lift_cache[key] = lift
+                rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
+                              **timing)
+                traj = _concatenate(lift, rest)
+            else:
+                traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
         except ValueError as exc:
             if any(key in str(exc) for key in timing):  # a bad option of the caller's, not the path's fault
                 raise
@@ -310,6 +328,29 @@ class _Waypoints:
         self.times = [float(x) for x in traj.waypoint_times]
         notes += list(traj.notes)
         return traj
+
+
+def _concatenate(a: Any, b: Any) -> Any:
+    """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
+    first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
+    first."""
+    from .timing import RetimedTrajectory
+
+    offset = float(a.t[-1])
+    dt = float(a.t[1] - a.t[0]) if len(a.t) > 1 else interp.CONTROL_PERIOD
+    t = interp.sample_times(0.0, offset + float(b.t[-1]), dt)
+    first = t <= offset
+    arrays = []
+    for nu in (0, 1, 2):
+        x = np.empty((len(t), a.q.shape[1]))
+        x[first] = a.spline(t[first], nu)
+        x[~first] = b.spline(t[~first] - offset, nu)
+        arrays.append(x)
+    arrays[0][-1] = b.q[-1]
+    return RetimedTrajectory(t, arrays[0], arrays[1], arrays[2], None,
+                             waypoint_times=np.concatenate([a.waypoint_times, b.waypoint_times[1:] + offset]),
+                             limits=b.limits, check=None, notes=tuple(a.notes) + tuple(b.notes),
+                             solve_time_s=b.solve_time_s)
 
 
 def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
@@ -564,6 +605,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
             robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
         way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
+        way.lift_cache = controller.__dict__.setdefault("_timed_lifts", {})
     else:
         q = way.qs[-1]
     results: list[TargetResult] = []
