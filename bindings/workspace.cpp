@@ -24,8 +24,8 @@ py::array_t<T> to_array(const std::vector<T>& v) {
 }
 
 // Runs `fn` without the GIL; the progress callback takes it back only while it runs Python. An
-// exception raised by the callback (KeyboardInterrupt from tqdm's loop, say) stops the sweep and
-// is re-raised here.
+// exception raised by the callback (KeyboardInterrupt from tqdm's loop, say), or by the truth test of
+// what it returned, stops the sweep and is re-raised here. A false result cancels: _core.Cancelled.
 template <class Fn>
 auto without_gil(const py::object& progress, Fn fn) {
   ProgressCallback cb;
@@ -34,7 +34,10 @@ auto without_gil(const py::object& progress, Fn fn) {
       py::gil_scoped_acquire gil;
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
       py::object r = progress(done, total);
-      return r.is_none() || r.cast<bool>();
+      if (r.is_none()) return true;
+      const int go_on = PyObject_IsTrue(r.ptr());  // Python's truth (numpy's bool_, 0/1, ...)
+      if (go_on < 0) throw py::error_already_set();
+      return go_on == 1;
     };
   }
   py::gil_scoped_release release;

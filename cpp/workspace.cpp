@@ -21,6 +21,7 @@ extern "C" {
 
 #include "snakehead/alpha_shape.hpp"
 #include "snakehead/kinematics.hpp"
+#include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
 #include "snakehead/trac_ik.hpp"
 
@@ -206,20 +207,28 @@ HullKind parse_hull_kind(const std::string& s) {
 const char* hull_kind_name(HullKind h) { return h == HullKind::Boundary ? "boundary" : "convex"; }
 
 void WorkspaceOptions::validate() const {
+  // Upper limits (limits.hpp) keep every buffer a sweep allocates, and the clock deadline of each IK call,
+  // within reach: a number beyond one is a mistake, reported before any work.
+  auto count_in = [](const char* field, long long value, long long least, long long most, const char* hint = "") {
+    if (value < least || value > most)
+      throw InputError(std::string(field) + " must be between " + std::to_string(least) + " and " +
+                       std::to_string(most) + hint + ", got " + std::to_string(value));
+  };
   if (!(std::isfinite(voxel_size) && voxel_size > 0))
-    throw InputError("voxel size must be a positive number of metres, got " + std::to_string(voxel_size));
-  if (directions < 1) throw InputError("directions must be at least 1, got " + std::to_string(directions));
-  if (!free_roll && rolls < 1) throw InputError("rolls must be at least 1 (or use free roll), got " + std::to_string(rolls));
-  if (!(std::isfinite(timeout) && timeout > 0))
-    throw InputError("timeout must be a positive number of seconds, got " + std::to_string(timeout));
+    throw InputError("voxel size must be a positive number of metres, got " + number_text(voxel_size));
+  count_in("directions", directions, 1, limits::kMaxDirections);
+  if (!free_roll) {
+    count_in("rolls", rolls, 1, limits::kMaxRolls, " (or use free roll)");
+    count_in("directions x rolls (frames per voxel)", static_cast<long long>(directions) * rolls, 1,
+             limits::kMaxFramesPerVoxel);
+  }
+  check_timeout(timeout, "timeout");
   if (!(std::isfinite(epsilon) && epsilon > 0))
-    throw InputError("epsilon must be positive, got " + std::to_string(epsilon));
-  if (cloud_samples < 100)
-    throw InputError("cloud_samples must be at least 100 (the hull needs a cloud), got " +
-                     std::to_string(cloud_samples));
+    throw InputError("epsilon must be positive, got " + number_text(epsilon));
+  count_in("cloud_samples", cloud_samples, 100, limits::kMaxCloudSamples, " (the hull needs a cloud)");
   if (!(shrink >= 0.0 && shrink <= 1.0))
-    throw InputError("shrink (the boundary's shrink factor) must be within [0, 1], got " + std::to_string(shrink));
-  if (threads < 0) throw InputError("threads must be >= 0 (0 = all cores), got " + std::to_string(threads));
+    throw InputError("shrink (the boundary's shrink factor) must be within [0, 1], got " + number_text(shrink));
+  count_in("threads", threads, 0, limits::kMaxThreads, " (0 = all cores)");
   if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
     throw InputError("shard must be i/N with 0 <= i < N, got " + std::to_string(shard_index) + "/" +
                      std::to_string(shard_count));
@@ -229,7 +238,11 @@ VoxelGrid VoxelGrid::around(const Eigen::Vector3d& centre, double side, double v
   if (!(std::isfinite(voxel) && voxel > 0)) throw InputError("voxel size must be positive");
   if (!(std::isfinite(side) && side > 0)) throw InputError("grid side must be positive");
   const double cells = std::ceil(side / voxel - 1e-9);
-  if (cells > 2000) throw InputError("voxel size too small for the grid: more than 2000 voxels per axis");
+  if (!(cells <= limits::kMaxVoxelsPerAxis))
+    throw InputError("voxel size " + number_text(voxel) + " m is too small for the grid of side " + number_text(side) +
+                     " m: " + number_text(cells) + " voxels per axis, at most " +
+                     std::to_string(limits::kMaxVoxelsPerAxis) + " (voxel size >= " +
+                     number_text(side / limits::kMaxVoxelsPerAxis) + " m)");
   VoxelGrid g;
   g.n = std::max(1, static_cast<int>(cells));
   g.voxel = voxel;
@@ -296,7 +309,9 @@ bool ConvexHull::contains(const Eigen::Vector3d& p, double tolerance) const {
 }
 
 std::vector<Eigen::Vector3d> fibonacci_directions(int n) {
-  if (n < 1) throw InputError("directions must be at least 1, got " + std::to_string(n));
+  if (n < 1 || n > limits::kMaxDirections)
+    throw InputError("directions must be between 1 and " + std::to_string(limits::kMaxDirections) + ", got " +
+                     std::to_string(n));
   // Points at equal-area heights z_k = 1 - (2k + 1) / n, turned by the golden angle each step.
   const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
   std::vector<Eigen::Vector3d> d(n);
@@ -337,7 +352,9 @@ Eigen::Isometry3d approach_frame(const Eigen::Vector3d& point, const Eigen::Vect
 }
 
 std::vector<Eigen::Vector3d> sample_tip_positions(const ChainModel& model, int samples, std::uint64_t seed) {
-  if (samples < 1) throw InputError("samples must be at least 1");
+  if (samples < 1 || samples > limits::kMaxCloudSamples)
+    throw InputError("samples must be between 1 and " + std::to_string(limits::kMaxCloudSamples) + ", got " +
+                     std::to_string(samples));
   std::mt19937_64 rng(stream_seed(seed, kCloudSalt, 0));
   std::vector<Eigen::Vector3d> pts(samples);
   for (int k = 0; k < samples; ++k) pts[k] = forward_kinematics(model, random_configuration(model, rng)).translation();

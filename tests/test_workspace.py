@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
+import sysconfig
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -32,11 +32,11 @@ DATA = Path(__file__).resolve().parent / "data"
 
 
 def workspace_gen() -> str:
-    """The workspace_gen installed with this Python's snakehead (beside its interpreter), else the one on PATH."""
-    here = Path(sys.executable).with_name("workspace_gen")
-    exe = str(here) if here.is_file() else shutil.which("workspace_gen")
-    assert exe, "workspace_gen is not on PATH (the wheel installs it)"
-    return exe
+    """The workspace_gen installed with this interpreter's snakehead (PATH may lead to another install)."""
+    exe = Path(sysconfig.get_path("scripts")) / "workspace_gen"
+    found = str(exe) if exe.exists() else shutil.which("workspace_gen")
+    assert found, "workspace_gen is not installed (the wheel installs it)"
+    return found
 
 
 def gen_args(robot, out, **kw):

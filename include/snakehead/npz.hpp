@@ -11,6 +11,10 @@ namespace snakehead {
 // CRC-32 (IEEE 802.3, the zip checksum) of `size` bytes, continuing from `crc` (0 to start).
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 
+// Throws std::runtime_error unless a file can be written at `path` by NpzWriter::write: its directory takes
+// new files, and `path` does not exist or is a regular file. (Tried by creating and removing a file there.)
+void check_output_path(const std::string& path);
+
 class NpzWriter {
  public:
   // Arrays in C order; `shape` empty for a 0-d array (a scalar).
@@ -26,6 +30,9 @@ class NpzWriter {
   void add_string(const std::string& name, const std::string& utf8);
 
   // The zip file's bytes, and writing them (throws std::runtime_error when the file cannot be written).
+  // The file is written under a temporary name in the same directory and renamed over `path`, so a failed
+  // write leaves an existing file intact and no partial file. (A process that does not ignore SIGXFSZ is
+  // killed by a write beyond its file-size limit before it can clean up: ignore it, as Python does.)
   std::string bytes() const;
   void write(const std::string& path) const;
 

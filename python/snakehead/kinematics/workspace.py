@@ -473,10 +473,7 @@ def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str])
         raise ValueError("urdf must be a path or an XML string")
     if source.lstrip().startswith("<"):
         return source
-    try:
-        return Path(source).read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
+    return _core.read_urdf_file(source)  # ValueError unless a regular file of bounded size, as Chain.from_urdf
 
 
 def _bar(progress: bool, total: int, unit: str) -> Any:
