@@ -123,6 +123,10 @@ void NpzWriter::add_u64(const std::string& name, const std::vector<std::uint64_t
                         std::vector<std::int64_t> shape) {
   add_raw(name, "<u8", shape, data.data(), checked_count(data, shape, name));
 }
+void NpzWriter::add_u8(const std::string& name, const std::vector<std::uint8_t>& data,
+                       std::vector<std::int64_t> shape) {
+  add_raw(name, "|u1", shape, data.data(), checked_count(data, shape, name));
+}
 void NpzWriter::add_bool(const std::string& name, bool value) {
   const unsigned char b = value ? 1 : 0;
   add_raw(name, "|b1", {}, &b, 1);

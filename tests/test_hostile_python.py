@@ -181,7 +181,7 @@ WRITERS = """
     run_scenes([scene], work, controller=controller, settings=Settings(simulate=False, figures=False),
                progress=Progress(quiet=True))
     report = json.load(open(os.path.join(work, "report.json")))
-    plan = snakehead.plan(scene, controller=controller, speed=0.24, min_segment=1.0)
+    plan = snakehead.plan(scene, controller=controller)
     figure, gif = body.plot_snapshots(plan, n_panels=3), animation.animate(plan, max_frames=3)
     scene_data = viewer.viewer_scene(plan, title="t")
     page = viewer.html_page(scene_data)
@@ -225,7 +225,7 @@ def test_a_failed_write_leaves_the_old_file_and_no_partial_one(tmp_path):
     results = dict(line.split(" ", 1) for line in r.stdout.splitlines())
     assert sorted(results) == sorted(OUTPUTS), r.stdout
     for name in OUTPUTS:
-        kind = "ValueError" if name == "map.npz" else "OSError"  # workspace.save says "cannot write the map"
+        kind = "ValueError" if name == "map.npz" else "OSError"  # workspace.save: the C++ writer's ValueError
         assert results[name] == f"{kind} True", (name, results[name])
         assert (out / name).read_bytes() == b"old\n", name
     assert sorted(p.name for p in out.iterdir()) == sorted(OUTPUTS)  # no temporary file left
@@ -343,6 +343,11 @@ def _indices(a, value):
     a["indices"][0] = value
 
 
+def _flip_bit(a):
+    a["reached"] = a["reached"].copy()
+    a["reached"][0, 0] ^= 1
+
+
 def _duplicate_ids(a):
     a["voxel_ids"] = a["voxel_ids"].copy()
     a["voxel_ids"][1] = a["voxel_ids"][0]
@@ -366,6 +371,15 @@ INCONSISTENT = [
     ("a missing key", lambda a: a.pop("solved"), "solved is missing"),
     ("NaN centres", lambda a: a.update(centers=np.full_like(a["centers"], np.nan)), "centers holds NaN"),
     ("a foreign format", lambda a: a.update(format=np.array("other")), "is not a snakehead reachability map"),
+    # the second format's per-direction results and hull
+    ("a direction's bit flipped", _flip_bit, r"reached \(the per-direction results\) disagree with the solved"),
+    ("bits for too few directions", lambda a: a.update(reached=a["reached"][:, :2]),
+     r"reached must be uint8 of shape \(\d+, 3\)"),
+    ("bits as numbers", lambda a: a.update(reached=a["reached"].astype(float)), "reached must be uint8"),
+    ("sphere directions missing a row", lambda a: a.update(sphere_directions=a["sphere_directions"][1:]),
+     r"sphere_directions must be \(20, 3\) finite numbers"),
+    ("an unknown hull", lambda a: a.update(hull=np.array("concave")), "hull must be 'convex' or 'boundary'"),
+    ("a NaN shrink", lambda a: a.update(shrink=np.float64("nan")), r"shrink must be within \[0, 1\]"),
 ]
 
 
@@ -379,9 +393,30 @@ def test_inconsistent_maps_are_refused_naming_the_field(tmp_path, change, messag
         ws.load(_write_map(tmp_path / "bad.npz", arrays))
 
 
+@pytest.mark.parametrize("options", [dict(), dict(rolls=3, any_roll=False), dict(free_roll=True, rolls=0),
+                                     dict(hull="convex", approach_axis="z"), dict(shard="1/2")],
+                         ids=["default", "every_roll", "free_roll", "convex_z", "shard"])
+def test_maps_as_the_sweep_writes_them_load(tmp_path, options):
+    """The validation accepts every map the C++ writer makes (format 2: per-direction bits, rolls counted each or
+    any, free roll, either hull, shards and their merge), and the first format's maps (tests/data)."""
+    chain = snakehead.Chain.from_urdf(URDF, "neck_end", "head_tip")
+    kw = dict(voxel=0.2, directions=6, rolls=2, timeout=1e-4, cloud_samples=2000, seed=3, progress=False, threads=1)
+    m = ws.compute(chain, **{**kw, **options})
+    ws.save(m, tmp_path / "m.npz")
+    back = ws.load(tmp_path / "m.npz")
+    assert back.tried == m.tried and np.array_equal(back.voxel_ids, m.voxel_ids)
+    assert np.array_equal(back.solved, m.solved) and np.array_equal(back.reached, m.reached)
+    if "shard" in options:  # the other shard, the merge, saved and read again
+        other = ws.compute(chain, **{**kw, "shard": "0/2"})
+        whole = ws.merge([m, other])
+        ws.save(whole, tmp_path / "whole.npz")
+        assert np.array_equal(ws.load(tmp_path / "whole.npz").solved, whole.solved)
+    assert ws.load(Path(__file__).parent / "data" / "map_format1.npz").lacks == ("reached",)
+
+
 # --- finding 7: durations and sizes without end -------------------------------------------------------------
 def test_durations_and_sizes_have_limits():
-    """simulate(control_dt=1e300) never returned; speed=1e-9 asked for 5.7 TiB. In a subprocess with 4 GiB of address
+    """simulate(control_dt=1e300) never returned; a slow plan (speed=1e-9) asked for 5.7 TiB. In a subprocess with 4 GiB of address
     space and a timeout: each is a ValueError at once, naming the argument or the count it would give."""
     r = python("""
         import resource
@@ -400,8 +435,8 @@ def test_durations_and_sizes_have_limits():
             lambda: sim.simulate_trajectory(robot, [0, 1], q, control_dt=1e-300, timestep=1e-300),
             lambda: sim.simulate_trajectory(robot, [0, 1], q, hold=1e300),
             lambda: sim.simulate_trajectory(robot, [0, 1e12], q),
-            lambda: snakehead.plan([sphere], speed=1e-9),
-            lambda: snakehead.plan([sphere], min_segment=1e300),
+            lambda: snakehead.plan([sphere], timing={"dt": 1e300}),
+            lambda: snakehead.plan([sphere], timing={"grid_step": 1e-300}),
             lambda: snakehead.plan(line),
             lambda: Target("a", *sphere, hold_s=1e300),
             lambda: interpolation.sample_times(0.0, 1e300),
@@ -420,8 +455,9 @@ def test_durations_and_sizes_have_limits():
                 "ValueError the simulated motion (t[-1] - t[0] + hold): 1 s in steps of 1e-300 s is 1e+300 samples",
                 "ValueError hold must be at most 86400 s, got 1e+300",
                 "ValueError the simulated motion (t[-1] - t[0] + hold): 1e+12 s in steps of 0.002 s",
-                "ValueError the trajectory (t1 - t0): 1.4",
-                "ValueError min_segment must be at most 86400 s",
+                "ValueError timing has no option 'dt'; its options are velocity_limit, acceleration_limit, "
+                "torque_limit, zmp_margin, friction",
+                "ValueError timing has no option 'grid_step'",
                 "ValueError target 'b': the line from 'a' is 0.06002 m long; at step_m = 1e-300 m that is 6e+298 poses",
                 "ValueError target 'a' hold_s must be at most 86400 s",
                 "ValueError the trajectory (t1 - t0): 1e+300 s in steps of 0.002 s is 5e+302 samples; at most 1000000",
@@ -485,7 +521,9 @@ def test_histogram_bins_must_be_numbers_in_order():
     (lambda: snakehead.HeadController(timeout=[0.1]), TypeError, "timeout must be a real number, got list"),
     (lambda: snakehead.HeadController(n_frames=2.5), TypeError, "n_frames must be an integer, got float"),
     (lambda: snakehead.HeadController(workspace_map="map.npz"), TypeError, "workspace_map must be a ReachabilityMap"),
-    (lambda: snakehead.plan([SPHERE_1], speed="fast"), TypeError, "speed must be a real number"),
+    (lambda: snakehead.plan([SPHERE_1], timing={"velocity_limit": "fast"}), TypeError,
+     "velocity_limit must be a number or an array of 16 numbers, got str"),
+    (lambda: snakehead.plan([SPHERE_1], timing={"friction": None}), TypeError, "friction must be a real number"),
     (lambda: snakehead.BasePlacement(x="1"), TypeError, "must be numbers, got text"),
     (lambda: snakehead.BasePlacement(yaw=None), TypeError, "must be numbers, got None"),
     (lambda: Target("a", [0, 0, "1"], [1, 0, 0]), TypeError, "position must be numbers"),

@@ -28,9 +28,10 @@ namespace {
 const char* kUsage = R"(usage: workspace_gen --urdf FILE --base LINK --tip LINK --out MAP.npz [options]
 
 Computes the reachability map of the chain BASE -> TIP (Algorithm 1 of the paper): voxels of the
-cube of side 2 * reach centred on BASE that lie inside the hull of random tip positions get the
+cube of side 2 * reach centred on BASE that lie inside the boundary of random tip positions get the
 index D = 100 * (points reached by TRAC-IK) / (points tried) over points spread on their inscribed
 sphere (a point is reached when one of its rolled frames is solved; --each-roll counts frames).
+The map keeps which points (or frames) were reached.
 
 required:
   --urdf FILE            the robot description
@@ -48,6 +49,9 @@ options:
   --timeout S            IK budget per call in seconds (default 0.0003)
   --epsilon E            IK tolerance (default 1e-5)
   --cloud-samples N      random configurations for the hull (default 50000)
+  --hull boundary|convex the voxels inside the cloud's boundary (the paper's boundary(P): an alpha
+                         shape chosen as MATLAB's boundary() does; default) or its convex hull
+  --shrink S             the boundary's shrink factor in [0, 1] (default 0.5, MATLAB's default)
   --seed N               random seed (default 1); the map is a function of the seed
   --threads N            worker threads (default: all cores); does not change the map
   --shard i/N            compute only shard i of N (0 <= i < N); merge the N files afterwards
@@ -119,7 +123,7 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   std::string urdf, base, tip, out, command;
   snakehead::WorkspaceOptions opt;
-  bool quiet = false, rolls_given = false;
+  bool quiet = false, rolls_given = false, shrink_given = false;
   for (int k = 0; k < argc; ++k) command += (k ? " " : "") + shell_quote(k ? argv[k] : "workspace_gen");
   try {
     for (int k = 1; k < argc; ++k) {
@@ -158,6 +162,11 @@ int main(int argc, char** argv) {
         opt.epsilon = parse_double(a, value());
       } else if (a == "--cloud-samples") {
         opt.cloud_samples = parse_count(a, value());
+      } else if (a == "--hull") {
+        opt.hull = snakehead::parse_hull_kind(value());
+      } else if (a == "--shrink") {
+        opt.shrink = parse_double(a, value());
+        shrink_given = true;
       } else if (a == "--seed") {
         const long long s = parse_int(a, value());
         if (s < 0) throw UsageError("--seed must be >= 0");
@@ -180,6 +189,8 @@ int main(int argc, char** argv) {
       throw UsageError("--urdf, --base, --tip and --out are required (see --help)");
     if (opt.free_roll && (rolls_given || !opt.any_roll))
       throw UsageError("--free-roll leaves the roll free: it takes neither --rolls nor --each-roll");
+    if (shrink_given && opt.hull == snakehead::HullKind::Convex)
+      throw UsageError("--shrink sets the boundary's shrink factor: it does not go with --hull convex");
     opt.validate();
     check_writable(out);
   } catch (const std::exception& e) {

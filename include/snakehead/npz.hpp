@@ -22,6 +22,7 @@ class NpzWriter {
   void add_i64(const std::string& name, const std::vector<std::int64_t>& data, std::vector<std::int64_t> shape);
   void add_i32(const std::string& name, const std::vector<std::int32_t>& data, std::vector<std::int64_t> shape);
   void add_u64(const std::string& name, const std::vector<std::uint64_t>& data, std::vector<std::int64_t> shape);
+  void add_u8(const std::string& name, const std::vector<std::uint8_t>& data, std::vector<std::int64_t> shape);
   void add_bool(const std::string& name, bool value);
   void add_scalar(const std::string& name, double value) { add_f64(name, {value}, {}); }
   void add_scalar(const std::string& name, std::int64_t value) { add_i64(name, {value}, {}); }

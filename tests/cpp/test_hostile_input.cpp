@@ -392,7 +392,7 @@ TEST(HostileUrdf, KinematicHashIsUnchangedAndTheBodiesHaveTheirOwn) {
 
 namespace {
 struct ThrowingSolver : PoseSolver {
-  bool solve(const Eigen::Isometry3d&, const Eigen::VectorXd&, std::uint64_t, Eigen::VectorXd&) override {
+  bool solve(const Eigen::Isometry3d&, const Eigen::VectorXd&, std::uint64_t, double, Eigen::VectorXd&) override {
     throw InputError("thrown in a worker thread");
   }
 };

@@ -47,7 +47,7 @@ EXIT_OK, EXIT_UNSUCCESSFUL, EXIT_BAD_INPUT, EXIT_INTERNAL_ERROR, EXIT_INTERRUPTE
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors on one line (argparse prints the whole usage first): exit status 2."""
 
-    def error(self, message: str) -> Any:  # type: ignore[override]
+    def error(self, message: str) -> Any:
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
@@ -296,9 +296,7 @@ def _add_planning_options(p: argparse.ArgumentParser) -> None:
                    help="the head's reachability map (default: the robot file's; for a robot without one, a map "
                         "computed on the first run and cached)")
     p.add_argument("--fast", action="store_true",
-                   help=f"quicker run of the same pipeline: joints planned at {FAST['speed']} rad/s instead of "
-                        f"{NORMAL['speed']} with {FAST['min_segment']:g} s segments (shorter motions, so fewer 2 ms "
-                        f"samples to check and simulate) and {FAST['max_frames']}-frame animations")
+                   help=f"quicker outputs: {FAST['max_frames']}-frame animations instead of {NORMAL['max_frames']}")
 
 
 _OUTPUTS = """outputs (in DIR):
@@ -327,11 +325,12 @@ def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: s
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="snakehead", description=__doc__.split("\n\n")[0],
-                                     epilog=__doc__.split("\n\n", 1)[1],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+                     epilog=__doc__.split("\n\n", 1)[1],
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p = sub.add_parser("info", help="describe a robot and print its head pose at q = 0",
-                       description="Describe a robot (its parts, joints, mass, map) and print its head pose at q = 0.")
+    p: argparse.ArgumentParser = sub.add_parser(
+        "info", help="describe a robot and print its head pose at q = 0",
+        description="Describe a robot (its parts, joints, mass, map) and print its head pose at q = 0.")
     _add_robot_option(p)
     p.set_defaults(func=_info)
 

@@ -26,8 +26,8 @@ if TYPE_CHECKING:
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
-FAST = {"speed": 0.24, "min_segment": 1.0, "max_frames": 30}
-NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
+FAST = {"max_frames": 30}
+NORMAL = {"max_frames": 100}
 
 
 class Progress:
@@ -75,8 +75,8 @@ class Settings:
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
-        return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "speed_rad_s": s["speed"],
-                "min_segment_s": s["min_segment"], "simulation": bool(self.simulate and mujoco_available())}
+        return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "animation_frames": s["max_frames"],
+                "simulation": bool(self.simulate and mujoco_available())}
 
 
 def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
@@ -89,7 +89,7 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
     name = scene.name
     label = scene.description or name
     with progress.stage(f"{name}: planning {label}"):
-        result = plan(scene, controller=controller, speed=s["speed"], min_segment=s["min_segment"])
+        result = plan(scene, controller=controller)
     progress.say(f"{name}: {'success' if result.success else 'NOT successful: ' + str(result.failure)}, "
                  f"{result.duration_s:.1f} s of motion, {len(result.t)} samples; targets: "
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
