@@ -10,6 +10,7 @@ from __future__ import annotations
 import numbers
 import os
 import stat
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -215,6 +216,14 @@ def sample_count(span: float, step: float, name: str, *, maximum: int = MAX_SAMP
 
 #: The longest name (UTF-8 bytes) that goes into a file name (a scene's: ``NAME_trajectory.csv``, ``NAME.html``...).
 MAX_NAME_BYTES = 100
+
+
+def sequence(x: Any, name: str) -> tuple:
+    """``x`` (a list, tuple or other iterable but text, bytes or a mapping) as a tuple; TypeError otherwise (Python's
+    own "'NoneType' object is not iterable" does not say which argument)."""
+    if isinstance(x, (str, bytes, Mapping)) or not isinstance(x, Iterable):
+        raise TypeError(f"{name} must be a sequence, got {type(x).__name__} {_shown(x)}")
+    return tuple(x)
 
 
 def file_name_part(name: Any, what: str) -> str:

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validate import integer
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -554,12 +555,14 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
     """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
     import os
 
+    from .._validate import sequence
     from ..scenes.scene import load_scene
 
     if isinstance(targets, Scene):
         scene = targets
+        obstacles = sequence(obstacles, "obstacles")
         if obstacles:
-            scene = Scene(name=scene.name, targets=scene.targets, obstacles=tuple(scene.obstacles) + tuple(obstacles),
+            scene = Scene(name=scene.name, targets=scene.targets, obstacles=tuple(scene.obstacles) + obstacles,
                           robot_file=scene.robot_file, base=scene.base, description=scene.description, path=scene.path)
         return scene
     if isinstance(targets, (str, os.PathLike)):
@@ -598,6 +601,14 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     scene = as_scene(targets, obstacles=obstacles, base=base)
     if timing is not None and not isinstance(timing, dict):
         raise TypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
+    # checked even when a controller (with its own method and seed) is given: a bad value is a mistake either way
+    if not isinstance(method, str) or method not in ("rotated", "free_roll"):
+        raise ValueError(f"method must be 'rotated' or 'free_roll', got {method!r}")
+    if seed is not None:
+        integer(seed, "seed", least=0, most=2**64 - 1)
+    if not isinstance(allow_relocation, (bool, np.bool_)):  # "False" or None would pass a truth test
+        raise TypeError(f"allow_relocation must be True or False, got {type(allow_relocation).__name__} "
+                        f"{allow_relocation!r}")
     if controller is not None:
         if not isinstance(controller, HeadController):
             raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")

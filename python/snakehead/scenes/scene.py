@@ -43,7 +43,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import duration, file_name_part, finite_float, unit_vector3, vector3
+from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, vector3
 from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, read_toml
@@ -109,7 +109,7 @@ class Scene:
         file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
         if not isinstance(self.description, str):
             raise TypeError(f"a scene's description must be a str, got {type(self.description).__name__}")
-        targets = tuple(self.targets)
+        targets = sequence(self.targets, f"scene {self.name!r} targets")
         if not targets:
             raise ValueError(f"scene {self.name!r} has no targets")
         for t in targets:
@@ -123,7 +123,7 @@ class Scene:
         names = [t.name for t in targets]
         if len(set(names)) != len(names):
             raise ValueError(f"scene {self.name!r}: target names must differ, got {names}")
-        obstacles = tuple(self.obstacles)
+        obstacles = sequence(self.obstacles, f"scene {self.name!r} obstacles")
         for ob in obstacles:
             if not isinstance(ob, (BoxObstacle, WallWithHole)):
                 raise TypeError(f"scene obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
@@ -142,7 +142,7 @@ class Scene:
                      base: BasePlacement | None = None, hold_s: float = 1.0) -> "Scene":
         """A scene of (position, direction) pairs (or :class:`Target` objects), each held ``hold_s`` s."""
         targets = []
-        items = list(pairs)
+        items = sequence(pairs, "targets")
         for k, item in enumerate(items):
             if isinstance(item, Target):
                 targets.append(item)
@@ -153,7 +153,7 @@ class Scene:
                 raise ValueError(f"targets[{k}] must be a (position, direction) pair or a Target, got {item!r}") from None
             label = name if len(items) == 1 else f"{name} {k + 1}"
             targets.append(Target(label, position, direction, hold_s=hold_s))
-        return cls(name=name, targets=tuple(targets), obstacles=tuple(obstacles), base=base)
+        return cls(name=name, targets=tuple(targets), obstacles=sequence(obstacles, "obstacles"), base=base)
 
 
 # --- files ------------------------------------------------------------------------------------------------
@@ -204,9 +204,9 @@ def _target_from(entry: Any, where: str) -> Target:
             raise ValueError(f"{where}: via must be true or false, got {entry['via']!r}")
         kwargs["via"] = entry["via"]
     try:
-        return Target(name, np.asarray(_number_list(entry["position"], f"{where}: position")),
-                      np.asarray(_number_list(entry["direction"], f"{where}: direction")), **kwargs)
-    except ValueError as exc:
+        return Target(name, np.asarray(_number_list(entry["position"], "position")),
+                      np.asarray(_number_list(entry["direction"], "direction")), **kwargs)
+    except ValueError as exc:  # the field's own message, said once where it is
         raise ValueError(f"{where}: {exc}") from None
 
 
@@ -218,13 +218,13 @@ def _obstacle_from(entry: Any, where: str) -> BoxObstacle | WallWithHole:
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
         if kind == "box":
-            return BoxObstacle.from_yaw(_number_list(entry["centre"], f"{where}: centre"),
-                                        _number_list(entry["size"], f"{where}: size"),
-                                        _number(entry.get("yaw", 0.0), f"{where}: yaw"))
-        return WallWithHole.standing(_number_list(entry["hole_centre"], f"{where}: hole_centre"),
-                                     _number_list(entry["normal"], f"{where}: normal"),
-                                     _number_list(entry["size"], f"{where}: size"),
-                                     _number(entry["hole_diameter"], f"{where}: hole_diameter"))
+            return BoxObstacle.from_yaw(_number_list(entry["centre"], "centre"),
+                                        _number_list(entry["size"], "size"),
+                                        _number(entry.get("yaw", 0.0), "yaw"))
+        return WallWithHole.standing(_number_list(entry["hole_centre"], "hole_centre"),
+                                     _number_list(entry["normal"], "normal"),
+                                     _number_list(entry["size"], "size"),
+                                     _number(entry["hole_diameter"], "hole_diameter"))
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 
