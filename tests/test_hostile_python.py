@@ -8,6 +8,7 @@ space limit), so that a hang or a crash fails the test instead of ending the run
 from __future__ import annotations
 
 import errno
+import functools
 import io
 import os
 import re
@@ -54,6 +55,12 @@ def without_inertial(urdf: str, links: list[str] | None = None) -> str:
 
 @pytest.fixture(scope="module")
 def controller():
+    return _CONTROLLER()
+
+
+@functools.cache
+def _CONTROLLER() -> snakehead.HeadController:
+    """One controller for the module (made on first use)."""
     return snakehead.HeadController(method="free_roll", seed=1)
 
 
@@ -136,6 +143,10 @@ def test_scene_names_cannot_name_files_outside_the_output_folder(tmp_path):
     scene.write_text('name = "../escaped"\n[[targets]]\nname = "a"\nposition = [-0.0405, 0.5443, 0.3]\n'
                      'direction = [0.0, 1.0, 0.0]\n')
     with pytest.raises(ValueError, match=r"scene file .*: a scene's name '../escaped' holds '/'"):
+        load_scene(scene)
+    # where a field is, said once (it was "scene, targets[0]: scene, targets[0]: position must ...")
+    scene.write_text('[[targets]]\nname = "a"\nposition = [0.0, 0.5]\ndirection = [0.0, 1.0, 0.0]\n')
+    with pytest.raises(ValueError, match=r"targets\[0\]: position must be a list of 3 numbers, got \[0.0, 0.5\]$"):
         load_scene(scene)
     r = subprocess.run([sys.executable, "-m", "snakehead", "plan", "--scene", str(scene), "--out",
                         str(tmp_path / "out"), "--no-sim", "--fast"], capture_output=True, text=True, timeout=300)
@@ -532,6 +543,18 @@ def test_histogram_bins_must_be_numbers_in_order():
     (lambda: sim.simulate_trajectory(SnakeRobot.default(), [0, 1], np.zeros((2, 16)), settle="0.3"), TypeError,
      "settle must be a real number"),
     (lambda: ws.load(3), TypeError, "must be a path"),
+    # found by test_properties.py: numpy dropped the imaginary part with a warning only; Python's own
+    # "'NoneType' object is not iterable"; method, seed and a truthy "False" ignored beside a controller
+    (lambda: Target("a", [1j, 0, 0], [1, 0, 0]), TypeError, "position must be real numbers, got complex128"),
+    (lambda: snakehead.plan([SPHERE_1], obstacles=None), TypeError,
+     "obstacles must be a sequence, got NoneType None"),
+    (lambda: snakehead.plan(3), TypeError, "targets must be a sequence, got int 3"),
+    (lambda: snakehead.plan([SPHERE_1], controller=_CONTROLLER(), seed=-1), ValueError, "seed must be between 0"),
+    (lambda: snakehead.plan([SPHERE_1], controller=_CONTROLLER(), method="fast"), ValueError,
+     "method must be 'rotated' or 'free_roll', got 'fast'"),
+    (lambda: snakehead.plan([SPHERE_1], controller=_CONTROLLER(), allow_relocation="False"), TypeError,
+     "allow_relocation must be True or False, got str 'False'"),
+    (lambda: snakehead.plan([SPHERE_1], timing={"dt": 1.0}), ValueError, "timing has no option 'dt'"),
 ])
 def test_wrong_kinds_of_numbers_are_type_errors(call, error, message):
     """timeout=10**400 raised OverflowError; "1" and True were accepted as 1 s; None became NaN."""

@@ -53,6 +53,8 @@ def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.
     if raw.dtype.kind in "USb" or (raw.dtype.kind == "O" and any(_not_a_number(v) for v in raw.flat)):
         what = "booleans" if raw.dtype.kind == "b" else "text" if raw.dtype.kind in "US" else "None or text"
         raise TypeError(f"{name} must be numbers, got {what}")
+    if raw.dtype.kind in "cmMV":  # numpy would drop the imaginary part (with a warning only), or read dates
+        raise TypeError(f"{name} must be real numbers, got {raw.dtype}")
     try:
         a = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as exc:  # None, complex, objects, ints beyond a float
