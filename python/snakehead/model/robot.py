@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import _core
 from .._validate import finite_array, joint_vector
-from .chain import Chain
+from .chain import Chain, _check_utf8
 
 import numpy.typing as npt
 from typing import Any
@@ -101,12 +101,14 @@ def _urdf_source(urdf: str | os.PathLike[str]) -> str:
         urdf = os.fspath(urdf)
     if not isinstance(urdf, str):
         raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+    _check_utf8(urdf, "urdf")  # before the core sees it (urdf_root_link below)
     return urdf
 
 
 def _frame_name(value: Any, what: str) -> str:
     if not isinstance(value, str) or not value:
         raise TypeError(f"{what} must be a frame name (a non-empty str), got {value!r}")
+    _check_utf8(value, what)
     return value
 
 
