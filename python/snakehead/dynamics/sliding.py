@@ -36,8 +36,10 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 #: A box whose bottom is within this height (m) of the lowest box bottom rests on the ground (flat shapes).
 RESTING_HEIGHT = 0.003
-#: Slips below this (m) count as none in the reweighting (keeps the weights finite where a contact sticks).
+#: Slips below this share of the largest shift count as none in the reweighting (keeps the weights finite).
 SLIP_FLOOR = 1e-9
+#: The iteration stops when a step is below this share of the largest shift.
+TRANSLATION_TOLERANCE = 1e-7
 
 
 def _loads(weights, k: int) -> np.ndarray:
@@ -52,7 +54,8 @@ def balance_translation(shifts, weights) -> np.ndarray:
     with loads ``weights`` (k,): the minimiser of sum_i w_i |t - s_i| (the weighted geometric median).
 
     A contact sticks (t = s_i) when its load is at least the pull of the others,
-    |sum_{j != i} w_j (s_i - s_j) / |s_i - s_j|| <= w_i; otherwise Weiszfeld's iteration from the weighted mean.
+    |sum_{j != i} w_j (s_i - s_j) / |s_i - s_j|| <= w_i; otherwise Newton's method from the weighted mean (with
+    Weiszfeld's step where Newton's does not lower the dissipation).
     """
     s = finite_array(shifts, "shifts", (None, 2))
     if len(s) == 0:
@@ -62,23 +65,48 @@ def balance_translation(shifts, weights) -> np.ndarray:
         return s[0].copy()
     # a sticking contact: the median sits on it (Weiszfeld would only creep towards it)
     diff = s[:, None, :] - s[None, :, :]  # (i, j, 2): s_i - s_j
-    dist = np.linalg.norm(diff, axis=2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(dist[..., None] > 0, diff / dist[..., None], 0.0)
-    pull = np.linalg.norm(np.einsum("j,ijk->ik", w, unit), axis=1)  # coincident points pull nothing
-    load = np.array([w[dist[i] == 0].sum() for i in range(len(s))])  # the point's own load (and its duplicates')
+    dist = np.sqrt(diff[..., 0] ** 2 + diff[..., 1] ** 2)
+    same = dist == 0.0
+    unit = diff / np.where(same, 1.0, dist)[..., None]  # coincident points pull nothing
+    pull = np.sqrt(((w[None, :, None] * unit).sum(axis=1) ** 2).sum(axis=1))
+    load = (same * w[None, :]).sum(axis=1)  # the point's own load (and its duplicates')
     sticking = np.flatnonzero((pull <= load + 1e-12) & (w > 0))
     if sticking.size:
         return s[sticking[0]].copy()
-    t = w @ s / w.sum()
+    # Newton's method on the dissipation from the weighted mean, halving a step that does not lower it, and a
+    # Weiszfeld step where Newton's cannot (next to a contact that nearly sticks, the curvature is huge)
     scale = max(float(np.abs(s).max()), 1e-12)
-    for _ in range(200):
-        d = np.maximum(np.linalg.norm(s - t, axis=1), SLIP_FLOOR * scale)
+
+    def dissipation(t):
+        return float(w @ np.sqrt(((s - t) ** 2).sum(axis=1)))
+
+    t = w @ s / w.sum()
+    f = dissipation(t)
+    for _ in range(100):
+        r = t - s
+        d = np.maximum(np.sqrt(r[:, 0] ** 2 + r[:, 1] ** 2), SLIP_FLOOR * scale)
+        u = r / d[:, None]
         a = w / d
-        t_new = a @ s / a.sum()
-        if np.linalg.norm(t_new - t) <= 1e-12 * scale:
-            return t_new
-        t = t_new
+        g = w @ u
+        hxx, hyy, hxy = (a * u[:, 1] ** 2).sum(), (a * u[:, 0] ** 2).sum(), -(a * u[:, 0] * u[:, 1]).sum()
+        det = hxx * hyy - hxy * hxy
+        moved = False
+        if det > 0:
+            step = -np.array([hyy * g[0] - hxy * g[1], hxx * g[1] - hxy * g[0]]) / det
+            for _ in range(20):
+                f_new = dissipation(t + step)
+                if f_new < f:
+                    t, f, moved = t + step, f_new, True
+                    break
+                step = 0.5 * step
+        if not moved:
+            step = a @ s / a.sum() - t  # Weiszfeld: never raises the dissipation
+            f_new = dissipation(t + step)
+            if f_new >= f:
+                break
+            t, f = t + step, f_new
+        if abs(step[0]) + abs(step[1]) <= TRANSLATION_TOLERANCE * scale:
+            break
     return t
 
 

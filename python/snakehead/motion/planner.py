@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import positive
+from .._validate import joint_vector, positive
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -362,12 +362,14 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets, obstacles=(), allow_relocation: bool = True
-                ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
+def choose_base(controller: HeadController, targets, obstacles=(), allow_relocation: bool = True,
+                base_shape=None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
-    one first) from which every target is solved. Returns the placement, a configuration with the base's shape
+    one first) from which every target is solved. ``base_shape``: a configuration whose base joints (and those of
+    the neck's links that stay on the ground) give the base's flat shape at the controller's placement (default:
+    the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
     from ..control.whole_body import solve_target
 
@@ -393,6 +395,8 @@ def choose_base(controller: HeadController, targets, obstacles=(), allow_relocat
         return None, None
 
     start, q0 = controller.base, controller.q_initial
+    if base_shape is not None:
+        q0 = _shape_of(robot, joint_vector(base_shape, robot.n_joints, "base_shape"), q0)
     first, why = failing(start, q0)
     if first is None:
         return start, q0.copy(), None, []
@@ -460,7 +464,7 @@ def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Sce
 def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
          base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
          speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT,
-         allow_relocation: bool = True) -> Plan:
+         allow_relocation: bool = True, base_shape=None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -478,6 +482,9 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     method : the head IK: "rotated" (the paper's Fig. 9) or "free_roll".
     seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
     speed : the largest joint rate a segment is planned for (rad/s). min_segment : the shortest segment (s).
+    base_shape : a configuration (n,) whose base joints (and those of the neck's links that stay on the ground) give
+        the base's flat shape at ``base`` (default: the controller's initial configuration's): a closed loop that
+        curled the body into a relocation's shape plans on from it (``snakehead.sim.loop``).
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
@@ -504,7 +511,8 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
-    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation)
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
+                                                          base_shape)
     notes += base_notes
     way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
     way.start("bending state", bending_state(controller, q_shape))
