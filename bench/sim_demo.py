@@ -121,10 +121,14 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
           f"python {platform.python_version()}")
     if args.out:
-        from snakehead.viz.sim import plot_dynamics_check
+        from pathlib import Path
 
-        for p in plot_dynamics_check(robot, t, q, res, args.out, base):
-            print("wrote", p)
+        from snakehead.viz import dynamics, save
+
+        P, L = stability.momenta(robot, t, q, base)
+        for name, fig in (("sim_momenta", dynamics.plot_momenta(t, P, L, simulated=res)),
+                          ("sim_zmp", dynamics.plot_zmp(robot, t, q, base=base, simulated=res, contact="footprint"))):
+            print("wrote", save(fig, Path(args.out) / f"{name}.png"))
 
 
 if __name__ == "__main__":

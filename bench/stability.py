@@ -18,12 +18,23 @@ from snakehead.geometry import collision as coll
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.motion import cartesian as cart
 from snakehead.motion import interpolation as interp
-from snakehead.viz.figures import stable_lift_motion
+
+
+def stable_lift_motion(robot: SnakeRobot) -> tuple[np.ndarray, np.ndarray]:
+    """A lift of the head that stays dynamically stable (the default robot's joints): the base curled in a tight
+    arc, the neck and head curled on the ground inside it, lifted to stand over the arc (found by maximising the
+    static margin of the raised configuration)."""
+    q_start = np.zeros(robot.n_joints)
+    q_start[0:7:2] = 0.9
+    q_end = q_start.copy()
+    q_start[8:16:2] = 0.9
+    q_end[7:] = [-1.57, 0.266, -0.285, 0.451, -0.173, -0.021, 0.322, 0.051, 0.027]
+    return q_start, q_end
 
 
 def scenario(robot: SnakeRobot):
     """A 36 s, 5-waypoint joint-space motion like the paper's sphere scenario: curl the base tighter (the base
-    moves), lift the head (viz.figures.stable_lift_motion), then turn and bend it twice."""
+    moves), lift the head (stable_lift_motion), then turn and bend it twice."""
     q0, q1 = stable_lift_motion(robot)
     qa = q0.copy()
     qa[0:7:2] = 0.8

@@ -104,7 +104,10 @@ def test_default_robot_parts_and_frames():
     assert robot.total_mass == pytest.approx(3.2, abs=1e-9)
     # Straight on the ground: P0 (base_end) and B0 (neck_end) at the ends of link_7 and link_9.
     F = robot.frames(np.zeros(16))
-    x = lambda n: F[names.index(n)][0, 3]
+
+    def x(n):
+        return F[names.index(n)][0, 3]
+
     assert x("base_end") == pytest.approx(0.0405 + 7 * 0.0865)
     assert x("neck_end") == pytest.approx(0.0405 + 9 * 0.0865)
     assert F[0][2, 3] == pytest.approx(0.0215)  # body axis height on the ground

@@ -18,7 +18,8 @@ import pytest
 from snakehead import BasePlacement, SnakeRobot, default_robot_file
 
 HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
-SCENARIO_FILES = ["{}_trajectory.csv", "{}_snapshots.png", "{}_momenta.png", "{}_zmp.png", "{}.gif"]
+SCENARIO_FILES = ["{}_trajectory.csv", "{}_snapshots.png", "{}_momenta.png", "{}_zmp.png", "{}.gif", "{}.html",
+                  "{}_viewer.npz"]
 SIM_KEYS = {"position_error_m": float, "direction_error_deg": float, "max_linear_momentum_error": float,
             "max_angular_momentum_error": float, "zmp_inside": bool}
 

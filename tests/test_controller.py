@@ -131,10 +131,10 @@ def test_bad_solve_input(robot, position, direction, message):
 
 
 def test_solution_figure(robot, tmp_path):
-    from snakehead.viz import scenario as scenario_plots
+    from snakehead.viz import body, save
 
     controller = HeadController(robot, method="free_roll", seed=0)
     sol = controller.solve(SPHERE_2, SPHERE_DIRECTION)
-    path = scenario_plots.plot_head_solution(robot, sol, tmp_path / "solution.png")
+    path = save(body.plot_head_solution(robot, sol), tmp_path / "solution.png")
     assert path.exists() and path.stat().st_size > 20_000
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

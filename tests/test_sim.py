@@ -290,14 +290,18 @@ def test_missing_mujoco_names_the_extra(monkeypatch, robot):
 
 
 def test_plots_write_pngs(robot, lift, tmp_path):
-    from snakehead.viz import sim as sim_plots
+    from snakehead.dynamics import stability
+    from snakehead.viz import dynamics, save
 
     t, q, res = lift
-    paths = sim_plots.plot_dynamics_check(robot, t, q, res, tmp_path)
-    assert [p.name for p in paths] == ["sim_angular_momentum.png", "sim_linear_momentum.png", "sim_zmp.png"]
-    for p in paths:
+    P, L = stability.momenta(robot, t, q, res.base)
+    figs = {"momenta": dynamics.plot_momenta(t, P, L, simulated=res),
+            "zmp": dynamics.plot_zmp(robot, t, q, base=res.base, simulated=res, contact="footprint")}
+    for name, fig in figs.items():
+        p = save(fig, tmp_path / f"sim_{name}.png")
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
-    with pytest.raises(ValueError, match="which"):
-        sim_plots.plot_momentum(t, res.P[:len(t)], res.t, res.P, "spin", tmp_path / "x.png")
-    with pytest.raises(ValueError, match="polygon"):
-        sim_plots.plot_zmp(np.zeros((3, 3)), res, tmp_path / "z.png")
+    # the simulated momenta are drawn: the dashed lines hold the simulation's samples
+    sim_lines = [ln for ax in figs["momenta"].axes for ln in ax.get_lines() if ln.get_linestyle() == "--"]
+    assert len(sim_lines) == 6 and all(len(ln.get_xdata()) == len(res.t) for ln in sim_lines)
+    with pytest.raises(ValueError, match="matching t"):
+        dynamics.plot_momenta(t, P[:-1], L)

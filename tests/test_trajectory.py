@@ -495,12 +495,33 @@ def test_cartesian_trajectory_is_timed_min_jerk(robot):
         cart.cartesian_trajectory(robot, q0, q1, duration=0.0)
 
 
-def test_figures_are_written(tmp_path):
-    from snakehead.viz import figures as plots
+def stable_lift_motion(robot):
+    """A lift of the head that stays dynamically stable (default robot): the base curled in a tight arc, the neck
+    and head curled on the ground inside it, lifted to stand over the arc (found by maximising the static margin
+    of the raised configuration)."""
+    q_start = np.zeros(robot.n_joints)
+    q_start[0:7:2] = 0.9
+    q_end = q_start.copy()
+    q_start[8:16:2] = 0.9
+    q_end[7:] = [-1.57, 0.266, -0.285, 0.451, -0.173, -0.021, 0.322, 0.051, 0.027]
+    return q_start, q_end
 
-    paths = plots.lift_head_figures(tmp_path, duration=2.0)
-    assert [p.name for p in paths] == ["fig11_13_interpolation.png", "fig18_19_momenta.png", "fig20_zmp.png"]
-    for p in paths:
+
+def test_figures_are_written(robot, tmp_path):
+    """Figs. 11/13 for the lift of lift_motion; Figs. 18-20 for the stable lift timed over 2 s."""
+    from snakehead.dynamics import stability
+    from snakehead.viz import body, dynamics, save
+
+    fig = body.plot_interpolation_comparison(robot, *lift_motion(robot))
+    # the clearance panel: joint space goes into the ground (Fig. 11), Eqs. 41-44 do not (Fig. 13)
+    joint_space, cartesian = fig.axes[2].get_lines()[:2]
+    assert joint_space.get_ydata().min() < -5 and cartesian.get_ydata().min() > -coll.GROUND_TOLERANCE * 1000
+    traj = cart.cartesian_trajectory(robot, *stable_lift_motion(robot), 2.0)
+    P, L = stability.momenta(robot, traj.t, traj.q)
+    figs = {"fig11_13_interpolation": fig, "fig18_19_momenta": dynamics.plot_momenta(traj.t, P, L),
+            "fig20_zmp": dynamics.plot_zmp(robot, traj.t, traj.q, contact="endpoints")}
+    for name, f in figs.items():
+        p = save(f, tmp_path / f"{name}.png")
         assert p.stat().st_size > 20_000
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

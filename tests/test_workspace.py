@@ -332,13 +332,15 @@ def test_shipped_head_map_g0(robot):
 
 # --- figures ------------------------------------------------------------------------------------------------
 def test_figures(small, tmp_path):
+    from snakehead.viz import save
     from snakehead.viz import workspace as wp
 
-    paths = wp.save_figures(small, tmp_path, prefix="small", k=2)
-    assert [p.name for p in paths] == ["small_map.png", "small_dexterous.png", "small_clusters.png"]
-    for p in paths:
+    figures = wp.map_figures(small, k=2)
+    assert list(figures) == ["map", "dexterous", "clusters"]
+    for name, fig in figures.items():
+        p = save(fig, tmp_path / f"small_{name}.png")
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
-    ax = wp.plot_section(small, axis="y", value=0.01)
+    ax = wp.plot_section(small, axis="y", value=0.01).axes[0]
     h = small.voxel_size
     layer_y = small.grid_origin[1] + (np.floor((0.01 - small.grid_origin[1]) / h) + 0.5) * h  # the layer holding y
     assert len(ax.collections[0].get_array()) == np.sum(np.isclose(small.centers[:, 1], layer_y)) > 0

@@ -1,12 +1,16 @@
 """Input checks shared by every public function: numpy in, a clear ValueError out."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+
+import numpy.typing as npt
 
 ORTHONORMAL_TOLERANCE = 1e-6
 
 
-def finite_array(x, name: str, shape: tuple | None = None) -> np.ndarray:
+def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.ndarray:
     """``x`` as a float64 array; ValueError unless finite and (when given) of ``shape`` (None = any size)."""
     try:
         a = np.asarray(x, dtype=np.float64)
@@ -21,16 +25,16 @@ def finite_array(x, name: str, shape: tuple | None = None) -> np.ndarray:
     return a
 
 
-def joint_vector(q, n: int, name: str = "q") -> np.ndarray:
+def joint_vector(q: npt.ArrayLike, n: int, name: str = "q") -> np.ndarray:
     """A 1-D float64 vector of ``n`` finite joint values."""
     return finite_array(q, name, (n,))
 
 
-def vector3(v, name: str) -> np.ndarray:
+def vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     return finite_array(v, name, (3,))
 
 
-def unit_vector3(v, name: str) -> np.ndarray:
+def unit_vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     a = vector3(v, name)
     norm = float(np.linalg.norm(a))
     if norm < 1e-12:
@@ -38,7 +42,7 @@ def unit_vector3(v, name: str) -> np.ndarray:
     return a / norm
 
 
-def pose(T, name: str = "pose") -> np.ndarray:
+def pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
     """A 4x4 homogeneous transform with an orthonormal, right-handed rotation."""
     a = finite_array(T, name, (4, 4))
     if not np.allclose(a[3], (0.0, 0.0, 0.0, 1.0), atol=1e-9):
@@ -47,7 +51,7 @@ def pose(T, name: str = "pose") -> np.ndarray:
     return a
 
 
-def rotation_matrix(R, name: str = "rotation") -> np.ndarray:
+def rotation_matrix(R: npt.ArrayLike, name: str = "rotation") -> np.ndarray:
     a = finite_array(R, name, (3, 3))
     err = np.abs(a.T @ a - np.eye(3)).max()
     if err > ORTHONORMAL_TOLERANCE or np.linalg.det(a) < 0:
@@ -55,7 +59,7 @@ def rotation_matrix(R, name: str = "rotation") -> np.ndarray:
     return a
 
 
-def positive(x, name: str) -> float:
+def positive(x: npt.ArrayLike, name: str) -> float:
     """``x`` as a positive finite float; ValueError naming ``name`` otherwise."""
     v = finite_float(x, name)
     if v <= 0:
@@ -63,7 +67,7 @@ def positive(x, name: str) -> float:
     return v
 
 
-def finite_float(x, name: str) -> float:
+def finite_float(x: Any, name: str) -> float:
     """``x`` as a finite float; ValueError naming ``name`` otherwise."""
     try:
         v = float(x)

@@ -6,6 +6,7 @@ The command is snakehead (also python -m snakehead). Subcommands:
   demo        the paper's two scenarios of Section 4 end to end, with figures, animations and a report
   plan        head targets (--position/--direction, or --scene FILE) with the same outputs
   workspace   compute a reachability map of a robot's head (Algorithm 1) into a .npz file
+  view        the interactive 3-D viewer of the output of plan or demo, served to a web browser
 
 Exit status: 0 on success; 1 when a scenario or target was planned but not successfully (the outputs are
 written all the same); 2 for bad arguments or input files; 130 when interrupted.
@@ -24,6 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from .pipeline import FAST, NORMAL
+
+from typing import TYPE_CHECKING, Any, Callable
+
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
 
 
 class UsageError(Exception):
@@ -68,6 +74,13 @@ def _seed(text: str) -> int:
     return _int(text, 0)
 
 
+def _port(text: str) -> int:
+    n = _int(text, 0)
+    if n > 65535:
+        raise argparse.ArgumentTypeError(f"must be a port number (0-65535), got {text!r}")
+    return n
+
+
 def _writable_dir(path: str) -> Path:
     """Create ``path`` (and its parents) if needed and check that files can be written in it."""
     out = Path(path)
@@ -85,7 +98,7 @@ def _writable_dir(path: str) -> Path:
 # ----------------------------------------------------------------------------------------------
 # the robot and its map
 # ----------------------------------------------------------------------------------------------
-def _robot(args: argparse.Namespace):
+def _robot(args: argparse.Namespace) -> SnakeRobot:
     from ..model.robot import SnakeRobot
 
     if getattr(args, "robot", None) is None:
@@ -93,7 +106,7 @@ def _robot(args: argparse.Namespace):
     return SnakeRobot.from_file(args.robot)
 
 
-def _map(args: argparse.Namespace, robot):
+def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
     """The map given with --map (checked against the robot's head), else None (the pipeline finds one)."""
     from ..kinematics import workspace
 
@@ -132,13 +145,13 @@ def _info(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 # demo and plan
 # ----------------------------------------------------------------------------------------------
-def _settings(args):
+def _settings(args: argparse.Namespace) -> Any:
     from .pipeline import Settings
 
     return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)
 
 
-def _done(command: str, out: Path, report: dict, progress) -> int:
+def _done(command: str, out: Path, report: dict, progress: Any) -> int:
     entries = report["scenarios"]
     ok = all(e["success"] for e in entries.values())
     progress.say(f"done in {progress.elapsed():.1f} s")
@@ -227,6 +240,27 @@ def _workspace(args: argparse.Namespace) -> int:
     return 0
 
 # ----------------------------------------------------------------------------------------------
+# view
+# ----------------------------------------------------------------------------------------------
+def _view(args: argparse.Namespace) -> int:
+    from ..viz import viewer
+
+    directory = Path(args.dir)
+    if not directory.is_dir():
+        raise UsageError(f"{args.dir!r} is not a directory (give the --out folder of 'snakehead plan' or 'demo')")
+    shown = viewer.serve(directory, host=args.host, port=args.port)
+    print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from "
+          f"{directory.resolve()}; Ctrl-C stops", flush=True)
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        shown.close()
+
+
+# ----------------------------------------------------------------------------------------------
 # the parser
 # ----------------------------------------------------------------------------------------------
 def _add_robot_option(p: argparse.ArgumentParser) -> None:
@@ -261,10 +295,14 @@ _OUTPUTS = """outputs (in DIR):
   NAME_momenta.png          planned (and simulated) angular and linear momenta (Figs. 18-19 / 23-24)
   NAME_zmp.png              the ZMP in the support polygon (Figs. 20 / 25)
   NAME.gif                  an animation of the motion
+  NAME.html                 the interactive 3-D viewer of the motion: opens from disk, no server, no network
+  NAME_viewer.npz           what the viewer shows (link boxes per frame, targets, obstacles, ZMP, the head's map);
+                            snakehead view DIR serves it
 """
 
 
-def _planning_parser(sub, name: str, func, help_text: str, description: str) -> argparse.ArgumentParser:
+def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: str, description: str
+                     ) -> argparse.ArgumentParser:
     p = sub.add_parser(name, help=help_text, description=description, epilog=_OUTPUTS,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_planning_options(p)
@@ -323,6 +361,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--shard", default=None, metavar="i/N", help="compute only shard i of N (merge them afterwards)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_workspace)
+
+    p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo (a web page)",
+                       description="Serve the scenes that 'snakehead plan' or 'snakehead demo' wrote into DIR "
+                                   "(NAME_viewer.npz) at http://HOST:PORT until Ctrl-C: the robot moving along its "
+                                   "motion with play/pause and a time slider, the targets, the obstacles, the "
+                                   "support polygon and the ZMP's trace, and the head's reachability map (toggled "
+                                   "on in the panel). Without a server, open DIR/NAME.html: the same scene.")
+    p.add_argument("dir", metavar="DIR", help="the --out folder of snakehead plan or demo")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for every interface)")
+    p.add_argument("--port", type=_port, default=8080, metavar="N",
+                   help="port (default 8080; the next free one if taken)")
+    p.set_defaults(func=_view)
     return parser
 
 

@@ -13,9 +13,16 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from . import report as rep
+
+
+if TYPE_CHECKING:
+    from ..control.controller import HeadController
+    from ..kinematics.workspace import ReachabilityMap
+    from ..model.robot import SnakeRobot
+    from ..scenes.scene import Scene
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
@@ -26,7 +33,7 @@ NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
 class Progress:
     """Stage lines on stderr (``[  12.3 s] what ...`` / ``... done in 1.2 s``) and a record of the stage times."""
 
-    def __init__(self, quiet: bool = False, stream=None):
+    def __init__(self, quiet: bool = False, stream: Any = None) -> None:
         self.t0 = time.perf_counter()
         self.quiet = quiet
         self.stream = stream
@@ -40,7 +47,7 @@ class Progress:
             print(f"[{self.elapsed():7.1f} s] {text}", file=self.stream or sys.stderr, flush=True)
 
     @contextlib.contextmanager
-    def stage(self, what: str):
+    def stage(self, what: str) -> Iterator[None]:
         self.say(f"{what} ...")
         start = time.perf_counter()
         yield
@@ -56,13 +63,15 @@ def mujoco_available() -> bool:
 @dataclass
 class Settings:
     """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
-    figures: write figures and the animation."""
+    figures: write figures, the animation and the 3-D viewer's page; parallel: draw what needs only the plan in a
+    second process while MuJoCo simulates (Linux)."""
 
     method: str = "rotated"
     seed: int | None = 1
     fast: bool = False
     simulate: bool = True
     figures: bool = True
+    parallel: bool = True
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
@@ -70,7 +79,7 @@ class Settings:
                 "min_segment_s": s["min_segment"], "simulation": bool(self.simulate and mujoco_available())}
 
 
-def run_scene(scene, controller, out: Path, settings: Settings, progress: Progress, *,
+def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
               solution_figure: bool = False) -> dict:
     """One scene through the pipeline; its report entry (``report.scenario_entry``) with the files written."""
     from ..motion.planner import plan
@@ -86,6 +95,10 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
+    drawing = None
+    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates
+        drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
+                          progress, parallel=settings.parallel)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -112,52 +125,112 @@ def run_scene(scene, controller, out: Path, settings: Settings, progress: Progre
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
-    if settings.figures:
-        files += _figures(scene, result, sim_result, out, s, progress, solution_figure)
+    if drawing is not None:
+        files += _dynamics_figures(scene, result, sim_result, out, progress)
+        files += drawing.files()
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return entry
 
 
-def _figures(scene, result, sim_result, out: Path, s: dict, progress: Progress, solution_figure: bool) -> list[str]:
-    from ..viz import scenario as scenario_plots
+def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progress, solution_figure: bool,
+                  workspace_map: ReachabilityMap | None = None) -> list[str]:
+    """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
+    from ..viz import animation, body, save, viewer
 
     robot = result.robot
     name = scene.name
-    paper = rep.PAPER.get(name, {})
-    snap, mom, zmp = paper.get("figures", (None, None, None))
-    spheres = [(t.position, t.sphere_diameter) for t in scene.targets if t.sphere_diameter is not None]
+    snap = rep.PAPER.get(name, {}).get("figures", (None, None, None))[0]
     label = scene.description or name
     files = []
     with progress.stage(f"{name}: figures"):
         if solution_figure and result.targets:
-            files.append(scenario_plots.plot_head_solution(robot, result.targets[0].solution,
-                                                           out / f"{name}_solution.png").name)
-        cols = 4 if len(result.targets) + 2 > 9 or len(spheres) else 3
+            files.append(save(body.plot_head_solution(robot, result.targets[0].solution),
+                              out / f"{name}_solution.png").name)
+        cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3
         n_panels = 12 if cols == 4 else 9
-        paths = [
-            scenario_plots.plot_snapshots(robot, result, out / f"{name}_snapshots.png", spheres=spheres,
-                                          n_panels=n_panels, columns=cols,
-                                          title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                                "the body at its states (collision boxes; axes in m, equal scales)"),
-            scenario_plots.plot_momenta(result, out / f"{name}_momenta.png", sim_result=sim_result,
-                                        figures=mom or (None, None),
-                                        title=f"{label}: momenta about the world origin, planned"
-                                              + (" and simulated" if sim_result is not None else "")),
-            scenario_plots.plot_zmp(robot, result, out / f"{name}_zmp.png", sim_result=sim_result, figure=zmp,
-                                    title=f"{label}: zero-moment point"),
-        ]
-        files += [p.name for p in paths]
+        snapshots = body.plot_snapshots(result, n_panels=n_panels, columns=cols,
+                                        title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                              "the body at its states (collision boxes; axes in m, equal scales)")
+        files.append(save(snapshots, out / f"{name}_snapshots.png").name)
     with progress.stage(f"{name}: animation"):
-        files.append(scenario_plots.animate(robot, result, out / f"{name}.gif", spheres=spheres,
-                                            max_frames=s["max_frames"]).name)
+        files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
+    with progress.stage(f"{name}: 3-D viewer page"):
+        data = viewer.viewer_scene(result, workspace_map=workspace_map, title=label)
+        files.append(viewer.save_viewer_scene(data, out / f"{name}{viewer.SCENE_SUFFIX}").name)
+        files.append(viewer.write_html(data, out / f"{name}.html").name)
     return files
 
 
-def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None, workspace_map=None,
+def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress) -> list[str]:
+    """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
+    from ..viz import dynamics, save
+
+    name = scene.name
+    _, mom, zmp = rep.PAPER.get(name, {}).get("figures", (None, None, None))
+    label = scene.description or name
+    simulated = " and simulated" if sim_result is not None else ""
+    with progress.stage(f"{name}: momenta and ZMP figures"):
+        figures = {
+            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
+                                             figures=mom or (None, None),
+                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
+            "zmp": dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base, stability=result.stability,
+                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
+        }
+        return [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
+
+
+class _Beside:
+    """Runs ``work(progress)`` (-> list of file names) beside the caller: in a forked child process on Linux, so
+    that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
+    elsewhere, or with ``parallel=False``. :meth:`files` waits for it; the child's stage times join ``progress``."""
+
+    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True) -> None:
+        import multiprocessing
+
+        self.progress = progress
+        self.proc = None
+        if not (parallel and sys.platform.startswith("linux")):
+            self._files = work(progress)
+            return
+        ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
+        self.recv, send = ctx.Pipe(duplex=False)
+        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-figures", daemon=True)
+        self.proc.start()
+        send.close()
+
+    def files(self) -> list[str]:
+        if self.proc is None:
+            return self._files
+        try:
+            ok, value, stages = self.recv.recv()
+        except EOFError:
+            self.proc.join()
+            raise RuntimeError(f"the process drawing the figures died (exit code {self.proc.exitcode})") from None
+        self.proc.join()
+        self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
+        if not ok:
+            raise RuntimeError(f"drawing the figures failed: {value}")
+        return value
+
+
+def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
+    import traceback
+
+    progress.stages = []
+    try:
+        send.send((True, work(progress), progress.stages))
+    except BaseException as exc:  # noqa: BLE001 -- reported to the parent, which raises
+        send.send((False, f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}", progress.stages))
+    finally:
+        send.close()
+
+
+def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController | None = None,
+               robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
                settings: Settings | None = None, progress: Progress | None = None, command: str = "plan",
-               notes: Sequence[str] = (), solution_figure: bool = False,
-               on_controller: Callable | None = None) -> dict:
+               notes: Sequence[str] = (), solution_figure: bool = False, on_controller: Callable | None = None) -> dict:
     """Every scene through :func:`run_scene` with one controller; writes ``report.json`` and ``summary.md`` into
     ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
     file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed)."""
@@ -203,5 +276,5 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller=None, robot=None
     return report
 
 
-def _map_label(m) -> str:
+def _map_label(m: Any) -> str:
     return str(m.path) if getattr(m, "path", None) is not None else "computed in this run"

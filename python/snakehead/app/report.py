@@ -25,9 +25,11 @@ import numpy as np
 
 from .._files import atomic_open, write_text_atomic
 
+from typing import Any
+
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
 #: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
-PAPER = {
+PAPER: dict[str, dict[str, Any]] = {
     "spheres": {"section": "4.1 (Figs. 17-20)", "position_error_m": 1.8e-3, "direction_error_deg": 0.76,
                 "max_angular_momentum_magnitude_error": 0.0383, "max_linear_momentum_magnitude_error": 0.216,
                 "zmp_inside": True, "duration_s": 36.0, "figures": (17, (18, 19), 20)},
@@ -41,7 +43,7 @@ SIM_KEYS = ("position_error_m", "direction_error_deg", "max_linear_momentum_erro
             "zmp_inside")
 
 
-def jsonable(x):
+def jsonable(x: Any) -> Any:
     """``x`` with numpy scalars and arrays turned into Python numbers and lists, non-finite floats into None,
     tuples into lists and dict keys into strings (recursively)."""
     if isinstance(x, dict):
@@ -64,7 +66,7 @@ def jsonable(x):
     return str(x)
 
 
-def scenario_entry(result, sim_metrics: dict | None = None, *, extra: dict | None = None) -> dict:
+def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict | None = None) -> dict:
     """The report entry of one planned scenario (``snakehead.scenarios.ScenarioResult``).
 
     ``sim_metrics``: the dict of :func:`snakehead.sim.compare` (None without a dynamics check). ``extra``: more
@@ -112,7 +114,7 @@ def environment() -> dict:
 
     from .. import __version__
 
-    versions = {"snakehead": __version__, "python": platform.python_version()}
+    versions: dict[str, str | None] = {"snakehead": __version__, "python": platform.python_version()}
     for dist in ("numpy", "scipy", "matplotlib", "mujoco", "scikit-learn", "pillow"):
         try:
             versions[dist] = metadata.version(dist)
@@ -139,7 +141,7 @@ def write_json(report: dict, path: str | os.PathLike) -> Path:
     return write_text_atomic(path, json.dumps(jsonable(report), indent=2, allow_nan=False) + "\n")
 
 
-def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
+def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
     """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
     time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)
@@ -157,7 +159,7 @@ def write_trajectory_csv(result, path: str | os.PathLike, joint_names: list[str]
     return path
 
 
-def _fmt(x, scale: float = 1.0, digits: int = 2) -> str:
+def _fmt(x: Any, scale: float = 1.0, digits: int = 2) -> str:
     if x is None:
         return "-"
     if isinstance(x, bool):

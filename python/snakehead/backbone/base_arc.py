@@ -19,14 +19,17 @@ from ..model.robot import YAW, BasePlacement, SnakeRobot, as_robot
 from .curves import SpaceCurve
 from .discretize import joint_intervals
 
-def _check_central_angle(theta) -> float:
+import numpy.typing as npt
+from typing import Any
+
+def _check_central_angle(theta: float) -> float:
     th = finite_float(theta, "central_angle")
     if not 0.0 < th <= 2.0 * math.pi:
         raise ValueError(f"central_angle must be in (0, 2*pi] rad, got {th!r}")
     return th
 
 
-def _check_turn(turn) -> int:
+def _check_turn(turn: int) -> int:
     if turn not in (1, -1):
         raise ValueError(f"turn must be +1 (left, counter-clockwise from above) or -1 (right), got {turn!r}")
     return int(turn)
@@ -50,7 +53,7 @@ class PlaneArc:
     turn: int = 1
     height: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         positive(self.radius, "radius")
         _check_central_angle(self.central_angle)
         _check_turn(self.turn)
@@ -69,7 +72,7 @@ class PlaneArc:
         n = self.turn * np.array([-math.sin(self.heading), math.cos(self.heading)])
         return np.asarray(self.start, dtype=np.float64) + self.radius * n
 
-    def point(self, s) -> np.ndarray:
+    def point(self, s: npt.ArrayLike) -> np.ndarray:
         """(..., 3) world points at arc lengths s (m)."""
         s = np.asarray(s, dtype=np.float64)
         a = self.heading + self.turn * s / self.radius
@@ -79,7 +82,7 @@ class PlaneArc:
         y = c[1] - self.radius * np.cos(a) * self.turn
         return np.stack([x, y, np.full_like(x, self.height)], axis=-1)
 
-    def tangent(self, s) -> np.ndarray:
+    def tangent(self, s: npt.ArrayLike) -> np.ndarray:
         """(..., 3) unit tangents at arc lengths s."""
         a = self.heading + self.turn * np.asarray(s, dtype=np.float64) / self.radius
         return np.stack([np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
@@ -88,14 +91,14 @@ class PlaneArc:
         """The arc as a :class:`SpaceCurve` parametrised by arc length, with exact derivatives."""
         k = self.turn / self.radius  # signed curvature
 
-        def d1(t):
+        def d1(t: float) -> np.ndarray:
             return self.tangent(t)
 
-        def d2(t):
+        def d2(t: float) -> np.ndarray:
             a = self.heading + k * t
             return k * np.array([-math.sin(a), math.cos(a), 0.0])
 
-        def d3(t):
+        def d3(t: float) -> np.ndarray:
             a = self.heading + k * t
             return -k * k * np.array([math.cos(a), math.sin(a), 0.0])
 
@@ -163,7 +166,7 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     return turn * q * robot.joint_signs[idx]
 
 
-def exact_chord_radius(chords, central_angle: float) -> float:
+def exact_chord_radius(chords: npt.ArrayLike, central_angle: float) -> float:
     """Radius r of the circle on which a polyline with chord lengths ``chords`` (m) spans ``central_angle``
     (rad): sum_j 2 asin(c_j / 2r) = theta. ValueError when no such circle exists (theta too large)."""
     c = finite_array(chords, "chords", (None,))
@@ -171,7 +174,7 @@ def exact_chord_radius(chords, central_angle: float) -> float:
         raise ValueError("chord lengths must be positive")
     theta = _check_central_angle(central_angle)
 
-    def span(r):
+    def span(r: Any) -> float:
         return float(np.sum(2.0 * np.arcsin(np.minimum(c / (2.0 * r), 1.0))))
 
     r_min = 0.5 * c.max()
@@ -233,7 +236,7 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
     return arc
 
 
-def arc_segment_area(length: float, central_angle) -> np.ndarray | float:
+def arc_segment_area(length: float, central_angle: npt.ArrayLike) -> np.ndarray | float:
     """Eq. 2 with Eq. 1: the area (m^2) between a plane arc of length l and its chord,
     S(theta) = 1/2 r^2 (theta - sin theta) with r = l / theta; theta scalar or array in (0, 2 pi]."""
     l = positive(length, "length")
@@ -269,7 +272,7 @@ def arc_area_maximum(length: float) -> tuple[float, float]:
 # ---------------------------------------------------------------------------------------------------
 # support polygon area and the optimised central angle
 # ---------------------------------------------------------------------------------------------------
-def polygon_area(vertices) -> float:
+def polygon_area(vertices: npt.ArrayLike) -> float:
     """Area (m^2) of a simple polygon given by its (k, 2) vertices in order (shoelace formula)."""
     v = finite_array(vertices, "vertices", (None, 2))
     if len(v) < 3:
@@ -278,7 +281,7 @@ def polygon_area(vertices) -> float:
     return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
-def _stability():
+def _stability() -> Any:
     from ..dynamics import stability  # imported lazily: stability.py imports robot only, not this module
     return stability
 
@@ -348,7 +351,7 @@ class ArcOptimum:
     grid: np.ndarray
 
 
-def optimize_base_arc(robot: SnakeRobot, q_up=None, base: BasePlacement | None = None, *,
+def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base: BasePlacement | None = None, *,
                       min_margin: float = 0.0, turn: int = 1, bounds: tuple[float, float] | None = None,
                       n_grid: int = 41, chords: str = "arclength") -> ArcOptimum:
     """The base arc's central angle that maximises the area of the discretised support polygon

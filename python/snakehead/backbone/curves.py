@@ -18,12 +18,14 @@ first bends.
 from __future__ import annotations
 
 import math
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 from scipy import integrate, optimize
 
 from .._validate import finite_array, finite_float, positive
+
+import numpy.typing as npt
 
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
 DEFAULT_FD_STEP = 2e-3
@@ -70,7 +72,7 @@ class SpaceCurve:
 
     def __init__(self, r: Callable[[float], np.ndarray], t0: float, t1: float, *,
                  derivatives: Sequence[Callable[[float], np.ndarray]] | None = None,
-                 fd_step: float | None = None, rtol: float = DEFAULT_RTOL):
+                 fd_step: float | None = None, rtol: float = DEFAULT_RTOL) -> None:
         if not callable(r):
             raise ValueError(f"r must be a callable t -> (3,) array, got {type(r).__name__}")
         self.t0 = finite_float(t0, "t0")
@@ -81,7 +83,7 @@ class SpaceCurve:
         if derivatives is not None:
             if len(derivatives) != 3 or not all(callable(d) for d in derivatives):
                 raise ValueError("derivatives must be three callables (dr, d2r, d3r), each t -> (3,) array")
-            self._d = tuple(derivatives)
+            self._d: tuple[Callable[[float], np.ndarray], ...] | None = tuple(derivatives)
         else:
             self._d = None
         span = self.t1 - self.t0
@@ -92,7 +94,7 @@ class SpaceCurve:
 
     # -- evaluation --------------------------------------------------------------------------------
     @staticmethod
-    def _call(f, t: float, name: str) -> np.ndarray:
+    def _call(f: Any, t: float, name: str) -> np.ndarray:
         try:
             v = f(t)
         except Exception as exc:  # a user's callable failing is an input error
@@ -103,7 +105,7 @@ class SpaceCurve:
         """r(t), (3,) m."""
         return self._call(self._r, float(t), "r")
 
-    def derivs(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def derivs(self, t: float) -> tuple[np.ndarray, ...]:
         """(r'(t), r''(t), r'''(t)), each (3,): supplied, or central finite differences."""
         t = float(t)
         if self._d is not None:
@@ -112,7 +114,7 @@ class SpaceCurve:
         P = np.array([self._call(self._r, t + k * h, "r") for k in _OFFSETS])  # (7, 3)
         return _D1 @ P / h, _D2 @ P / h ** 2, _D3 @ P / h ** 3
 
-    def curvature_torsion(self, t) -> tuple[np.ndarray, np.ndarray]:
+    def curvature_torsion(self, t: npt.ArrayLike) -> tuple[Any, Any]:
         """Curvature kappa (1/m) and torsion tau (1/m) at t (scalar or (m,)), Eq. 7:
 
         kappa = |r' x r''| / |r'|^3,   tau = (r' x r'') . r''' / |r' x r''|^2.
@@ -154,13 +156,13 @@ class SpaceCurve:
         """Regularity and no inflection: sample r' and r' x r'' on an even grid of t."""
         ts = np.linspace(self.t0, self.t1, n)
         self.point(self.t0)  # shape / NaN check of r itself
-        speeds, cs = [], []
+        speed_list, cross_list = [], []
         for t in ts:
             d1, d2, _ = self.derivs(t)
-            speeds.append(np.linalg.norm(d1))
-            cs.append(np.cross(d1, d2))
-        speeds = np.array(speeds)
-        cs = np.array(cs)
+            speed_list.append(np.linalg.norm(d1))
+            cross_list.append(np.cross(d1, d2))
+        speeds = np.array(speed_list)
+        cs = np.array(cross_list)
         if speeds.min() <= 1e-9 * max(speeds.max(), 1e-300):
             i = int(np.argmin(speeds))
             raise ValueError(f"the curve is not regular: r'(t) = 0 near t = {ts[i]:.6g}")
@@ -190,7 +192,7 @@ class SpaceCurve:
         # ds/dt = |r'|; dphi/dt = tau ds/dt (Eq. 3); d/dt int kappa cos(phi) ds, int kappa sin(phi) ds (Eq. 4)
         return np.array([speed, tau * speed, kappa * math.cos(phi) * speed, kappa * math.sin(phi) * speed])
 
-    def _solution(self):
+    def _solution(self) -> Any:
         if self._sol is None:
             sol = integrate.solve_ivp(self._rhs, (self.t0, self.t1), np.zeros(4), method="DOP853",
                                       rtol=self.rtol, atol=self.rtol * 1e-3, dense_output=True)
@@ -204,7 +206,7 @@ class SpaceCurve:
         """Total arc length L = int_t0^t1 |r'(t)| dt (m)."""
         return float(self._solution().y[0, -1])
 
-    def arc_length(self, t) -> np.ndarray | float:
+    def arc_length(self, t: npt.ArrayLike) -> np.ndarray | float:
         """s(t) = int_t0^t |r'| dt (m) at t (scalar or array within [t0, t1])."""
         ta = np.asarray(t, dtype=np.float64)
         if np.any(ta < self.t0 - 1e-12) or np.any(ta > self.t1 + 1e-12):
@@ -212,7 +214,7 @@ class SpaceCurve:
         s = self._solution().sol(np.clip(ta, self.t0, self.t1))[0]
         return float(s) if ta.ndim == 0 else s
 
-    def t_at(self, s) -> np.ndarray | float:
+    def t_at(self, s: npt.ArrayLike) -> np.ndarray | float:
         """Inverse of :meth:`arc_length`: the parameter t at arc length s (scalar or array in [0, L])."""
         sa = np.atleast_1d(np.asarray(s, dtype=np.float64))
         L = self.length
@@ -229,16 +231,16 @@ class SpaceCurve:
                 out[i] = optimize.brentq(lambda t: sol(t)[0] - si, self.t0, self.t1, xtol=1e-15, rtol=1e-15)
         return float(out[0]) if np.ndim(s) == 0 else out
 
-    def _state_at_s(self, s) -> np.ndarray:
+    def _state_at_s(self, s: npt.ArrayLike) -> np.ndarray:
         t = np.atleast_1d(self.t_at(s))
         return self._solution().sol(t)  # (4, m)
 
-    def phase(self, s, phi0: float = 0.0) -> np.ndarray | float:
+    def phase(self, s: npt.ArrayLike, phi0: float = 0.0) -> Any:
         """phi(s) = phi0 + int_0^s tau ds (rad), Eq. 3; scalar or array."""
         phi = self._state_at_s(s)[1] + finite_float(phi0, "phi0")
         return float(phi[0]) if np.ndim(s) == 0 else phi
 
-    def curvature_projections(self, s, phi0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def curvature_projections(self, s: npt.ArrayLike, phi0: float = 0.0) -> tuple[Any, Any]:
         """(kappa_y, kappa_p) = kappa (cos phi, sin phi) at arc lengths s (1/m), Eq. 4."""
         sa = np.atleast_1d(np.asarray(s, dtype=np.float64))
         t = np.atleast_1d(self.t_at(sa))
@@ -249,7 +251,7 @@ class SpaceCurve:
             return float(ky[0]), float(kp[0])
         return ky, kp
 
-    def bending(self, s1, s2, phi0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def bending(self, s1: Any, s2: Any, phi0: float = 0.0) -> tuple[Any, Any]:
         """(theta_y, theta_p) = (int_s1^s2 kappa_y ds, int_s1^s2 kappa_p ds) in rad, Eqs. 5-6.
 
         s1, s2 scalars or equal-shape arrays (m) within [0, L]. phi0 is the phase at s = 0 (Eq. 3's
@@ -269,7 +271,7 @@ class SpaceCurve:
             return float(ty[0]), float(tp[0])
         return ty, tp
 
-    def initial_phase(self, frame0) -> float:
+    def initial_phase(self, frame0: npt.ArrayLike) -> float:
         """phi0 for a body whose frame at the curve's start has rotation ``frame0`` (3, 3) (columns x, y, z).
 
         Its x-axis must be the curve's start tangent (to 1e-6); phi0 = atan2(N.z, N.y) with N the Frenet
@@ -295,23 +297,23 @@ class SpaceCurve:
         return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1])) - self.phase(s1)
 
 
-def cubic_bezier(control_points) -> SpaceCurve:
+def cubic_bezier(control_points: npt.ArrayLike) -> SpaceCurve:
     """The cubic Bezier curve B(t) = sum_k C(3,k) (1-t)^(3-k) t^k P_k, t in [0, 1], of four (3,) control
     points (m), as a :class:`SpaceCurve` with its exact derivatives."""
     P = finite_array(control_points, "control_points", (4, 3))
 
-    def r(t):
+    def r(t: float) -> np.ndarray:
         u = 1.0 - t
         return u ** 3 * P[0] + 3 * u * u * t * P[1] + 3 * u * t * t * P[2] + t ** 3 * P[3]
 
-    def d1(t):
+    def d1(t: float) -> np.ndarray:
         u = 1.0 - t
         return 3.0 * (u * u * (P[1] - P[0]) + 2 * u * t * (P[2] - P[1]) + t * t * (P[3] - P[2]))
 
-    def d2(t):
+    def d2(t: float) -> np.ndarray:
         return 6.0 * ((1.0 - t) * (P[2] - 2 * P[1] + P[0]) + t * (P[3] - 2 * P[2] + P[1]))
 
-    def d3(t):
+    def d3(t: float) -> np.ndarray:
         return 6.0 * (P[3] - 3 * P[2] + 3 * P[1] - P[0])
 
     return SpaceCurve(r, 0.0, 1.0, derivatives=(d1, d2, d3))

@@ -48,8 +48,10 @@ from .._validate import finite_array, finite_float, positive
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .curves import SpaceCurve
 
+import numpy.typing as npt
 
-def joint_intervals(s_joints, kinds: Sequence[str], curve_length: float) -> np.ndarray:
+
+def joint_intervals(s_joints: npt.ArrayLike, kinds: Sequence[str], curve_length: float) -> np.ndarray:
     """The [s1, s2] of Eqs. 5-6 for each joint (see the module notes, "Joint intervals"): (m, 2) m.
 
     s_joints (m,) arc lengths of the joints on the curve (increasing, within [0, curve_length]);
@@ -74,7 +76,7 @@ def joint_intervals(s_joints, kinds: Sequence[str], curve_length: float) -> np.n
     return out
 
 
-def discretize(curve: SpaceCurve, s_joints, kinds: Sequence[str], *, phi0: float = 0.0,
+def discretize(curve: SpaceCurve, s_joints: np.ndarray, kinds: Sequence[str], *, phi0: float = 0.0,
                end: float | None = None) -> np.ndarray:
     """Eqs. 3-6: the bending angle theta (rad) of each joint, theta_y for yaw joints and theta_p for pitch
     joints, integrated over :func:`joint_intervals` of the stretch [0, end] of the curve (default: all of
@@ -89,7 +91,7 @@ def discretize(curve: SpaceCurve, s_joints, kinds: Sequence[str], *, phi0: float
 
 
 def curve_joint_angles(robot: SnakeRobot, curve: SpaceCurve, joints: slice, *, s_start: float | None = None,
-                       phi0: float | None = None, frame0=None) -> np.ndarray:
+                       phi0: float | None = None, frame0: npt.ArrayLike | None = None) -> np.ndarray:
     """URDF joint angles (rad) of ``robot.joints[joints]`` that lay the body along ``curve``.
 
     Parameters

@@ -16,6 +16,8 @@ from .base_arc import (ArcOptimum, PlaneArc, _check_central_angle, _check_turn, 
 from .curves import SpaceCurve, _planar_bezier_length, cubic_bezier
 from .discretize import curve_joint_angles
 
+from typing import Any
+
 #: The default up curve's end point as shares of the neck and head's length (0.55 m and -0.10 m of 0.738 m on
 #: the default robot), so that the shape scales with any robot.
 HEIGHT_SHARE = 0.55 / 0.738
@@ -60,7 +62,7 @@ class UpCurveShape:
     tip_angle: float = math.radians(140.0)
     handle_ratio: float = 2.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         finite_array([self.height, self.reach, self.tip_angle, self.handle_ratio], "UpCurveShape", (4,))
         if self.height <= 0:
             raise ValueError(f"height must be > 0 m (the head is raised), got {self.height}")
@@ -211,8 +213,8 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
                            shape=shape, base=base, optimum=optimum)
 
 
-def _searched_backbone(robot: SnakeRobot, central_angle, base, turn: int, min_margin: float,
-                       first_error: ValueError) -> InitialBackbone:
+def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: BasePlacement | None, turn: int,
+                       min_margin: float, first_error: ValueError) -> InitialBackbone:
     """The backbone of SHAPE_SEARCH's shapes with the largest static margin (see :func:`initial_backbone`)."""
     from ..dynamics import stability
 
@@ -233,7 +235,7 @@ def _searched_backbone(robot: SnakeRobot, central_angle, base, turn: int, min_ma
     return best
 
 
-def initial_configuration(robot: SnakeRobot, **kwargs) -> np.ndarray:
+def initial_configuration(robot: SnakeRobot, **kwargs: Any) -> np.ndarray:
     """The initial configuration q (n,) of Section 3.3 (1); see :func:`initial_backbone` for the keyword
     arguments (central_angle, shape, base, turn, min_margin) and their defaults."""
     return initial_backbone(robot, **kwargs).q

@@ -25,6 +25,12 @@ from .._validate import joint_vector, positive, unit_vector3, vector3
 from ..kinematics.ik import TracIK
 from ..model.robot import BasePlacement, SnakeRobot
 
+import numpy.typing as npt
+from typing import TYPE_CHECKING, Any, Callable
+
+if TYPE_CHECKING:
+    from ..kinematics.workspace import ReachabilityMap
+
 
 @dataclass
 class HeadSolution:
@@ -65,10 +71,10 @@ class HeadController:
     solutions reproducible.
     """
 
-    def __init__(self, robot: SnakeRobot | None = None, workspace_map=None, base_pose: BasePlacement | None = None,
-                 *, method: str = "rotated", n_frames: int = 10, timeout: float = 0.005, epsilon: float = 1e-5,
-                 seed: int | None = None, slack: float | None = None, base_configuration=None,
-                 allow_base_move: bool = True):
+    def __init__(self, robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
+                 base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
+                 timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
+                 base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
         from .. import backbone  # late: heavier imports, only needed here
 
         self.robot = robot if robot is not None else SnakeRobot.default()
@@ -108,8 +114,9 @@ class HeadController:
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 
     # --- the process ---------------------------------------------------------------------------
-    def solve(self, position, direction, q_prev=None, base: BasePlacement | None = None,
-              accept=None, allow_base_move: bool | None = None) -> HeadSolution:
+    def solve(self, position: npt.ArrayLike, direction: npt.ArrayLike, q_prev: npt.ArrayLike | None = None,
+              base: BasePlacement | None = None, accept: Callable[..., bool] | None = None,
+              allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
         ``q_prev`` (16,): the current joints; the base keeps its shape from it and the neck and head start
@@ -159,7 +166,7 @@ class HeadController:
         return solution
 
     def _solve_from(self, base: BasePlacement, q: np.ndarray, desired: np.ndarray, keep_close: bool,
-                    accept=None) -> HeadSolution:
+                    accept: Callable[..., bool] | None = None) -> HeadSolution:
         """Steps 3-5 with the base where it is: the neck by Eqs. 18-22, the head by TRAC-IK, the static check."""
         timings: dict[str, float] = {}
         q = q.copy()
@@ -182,7 +189,7 @@ class HeadController:
         target = np.linalg.inv(neck.frame) @ desired
         q_close = q[parts.head].copy() if keep_close else None
 
-        def accepted(q_head) -> bool:
+        def accepted(q_head: Any) -> bool:
             if accept is None:
                 return True
             q_full = q.copy()
@@ -219,7 +226,7 @@ class HeadController:
                             neck=neck, head=head)
 
     @property
-    def body_problem(self):
+    def body_problem(self) -> Any:
         """The geometry the whole-body solve needs for this robot (``control.whole_body.BodyProblem``), made once."""
         if getattr(self, "_body_problem", None) is None:
             from .whole_body import BodyProblem

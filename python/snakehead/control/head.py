@@ -17,11 +17,15 @@ import numpy as np
 from .._validate import finite_array, pose, unit_vector3, vector3
 from ..kinematics.ik import TracIK
 
+import numpy.typing as npt
+from typing import Any, Callable
+
 #: Tolerances (vx vy vz wx wy wz, target frame) that leave the roll about the head's x-axis free.
 FREE_ROLL_BOUNDS = np.array([0.0, 0.0, 0.0, np.inf, 0.0, 0.0])
 
 
-def frame_from_direction(position, direction, up=(0.0, 0.0, 1.0)) -> np.ndarray:
+def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)
+                         ) -> np.ndarray:
     """A 4x4 frame at ``position`` (3,) whose x-axis is ``direction`` (3,), z as close to ``up`` as possible.
 
     When the direction is parallel to ``up``, world x (or y) is used instead, so every direction has a frame.
@@ -40,7 +44,7 @@ def frame_from_direction(position, direction, up=(0.0, 0.0, 1.0)) -> np.ndarray:
     return T
 
 
-def roll_about_x(T, angle: float) -> np.ndarray:
+def roll_about_x(T: npt.ArrayLike, angle: float) -> np.ndarray:
     """``T`` rotated by ``angle`` (rad) about its own x-axis (Fig. 9)."""
     c, s = np.cos(angle), np.sin(angle)
     R = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
@@ -49,14 +53,14 @@ def roll_about_x(T, angle: float) -> np.ndarray:
     return out
 
 
-def angle_between_deg(a, b) -> float:
+def angle_between_deg(a: Any, b: Any) -> float:
     """Angle (deg) between two directions (3,), e.g. an achieved and a desired head x-axis."""
     a, b = unit_vector3(a, "direction a"), unit_vector3(b, "direction b")
     cosang = float(np.clip(a @ b, -1.0, 1.0))
     return float(np.degrees(np.arccos(cosang)))
 
 
-def position_and_direction_error(achieved, desired) -> tuple[float, float]:
+def position_and_direction_error(achieved: npt.ArrayLike, desired: npt.ArrayLike) -> tuple[float, float]:
     """|p_a - p_d| (m) and the angle between the x-axes (deg) of two frames (4, 4)."""
     achieved, desired = np.asarray(achieved), np.asarray(desired)
     return float(np.linalg.norm(achieved[:3, 3] - desired[:3, 3])), angle_between_deg(achieved[:3, 0], desired[:3, 0])
@@ -86,7 +90,8 @@ def _roll_between(achieved: np.ndarray, desired: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(R[2, 1], R[1, 1])))
 
 
-def _finish(ik: TracIK, q, target, tried, solved, t0, candidates) -> HeadIKResult:
+def _finish(ik: TracIK, q: np.ndarray | None, target: Any, tried: int, solved: int, t0: float, candidates: list[Any]
+            ) -> HeadIKResult:
     if q is None:
         return HeadIKResult(None, None, np.inf, np.inf, np.nan, tried, solved, time.perf_counter() - t0, candidates)
     T = ik.fk(q)
@@ -94,7 +99,9 @@ def _finish(ik: TracIK, q, target, tried, solved, t0, candidates) -> HeadIKResul
     return HeadIKResult(q, T, pe, de, _roll_between(T, target), tried, solved, time.perf_counter() - t0, candidates)
 
 
-def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=None, accept=None) -> HeadIKResult:
+def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None = None,
+                   q_prev: npt.ArrayLike | None = None, accept: Callable[..., bool] | None = None
+                   ) -> HeadIKResult:
     """The paper's method: solve ``n_frames`` frames rolled evenly about the target's x-axis, keep one.
 
     ``target`` (4, 4) is the desired head frame in the head chain's base frame (its roll is the preferred
@@ -121,7 +128,7 @@ def rotated_frames(ik: TracIK, target, n_frames: int = 10, q_init=None, q_prev=N
     return _finish(ik, select(candidates, q_prev), target, int(n_frames), len(found), t0, candidates)
 
 
-def select(candidates, q_prev=None):
+def select(candidates: list[Any], q_prev: np.ndarray | None = None) -> Any:
     """The kept solution among (roll angle, q) candidates: closest to ``q_prev`` in joint space when given,
     else the least rolled from the desired frame. None when there is no candidate."""
     if not candidates:
@@ -131,7 +138,7 @@ def select(candidates, q_prev=None):
     return min(candidates, key=lambda c: abs(np.arctan2(np.sin(c[0]), np.cos(c[0]))))[1]
 
 
-def free_roll(ik: TracIK, target, q_init=None, attempts: int = 1) -> HeadIKResult:
+def free_roll(ik: TracIK, target: Any, q_init: npt.ArrayLike | None = None, attempts: int = 1) -> HeadIKResult:
     """One TRAC-IK call (or ``attempts`` calls from random seeds) with the roll about x left free."""
     target = pose(target, "target")
     n = ik.n_joints

@@ -15,6 +15,9 @@ from ..model.chain import Chain
 from .head import angle_between_deg
 from ..model.robot import BasePlacement
 
+import numpy.typing as npt
+from typing import Any, Callable
+
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
 #: How much lower (m^2) Eq. 22's cost from another start must be to leave the minimum reached from q_init.
@@ -32,7 +35,7 @@ class NeckGoal:
     P_d: np.ndarray  # Eq. 20: G0 - Lc r_d
 
 
-def neck_goal(P0, G0, Lc: float) -> NeckGoal:
+def neck_goal(P0: npt.ArrayLike, G0: npt.ArrayLike, Lc: float) -> NeckGoal:
     """Eqs. 19-20: r_d = (G0 - P0) / |G0 - P0|, P_d = G0 - Lc r_d. P0, G0 (3,) world, Lc (m)."""
     P0, G0 = vector3(P0, "P0"), vector3(G0, "G0")
     Lc = positive(Lc, "Lc")
@@ -44,7 +47,7 @@ def neck_goal(P0, G0, Lc: float) -> NeckGoal:
     return NeckGoal(P0=P0, G0=G0, Lc=Lc, r_d=r_d, P_d=G0 - Lc * r_d)
 
 
-def dexterous_distance(G0_local) -> float:
+def dexterous_distance(G0_local: npt.ArrayLike) -> float:
     """Eq. 18: L_c = |B0 - G0| with G0 given in the head's base frame B0 (3,) (m)."""
     return float(np.linalg.norm(vector3(G0_local, "G0 (head base frame)")))
 
@@ -60,7 +63,7 @@ class RangeCheck:
     reason: str
 
 
-def accepted_range(P_hd, P0, Lc: float, neck_length: float, slack: float) -> RangeCheck:
+def accepted_range(P_hd: npt.ArrayLike, P0: npt.ArrayLike, Lc: float, neck_length: float, slack: float) -> RangeCheck:
     """Section 3.3 (3): accepted iff  0 < sum(L_i) - (|P_hd - P0| - L_c) < L_0.
 
     The paper's condition lost its operators in print; we read it as: the neck (links summing to
@@ -91,7 +94,8 @@ class NeckSolution:
     direction_error_deg: float  # angle between r_a and r_d (deg)
 
 
-def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_init=None) -> NeckSolution:
+def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = DEFAULT_H,
+               q_init: npt.ArrayLike | None = None) -> NeckSolution:
     """Eq. 22: argmin |P_a - P_d|^2 + h |r_d x r_a|^2 over the neck joints within their limits.
 
     ``neck`` is the chain from the base's end frame (P0) to the neck end frame (B0); ``P0_frame`` (4, 4) is
@@ -116,7 +120,7 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
 
     model = neck.model  # the C++ model checks q itself; skipping the Python checks halves this loop's cost
 
-    def residual(q, with_jacobian=True):
+    def residual(q: np.ndarray, with_jacobian: bool = True) -> Any:
         T = model.fk(q)
         ra = R0 @ T[:3, 0]
         r = np.concatenate([R0 @ T[:3, 3] + p0 - goal.P_d, sqrt_h * (S_rd @ ra)])
@@ -139,6 +143,7 @@ def solve_neck(neck: Chain, P0_frame, goal: NeckGoal, h: float = DEFAULT_H, q_in
         # clearly better, so that nearby targets give nearby necks instead of jumping between minima.
         if k == 0 or cost < best_cost - CONTINUITY_TOLERANCE:
             best_q, best_cost = q, cost
+    assert best_q is not None  # starts holds at least one start
     T = P0_frame @ neck.fk(best_q)
     return NeckSolution(q=best_q, frame=T, cost=float(best_cost),
                         position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
@@ -149,7 +154,8 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float = 1e-9):
+def _bounded_least_squares(residual: Callable[..., Any], q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60,
+                           tol: float = 1e-9) -> Any:
     """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
     r, J = residual(q)
     cost = float(r @ r)
@@ -180,8 +186,8 @@ def _bounded_least_squares(residual, q, lo, hi, iterations: int = 60, tol: float
     return q, cost
 
 
-def base_move_into_range(P_hd, P0_local, base: BasePlacement, Lc: float, length: float, slack: float,
-                         height: float) -> BasePlacement | None:
+def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: BasePlacement, Lc: float, length: float,
+                         slack: float, height: float) -> BasePlacement | None:
     """The planar move of the base (as the rolling gait or turning in place would give) that brings P_hd in range.
 
     ``P0_local`` (4, 4) is P0's pose relative to the root frame (fixed while the base keeps its shape);

@@ -32,6 +32,12 @@ from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
+import numpy.typing as npt
+from typing import TYPE_CHECKING, Any, Sequence
+
+if TYPE_CHECKING:
+    from ..control.controller import HeadController
+
 #: Default required static margin of a solution (m).
 MIN_MARGIN = 0.005
 #: Default least gap between the boxes of two links that are not neighbours (m), and from obstacles.
@@ -92,12 +98,12 @@ class WholeBodySolution:
                 f"{1000 * self.ground_clearance_m:.1f} mm, self clearance {1000 * self.self_clearance_m:.1f} mm")
 
     @property
-    def neck_goal(self):
+    def neck_goal(self) -> Any:
         """Eqs. 18-20's goal of the segmented solve, when that solve is the solution (for Fig. 8)."""
         return getattr(self.segmented, "neck_goal", None) if self.stage == STAGES[0] else None
 
     @property
-    def neck(self):
+    def neck(self) -> Any:
         return getattr(self.segmented, "neck", None) if self.stage == STAGES[0] else None
 
 
@@ -105,7 +111,7 @@ class BodyProblem:
     """The geometry of one robot that the whole-body solve needs, computed once: which joints are free, which
     links lie on the ground, the links' capsules and the pairs that may collide."""
 
-    def __init__(self, robot: SnakeRobot):
+    def __init__(self, robot: SnakeRobot) -> None:
         self.robot = robot = as_robot(robot)
         n = robot.n_joints
         child = np.asarray(robot.body.model.joint_child_links)
@@ -137,7 +143,7 @@ class BodyProblem:
         self.head_index = robot.link_index(robot.parts.head_tip)
         self._iks: dict = {}
 
-    def lifted_ik(self, seed: int = 0):
+    def lifted_ik(self, seed: int = 0) -> Any:
         """TRAC-IK of the lifted chain (lift_frame -> head_tip), seeded (made once per seed)."""
         from ..kinematics.ik import TracIK
 
@@ -228,7 +234,7 @@ class BodyProblem:
         return margin, g
 
 
-def _segment_closest(p1, q1, p2, q2):
+def _segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> Any:
     """Closest points of segments [p1, q1], [p2, q2] (arrays (..., 3)): (s, t) parameters (Ericson 5.1.9)."""
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
     a = np.sum(d1 * d1, -1)
@@ -257,9 +263,9 @@ def _direction_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class _Objective:
     """The optimisation problem for one target, variables z = (free joints, [x, y, yaw] when the base moves)."""
 
-    def __init__(self, prob: BodyProblem, q_template: np.ndarray, base0: BasePlacement, position, direction,
-                 move_base: bool, obstacles, min_margin: float, self_clearance: float, obstacle_clearance: float,
-                 regularise: np.ndarray | None):
+    def __init__(self, prob: BodyProblem, q_template: np.ndarray, base0: BasePlacement, position: np.ndarray,
+                 direction: np.ndarray, move_base: bool, obstacles: Sequence[Any], min_margin: float,
+                 self_clearance: float, obstacle_clearance: float, regularise: np.ndarray | None) -> None:
         self.prob, self.r = prob, prob.robot
         self.q_template = q_template.copy()
         self.q_template[prob.flat] = 0.0
@@ -375,7 +381,7 @@ class _Objective:
         self._cache_z, self._cache = z.copy(), out
         return out
 
-    def objective(self, z):
+    def objective(self, z: np.ndarray) -> Any:
         e = self.evaluate(z)
         f = -e["margin"]
         if self.reg is not None:
@@ -383,7 +389,7 @@ class _Objective:
             f += 1e-3 * float(d @ d)
         return f
 
-    def objective_jac(self, z):
+    def objective_jac(self, z: np.ndarray) -> Any:
         e = self.evaluate(z)
         g = -e["margin_jac"].copy()
         if self.reg is not None:
@@ -391,11 +397,11 @@ class _Objective:
         return g
 
 
-def _distance_and_gradient(ob, pts: np.ndarray, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
     """An obstacle's distance at points (P, 3) and its gradient by central differences."""
     from ..geometry.obstacles import BoxObstacle
 
-    def dist(x):
+    def dist(x: np.ndarray) -> Any:
         if isinstance(ob, BoxObstacle):
             loc = (x - ob.centre) @ ob.rotation
             q = np.abs(loc) - ob.size / 2
@@ -413,8 +419,8 @@ def _distance_and_gradient(ob, pts: np.ndarray, h: float = 1e-6) -> tuple[np.nda
     return d0, g
 
 
-def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position, direction, obstacles=(),
-                   *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
+def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
+                   obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
                    obstacle_clearance: float = OBSTACLE_CLEARANCE) -> dict:
     """Exact checks of a configuration: head errors, static margin (support polygon of the boxes lying on the
     ground), lowest lifted box corner, separating-axis self clearance, obstacle clearance, and the verdict
@@ -441,10 +447,10 @@ def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, positi
             "ground_clearance_m": ground, "self_clearance_m": selfc, "obstacle_clearance_m": obst, "reason": reason}
 
 
-def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position, direction, *, move_base: bool,
-           obstacles=(), min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
-           obstacle_clearance: float = OBSTACLE_CLEARANCE, max_iterations: int = MAX_ITERATIONS
-           ) -> tuple[np.ndarray, BasePlacement]:
+def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np.ndarray, direction: np.ndarray, *,
+           move_base: bool, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
+           self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
+           max_iterations: int = MAX_ITERATIONS) -> tuple[np.ndarray, BasePlacement]:
     """One SLSQP run from (q0, base0): the configuration and placement it ends at."""
     obj = _Objective(prob, q0, base0, position, direction, move_base, obstacles, min_margin, self_clearance,
                      obstacle_clearance, None)
@@ -458,10 +464,10 @@ def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position, di
     return obj.unpack(res.x)
 
 
-def solve_whole_body(robot: SnakeRobot, position, direction, starts, *, move_base: bool = True, obstacles=(),
-                     min_margin: float = MIN_MARGIN, self_clearance: float = SELF_CLEARANCE,
-                     obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None,
-                     time_budget: float = 3.0) -> WholeBodySolution:
+def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: Sequence[Any], *,
+                     move_base: bool = True, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
+                     self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
+                     problem: BodyProblem | None = None, time_budget: float = 3.0) -> WholeBodySolution:
     """The whole-body solve from ``starts``, a sequence of (q (n,), BasePlacement) in the order to try; the first
     whose refined solution passes every exact check is returned (stage "whole-body, base kept" when its base is
     the first start's, else "whole-body, base moved"), else the best attempt with the reason it fails.
@@ -502,7 +508,7 @@ def solve_whole_body(robot: SnakeRobot, position, direction, starts, *, move_bas
                              seconds=time.perf_counter() - t0)
 
 
-def _base_shapes(controller) -> list[np.ndarray]:
+def _base_shapes(controller: HeadController) -> list[np.ndarray]:
     """Base joint vectors to start from besides the controller's: its arc turned the other way, a straight base,
     and arcs of a half and of one and a half times its central angle."""
     robot = controller.robot
@@ -517,8 +523,8 @@ CANDIDATE_ROLLS = 8
 CANDIDATE_SEEDS = 2
 
 
-def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position, direction,
-                      seed: int = 0) -> list[np.ndarray]:
+def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray,
+                      direction: np.ndarray, seed: int = 0) -> list[np.ndarray]:
     """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
     chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
     frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
@@ -544,8 +550,8 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     return out
 
 
-def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position, direction, seed: int
-                   ) -> np.ndarray | None:
+def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, position: np.ndarray,
+                   direction: np.ndarray, seed: int) -> np.ndarray | None:
     """The lifted chain's IK from the current joints, the roll about the direction free: the nearest solution."""
     from ..kinematics.ik import FREE_ROLL
     from .head import frame_from_direction
@@ -563,7 +569,8 @@ def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, po
     return q
 
 
-def solve_target(controller, position, direction, *, q_prev=None, base: BasePlacement | None = None, obstacles=(),
+def solve_target(controller: HeadController, position: npt.ArrayLike, direction: npt.ArrayLike, *,
+                 q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None, obstacles: Sequence[Any] = (),
                  allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
                  problem: BodyProblem | None = None, seed: int = 0, near: bool = False) -> WholeBodySolution:
     """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
@@ -594,10 +601,10 @@ def solve_target(controller, position, direction, *, q_prev=None, base: BasePlac
     prob = problem if problem is not None else BodyProblem(robot)
     obstacles = list(obstacles)
 
-    def check(q, b):
+    def check(q: np.ndarray, b: Any) -> Any:
         return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin)
 
-    def solution(q, b, chk, stage, starts):
+    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: int) -> Any:
         return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
                                  position_error_m=chk["position_error_m"],
                                  direction_error_deg=chk["direction_error_deg"],
@@ -606,14 +613,14 @@ def solve_target(controller, position, direction, *, q_prev=None, base: BasePlac
                                  obstacle_clearance_m=chk["obstacle_clearance_m"], starts=starts,
                                  seconds=time.perf_counter() - t0)
 
-    def accept(q, b):
+    def accept(q: np.ndarray, b: Any) -> Any:
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
     best = None
     seg_holder = [None]
 
-    def consider(q, b, stage, starts):
+    def consider(q: np.ndarray, b: Any, stage: str, starts: int) -> Any:
         """Check a configuration; keep the best attempt; return the solution when it passes."""
         nonlocal best
         chk = check(q, b)
@@ -680,7 +687,8 @@ def solve_target(controller, position, direction, *, q_prev=None, base: BasePlac
     return best
 
 
-def placements(prob: BodyProblem, P0_local: np.ndarray, position, direction) -> list[BasePlacement]:
+def placements(prob: BodyProblem, P0_local: np.ndarray, position: np.ndarray, direction: np.ndarray
+               ) -> list[BasePlacement]:
     """Base placements that put the frame the neck lifts from (``P0_local``: its pose in the root frame, for the
     base's shape) a few horizontal distances short of the target, its body axis pointing at the target along the
     head's direction or its opposite's horizontal part: where the lifted chain can reach the target whatever its

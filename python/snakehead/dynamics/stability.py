@@ -22,6 +22,8 @@ from .. import _core
 from .._validate import finite_array, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
+import numpy.typing as npt
+
 #: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
 GRAVITY = 9.80665
 
@@ -38,7 +40,7 @@ CONTACT_MODELS = ("endpoints", "footprint", "ground")
 # ------------------------------------------------------------------------------------------------
 
 
-def _joint_matrix(robot: SnakeRobot, q, name: str = "q") -> tuple[np.ndarray, bool]:
+def _joint_matrix(robot: SnakeRobot, q: npt.ArrayLike, name: str = "q") -> tuple[np.ndarray, bool]:
     """q as (T, n) and whether it was a single vector (n,)."""
     a = finite_array(q, name)
     n = robot.n_joints
@@ -92,7 +94,7 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     return pts, active
 
 
-def polygon_margin_many(points, active, xy) -> np.ndarray:
+def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.ArrayLike) -> np.ndarray:
     """Signed distance (m) of ``xy`` to the convex hull of the active ``points``, positive inside.
 
     points (T, N, 2), active (T, N) bool, xy (T, 2) -> (T,). Inside a convex polygon the distance to its
@@ -112,7 +114,7 @@ def polygon_margin_many(points, active, xy) -> np.ndarray:
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
-def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> np.ndarray:
+def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
 
     q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3).
@@ -136,7 +138,7 @@ def center_of_mass(robot: SnakeRobot, q, base: BasePlacement | None = None) -> n
 # ------------------------------------------------------------------------------------------------
 # Eq. 24: support polygon
 # ------------------------------------------------------------------------------------------------
-def hull_indices(pts: np.ndarray) -> list[int]:
+def hull_indices(pts: npt.ArrayLike) -> list[int]:
     """Indices of the counter-clockwise convex hull vertices of 2-D points (N, 2), collinear points on edges left
     out (the C++ core's monotone chain): one index for coincident points, the two extremes for collinear points."""
     return list(_core.convex_hull(finite_array(pts, "points", (None, 2))))
@@ -147,7 +149,7 @@ def _hull_ccw(pts: np.ndarray) -> np.ndarray:
     return np.asarray(pts, float)[hull_indices(pts)]
 
 
-def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+def support_polygon(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
                     contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
     """Support polygon of the base part on the ground, Eq. 24: (k, 2) world (x, y) vertices, counter-clockwise.
 
@@ -178,7 +180,7 @@ def support_polygon(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     return _hull_ccw(pts)
 
 
-def static_margin(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+def static_margin(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
                   contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> float:
     """Signed distance (m) from the CoM's ground projection to the support polygon's edge; > 0 inside.
 
@@ -193,7 +195,7 @@ def static_margin(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
     return float(polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), c[None, :2])[0])
 
 
-def is_statically_stable(robot: SnakeRobot, q, base: BasePlacement | None = None, *,
+def is_statically_stable(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
                          contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
                          margin: float = 0.0) -> bool:
     """True when the CoM's ground projection lies inside the support polygon by more than ``margin`` m."""
@@ -203,7 +205,7 @@ def is_statically_stable(robot: SnakeRobot, q, base: BasePlacement | None = None
 # ------------------------------------------------------------------------------------------------
 # Eqs. 25-31: momenta
 # ------------------------------------------------------------------------------------------------
-def _check_times(t, name: str = "t") -> np.ndarray:
+def _check_times(t: npt.ArrayLike, name: str = "t") -> np.ndarray:
     t = finite_array(t, name, (None,))
     if t.shape[0] < 2:
         raise ValueError(f"{name} needs at least two samples, got {t.shape[0]}")
@@ -212,7 +214,7 @@ def _check_times(t, name: str = "t") -> np.ndarray:
     return t
 
 
-def _check_trajectory(robot: SnakeRobot, t, q) -> tuple[np.ndarray, np.ndarray]:
+def _check_trajectory(robot: SnakeRobot, t: np.ndarray, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     t = _check_times(t)
     q = finite_array(q, "q", (None, robot.n_joints))
     if q.shape[0] != t.shape[0]:
@@ -220,7 +222,7 @@ def _check_trajectory(robot: SnakeRobot, t, q) -> tuple[np.ndarray, np.ndarray]:
     return t, q
 
 
-def joint_velocities(t, q) -> np.ndarray:
+def joint_velocities(t: np.ndarray, q: npt.ArrayLike) -> np.ndarray:
     """Joint velocities (rad/s) of a sampled trajectory by finite differences: (T,) and (T, n) -> (T, n).
 
     ``np.gradient``: central differences inside (second order on non-uniform steps too), second-order
@@ -287,7 +289,7 @@ def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlaceme
     return Pw, Lw, cw
 
 
-def momenta_from_velocities(robot: SnakeRobot, q, qd, base: BasePlacement | None = None
+def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement | None = None
                             ) -> tuple[np.ndarray, np.ndarray]:
     """Linear momentum P (kg m/s) and angular momentum L about the world origin (kg m^2/s), Eqs. 25-31.
 
@@ -304,8 +306,8 @@ def momenta_from_velocities(robot: SnakeRobot, q, qd, base: BasePlacement | None
     return (P[0], L[0]) if single else (P, L)
 
 
-def momenta(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None
-            ) -> tuple[np.ndarray, np.ndarray]:
+def momenta(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
+            qd: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Momenta along a sampled trajectory, Eqs. 25-31: t (T,) s, q (T, 16) rad -> P (T, 3), L (T, 3).
 
     P in kg m/s; L in kg m^2/s about the world origin. The joint velocities are ``qd`` when given (e.g. a
@@ -332,7 +334,8 @@ def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz:
     return np.stack([px, py], axis=1)
 
 
-def _zmp(robot: SnakeRobot, t, q, base, qd) -> tuple[np.ndarray, ...]:
+def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None
+         ) -> tuple[np.ndarray, ...]:
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     P, L, com = _momenta(robot, q, qd, base)
@@ -342,7 +345,8 @@ def _zmp(robot: SnakeRobot, t, q, base, qd) -> tuple[np.ndarray, ...]:
     return _zmp_from(com, Pdot, Ldot, robot.total_mass), P, L, com, q
 
 
-def zmp(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None) -> np.ndarray:
+def zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: np.ndarray | None = None
+        ) -> np.ndarray:
     """Zero-moment point on the ground along a trajectory, Eqs. 36-40 with p_z = 0: (T, 2) world (x, y), m.
 
     The time derivatives of P and L (Eqs. 33, 34) are taken numerically along the samples (np.gradient);
@@ -375,9 +379,9 @@ class DynamicStability:
     com: np.ndarray
 
 
-def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None, qd=None, *,
-                      contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
-                      frames: np.ndarray | None = None) -> DynamicStability:
+def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
+                      qd: npt.ArrayLike | None = None, *, contact: str = "endpoints",
+                      tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None) -> DynamicStability:
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
     The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
@@ -397,8 +401,9 @@ def dynamic_stability(robot: SnakeRobot, t, q, base: BasePlacement | None = None
     return DynamicStability(p, margin, inside, float(margin[k]), k, bool(inside.all()), P, L, com)
 
 
-def support_margins(robot: SnakeRobot, q, xy, base: BasePlacement | None = None, *, contact: str = "endpoints",
-                    tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None) -> np.ndarray:
+def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base: BasePlacement | None = None, *,
+                    contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                    frames: np.ndarray | None = None) -> np.ndarray:
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 

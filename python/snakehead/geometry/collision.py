@@ -18,12 +18,15 @@ from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .obstacles import BoxObstacle, WallWithHole
 
+import numpy.typing as npt
+from typing import Any, Sequence
+
 #: A link whose box dips lower than this below the ground (m) is driven into it by the plan; a box within
 #: this distance of the ground touches it (the base lies at exactly 0).
 GROUND_TOLERANCE = 1e-3
 
 
-def _trajectory(robot: SnakeRobot, qs) -> np.ndarray:
+def _trajectory(robot: SnakeRobot, qs: npt.ArrayLike) -> np.ndarray:
     a = finite_array(qs, "qs")
     if a.ndim == 1:
         a = a[None, :]
@@ -32,7 +35,7 @@ def _trajectory(robot: SnakeRobot, qs) -> np.ndarray:
     return a
 
 
-def ground_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -> np.ndarray:
+def ground_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
     """Height (m) of the lowest corner of every link's collision box above the ground: (T, n_links).
 
     qs (T, 16) (or (16,) -> (1, n_links)). Negative values are below the ground. The base links lying flat are
@@ -48,7 +51,7 @@ def ground_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -
     return out
 
 
-def below_ground(robot: SnakeRobot, qs, base: BasePlacement | None = None,
+def below_ground(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None,
                  tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
     """(T, n_links) bool: the neck and head links whose boxes go deeper than ``tolerance`` m into the ground.
 
@@ -62,7 +65,7 @@ def below_ground(robot: SnakeRobot, qs, base: BasePlacement | None = None,
     return out
 
 
-def touching_ground(robot: SnakeRobot, qs, base: BasePlacement | None = None,
+def touching_ground(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None,
                     tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
     """(T, n_links) bool: the neck and head links whose boxes come within ``tolerance`` m of the ground (or
     below it). The base links, which lie on the ground, are never flagged."""
@@ -82,7 +85,7 @@ _EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)
                    if np.count_nonzero(_SIGNS[a] != _SIGNS[b]) == 1])  # (12, 2) vertex pairs
 
 
-def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement):
+def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """World collision boxes of the links along a trajectory: links (k,), centres (T, k, 3), rotations
     (T, k, 3, 3), half extents (k, 3)."""
     links = robot.boxed_links
@@ -90,7 +93,7 @@ def _link_boxes(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement):
     return links, B[..., :3, 3], B[..., :3, :3], 0.5 * robot.box_sizes[links]
 
 
-def self_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -> np.ndarray:
+def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
     """Self-collision of the body along a trajectory: (T,) the smallest separating-axis gap (m) between the
     collision boxes of any two links that are not neighbours in the chain (neighbours share a joint and
     always touch there). > 0: no two such boxes meet (and this is a lower bound of their distance); <= 0: some
@@ -105,7 +108,7 @@ def self_clearance(robot: SnakeRobot, qs, base: BasePlacement | None = None) -> 
     return gaps.min(axis=1)
 
 
-def _broadcast_boxes(ca, Ra, ha, cb, Rb, hb):
+def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> list[np.ndarray]:
     """Broadcast two batches of boxes (centres (..., 3), rotations (..., 3, 3), half extents (..., 3))."""
     arrs = [np.asarray(v, float) for v in (ca, Ra, ha, cb, Rb, hb)]
     core = [(3,), (3, 3), (3,), (3,), (3, 3), (3,)]
@@ -116,7 +119,8 @@ def _broadcast_boxes(ca, Ra, ha, cb, Rb, hb):
     return [np.broadcast_to(a, batch + cs) for a, cs in zip(arrs, core)]
 
 
-def box_box_sat(ca, Ra, ha, cb, Rb, hb) -> np.ndarray:
+def box_box_sat(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray
+                ) -> np.ndarray:
     """Separating-axis test of boxes A (centres (..., 3), rotations (..., 3, 3), half extents (..., 3)) and B.
 
     Returns the largest gap (m) over the 15 candidate axes (3 + 3 face normals, 9 edge cross products): > 0 the
@@ -147,13 +151,13 @@ def box_box_sat(ca, Ra, ha, cb, Rb, hb) -> np.ndarray:
     return np.max(np.stack(gaps, axis=-1), axis=-1)
 
 
-def _point_box_distance(p, c, R, h) -> np.ndarray:
+def _point_box_distance(p: np.ndarray, c: np.ndarray, R: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Distance (m) of points p (..., 3) to boxes (c (..., 3), R (..., 3, 3), h (..., 3)); 0 inside."""
     loc = np.einsum("...ik,...i->...k", R, p - c)
     return np.linalg.norm(np.maximum(np.abs(loc) - h, 0.0), axis=-1)
 
 
-def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
+def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
     """Distance between segments [p1, q1] and [p2, q2], arrays (..., 3) (Ericson, Real-Time Collision
     Detection, 5.1.9), vectorised, degenerate segments included."""
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
@@ -177,7 +181,8 @@ def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
     return np.linalg.norm(diff, axis=-1)
 
 
-def box_box_distance(ca, Ra, ha, cb, Rb, hb) -> np.ndarray:
+def box_box_distance(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray
+                     ) -> np.ndarray:
     """Signed distance (m) between boxes A and B (shapes as :func:`box_box_sat`): exact when apart (the
     smallest of vertex-box and edge-edge distances, which covers every closest-feature pair of two convex
     polyhedra), minus the separating-axis penetration depth when they intersect."""
@@ -195,7 +200,7 @@ def box_box_distance(ca, Ra, ha, cb, Rb, hb) -> np.ndarray:
     return np.where(sat > 0.0, d, sat)
 
 
-def box_wall_collision(c, R, h, wall: WallWithHole) -> np.ndarray:
+def box_wall_collision(c: np.ndarray, R: np.ndarray, h: np.ndarray, wall: WallWithHole) -> np.ndarray:
     """Exact intersection test of boxes (c (..., 3), R (..., 3, 3), h (..., 3)) with a wall's solid: (...) bool.
 
     The box meets the solid (slab minus the hole's cylinder) exactly when it meets the slab (separating axes)
@@ -255,7 +260,7 @@ class CollisionReport:
     links: np.ndarray
 
 
-def collision_check(robot: SnakeRobot, qs, obstacles, base: BasePlacement | None = None, *,
+def collision_check(robot: SnakeRobot, qs: np.ndarray, obstacles: Sequence[Any], base: BasePlacement | None = None, *,
                     exact_within: float = 0.05, spacing: float = 0.004) -> CollisionReport:
     """Collisions of every link's collision box with obstacles along a trajectory qs (T, 16).
 
@@ -312,4 +317,4 @@ def collision_check(robot: SnakeRobot, qs, obstacles, base: BasePlacement | None
                 d[rows, li] = ob.distance_to_points(p).min(axis=1)
             d = np.where(collide, 0.0, d)
         dist[..., o], hit[..., o] = d, collide
-    return CollisionReport(dist.min(axis=(1, 2)), hit.any(axis=(1, 2)), dist, hit, links)
+    return CollisionReport(dist.min(axis=(1, 2)), np.asarray(hit.any(axis=(1, 2))), dist, hit, links)

@@ -9,6 +9,8 @@ import numpy as np
 
 from .._validate import finite_array, finite_float, positive, rotation_matrix, unit_vector3, vector3
 
+import numpy.typing as npt
+
 
 @dataclass(frozen=True)
 class BoxObstacle:
@@ -18,7 +20,7 @@ class BoxObstacle:
     size: np.ndarray
     rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "centre", vector3(self.centre, "box centre"))
         size = vector3(self.size, "box size")
         if np.any(size <= 0):
@@ -27,11 +29,11 @@ class BoxObstacle:
         object.__setattr__(self, "rotation", rotation_matrix(self.rotation, "box rotation"))
 
     @classmethod
-    def from_yaw(cls, centre, size, yaw: float = 0.0) -> "BoxObstacle":
+    def from_yaw(cls, centre: npt.ArrayLike, size: npt.ArrayLike, yaw: float = 0.0) -> "BoxObstacle":
         """A box standing upright, turned by ``yaw`` rad about the world z-axis."""
         yaw = finite_float(yaw, "box yaw")
         c, s = np.cos(yaw), np.sin(yaw)
-        return cls(centre, size, np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
+        return cls(np.asarray(centre, float), np.asarray(size, float), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
 
 
 @dataclass(frozen=True)
@@ -51,7 +53,7 @@ class WallWithHole:
     hole_diameter: float
     hole_offset: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "centre", vector3(self.centre, "wall centre"))
         object.__setattr__(self, "normal", unit_vector3(self.normal, "wall normal"))
         size = vector3(self.size, "wall size (w, h, thickness)")
@@ -66,7 +68,8 @@ class WallWithHole:
             raise ValueError("the hole does not lie inside the wall")
 
     @classmethod
-    def standing(cls, hole_centre, normal, size, hole_diameter: float) -> "WallWithHole":
+    def standing(cls, hole_centre: npt.ArrayLike, normal: npt.ArrayLike, size: npt.ArrayLike, hole_diameter: float
+                 ) -> "WallWithHole":
         """A wall standing on the ground (its bottom at z = 0) with the hole on its vertical centre line, facing
         along the horizontal ``normal``: the paper's wall of Section 4.2 as snakehead places it."""
         normal = unit_vector3(normal, "wall normal")

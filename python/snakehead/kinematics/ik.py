@@ -21,12 +21,15 @@ from .. import _core
 from .._validate import ORTHONORMAL_TOLERANCE, finite_array, joint_vector, pose as check_pose, positive
 from ..model.chain import Chain
 
+import numpy.typing as npt
+from typing import Any
+
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
 #: Bounds that leave the roll about the target's x-axis free.
 FREE_ROLL = (0.0, 0.0, 0.0, np.inf, 0.0, 0.0)
 
 
-def _bounds(bounds) -> np.ndarray:
+def _bounds(bounds: Any) -> np.ndarray:
     try:
         b = np.asarray(bounds, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -38,7 +41,7 @@ def _bounds(bounds) -> np.ndarray:
     return b
 
 
-def _pose(T, name: str = "pose") -> np.ndarray:
+def _pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
     """``T`` as a valid 4x4 pose. The common case (a valid float64 array) is checked in plain Python, several
     times faster than the numpy checks of ``_validate.pose`` for one small matrix; anything that fails here
     goes to ``_validate.pose``, whose message says what is wrong (same tolerances)."""
@@ -56,7 +59,7 @@ def _pose(T, name: str = "pose") -> np.ndarray:
     return check_pose(T, name)
 
 
-def _seed(seed) -> int | None:
+def _seed(seed: int | None) -> int | None:
     if seed is None:
         return None
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
@@ -76,12 +79,12 @@ class TracIK:
     """
 
     def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = 0.005,
-                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds=None):
+                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds: Any = None) -> None:
         self._init(Chain.from_urdf(urdf, base, tip), timeout, epsilon, solve_type, seed, bounds)
 
     @classmethod
     def from_chain(cls, chain: Chain, timeout: float = 0.005, epsilon: float = 1e-5, solve_type: str = "Speed",
-                   seed: int | None = None, bounds=None) -> "TracIK":
+                   seed: int | None = None, bounds: Any = None) -> "TracIK":
         """A solver for an existing :class:`Chain` (its model is copied into the solver)."""
         if not isinstance(chain, Chain):
             raise TypeError(f"chain must be a snakehead.Chain, got {type(chain).__name__}")
@@ -89,7 +92,8 @@ class TracIK:
         self._init(chain, timeout, epsilon, solve_type, seed, bounds)
         return self
 
-    def _init(self, chain, timeout, epsilon, solve_type, seed, bounds):
+    def _init(self, chain: Chain, timeout: float, epsilon: float, solve_type: str, seed: int | None, bounds: Any
+              ) -> None:
         if solve_type not in SOLVE_TYPES:
             raise ValueError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
         self._chain = chain
@@ -136,11 +140,11 @@ class TracIK:
         return self._solver.seed
 
     # --- solving -----------------------------------------------------------------------------
-    def fk(self, q) -> np.ndarray:
+    def fk(self, q: npt.ArrayLike) -> np.ndarray:
         """Pose of the tip in the base frame, (4, 4)."""
         return self._solver.fk(joint_vector(q, self.n_joints))
 
-    def _q_init(self, q_init, name="q_init") -> np.ndarray:
+    def _q_init(self, q_init: npt.ArrayLike, name: str = "q_init") -> np.ndarray:
         if isinstance(q_init, np.ndarray) and q_init.shape == (self.n_joints,) and q_init.dtype == np.float64:
             # The common case in plain Python (faster than numpy's reductions for a few values).
             if all(lo - 1e-9 <= v <= hi + 1e-9 for v, lo, hi in zip(q_init.tolist(), self._lo, self._hi)):
@@ -162,7 +166,7 @@ class TracIK:
         # identical calls get identical starts (and results); without one, the solver's running generator.
         return self._rng if self.seed is None else np.random.default_rng(self.seed)
 
-    def ik(self, pose, q_init=None, bounds=None) -> np.ndarray | None:
+    def ik(self, pose: np.ndarray, q_init: np.ndarray | None = None, bounds: Any = None) -> np.ndarray | None:
         """Joint angles putting the tip at ``pose`` (4x4, base frame), or None if none was found in time.
 
         ``q_init``: the start (and the reference of ``Distance``); random within the limits when omitted (with a
@@ -172,7 +176,8 @@ class TracIK:
         found, q, _ = self.ik_ex(pose, q_init, bounds)
         return q if found else None
 
-    def ik_ex(self, pose, q_init=None, bounds=None, algorithm: str = "TRAC-IK", timeout: float | None = None):
+    def ik_ex(self, pose: npt.ArrayLike, q_init: npt.ArrayLike | None = None, bounds: Any = None,
+              algorithm: str = "TRAC-IK", timeout: float | None = None) -> Any:
         """(found, q, seconds): like :meth:`ik`, with the wall-clock time of the C++ call, a per-call timeout,
         and a choice of ``algorithm`` ("TRAC-IK", or for comparisons "KDL-RR" or "SQP" alone)."""
         T = _pose(pose)
@@ -183,7 +188,7 @@ class TracIK:
             raise ValueError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
         return self._solver.ik(T, q, b, t, algorithm)
 
-    def ik_many(self, poses, q_inits=None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Solve many targets across all cores: poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
 
         Rows of ``q`` where ``ok`` is False hold the start configuration. With a seed, target k's search
@@ -207,6 +212,6 @@ class TracIK:
                 f"{self.solve_type}, timeout={self.timeout:g} s, epsilon={self.epsilon:g})")
 
 
-def pose_error(target, current) -> np.ndarray:
+def pose_error(target: Any, current: Any) -> np.ndarray:
     """The IK pose error (vx vy vz wx wy wz) of ``current`` relative to ``target``, in the target's frame."""
     return _core.pose_error(check_pose(target, "target"), check_pose(current, "current"))

@@ -21,12 +21,17 @@ import os
 from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
 import numpy as np
 
 from .. import _core
 from ..model.chain import Chain
+
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
+
+import numpy.typing as npt
 
 FORMAT = "snakehead-reachability-1"
 #: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
@@ -104,7 +109,7 @@ class ReachabilityMap:
         pct = 100.0 * counts / max(len(self), 1)
         return counts, pct
 
-    def index_at(self, points) -> np.ndarray:
+    def index_at(self, points: npt.ArrayLike) -> np.ndarray:
         """Index of the voxel containing each point (0 outside the map's voxels), (k,) for (k, 3) points."""
         p = np.atleast_2d(np.asarray(points, dtype=float))
         if p.shape[-1] != 3 or not np.all(np.isfinite(p)):
@@ -228,15 +233,16 @@ class ReachabilityMap:
                 f"{self.params['directions']} directions{s}, mean index {self.indices.mean() if len(self) else 0:.1f})")
 
 
-def _param_equal(a, b) -> bool:
+def _param_equal(a: Any, b: Any) -> bool:
     if isinstance(a, float) or isinstance(b, float):
         return float(a) == float(b)
     return a == b
 
 
 # --- computing -------------------------------------------------------------------------------------------
-def _options(voxel, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, cloud_samples, seed,
-             threads, shard) -> _core.WorkspaceOptions:
+def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: str,
+             timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any
+             ) -> _core.WorkspaceOptions:
     o = _core.WorkspaceOptions()
     for name, value in (("directions", directions), ("rolls", rolls), ("cloud_samples", cloud_samples),
                         ("seed", seed)):
@@ -265,7 +271,7 @@ def _options(voxel, directions, rolls, any_roll, free_roll, approach_axis, timeo
     return o
 
 
-def _parse_shard(shard) -> tuple[int, int]:
+def _parse_shard(shard: Any) -> tuple[int, int]:
     if shard is None:
         return 0, 1
     if isinstance(shard, str):
@@ -283,7 +289,7 @@ def _parse_shard(shard) -> tuple[int, int]:
     return i, n
 
 
-def _resolve_chain(chain_or_robot) -> Chain:
+def _resolve_chain(chain_or_robot: Chain | SnakeRobot) -> Chain:
     from ..model.robot import SnakeRobot
 
     if isinstance(chain_or_robot, SnakeRobot):
@@ -326,11 +332,11 @@ def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, cou
     return _from_result(d, o, f"snakehead.workspace.compute(shard={index}/{count})")
 
 
-def compute(chain_or_robot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4, any_roll: bool = True,
-            free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4, epsilon: float = 1e-5,
-            cloud_samples: int = 50000, seed: int = 1, threads: int | None = None, shard=None,
-            executor: Executor | None = None, shards: int | None = None, urdf: str | os.PathLike | None = None,
-            progress: bool = True) -> ReachabilityMap:
+def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
+            any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
+            epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, threads: int | None = None,
+            shard: Any = None, executor: Executor | None = None, shards: int | None = None,
+            urdf: str | os.PathLike | None = None, progress: bool = True) -> ReachabilityMap:
     """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
 
     voxel: voxel edge (m); directions: points per voxel sphere; rolls: frames about the approach axis per
@@ -386,12 +392,12 @@ def compute(chain_or_robot, *, voxel: float = 0.05, directions: int = 20, rolls:
     return merged
 
 
-def _default_shards(executor) -> int:
+def _default_shards(executor: Any) -> int:
     workers = getattr(executor, "_max_workers", None)
     return 4 * int(workers) if isinstance(workers, int) and workers > 0 else 8
 
 
-def _urdf_text(chain_or_robot, urdf) -> str:
+def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str]) -> str:
     source = urdf if urdf is not None else getattr(chain_or_robot, "urdf", None)
     if source is None:
         raise ValueError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
@@ -407,7 +413,7 @@ def _urdf_text(chain_or_robot, urdf) -> str:
         raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
 
 
-def _bar(progress: bool, total: int, unit: str):
+def _bar(progress: bool, total: int, unit: str) -> Any:
     if not progress:
         return None
     from tqdm.auto import tqdm
@@ -415,14 +421,14 @@ def _bar(progress: bool, total: int, unit: str):
     return tqdm(total=total, unit=unit, desc="reachability", leave=False)
 
 
-def _compute_local(chain: Chain, options, progress: bool) -> ReachabilityMap:
+def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMap:
     bar = _bar(progress, 0, "voxel")
 
-    def callback(done, total):  # called about every 0.1 s; the binding checks for Ctrl-C before each call
+    def callback(done: int, total: int) -> bool:  # called about every 0.1 s; the binding checks for Ctrl-C before each call
         return True
 
     if bar is not None:
-        def callback(done, total):
+        def callback(done: int, total: int) -> bool:
             if bar.total != total:
                 bar.total = total
                 bar.refresh()
@@ -436,9 +442,9 @@ def _compute_local(chain: Chain, options, progress: bool) -> ReachabilityMap:
     return _from_result(d, options, "snakehead.workspace.compute")
 
 
-def evaluate(chain_or_robot, centers, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
-             any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
-             epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
+def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = 0.05, directions: int = 20,
+             rolls: int = 4, any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x",
+             timeout: float = 3e-4, epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
     """Reachability index of voxels at arbitrary centres, each on its own (random initial guesses only).
 
     An independent check of a map (e.g. with a long timeout on a sample of its voxels), (k,) for (k, 3).
@@ -506,7 +512,7 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
         if "format" not in z.files or str(z["format"]) != FORMAT:
             raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
 
-        def scalar(k, cast):
+        def scalar(k: str, cast: Callable[[Any], Any]) -> Any:
             return cast(z[k][()])
 
         params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")
@@ -579,7 +585,7 @@ def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
     )
 
 
-def default_map_options(chain_or_robot) -> dict:
+def default_map_options(chain_or_robot: Chain | SnakeRobot) -> dict:
     """Options of :func:`compute` for a robot's head that has no map yet: the shipped maps' parameters (20
     directions x 4 rolls, 0.3 ms per IK call), with voxels scaled to the head (a twelfth of its reach, 0.05 m on
     the default robot's 7-DOF head, rounded to 5 mm) so that every head gets a grid of about the same size."""
@@ -597,7 +603,7 @@ def cache_dir() -> Path:
     return Path(base) / "snakehead"
 
 
-def map_for(robot, *, progress: bool = True, cache: bool = True, **options) -> ReachabilityMap:
+def map_for(robot: SnakeRobot, *, progress: bool = True, cache: bool = True, **options: Any) -> ReachabilityMap:
     """The reachability map of a robot's head: the robot file's map when it has one; else a map computed earlier
     for this head chain and these options (cached under :func:`cache_dir`); else one computed now (with a
     progress bar; :func:`default_map_options` unless ``options`` say otherwise) and cached. The map's ``path``
@@ -641,7 +647,7 @@ def fibonacci_directions(n: int) -> np.ndarray:
     return _core.fibonacci_directions(int(n))
 
 
-def approach_frame(point, direction, roll: float = 0.0, axis: str = "x") -> np.ndarray:
+def approach_frame(point: npt.ArrayLike, direction: npt.ArrayLike, roll: float = 0.0, axis: str = "x") -> np.ndarray:
     """The sweep's frame at ``point`` whose ``axis`` ('x' or 'z') is ``direction``, rolled by ``roll`` rad, (4, 4)."""
     from .._validate import finite_array
 

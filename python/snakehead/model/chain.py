@@ -8,6 +8,8 @@ import numpy as np
 from .. import _core
 from .._validate import finite_array, joint_vector
 
+import numpy.typing as npt
+
 
 class Chain:
     """An immutable kinematic chain from ``base`` to ``tip``.
@@ -17,7 +19,7 @@ class Chain:
     moving segments, but every link on the path (fixed ones included) has a frame in ``fk_all``.
     """
 
-    def __init__(self, model: _core.ChainModel, urdf: str | None = None):
+    def __init__(self, model: _core.ChainModel, urdf: str | None = None) -> None:
         self._model = model
         #: The URDF the chain was read from (a path or the XML), when known: lets workers rebuild it.
         self.urdf = urdf
@@ -94,20 +96,20 @@ class Chain:
             raise ValueError(f"link {name!r} is not on the chain {self.base!r} -> {self.tip!r}") from None
 
     # --- kinematics --------------------------------------------------------------------------
-    def fk(self, q) -> np.ndarray:
+    def fk(self, q: npt.ArrayLike) -> np.ndarray:
         """Pose of the tip in the base frame, (4, 4)."""
         return self._model.fk(joint_vector(q, self.n_joints))
 
-    def fk_all(self, q) -> np.ndarray:
+    def fk_all(self, q: npt.ArrayLike) -> np.ndarray:
         """Poses of every link of ``link_names`` in the base frame, (n_links, 4, 4)."""
         return self._model.fk_all(joint_vector(q, self.n_joints))
 
-    def fk_all_many(self, qs) -> np.ndarray:
+    def fk_all_many(self, qs: npt.ArrayLike) -> np.ndarray:
         """``fk_all`` for many configurations: qs (T, n) -> (T, n_links, 4, 4)."""
         qs = finite_array(qs, "qs", (None, self.n_joints))
         return self._model.fk_all_many(np.ascontiguousarray(qs))
 
-    def jacobian(self, q) -> np.ndarray:
+    def jacobian(self, q: npt.ArrayLike) -> np.ndarray:
         """Geometric Jacobian of the tip, (6, n): rows (v, omega) in the base frame, point at the tip."""
         return self._model.jacobian(joint_vector(q, self.n_joints))
 

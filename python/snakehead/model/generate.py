@@ -21,6 +21,8 @@ from xml.sax.saxutils import quoteattr
 
 from .._validate import finite_float
 
+from typing import Any
+
 GRAVITY = 9.80665
 
 
@@ -56,7 +58,7 @@ class SnakeSpec:
     name: str = "snake"
     comment: str = ""
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if isinstance(self.n_joints, bool) or not isinstance(self.n_joints, int) or self.n_joints < 1:
             raise ValueError(f"n_joints must be a positive integer, got {self.n_joints!r}")
         for key in ("module_length", "section", "mass_per_module", "joint_limit_deg", "velocity"):
@@ -152,7 +154,7 @@ def _marker_xml(name: str, parent: str, x: float) -> str:
 """
 
 
-def snake_urdf(spec: SnakeSpec | None = None, **kwargs) -> str:
+def snake_urdf(spec: SnakeSpec | None = None, **kwargs: Any) -> str:
     """The URDF (XML text) of the snake ``spec`` (or ``SnakeSpec(**kwargs)``)."""
     if spec is None:
         spec = SnakeSpec(**kwargs)

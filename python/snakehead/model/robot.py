@@ -28,6 +28,9 @@ from .. import _core
 from .._validate import finite_array, joint_vector
 from .chain import Chain
 
+import numpy.typing as npt
+from typing import Any
+
 YAW = "yaw"
 PITCH = "pitch"
 
@@ -63,7 +66,7 @@ class BasePlacement:
     y: float = 0.0
     yaw: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         finite_array([self.x, self.y, self.yaw], "base placement (x, y, yaw)", (3,))
         for name in ("x", "y", "yaw"):
             object.__setattr__(self, name, float(getattr(self, name)))
@@ -93,7 +96,7 @@ class RobotParts:
     head_tip: str  # head link frame; its x-axis is the head's direction
 
 
-def _urdf_source(urdf) -> str:
+def _urdf_source(urdf: str | os.PathLike[str]) -> str:
     if isinstance(urdf, os.PathLike):
         urdf = os.fspath(urdf)
     if not isinstance(urdf, str):
@@ -101,7 +104,7 @@ def _urdf_source(urdf) -> str:
     return urdf
 
 
-def _frame_name(value, what: str) -> str:
+def _frame_name(value: Any, what: str) -> str:
     if not isinstance(value, str) or not value:
         raise TypeError(f"{what} must be a frame name (a non-empty str), got {value!r}")
     return value
@@ -115,7 +118,7 @@ class SnakeRobot:
     """
 
     def __init__(self, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
-                 root: str | None = None, map_path: str | os.PathLike | None = None, source: str | None = None):
+                 root: str | None = None, map_path: str | os.PathLike | None = None, source: str | None = None) -> None:
         self.urdf = _urdf_source(urdf)
         base_end = _frame_name(base_end, "base_end")
         neck_end = _frame_name(neck_end, "neck_end")
@@ -338,6 +341,13 @@ class SnakeRobot:
         return axes
 
     @cached_property
+    def joint_frames(self) -> np.ndarray:
+        """(n,) index (link_names) of each joint's frame: the link it moves, whose frame sits on the joint."""
+        child = np.asarray(self.body.model.joint_child_links, dtype=np.intp)
+        child.setflags(write=False)
+        return child
+
+    @cached_property
     def joint_kinds(self) -> tuple[str, ...]:
         """Each joint's kind: ``"yaw"`` (axis +-z of the root frame) or ``"pitch"`` (+-y)."""
         return tuple(YAW if abs(a[2]) > 0.5 else PITCH for a in self.joint_axes)
@@ -468,7 +478,7 @@ class SnakeRobot:
         local = np.asarray(self.body.model.joint_axes, float)
         return np.einsum("jik,jk->ji", frames[child, :3, :3], local), frames[child, :3, 3]
 
-    def point_jacobians(self, frames: np.ndarray, points: np.ndarray, links) -> np.ndarray:
+    def point_jacobians(self, frames: np.ndarray, points: np.ndarray, links: Any) -> np.ndarray:
         """d(point)/d(q, x, y, yaw) of world points rigidly attached to ``links`` (indices into link_names), for
         the configuration of ``frames`` (n_links, 4, 4): (P, 3, n + 3). The last three columns are the base
         placement's x, y and yaw.
@@ -497,21 +507,21 @@ class SnakeRobot:
         """World pose (4, 4) of the root frame when the base lies on the ground at ``base`` (default placement)."""
         return as_base(base).matrix(self.body_axis_height)
 
-    def frames(self, q, base: BasePlacement | None = None) -> np.ndarray:
+    def frames(self, q: npt.ArrayLike, base: BasePlacement | None = None) -> np.ndarray:
         """World poses of every frame in ``link_names`` at joint vector ``q`` (n,): (n_links, 4, 4)."""
         q = joint_vector(q, self.n_joints)
         return self.root_pose(base) @ self.body.fk_all(q)
 
-    def frames_many(self, qs, base: BasePlacement | None = None) -> np.ndarray:
+    def frames_many(self, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
         """``frames`` along a trajectory: qs (T, n) -> (T, n_links, 4, 4)."""
         return self.root_pose(base) @ self.body.fk_all_many(qs)
 
-    def frame(self, q, name: str, base: BasePlacement | None = None) -> np.ndarray:
+    def frame(self, q: np.ndarray, name: str, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of one named frame (a link or a marker)."""
         k = self.link_index(name)
         return self.frames(q, base)[k]
 
-    def head_pose(self, q, base: BasePlacement | None = None) -> np.ndarray:
+    def head_pose(self, q: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of the head tip: its x-axis is the head's direction."""
         return self.frame(q, self.parts.head_tip, base)
 
@@ -528,14 +538,14 @@ class SnakeRobot:
 _BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
 
 
-def as_robot(robot) -> SnakeRobot:
+def as_robot(robot: SnakeRobot) -> SnakeRobot:
     """``robot`` itself if it is a SnakeRobot, else TypeError (the check every planning function makes)."""
     if not isinstance(robot, SnakeRobot):
         raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
     return robot
 
 
-def as_base(base) -> BasePlacement:
+def as_base(base: BasePlacement | None) -> BasePlacement:
     """``base`` if it is a BasePlacement, the default placement for None, else TypeError."""
     if base is None:
         return BasePlacement()

@@ -19,6 +19,9 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+
+from typing import Sequence
+
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
 OPTIONAL_KEYS = ("root", "map")
@@ -60,7 +63,7 @@ def read_toml(path: str | os.PathLike, what: str) -> dict:
         raise ValueError(f"{what} {os.fspath(p)!r} is not valid TOML: {exc}") from None
 
 
-def check_keys(data: dict, required, optional, where: str) -> None:
+def check_keys(data: dict, required: Sequence[str], optional: Sequence[str], where: str) -> None:
     """ValueError for unknown or missing keys of a TOML table."""
     unknown = sorted(set(data) - set(required) - set(optional))
     if unknown:
@@ -103,8 +106,8 @@ def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_e
     out = Path(path)
     folder = out.resolve().parent
 
-    def rel(p) -> str:
-        p = Path(p).resolve()
+    def rel(where: str | os.PathLike[str]) -> str:
+        p = Path(where).resolve()
         try:
             return p.relative_to(folder).as_posix()
         except ValueError:

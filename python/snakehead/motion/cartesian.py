@@ -13,6 +13,9 @@ from .._validate import finite_array, joint_vector, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
 
+import numpy.typing as npt
+from typing import Any
+
 
 @dataclass(frozen=True)
 class CartesianInterpolation:
@@ -69,7 +72,7 @@ def joint_angle_towards(R0: np.ndarray, axis_local: np.ndarray, d_local: np.ndar
     return theta, ok
 
 
-def _interpolation_parameters(n) -> np.ndarray:
+def _interpolation_parameters(n: int) -> np.ndarray:
     """Eq. 41's t_0 .. t_m: n evenly spaced in [0, 1] for an integer n >= 2, or the given non-decreasing values
     from 0 to 1."""
     if isinstance(n, (int, np.integer)) and not isinstance(n, bool):
@@ -85,8 +88,8 @@ def _interpolation_parameters(n) -> np.ndarray:
     return s
 
 
-def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlacement | None = None, *,
-                            aim: str = "segment", full_output: bool = False):
+def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int | npt.ArrayLike,
+                            base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False) -> Any:
     """Whole-body interpolation in Cartesian space, Eqs. 41-44: n configurations (n, 16) from q_start to q_end.
 
     ``n`` is the number of samples (t_j of Eq. 41 evenly spaced in [0, 1]) or the t_j themselves, a
@@ -160,8 +163,9 @@ def cartesian_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlac
     return CartesianInterpolation(q, s, P, actual, dev, float(dev.max()), angle.max(axis=1), clipped)
 
 
-def cartesian_trajectory(robot: SnakeRobot, q_start, q_end, duration: float, dt: float = CONTROL_PERIOD,
-                         base: BasePlacement | None = None, *, aim: str = "segment") -> JointTrajectory:
+def cartesian_trajectory(robot: SnakeRobot, q_start: np.ndarray, q_end: np.ndarray, duration: float,
+                         dt: float = CONTROL_PERIOD, base: BasePlacement | None = None, *, aim: str = "segment"
+                         ) -> JointTrajectory:
     """A timed whole-body Cartesian motion: Eqs. 41-44 sampled every ``dt`` s over ``duration`` s.
 
     Eq. 41's parameter follows the minimum-jerk scaling t_j = s(t / duration) (:func:`minimum_jerk`), so the
@@ -213,8 +217,8 @@ def tracked_points(robot: SnakeRobot) -> np.ndarray:
     return np.r_[child[robot.lift_joints.start:], robot.link_index(robot.parts.head_tip)]
 
 
-def tracking_interpolation(robot: SnakeRobot, q_start, q_end, n, base: BasePlacement | None = None
-                           ) -> TrackingInterpolation:
+def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+                           base: BasePlacement | None = None) -> TrackingInterpolation:
     """Eq. 41 made to track: the lifted joints' positions (from the neck's first lifting joint to the head tip)
     move on straight lines, p_ij = (1 - t_j) p_si + t_j p_fi, and at every sample the lifted joint angles are fitted
     to all those points at once by damped least squares (Levenberg-Marquardt steps, warm-started from the previous

@@ -51,18 +51,21 @@ from .._validate import finite_float, positive
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .interpolation import CONTROL_PERIOD
 
+import numpy.typing as npt
+from typing import Any
+
 #: The fewest joints of a kind per wave (fewer alias the wave: it no longer looks like a wave on the body).
 MIN_JOINTS_PER_WAVE = 3.0
 
 
-def _non_negative(value, name: str) -> float:
+def _non_negative(value: Any, name: str) -> float:
     v = finite_float(value, name)
     if v < 0:
         raise ValueError(f"{name} must be >= 0, got {value!r}")
     return v
 
 
-def _direction(value) -> int:
+def _direction(value: Any) -> int:
     if isinstance(value, bool) or value not in (1, -1):
         raise ValueError(f"direction must be +1 or -1, got {value!r}")
     return int(value)
@@ -79,7 +82,7 @@ class Wave:
     offset: float = 0.0
     taper: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "amplitude", _non_negative(self.amplitude, "amplitude"))
         for key in ("waves", "phase", "offset"):
             object.__setattr__(self, key, finite_float(getattr(self, key), key))
@@ -109,7 +112,7 @@ class Gait:
     ramp_s: float = 1.0
     parameters: dict = field(default_factory=dict, compare=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "frequency", positive(self.frequency, "frequency"))
         object.__setattr__(self, "ramp_s", _non_negative(self.ramp_s, "ramp_s"))
         object.__setattr__(self, "direction", _direction(self.direction))
@@ -151,7 +154,7 @@ class Gait:
                                  f"{math.degrees(reach.max()):.1f} deg, beyond its limit of "
                                  f"{math.degrees(lim.min()):.1f} deg: lower the amplitude")
 
-    def joint_angles(self, robot: SnakeRobot, t, cycles: float) -> np.ndarray:
+    def joint_angles(self, robot: SnakeRobot, t: npt.ArrayLike, cycles: float) -> np.ndarray:
         """Joint angles (T, n) rad at times t (T,) s from the start of a run of ``cycles`` cycles."""
         robot = as_robot(robot)
         t = np.atleast_1d(np.asarray(t, float))
@@ -202,7 +205,7 @@ class Gait:
         return t, self.joint_angles(robot, t, cycles)
 
 
-def virtual_chassis(points: np.ndarray, previous: np.ndarray | None = None, forward=None) -> np.ndarray:
+def virtual_chassis(points: np.ndarray, previous: np.ndarray | None = None, forward: npt.ArrayLike | None = None) -> np.ndarray:
     """The virtual chassis (4, 4) of body points (k, 3) given in some frame (world): origin at their centroid,
     axes the principal axes of the points (x the longest), z turned up (+z of the frame) and x kept close to
     ``previous``'s x-axis (a 3x3 or 4x4 frame) or, without one, close to ``forward`` (e.g. tail -> head).
@@ -271,7 +274,7 @@ def lateral_undulation(direction: int = 1, *, amplitude: float = 0.6, waves: flo
 GAITS = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning, "lateral_undulation": lateral_undulation}
 
 
-def make_gait(name: str, direction: int = 1, **parameters) -> Gait:
+def make_gait(name: str, direction: int = 1, **parameters: Any) -> Gait:
     """The gait called ``name`` (one of :data:`GAITS`) with its commanded ``direction`` and parameters."""
     if not isinstance(name, str) or name not in GAITS:
         raise ValueError(f"unknown gait {name!r}; the gaits are {', '.join(GAITS)}")

@@ -13,6 +13,8 @@ from scipy.interpolate import BSpline, make_interp_spline
 
 from .._validate import finite_array, joint_vector, positive
 
+import numpy.typing as npt
+
 #: The joint controller's period (s), Section 4.
 CONTROL_PERIOD = 0.002
 
@@ -30,7 +32,7 @@ class JointTrajectory:
     spline: BSpline | None
 
 
-def _check_waypoints(times, waypoints) -> tuple[np.ndarray, np.ndarray]:
+def _check_waypoints(times: npt.ArrayLike, waypoints: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     times = finite_array(times, "times", (None,))
     if times.shape[0] < 2:
         raise ValueError(f"times needs at least two waypoints, got {times.shape[0]}")
@@ -42,7 +44,7 @@ def _check_waypoints(times, waypoints) -> tuple[np.ndarray, np.ndarray]:
     return times, waypoints
 
 
-def joint_spline(times, waypoints) -> BSpline:
+def joint_spline(times: np.ndarray, waypoints: np.ndarray) -> BSpline:
     """The interpolating spline of :func:`joint_trajectory`: times (K,) s, waypoints (K, n) rad -> BSpline.
 
     A quintic spline (degree 5, scipy ``make_interp_spline``) through every waypoint with zero velocity and
@@ -67,7 +69,7 @@ class MonotoneQuintic:
     sit on a joint limit, where the C4 spline of :func:`joint_spline` can overshoot. Call as ``f(t, nu)``.
     """
 
-    def __init__(self, times, waypoints):
+    def __init__(self, times: np.ndarray, waypoints: np.ndarray) -> None:
         self.times, self.q = _check_waypoints(times, waypoints)
         h = np.diff(self.times)[:, None]
         d = np.diff(self.q, axis=0) / h  # secant slopes (K-1, n)
@@ -79,7 +81,7 @@ class MonotoneQuintic:
         v[1:-1] = hm
         self.v = v
 
-    def __call__(self, t, nu: int = 0) -> np.ndarray:
+    def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t, float))
         k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
         h = (self.times[k + 1] - self.times[k])[:, None]
@@ -111,8 +113,9 @@ def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray
     return t
 
 
-def joint_trajectory(times, waypoints, dt: float = CONTROL_PERIOD, *, lower=None, upper=None,
-                     method: str = "spline") -> JointTrajectory:
+def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD, *,
+                     lower: np.ndarray | None = None, upper: np.ndarray | None = None, method: str = "spline"
+                     ) -> JointTrajectory:
     """Multi-segment joint-space interpolation through waypoints, sampled every ``dt`` s.
 
     times (K,) strictly increasing (s); waypoints (K, n) joint vectors (rad), the first at rest and the last at
@@ -148,7 +151,8 @@ def joint_trajectory(times, waypoints, dt: float = CONTROL_PERIOD, *, lower=None
     return JointTrajectory(t, q, qd, qdd, spline)
 
 
-def joint_interpolation(times, waypoints, dt: float = CONTROL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
+def joint_interpolation(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTROL_PERIOD
+                        ) -> tuple[np.ndarray, np.ndarray]:
     """Multi-segment joint-space interpolation (Section 3.2): -> (t (T,) s, q (T, n) rad) at the control period.
 
     Continuous in velocity and acceleration, at rest at both ends; see :func:`joint_trajectory` for the

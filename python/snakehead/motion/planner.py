@@ -34,6 +34,14 @@ from ..scenes.scene import Scene, Target
 from . import interpolation as interp
 from .cartesian import tracking_interpolation
 
+import os
+
+import numpy.typing as npt
+from typing import TYPE_CHECKING, Any, Sequence
+
+if TYPE_CHECKING:
+    from ..geometry.obstacles import BoxObstacle, WallWithHole
+
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
 DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
@@ -62,7 +70,7 @@ class TargetResult:
     position: np.ndarray  # (3,) m
     direction: np.ndarray  # (3,) unit
     time_s: float  # when the plan arrives
-    solution: object  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
+    solution: Any  # control.whole_body.WholeBodySolution (the segmented HeadSolution in its ``segmented``)
 
     @property
     def position_error_m(self) -> float:
@@ -138,7 +146,7 @@ class Plan:
             k = int(np.argmin(self.ground_clearance))
             return (f"a neck or head link goes {-1000 * self.min_ground_clearance_m:.1f} mm into the ground at "
                     f"t = {self.t[k]:.2f} s")
-        if self.touches_obstacle:
+        if self.touches_obstacle and self.obstacle_distance is not None:
             k = int(np.argmax(self.obstacle_distance <= 0))
             return f"a link touches an obstacle at t = {self.t[k]:.2f} s"
         return None
@@ -162,7 +170,8 @@ def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
 class _Waypoints:
     """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
 
-    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float, obstacles=()):
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float,
+                 obstacles: Sequence[Any] = ()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
         self.speed, self.min_segment = speed, min_segment
@@ -171,10 +180,10 @@ class _Waypoints:
         self.times: list[float] = []
         self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
 
-    def start(self, label: str, q):
+    def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
 
-    def move_joint(self, label: str, q, duration: float | None = None):
+    def move_joint(self, label: str, q: npt.ArrayLike, duration: float | None = None) -> None:
         """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
         the straight step is not safe throughout."""
         q = np.asarray(q, float)
@@ -188,7 +197,7 @@ class _Waypoints:
         self.labels.append(label)
         self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
 
-    def move(self, label: str, q, n: int = 12) -> str:
+    def move(self, label: str, q: npt.ArrayLike, n: int = 12) -> str:
         """A whole-body move from the last state to q (Section 3.2); returns the method used.
 
         First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
@@ -255,7 +264,7 @@ class _Waypoints:
         worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
         return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
 
-    def hold(self, seconds: float):
+    def hold(self, seconds: float) -> None:
         self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
 
     def sample(self, notes: list) -> interp.JointTrajectory:
@@ -270,7 +279,8 @@ class _Waypoints:
         return traj
 
 
-def _finish(name, plan: _Waypoints, targets, t_start, obstacles=(), notes=(), scene=None) -> Plan:
+def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
+            notes: Sequence[str] = (), scene: Scene | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
     traj = plan.sample(notes)
@@ -362,8 +372,9 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
     return q
 
 
-def choose_base(controller: HeadController, targets, obstacles=(), allow_relocation: bool = True,
-                base_shape=None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
+def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = (),
+                allow_relocation: bool = True,
+                base_shape: npt.ArrayLike | None = None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -377,13 +388,13 @@ def choose_base(controller: HeadController, targets, obstacles=(), allow_relocat
     obstacles = list(obstacles)
     targets = list(targets)
 
-    def clear(q, b) -> bool:
+    def clear(q: np.ndarray, b: Any) -> bool:
         if not obstacles:
             return True
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
-    def failing(b, q_shape):
+    def failing(b: Any, q_shape: Any) -> Any:
         """The first target not solved from this base (None: all are), or the start state in an obstacle."""
         if not clear(bending_state(controller, q_shape), b):
             return "the start", None
@@ -432,8 +443,8 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
 
 
-def _solve(controller: HeadController, position, direction, q_prev, base, obstacles, name: str, notes: list,
-           near: bool = False):
+def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
+           base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list, near: bool = False) -> Any:
     """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
     from ..control.whole_body import solve_target
 
@@ -444,7 +455,7 @@ def _solve(controller: HeadController, position, direction, q_prev, base, obstac
     return sol
 
 
-def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Scene:
+def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
     """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
     import os
 
@@ -461,10 +472,12 @@ def as_scene(targets, *, obstacles=(), base: BasePlacement | None = None) -> Sce
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
 
 
-def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController | None = None, obstacles=(),
-         base: BasePlacement | None = None, method: str = "rotated", seed: int | None = 1,
-         speed: float = DEFAULT_SPEED, min_segment: float = DEFAULT_MIN_SEGMENT,
-         allow_relocation: bool = True, base_shape=None) -> Plan:
+def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike, npt.ArrayLike]], *,
+         robot: SnakeRobot | None = None, controller: HeadController | None = None,
+         obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None,
+         method: str = "rotated", seed: int | None = 1, speed: float = DEFAULT_SPEED,
+         min_segment: float = DEFAULT_MIN_SEGMENT, allow_relocation: bool = True,
+         base_shape: npt.ArrayLike | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -497,8 +510,9 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
             raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
         if robot is not None and robot is not controller.robot:
             raise ValueError("give a robot or a controller (whose robot is used), not both")
-        if base is not None or scene.base is not None:
-            controller.base = base if base is not None else scene.base
+        chosen = base if base is not None else scene.base
+        if chosen is not None:
+            controller.base = chosen
     else:
         if robot is None:
             robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
@@ -526,14 +540,14 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
         q = way.qs[-1]
     results: list[TargetResult] = []
     k = 0
-    targets = scene.targets
-    while k < len(targets):
+    scene_targets = scene.targets
+    while k < len(scene_targets):
         # a run: this target and the following ones approached along a line from it
         end = k
-        while end + 1 < len(targets) and targets[end + 1].approach == "line":
+        while end + 1 < len(scene_targets) and scene_targets[end + 1].approach == "line":
             end += 1
         if end == k:
-            tg = targets[k]
+            tg = scene_targets[k]
             sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
             way.move(tg.name, sol.q)
             q = sol.q
@@ -547,13 +561,13 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
         # a hole) out to the run's first target, each from the previous joints: a branch of solutions that clears
         # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
         poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
-            (targets[k].name, targets[k].position, targets[k].direction, targets[k])]
+            (scene_targets[k].name, scene_targets[k].position, scene_targets[k].direction, scene_targets[k])]
         for j in range(k + 1, end + 1):
-            line = _line_poses(targets[j - 1], targets[j])
+            line = _line_poses(scene_targets[j - 1], scene_targets[j])
             for m, p in enumerate(line):
                 last = m == len(line) - 1
-                label = targets[j].name if last else f"{targets[j].name} ({m + 1}/{len(line)})"
-                poses.append((label, p, targets[j].direction, targets[j] if last else None))
+                label = scene_targets[j].name if last else f"{scene_targets[j].name} ({m + 1}/{len(line)})"
+                poses.append((label, p, scene_targets[j].direction, scene_targets[j] if last else None))
         sols: list = [None] * len(poses)
         q_back = q
         for m in range(len(poses) - 1, -1, -1):
@@ -561,16 +575,16 @@ def plan(targets, *, robot: SnakeRobot | None = None, controller: HeadController
             sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
             if sols[m].success:
                 q_back = sols[m].q
-        for m, (label, p, d, tg) in enumerate(poses):
+        for m, (label, p, d, line_target) in enumerate(poses):
             if m == 0:
                 way.move(label, sols[m].q)
             else:
                 way.move_joint(label, sols[m].q)
-            if tg is not None:
-                if not tg.via:
-                    results.append(TargetResult(tg.name, tg.position, tg.direction, way.times[-1], sols[m]))
-                if tg.hold_s > 0:
-                    way.hold(tg.hold_s)
+            if line_target is not None:
+                if not line_target.via:
+                    results.append(TargetResult(line_target.name, line_target.position, line_target.direction, way.times[-1], sols[m]))
+                if line_target.hold_s > 0:
+                    way.hold(line_target.hold_s)
         q = sols[-1].q
         k = end + 1
     plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)

@@ -15,12 +15,16 @@ some are out of reach, which is what they are for (the planner must say why it f
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement
+
+if TYPE_CHECKING:
+    from ..control.controller import HeadController
 
 KINDS = ("same", "shape", "place")
 
@@ -36,7 +40,7 @@ class ReachableTarget:
     kind: str
 
 
-def reachable_targets(controller, kind: str, count: int, rng: np.random.Generator | None = None, *,
+def reachable_targets(controller: HeadController, kind: str, count: int, rng: np.random.Generator | None = None, *,
                       min_margin: float = 0.005, reach: float = 1.0, max_draws: int = 200000) -> list[ReachableTarget]:
     """``count`` targets reachable by construction of the given ``kind`` (see the module's docstring) for the
     controller's robot, from its initial configuration and placement."""
@@ -74,7 +78,7 @@ def reachable_targets(controller, kind: str, count: int, rng: np.random.Generato
     return out
 
 
-def random_targets(controller, count: int, rng: np.random.Generator | None = None, *, half_width: float | None = None,
+def random_targets(controller: HeadController, count: int, rng: np.random.Generator | None = None, *, half_width: float | None = None,
                    height: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """``count`` (position, direction) pairs: positions uniform in the box of +-``half_width`` m around the base's
     placement (default: the body's length) and 0 .. ``height`` m high (default: the neck and head's length),

@@ -72,7 +72,7 @@ class Target:
     via: bool = False
     sphere_diameter: float | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
         object.__setattr__(self, "position", vector3(self.position, f"target {self.name!r} position"))
@@ -108,7 +108,7 @@ class Scene:
     description: str = ""
     path: Path | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         targets = tuple(self.targets)
         if not targets:
             raise ValueError(f"scene {self.name!r} has no targets")
@@ -204,13 +204,13 @@ def _target_from(entry: Any, where: str) -> Target:
             raise ValueError(f"{where}: via must be true or false, got {entry['via']!r}")
         kwargs["via"] = entry["via"]
     try:
-        return Target(name, _number_list(entry["position"], f"{where}: position"),
-                      _number_list(entry["direction"], f"{where}: direction"), **kwargs)
+        return Target(name, np.asarray(_number_list(entry["position"], f"{where}: position")),
+                      np.asarray(_number_list(entry["direction"], f"{where}: direction")), **kwargs)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _obstacle_from(entry: Any, where: str):
+def _obstacle_from(entry: Any, where: str) -> BoxObstacle | WallWithHole:
     entry = _table(entry, where)
     kind = entry.get("kind")
     if kind not in _OBSTACLE_KEYS:

@@ -8,8 +8,10 @@ from ..control.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .tracking import SimResult, check_trajectory
 
+from typing import Any
 
-def _targets(robot, planned_t, planned_q, base, targets):
+
+def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement | None, targets: Any) -> list[tuple[float, np.ndarray, np.ndarray]]:
     """[(time, desired position (3,), desired unit direction (3,))]."""
     if targets is None:
         targets = [float(planned_t[-1])]
@@ -38,7 +40,7 @@ def _targets(robot, planned_t, planned_q, base, targets):
     return out
 
 
-def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=None,
+def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, result: SimResult, targets: Any = None,
             base: BasePlacement | None = None) -> dict:
     """Compare a simulation with its plan, as the paper does in Section 4.
 
@@ -110,8 +112,8 @@ def compare(robot: SnakeRobot, planned_t, planned_q, result: SimResult, targets=
     }
 
 
-def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t, planned_q, base: BasePlacement | None = None,
-                contact: str = "ground") -> np.ndarray:
+def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t: np.ndarray, planned_q: np.ndarray,
+                base: BasePlacement | None = None, contact: str = "ground") -> np.ndarray:
     """Signed distance (m, positive inside) of each simulated ZMP to the planned support polygon at that tick.
 
     The polygon is :func:`snakehead.dynamics.stability.support_polygon` of the planned configuration interpolated

@@ -38,6 +38,8 @@ from ..dynamics.sliding import balance_translation
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..motion.gaits import virtual_chassis
 
+import numpy.typing as npt
+
 #: A box whose lowest corner is within this height (m) of the ground touches it.
 CONTACT_HEIGHT = 0.003
 #: Corners within this height (m) of a box's lowest corner make its contact patch.
@@ -102,7 +104,7 @@ class BodyPoseEstimator:
     """
 
     def __init__(self, robot: SnakeRobot, imu_link: str | None = None, *, contact_height: float = CONTACT_HEIGHT,
-                 patch_height: float = PATCH_HEIGHT, odometry: str = "friction"):
+                 patch_height: float = PATCH_HEIGHT, odometry: str = "friction") -> None:
         self.robot = as_robot(robot)
         boxed = self.robot.boxed_links
         if imu_link is None:
@@ -132,7 +134,7 @@ class BodyPoseEstimator:
         self._heading_correction = np.eye(3)  # turns the IMU's heading onto the known one (set by reset)
 
     # --- the body in world axes, relative to the root origin --------------------------------------
-    def _boxes(self, q, R_imu) -> tuple[np.ndarray, np.ndarray]:
+    def _boxes(self, q: npt.ArrayLike, R_imu: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Box poses (k, 4, 4) relative to the root origin in world axes, and the root's world rotation."""
         q = joint_vector(q, self.robot.n_joints)
         R_imu = self._heading_correction @ rotation_matrix(R_imu, "IMU orientation")
@@ -177,7 +179,7 @@ class BodyPoseEstimator:
         return BodyPose(root=root, chassis=self._chassis)
 
     # --- the estimate ----------------------------------------------------------------------------------
-    def reset(self, q, R_imu, root_xy, root_yaw: float | None = None) -> BodyPose:
+    def reset(self, q: np.ndarray, R_imu: npt.ArrayLike, root_xy: npt.ArrayLike, root_yaw: float | None = None) -> BodyPose:
         """Start from joint angles q (n,), the IMU's world orientation (3, 3) and the root frame's known planar
         position (x, y) m; with ``root_yaw`` (rad, the known heading of the root frame's x-axis), the IMU's heading
         is corrected onto it from now on (a gyro's heading is only relative)."""
@@ -194,7 +196,7 @@ class BodyPoseEstimator:
         self._remember(W, R_root, np.array([root_xy[0], root_xy[1], -corners[..., 2].min()]), corners)
         return self.pose()
 
-    def update(self, q, R_imu) -> None:
+    def update(self, q: np.ndarray, R_imu: npt.ArrayLike) -> None:
         """The body moved to joint angles q (n,) with the IMU at world orientation R_imu (3, 3): move the estimate
         by the contact odometry (see the module; :meth:`pose` reads it)."""
         if self._W is None:

@@ -34,6 +34,9 @@ from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
 from .tracking import SimState, _gains
 
+import numpy.typing as npt
+from typing import Any
+
 
 @dataclass
 class GaitRun:
@@ -111,9 +114,10 @@ class GaitSimulator:
     (friction, torque_limit, obstacles, armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
     """
 
-    def __init__(self, robot: SnakeRobot, *, kp=None, kd=None, imu_link: str | None = None,
-                 imu_yaw_drift_deg_per_s: float = 0.0, control_dt: float = DEFAULT_CONTROL_DT,
-                 timestep: float = DEFAULT_TIMESTEP, odometry: str = "friction", **model_options):
+    def __init__(self, robot: SnakeRobot, *, kp: float | None = None, kd: float | None = None,
+                 imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
+                 control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
+                 odometry: str = "friction", **model_options: Any) -> None:
         self._mj = _mujoco()
         self.robot = as_robot(robot)
         n = self.robot.n_joints
@@ -140,7 +144,7 @@ class GaitSimulator:
         self._box_bodies = self.sim.body_ids[self.robot.boxed_links]
 
     # --- states -------------------------------------------------------------------------------------
-    def lying(self, base: BasePlacement | None = None, q=None, settle_s: float = 0.3) -> SimState:
+    def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
         """The robot lying at ``base`` (default placement) with joints ``q`` (default straight), settled on the
         ground for ``settle_s`` s while its servos hold q."""
         base = as_base(base)
@@ -166,7 +170,7 @@ class GaitSimulator:
         state.load(self.sim, self.data)
         self.time = float(state.time)
 
-    def _step(self, q_ref, qd_ref) -> None:
+    def _step(self, q_ref: np.ndarray, qd_ref: np.ndarray) -> None:
         """One control period; then the positions of everything (what the sensors read) for the new state."""
         self.data.ctrl[:] = self.kp * q_ref + self.kd * qd_ref
         self._mj.mj_step(self.sim.model, self.data, self.substeps)

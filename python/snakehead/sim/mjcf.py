@@ -60,6 +60,9 @@ from ..geometry.obstacles import BoxObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from .gains import default_torque_limits
 
+import numpy.typing as npt
+from typing import Any
+
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
 
@@ -71,7 +74,7 @@ _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
 
 
-def _mujoco():
+def _mujoco() -> Any:
     """Import MuJoCo lazily; ImportError naming the extra when it is missing."""
     try:
         import mujoco
@@ -83,7 +86,7 @@ def _mujoco():
 DEFAULT_HOLE_SLICES = 32
 
 
-def obstacle_boxes(obstacles, hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
+def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
     """The scene's obstacles as MuJoCo can collide them: boxes.
 
     A :class:`~snakehead.geometry.obstacles.WallWithHole` becomes the boxes of the wall around its hole, the round
@@ -149,7 +152,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     return np.asarray(q, float)
 
 
-def _torque_limits(robot: SnakeRobot, torque_limit) -> np.ndarray:
+def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
         lim = default_torque_limits(robot)
@@ -179,9 +182,9 @@ def _check_names(robot: SnakeRobot) -> None:
 
 
 def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
-               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit=None,
+               joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
-               contact_solref: tuple = (0.005, 1.0)):
+               contact_solref: tuple = (0.005, 1.0)) -> Any:
     """The MuJoCo model of the robot (free-floating root) on a ground plane with the scene's obstacles, as a
     ``mujoco.MjSpec`` built element by element from the robot's own data (``spec.compile()`` gives the
     ``MjModel``; ``spec.to_xml()`` its MJCF text, for reading only).
@@ -281,7 +284,7 @@ class SimModel:
     """
 
     robot: SnakeRobot
-    model: object
+    model: Any  # mujoco.MjModel
     body_ids: np.ndarray
     site_ids: np.ndarray
     qpos_adr: np.ndarray
@@ -292,7 +295,7 @@ class SimModel:
     torque_limit: np.ndarray
     spec: object = None  #: the mujoco.MjSpec it was compiled from (``spec.to_xml()`` to read it)
 
-    def set_state(self, data, q, base: BasePlacement | None = None, lift: float = 0.0) -> None:
+    def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
         """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
         mj = _mujoco()
         T = self.robot.root_pose(base)
@@ -303,7 +306,7 @@ class SimModel:
         data.qpos[self.qpos_adr] = q
         mj.mj_forward(self.model, data)
 
-    def frames(self, data) -> np.ndarray:
+    def frames(self, data: Any) -> np.ndarray:
         """World poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics)."""
         out = np.zeros((len(self.body_ids), 4, 4))
         out[:, :3, :3] = data.xmat[self.body_ids].reshape(-1, 3, 3)
@@ -312,7 +315,7 @@ class SimModel:
         return out
 
 
-def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
+def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
     """Compile :func:`build_spec` (same keyword arguments) into a :class:`SimModel`."""
     mj = _mujoco()
     robot = as_robot(robot)
@@ -323,7 +326,7 @@ def build_model(robot: SnakeRobot, **kwargs) -> SimModel:
         raise ValueError(f"MuJoCo could not compile the robot's model: {exc}") from None
     names = robot.link_names
 
-    def ids(kind, keys):
+    def ids(kind: str, keys: Any) -> np.ndarray:
         return np.array([mj.mj_name2id(model, kind, k) for k in keys], int)
 
     body_ids = ids(mj.mjtObj.mjOBJ_BODY, names)

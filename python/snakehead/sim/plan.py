@@ -7,6 +7,8 @@ from dataclasses import dataclass
 from .compare import compare
 from .tracking import SimResult, simulate_trajectory
 
+from typing import Any
+
 
 @dataclass
 class PlanSimulation:
@@ -34,7 +36,7 @@ class PlanSimulation:
         return bool(self.metrics["zmp_inside"])
 
 
-def simulate(plan, **options) -> PlanSimulation:
+def simulate(plan: Any, **options: Any) -> PlanSimulation:
     """Track ``plan`` (a :class:`~snakehead.motion.planner.Plan`) in MuJoCo with PD control and gravity
     compensation at 2 ms, its obstacles included, and compare with the plan at its targets.
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -14,11 +14,13 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco, build_model
 
+import numpy.typing as npt
+
 
 # ------------------------------------------------------------------------------------------------
 # measurements on a MuJoCo state
 # ------------------------------------------------------------------------------------------------
-def momenta_of_state(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+def momenta_of_state(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     """Linear (kg m/s) and angular (kg m^2/s) momentum of the robot about the world origin, (3,) each.
 
     From MuJoCo's subtree quantities of the root link (``mj_subtreeVel``): P = M v_c,
@@ -34,7 +36,7 @@ def momenta_of_state(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
     return P.copy(), L.copy()
 
 
-def momenta_per_body(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     """The same momenta summed link by link (paper Eqs. 27-31) from ``mj_objectVelocity`` at each body's CoM.
 
     An independent path to :func:`momenta_of_state`, used to check it.
@@ -57,7 +59,7 @@ def momenta_per_body(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
     return P, L
 
 
-def ground_contacts(sim: SimModel, data) -> tuple[np.ndarray, np.ndarray]:
+def ground_contacts(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     """Contact points (k, 3) m and forces on the robot (k, 3) N, world frame, of every robot-floor contact."""
     mj = _mujoco()
     pts, frc = [], []
@@ -182,7 +184,7 @@ class SimResult:
         return float(np.mean(np.abs(self.tau) >= self.torque_limit * (1 - 1e-9)))
 
 
-def _gains(x, n: int, name: str, allow_zero: bool) -> np.ndarray:
+def _gains(x: npt.ArrayLike, n: int, name: str, allow_zero: bool) -> np.ndarray:
     a = finite_array(x, name)
     if a.ndim == 0:
         a = np.full(n, float(a))
@@ -193,7 +195,7 @@ def _gains(x, n: int, name: str, allow_zero: bool) -> np.ndarray:
     return a
 
 
-def check_trajectory(robot: SnakeRobot, t, q) -> tuple[np.ndarray, np.ndarray]:
+def check_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Validate a planned trajectory: t (T,) strictly increasing, q (T, n) finite within the joint limits."""
     n = robot.n_joints
     t = finite_array(t, "t")
@@ -250,13 +252,13 @@ def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RA
     return W
 
 
-def _compensated_mode(gravity_compensation) -> str:
+def _compensated_mode(gravity_compensation: str) -> str:
     if gravity_compensation not in GRAVITY_COMPENSATION:
         raise ValueError(f"gravity_compensation must be one of {GRAVITY_COMPENSATION}, got {gravity_compensation!r}")
     return gravity_compensation
 
 
-def gravity_torques(sim: SimModel, data, weights: np.ndarray) -> np.ndarray:
+def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray:
     """Joint torques (n,) N m holding the weighted link weights against gravity in the state ``data``.
 
     tau_j = -a_j . sum_i W_ji (c_i - p_j) x (m_i g): a_j, p_j the joint's world axis and anchor, c_i, m_i each
@@ -274,11 +276,14 @@ def gravity_torques(sim: SimModel, data, weights: np.ndarray) -> np.ndarray:
     return -np.einsum("nl,nlk,nk->n", weights, torque, a)
 
 
-def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = None, kp=None, kd=None, *,
-             control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, settle: float = 0.3,
-             hold: float = 0.0, gravity_compensation: str = "supported", torque_limit=None, friction: float = 0.8,
-             joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES,
-             self_collision: bool = False, drop: float = 2e-4, state: SimState | None = None) -> SimResult:
+def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
+                        kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None, *,
+                        control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
+                        settle: float = 0.3, hold: float = 0.0, gravity_compensation: str = "supported",
+                        torque_limit: npt.ArrayLike | None = None, friction: float = 0.8,
+                        joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (),
+                        hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
+                        drop: float = 2e-4, state: SimState | None = None) -> SimResult:
     """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
@@ -340,8 +345,10 @@ def simulate_trajectory(robot: SnakeRobot, t, q, base: BasePlacement | None = No
     qdot_plan = np.gradient(q, t, axis=0)
     qa, da = sim.qpos_adr, sim.dof_adr
 
-    def control(qr, qdr, W):
+    def control(qr: np.ndarray, qdr: np.ndarray, W: np.ndarray | None) -> None:
+        tau_g: np.ndarray | float
         if mode == "supported":
+            assert W is not None  # the supported mode computes the weights
             tau_g = gravity_torques(sim, d, W)
         elif mode == "bias":
             tau_g = d.qfrc_bias[da]

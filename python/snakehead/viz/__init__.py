@@ -1,1 +1,19 @@
-"""Figures and animations (matplotlib): the body, the backbone, the workspace maps, the dynamics."""
+"""Figures, animations and the 3-D viewer.
+
+One convention: every plotting function returns a :class:`matplotlib.figure.Figure` (made outside pyplot, so no
+backend is chosen at import or at all, and nothing needs closing), and :func:`save` writes a figure or an animation
+to a file, atomically. By topic:
+
+* :mod:`.body` -- the body in 3-D with its scene: Figs. 17/22 (snapshots), Fig. 8 (a head solution), Figs. 11/13;
+* :mod:`.backbone` -- backbone curves and their links: Figs. 2-3 and 14, the base arc's area against its angle;
+* :mod:`.workspace` -- reachability maps: Figs. 4-7;
+* :mod:`.dynamics` -- momenta (Figs. 18-19) and the ZMP in the support polygon (Fig. 20);
+* :mod:`.animation` -- a plan's motion as a GIF (:func:`~.animation.animate`);
+* :mod:`.viewer` -- the interactive 3-D viewer (viser): a standalone HTML page per plan and ``snakehead view``.
+
+>>> from snakehead.viz import save, body
+>>> save(body.plot_snapshots(plan), "snapshots.png")                    # doctest: +SKIP
+"""
+from ._common import save
+
+__all__ = ["save"]

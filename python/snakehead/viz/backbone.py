@@ -1,7 +1,7 @@
 """Figures of the backbone curves and the links that discretise them (paper Figs. 2, 3 and 14).
 
-All functions draw with matplotlib's Agg backend and return the ``Figure``; pass ``path`` to save it
-(PNG, PDF, ... by the suffix). Lengths are in m, world frame (z up).
+Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`. Lengths are
+in m, world frame (z up).
 
 * :func:`plot_arc_discretisation` -- Figs. 2-3: the base's plane arc, its discretised links (Eq. 9 and
   exact chords) and the support polygon, top view.
@@ -13,38 +13,32 @@ All functions draw with matplotlib's Agg backend and return the ``Figure``; pass
 from __future__ import annotations
 
 import math
-import os
+from typing import TYPE_CHECKING, Sequence
 
-import matplotlib
+import numpy as np
+import numpy.typing as npt
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from .. import backbone as bb
+from ..dynamics import stability
+from ..model.robot import BasePlacement, SnakeRobot
+from ._common import LINK_COLOR, new_figure
+from .body import body_points
 
-from .. import backbone as bb  # noqa: E402
-from ..dynamics import stability  # noqa: E402
-from ..model.robot import BasePlacement, SnakeRobot  # noqa: E402
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 _BC = "#1f77b4"  # backbone curves
 _UP = "#d62728"  # the up curve
-_LINK = "#333333"
 
 
-def _save(fig, path: str | os.PathLike | None):
-    if path is not None:
-        fig.savefig(os.fspath(path), dpi=150, bbox_inches="tight")
-    return fig
+def _body_points(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None) -> tuple[np.ndarray, np.ndarray]:
+    """(points along the body: tail end, every joint, head tip (n+2, 3); indices of the joints in it)."""
+    return body_points(robot, robot.frames(q, base)), np.arange(1, robot.n_joints + 1)
 
 
-def _body_points(robot: SnakeRobot, q, base: BasePlacement | None) -> tuple[np.ndarray, np.ndarray]:
-    """(points along the body: tail end, every joint, head tip (m+2, 3); indices of the joints in it)."""
-    F = robot.frames(q, base)
-    child = list(robot.body.model.joint_child_links)
-    idx = [0] + child + [len(robot.link_names) - 1]
-    return F[idx, :3, 3], np.arange(1, len(child) + 1)
-
-
-def _draw_links_2d(ax, P: np.ndarray, joints: np.ndarray, kinds, label: str, color=_LINK, lw=3.0):
+def _draw_links_2d(ax: Axes, P: np.ndarray, joints: np.ndarray, kinds: Sequence[str], label: str,
+                   color: str = LINK_COLOR, lw: float = 3.0) -> None:
     ax.plot(P[:, 0], P[:, 1], "-", color=color, lw=lw, alpha=0.75, label=label, solid_capstyle="round")
     yaw = [j for j, k in zip(joints, kinds) if k == "yaw"]
     pitch = [j for j, k in zip(joints, kinds) if k == "pitch"]
@@ -52,8 +46,7 @@ def _draw_links_2d(ax, P: np.ndarray, joints: np.ndarray, kinds, label: str, col
     ax.plot(P[pitch, 0], P[pitch, 1], "s", ms=4, color=color)
 
 
-def plot_arc_discretisation(robot: SnakeRobot | None = None, central_angle: float = math.pi, *,
-                            path: str | os.PathLike | None = None):
+def plot_arc_discretisation(robot: SnakeRobot | None = None, central_angle: float = math.pi) -> Figure:
     """Figs. 2-3: the base arc (central angle in rad) and its discretisations, top view.
 
     Left: Eq. 9 (``"arclength"``): links as pieces of the arc, the body leaves along the arc's end tangent.
@@ -63,7 +56,8 @@ def plot_arc_discretisation(robot: SnakeRobot | None = None, central_angle: floa
     robot = SnakeRobot.default() if robot is None else robot
     l = robot.base_length
     nb = robot.parts.base.stop
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5.2))
+    fig = new_figure(figsize=(11, 5.2))
+    axes = fig.subplots(1, 2)
     for ax, chords, title in zip(axes, ("arclength", "exact"), ("Eq. 9: links as arc pieces", "exact chords")):
         q = np.zeros(robot.n_joints)
         q[robot.parts.base] = bb.arc_joint_angles(l, central_angle, robot, chords=chords)
@@ -88,11 +82,11 @@ def plot_arc_discretisation(robot: SnakeRobot | None = None, central_angle: floa
         ax.set_ylabel("y (m)")
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
     fig.tight_layout()
-    return _save(fig, path)
+    return fig
 
 
-def plot_initial_configuration(backbone: bb.InitialBackbone | None = None, robot: SnakeRobot | None = None, *,
-                               path: str | os.PathLike | None = None):
+def plot_initial_configuration(backbone: bb.InitialBackbone | None = None,
+                               robot: SnakeRobot | None = None) -> Figure:
     """Fig. 14: the initial configuration of Section 3.3 (1) -- the base arc ("bc of base part"), the
     neck-and-head Bezier ("bc of up part") with its control points, the links, the support polygon and the
     centre of mass -- in a top view (left) and in 3-D (right)."""
@@ -105,7 +99,7 @@ def plot_initial_configuration(backbone: bb.InitialBackbone | None = None, robot
     com = stability.center_of_mass(robot, ib.q, ib.base)
     C = ib.control_points
 
-    fig = plt.figure(figsize=(13, 5.8))
+    fig = new_figure(figsize=(13, 5.8))
     ax = fig.add_subplot(1, 2, 1)
     closed = np.vstack([poly, poly[:1]])
     ax.fill(closed[:, 0], closed[:, 1], color="#2ca02c", alpha=0.15, label="support polygon")
@@ -126,8 +120,8 @@ def plot_initial_configuration(backbone: bb.InitialBackbone | None = None, robot
     ax3.plot(A[:, 0], A[:, 1], A[:, 2], "-", color=_BC, lw=1.5, label="bc of base part")
     ax3.plot(U[:, 0], U[:, 1], U[:, 2], "-", color=_UP, lw=1.5, label="bc of up part")
     ax3.plot(C[:, 0], C[:, 1], C[:, 2], ":o", color=_UP, ms=4, lw=1, alpha=0.7, label="Bezier control points")
-    ax3.plot(P[:, 0], P[:, 1], P[:, 2], "-", color=_LINK, lw=3, alpha=0.75, label="links")
-    ax3.plot(P[1:-1, 0], P[1:-1, 1], P[1:-1, 2], "o", ms=3.5, color=_LINK)
+    ax3.plot(P[:, 0], P[:, 1], P[:, 2], "-", color=LINK_COLOR, lw=3, alpha=0.75, label="links")
+    ax3.plot(P[1:-1, 0], P[1:-1, 1], P[1:-1, 2], "o", ms=3.5, color=LINK_COLOR)
     ax3.plot(closed[:, 0], closed[:, 1], np.zeros(len(closed)), "--", color="#2ca02c", lw=1)
     ax3.plot([com[0]], [com[1]], [0.0], "X", ms=8, color="m")
     lo = np.minimum(P.min(axis=0), A.min(axis=0))
@@ -144,11 +138,10 @@ def plot_initial_configuration(backbone: bb.InitialBackbone | None = None, robot
     ax3.set_title("3-D: head raised on the Bezier, G1 at P0", fontsize=10)
     ax3.legend(loc="upper center", bbox_to_anchor=(0.5, -0.02), ncol=2, fontsize=8)
     fig.tight_layout()
-    return _save(fig, path)
+    return fig
 
 
-def plot_area_vs_angle(optimum: bb.ArcOptimum | None = None, robot: SnakeRobot | None = None, *,
-                       path: str | os.PathLike | None = None):
+def plot_area_vs_angle(optimum: bb.ArcOptimum | None = None, robot: SnakeRobot | None = None) -> Figure:
     """The discretised support polygon's area and the CoM's static margin against the base arc's central
     angle (the optimiser's scan), with Eq. 2's continuous area and both maxima."""
     robot = SnakeRobot.default() if robot is None else robot
@@ -156,7 +149,8 @@ def plot_area_vs_angle(optimum: bb.ArcOptimum | None = None, robot: SnakeRobot |
     l = robot.base_length
     g = opt.grid
     th = np.linspace(g[0, 0], g[-1, 0], 400)
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    fig = new_figure(figsize=(7.5, 4.5))
+    ax = fig.subplots()
     ax.plot(np.degrees(th), bb.arc_segment_area(l, th) * 1e4, "-", color=_BC, label="Eq. 2 (continuous arc)")
     ax.plot(np.degrees(g[:, 0]), g[:, 1] * 1e4, ".-", color="k", label="discretised support polygon")
     ax.plot(math.degrees(opt.eq2_angle), opt.eq2_area * 1e4, "o", color=_BC,
@@ -175,4 +169,4 @@ def plot_area_vs_angle(optimum: bb.ArcOptimum | None = None, robot: SnakeRobot |
     ax.set_title(f"base arc (l = {l:.3f} m): area against central angle "
                  f"(joint limits: theta <= {math.degrees(opt.angle_limit):.0f} deg)", fontsize=10)
     fig.tight_layout()
-    return _save(fig, path)
+    return fig

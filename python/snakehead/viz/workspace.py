@@ -1,59 +1,68 @@
-"""Figures of reachability maps like the paper's Figs. 4-7 (matplotlib; pass an Axes or get a new Figure).
+"""Figures of reachability maps like the paper's Figs. 4-7.
 
-- ``plot_map``: the voxels as a 3-D scatter coloured on a 20-step colour bar, red (low) to blue (high),
+- :func:`plot_map`: the voxels as a 3-D scatter coloured on a 20-step colour bar, red (low) to blue (high),
   as in Figs. 4(a) and 5(a);
-- ``plot_section``: a sectional view, the voxels of one grid layer (Figs. 4(b), 5(b));
-- ``plot_dexterous``: the voxels of index 100 (Fig. 6);
-- ``plot_clusters``: their k-means++ clusters, the centroids and the chosen centre G0 (Fig. 7);
-- ``figure_map``: (a) and (b) side by side, as Figs. 4 and 5.
-Coordinates are in the map's frame (the chain's base frame), in metres. Drawn with the Agg backend.
+- :func:`plot_section`: a sectional view, the voxels of one grid layer (Figs. 4(b), 5(b));
+- :func:`plot_dexterous`: the voxels of index 100 (Fig. 6);
+- :func:`plot_clusters`: their k-means++ clusters, the centroids and the chosen centre G0 (Fig. 7);
+- :func:`figure_map`: (a) and (b) side by side, as Figs. 4 and 5; :func:`map_figures`: Figs. 4/5, 6 and 7 at once.
+
+Coordinates are in the map's frame (the chain's base frame), in metres. Each function draws into ``ax`` when given
+one (a 3-D Axes for the 3-D views), else into a new figure, and returns the :class:`~matplotlib.figure.Figure`;
+write it with :func:`snakehead.viz.save`. :func:`index_colors` gives the colour bar's colours (the 3-D viewer uses
+them too).
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+import numpy.typing as npt
+from matplotlib.figure import Figure
 
 from ..kinematics.workspace import Clusters, ReachabilityMap
+from ._common import new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.colors import BoundaryNorm, Colormap
 
 #: 20 colours over [0, 100]: red for low reachability through to blue for high (the paper's bar).
 N_STEPS = 20
 
 
-def _plt():
+def _cmap_norm() -> tuple[Colormap, BoundaryNorm]:
     import matplotlib
-
-    matplotlib.use("Agg")  # files, no windows (as the package's other plots)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _cmap_norm():
     import matplotlib.colors as mcolors
-    import matplotlib.pyplot as plt
 
-    cmap = plt.get_cmap("jet_r", N_STEPS)
+    cmap = matplotlib.colormaps["jet_r"].resampled(N_STEPS)
     norm = mcolors.BoundaryNorm(np.linspace(0.0, 100.0, N_STEPS + 1), cmap.N)
     return cmap, norm
 
 
-def _check(m):
+def index_colors(indices: npt.ArrayLike) -> np.ndarray:
+    """The colour of each reachability index (0-100) on the paper's 20-step bar: (N, 3) RGB in [0, 1]."""
+    cmap, norm = _cmap_norm()
+    return np.asarray(cmap(norm(np.asarray(indices, float))), float)[..., :3]
+
+
+def _check(m: Any) -> None:
     if not isinstance(m, ReachabilityMap):
         raise ValueError(f"expected a ReachabilityMap, got {type(m).__name__}")
     if len(m) == 0:
         raise ValueError("the map has no voxels")
 
 
-def _axes3d(ax):
-    plt = _plt()
+def _axes3d(ax: Any) -> Any:
     if ax is None:
-        fig = plt.figure(figsize=(6.5, 5.5))
+        fig = new_figure(figsize=(6.5, 5.5))
         ax = fig.add_subplot(projection="3d")
     if getattr(ax, "name", "") != "3d":
         raise ValueError("a 3-D Axes is needed (fig.add_subplot(projection='3d'))")
     return ax
 
 
-def _label3d(ax, m: ReachabilityMap):
+def _label3d(ax: Any, m: ReachabilityMap) -> None:
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
@@ -64,14 +73,14 @@ def _label3d(ax, m: ReachabilityMap):
     ax.set_box_aspect((1, 1, 1))
 
 
-def _colorbar(fig, mappable, ax):
+def _colorbar(fig: Any, mappable: Any, ax: Any) -> Any:
     cb = fig.colorbar(mappable, ax=ax, shrink=0.75, pad=0.1, ticks=np.linspace(0, 100, 11))
     cb.set_label("reachability index D")
     return cb
 
 
-def plot_map(m: ReachabilityMap, ax=None, min_index: float = 0.0, size: float | None = None, alpha: float = 0.6,
-             colorbar: bool = True):
+def plot_map(m: ReachabilityMap, ax: Any = None, min_index: float = 0.0, size: float | None = None,
+             alpha: float = 0.6, colorbar: bool = True) -> Figure:
     """3-D scatter of the voxels with index >= min_index, coloured by index (Figs. 4(a), 5(a))."""
     _check(m)
     ax = _axes3d(ax)
@@ -85,13 +94,13 @@ def plot_map(m: ReachabilityMap, ax=None, min_index: float = 0.0, size: float | 
     ax.set_title(f"{m.base} \u2192 {m.tip}: {len(p)} voxels")
     if colorbar:
         _colorbar(ax.figure, sc, ax)
-    return ax
+    return ax.figure
 
 
-def plot_section(m: ReachabilityMap, ax=None, axis: str = "z", value: float = 0.0, colorbar: bool = True):
+def plot_section(m: ReachabilityMap, ax: Axes | None = None, axis: str = "z", value: float = 0.0,
+                 colorbar: bool = True) -> Figure:
     """The voxels of the grid layer containing ``axis = value`` as squares (Figs. 4(b), 5(b))."""
     _check(m)
-    import matplotlib.pyplot as plt
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Rectangle
 
@@ -106,8 +115,7 @@ def plot_section(m: ReachabilityMap, ax=None, axis: str = "z", value: float = 0.
     at = m.grid_origin[k] + (layer + 0.5) * h
     keep = np.abs(m.centers[:, k] - at) < h / 2
     if ax is None:
-        _plt()
-        fig, ax = plt.subplots(figsize=(6, 5))
+        ax = new_figure(figsize=(6, 5)).subplots()
     cmap, norm = _cmap_norm()
     squares = [Rectangle((c[u] - h / 2, c[v] - h / 2), h, h) for c in m.centers[keep]]
     pc = PatchCollection(squares, cmap=cmap, norm=norm, edgecolor="white", linewidth=0.3)
@@ -123,13 +131,14 @@ def plot_section(m: ReachabilityMap, ax=None, axis: str = "z", value: float = 0.
     ax.set_title(f"section {axis} = {at:+.3f} m ({int(keep.sum())} voxels)")
     if colorbar:
         _colorbar(ax.figure, pc, ax)
-    return ax
+    fig = ax.get_figure(root=True)
+    assert fig is not None  # the axes belong to a figure
+    return fig
 
 
-def figure_map(m: ReachabilityMap, axis: str = "z", value: float = 0.0, title: str | None = None):
-    """Figs. 4 and 5: (a) the map in 3-D, (b) a sectional view. Returns the Figure."""
-    plt = _plt()
-    fig = plt.figure(figsize=(13, 5.5))
+def figure_map(m: ReachabilityMap, axis: str = "z", value: float = 0.0, title: str | None = None) -> Figure:
+    """Figs. 4 and 5: (a) the map in 3-D, (b) a sectional view through ``axis = value`` (m)."""
+    fig = new_figure(figsize=(13, 5.5))
     a = fig.add_subplot(1, 2, 1, projection="3d")
     plot_map(m, a, colorbar=False)
     b = fig.add_subplot(1, 2, 2)
@@ -142,7 +151,7 @@ def figure_map(m: ReachabilityMap, axis: str = "z", value: float = 0.0, title: s
     return fig
 
 
-def plot_dexterous(m: ReachabilityMap, ax=None, threshold: float = 100.0):
+def plot_dexterous(m: ReachabilityMap, ax: Any = None, threshold: float = 100.0) -> Figure:
     """The dexterous workspace: voxels of index >= threshold (Fig. 6)."""
     _check(m)
     ax = _axes3d(ax)
@@ -151,11 +160,11 @@ def plot_dexterous(m: ReachabilityMap, ax=None, threshold: float = 100.0):
                depthshade=False)
     _label3d(ax, m)
     ax.set_title(f"index \u2265 {threshold:g}: {len(p)} voxels ({100 * len(p) / len(m):.2f} %)")
-    return ax
+    return ax.figure
 
 
-def plot_clusters(m: ReachabilityMap, clusters: Clusters | None = None, ax=None, k: int = 3,
-                  threshold: float = 100.0):
+def plot_clusters(m: ReachabilityMap, clusters: Clusters | None = None, ax: Any = None, k: int = 3,
+                  threshold: float = 100.0) -> Figure:
     """The dexterous voxels by k-means++ cluster, the centroids (x) and G0 (star) (Fig. 7)."""
     _check(m)
     ax = _axes3d(ax)
@@ -173,25 +182,15 @@ def plot_clusters(m: ReachabilityMap, clusters: Clusters | None = None, ax=None,
     _label3d(ax, m)
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"k-means++ clusters of the dexterous workspace (G0: {c.rule} cluster)")
-    return ax
+    return ax.figure
 
 
-def save_figures(m: ReachabilityMap, directory, prefix: str = "workspace", k: int = 3, dpi: int = 120) -> list:
-    """Write Figs. 4/5-, 6- and 7-like PNGs of ``m`` into ``directory``; returns their paths."""
-    from pathlib import Path
-
-    plt = _plt()
-    out = Path(directory)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = []
-    fig = figure_map(m)
-    paths.append(out / f"{prefix}_map.png")
-    fig.savefig(paths[-1], dpi=dpi)
-    plt.close(fig)
-    for name, fn in (("dexterous", plot_dexterous), ("clusters", lambda mm, ax: plot_clusters(mm, ax=ax, k=k))):
-        fig = plt.figure(figsize=(7, 6))
-        fn(m, fig.add_subplot(projection="3d"))
-        paths.append(out / f"{prefix}_{name}.png")
-        fig.savefig(paths[-1], dpi=dpi)
-        plt.close(fig)
-    return paths
+def map_figures(m: ReachabilityMap, k: int = 3) -> dict[str, Figure]:
+    """Figs. 4/5-, 6- and 7-like figures of ``m``: {"map": :func:`figure_map`, "dexterous": :func:`plot_dexterous`,
+    "clusters": :func:`plot_clusters` with ``k`` clusters}."""
+    figures = {"map": figure_map(m)}
+    for name, draw in (("dexterous", plot_dexterous), ("clusters", lambda mm, ax: plot_clusters(mm, ax=ax, k=k))):
+        fig = new_figure(figsize=(7, 6))
+        draw(m, fig.add_subplot(projection="3d"))
+        figures[name] = fig
+    return figures

@@ -1,0 +1,174 @@
+"""Sphinx configuration of snakehead's documentation: ``python -m sphinx -W -b html docs docs/_build/html``.
+
+The API reference is generated from the docstrings of every public module (autosummary, recursively); the build
+then checks that every public name of the package is documented (a warning, so an error with ``-W``), and the
+CLI reference is the argparse help of ``snakehead`` itself.
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+import re
+
+from docutils import nodes
+from docutils.parsers.rst import Directive
+
+import snakehead
+
+project = "snakehead"
+author = "the snakehead developers"
+copyright = "the snakehead developers"
+release = snakehead.__version__
+version = snakehead.__version__
+
+extensions = ["sphinx.ext.autodoc", "myst_parser"]
+source_suffix = {".rst": "restructuredtext"}
+templates_path = ["_templates"]
+exclude_patterns = ["_build"]
+API_DIR = "_api"  # one generated page per public module (write_api_pages)
+html_theme = "furo"
+html_static_path = ["_static"]
+html_title = f"snakehead {release}"
+autodoc_member_order = "bysource"
+autodoc_typehints = "signature"
+# A module documents what it defines; a package's re-exports (its __all__) are documented where they are defined.
+autodoc_default_options = {"members": True, "undoc-members": True, "show-inheritance": True,
+                           "ignore-module-all": True}
+myst_heading_anchors = 3
+# The pages include Markdown files (bench/RESULTS.md) whose first heading is not level 1.
+suppress_warnings = ["myst.header"]
+
+
+def public_modules() -> list[str]:
+    """Every module of the package whose dotted name has no part starting with an underscore."""
+    names = ["snakehead"]
+    for info in pkgutil.walk_packages(snakehead.__path__, "snakehead."):
+        if not any(part.startswith("_") for part in info.name.split(".")):
+            names.append(info.name)
+    return sorted(names)
+
+
+def public_names() -> dict[str, str]:
+    """{documented name: where it is public} for every public function and class of the package: the names each
+    public module lists in ``__all__``, and those defined in a public module without a leading underscore."""
+    out: dict[str, str] = {}
+    for modname in public_modules():
+        module = importlib.import_module(modname)
+        listed = getattr(module, "__all__", None)
+        names = listed if listed is not None else [n for n in vars(module) if not n.startswith("_")]
+        for name in names:
+            obj = getattr(module, name)
+            if not (inspect.isclass(obj) or inspect.isfunction(obj)):
+                continue
+            home = getattr(obj, "__module__", "") or ""
+            if listed is None and home != modname:
+                continue  # imported here, not defined here
+            if not home.startswith("snakehead") or any(p.startswith("_") for p in home.split(".")[1:]):
+                home = modname
+            out[f"{home}.{obj.__qualname__}"] = f"{modname}.{name}"
+    return out
+
+
+def write_api_pages(app) -> None:
+    """One page per public module (``automodule`` with its members) and their index, under ``_api``. Written
+    here, not by autosummary: some modules share their name with a function their package exports
+    (``snakehead.sim.compare``), which autosummary's lookup by attribute would take for the function."""
+    from pathlib import Path
+
+    folder = Path(app.srcdir) / API_DIR
+    folder.mkdir(exist_ok=True)
+    pages = {}
+    for modname in public_modules():
+        module = importlib.import_module(modname)
+        summary = (inspect.getdoc(module) or "").strip().split("\n")[0]
+        pages[modname] = summary
+        text = f"{modname}\n{'=' * len(modname)}\n\n.. automodule:: {modname}\n"
+        # names this module exports from a private module (e.g. viz.save from viz._common) are documented here
+        for name in getattr(module, "__all__", ()):
+            obj = getattr(module, name)
+            home = getattr(obj, "__module__", "") or ""
+            if home.startswith("snakehead") and any(p.startswith("_") for p in home.split(".")[1:]):
+                kind = "autoclass" if inspect.isclass(obj) else "autofunction"
+                text += f"\n.. {kind}:: {modname}.{name}\n"
+        path = folder / f"{modname}.rst"
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+    index = ["Modules", "=======", "", ".. toctree::", "   :maxdepth: 1", ""]
+    index += [f"   {name} <{name}>" for name in pages]
+    text = "\n".join(index) + "\n"
+    path = folder / "index.rst"
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
+
+
+def check_every_public_name(app, env) -> None:
+    from sphinx.util import logging
+
+    logger = logging.getLogger("snakehead.docs")
+    documented = set(env.get_domain("py").objects)
+    for name, where in sorted(public_names().items()):
+        if name not in documented and where not in documented:
+            logger.warning(f"public name {where} ({name}) is not in the API reference")
+
+
+class CliHelp(Directive):
+    """``.. snakehead-cli::``: the help of ``snakehead`` and of each subcommand, as argparse prints it."""
+
+    def run(self):
+        from snakehead.app.cli import build_parser
+
+        parser = build_parser()
+        out = [nodes.literal_block(text=parser.format_help())]
+        for action in parser._subparsers._group_actions:  # the subcommands, in the order they are listed
+            for name, sub in action.choices.items():
+                section = nodes.section(ids=[f"snakehead-{name}"])
+                section += nodes.title(text=f"snakehead {name}")
+                section += nodes.literal_block(text=sub.format_help())
+                out.append(section)
+        return out
+
+
+_FIELD = re.compile(r"^[A-Za-z_][\w /*,()]*? : \S")  # "name : what it is", as the docstrings list parameters
+_ITEM = re.compile(r"^(\s*)([-*]|\d+\.) \S")
+
+
+def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
+    """The docstrings are written for ``help()``: plain text with a little reStructuredText (````code````, roles).
+    Make the plain-text habits valid reStructuredText: norms written |a - b| are not substitutions; a parameter
+    line "name : what" continued on indented lines is one line; an indented block after "text:" is shown as
+    written (a literal block); lists and indented blocks get the blank lines around them that reStructuredText
+    needs."""
+    text = [line.replace("|", "\\|") for line in lines]
+    joined: list[str] = []
+    for line in text:
+        if joined and line.startswith(" ") and line.strip() and _FIELD.match(joined[-1]):
+            joined[-1] += " " + line.strip()
+        else:
+            joined.append(line)
+    # "text:" introducing an indented block (a formula, a table of values) makes it a literal block
+    for i in range(len(joined) - 2):
+        line, gap, block = joined[i], joined[i + 1], joined[i + 2]
+        if (line.rstrip().endswith(":") and not line.rstrip().endswith("::") and not gap.strip()
+                and block.startswith(" ") and block.strip() and not _ITEM.match(block)):
+            joined[i] = line.rstrip() + ":"
+    out: list[str] = []
+    for line in joined:
+        prev = out[-1] if out else ""
+        item, prev_item = _ITEM.match(line), _ITEM.match(prev)
+        indented, prev_indented = line.startswith(" "), prev.startswith(" ")
+        if prev.strip() and line.strip():
+            starts_list = item and not item.group(1)  # (items apart: "1." then "3." is two lists)
+            leaves_block = not indented and not item and (prev_indented or prev_item)
+            if starts_list or leaves_block:
+                out.append("")
+        out.append(line)
+    lines[:] = out
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", plain_text_to_rst)
+    app.add_directive("snakehead-cli", CliHelp)
+    app.connect("builder-inited", write_api_pages)
+    app.connect("env-check-consistency", check_every_public_name)
+    return {"parallel_read_safe": True}

@@ -1,0 +1,406 @@
+"""Figures of the body in 3-D: its collision boxes coloured by part, with the scene's targets and obstacles.
+
+* :func:`plot_snapshots` -- Figs. 17 and 22: the whole body at a plan's key states, one panel per state.
+* :func:`plot_head_solution` -- one :class:`~snakehead.control.HeadController` solution: the robot at it and the
+  neck geometry of Fig. 8.
+* :func:`plot_interpolation_comparison` -- Fig. 11 against Fig. 13: a joint-space interpolation that drives the
+  head into the ground beside the Cartesian interpolation of Eqs. 41-44 that does not.
+
+The geometry the figures, the animation and the 3-D viewer share: :func:`body_faces` (the boxes' faces),
+:func:`wall_faces` (a wall with a hole), :func:`part_colors` (base grey, neck orange, head blue).
+
+Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`. Positions in
+m, times in s, world frame with z up and the ground at z = 0.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Sequence
+
+import numpy as np
+import numpy.typing as npt
+from matplotlib.figure import Figure
+
+from ..geometry import collision as coll
+from ..geometry.obstacles import WallWithHole
+from ..model.robot import BasePlacement, SnakeRobot
+from ..motion.cartesian import cartesian_interpolation
+from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, new_figure,
+                      setup_axes3d)
+
+if TYPE_CHECKING:
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from mpl_toolkits.mplot3d.axes3d import Axes3D
+
+    from ..control.controller import HeadSolution
+    from ..motion.planner import Plan
+
+#: A sphere drawn at a target: (centre (3,) m, diameter m).
+Sphere = tuple[npt.ArrayLike, float]
+
+_JOINT_SPACE = "#c0392b"
+_CARTESIAN = "#1f77b4"
+
+# unit cube corners (8, 3) and its faces (6, 4) as corner indices
+_CORNERS = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+_FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
+
+
+# ----------------------------------------------------------------------------------------------
+# geometry shared with the animation and the viewer
+# ----------------------------------------------------------------------------------------------
+def part_colors(robot: SnakeRobot) -> list[str]:
+    """A colour per frame of ``robot.link_names``: base grey, neck orange, head blue."""
+    names = robot.link_names
+    base_end = names.index(robot.parts.base_end)
+    neck_end = names.index(robot.parts.neck_end)
+    return [BASE_COLOR if i <= base_end else NECK_COLOR if i <= neck_end else HEAD_COLOR for i in range(len(names))]
+
+
+def body_faces(robot: SnakeRobot, frames: npt.ArrayLike) -> tuple[np.ndarray, list[str]]:
+    """The faces of every collision box: (B * 6, 4, 3) world corners (m) and one colour per face.
+
+    frames (L, 4, 4): world poses of ``robot.link_names`` (``robot.frames``); frames without a box are skipped.
+    """
+    frames = np.asarray(frames, float)
+    boxed = robot.boxed_links
+    B = frames[boxed] @ robot.box_origins[boxed]  # (B, 4, 4)
+    corners = B[:, None, :3, 3] + np.einsum("bij,bkj->bki", B[:, :3, :3], _CORNERS[None] * robot.box_sizes[boxed, None])
+    faces = corners[:, _FACES].reshape(-1, 4, 3)
+    colors = part_colors(robot)
+    return faces, [colors[i] for i in boxed for _ in range(6)]
+
+
+def wall_faces(wall: WallWithHole, n: int = 64) -> np.ndarray:
+    """The wall's mid-plane as quads tiling the rectangle minus the hole: (K, 4, 3) world corners (m).
+
+    Each quad joins two neighbouring points of the hole's rim to the points where the same rays from the hole's
+    centre leave the rectangle; the rays include the rectangle's corners, so the tiling is exact up to the rim's
+    ``n``-gon.
+    """
+    R = wall.rotation
+    half = wall.size[:2] / 2
+    off = wall.hole_offset
+    r = wall.hole_diameter / 2
+    corners = np.array([[sx, sy] for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]) * half + off
+    angles = np.sort(np.r_[np.linspace(0, 2 * np.pi, n, endpoint=False),
+                           np.arctan2(corners[:, 1], corners[:, 0]) % (2 * np.pi)])
+    d = np.column_stack([np.cos(angles), np.sin(angles)])
+    # distance along each ray to the rectangle [off - half, off + half] (the hole's centre is inside it)
+    with np.errstate(divide="ignore"):
+        tx = np.where(d[:, 0] > 0, (off[0] + half[0]) / d[:, 0],
+                      np.where(d[:, 0] < 0, (off[0] - half[0]) / d[:, 0], np.inf))
+        ty = np.where(d[:, 1] > 0, (off[1] + half[1]) / d[:, 1],
+                      np.where(d[:, 1] < 0, (off[1] - half[1]) / d[:, 1], np.inf))
+    outer = d * np.minimum(tx, ty)[:, None]
+    inner = d * r
+    nxt = np.roll(np.arange(len(angles)), -1)
+    quads = np.stack([inner, inner[nxt], outer[nxt], outer], axis=1)  # (K, 4, 2) in (width, height)
+    return wall.centre + quads @ R[:, :2].T
+
+
+def hole_rim(wall: WallWithHole, n: int = 65) -> np.ndarray:
+    """The hole's rim: (n, 3) world points (m), closed (the last equals the first)."""
+    th = np.linspace(0, 2 * np.pi, n)
+    return wall.centre + (wall.hole_diameter / 2) * (np.outer(np.cos(th), wall.rotation[:, 0])
+                                                     + np.outer(np.sin(th), wall.rotation[:, 1]))
+
+
+def plan_spheres(plan: Plan) -> list[Sphere]:
+    """The spheres a plan's scene draws at its targets (targets with a ``sphere_diameter``)."""
+    scene = getattr(plan, "scene", None)
+    if scene is None:
+        return []
+    return [(t.position, float(t.sphere_diameter)) for t in scene.targets if t.sphere_diameter is not None]
+
+
+def _sphere_mesh(centre: np.ndarray, diameter: float, n: int = 14) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2 + 1))
+    r = diameter / 2
+    return (centre[0] + r * np.cos(u) * np.sin(v), centre[1] + r * np.sin(u) * np.sin(v), centre[2] + r * np.cos(v))
+
+
+def scene_bounds(plan: Plan, spheres: Sequence[Sphere] = (), margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners (3,) m of a box holding the body over the whole motion, the scenery and the ground."""
+    step = max(1, len(plan.q) // 200)
+    pts = plan.robot.frames_many(plan.q[::step], plan.base)[..., :3, 3].reshape(-1, 3)
+    extra = [pts, np.zeros((1, 3))]
+    extra += [np.asarray(c, float)[None] for c, _ in spheres]
+    extra += [tg.position[None] for tg in plan.targets]
+    for ob in plan.obstacles:
+        if isinstance(ob, WallWithHole):
+            R = ob.rotation
+            half = ob.size[:2] / 2
+            corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half + ob.hole_offset
+            extra.append(ob.centre + corners @ R[:, :2].T)
+    allp = np.vstack(extra)
+    return allp.min(axis=0) - margin, allp.max(axis=0) + margin
+
+
+def view_angles(plan: Plan) -> tuple[float, float]:
+    """(elevation, azimuth) in degrees: from behind and to the side of the head's approach."""
+    return (18.0, -58.0) if plan.obstacles else (22.0, -62.0)
+
+
+def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: bool = True) -> None:
+    """The spheres, the plan's walls (with the hole's rim) and, with ``arrows``, each target along its direction."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    for centre, diameter in spheres:
+        ax.plot_surface(*_sphere_mesh(np.asarray(centre, float), diameter), color=SPHERE_COLOR, alpha=0.55,
+                        linewidth=0)
+    for ob in plan.obstacles:
+        if isinstance(ob, WallWithHole):
+            ax.add_collection3d(Poly3DCollection(wall_faces(ob), facecolor=WALL_COLOR, edgecolor="none", alpha=0.35))
+            rim = hole_rim(ob)
+            ax.plot(rim[:, 0], rim[:, 1], rim[:, 2], "-", color="k", lw=1.0)
+    if arrows:
+        for tg in plan.targets:
+            p, d = tg.position, 0.08 * tg.direction
+            ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.0, arrow_length_ratio=0.3)
+
+
+def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
+    """The collision boxes at ``frames`` (L, 4, 4) as one collection (returned, so that it can be moved)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    faces, colors = body_faces(robot, frames)
+    boxes = Poly3DCollection(faces, facecolors=colors, edgecolors="k", linewidths=0.15, alpha=alpha)
+    ax.add_collection3d(boxes)
+    return boxes
+
+
+def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
+    from matplotlib.patches import Patch
+
+    handles = [Patch(color=BASE_COLOR, label="base part"), Patch(color=NECK_COLOR, label="neck part"),
+               Patch(color=HEAD_COLOR, label="head part")]
+    if spheres:
+        handles.append(Patch(color=SPHERE_COLOR, alpha=0.55, label=f"spheres ({1000 * spheres[0][1]:.0f} mm)"))
+    wall = next((o for o in plan.obstacles if isinstance(o, WallWithHole)), None)
+    if wall is not None:
+        handles.append(Patch(color=WALL_COLOR, alpha=0.35, label=f"wall, hole {1000 * wall.hole_diameter:.0f} mm"))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
+
+
+# ----------------------------------------------------------------------------------------------
+# Figs. 17 / 22
+# ----------------------------------------------------------------------------------------------
+def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np.ndarray]]:
+    """Up to ``n_panels`` of the plan's states (label, time s, q (n,)) in time order: the first and last, every
+    target, then the waypoints nearest to evenly spaced times. Holds are left out."""
+    states = [s for s in plan.states if not s[0].endswith("(hold)")]
+    if not states:
+        raise ValueError("the plan has no states")
+    times = np.array([s[1] for s in states])
+    chosen = {0, len(states) - 1}
+    for tg in plan.targets:
+        chosen.add(int(np.argmin(np.abs(times - tg.time_s))))
+    for want in np.linspace(times[0], times[-1], max(n_panels, 2)):
+        if len(chosen) >= n_panels:
+            break
+        order = np.argsort(np.abs(times - want))
+        for k in order:
+            if int(k) not in chosen:
+                chosen.add(int(k))
+                break
+    return [states[k] for k in sorted(chosen)][:max(n_panels, len(plan.targets) + 2)]
+
+
+def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_panels: int = 12, columns: int = 4,
+                   title: str = "") -> Figure:
+    """Figs. 17 / 22: the body in 3-D at up to ``n_panels`` states of ``plan`` (see :func:`snapshot_states`),
+    base grey, neck orange, head blue (collision boxes), with the scenery: ``spheres`` [(centre (3,) m, diameter
+    m)] (default: the plan's scene's, :func:`plan_spheres`), the plan's walls, and each head target as an arrow
+    along its direction. Equal axis scales."""
+    robot = plan.robot
+    spheres = plan_spheres(plan) if spheres is None else list(spheres)
+    picks = snapshot_states(plan, n_panels)
+    rows = -(-len(picks) // columns)
+    fig = new_figure(figsize=(3.0 * columns, 3.8 * rows + 0.6))
+    lo, hi = scene_bounds(plan, spheres)
+    elev, azim = view_angles(plan)
+    for k, (label, time, q) in enumerate(picks):
+        ax = fig.add_subplot(rows, columns, k + 1, projection="3d", computed_zorder=False)
+        setup_axes3d(ax, lo, hi, elev, azim, labels=False, zoom=1.2)
+        draw_scenery(ax, plan, spheres, arrows=not spheres and not plan.obstacles)
+        draw_body(ax, robot, robot.frames(q, plan.base))
+        tip = robot.head_pose(q, plan.base)[:3, 3]
+        ax.scatter(*tip, color="k", s=6)
+        ax.set_title(f"({chr(ord('a') + k)}) {label}\nt = {time:.1f} s", fontsize=8)
+    _part_legend(fig, plan, spheres)
+    fig.suptitle(title or f"{plan.name}: the body at the scenario's states (axes in m, equal scales)", fontsize=11)
+    fig.subplots_adjust(left=0.0, right=0.97, bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(),
+                        wspace=0.12, hspace=0.12)
+    return fig
+
+
+# ----------------------------------------------------------------------------------------------
+# one head solution: the robot in 3-D and the neck geometry of Fig. 8
+# ----------------------------------------------------------------------------------------------
+def plot_head_solution(robot: SnakeRobot, solution: HeadSolution) -> Figure:
+    """A ``HeadController`` solution: the body in 3-D (left) and the neck geometry of Fig. 8 (right).
+
+    Right: in the vertical plane through P0 and the target, P0 (end of the base), G0 (where the dexterous
+    centre should go: the target), P_d and r_d (Eqs. 19-20: the desired neck end), and the neck end B0 and its
+    x-axis r_a that Eq. 22 reached; the neck and head drawn as their joint chain. Lengths in m.
+    """
+    frames = robot.frames(solution.q, solution.base)
+    fig = new_figure(figsize=(12, 5.5))
+    ax = fig.add_subplot(1, 2, 1, projection="3d")
+    draw_body(ax, robot, frames)
+    p, d = solution.desired_frame[:3, 3], 0.08 * solution.desired_frame[:3, 0]
+    ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.2, arrow_length_ratio=0.3)
+    pts = frames[:, :3, 3]
+    lo = np.minimum(pts.min(axis=0), p) - 0.08
+    hi = np.maximum(pts.max(axis=0), p) + 0.08
+    setup_axes3d(ax, lo, hi, elev=22.0, azim=-60.0)
+    ax.set_title(f"head at the target: {1000 * solution.position_error_m:.4f} mm, "
+                 f"{solution.direction_error_deg:.4f} deg\nstatic margin {1000 * solution.static_margin_m:.1f} mm",
+                 fontsize=9)
+
+    ax2 = fig.add_subplot(1, 2, 2)
+    g = solution.neck_goal
+    if g is not None and solution.neck is not None:
+        # the plane through P0 spanned by the horizontal direction to G0 and the vertical
+        u = g.G0 - g.P0
+        u[2] = 0.0
+        u = u / np.linalg.norm(u) if np.linalg.norm(u) > 1e-9 else np.array([1.0, 0.0, 0.0])
+
+        def plane(x: Any) -> np.ndarray:
+            x = np.atleast_2d(np.asarray(x, float)) - g.P0
+            return np.column_stack([x @ u, x[:, 2]])
+
+        start = robot.link_index(robot.parts.base_end)
+        chain = plane(pts[start:])
+        ax2.plot(chain[:, 0], chain[:, 1], "-o", color=HEAD_COLOR, ms=3, lw=1.5,
+                 label="neck and head joints (projected)")
+        neck_end = robot.link_index(robot.parts.neck_end)
+        ax2.plot(*plane(pts[start:neck_end + 1]).T, "-o", color=NECK_COLOR, ms=4, lw=2.5, label="neck")
+        P0, G0, Pd = plane(g.P0)[0], plane(g.G0)[0], plane(g.P_d)[0]
+        ax2.plot(*np.vstack([P0, G0]).T, ":", color="k", lw=1)
+        ax2.plot(*P0, "s", color=BASE_COLOR, ms=8, label="P0 (end of the base)")
+        ax2.plot(*G0, "*", color=SPHERE_COLOR, ms=14, label="G0 = target (Eq. 19)")
+        ax2.plot(*Pd, "D", color="k", ms=6, mfc="none", label="P_d (Eq. 20)")
+        B0 = plane(solution.neck.frame[:3, 3])[0]
+        ra = solution.neck.frame[:3, 0]
+        rd_dir = plane(g.P0 + g.r_d)[0] - P0
+        ra_dir = plane(g.P0 + ra)[0] - P0
+        ax2.plot(*B0, "o", color=NECK_COLOR, ms=8, mfc="white", label="B0 reached (Eq. 22)")
+        ax2.quiver(*Pd, *(0.08 * rd_dir), angles="xy", scale_units="xy", scale=1, color="k", width=0.004,
+                   label="r_d")
+        ax2.quiver(*B0, *(0.08 * ra_dir), angles="xy", scale_units="xy", scale=1, color=NECK_COLOR, width=0.004,
+                   label="r_a")
+        ax2.axhline(-g.P0[2], color=GROUND_COLOR, lw=2)
+        ax2.set_aspect("equal")
+        ax2.set_xlabel("horizontal distance from P0 towards the target (m)")
+        ax2.set_ylabel("height above P0 (m)")
+        ax2.set_title(f"Fig. 8: the neck end frame; L_c = {g.Lc:.3f} m; |P_a - P_d| = "
+                      f"{1000 * solution.neck.position_error_m:.1f} mm, angle(r_a, r_d) = "
+                      f"{solution.neck.direction_error_deg:.1f} deg", fontsize=9)
+        ax2.legend(fontsize=7, loc="lower right")
+        ax2.grid(alpha=0.3)
+    else:
+        ax2.text(0.5, 0.5, "no neck goal: " + solution.message, ha="center", va="center", wrap=True)
+        ax2.set_axis_off()
+    fig.suptitle("HeadController solution (Section 2.4, Fig. 8)")
+    return fig
+
+
+# ----------------------------------------------------------------------------------------------
+# Fig. 11 against Fig. 13
+# ----------------------------------------------------------------------------------------------
+def body_points(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
+    """Points along the body's axis, tail end to head tip: the root frame, every joint, the head tip.
+
+    frames (..., L, 4, 4) (``robot.frames`` / ``frames_many``) -> (..., n + 2, 3) m.
+    """
+    idx = np.r_[0, robot.joint_frames, robot.link_index(robot.parts.head_tip)]
+    return np.take(frames, idx, axis=-3)[..., :3, 3]
+
+
+def _draw_snapshots(ax: Axes3D, robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, color: str,
+                    k: int = 6) -> np.ndarray:
+    frames = robot.frames_many(qs, base)
+    pts = body_points(robot, frames)
+    n_base = robot.parts.base.stop + 1  # points 0 .. n_base: the root, the base's joints and P0 (the neck's first)
+    clear = coll.ground_clearance(robot, qs, base)
+    links = robot.lifted_links
+    worst = clear[:, links].min(axis=1)
+    picks = np.unique(np.r_[np.linspace(0, len(qs) - 1, k).round().astype(int), np.argmin(worst)])
+    b = pts[-1, : n_base + 1]
+    ax.plot(b[:, 0], b[:, 1], b[:, 2], "-", color="0.35", lw=4, solid_capstyle="round", label="base")
+    for n, i in enumerate(picks):
+        alpha = min(1.0, 0.2 + 0.8 * n / max(1, len(picks) - 1))
+        p = pts[i, n_base:]
+        ax.plot(p[:, 0], p[:, 1], p[:, 2], "-o", color=color, lw=2.2, ms=2.5, alpha=alpha)
+    for i, label in ((0, "State 1"), (len(qs) - 1, "State 2")):
+        ax.text(*pts[i, -1] + [0, 0, 0.03], label, fontsize=9, color="k")
+    tip = pts[:, -1]
+    ax.plot(tip[:, 0], tip[:, 1], tip[:, 2], ":", color="k", lw=1.2, label="head tip path")
+    worst_i = int(np.argmin(worst))
+    p = pts[worst_i, n_base:]
+    ax.plot(p[:, 0], p[:, 1], p[:, 2], "-", color=color, lw=3.5, label=f"lowest ({1000 * worst[worst_i]:.0f} mm)")
+    # box corners below the ground, over the whole motion
+    below = clear < -coll.GROUND_TOLERANCE
+    if below.any():
+        ti, li = np.nonzero(below)
+        corners = robot.box_corners(frames, np.arange(len(robot.link_names)))[ti, li].reshape(-1, 3)
+        corners = corners[corners[:, 2] < 0]
+        ax.scatter(corners[:, 0], corners[:, 1], corners[:, 2], s=2, color="k", alpha=0.3,
+                   label="box corners in the ground")
+    return picks
+
+
+def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, *,
+                                  base: BasePlacement | None = None, n: int = 200) -> Figure:
+    """Fig. 11 vs Fig. 13: the same start and end (n,) rad, interpolated in joint space (left) and by Eqs. 41-44
+    (middle) in ``n`` steps; right: the lowest point of the neck's and head's collision boxes over the motion."""
+    base = BasePlacement() if base is None else base
+    q_start = np.asarray(q_start, float)
+    q_end = np.asarray(q_end, float)
+    s = np.linspace(0.0, 1.0, n)
+    q_joint = q_start + (q_end - q_start) * s[:, None]
+    res = cartesian_interpolation(robot, q_start, q_end, n, base, full_output=True)
+    q_cart = res.q
+    links = robot.lifted_links
+    cj = coll.ground_clearance(robot, q_joint, base)[:, links].min(axis=1)
+    cc = coll.ground_clearance(robot, q_cart, base)[:, links].min(axis=1)
+    fig = new_figure(figsize=(17, 6.2))
+    allp = body_points(robot, robot.frames_many(np.vstack([q_joint, q_cart]), base)).reshape(-1, 3)
+    lo, hi = allp.min(axis=0) - 0.05, allp.max(axis=0) + 0.05
+    span = (hi - lo).max()
+    for k, (qs, color, title) in enumerate([
+            (q_joint, _JOINT_SPACE, f"Fig. 11: joint-space interpolation\nlowest box point {1000 * cj.min():.0f} mm"),
+            (q_cart, _CARTESIAN, f"Fig. 13: Cartesian interpolation (Eqs. 41-44)\nlowest box point "
+                                 f"{1000 * cc.min():.1f} mm, joints stray <= {1000 * res.max_deviation:.0f} mm")]):
+        ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
+        X, Y = np.meshgrid(np.linspace(lo[0], lo[0] + span, 2), np.linspace(lo[1], lo[1] + span, 2))
+        ax.plot_surface(X, Y, np.zeros_like(X), color=GROUND_COLOR, alpha=0.15, linewidth=0)
+        _draw_snapshots(ax, robot, qs, base, color)
+        ax.set_xlim(lo[0], lo[0] + span)
+        ax.set_ylim(lo[1], lo[1] + span)
+        ax.set_zlim(-0.08, -0.08 + 0.5 * span)
+        ax.set_box_aspect((1, 1, 0.5), zoom=1.15)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_zlabel("z (m)")
+        ax.view_init(elev=14, azim=-125)
+        ax.set_title(title, fontsize=10)
+        ax.legend(loc="upper left", fontsize=8)
+    ax = fig.add_subplot(1, 3, 3)
+    ax.plot(s, 1000 * cj, color=_JOINT_SPACE, lw=2, label="joint space")
+    ax.plot(s, 1000 * cc, color=_CARTESIAN, lw=2, label="Cartesian (Eqs. 41-44)")
+    ax.axhline(0, color=GROUND_COLOR, lw=1.5)
+    ax.fill_between(s, 1000 * np.minimum(cj, 0), 0, color=_JOINT_SPACE, alpha=0.2, label="in the ground")
+    ax.set_xlabel("interpolation parameter $t_j$ (Eq. 41)")
+    ax.set_ylabel("lowest point of neck and head boxes (mm)")
+    ax.set_title("clearance of the neck and head above the ground", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+__all__ = ["part_colors", "body_faces", "wall_faces", "hole_rim", "plan_spheres", "scene_bounds", "view_angles",
+           "draw_scenery", "draw_body", "body_points", "snapshot_states", "plot_snapshots", "plot_head_solution",
+           "plot_interpolation_comparison"]

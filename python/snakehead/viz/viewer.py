@@ -1,0 +1,535 @@
+"""The interactive 3-D viewer (viser): a plan's motion in a web browser.
+
+What it shows: the robot's collision boxes (base grey, neck orange, head blue) moving along the planned motion,
+with play/pause and a time slider; the targets (spheres or arrows along the desired direction); the obstacles; the
+support polygon and the zero-moment point's trace on the ground (with the ZMP and the centre of mass's ground
+projection now); the head tip's path; and the head's reachability map as voxels coloured by their index (the
+paper's 20-step bar, Figs. 4-5), attached to the head's base frame and hidden until toggled on.
+
+Three ways to it:
+
+* :func:`viewer_scene` turns a :class:`~snakehead.motion.planner.Plan` into a :class:`ViewerScene` (plain arrays),
+  which :func:`save_viewer_scene` writes as ``NAME_viewer.npz`` (``numpy.load`` reads it) and
+  :func:`load_viewer_scene` reads back -- ``snakehead plan`` and ``snakehead demo`` write one per scenario;
+* :func:`write_html`: a single HTML file that opens from disk in a browser, with no server and no network (viser's
+  client, with the recorded scene inside the file). ``plan`` and ``demo`` write ``NAME.html`` beside the GIF;
+  the scene tree (the tree icon at the bottom right) toggles the map, the ZMP, the targets and the obstacles;
+* :func:`serve` (``snakehead view DIR``): a live viser server over the scenes in a folder, with a scenario menu,
+  play/pause, a time slider, a speed menu and check boxes for the layers.
+
+viser is a dependency of snakehead; it is imported only when a page is made or served.
+"""
+from __future__ import annotations
+
+import contextlib
+import io
+import threading
+import time
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterator, Sequence
+
+import numpy as np
+
+from .._files import atomic_open, write_text_atomic
+from ..geometry.obstacles import BoxObstacle, WallWithHole
+from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
+
+if TYPE_CHECKING:
+    import viser
+
+    from ..kinematics.workspace import ReachabilityMap
+    from ..motion.planner import Plan
+
+#: What :func:`save_viewer_scene` appends to a scenario's name.
+SCENE_SUFFIX = "_viewer.npz"
+#: Format of ``NAME_viewer.npz`` (stored in the file; :func:`load_viewer_scene` refuses other versions).
+SCENE_FORMAT = 1
+#: s: default spacing of the viewer's frames along the motion (five frames per second of motion).
+FRAME_STEP_S = 0.2
+#: Colours (RGB 0-255) of what the viewer draws besides the robot (its parts: viz.body.part_colors).
+ZMP_RGB = (192, 57, 43)
+COM_RGB = (20, 20, 20)
+POLYGON_RGB = (30, 30, 30)
+TARGET_RGB = (192, 57, 43)
+WALL_RGB = (161, 136, 127)
+OBSTACLE_RGB = (141, 110, 99)
+TIP_PATH_RGB = (90, 90, 90)
+#: Vertical field of view of the initial camera (deg); the browser test projects with it.
+CAMERA_FOV_DEG = 45.0
+#: (elevation, azimuth) in degrees of the initial camera about the scene's centre, as matplotlib's view_init.
+CAMERA_VIEW_DEG = (24.0, -60.0)
+
+_CUBE_VERTICES = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)], np.float32)
+_CUBE_TRIANGLES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                            [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], np.uint32)
+
+
+@dataclass
+class ViewerScene:
+    """Everything the viewer draws, as arrays (m, s, world frame, z up; quaternions w, x, y, z).
+
+    Frames: ``times`` (F,) s; the K collision boxes' ``box_positions`` (F, K, 3) and ``box_wxyz`` (F, K, 4), with
+    ``box_sizes`` (K, 3) and ``box_colors`` (K, 3) RGB 0-255; ``head_tip`` (F, 3); ``map_frame_positions`` (F, 3)
+    and ``map_frame_wxyz`` (F, 4): the head's base frame, in which the map's ``voxel_centers`` (V, 3) lie (edge
+    ``voxel_size``; ``voxel_indices`` (V,) 0-100; V = 0 without a map). ``zmp`` (F, 2) and ``com`` (F, 3) at the
+    frames; ``zmp_path`` (Z, 2): the planned ZMP along the whole motion. ``polygons`` (P, M, 2): the distinct
+    support polygons, NaN-padded to M vertices; ``polygon_of_frame`` (F,) which one each frame stands on.
+    Targets: ``target_positions`` / ``target_directions`` (N, 3), ``target_names`` (N,), ``target_diameters`` (N,)
+    (NaN: drawn as an arrow). Obstacles: boxes ``obstacle_centres`` / ``obstacle_sizes`` (B, 3),
+    ``obstacle_wxyz`` (B, 4); walls as triangles ``wall_vertices`` (W, 3), ``wall_triangles`` (T, 3) and the holes'
+    rims ``hole_rims`` (H, 65, 3).
+    """
+
+    name: str
+    title: str
+    times: np.ndarray
+    box_positions: np.ndarray
+    box_wxyz: np.ndarray
+    box_sizes: np.ndarray
+    box_colors: np.ndarray
+    head_tip: np.ndarray
+    map_frame_positions: np.ndarray
+    map_frame_wxyz: np.ndarray
+    voxel_centers: np.ndarray
+    voxel_indices: np.ndarray
+    voxel_size: float
+    zmp: np.ndarray
+    com: np.ndarray
+    zmp_path: np.ndarray
+    polygons: np.ndarray
+    polygon_of_frame: np.ndarray
+    target_positions: np.ndarray
+    target_directions: np.ndarray
+    target_names: np.ndarray
+    target_diameters: np.ndarray
+    obstacle_centres: np.ndarray
+    obstacle_sizes: np.ndarray
+    obstacle_wxyz: np.ndarray
+    wall_vertices: np.ndarray
+    wall_triangles: np.ndarray
+    hole_rims: np.ndarray
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.times)
+
+    def bounds(self, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3,) m of what the scene shows (without the map), with the ground (z = 0)."""
+        pts = [self.box_positions.reshape(-1, 3), self.target_positions, np.zeros((1, 3))]
+        if len(self.wall_vertices):
+            pts.append(self.wall_vertices)
+        if len(self.obstacle_centres):
+            pts.append(self.obstacle_centres)
+        allp = np.vstack(pts)
+        return allp.min(axis=0) - margin, allp.max(axis=0) + margin
+
+    def camera(self) -> tuple[np.ndarray, np.ndarray]:
+        """(position, look-at point) of the initial camera: the whole scene in view from :data:`CAMERA_VIEW_DEG`."""
+        lo, hi = self.bounds()
+        centre = 0.5 * (lo + hi)
+        radius = 0.5 * float(np.linalg.norm(hi - lo))
+        elev, azim = np.radians(CAMERA_VIEW_DEG)
+        towards_eye = np.array([np.cos(elev) * np.cos(azim), np.cos(elev) * np.sin(azim), np.sin(elev)])
+        distance = 1.05 * radius / np.sin(np.radians(CAMERA_FOV_DEG) / 2)
+        return centre + distance * towards_eye, centre
+
+
+def _wxyz(R: np.ndarray) -> np.ndarray:
+    """Quaternions (w, x, y, z) of rotation matrices (..., 3, 3)."""
+    from scipy.spatial.transform import Rotation
+
+    shape = R.shape[:-2]
+    xyzw = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat()
+    return np.concatenate([xyzw[:, 3:], xyzw[:, :3]], axis=1).reshape(*shape, 4)
+
+
+def _rgb(color: str) -> tuple[int, int, int]:
+    from matplotlib.colors import to_rgb
+
+    r, g, b = to_rgb(color)
+    return round(255 * r), round(255 * g), round(255 * b)
+
+
+def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, spheres: Sequence[Sphere] | None = None,
+                 frame_step_s: float = FRAME_STEP_S, max_frames: int = 2000, title: str = "",
+                 contact: str = "ground") -> ViewerScene:
+    """What the viewer shows of ``plan``: frames every ``frame_step_s`` s of motion (at most ``max_frames``, the
+    first and the last sample included), the plan's targets and obstacles, ``spheres`` (default: the scene's), the
+    head's ``workspace_map`` (a map of the robot's head chain, in the head's base frame) and the support polygons
+    of ``contact`` (the contact model the plan was checked with)."""
+    from ..dynamics import stability as st
+
+    if not (np.isfinite(frame_step_s) and frame_step_s > 0):
+        raise ValueError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
+    if int(max_frames) != max_frames or max_frames < 2:
+        raise ValueError(f"max_frames must be an integer >= 2, got {max_frames!r}")
+    robot = plan.robot
+    t = np.asarray(plan.t, float)
+    n = int(min(max_frames, len(t), np.floor((t[-1] - t[0]) / frame_step_s) + 1))
+    idx = np.unique(np.r_[np.searchsorted(t, np.linspace(t[0], t[-1], max(n, 2))), len(t) - 1].clip(0, len(t) - 1))
+    q = plan.q[idx]
+    frames = robot.frames_many(q, plan.base)
+    boxed = robot.boxed_links
+    B = robot.box_poses(frames, boxed)
+    colors = part_colors(robot)
+    map_frame = frames[:, robot.link_index(robot.parts.neck_end)]
+
+    if workspace_map is not None and len(workspace_map):
+        if workspace_map.chain_hash != robot.head_chain.hash:
+            raise ValueError(f"the map was made for another head chain ({workspace_map.base} -> {workspace_map.tip});"
+                             f" this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip}")
+        voxels = np.asarray(workspace_map.centers, float)
+        indices = np.asarray(workspace_map.indices, float)
+        voxel_size = float(workspace_map.voxel_size)
+    else:
+        voxels, indices, voxel_size = np.zeros((0, 3)), np.zeros(0), 0.0
+
+    # the support polygon of each frame; the frames share a few distinct ones (the base keeps its shape)
+    polys: list[np.ndarray] = []
+    of_frame = np.zeros(len(idx), np.int32)
+    for k, qk in enumerate(q):
+        poly = st.support_polygon(robot, qk, plan.base, contact=contact)
+        last = polys[of_frame[k - 1]] if k else None
+        if last is not None and last.shape == poly.shape and np.allclose(last, poly, atol=1e-6):
+            of_frame[k] = of_frame[k - 1]
+            continue
+        match = [i for i, p in enumerate(polys) if p.shape == poly.shape and np.allclose(p, poly, atol=1e-6)]
+        if not match:
+            polys.append(poly)
+            match = [len(polys) - 1]
+        of_frame[k] = match[0]
+    width = max(len(p) for p in polys)
+    polygons = np.full((len(polys), width, 2), np.nan)
+    for i, p in enumerate(polys):
+        polygons[i, :len(p)] = p
+
+    dyn = plan.stability
+    step = max(1, len(t) // 2000)
+    spheres = plan_spheres(plan) if spheres is None else list(spheres)
+    diameters = {tuple(np.round(np.asarray(c, float), 9)): d for c, d in spheres}
+    targets = list(plan.targets)
+    boxes = [o for o in plan.obstacles if isinstance(o, BoxObstacle)]
+    walls = [o for o in plan.obstacles if isinstance(o, WallWithHole)]
+    quads = [wall_faces(w) for w in walls]
+    wall_vertices = np.concatenate([qd.reshape(-1, 3) for qd in quads]) if quads else np.zeros((0, 3))
+    tris = []
+    offset = 0
+    for qd in quads:
+        base_idx = offset + 4 * np.arange(len(qd))[:, None]
+        tris.append(np.concatenate([base_idx + [0, 1, 2], base_idx + [0, 2, 3]]))
+        offset += 4 * len(qd)
+    return ViewerScene(
+        name=plan.name, title=title or plan.name, times=t[idx],
+        box_positions=B[..., :3, 3], box_wxyz=_wxyz(B[..., :3, :3]), box_sizes=robot.box_sizes[boxed].copy(),
+        box_colors=np.array([_rgb(colors[i]) for i in boxed], np.uint8),
+        head_tip=frames[:, robot.link_index(robot.parts.head_tip), :3, 3],
+        map_frame_positions=map_frame[:, :3, 3], map_frame_wxyz=_wxyz(map_frame[:, :3, :3]),
+        voxel_centers=voxels, voxel_indices=indices, voxel_size=voxel_size,
+        zmp=dyn.zmp[idx], com=dyn.com[idx], zmp_path=dyn.zmp[::step], polygons=polygons, polygon_of_frame=of_frame,
+        target_positions=np.array([tg.position for tg in targets]).reshape(-1, 3),
+        target_directions=np.array([tg.direction for tg in targets]).reshape(-1, 3),
+        target_names=np.array([tg.name for tg in targets], dtype=str),
+        target_diameters=np.array([diameters.get(tuple(np.round(tg.position, 9)), np.nan) for tg in targets], float),
+        obstacle_centres=np.array([b.centre for b in boxes]).reshape(-1, 3),
+        obstacle_sizes=np.array([b.size for b in boxes]).reshape(-1, 3),
+        obstacle_wxyz=_wxyz(np.array([b.rotation for b in boxes]).reshape(-1, 3, 3)),
+        wall_vertices=wall_vertices,
+        wall_triangles=np.concatenate(tris).astype(np.int32) if tris else np.zeros((0, 3), np.int32),
+        hole_rims=np.array([hole_rim(w) for w in walls]).reshape(-1, 65, 3),
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# NAME_viewer.npz
+# ----------------------------------------------------------------------------------------------
+def save_viewer_scene(scene: ViewerScene, path: str | Path) -> Path:
+    """Write ``scene`` as a compressed ``.npz`` (atomically); returns the path."""
+    path = Path(path)
+    arrays = {f.name: np.asarray(getattr(scene, f.name)) for f in fields(scene)}
+    arrays["format"] = np.asarray(SCENE_FORMAT)
+    with atomic_open(path, "wb") as f:
+        np.savez_compressed(f, **arrays)  # type: ignore[arg-type]
+    return path
+
+
+def load_viewer_scene(path: str | Path) -> ViewerScene:
+    """Read a scene written by :func:`save_viewer_scene` (ValueError if the file is not one)."""
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            contents = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{path}: not a viewer scene (.npz): {exc}") from None
+    version = contents.pop("format", None)
+    if version is None or int(version) != SCENE_FORMAT:
+        raise ValueError(f"{path}: viewer scene format {version!r}, this snakehead reads {SCENE_FORMAT}")
+    names = {f.name for f in fields(ViewerScene)}
+    missing = names - set(contents)
+    if missing:
+        raise ValueError(f"{path}: viewer scene without {sorted(missing)}")
+    values: dict[str, Any] = {k: contents[k] for k in names}
+    values["name"] = str(values["name"])
+    values["title"] = str(values["title"])
+    values["voxel_size"] = float(values["voxel_size"])
+    return ViewerScene(**values)
+
+
+def scenes_in(directory: str | Path) -> list[Path]:
+    """The viewer scenes (``*_viewer.npz``) in the output folder of ``snakehead plan`` or ``demo``, sorted."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise ValueError(f"{directory} is not a directory")
+    return sorted(directory.glob("*" + SCENE_SUFFIX))
+
+
+# ----------------------------------------------------------------------------------------------
+# the scene in viser
+# ----------------------------------------------------------------------------------------------
+class SceneNodes:
+    """The nodes of one :class:`ViewerScene` in a viser scene, under ``/ROOT``; :meth:`show_frame` moves them."""
+
+    LAYERS = ("robot", "reachability map", "ZMP and support polygon", "targets", "obstacles", "head tip path")
+
+    def __init__(self, scene_api: viser.SceneApi, data: ViewerScene, root: str = "/snakehead") -> None:
+        self.data = data
+        self.root = root
+        self.frame = -1
+        s = scene_api
+        # lit by an environment map at 0.4 of its strength: at full strength the parts' colours wash out to white
+        s.configure_environment_map(hdri="warehouse", environment_intensity=0.4)
+        # one parent node per layer, so that a layer shows or hides as one (viser's visibility is inherited)
+        self.groups = {layer: s.add_frame(f"{root}/{layer}", show_axes=False)
+                       for layer in ("ZMP and support polygon", "targets", "obstacles", "head tip path")}
+        lo, hi = data.bounds(margin=0.2)
+        size = float(max(hi[0] - lo[0], hi[1] - lo[1]))
+        centre = 0.5 * (lo + hi)
+        self.ground = s.add_grid(f"{root}/ground", width=size, height=size, plane="xy", cell_size=0.1,
+                                 section_size=0.5, position=(centre[0], centre[1], 0.0))
+        self.robot = s.add_batched_meshes_simple(
+            f"{root}/robot", _CUBE_VERTICES, _CUBE_TRIANGLES, batched_wxyzs=data.box_wxyz[0],
+            batched_positions=data.box_positions[0], batched_scales=data.box_sizes, batched_colors=data.box_colors,
+            lod="off", flat_shading=True)
+        self.map_frame = s.add_frame(f"{root}/head base frame", show_axes=True, axes_length=0.05, axes_radius=0.002,
+                                     position=data.map_frame_positions[0], wxyz=data.map_frame_wxyz[0])
+        self.voxels = None
+        if len(data.voxel_centers):
+            from .workspace import index_colors
+
+            rgb = np.round(255 * index_colors(data.voxel_indices)).astype(np.uint8)
+            n = len(data.voxel_centers)
+            self.voxels = s.add_batched_meshes_simple(
+                f"{root}/head base frame/reachability map", _CUBE_VERTICES, _CUBE_TRIANGLES,
+                batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)), batched_positions=data.voxel_centers,
+                batched_scales=np.full(n, 0.8 * data.voxel_size), batched_colors=rgb, opacity=0.35, lod="off",
+                cast_shadow=False, receive_shadow=False, visible=False)
+        self.polygons = []
+        for i, poly in enumerate(data.polygons):
+            p = poly[np.all(np.isfinite(poly), axis=1)]
+            p3 = np.column_stack([p, np.full(len(p), 0.001)])
+            segs = np.stack([p3, np.roll(p3, -1, axis=0)], axis=1)
+            self.polygons.append(s.add_line_segments(f"{root}/ZMP and support polygon/support polygon {i}", segs,
+                                                     POLYGON_RGB, thickness=0.004,
+                                                     visible=bool(data.polygon_of_frame[0] == i)))
+        z3 = np.column_stack([data.zmp_path, np.full(len(data.zmp_path), 0.0015)])
+        if len(z3) > 1:
+            s.add_line_segments(f"{root}/ZMP and support polygon/ZMP path", np.stack([z3[:-1], z3[1:]], axis=1),
+                                ZMP_RGB, thickness=0.002)
+        self.zmp = s.add_icosphere(f"{root}/ZMP and support polygon/ZMP", radius=0.008, color=ZMP_RGB,
+                                   position=(*data.zmp[0], 0.0), cast_shadow=False)
+        self.com = s.add_icosphere(f"{root}/ZMP and support polygon/CoM ground projection", radius=0.006,
+                                   color=COM_RGB, position=(data.com[0, 0], data.com[0, 1], 0.0), cast_shadow=False)
+        tip = data.head_tip
+        if len(tip) > 1:
+            s.add_line_segments(f"{root}/head tip path/path", np.stack([tip[:-1], tip[1:]], axis=1), TIP_PATH_RGB,
+                                thickness=0.002)
+        for i, (p, d, name, dia) in enumerate(zip(data.target_positions, data.target_directions, data.target_names,
+                                                  data.target_diameters)):
+            node = f"{root}/targets/{i + 1} {name}"
+            if np.isfinite(dia):
+                s.add_icosphere(node + "/sphere", radius=float(dia) / 2, color=TARGET_RGB, opacity=0.6,
+                                position=p, cast_shadow=False)
+            s.add_arrows(node + "/direction", np.array([[p - 0.09 * d, p - 0.01 * d]]), TARGET_RGB,
+                         shaft_radius=0.003, head_radius=0.008, head_length=0.02)
+            s.add_label(node + "/label", str(name), position=p + np.array([0.0, 0.0, 0.04]))
+        for i, (c, size, q) in enumerate(zip(data.obstacle_centres, data.obstacle_sizes, data.obstacle_wxyz)):
+            s.add_box(f"{root}/obstacles/box {i + 1}", color=OBSTACLE_RGB, dimensions=tuple(size), position=c, wxyz=q,
+                      opacity=0.6)
+        if len(data.wall_triangles):
+            s.add_mesh_simple(f"{root}/obstacles/wall", data.wall_vertices.astype(np.float32),
+                              data.wall_triangles.astype(np.uint32), color=WALL_RGB, opacity=0.45, side="double",
+                              cast_shadow=False)
+            for i, rim in enumerate(data.hole_rims):
+                s.add_line_segments(f"{root}/obstacles/hole {i + 1}", np.stack([rim[:-1], rim[1:]], axis=1),
+                                    (0, 0, 0), thickness=0.002)
+        self.show_frame(0)
+
+    def show_frame(self, k: int) -> None:
+        """Move everything that moves to frame ``k`` (0 .. n_frames - 1); only what changed is sent."""
+        d = self.data
+        k = int(np.clip(k, 0, d.n_frames - 1))
+        if k == self.frame:
+            return
+        before = self.frame
+        self.frame = k
+        self.robot.batched_positions = d.box_positions[k]
+        self.robot.batched_wxyzs = d.box_wxyz[k]
+        self.map_frame.position = d.map_frame_positions[k]
+        self.map_frame.wxyz = d.map_frame_wxyz[k]
+        self.zmp.position = (d.zmp[k, 0], d.zmp[k, 1], 0.0)
+        self.com.position = (d.com[k, 0], d.com[k, 1], 0.0)
+        if before < 0 or d.polygon_of_frame[before] != d.polygon_of_frame[k]:
+            for i, node in enumerate(self.polygons):
+                node.visible = bool(d.polygon_of_frame[k] == i)
+
+
+def _camera_to(target: Any, data: ViewerScene) -> None:
+    position, look_at = data.camera()
+    target.fov = np.radians(CAMERA_FOV_DEG)
+    target.up = (0.0, 0.0, 1.0)
+    target.position = position
+    target.look_at = look_at
+
+
+@contextlib.contextmanager
+def _quiet_server(port: int = 0) -> Iterator[viser.ViserServer]:
+    """A viser server on the loopback interface (a free port by default) that prints nothing; stopped after."""
+    import viser
+
+    with contextlib.redirect_stdout(io.StringIO()):
+        server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    try:
+        yield server
+    finally:
+        with contextlib.redirect_stdout(io.StringIO()):
+            server.stop()
+
+
+def html_page(data: ViewerScene) -> str:
+    """A standalone HTML page (str) playing ``data``: viser's client with the recorded scene inside, for a browser
+    that opens it from disk -- no server, no network. Play/pause and the time slider are at the bottom; the scene
+    tree (bottom right) toggles the layers (the reachability map starts hidden)."""
+    with _quiet_server() as server:
+        _camera_to(server.initial_camera, data)
+        recording = server.get_scene_serializer()
+        nodes = SceneNodes(server.scene, data)
+        for k in range(1, data.n_frames):
+            recording.insert_sleep(float(data.times[k] - data.times[k - 1]))
+            nodes.show_frame(k)
+        recording.insert_sleep(1.0)  # hold the last frame a moment before the player loops
+        page = recording.as_html()
+    return page.replace("<title>Viser</title>", f"<title>snakehead: {_escape(data.title)}</title>", 1)
+
+
+def _escape(text: str) -> str:
+    import html
+
+    return html.escape(text, quote=True)
+
+
+def write_html(data: ViewerScene, path: str | Path) -> Path:
+    """Write :func:`html_page` of ``data`` to ``path`` (atomically); returns the path."""
+    return write_text_atomic(path, html_page(data))
+
+
+# ----------------------------------------------------------------------------------------------
+# snakehead view DIR
+# ----------------------------------------------------------------------------------------------
+class Viewer:
+    """A live viser server over viewer scenes (``snakehead view``): the GUI picks the scenario, plays and pauses,
+    scrubs time, sets the speed and toggles the layers. :meth:`close` stops it."""
+
+    SPEEDS = ("0.5x", "1x", "2x", "4x", "8x", "16x")
+
+    def __init__(self, scenes: Sequence[ViewerScene], *, host: str = "127.0.0.1", port: int = 8080) -> None:
+        import viser
+
+        if not scenes:
+            raise ValueError("no viewer scenes to show")
+        self.scenes = {s.name: s for s in scenes}
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        self.lock = threading.Lock()
+        gui = self.server.gui
+        gui.configure_theme(control_width="medium")
+        self.scenario = gui.add_dropdown("scenario", tuple(self.scenes), initial_value=scenes[0].name)
+        self.playing = gui.add_checkbox("play", initial_value=True)
+        self.time = gui.add_slider("time (s)", min=0.0, max=1.0, step=0.1, initial_value=0.0)
+        self.speed = gui.add_dropdown("speed", self.SPEEDS, initial_value="4x")
+        self.layers = {name: gui.add_checkbox(name, initial_value=name != "reachability map")
+                       for name in SceneNodes.LAYERS}
+        self.nodes: SceneNodes | None = None
+        self._stop = threading.Event()
+        self._load(scenes[0].name)
+        self.scenario.on_update(lambda _: self._load(self.scenario.value))
+        self.time.on_update(lambda _: self._seek(self.time.value))
+        for layer in self.layers.values():
+            layer.on_update(lambda _: self._apply_layers())
+        self._thread = threading.Thread(target=self._play, name="snakehead-viewer", daemon=True)
+        self._thread.start()
+
+    @property
+    def port(self) -> int:
+        return int(self.server.get_port())
+
+    def _load(self, name: str) -> None:
+        with self.lock:
+            data = self.scenes[name]
+            self.server.scene.reset()
+            self.nodes = SceneNodes(self.server.scene, data)
+            _camera_to(self.server.initial_camera, data)
+            for client in self.server.get_clients().values():
+                _camera_to(client.camera, data)
+            duration = float(data.times[-1] - data.times[0])
+            step = float(max(0.01, np.round(duration / 1000, 2)))
+            self.time.max = max(round(duration, 2), step)
+            self.time.step = step
+            self.time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
+            self._apply_layers()
+
+    def _frame_at(self, t_rel: float) -> int:
+        assert self.nodes is not None
+        times = self.nodes.data.times
+        return int(np.searchsorted(times - times[0], t_rel + 1e-9, side="right") - 1)
+
+    def _seek(self, t_rel: float) -> None:
+        with self.lock:
+            if self.nodes is not None:
+                self.nodes.show_frame(self._frame_at(float(t_rel)))
+
+    def _apply_layers(self) -> None:
+        if self.nodes is None:
+            return
+        self.nodes.robot.visible = self.layers["robot"].value
+        if self.nodes.voxels is not None:
+            self.nodes.voxels.visible = self.layers["reachability map"].value
+        for layer, group in self.nodes.groups.items():
+            group.visible = self.layers[layer].value
+
+    def _play(self, tick_s: float = 0.05) -> None:
+        last = time.perf_counter()
+        while not self._stop.wait(tick_s):
+            now = time.perf_counter()
+            dt, last = now - last, now
+            if not self.playing.value or self.nodes is None:
+                continue
+            factor = float(self.speed.value.rstrip("x"))
+            t_next = self.time.value + factor * dt
+            if t_next > self.time.max:
+                t_next = 0.0
+            self.time.value = t_next  # type: ignore[misc]  # (viser: assignable, typed read-only); moves the scene
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self.server.stop()
+
+
+def serve(directory: str | Path, *, host: str = "127.0.0.1", port: int = 8080) -> Viewer:
+    """Serve the viewer scenes of ``directory`` (the output of ``snakehead plan`` or ``demo``) at
+    http://HOST:PORT (the next free port if PORT is taken); returns the running :class:`Viewer`."""
+    paths = scenes_in(directory)
+    if not paths:
+        raise ValueError(f"{directory} holds no viewer scenes (*{SCENE_SUFFIX}); 'snakehead plan' and "
+                         "'snakehead demo' write them")
+    return Viewer([load_viewer_scene(p) for p in paths], host=host, port=port)

@@ -1,0 +1,226 @@
+"""Figures and animations (snakehead.viz): the plotting convention, save(), the GIF's frames, and the figures of a
+generated snake whose frames and parts are named unlike the default robot's."""
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from snakehead import BasePlacement, SnakeRobot
+from snakehead.dynamics import stability
+from snakehead.geometry import collision as coll
+from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
+from snakehead.model.generate import SnakeSpec, snake_urdf
+from snakehead.motion.planner import Plan
+from snakehead.viz import animation, body, dynamics, save, viewer
+
+
+@pytest.fixture(scope="module")
+def snake(tmp_path_factory) -> SnakeRobot:
+    """A 12-joint snake that starts with a pitch joint, with 7 cm modules, a 5 cm section and its own names."""
+    spec = SnakeSpec(n_joints=12, module_length=0.07, section=0.05, mass_per_module=0.25, first_axis="pitch",
+                     markers={"p0": 5, "b0": 7}, tip_name="nose", link_prefix="seg", joint_prefix="j")
+    path = tmp_path_factory.mktemp("snake") / "snake12.urdf"
+    path.write_text(snake_urdf(spec))
+    return SnakeRobot.from_urdf(path, base_end="p0", neck_end="b0", head_tip="nose")
+
+
+@pytest.fixture(scope="module")
+def plan(snake) -> Plan:
+    """A made-up 4 s motion of the snake (the base curls, the neck rises) wrapped as a Plan, with a wall and a box."""
+    base = BasePlacement(0.1, -0.05, 0.3)
+    t = np.linspace(0.0, 4.0, 401)
+    q_end = np.zeros(snake.n_joints)
+    yaw = np.array([k == "yaw" for k in snake.joint_kinds])
+    q_end[snake.parts.base][yaw[snake.parts.base]] = 0.5
+    neck = np.arange(snake.n_joints)[snake.parts.neck]
+    q_end[neck[~yaw[neck]]] = -0.6  # the neck's pitch joint lifts neck and head
+    s = 0.5 - 0.5 * np.cos(np.pi * t / t[-1])
+    q = s[:, None] * q_end
+    qd = np.gradient(q, t, axis=0)
+    dyn = stability.dynamic_stability(snake, t, q, base, contact="ground")
+    wall = WallWithHole.standing([0.6, 0.4, 0.3], [0.0, 1.0, 0.0], [0.5, 0.45, 0.01], 0.08)
+    box = BoxObstacle.from_yaw([0.2, 0.45, 0.05], [0.1, 0.1, 0.1], 0.4)
+    return Plan(name="made-up", robot=snake, base=base, t=t, q=q, qd=qd,
+                states=[("lying", 0.0, q[0]), ("halfway", 2.0, q[200]), ("raised", 4.0, q[-1])], targets=[],
+                stability=dyn, ground_clearance=coll.ground_clearance(snake, q, base)[:, snake.lifted_links].min(1),
+                obstacles=[wall, box])
+
+
+# ----------------------------------------------------------------------------------------------
+# the convention
+# ----------------------------------------------------------------------------------------------
+def test_no_backend_is_chosen_at_import_or_when_drawing(tmp_path):
+    """Importing snakehead.viz and making and saving a figure leave matplotlib's backend to the user."""
+    code = ("import matplotlib, snakehead.viz, sys\n"
+            "from snakehead.viz import animation, backbone, body, dynamics, viewer, workspace\n"
+            "from snakehead.viz import save\n"
+            "save(backbone.plot_area_vs_angle(), sys.argv[1])\n"
+            "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot was imported'\n"
+            "print(matplotlib.get_backend())\n")
+    env = {**os.environ, "MPLBACKEND": "template"}
+    run = subprocess.run([sys.executable, "-c", code, str(tmp_path / "a.png")], capture_output=True, text=True,
+                         env=env)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "template"
+
+
+def test_save_writes_by_suffix_atomically(tmp_path, monkeypatch):
+    fig = Figure(figsize=(2, 2))
+    fig.subplots().plot([0, 1], [1, 0])
+    starts = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
+    for suffix, magic in starts.items():
+        p = save(fig, tmp_path / "sub" / f"f.{suffix}")  # missing folders are made
+        assert p.read_bytes().startswith(magic)
+    # files get the permissions open() would give them, not mkstemp's private ones
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE((tmp_path / "sub" / "f.png").stat().st_mode) == 0o666 & ~umask
+    with pytest.raises(ValueError, match="suffix"):
+        save(fig, tmp_path / "nosuffix")
+    with pytest.raises(TypeError, match="Figure"):
+        save("not a figure", tmp_path / "x.png")
+    # a failure while writing leaves the old file as it was and no temporary file behind
+    target = tmp_path / "kept.png"
+    target.write_bytes(b"old")
+
+    def broken(f, **kwargs):
+        f.write(b"half a PNG")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(fig, "savefig", broken)
+    with pytest.raises(RuntimeError, match="disk full"):
+        save(fig, target)
+    assert target.read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.png", "sub"]
+
+
+# ----------------------------------------------------------------------------------------------
+# a generated snake: frames and parts named unlike the default robot's
+# ----------------------------------------------------------------------------------------------
+def test_body_geometry_of_a_generated_snake(snake, plan):
+    colors = body.part_colors(snake)
+    assert len(colors) == len(snake.link_names)
+    for links, color in ((snake.base_links, "#7f8c8d"), (snake.neck_links, "#e67e22"),
+                         (snake.head_links, "#2e86c1")):
+        assert {colors[i] for i in links} == {color}
+    F = snake.frames(plan.q[-1], plan.base)
+    faces, face_colors = body.body_faces(snake, F)
+    assert faces.shape == (6 * len(snake.boxed_links), 4, 3) and len(face_colors) == len(faces)
+    # the faces' corners are the robot's box corners
+    corners = snake.box_corners(F[None])[0].reshape(-1, 3)
+    np.testing.assert_allclose(np.unique(faces.reshape(-1, 3).round(12), axis=0),
+                               np.unique(corners.round(12), axis=0), atol=1e-12)
+    # points along the body: the root, each joint (its frame's origin) and the nose
+    P = body.body_points(snake, F)
+    assert P.shape == (snake.n_joints + 2, 3)
+    np.testing.assert_allclose(P[1:-1], F[snake.joint_frames, :3, 3])
+    np.testing.assert_allclose(P[-1], snake.head_pose(plan.q[-1], plan.base)[:3, 3])
+    # consecutive joints are one module apart (the body's links are rigid)
+    gaps = np.linalg.norm(np.diff(P[1:-1], axis=0), axis=1)
+    np.testing.assert_allclose(gaps, 0.07, atol=1e-12)
+
+
+def test_wall_faces_tile_the_wall_minus_the_hole(plan):
+    wall = plan.obstacles[0]
+    quads = body.wall_faces(wall, n=256)
+
+    def area(q):  # planar quads in the wall's plane: two triangles each
+        a = np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0])
+        b = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 0])
+        return 0.5 * (np.linalg.norm(a, axis=1) + np.linalg.norm(b, axis=1)).sum()
+
+    expected = wall.size[0] * wall.size[1] - np.pi * (wall.hole_diameter / 2) ** 2
+    assert area(quads) == pytest.approx(expected, rel=1e-3)
+    # every corner lies in the wall's mid-plane
+    np.testing.assert_allclose((quads.reshape(-1, 3) - wall.centre) @ wall.normal, 0.0, atol=1e-12)
+
+
+def test_figures_of_a_generated_snake(plan, tmp_path):
+    snaps = body.plot_snapshots(plan, columns=3)
+    assert len([ax for ax in snaps.axes if ax.name == "3d"]) == len(body.snapshot_states(plan)) == 3
+    zmp = dynamics.plot_zmp(plan.robot, plan.t, plan.q, base=plan.base, stability=plan.stability)
+    # the planned ZMP scatter holds the plan's ZMP
+    scatter = zmp.axes[0].collections[0]
+    np.testing.assert_allclose(scatter.get_offsets(), plan.stability.zmp[::1])
+    mom = dynamics.plot_momenta(plan.t, plan.stability.P, plan.stability.L, figures=(None, None))
+    np.testing.assert_allclose(mom.axes[0].get_lines()[0].get_ydata(), plan.stability.L[:, 0])
+    for name, fig in (("snapshots", snaps), ("zmp", zmp), ("momenta", mom)):
+        assert save(fig, tmp_path / f"{name}.png").stat().st_size > 10_000
+
+
+def test_the_gif_frames_are_full_redraws(plan, tmp_path):
+    """Blitting draws each frame as a full draw of the figure would: compare with full draws of the same state."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    anim = animation.animate(plan, max_frames=4)
+    frames = [np.asarray(im) for im in anim.images()]
+    assert len(frames) == len(anim) == 4
+    body_art, trace, clock = anim._artists
+    robot = plan.robot
+    tip = anim._frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
+    canvas = FigureCanvasAgg(anim.figure)
+    for k in (0, 3):
+        body_art.set_verts(body.body_faces(robot, anim._frames[k])[0])
+        trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
+        clock.set_text(f"{plan.name}: t = {anim.times[k]:5.1f} s  (x{anim._speedup:.1f} speed)")
+        canvas.draw()
+        full = np.asarray(canvas.buffer_rgba())
+        assert np.abs(full.astype(int) - frames[k]).max() <= 1, k
+    assert np.abs(frames[0].astype(int) - frames[3]).sum(axis=2).astype(bool).mean() > 0.005  # the body moved
+    p = save(anim, tmp_path / "made-up.gif")
+    from PIL import Image
+
+    with Image.open(p) as im:
+        assert im.n_frames == 4 and im.size == (400, 320)
+    with pytest.raises(ValueError, match="gif"):
+        save(anim, tmp_path / "made-up.png")
+    with pytest.raises(ValueError, match="fps"):
+        animation.animate(plan, fps=0)
+    with pytest.raises(ValueError, match="max_frames"):
+        animation.animate(plan, max_frames=1)
+
+
+def test_viewer_scene_of_a_generated_snake(plan, tmp_path):
+    data = viewer.viewer_scene(plan, frame_step_s=0.5)
+    assert data.n_frames == 9 and data.times[0] == 0.0 and data.times[-1] == 4.0
+    robot = plan.robot
+    F = robot.frames_many(plan.q[[0, -1]], plan.base)
+    B = robot.box_poses(F)
+    np.testing.assert_allclose(data.box_positions[[0, -1]], B[..., :3, 3], atol=1e-12)
+    # the quaternions turn the boxes like their rotation matrices
+    from scipy.spatial.transform import Rotation
+
+    w, xyz = data.box_wxyz[-1][:, :1], data.box_wxyz[-1][:, 1:]
+    np.testing.assert_allclose(Rotation.from_quat(np.hstack([xyz, w])).as_matrix(), B[-1, :, :3, :3], atol=1e-12)
+    np.testing.assert_array_equal(data.box_sizes, robot.box_sizes[robot.boxed_links])
+    assert len(data.voxel_centers) == 0  # no map given
+    assert data.obstacle_centres.shape == (1, 3) and data.hole_rims.shape == (1, 65, 3)
+    assert data.wall_triangles.max() < len(data.wall_vertices)
+    # the map's frame is the head's base frame (neck_end = b0) at every frame
+    np.testing.assert_allclose(data.map_frame_positions[-1], F[-1, robot.link_index("b0"), :3, 3], atol=1e-12)
+    # the camera sees the whole scene: every box centre within the field of view
+    eye, look_at = data.camera()
+    d = data.box_positions.reshape(-1, 3) - eye
+    axis = (look_at - eye) / np.linalg.norm(look_at - eye)
+    angle = np.degrees(np.arccos(d @ axis / np.linalg.norm(d, axis=1)))
+    assert angle.max() < viewer.CAMERA_FOV_DEG / 2
+    page = viewer.write_html(data, tmp_path / "made-up.html")
+    assert page.read_text().count("__VISER_EMBED_DATA__") == 1
+    with pytest.raises(ValueError, match="frame_step_s"):
+        viewer.viewer_scene(plan, frame_step_s=0.0)
+    with pytest.raises(ValueError, match="max_frames"):
+        viewer.viewer_scene(plan, max_frames=1)
+
+
+def test_viewer_refuses_a_map_of_another_head(plan):
+    from snakehead import load_map
+
+    m = load_map(SnakeRobot.default().map_path)
+    with pytest.raises(ValueError, match="another head chain"):
+        viewer.viewer_scene(plan, workspace_map=m)
