@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import finite_array
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -42,14 +43,14 @@ SLIP_FLOOR = 1e-9
 TRANSLATION_TOLERANCE = 1e-7
 
 
-def _loads(weights, k: int) -> np.ndarray:
+def _loads(weights: npt.ArrayLike, k: int) -> np.ndarray:
     w = finite_array(weights, "weights", (k,))
     if np.any(w < 0) or w.sum() <= 0:
         raise ValueError("weights (normal loads) must be >= 0 with a positive sum")
     return w
 
 
-def balance_translation(shifts, weights) -> np.ndarray:
+def balance_translation(shifts: npt.ArrayLike, weights: npt.ArrayLike) -> np.ndarray:
     """The translation t (2,) that balances the friction of contacts whose no-slip shifts are ``shifts`` (k, 2)
     with loads ``weights`` (k,): the minimiser of sum_i w_i |t - s_i| (the weighted geometric median).
 
@@ -77,7 +78,7 @@ def balance_translation(shifts, weights) -> np.ndarray:
     # Weiszfeld step where Newton's cannot (next to a contact that nearly sticks, the curvature is huge)
     scale = max(float(np.abs(s).max()), 1e-12)
 
-    def dissipation(t):
+    def dissipation(t: np.ndarray) -> float:
         return float(w @ np.sqrt(((s - t) ** 2).sum(axis=1)))
 
     t = w @ s / w.sum()
@@ -110,7 +111,8 @@ def balance_translation(shifts, weights) -> np.ndarray:
     return t
 
 
-def balance_motion(before, after, weights, iterations: int = 60) -> tuple[np.ndarray, float]:
+def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.ArrayLike, iterations: int = 60
+                   ) -> tuple[np.ndarray, float]:
     """The planar rigid motion (t (2,), angle w rad) that, applied to contact points ``after`` (k, 2) (the shape
     changed in the body's frame), best keeps them where they were (``before`` (k, 2)) in the sense of friction:
     the minimiser of sum_i N_i |R(w) a_i + t - b_i|, by iteratively reweighted least squares (Gauss-Newton on the
@@ -140,7 +142,7 @@ def balance_motion(before, after, weights, iterations: int = 60) -> tuple[np.nda
     return t, w
 
 
-def resting_contacts(robot: SnakeRobot, q) -> tuple[np.ndarray, np.ndarray]:
+def resting_contacts(robot: SnakeRobot, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Where a body lying flat with joints ``q`` (n,) touches the ground: the centres (k, 2) of its boxes in the
     root frame's ground plane (m), and their loads (the links' masses, kg). ValueError unless every box rests on
     the ground (its bottom within RESTING_HEIGHT of the lowest): the model is for flat shapes."""
@@ -155,7 +157,8 @@ def resting_contacts(robot: SnakeRobot, q) -> tuple[np.ndarray, np.ndarray]:
     return centres, robot.masses[robot.boxed_links]
 
 
-def predict_slide(robot: SnakeRobot, q_path, start: BasePlacement | None = None) -> list[BasePlacement]:
+def predict_slide(robot: SnakeRobot, q_path: npt.ArrayLike, start: BasePlacement | None = None
+                  ) -> list[BasePlacement]:
     """Where the root frame goes while a body lying on the ground changes its shape along ``q_path`` (T, n) (flat
     shapes: the joints that would lift it kept at zero), starting at ``start``: the placement at every
     configuration (T,), by :func:`balance_motion` between consecutive configurations. Sample the path finely

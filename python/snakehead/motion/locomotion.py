@@ -10,7 +10,7 @@ rigid motions (:func:`compose`, :func:`relative`).
   default robot). :func:`curl_displacement` predicts that motion with the quasi-static friction model of
   :mod:`snakehead.dynamics.sliding`; :func:`straight_pose_for` is where a straight body must lie for the curl to
   leave its base at a given placement.
-* The gaits (:mod:`.gaits`): every run starts and ends with the body straight. Turning in place turns it about
+* The gaits (:mod:`snakehead.motion.gaits`): every run starts and ends with the body straight. Turning in place turns it about
   its middle; sidewinding carries it sideways, square to its axis. Nothing carries it along its axis on an
   isotropic friction ground. :func:`next_step` therefore moves the body's middle (the straight body's virtual
   chassis, :func:`chassis_offset`) to the goal's in the goal's own frame, one leg at a time: along the goal's
@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import finite_array, finite_float, positive
 from ..dynamics.sliding import predict_slide
@@ -67,7 +68,7 @@ def inverse(a: BasePlacement) -> BasePlacement:
 CURL_STEPS = 40
 
 
-def flat_shape(robot: SnakeRobot, q, name: str = "q") -> np.ndarray:
+def flat_shape(robot: SnakeRobot, q: npt.ArrayLike, name: str = "q") -> np.ndarray:
     """``q`` (n,) checked to be a shape lying flat on the ground: finite, within the joint limits, every pitch
     joint at 0 (ValueError otherwise)."""
     robot = as_robot(robot)
@@ -84,14 +85,15 @@ def flat_shape(robot: SnakeRobot, q, name: str = "q") -> np.ndarray:
     return q
 
 
-def curl_path(q_from, q_to, steps: int = CURL_STEPS) -> np.ndarray:
+def curl_path(q_from: npt.ArrayLike, q_to: npt.ArrayLike, steps: int = CURL_STEPS) -> np.ndarray:
     """The joint path of a curl on the ground: straight in joint space from ``q_from`` to ``q_to``, (steps + 1, n)."""
     a, b = np.asarray(q_from, float), np.asarray(q_to, float)
     s = np.linspace(0.0, 1.0, int(steps) + 1)[:, None]
     return a + s * (b - a)
 
 
-def curl_displacement(robot: SnakeRobot, q_from, q_to, steps: int = CURL_STEPS) -> BasePlacement:
+def curl_displacement(robot: SnakeRobot, q_from: npt.ArrayLike, q_to: npt.ArrayLike, steps: int = CURL_STEPS
+                      ) -> BasePlacement:
     """Where the root frame goes, in its own starting frame, when a body lying flat changes its shape from
     ``q_from`` to ``q_to`` along :func:`curl_path` (:func:`snakehead.dynamics.sliding.predict_slide`)."""
     robot = as_robot(robot)
@@ -99,7 +101,8 @@ def curl_displacement(robot: SnakeRobot, q_from, q_to, steps: int = CURL_STEPS) 
     return predict_slide(robot, curl_path(q_from, q_to, steps))[-1]
 
 
-def straight_pose_for(robot: SnakeRobot, base: BasePlacement, q_curled, steps: int = CURL_STEPS) -> BasePlacement:
+def straight_pose_for(robot: SnakeRobot, base: BasePlacement, q_curled: npt.ArrayLike, steps: int = CURL_STEPS
+                      ) -> BasePlacement:
     """Where a body lying straight must lie for the curl into ``q_curled`` (e.g. the bending state) to leave its
     root frame at ``base``: base * D^-1, D = :func:`curl_displacement` from straight to ``q_curled``."""
     robot = as_robot(robot)
@@ -180,7 +183,7 @@ class Tolerance:
     yaw_deg: float = 4.0
     align_deg: float = 5.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in ("along_m", "across_m", "yaw_deg", "align_deg"):
             object.__setattr__(self, name, positive(getattr(self, name), name))
 

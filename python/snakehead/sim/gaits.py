@@ -227,7 +227,7 @@ class GaitSimulator:
         _, q_plan = gait.trajectory(self.robot, cycles, self.control_dt)
         return self._run(state, q_plan, gait.name, rest_s, record_every, start_estimate, gait=gait, cycles=cycles)
 
-    def run_path(self, state: SimState, q_path, duration_s: float, *, rest_s: float = 0.5, record_every: int = 5,
+    def run_path(self, state: SimState, q_path: npt.ArrayLike, duration_s: float, *, rest_s: float = 0.5, record_every: int = 5,
                  start_estimate: BodyPose | None = None, name: str = "path") -> GaitRun:
         """Run the joint path ``q_path`` (K, n) rad from ``state``: its configurations evenly spread over
         ``duration_s`` s and joined by a smooth-step in time (zero joint velocity at both ends), linear in the joints

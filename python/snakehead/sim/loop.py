@@ -43,16 +43,17 @@ import math
 import re
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 
 from .._validate import finite_float, positive
 from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
-from ..motion.planner import Plan, as_scene, bending_state, choose_base, plan
+from ..motion.planner import Plan, Relocation, as_scene, bending_state, choose_base, plan
 from ..scenes.scene import Scene
 from .compare import compare
 from .estimate import BodyPose, pose_error
@@ -74,7 +75,7 @@ class PoseFix:
     yaw_noise_deg: float = 0.05
     seed: int | None = 0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in ("position_noise_m", "yaw_noise_deg"):
             v = finite_float(getattr(self, name), name)
             if v < 0:
@@ -262,11 +263,11 @@ class ClosedLoop:
     :class:`~snakehead.sim.GaitSimulator`; the head phases' simulation uses the same ground.
     """
 
-    def __init__(self, scene, *, controller: HeadController | None = None, robot: SnakeRobot | None = None,
+    def __init__(self, scene: Any, *, controller: HeadController | None = None, robot: SnakeRobot | None = None,
                  speed: float = 0.12, min_segment: float = 2.0, fix: PoseFix | None = PoseFix(),
                  frequency: float = 0.5, curl_speed: float = 0.4, tolerance: lc.Tolerance = lc.Tolerance(),
                  max_gait_runs: int = 16, max_corrections: int = 3, method: str = "rotated", seed: int | None = 1,
-                 **sim_options):
+                 **sim_options: Any) -> None:
         self.scene = as_scene(scene)
         if controller is None:
             if robot is None:
@@ -303,8 +304,16 @@ class ClosedLoop:
                                          "hole_slices", "torque_limit")}
         self._offset = lc.chassis_offset(self.robot)
 
+    def straight_start(self, base: BasePlacement | None = None) -> BasePlacement:
+        """Where the body lies straight when the curl into the bending state alone brings its base to ``base``
+        (default: the scene's placement, else the default one): the paper's "current state" (Fig. 17a) before
+        its bending state (Fig. 17b)."""
+        base = as_base(base if base is not None else self.scene.base)
+        return lc.straight_pose_for(self.robot, base, bending_state(self.controller))
+
     # --- the planner's verdicts -------------------------------------------------------------------
-    def _base_for(self, placement: BasePlacement, q_shape: np.ndarray, allow_relocation: bool):
+    def _base_for(self, placement: BasePlacement, q_shape: np.ndarray, allow_relocation: bool
+                  ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
         """choose_base from ``placement`` with the base shape of ``q_shape``."""
         self.controller.base = placement
         return choose_base(self.controller, self.scene.reported, self.obstacles, allow_relocation, q_shape)
@@ -314,7 +323,7 @@ class ClosedLoop:
         return not notes
 
     # --- running ---------------------------------------------------------------------------------------
-    def run(self, start: BasePlacement, q_start=None, *, believed_start: BasePlacement | None = None,
+    def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *, believed_start: BasePlacement | None = None,
             progress: Callable[[str], None] | None = None) -> LoopRun:
         """Run the loop from the body lying at ``start`` (the root frame's placement) with joints ``q_start``
         (default straight; a flat shape: pitch joints 0). The loop knows where the body starts
@@ -327,6 +336,9 @@ class ClosedLoop:
         q_first = q_now.copy()
         if coll.self_clearance(robot, q_now[None])[0] <= 0.0:
             raise ValueError("q_start folds the body onto itself (two links overlap)")
+        if self.obstacles and coll.collision_check(robot, q_now[None], self.obstacles, start,
+                                                   exact_within=0.005).distance[0] <= 0.0:
+            raise ValueError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
         say = progress or (lambda text: None)
         sim = self.simulator
         rng = np.random.default_rng(None if self.fix is None else self.fix.seed)
@@ -411,11 +423,11 @@ class ClosedLoop:
                 continue
             # 5. the fix
             if self.fix is not None:
-                before, truth = est, sim.true_pose()
+                dead_reckoned, truth = est, sim.true_pose()
                 est = self.fix.measure(sim, rng)
-                fixes.append({"t_s": float(state.time), "dead_reckoning": pose_error(before, truth),
+                fixes.append({"t_s": float(state.time), "dead_reckoning": pose_error(dead_reckoned, truth),
                               "fix": pose_error(est, truth)})
-                say(f"the fix puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(before.base)})")
+                say(f"the fix puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
                 t0 = time.perf_counter()
                 ok = self._reachable(est.base, q_shape)
                 planning += time.perf_counter() - t0

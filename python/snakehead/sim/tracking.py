@@ -115,7 +115,7 @@ class SimState:
     def copy(self) -> "SimState":
         return SimState(self.qpos.copy(), self.qvel.copy(), float(self.time))
 
-    def load(self, sim: SimModel, data) -> None:
+    def load(self, sim: SimModel, data: Any) -> None:
         """Put ``data`` (of ``sim``'s model) in this state and compute its kinematics."""
         if self.qpos.shape != data.qpos.shape or self.qvel.shape != data.qvel.shape:
             raise ValueError(f"the state (qpos {self.qpos.shape}) belongs to another robot's model (qpos "

@@ -14,7 +14,13 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO
+from typing import IO, TYPE_CHECKING, Any, Iterator
+
+if TYPE_CHECKING:
+    from PIL import Image
+
+    from ..model.robot import SnakeRobot
+    from ..sim.loop import LoopRun
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -30,25 +36,25 @@ TARGET_COLOR = "#c0392b"
 _FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
 
 
-def _part_colors(robot) -> list[str]:
+def _part_colors(robot: SnakeRobot) -> list[str]:
     names = robot.link_names
     base_end, neck_end = names.index(robot.parts.base_end), names.index(robot.parts.neck_end)
     return [PART_COLORS[0] if i <= base_end else PART_COLORS[1] if i <= neck_end else PART_COLORS[2]
             for i in robot.boxed_links]
 
 
-def _frames(robot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
+def _frames(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
     """World frames (T, L, 4, 4) from root poses (T, 4, 4) and joints (T, n)."""
     return root[:, None] @ robot.body.fk_all_many(q)
 
 
-def _footprint(robot, frames: np.ndarray) -> np.ndarray:
+def _footprint(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
     """The boxes' outlines seen from above, (k, 4, 2): each box's bottom face."""
     corners = robot.box_corners(frames[None])[0]  # (k, 8, 3)
     return corners[:, [0, 2, 6, 4], :2]  # the -z face, in order around it
 
 
-def _check(run) -> None:
+def _check(run: Any) -> None:
     from ..sim.loop import LoopRun
 
     if not isinstance(run, LoopRun):
@@ -57,7 +63,7 @@ def _check(run) -> None:
         raise ValueError("the loop ran no phase: nothing to draw")
 
 
-def plot_ground_path(run, *, size: tuple[float, float] = (6.5, 6.0), title: str | None = None) -> Figure:
+def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), title: str | None = None) -> Figure:
     """The top view: the tail's path over the ground (MuJoCo's) coloured by the kind of phase, and where the loop
     believed it was (dead reckoning, dashed; a fix is a jump of it); the body's footprint at the start, after every
     ground phase and at the end; the targets (crosses, their height written beside them). Phases are numbered
@@ -75,20 +81,20 @@ def plot_ground_path(run, *, size: tuple[float, float] = (6.5, 6.0), title: str 
 
     def body(root: np.ndarray, q: np.ndarray, alpha: float, zorder: int = 2) -> None:
         fp = _footprint(robot, _frames(robot, root[None], q[None])[0])
-        ax.add_collection(PolyCollection(fp, facecolors=colors, edgecolors="k", linewidths=0.3, alpha=alpha,
+        ax.add_collection(PolyCollection(list(fp), facecolors=colors, edgecolors="k", linewidths=0.3, alpha=alpha,
                                          zorder=zorder))
 
     legend = []
     if len(t_all):
         body(roots[0], qs[0], 0.35)
-        ax.annotate("start", roots[0, :2, 3], fontsize=7, xytext=(4, -10), textcoords="offset points")
+        ax.annotate("start", (roots[0, 0, 3], roots[0, 1, 3]), fontsize=7, xytext=(4, -10), textcoords="offset points")
     for k, ph in enumerate(run.phases, start=1):
         inside = (t_all >= ph.t0_s - 1e-9) & (t_all <= ph.t1_s + 1e-9)
         c = KIND_COLORS[ph.kind]
         if inside.any():
             xy = roots[inside, :2, 3]
             ax.plot(xy[:, 0], xy[:, 1], "-", color=c, lw=1.6, zorder=3)
-            ax.annotate(str(k), xy[-1], fontsize=7, color=c, xytext=(3, 3), textcoords="offset points", zorder=5)
+            ax.annotate(str(k), (xy[-1, 0], xy[-1, 1]), fontsize=7, color=c, xytext=(3, 3), textcoords="offset points", zorder=5)
         if ph.run is not None:
             est = ph.run.root_estimate[:, :2, 3]
             ax.plot(est[:, 0], est[:, 1], "--", color=c, lw=0.9, alpha=0.8, zorder=3)
@@ -101,7 +107,7 @@ def plot_ground_path(run, *, size: tuple[float, float] = (6.5, 6.0), title: str 
         ax.plot(*roots[k, :2, 3], "*", color="k", ms=9, zorder=6)
     for tg in run.scene.targets:
         ax.plot(tg.position[0], tg.position[1], "x", color=TARGET_COLOR, ms=8, mew=2, zorder=6)
-        ax.annotate(f"{tg.name} (z {tg.position[2]:.2f} m)", tg.position[:2], fontsize=7, color=TARGET_COLOR,
+        ax.annotate(f"{tg.name} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7, color=TARGET_COLOR,
                     xytext=(5, 5), textcoords="offset points", zorder=6)
     legend += [Line2D([], [], color="k", ls="--", lw=0.9, label="estimated (dead reckoning)"),
                Line2D([], [], color="k", marker="*", ls="", label="outside fix"),
@@ -131,12 +137,12 @@ class LoopAnimation:
     _frames: np.ndarray = field(repr=False)
     _labels: list = field(repr=False)
     _artists: tuple = field(repr=False)
-    _robot: object = field(repr=False)
+    _robot: SnakeRobot = field(repr=False)
 
     def __len__(self) -> int:
         return len(self.times)
 
-    def images(self):
+    def images(self) -> Iterator[Image.Image]:
         """Each frame as an RGB :class:`PIL.Image.Image`."""
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from PIL import Image
@@ -168,7 +174,7 @@ class LoopAnimation:
         return path
 
 
-def animate_loop(run, *, max_frames: int = 100, fps: float = 10.0, size: tuple[float, float] = (6.0, 4.5),
+def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size: tuple[float, float] = (6.0, 4.5),
                  dpi: int = 80) -> LoopAnimation:
     """The whole sequence as MuJoCo ran it, in 3-D: at most ``max_frames`` frames evenly spaced in time (so faster
     than real time: the title gives the factor), the tail's path on the ground, the targets, the phase and the
