@@ -157,7 +157,12 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
     s = FAST if settings.fast else NORMAL
     name = scene.name
     loop = ClosedLoop(scene, controller=controller, speed=s["speed"], min_segment=s["min_segment"])
-    begin = loop.straight_start() if isinstance(start, str) and start == PAPER_START else start
+    if isinstance(start, str):
+        if start != PAPER_START:
+            raise ValueError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
+        begin = loop.straight_start()
+    else:
+        begin = start
     with progress.stage(f"{name}: closed loop from lying straight, tail at ({begin.x:.3f}, {begin.y:.3f}) m, "
                         f"heading {begin.yaw:.3f} rad"):
         run = loop.run(begin, progress=lambda text: progress.say(f"{name}: {text}"))
