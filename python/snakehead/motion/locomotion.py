@@ -10,7 +10,8 @@ rigid motions (:func:`compose`, :func:`relative`).
   default robot). :func:`curl_displacement` predicts that motion with the quasi-static friction model of
   :mod:`snakehead.dynamics.sliding`; :func:`straight_pose_for` is where a straight body must lie for the curl to
   leave its base at a given placement.
-* The gaits (:mod:`snakehead.motion.gaits`): every run starts and ends with the body straight. Turning in place turns it about
+* The gaits (:mod:`snakehead.motion.gaits`): every run starts and ends with the body straight, and runs whole
+  cycles, its amplitudes scaled down for a smaller effect (:func:`gait_run`). Turning in place turns it about
   its middle; sidewinding carries it sideways, square to its axis. Nothing carries it along its axis on an
   isotropic friction ground. :func:`next_step` therefore moves the body's middle (the straight body's virtual
   chassis, :func:`chassis_offset`) to the goal's in the goal's own frame, one leg at a time: along the goal's
@@ -18,8 +19,8 @@ rigid motions (:func:`compose`, :func:`relative`).
   axis (sidewinding at the goal's heading), the last leg the most precise since turning in place shifts the middle
   a little. Each step is one gait run; the loop re-estimates the pose after it and asks again, so errors of a leg
   are corrected by the next step.
-* :class:`GaitRates` are what one cycle of each gait does, learnt from the runs (estimated, as the robot knows
-  them): the first guesses are 0.25 body lengths per cycle sideways and 40 deg per cycle.
+* :class:`GaitRates` are what one cycle of each gait does at full amplitude, learnt from the runs (estimated, as the
+  robot knows them): the first guesses are 0.25 body lengths per cycle sideways and 40 deg per cycle.
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from .._validate import finite_array, finite_float, positive
+from .._validate import finite_array, positive
 from ..dynamics.sliding import predict_slide
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gaits import Gait, make_gait, virtual_chassis
@@ -122,14 +123,22 @@ def chassis_offset(robot: SnakeRobot) -> BasePlacement:
     return BasePlacement(float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
 
 
+#: How a gait's effect per cycle grows with the scale k of its amplitudes (both waves scaled alike), as k**exponent:
+#: measured on the default robot at 0.5 Hz, whole cycles (sidewinding 101, 204, 307, 391 mm per cycle at k = 0.25,
+#: 0.5, 0.75, 1; turning 8, 20, 34, 46 deg).
+AMPLITUDE_EXPONENT = {"sidewinding": 1.0, "turning": 1.25}
+#: The smallest amplitude scale a run uses (smaller waves barely move the body).
+MIN_AMPLITUDE_SCALE = 0.1
+
+
 @dataclass
 class GaitRates:
-    """What one cycle of a gait does, as the loop has seen it (its estimates).
+    """What one cycle of a gait at full amplitude does, as the loop has seen it (its estimates).
 
     sideways_m: how far a sidewinding cycle carries the body (m); sideways_angle_rad: the direction it goes for
     ``direction`` +1, from the body's axis (+pi/2: square to its left; -1 goes the mirror way); turn_rad: how far
-    a turning cycle turns it (rad, > 0). :meth:`update` learns them from runs: distance (or angle) over cycles,
-    summed over every run so far (so the ramps' share is in them, as it is in the runs to come).
+    a turning cycle turns it (rad, > 0). :meth:`update` learns them from runs: the effect over the cycles run at the
+    run's amplitude scale k, over k**AMPLITUDE_EXPONENT, summed over every run so far.
     """
 
     sideways_m: float
@@ -144,21 +153,21 @@ class GaitRates:
         robot does 0.28 and 46 at 0.5 Hz: bench/RESULTS.md, "Gaits")."""
         return cls(sideways_m=0.25 * as_robot(robot).body_length)
 
-    def update(self, gait: Gait, cycles: float, start: BasePlacement, end: BasePlacement,
+    def update(self, step: "LocomotionStep", start: BasePlacement, end: BasePlacement,
                offset: BasePlacement) -> None:
-        """Learn from a run of ``cycles`` cycles of ``gait`` that took the root from ``start`` to ``end``
-        (``offset``: :func:`chassis_offset`). Runs under a tenth of a cycle, and turns the wrong way, teach
-        nothing."""
-        cycles = finite_float(cycles, "cycles")
-        if cycles < 0.1:
+        """Learn from ``step``, which took the root from ``start`` to ``end`` (``offset``: :func:`chassis_offset`).
+        A turn the wrong way teaches nothing."""
+        gait = step.gait
+        full = step.cycles * step.scale ** AMPLITUDE_EXPONENT.get(gait.name, 1.0)  # in full-amplitude cycles
+        if full <= 0:
             return
         a, b = compose(start, offset), compose(end, offset)
         d = relative(a, BasePlacement(b.x, b.y, a.yaw))  # the middle's travel in the start frame
         S = self._sums
         if gait.name == "sidewinding":
             S["side_m"] += math.hypot(d.x, d.y)
-            S["side_angle"] += cycles * gait.direction * math.atan2(d.y, d.x)  # mirrored for direction -1
-            S["side_cycles"] += cycles
+            S["side_angle"] += full * gait.direction * math.atan2(d.y, d.x)  # mirrored for direction -1
+            S["side_cycles"] += full
             self.sideways_m = S["side_m"] / S["side_cycles"]
             self.sideways_angle_rad = S["side_angle"] / S["side_cycles"]
         elif gait.name == "turning":
@@ -166,7 +175,7 @@ class GaitRates:
             if turned <= 0:
                 return
             S["turn_rad"] += turned
-            S["turn_cycles"] += cycles
+            S["turn_cycles"] += full
             self.turn_rad = S["turn_rad"] / S["turn_cycles"]
 
 
@@ -176,7 +185,7 @@ class Tolerance:
     across it, its heading within ``yaw_deg``; ``align_deg``: how square to the goal's axis the body must be
     before sidewinding along it. ``along_m`` is the loosest: the legs after it (turning in place, sidewinding
     across) shift the middle along the axis by a few centimetres, and a tighter bound would send the body back to
-    the first leg."""
+    the first leg. A turning run is precise to a degree or two, a sidewinding run to a centimetre or two."""
 
     along_m: float = 0.08
     across_m: float = 0.03
@@ -187,29 +196,55 @@ class Tolerance:
         for name in ("along_m", "across_m", "yaw_deg", "align_deg"):
             object.__setattr__(self, name, positive(getattr(self, name), name))
 
+    def tighter(self, floor: "Tolerance | None" = None) -> "Tolerance":
+        """Half this tolerance, but not below ``floor`` (default: 3 cm, 2 cm, 2 deg, 3 deg)."""
+        floor = floor or Tolerance(0.03, 0.02, 2.0, 3.0)
+        return Tolerance(max(0.5 * self.along_m, floor.along_m), max(0.5 * self.across_m, floor.across_m),
+                         max(0.5 * self.yaw_deg, floor.yaw_deg), max(0.5 * self.align_deg, floor.align_deg))
+
 
 @dataclass(frozen=True)
 class LocomotionStep:
-    """One gait run: ``gait`` for ``cycles`` cycles, and why (``leg``: "along", "heading" or "across")."""
+    """One gait run: ``gait`` (its amplitudes scaled by ``scale``) for ``cycles`` whole cycles, and why (``leg``:
+    "along", "heading" or "across")."""
 
     gait: Gait
     cycles: float
     leg: str
+    scale: float = 1.0
+
+
+def gait_run(name: str, direction: int, amount: float, full_rate: float, *, max_cycles: int = 4,
+             frequency: float = 0.5, gait_options: dict | None = None) -> LocomotionStep:
+    """A run of gait ``name`` that does ``amount`` (m sideways, rad of turn; > 0) at ``full_rate`` per cycle at full
+    amplitude: whole cycles (a run of whole cycles ends in the shape it started from, so the sliding of its ramps
+    cancels; fractions of a cycle do not, and turn the body by as much as they were meant to), as few as do it
+    (at most ``max_cycles``), the amplitudes scaled down for the rest (AMPLITUDE_EXPONENT)."""
+    amount, full_rate = positive(amount, "amount"), positive(full_rate, "full_rate")
+    cycles = int(min(max(math.ceil(amount / full_rate - 1e-9), 1), max_cycles))
+    share = min(amount / (cycles * full_rate), 1.0)
+    scale = max(share ** (1.0 / AMPLITUDE_EXPONENT.get(name, 1.0)), MIN_AMPLITUDE_SCALE)
+    options = dict(gait_options or {})
+    options.setdefault("frequency", frequency)
+    full = make_gait(name, direction, **options)
+    for key in ("yaw_amplitude", "pitch_amplitude", "amplitude"):
+        if key in full.parameters:
+            options[key] = scale * full.parameters[key]
+    return LocomotionStep(make_gait(name, direction, **options), float(cycles), "", scale)
 
 
 def next_step(robot: SnakeRobot, current: BasePlacement, goal: BasePlacement, rates: GaitRates, *,
-              tolerance: Tolerance = Tolerance(), frequency: float = 0.5, max_cycles: float = 4.0,
+              tolerance: Tolerance = Tolerance(), frequency: float = 0.5, max_cycles: int = 4,
               gait_options: dict | None = None) -> LocomotionStep | None:
     """The next gait run that brings a straight body's root frame from ``current`` towards ``goal`` (see the
     module), or None when it is there within ``tolerance``. ``frequency`` Hz of the gaits; a run is at most
-    ``max_cycles`` cycles (the loop looks again after each); ``gait_options`` go to every gait
+    ``max_cycles`` cycles (the loop looks again after each; :func:`gait_run`); ``gait_options`` go to every gait
     (:func:`~snakehead.motion.gaits.make_gait`)."""
     robot = as_robot(robot)
     current, goal = as_base(current), as_base(goal)
     frequency = positive(frequency, "frequency")
-    max_cycles = positive(max_cycles, "max_cycles")
-    options = dict(gait_options or {})
-    options.setdefault("frequency", frequency)
+    if isinstance(max_cycles, bool) or not isinstance(max_cycles, (int, np.integer)) or max_cycles < 1:
+        raise ValueError(f"max_cycles must be a positive integer, got {max_cycles!r}")
     offset = chassis_offset(robot)
     here, there = compose(current, offset), compose(goal, offset)
     error = relative(there, BasePlacement(here.x, here.y, here.yaw))  # the middle in the goal's frame
@@ -218,12 +253,14 @@ def next_step(robot: SnakeRobot, current: BasePlacement, goal: BasePlacement, ra
 
     def turn_to(heading: float, leg: str) -> LocomotionStep:
         angle = wrap_angle(heading - current.yaw)
-        cycles = min(abs(angle) / rates.turn_rad, max_cycles)
-        return LocomotionStep(make_gait("turning", 1 if angle > 0 else -1, **options), cycles, leg)
+        step = gait_run("turning", 1 if angle > 0 else -1, abs(angle), rates.turn_rad, max_cycles=max_cycles,
+                        frequency=frequency, gait_options=gait_options)
+        return LocomotionStep(step.gait, step.cycles, leg, step.scale)
 
     def sidewind(distance: float, leg: str, direction: int) -> LocomotionStep:
-        cycles = min(abs(distance) / rates.sideways_m, max_cycles)
-        return LocomotionStep(make_gait("sidewinding", direction, **options), cycles, leg)
+        step = gait_run("sidewinding", direction, abs(distance), rates.sideways_m, max_cycles=max_cycles,
+                        frequency=frequency, gait_options=gait_options)
+        return LocomotionStep(step.gait, step.cycles, leg, step.scale)
 
     if abs(along) > tolerance.along_m:
         # travel along the goal's axis by -along: face square to it, the side that needs the least turning

@@ -477,7 +477,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
          obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None,
          method: str = "rotated", seed: int | None = 1, speed: float = DEFAULT_SPEED,
          min_segment: float = DEFAULT_MIN_SEGMENT, allow_relocation: bool = True,
-         base_shape: npt.ArrayLike | None = None) -> Plan:
+         base_shape: npt.ArrayLike | None = None, start_q: npt.ArrayLike | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -498,6 +498,10 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     base_shape : a configuration (n,) whose base joints (and those of the neck's links that stay on the ground) give
         the base's flat shape at ``base`` (default: the controller's initial configuration's): a closed loop that
         curled the body into a relocation's shape plans on from it (``snakehead.sim.loop``).
+    start_q : the configuration (n,) the plan starts from instead of the bending state it would choose: the body as
+        it lies (measured) in a bending state on the ground, so that the plan starts where the robot is (a closed
+        loop, ``snakehead.sim.loop``). Its base shape is ``base_shape``'s default. Used when the base stays (no
+        relocation); a note says so otherwise.
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
@@ -525,11 +529,18 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
+    if start_q is not None:
+        start_q = joint_vector(start_q, robot.n_joints, "start_q")
+        if base_shape is None:
+            base_shape = start_q
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape)
     notes += base_notes
     way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
-    way.start("bending state", bending_state(controller, q_shape))
+    if start_q is not None and relocation is not None:
+        notes.append("start_q is not used: the plan starts at the relocated base, in its bending state")
+        start_q = None
+    way.start("bending state", bending_state(controller, q_shape) if start_q is None else start_q)
     # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
     # state there; else the lift goes straight to the first target
     q = _shape_of(robot, q_shape, controller.q_initial)

@@ -8,30 +8,34 @@ the pose estimated after the last one, as the robot would do it.
 
 :class:`ClosedLoop` ``.run(start)``, from the body lying at ``start`` (straight, or curled with ``q_start``):
 
-1. **Where the base must go.** The planner's base choice (:func:`snakehead.motion.planner.choose_base`) from where
-   the curl would leave the base (:func:`snakehead.motion.locomotion.curl_displacement`, the quasi-static friction
-   model): that placement when the targets are reached from it, else the placement of the relocation it finds.
-2. **Locomotion** (when the base must move): the body uncurls if it is curled, then gait runs
+1. **Where the base must go.** ``plan(..., allow_relocation=True)`` from where the curl into the bending state would
+   leave the base (:func:`snakehead.motion.locomotion.curl_displacement`, the quasi-static friction model): that
+   placement when the plan succeeds from it, else the relocation's (the plan then starts there). The placement of a
+   successful plan is the loop's goal.
+2. **Locomotion** (when the curl from here would not leave the base at the goal, within
+   :class:`~snakehead.motion.locomotion.Tolerance`): the body uncurls if it is curled, then gait runs
    (:func:`snakehead.motion.locomotion.next_step`: turning in place and sidewinding) take the straight body to
-   where the curl will leave its base at that placement (:func:`~snakehead.motion.locomotion.straight_pose_for`).
-   After each run the pose is the estimate's (:mod:`snakehead.sim.estimate`: joint angles, one IMU, contact
-   odometry), never MuJoCo's, and the runs stop as soon as the curl from the estimated pose would leave the base
-   where the targets are reached (``choose_base`` with the base kept).
+   where the curl will leave its base at the goal (:func:`~snakehead.motion.locomotion.straight_pose_for`). After
+   each run the next is decided from the pose the robot estimates (:mod:`snakehead.sim.estimate`: joint angles, one
+   IMU, contact odometry), never from MuJoCo's.
 3. **The curl** into the bending state: a joint motion on the ground (it slides the body by most of a metre on the
    default robot: predicted by the friction model, followed by the estimate).
-4. **Re-plan** from the estimated pose with the base kept: when a target is not reached from it, back to 1 (a
-   correction: uncurl, gaits, curl).
+4. **Re-plan** from the estimated pose with the base kept (``allow_relocation=False``, the base's measured shape):
+   when the plan fails, back to 2 (a correction: uncurl, gaits, curl), with half the tolerance.
 5. **The fix.** Dead reckoning drifts: by 2-5 % of the distance travelled with the friction odometry, tens of
    millimetres after a metre, far from the 2 mm the head must reach. The loop closes it the way the paper's
    simulation does ("the pose of the base frame of the neck part is obtained in time"): once the body rests in
    the bending state, an outside measurement of the pose of the neck's base frame (``base_end``, the paper's P0;
    a motion-capture system, or the head's camera fixing known landmarks) with the joint angles gives the root
    frame's placement (:class:`PoseFix`, with Gaussian noise: 0.5 mm and 0.05 deg by default). This is an
-   assumption of the loop, stated in every report. When the targets are not reached from the fixed pose, back
-   to 1.
-6. **The head phases**: ``plan`` from the fixed pose with the base kept (checked as every plan: ZMP, clearance,
-   obstacles), run in MuJoCo from the simulation's state (:func:`snakehead.sim.simulate_trajectory` with
-   ``state=``), compared with the plan (:func:`snakehead.sim.compare`).
+   assumption of the loop, stated in every report. The head phases are planned again from the fixed pose (base
+   kept); when that plan fails, back to 2.
+6. **The head phases**, checked as every plan (ZMP, clearance, obstacles) and in dynamics the way the pipeline
+   checks a plan (simulated from the plan's own start, the base where the loop believes it lies: a plan whose
+   simulated ZMP leaves the support polygon is a failed plan, back to 2; the planner's ZMP margin is a few
+   millimetres, and near the edge of the reachable bases it is not always enough), then run in MuJoCo from the
+   simulation's state (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
+   (:func:`snakehead.sim.compare`).
 
 The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/curl/lift/move/hold, ``t0_s``,
 ``t1_s``), the estimate's error after every ground phase, how far the tail travelled, and the head's errors.
@@ -53,7 +57,7 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
-from ..motion.planner import Plan, Relocation, as_scene, bending_state, choose_base, plan
+from ..motion.planner import Plan, as_scene, bending_state, plan
 from ..scenes.scene import Scene
 from .compare import compare
 from .estimate import BodyPose, pose_error
@@ -258,7 +262,8 @@ class ClosedLoop:
     the shipped one). speed / min_segment: the planner's (rad/s, s). fix: the :class:`PoseFix` (None: no fix, the
     head phases planned from dead reckoning alone). frequency: the gaits' (Hz). curl_speed: the curl's largest
     joint rate (rad/s). tolerance: the locomotion's (:class:`snakehead.motion.locomotion.Tolerance`).
-    max_gait_runs: per correction; max_corrections: returns to step 1 after a curl before giving up.
+    max_gait_runs: per correction; max_corrections: returns to step 2 after a curl before giving up.
+    dynamics_check: simulate the head phases from the plan's own start before running them (step 6).
     imu_yaw_drift_deg_per_s, odometry and the other keywords (friction, ...) go to the
     :class:`~snakehead.sim.GaitSimulator`; the head phases' simulation uses the same ground.
     """
@@ -267,7 +272,7 @@ class ClosedLoop:
                  speed: float = 0.12, min_segment: float = 2.0, fix: PoseFix | None = PoseFix(),
                  frequency: float = 0.5, curl_speed: float = 0.4, tolerance: lc.Tolerance = lc.Tolerance(),
                  max_gait_runs: int = 16, max_corrections: int = 3, method: str = "rotated", seed: int | None = 1,
-                 **sim_options: Any) -> None:
+                 dynamics_check: bool = True, **sim_options: Any) -> None:
         self.scene = as_scene(scene)
         if controller is None:
             if robot is None:
@@ -296,6 +301,7 @@ class ClosedLoop:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value!r}")
         self.max_gait_runs, self.max_corrections = int(max_gait_runs), int(max_corrections)
+        self.dynamics_check = bool(dynamics_check)
         self.obstacles = list(self.scene.obstacles)
         self.sim_options = dict(sim_options)
         self.simulator = GaitSimulator(self.robot, obstacles=self.obstacles, **self.sim_options)
@@ -310,17 +316,6 @@ class ClosedLoop:
         its bending state (Fig. 17b)."""
         base = as_base(base if base is not None else self.scene.base)
         return lc.straight_pose_for(self.robot, base, bending_state(self.controller))
-
-    # --- the planner's verdicts -------------------------------------------------------------------
-    def _base_for(self, placement: BasePlacement, q_shape: np.ndarray, allow_relocation: bool
-                  ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
-        """choose_base from ``placement`` with the base shape of ``q_shape``."""
-        self.controller.base = placement
-        return choose_base(self.controller, self.scene.reported, self.obstacles, allow_relocation, q_shape)
-
-    def _reachable(self, placement: BasePlacement, q_shape: np.ndarray) -> bool:
-        _, _, _, notes = self._base_for(placement, q_shape, False)
-        return not notes
 
     # --- running ---------------------------------------------------------------------------------------
     def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *, believed_start: BasePlacement | None = None,
@@ -350,8 +345,9 @@ class ClosedLoop:
         notes: list[str] = []
         rates = lc.GaitRates.first_guess(robot)
         planning = 0.0
-        q_shape = self.controller.q_initial.copy()
-        head_plan, head, metrics, head_t0 = None, None, None, 0.0
+        head_plan: Plan | None = None
+        head: SimResult | None = None
+        metrics, head_t0 = None, 0.0
         failure = None
         corrections = -1
 
@@ -370,79 +366,97 @@ class ClosedLoop:
                    "curl")
             q_now = q_to.copy()
 
+        goal: BasePlacement | None = None  # where the base must lie: a placement whose plan succeeds
+        q_bend = bending_state(self.controller, self.controller.q_initial)
+        tolerance = self.tolerance
+
+        def replan(label: str) -> Plan:
+            """The head phases from the current estimate, the base kept, starting from the joints as they are
+            (measured): they rest a few tenths of a degree from their commands (friction holds the links against
+            the servos), which moves P0 by millimetres."""
+            nonlocal planning
+            t0 = time.perf_counter()
+            p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
+                     start_q=sim.joint_angles(), speed=self.speed, min_segment=self.min_segment)
+            planning += time.perf_counter() - t0
+            if not p.success:
+                notes.append(f"{label}: the head phases from {_fmt(est.base)} fail ({p.failure}): a correction")
+                say(notes[-1])
+            return p
+
         while failure is None:
             corrections += 1
             if corrections > self.max_corrections:
-                failure = f"the body was not brought where the targets are reached after {self.max_corrections} " \
-                          "corrections"
+                failure = (f"the body was not brought where the head phases succeed after {self.max_corrections} "
+                           "corrections")
                 break
-            # 1. where must the base go?
-            t0 = time.perf_counter()
-            q_bend = bending_state(self.controller, q_shape)
-            after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-            goal, q_goal, relocation, base_notes = self._base_for(after_curl, q_shape, True)
-            planning += time.perf_counter() - t0
-            if relocation is None and base_notes:
-                failure = base_notes[-1]
-                break
-            if relocation is not None:
-                q_shape = q_goal
-                q_bend = bending_state(self.controller, q_shape)
-                say(f"the base must go to {_fmt(goal)} ({relocation.reason})")
-                # 2. locomotion: straight, then gaits until the curl from here leaves the base where it reaches
+            if goal is None:
+                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be
+                after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
+                t0 = time.perf_counter()
+                first = plan(self.scene, controller=self.controller, base=after_curl, allow_relocation=True,
+                             speed=self.speed, min_segment=self.min_segment)
+                planning += time.perf_counter() - t0
+                if not first.success:
+                    failure = f"no plan reaches the targets from {_fmt(after_curl)}: {first.failure}"
+                    break
+                goal, q_bend = first.base, first.states[0][2].copy()
+                if first.relocation is not None:
+                    say(f"the base must go to {_fmt(goal)} ({first.relocation.reason})")
+            else:  # a correction: closer to the goal than last time
+                tolerance = tolerance.tighter()
+            # 2. locomotion, when the curl from here would not leave the base at the goal
+            D = lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)
+            straight_goal = lc.compose(goal, lc.inverse(D))
+            landing = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
+            if lc.next_step(robot, lc.compose(landing, lc.inverse(D)), straight_goal, rates,
+                            tolerance=tolerance) is not None:
                 if np.abs(q_now).max() > 0.0:
                     curl(np.zeros(robot.n_joints), "uncurl")
-                straight_goal = lc.straight_pose_for(robot, goal, q_bend)
-                D = lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)
                 for _ in range(self.max_gait_runs):
-                    t0 = time.perf_counter()
-                    there = self._reachable(lc.compose(est.base, D), q_shape)
-                    planning += time.perf_counter() - t0
-                    if there:
-                        break
-                    step = lc.next_step(robot, est.base, straight_goal, rates, tolerance=self.tolerance,
+                    step = lc.next_step(robot, est.base, straight_goal, rates, tolerance=tolerance,
                                         frequency=self.frequency)
                     if step is None:
                         break
                     before = est.base
                     run = sim.run(state, step.gait, step.cycles, start_estimate=est)
                     direction = {1: "+", -1: "-"}[step.gait.direction]
-                    ground(run, f"{step.gait.name} {direction} ({step.leg})", "gait")
-                    rates.update(step.gait, step.cycles, before, est.base, self._offset)
+                    ground(run, f"{step.gait.name} {direction} ({step.leg}, {step.cycles:.0f} x {step.scale:.2f})",
+                           "gait")
+                    rates.update(step, before, est.base, self._offset)
             # 3. the curl into the bending state
             if np.abs(q_bend - q_now).max() > 1e-9:
                 curl(q_bend, "curl into the bending state")
-            # 4. re-plan from the estimate
-            t0 = time.perf_counter()
-            ok = self._reachable(est.base, q_shape)
-            planning += time.perf_counter() - t0
-            if not ok:
-                notes.append(f"after the curl the estimated base {_fmt(est.base)} does not reach every target: "
-                             "a correction")
-                say(notes[-1])
+            # 4. re-plan from the estimate (dead reckoning)
+            if not replan("after the curl").success:
                 continue
-            # 5. the fix
+            # 5. the fix, and the plan from it
             if self.fix is not None:
                 dead_reckoned, truth = est, sim.true_pose()
                 est = self.fix.measure(sim, rng)
                 fixes.append({"t_s": float(state.time), "dead_reckoning": pose_error(dead_reckoned, truth),
                               "fix": pose_error(est, truth)})
                 say(f"the fix puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
-                t0 = time.perf_counter()
-                ok = self._reachable(est.base, q_shape)
-                planning += time.perf_counter() - t0
-                if not ok:
-                    notes.append(f"the fixed base {_fmt(est.base)} does not reach every target: a correction")
+                head_plan = replan("after the fix")
+                if not head_plan.success:
+                    continue
+            else:
+                head_plan = replan("after the curl")
+            # the dynamics check of the plan, as the pipeline checks every plan: from its own start (the base where
+            # the loop believes it is, the joints as planned), not from the truth; a plan whose ZMP leaves the
+            # support polygon in it would tip the body
+            if self.dynamics_check:
+                checked = simulate_trajectory(robot, head_plan.t, head_plan.q, head_plan.base,
+                                              obstacles=self.obstacles, **self._ground_options)
+                check = compare(robot, head_plan.t, head_plan.q, checked, base=head_plan.base,
+                                targets=[(tg.time_s, tg.position, tg.direction) for tg in head_plan.targets] or None)
+                if not check["zmp_inside"]:
+                    notes.append(f"the head phases from {_fmt(est.base)} fail their dynamics check (the simulated "
+                                 f"ZMP leaves the support polygon by {1000 * -check['zmp_min_margin_m']:.1f} mm): "
+                                 "a correction")
                     say(notes[-1])
                     continue
-            # 6. the head phases
-            t0 = time.perf_counter()
-            head_plan = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
-                             base_shape=q_shape, speed=self.speed, min_segment=self.min_segment)
-            planning += time.perf_counter() - t0
-            if not head_plan.success:
-                failure = f"the head phases from {_fmt(est.base)}: {head_plan.failure}"
-                break
+            # 6. the head phases, in MuJoCo from where the body is
             say(f"head phases planned from {_fmt(est.base)}: {head_plan.duration_s:.1f} s; simulating")
             head_t0 = float(state.time)
             head = simulate_trajectory(robot, head_plan.t, head_plan.q, head_plan.base, state=state, settle=0.0,
