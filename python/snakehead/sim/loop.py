@@ -32,9 +32,8 @@ the pose estimated after the last one, as the robot would do it.
    kept); when that plan fails, back to 2.
 6. **The head phases**, checked as every plan (ZMP, clearance, obstacles) and in dynamics the way the pipeline
    checks a plan (simulated from the plan's own start, the base where the loop believes it lies: a plan whose
-   simulated ZMP leaves the support polygon is a failed plan, back to 2; the planner's ZMP margin is a few
-   millimetres, and near the edge of the reachable bases it is not always enough), then run in MuJoCo from the
-   simulation's state (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
+   body tips in it, CHECK_ZMP_OUTSIDE and CHECK_BASE_LIFT, is a failed plan, back to 2; the planner keeps its ZMP
+   5 mm inside, which fast plans do not always keep in MuJoCo), then run in MuJoCo from the simulation's state (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
    (:func:`snakehead.sim.compare`).
 
 The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/curl/lift/move/hold, ``t0_s``,
@@ -57,7 +56,7 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
-from ..motion.planner import Plan, as_scene, bending_state, plan
+from ..motion.planner import ZMP_MARGIN, Plan, as_scene, bending_state, plan
 from ..scenes.scene import Scene
 from .compare import compare
 from .estimate import BodyPose, pose_error
@@ -66,6 +65,17 @@ from .tracking import SimResult, simulate_trajectory
 
 #: The kinds of phases in a loop's report.
 PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
+#: The dynamics check of the head phases fails when the simulated ZMP leaves the planned support polygon by more
+#: than this (m) or a base frame rises more than CHECK_BASE_LIFT (m): the body tips (a plan that tips goes out by
+#: tens of millimetres and lifts its base by centimetres; the ZMP grazing the edge at the first tick does not).
+CHECK_ZMP_OUTSIDE = 0.002
+CHECK_BASE_LIFT = 0.005
+#: Head phases that fail from where the body is are planned again this many times, each at half the speed.
+SLOWER_RETRIES = 1
+#: When the body is as close to its goal as the gaits bring it and the head phases still fail, the loop looks for
+#: another goal this far from it (m along and across, deg turned).
+NEARBY_STEP_M = 0.08
+NEARBY_STEP_DEG = 8.0
 
 
 @dataclass(frozen=True)
@@ -317,6 +327,32 @@ class ClosedLoop:
         base = as_base(base if base is not None else self.scene.base)
         return lc.straight_pose_for(self.robot, base, bending_state(self.controller))
 
+    # --- checks --------------------------------------------------------------------------------------
+    def _dynamics_check(self, p: Plan) -> str | None:
+        """The dynamics check of a plan, as the pipeline checks every plan: simulated from its own start (the base
+        where the loop believes it lies, the joints as planned), not from the truth. None when the body does not
+        tip in it (CHECK_ZMP_OUTSIDE, CHECK_BASE_LIFT), else why."""
+        robot = self.robot
+        checked = simulate_trajectory(robot, p.t, p.q, p.base, obstacles=self.obstacles, **self._ground_options)
+        check = compare(robot, p.t, p.q, checked, base=p.base,
+                        targets=[(tg.time_s, tg.position, tg.direction) for tg in p.targets] or None)
+        if check["zmp_min_margin_m"] < -CHECK_ZMP_OUTSIDE or check["base_lift_m"] > CHECK_BASE_LIFT:
+            return (f"in its dynamics check the simulated ZMP leaves the support polygon by "
+                    f"{1000 * -check['zmp_min_margin_m']:.1f} mm and the base lifts {1000 * check['base_lift_m']:.1f} mm")
+        return None
+
+    def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
+        """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
+        phases are planned successfully, the nearest first; None if there is none."""
+        d, a = NEARBY_STEP_M, math.radians(NEARBY_STEP_DEG)
+        for offset in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a)):
+            candidate = lc.compose(goal, BasePlacement(*offset))
+            p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
+                     base_shape=q_bend, speed=self.speed, min_segment=self.min_segment)
+            if p.success:
+                return candidate
+        return None
+
     # --- running ---------------------------------------------------------------------------------------
     def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *, believed_start: BasePlacement | None = None,
             progress: Callable[[str], None] | None = None) -> LoopRun:
@@ -370,19 +406,32 @@ class ClosedLoop:
         q_bend = bending_state(self.controller, self.controller.q_initial)
         tolerance = self.tolerance
 
-        def replan(label: str) -> Plan:
+        def head_plan_here(label: str, dynamics_check: bool) -> Plan | None:
             """The head phases from the current estimate, the base kept, starting from the joints as they are
-            (measured): they rest a few tenths of a degree from their commands (friction holds the links against
-            the servos), which moves P0 by millimetres."""
+            (measured: they rest a few tenths of a degree from their commands, friction holding the links against
+            the servos, which moves P0 by millimetres), checked in dynamics when asked; at the loop's speed, then,
+            if the plan's own ZMP check fails, at half of it (a slower plan's ZMP is closer to its static one; a
+            body that tips in the dynamics check tips as well slower). None when it fails."""
             nonlocal planning
-            t0 = time.perf_counter()
-            p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
-                     start_q=sim.joint_angles(), speed=self.speed, min_segment=self.min_segment)
-            planning += time.perf_counter() - t0
-            if not p.success:
-                notes.append(f"{label}: the head phases from {_fmt(est.base)} fail ({p.failure}): a correction")
+            for k in range(SLOWER_RETRIES + 1):
+                speed, min_segment = self.speed / 2 ** k, self.min_segment * 2 ** k
+                t0 = time.perf_counter()
+                p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
+                         start_q=sim.joint_angles(), speed=speed, min_segment=min_segment)
+                planning += time.perf_counter() - t0
+                if p.failure is None:
+                    why = self._dynamics_check(p) if dynamics_check else None
+                    if why is None:
+                        return p
+                    notes.append(f"{label}: the head phases from {_fmt(est.base)} at {speed:.3g} rad/s fail ({why})")
+                    say(notes[-1])
+                    return None  # a body that tips in the dynamics check tips as well slower
+                notes.append(f"{label}: the head phases from {_fmt(est.base)} at {speed:.3g} rad/s fail "
+                             f"({p.failure})")
                 say(notes[-1])
-            return p
+                if not (all(tg.solved for tg in p.targets) and p.min_zmp_margin_m < ZMP_MARGIN):
+                    return None  # not the ZMP of a fast motion: slower would not help
+            return None
 
         while failure is None:
             corrections += 1
@@ -403,8 +452,22 @@ class ClosedLoop:
                 goal, q_bend = first.base, first.states[0][2].copy()
                 if first.relocation is not None:
                     say(f"the base must go to {_fmt(goal)} ({first.relocation.reason})")
-            else:  # a correction: closer to the goal than last time
+            else:  # a correction: closer to the goal than last time, or to another goal nearby
                 tolerance = tolerance.tighter()
+                straight_here = lc.compose(lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend)),
+                                           lc.inverse(lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)))
+                straight_goal = lc.compose(goal, lc.inverse(lc.curl_displacement(robot, np.zeros(robot.n_joints),
+                                                                                q_bend)))
+                if lc.next_step(robot, straight_here, straight_goal, rates, tolerance=tolerance) is None:
+                    # as close to the goal as the gaits get, and the head phases still fail: another goal nearby
+                    t0 = time.perf_counter()
+                    nearby = self._nearby_goal(goal, q_bend)
+                    planning += time.perf_counter() - t0
+                    if nearby is None:
+                        failure = f"no placement near {_fmt(goal)} gives head phases that succeed"
+                        break
+                    goal = nearby
+                    say(f"the base must go to {_fmt(goal)} instead")
             # 2. locomotion, when the curl from here would not leave the base at the goal
             D = lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)
             straight_goal = lc.compose(goal, lc.inverse(D))
@@ -428,7 +491,8 @@ class ClosedLoop:
             if np.abs(q_bend - q_now).max() > 1e-9:
                 curl(q_bend, "curl into the bending state")
             # 4. re-plan from the estimate (dead reckoning)
-            if not replan("after the curl").success:
+            head_plan = head_plan_here("after the curl", self.dynamics_check and self.fix is None)
+            if head_plan is None:
                 continue
             # 5. the fix, and the plan from it
             if self.fix is not None:
@@ -437,24 +501,8 @@ class ClosedLoop:
                 fixes.append({"t_s": float(state.time), "dead_reckoning": pose_error(dead_reckoned, truth),
                               "fix": pose_error(est, truth)})
                 say(f"the fix puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
-                head_plan = replan("after the fix")
-                if not head_plan.success:
-                    continue
-            else:
-                head_plan = replan("after the curl")
-            # the dynamics check of the plan, as the pipeline checks every plan: from its own start (the base where
-            # the loop believes it is, the joints as planned), not from the truth; a plan whose ZMP leaves the
-            # support polygon in it would tip the body
-            if self.dynamics_check:
-                checked = simulate_trajectory(robot, head_plan.t, head_plan.q, head_plan.base,
-                                              obstacles=self.obstacles, **self._ground_options)
-                check = compare(robot, head_plan.t, head_plan.q, checked, base=head_plan.base,
-                                targets=[(tg.time_s, tg.position, tg.direction) for tg in head_plan.targets] or None)
-                if not check["zmp_inside"]:
-                    notes.append(f"the head phases from {_fmt(est.base)} fail their dynamics check (the simulated "
-                                 f"ZMP leaves the support polygon by {1000 * -check['zmp_min_margin_m']:.1f} mm): "
-                                 "a correction")
-                    say(notes[-1])
+                head_plan = head_plan_here("after the fix", self.dynamics_check)
+                if head_plan is None:
                     continue
             # 6. the head phases, in MuJoCo from where the body is
             say(f"head phases planned from {_fmt(est.base)}: {head_plan.duration_s:.1f} s; simulating")
