@@ -111,12 +111,14 @@ def balance_translation(shifts: npt.ArrayLike, weights: npt.ArrayLike) -> np.nda
     return t
 
 
-def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.ArrayLike, iterations: int = 60
+def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.ArrayLike, iterations: int = 300
                    ) -> tuple[np.ndarray, float]:
     """The planar rigid motion (t (2,), angle w rad) that, applied to contact points ``after`` (k, 2) (the shape
     changed in the body's frame), best keeps them where they were (``before`` (k, 2)) in the sense of friction:
     the minimiser of sum_i N_i |R(w) a_i + t - b_i|, by iteratively reweighted least squares (Gauss-Newton on the
-    rotation, relinearised at every iteration)."""
+    rotation, relinearised at every iteration). When a contact sticks at the optimum the iteration converges only
+    linearly: 60 iterations left the dissipation 1e-5 (relative) above SciPy's minimiser in a test, 200 matched it;
+    the default is 300 (a curl's prediction, ~40 steps, takes 0.1 s)."""
     b = finite_array(before, "before", (None, 2))
     a = finite_array(after, "after", b.shape)
     N = _loads(weights, len(b))

@@ -20,8 +20,10 @@ the pose estimated after the last one, as the robot would do it.
    IMU, contact odometry), never from MuJoCo's.
 3. **The curl** into the bending state: a joint motion on the ground (it slides the body by most of a metre on the
    default robot: predicted by the friction model, followed by the estimate).
-4. **Re-plan** from the estimated pose with the base kept (``allow_relocation=False``, the base's measured shape):
-   when the plan fails, back to 2 (a correction: uncurl, gaits, curl), with half the tolerance.
+4. **Re-plan** from the estimated pose with the base kept (``allow_relocation=False``, from the joints as measured):
+   when the plan fails, back to 2 (a correction: uncurl, gaits, curl) with a tighter tolerance, or, when the body
+   is already as close to the goal as the gaits bring it, towards another goal nearby whose plan succeeds. Head
+   phases whose own ZMP check fails are first planned again at half the speed.
 5. **The fix.** Dead reckoning drifts: by 2-5 % of the distance travelled with the friction odometry, tens of
    millimetres after a metre, far from the 2 mm the head must reach. The loop closes it the way the paper's
    simulation does ("the pose of the base frame of the neck part is obtained in time"): once the body rests in
@@ -29,11 +31,12 @@ the pose estimated after the last one, as the robot would do it.
    a motion-capture system, or the head's camera fixing known landmarks) with the joint angles gives the root
    frame's placement (:class:`PoseFix`, with Gaussian noise: 0.5 mm and 0.05 deg by default). This is an
    assumption of the loop, stated in every report. The head phases are planned again from the fixed pose (base
-   kept); when that plan fails, back to 2.
+   kept); when that plan fails, back to 2, the locomotion starting from the fixed pose.
 6. **The head phases**, checked as every plan (ZMP, clearance, obstacles) and in dynamics the way the pipeline
    checks a plan (simulated from the plan's own start, the base where the loop believes it lies: a plan whose
    body tips in it, CHECK_ZMP_OUTSIDE and CHECK_BASE_LIFT, is a failed plan, back to 2; the planner keeps its ZMP
-   5 mm inside, which fast plans do not always keep in MuJoCo), then run in MuJoCo from the simulation's state (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
+   5 mm inside, which is not always enough in MuJoCo), then run in MuJoCo from the simulation's state
+   (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
    (:func:`snakehead.sim.compare`).
 
 The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/curl/lift/move/hold, ``t0_s``,
