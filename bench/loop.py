@@ -8,7 +8,7 @@ far the tail travelled, the simulated time of the whole sequence, the dead recko
 ground phase) and the fix's, and the head's error in MuJoCo at the target against the target (position mm,
 direction deg), the simulated ZMP inside the support polygon during the head phases, and the wall time.
 
-    python3 bench/loop.py [--poses 10] [--seed 7] [--speed 0.24] [--robot default]
+    python3 bench/loop.py [--poses 10] [--seed 7] [--robot default]
 """
 from __future__ import annotations
 
@@ -33,8 +33,6 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=10)
     ap.add_argument("--seed", type=int, default=7)
-    ap.add_argument("--speed", type=float, default=0.24, help="the planner's joint speed (rad/s; 0.24 = --fast)")
-    ap.add_argument("--min-segment", type=float, default=1.0)
     ap.add_argument("--target", type=float, nargs=3, default=SPHERE_1)
     ap.add_argument("--robot", default="default", choices=sorted(ROBOTS))
     ap.add_argument("--verbose", action="store_true", help="the loop's steps on stderr")
@@ -43,10 +41,9 @@ def main() -> None:
     controller = HeadController(robot, seed=1)
     target = np.array(args.target, float)
     scene = Scene.from_targets([(target, np.array([0.0, 1.0, 0.0]))], name="target", hold_s=1.0)
-    loop = ClosedLoop(scene, controller=controller, speed=args.speed, min_segment=args.min_segment)
+    loop = ClosedLoop(scene, controller=controller)
     rng = np.random.default_rng(args.seed)
-    print(f"robot {args.robot} ({ROBOTS[args.robot][0]}); target {target.tolist()} m along +y; speed {args.speed} "
-          f"rad/s; seed {args.seed}; {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}\n")
+    print(f"robot {args.robot} ({ROBOTS[args.robot][0]}); target {target.tolist()} m along +y; seed {args.seed}; {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}\n")
     print("| # | start x, y (m), heading (deg) | distance (m) | gait runs | curls | corrections | tail travel (m) "
           "| simulated time (s) | dead reckoning max (mm) | fix (mm / deg) | head (mm) | head (deg) | ZMP inside "
           "| wall (s) |")

@@ -5,6 +5,7 @@
 #include "bindings.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/model.hpp"
+#include "snakehead/urdf_input.hpp"
 
 namespace py = pybind11;
 
@@ -35,6 +36,8 @@ const char* type_name(JointType t) {
 }  // namespace
 
 void bind_model(py::module_& m) {
+  m.def("read_urdf_file", &read_urdf_file, py::arg("path"),
+        "The text of a URDF file: ValueError unless a readable regular file of at most 8 MiB");
   m.def("urdf_root_link", &urdf_root_link, py::arg("urdf"),
         "The root link of a URDF (an XML document or a file path)");
   py::class_<ChainModel>(m, "ChainModel", "Immutable serial chain between two links of a URDF.")
@@ -79,7 +82,10 @@ void bind_model(py::module_& m) {
                              },
                              "index into link_names of the link each joint moves (its frame is the joint frame)")
       .def_property_readonly("reach", &ChainModel::reach)
-      .def_property_readonly("hash", &ChainModel::hash)
+      .def_property_readonly("hash", &ChainModel::hash, "digest of the kinematics (what maps depend on)")
+      .def_property_readonly("body_hash", &ChainModel::body_hash,
+                             "digest of the links' masses, centres of mass, inertias and collision boxes")
+      .def_property_readonly("total_mass", &ChainModel::total_mass, "sum of the link masses (kg); may be 0")
       .def_property_readonly("link_names",
                              [](const ChainModel& c) {
                                std::vector<std::string> n;

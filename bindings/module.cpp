@@ -1,4 +1,13 @@
+#include <pybind11/pybind11.h>
+
+#include <new>
+#include <stdexcept>
+
 #include "bindings.hpp"
+#include "snakehead/model.hpp"
+#include "snakehead/workspace.hpp"
+
+namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep";
@@ -6,4 +15,31 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
   snakehead::bindings::bind_support(m);
+
+  // A sweep stopped because its progress callback returned False (not an error of the input).
+  py::register_exception<snakehead::Cancelled>(m, "Cancelled");
+
+  // Every C++ exception reaches Python as ValueError (bad input; also any other failure of the core, with
+  // its message), TypeError (a value pybind11 could not convert), MemoryError, Cancelled, or the Python
+  // exception a callback raised; never RuntimeError, never an abort (tried before register_exception's).
+  // This also covers exceptions raised in worker threads: the core carries them to the calling thread.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const py::error_already_set&) {
+      throw;  // a Python exception (from a callback): pybind11 restores it as it was
+    } catch (const py::cast_error& e) {
+      PyErr_SetString(PyExc_TypeError, e.what());
+    } catch (const py::builtin_exception&) {
+      throw;  // pybind11's own value_error, type_error, ...: already the right Python type
+    } catch (const snakehead::Cancelled&) {
+      throw;  // to the translator register_exception made: snakehead._core.Cancelled
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError, "out of memory in snakehead's C++ core");
+    } catch (const std::exception& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (...) {
+      PyErr_SetString(PyExc_ValueError, "snakehead's C++ core failed with an exception of unknown type");
+    }
+  });
 }

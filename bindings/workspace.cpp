@@ -3,7 +3,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <optional>
+
 #include "bindings.hpp"
+#include "snakehead/alpha_shape.hpp"
 #include "snakehead/workspace.hpp"
 
 namespace py = pybind11;
@@ -21,8 +24,8 @@ py::array_t<T> to_array(const std::vector<T>& v) {
 }
 
 // Runs `fn` without the GIL; the progress callback takes it back only while it runs Python. An
-// exception raised by the callback (KeyboardInterrupt from tqdm's loop, say) stops the sweep and
-// is re-raised here.
+// exception raised by the callback (KeyboardInterrupt from tqdm's loop, say), or by the truth test of
+// what it returned, stops the sweep and is re-raised here. A false result cancels: _core.Cancelled.
 template <class Fn>
 auto without_gil(const py::object& progress, Fn fn) {
   ProgressCallback cb;
@@ -31,11 +34,23 @@ auto without_gil(const py::object& progress, Fn fn) {
       py::gil_scoped_acquire gil;
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
       py::object r = progress(done, total);
-      return r.is_none() || r.cast<bool>();
+      if (r.is_none()) return true;
+      const int go_on = PyObject_IsTrue(r.ptr());  // Python's truth (numpy's bool_, 0/1, ...)
+      if (go_on < 0) throw py::error_already_set();
+      return go_on == 1;
     };
   }
   py::gil_scoped_release release;
   return fn(cb);
+}
+
+// The per-direction bits as a (voxels, bytes per voxel) uint8 array.
+py::array_t<std::uint8_t> bits_array(const std::vector<std::uint8_t>& bits, std::size_t voxels, int tried) {
+  const auto bytes = static_cast<py::ssize_t>(reached_bytes_per_voxel(tried));
+  py::array_t<std::uint8_t> a({static_cast<py::ssize_t>(voxels), bytes});
+  if (bits.size() != voxels * static_cast<std::size_t>(bytes)) throw std::logic_error("per-direction bits of the wrong size");
+  std::copy(bits.begin(), bits.end(), a.mutable_data());
+  return a;
 }
 
 py::dict map_to_dict(const ReachabilityMap& m) {
@@ -43,6 +58,7 @@ py::dict map_to_dict(const ReachabilityMap& m) {
   d["centers"] = py::array_t<double>(py::array::ShapeContainer{static_cast<py::ssize_t>(m.centres.rows()), py::ssize_t{3}},
                                      m.centres.data());
   d["solved"] = to_array(m.solved);
+  d["reached"] = bits_array(m.reached, m.voxel_ids.size(), m.tried);
   d["voxel_ids"] = to_array(m.voxel_ids);
   d["tried"] = m.tried;
   d["grid_origin"] = Eigen::Vector3d(m.grid.origin);
@@ -50,6 +66,7 @@ py::dict map_to_dict(const ReachabilityMap& m) {
   d["grid_shape"] = std::vector<int>{m.grid.n, m.grid.n, m.grid.n};
   d["hull_voxels"] = m.hull_voxels;
   d["hull_facets"] = m.hull_facets;
+  d["alpha"] = m.alpha;
   d["reach"] = m.reach;
   d["chain_hash"] = m.chain_hash;
   d["base"] = m.base;
@@ -79,6 +96,11 @@ void bind_workspace(py::module_& m) {
       .def_readwrite("timeout", &WorkspaceOptions::timeout)
       .def_readwrite("epsilon", &WorkspaceOptions::epsilon)
       .def_readwrite("cloud_samples", &WorkspaceOptions::cloud_samples)
+      .def_property(
+          "hull", [](const WorkspaceOptions& o) { return std::string(hull_kind_name(o.hull)); },
+          [](WorkspaceOptions& o, const std::string& s) { o.hull = parse_hull_kind(s); })
+      .def_readwrite("shrink", &WorkspaceOptions::shrink)
+      .def_property_readonly("map_shrink", &WorkspaceOptions::map_shrink)
       .def_readwrite("seed", &WorkspaceOptions::seed)
       .def_readwrite("threads", &WorkspaceOptions::threads)
       .def_readwrite("shard_index", &WorkspaceOptions::shard_index)
@@ -126,6 +148,79 @@ void bind_workspace(py::module_& m) {
           return d;
         },
         py::arg("points"), "qhull's hull of (n, 3) points: facet planes normal . x + offset <= 0 inside, volume");
+  m.def("boundary",
+        [](const Eigen::Ref<const RowMat3>& points, double shrink) {
+          if (!points.allFinite()) throw InputError("points must be finite");
+          std::vector<Eigen::Vector3d> p(static_cast<std::size_t>(points.rows()));
+          for (Eigen::Index k = 0; k < points.rows(); ++k) p[static_cast<std::size_t>(k)] = points.row(k).transpose();
+          AlphaShape a = [&] {
+            py::gil_scoped_release release;
+            return AlphaShape::boundary(p, shrink);
+          }();
+          py::dict d;
+          d["alpha"] = a.alpha();
+          d["critical_alpha"] = a.critical_alpha();
+          d["spectrum_size"] = a.spectrum_size();
+          d["tetrahedra"] = a.n_tetrahedra();
+          d["solid_tetrahedra"] = a.n_solid_tetrahedra();
+          d["boundary_facets"] = a.n_boundary_facets();
+          d["regions"] = a.n_regions();
+          d["volume"] = a.volume();
+          return d;
+        },
+        py::arg("points"), py::arg("shrink") = 0.5,
+        "The paper's boundary(P) of (n, 3) points (alpha_shape.hpp): its alpha and size, as a dict");
+  m.def("boundary_voxels",
+        [](const Eigen::Ref<const RowMat3>& points, double shrink, const Eigen::Vector3d& origin, double voxel, int n) {
+          if (!points.allFinite()) throw InputError("points must be finite");
+          std::vector<Eigen::Vector3d> p(static_cast<std::size_t>(points.rows()));
+          for (Eigen::Index k = 0; k < points.rows(); ++k) p[static_cast<std::size_t>(k)] = points.row(k).transpose();
+          VoxelGrid g;
+          g.origin = origin;
+          g.voxel = voxel;
+          g.n = n;
+          if (!(voxel > 0) || n < 1) throw InputError("the grid needs a positive voxel size and at least one voxel");
+          return to_array(AlphaShape::boundary(p, shrink).voxels_inside(g));
+        },
+        py::arg("points"), py::arg("shrink"), py::arg("origin"), py::arg("voxel"), py::arg("n"),
+        "Linear ids of the grid voxels whose centre lies inside the boundary of the points");
+  m.def("save_map",
+        [](const std::string& path, const std::string& command, const WorkspaceOptions& o,
+           const Eigen::Ref<const RowMat3>& centres, std::vector<std::int32_t> solved, std::vector<std::int64_t> voxel_ids,
+           std::optional<py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>> reached, int tried,
+           const Eigen::Vector3d& grid_origin, double grid_voxel, int grid_n, std::int64_t hull_voxels, int hull_facets,
+           double alpha, double reach, const std::string& chain_hash, const std::string& base, const std::string& tip,
+           std::int64_t ik_calls, std::int64_t cheap_exits, double seconds, int threads) {
+          ReachabilityMap map;
+          map.options = o;
+          map.centres = centres;
+          map.solved = std::move(solved);
+          map.voxel_ids = std::move(voxel_ids);
+          if (reached) map.reached.assign(reached->data(), reached->data() + reached->size());
+          map.tried = tried;
+          map.grid.origin = grid_origin;
+          map.grid.voxel = grid_voxel;
+          map.grid.n = grid_n;
+          map.hull_voxels = hull_voxels;
+          map.hull_facets = hull_facets;
+          map.alpha = alpha;
+          map.reach = reach;
+          map.chain_hash = chain_hash;
+          map.base = base;
+          map.tip = tip;
+          map.ik_calls = ik_calls;
+          map.cheap_exits = cheap_exits;
+          map.seconds = seconds;
+          map.threads_used = threads;
+          py::gil_scoped_release release;
+          save_npz(map, path, command);
+        },
+        py::arg("path"), py::arg("command"), py::arg("options"), py::arg("centers"), py::arg("solved"),
+        py::arg("voxel_ids"), py::arg("reached"), py::arg("tried"), py::arg("grid_origin"), py::arg("grid_voxel"),
+        py::arg("grid_n"), py::arg("hull_voxels"), py::arg("hull_facets"), py::arg("alpha"), py::arg("reach"),
+        py::arg("chain_hash"), py::arg("base"), py::arg("tip"), py::arg("ik_calls"), py::arg("cheap_exits"),
+        py::arg("seconds"), py::arg("threads"),
+        "The one map writer (save_npz, also workspace_gen's): a map's arrays to an .npz that numpy.load reads");
   m.def("evaluate_voxels",
         [](const ChainModel& model, const WorkspaceOptions& o, const Eigen::Ref<const RowMat3>& centres,
            std::vector<std::uint64_t> stream_ids, const py::object& progress) {
@@ -135,6 +230,7 @@ void bind_workspace(py::module_& m) {
           });
           py::dict d;
           d["solved"] = to_array(e.solved);
+          d["reached"] = bits_array(e.reached, e.solved.size(), e.tried);
           d["tried"] = e.tried;
           d["ik_calls"] = e.ik_calls;
           d["cheap_exits"] = e.cheap_exits;

@@ -1,15 +1,18 @@
 #include "snakehead/model.hpp"
 
 #include <urdf_model/model.h>
-#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <sstream>
+
+#include "snakehead/limits.hpp"
+#include "snakehead/urdf_input.hpp"
 
 namespace snakehead {
 namespace {
@@ -31,17 +34,57 @@ KDL::Frame to_kdl(const Eigen::Isometry3d& t) {
 
 KDL::Vector to_kdl(const Eigen::Vector3d& v) { return KDL::Vector(v.x(), v.y(), v.z()); }
 
+std::string vector_text(double x, double y, double z) {
+  return number_text(x) + " " + number_text(y) + " " + number_text(z);
+}
+
+// A link's mass and inertia must describe a body: mass >= 0, the inertia symmetric positive semidefinite with
+// principal moments that satisfy the triangle inequality (A + B >= C, as for any distribution of mass).
+void check_inertial(const std::string& link, double mass, const Eigen::Matrix3d& inertia) {
+  const std::string where = "link '" + link + "' <inertial>: ";
+  if (!std::isfinite(mass) || mass < 0)
+    throw InputError(where + "mass must be a finite number of kg >= 0, got " + number_text(mass));
+  if (!inertia.allFinite()) throw InputError(where + "the inertia holds a non-finite value");
+  const Eigen::Vector3d moments =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia, Eigen::EigenvaluesOnly).eigenvalues();  // ascending
+  const double tolerance = 1e-9 * moments.cwiseAbs().maxCoeff();
+  const std::string got = " (principal moments " + vector_text(moments[0], moments[1], moments[2]) + " kg m^2)";
+  if (moments[0] < -tolerance) throw InputError(where + "the inertia is not positive semidefinite" + got);
+  if (moments[0] + moments[1] < moments[2] - tolerance)
+    throw InputError(where + "the inertia's principal moments violate the triangle inequality A + B >= C" + got);
+}
+
+// Collision shapes must have positive, finite sizes (a box of size 0 or -1 is not a body).
+void check_collision(const std::string& link, const urdf::Collision& collision) {
+  if (!collision.geometry) return;
+  const std::string where = "link '" + link + "' <collision>: ";
+  const urdf::Geometry& g = *collision.geometry;
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (g.type == urdf::Geometry::BOX) {
+    const auto& d = static_cast<const urdf::Box&>(g).dim;
+    if (!positive(d.x) || !positive(d.y) || !positive(d.z))
+      throw InputError(where + "a box size must be three positive numbers of metres, got " + vector_text(d.x, d.y, d.z));
+  } else if (g.type == urdf::Geometry::SPHERE) {
+    const double r = static_cast<const urdf::Sphere&>(g).radius;
+    if (!positive(r)) throw InputError(where + "a sphere radius must be positive, got " + number_text(r));
+  } else if (g.type == urdf::Geometry::CYLINDER) {
+    const auto& c = static_cast<const urdf::Cylinder&>(g);
+    if (!positive(c.radius) || !positive(c.length))
+      throw InputError(where + "a cylinder's radius and length must be positive, got " + number_text(c.radius) + " and " +
+                       number_text(c.length));
+  }
+}
+
 void fill_inertial(const urdf::Link& link, LinkInfo& info) {
   info.mass = 0.0;
   info.com.setZero();
   info.inertia.setZero();
   if (link.inertial) {
     const urdf::Inertial& in = *link.inertial;
-    if (!(in.mass >= 0.0) || !std::isfinite(in.mass))
-      throw InputError("link '" + link.name + "' has an invalid mass");
-    const Eigen::Isometry3d origin = to_isometry(in.origin);
     Eigen::Matrix3d local;
     local << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    check_inertial(link.name, in.mass, local);
+    const Eigen::Isometry3d origin = to_isometry(in.origin);
     info.mass = in.mass;
     info.com = origin.translation();
     info.inertia = origin.linear() * local * origin.linear().transpose();
@@ -50,12 +93,13 @@ void fill_inertial(const urdf::Link& link, LinkInfo& info) {
   info.box_size.setZero();
   info.box_origin = Eigen::Isometry3d::Identity();
   for (const auto& collision : link.collision_array) {
-    if (collision && collision->geometry && collision->geometry->type == urdf::Geometry::BOX) {
+    if (!collision) continue;
+    check_collision(link.name, *collision);
+    if (!info.has_box && collision->geometry && collision->geometry->type == urdf::Geometry::BOX) {
       const auto* box = static_cast<const urdf::Box*>(collision->geometry.get());
       info.has_box = true;
       info.box_size = Eigen::Vector3d(box->dim.x, box->dim.y, box->dim.z);
       info.box_origin = to_isometry(collision->origin);
-      break;
     }
   }
 }
@@ -79,54 +123,34 @@ void append(std::ostringstream& os, const Eigen::Isometry3d& t) {
 
 }  // namespace
 
-ChainModel ChainModel::from_urdf(const std::string& urdf, const std::string& base, const std::string& tip) {
-  const auto first = urdf.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && urdf[first] == '<') return from_urdf_string(urdf, base, tip);
-  return from_urdf_file(urdf, base, tip);
-}
-
-ChainModel ChainModel::from_urdf_file(const std::string& path, const std::string& base, const std::string& tip) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read URDF file '" + path + "': no such file or not readable");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return from_urdf_string(buffer.str(), base, tip);
-}
-
 namespace {
 
-urdf::ModelInterfaceSharedPtr parse_document(const std::string& xml) {
-  urdf::ModelInterfaceSharedPtr robot;
-  try {
-    robot = urdf::parseURDF(xml);
-  } catch (const std::exception& e) {
-    throw InputError(std::string("malformed URDF: ") + e.what());
-  }
-  if (!robot) throw InputError("malformed URDF: urdfdom could not parse the document (not a valid <robot> description)");
-  return robot;
-}
-
-std::string read_document(const std::string& urdf) {
+// The text of a URDF given as an XML document (its first non-blank character is '<') or a file path.
+std::string document_text(const std::string& urdf) {
   const auto first = urdf.find_first_not_of(" \t\r\n");
   if (first != std::string::npos && urdf[first] == '<') return urdf;
-  std::ifstream in(urdf);
-  if (!in) throw InputError("cannot read URDF file '" + urdf + "': no such file or not readable");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  return read_urdf_file(urdf);
 }
 
 }  // namespace
 
+ChainModel ChainModel::from_urdf(const std::string& urdf, const std::string& base, const std::string& tip) {
+  return from_urdf_string(document_text(urdf), base, tip);
+}
+
+ChainModel ChainModel::from_urdf_file(const std::string& path, const std::string& base, const std::string& tip) {
+  return from_urdf_string(read_urdf_file(path), base, tip);
+}
+
 std::string urdf_root_link(const std::string& urdf) {
-  const auto robot = parse_document(read_document(urdf));
+  const auto robot = parse_urdf(document_text(urdf));  // checked, and urdfdom's complaints as InputError
   const auto root = robot->getRoot();
   if (!root) throw InputError("the URDF has no root link");
   return root->name;
 }
 
 ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::string& base, const std::string& tip) {
-  const urdf::ModelInterfaceSharedPtr robot = parse_document(xml);
+  const urdf::ModelInterfaceSharedPtr robot = parse_urdf(xml);  // checked, and urdfdom's complaints as InputError
   if (base == tip) throw InputError("base and tip are the same link '" + base + "': a chain needs two links");
   const auto base_link = robot->getLink(base);
   if (!base_link) throw InputError("unknown base link '" + base + "' in URDF robot '" + robot->getName() + "'");
@@ -172,6 +196,9 @@ ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::strin
     j.name = joint.name;
     j.effort = joint.limits ? joint.limits->effort : 0.0;
     j.velocity = joint.limits ? joint.limits->velocity : 0.0;
+    if (!(std::isfinite(j.effort) && j.effort >= 0) || !(std::isfinite(j.velocity) && j.velocity >= 0))
+      throw InputError("joint '" + joint.name + "' <limit>: effort and velocity must be finite and >= 0, got " +
+                       number_text(j.effort) + " and " + number_text(j.velocity));
     switch (joint.type) {
       case urdf::Joint::REVOLUTE:
         j.type = JointType::Revolute;
@@ -253,7 +280,21 @@ ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::strin
   }
   reach += (frame.translation() - previous).norm();
   m.reach_ = reach;
-  m.hash_ = digest(canon.str());
+  m.hash_ = digest(canon.str());  // unchanged text: the shipped maps record this value
+
+  // The bodies: what the dynamics and the collision checks use, and the maps do not.
+  std::ostringstream bodies;
+  bodies.precision(17);
+  m.total_mass_ = 0.0;
+  for (const LinkInfo& l : m.links_) {
+    m.total_mass_ += l.mass;
+    bodies << l.mass << ' ' << l.com.transpose() << ' ';
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) bodies << l.inertia(r, c) << ' ';
+    bodies << l.has_box << ' ' << l.box_size.transpose() << ' ';
+    append(bodies, l.box_origin);
+  }
+  m.body_hash_ = digest(bodies.str());
   return m;
 }
 

@@ -1,6 +1,11 @@
 #include "snakehead/npz.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -118,6 +123,10 @@ void NpzWriter::add_u64(const std::string& name, const std::vector<std::uint64_t
                         std::vector<std::int64_t> shape) {
   add_raw(name, "<u8", shape, data.data(), checked_count(data, shape, name));
 }
+void NpzWriter::add_u8(const std::string& name, const std::vector<std::uint8_t>& data,
+                       std::vector<std::int64_t> shape) {
+  add_raw(name, "|u1", shape, data.data(), checked_count(data, shape, name));
+}
 void NpzWriter::add_bool(const std::string& name, bool value) {
   const unsigned char b = value ? 1 : 0;
   add_raw(name, "|b1", {}, &b, 1);
@@ -185,19 +194,61 @@ std::string NpzWriter::bytes() const {
   return out;
 }
 
+namespace {
+
+// A new file beside `path`, created by this call (O_EXCL) with the permissions a plain open would give.
+int create_temporary(const std::string& path, std::string& tmp) {
+  static std::atomic<unsigned> counter{0};
+  for (int attempt = 0;; ++attempt) {
+    tmp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) return fd;
+    if (errno != EEXIST || attempt > 100) throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
+  }
+}
+
+}  // namespace
+
+void check_output_path(const std::string& path) {
+  if (path.empty() || path.find('\0') != std::string::npos)
+    throw std::runtime_error("the output path is empty or holds a NUL character");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))  // renaming over it would replace a device, a FIFO...
+    throw std::runtime_error("cannot write '" + path + "': it exists and is not a regular file");
+  std::string tmp;
+  ::close(create_temporary(path, tmp));
+  ::unlink(tmp.c_str());
+}
+
 void NpzWriter::write(const std::string& path) const {
   const std::string data = bytes();
-  // Write beside the target and rename, so that a failed run never leaves a truncated map.
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
-  const bool ok = std::fwrite(data.data(), 1, data.size(), f) == data.size();
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw std::runtime_error("cannot write '" + path + "': it exists and is not a regular file");
+  // Write to a new file beside the target, then rename it over the target: a failed or interrupted write
+  // (disk full, file-size limit, a signal) leaves any old file as it was and never a truncated one.
+  std::string tmp;
+  int fd = create_temporary(path, tmp);
+  auto fail = [&](const char* step) {
     const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write '" + path + "': " + why);
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot write '" + path + "' (" + step + "): " + why);
+  };
+  for (std::size_t done = 0; done < data.size();) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      fail("write");
+    }
+    done += static_cast<std::size_t>(n);
   }
+  if (::fsync(fd) != 0) fail("fsync");  // a full disk may only say so here
+  const int closed = ::close(fd);
+  fd = -1;
+  if (closed != 0) fail("close");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("rename");
 }
 
 }  // namespace snakehead

@@ -1,6 +1,7 @@
 #include "snakehead/trac_ik.hpp"
 
 #include "snakehead/kinematics.hpp"
+#include "snakehead/limits.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr_jl.hpp>
@@ -32,6 +33,15 @@ using Clock = std::chrono::steady_clock;
 // own bookkeeping included) manages about 0.7 evaluations per microsecond on the development machine (AMD
 // EPYC, 2.6 GHz), so there a failing seeded call takes about the timeout.
 constexpr double kEvaluationsPerSecond = 7.0e5;
+// The wall-clock guard of a seeded call, as a multiple of its timeout (trac_ik.hpp). A build with sanitizers
+// (cmake -DSNAKEHEAD_SANITIZE=ON) runs tens of times slower (a seeded 10 ms call took 0.37 s with ASan and
+// UBSan on the 2-core development machine at load 6); its guard is a hundred times longer, so that there too
+// it never cuts a seeded search and seeded results stay reproducible.
+#ifdef SNAKEHEAD_SANITIZE
+constexpr double kSeededGuardFactor = 1000.0;
+#else
+constexpr double kSeededGuardFactor = 10.0;
+#endif
 
 // Local-search limits. A Newton descent that has not converged in this many iterations is treated as
 // stuck; so is an SLSQP run that used its evaluations.
@@ -508,14 +518,13 @@ const char* to_string(SolveType type) {
 }
 
 void check_options(const TracIKOptions& o) {
-  if (!(o.timeout > 0) || !std::isfinite(o.timeout))
-    throw InputError("timeout must be a positive finite number of seconds, got " + std::to_string(o.timeout));
+  check_timeout(o.timeout, "timeout");
   if (!(o.epsilon > 0) || !std::isfinite(o.epsilon))
-    throw InputError("epsilon must be a positive finite number, got " + std::to_string(o.epsilon));
+    throw InputError("epsilon must be a positive finite number, got " + number_text(o.epsilon));
   for (int i = 0; i < 6; ++i)
     if (std::isnan(o.bounds[i]) || o.bounds[i] < 0)
       throw InputError("bounds must be 6 tolerances >= 0 (inf leaves an axis free); bounds[" + std::to_string(i) +
-                       "] = " + std::to_string(o.bounds[i]));
+                       "] = " + number_text(o.bounds[i]));
   switch (o.solve_type) {
     case SolveType::Speed: case SolveType::Distance: case SolveType::Manip1: case SolveType::Manip2: break;
     default: throw InputError("unknown solve type");
@@ -586,22 +595,21 @@ struct TracIK::Impl {
     Rng rng_nr;
     if (o.seed) {
       c.budgeted = true;
+      // (timeout <= limits::kMaxTimeoutSeconds, so the budget fits a long: at most 6e10 evaluations)
       c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
-      c.deadline = t0 + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double>(std::max(10 * o.timeout, o.timeout + 0.05)));
+      c.deadline = deadline_after(t0, std::max(kSeededGuardFactor * o.timeout, o.timeout + 0.05));
       const std::uint64_t base = splitmix64(*o.seed ^ splitmix64(stream));
       rng_nr.seed(splitmix64(base ^ 0x6E72ULL));
       st->rng_sq.seed(splitmix64(base ^ 0x737170ULL));
       schedule = Schedule::Interleaved;
     } else {
-      c.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.timeout));
+      c.deadline = deadline_after(t0, o.timeout);
       rng_nr.seed(thread_rng()());
       st->rng_sq.seed(thread_rng()());
     }
     Search nr(st->p, c, rng_nr);
     Search& sq = st->sq;
-    const auto inline_end =
-        t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kInlineFraction * o.timeout));
+    const auto inline_end = deadline_after(t0, kInlineFraction * o.timeout);
 
     if (algorithm == IKAlgorithm::KdlRR) {
       kdl_rr_loop(nr, q_init);
@@ -673,6 +681,10 @@ TracIK::TracIK(const ChainModel& model, const TracIKOptions& options)
 TracIK::TracIK(std::shared_ptr<const ChainModel> model, const TracIKOptions& options) {
   if (!model) throw InputError("TracIK needs a chain model");
   if (model->n_joints() < 1) throw InputError("TracIK needs a chain with at least one moving joint");
+  if (model->n_joints() > limits::kMaxIKJoints)
+    throw InputError("TracIK handles chains of at most " + std::to_string(limits::kMaxIKJoints) +
+                     " joints (its SQP half needs memory growing with the square of the joint count); this chain has " +
+                     std::to_string(model->n_joints()));
   check_options(options);
   impl_ = std::make_unique<Impl>(std::move(model), options);
 }
@@ -761,10 +773,9 @@ bool kdl_nr_jl_ik(const ChainModel& model, const Eigen::Isometry3d& target,
                   double epsilon) {
   check_pose(target);
   model.check_configuration(q_init, "q_init");
-  if (!(timeout > 0) || !std::isfinite(timeout)) throw InputError("timeout must be a positive finite number");
+  check_timeout(timeout, "timeout");
   if (!(epsilon > 0) || !std::isfinite(epsilon)) throw InputError("epsilon must be a positive finite number");
-  const auto t0 = Clock::now();
-  const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const auto deadline = deadline_after(Clock::now(), timeout);
   const KDL::Chain& chain = model.kdl_chain();
   const unsigned n = chain.getNrOfJoints();
   KDL::JntArray lo(n), hi(n), q(n), out(n);

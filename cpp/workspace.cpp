@@ -6,10 +6,12 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <random>
 #include <thread>
 
@@ -17,7 +19,9 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include "snakehead/alpha_shape.hpp"
 #include "snakehead/kinematics.hpp"
+#include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
 #include "snakehead/trac_ik.hpp"
 
@@ -52,7 +56,22 @@ Eigen::VectorXd random_configuration(const ChainModel& model, std::mt19937_64& r
 
 constexpr std::uint64_t kCloudSalt = 0xC10D;
 constexpr std::uint64_t kVoxelSalt = 0x70CE1;
-constexpr std::uint64_t kBackwardSalt = 0xBAC4;
+
+// Shares of the IK budget for calls that start next to a solution: from a neighbouring voxel's solution
+// of the same frame (a failure falls back to the full search), and the steps of a roll continuation.
+// Such a start converges in a few Newton steps when the target is reachable (about 20 kinematics
+// evaluations on the default head, against ~200 for a full 0.3 ms budget), so most of the budget would
+// only be spent on failures.
+// Shares of the IK budget (the options' timeout) in the sweep (see evaluate_tiles). A call that starts
+// from a neighbouring voxel's solution of the same frame converges in a few Newton steps when the frame
+// is reachable (about 10 kinematics evaluations on the default head, against ~200 for a full 0.3 ms
+// budget); one from the free-roll solution of the same point needs about 20.
+constexpr double kNearBudget = 1.0 / 3.0;  // from a neighbour's solution (a failure falls back to the full search)
+constexpr double kRollBudget = 0.5;        // a rolled frame from the free-roll solution
+constexpr double kBriefBudget = 0.25;      // a direction the visited neighbours say is unreachable
+constexpr std::uint64_t kNeighbourSalt = 0x4E1B;
+// The sweep's tiles are blocks of kTileLines x kTileLines grid lines along z (part of what defines a map).
+constexpr int kTileLines = 4;
 
 class TracIKPoseSolver : public PoseSolver {
  public:
@@ -61,19 +80,31 @@ class TracIKPoseSolver : public PoseSolver {
     opts_.epsilon = o.epsilon;
     opts_.solve_type = SolveType::Speed;
     opts_.bounds.setZero();
-    if (o.free_roll) opts_.bounds[o.approach == ApproachAxis::X ? 3 : 5] = std::numeric_limits<double>::infinity();
+    free_ = opts_;
+    free_.bounds[o.approach == ApproachAxis::X ? 3 : 5] = std::numeric_limits<double>::infinity();
+    if (o.free_roll) opts_ = free_;
   }
-  bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, std::uint64_t call_seed,
+  bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, std::uint64_t call_seed, double budget,
              Eigen::VectorXd& q_out) override {
-    opts_.seed = call_seed;  // seeded TRAC-IK: a pure function of its inputs, run in this thread
-    IKResult r = ik_->solve_ex(target, q_init, opts_);
-    if (r.found) q_out = r.q;
-    return r.found;
+    return run(opts_, target, q_init, call_seed, budget, q_out);
+  }
+  bool solve_free_roll(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, std::uint64_t call_seed,
+                       double budget, Eigen::VectorXd& q_out) override {
+    return run(free_, target, q_init, call_seed, budget, q_out);
   }
 
  private:
+  bool run(const TracIKOptions& base, const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init,
+           std::uint64_t call_seed, double budget, Eigen::VectorXd& q_out) {
+    call_ = base;
+    call_.timeout = base.timeout * budget;
+    call_.seed = call_seed;  // seeded TRAC-IK: a pure function of its inputs, run in this thread
+    IKResult r = ik_->solve_ex(target, q_init, call_);
+    if (r.found) q_out = r.q;
+    return r.found;
+  }
   std::shared_ptr<const TracIK> ik_;
-  TracIKOptions opts_;
+  TracIKOptions opts_, free_, call_;
 };
 
 }  // namespace
@@ -167,19 +198,37 @@ ApproachAxis parse_approach_axis(const std::string& s) {
 
 const char* approach_axis_name(ApproachAxis a) { return a == ApproachAxis::X ? "x" : "z"; }
 
+HullKind parse_hull_kind(const std::string& s) {
+  if (s == "boundary") return HullKind::Boundary;
+  if (s == "convex") return HullKind::Convex;
+  throw InputError("hull must be 'boundary' or 'convex', got '" + s + "'");
+}
+
+const char* hull_kind_name(HullKind h) { return h == HullKind::Boundary ? "boundary" : "convex"; }
+
 void WorkspaceOptions::validate() const {
+  // Upper limits (limits.hpp) keep every buffer a sweep allocates, and the clock deadline of each IK call,
+  // within reach: a number beyond one is a mistake, reported before any work.
+  auto count_in = [](const char* field, long long value, long long least, long long most, const char* hint = "") {
+    if (value < least || value > most)
+      throw InputError(std::string(field) + " must be between " + std::to_string(least) + " and " +
+                       std::to_string(most) + hint + ", got " + std::to_string(value));
+  };
   if (!(std::isfinite(voxel_size) && voxel_size > 0))
-    throw InputError("voxel size must be a positive number of metres, got " + std::to_string(voxel_size));
-  if (directions < 1) throw InputError("directions must be at least 1, got " + std::to_string(directions));
-  if (!free_roll && rolls < 1) throw InputError("rolls must be at least 1 (or use free roll), got " + std::to_string(rolls));
-  if (!(std::isfinite(timeout) && timeout > 0))
-    throw InputError("timeout must be a positive number of seconds, got " + std::to_string(timeout));
+    throw InputError("voxel size must be a positive number of metres, got " + number_text(voxel_size));
+  count_in("directions", directions, 1, limits::kMaxDirections);
+  if (!free_roll) {
+    count_in("rolls", rolls, 1, limits::kMaxRolls, " (or use free roll)");
+    count_in("directions x rolls (frames per voxel)", static_cast<long long>(directions) * rolls, 1,
+             limits::kMaxFramesPerVoxel);
+  }
+  check_timeout(timeout, "timeout");
   if (!(std::isfinite(epsilon) && epsilon > 0))
-    throw InputError("epsilon must be positive, got " + std::to_string(epsilon));
-  if (cloud_samples < 100)
-    throw InputError("cloud_samples must be at least 100 (the hull needs a cloud), got " +
-                     std::to_string(cloud_samples));
-  if (threads < 0) throw InputError("threads must be >= 0 (0 = all cores), got " + std::to_string(threads));
+    throw InputError("epsilon must be positive, got " + number_text(epsilon));
+  count_in("cloud_samples", cloud_samples, 100, limits::kMaxCloudSamples, " (the hull needs a cloud)");
+  if (!(shrink >= 0.0 && shrink <= 1.0))
+    throw InputError("shrink (the boundary's shrink factor) must be within [0, 1], got " + number_text(shrink));
+  count_in("threads", threads, 0, limits::kMaxThreads, " (0 = all cores)");
   if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
     throw InputError("shard must be i/N with 0 <= i < N, got " + std::to_string(shard_index) + "/" +
                      std::to_string(shard_count));
@@ -189,7 +238,11 @@ VoxelGrid VoxelGrid::around(const Eigen::Vector3d& centre, double side, double v
   if (!(std::isfinite(voxel) && voxel > 0)) throw InputError("voxel size must be positive");
   if (!(std::isfinite(side) && side > 0)) throw InputError("grid side must be positive");
   const double cells = std::ceil(side / voxel - 1e-9);
-  if (cells > 2000) throw InputError("voxel size too small for the grid: more than 2000 voxels per axis");
+  if (!(cells <= limits::kMaxVoxelsPerAxis))
+    throw InputError("voxel size " + number_text(voxel) + " m is too small for the grid of side " + number_text(side) +
+                     " m: " + number_text(cells) + " voxels per axis, at most " +
+                     std::to_string(limits::kMaxVoxelsPerAxis) + " (voxel size >= " +
+                     number_text(side / limits::kMaxVoxelsPerAxis) + " m)");
   VoxelGrid g;
   g.n = std::max(1, static_cast<int>(cells));
   g.voxel = voxel;
@@ -256,7 +309,9 @@ bool ConvexHull::contains(const Eigen::Vector3d& p, double tolerance) const {
 }
 
 std::vector<Eigen::Vector3d> fibonacci_directions(int n) {
-  if (n < 1) throw InputError("directions must be at least 1, got " + std::to_string(n));
+  if (n < 1 || n > limits::kMaxDirections)
+    throw InputError("directions must be between 1 and " + std::to_string(limits::kMaxDirections) + ", got " +
+                     std::to_string(n));
   // Points at equal-area heights z_k = 1 - (2k + 1) / n, turned by the golden angle each step.
   const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
   std::vector<Eigen::Vector3d> d(n);
@@ -297,7 +352,9 @@ Eigen::Isometry3d approach_frame(const Eigen::Vector3d& point, const Eigen::Vect
 }
 
 std::vector<Eigen::Vector3d> sample_tip_positions(const ChainModel& model, int samples, std::uint64_t seed) {
-  if (samples < 1) throw InputError("samples must be at least 1");
+  if (samples < 1 || samples > limits::kMaxCloudSamples)
+    throw InputError("samples must be between 1 and " + std::to_string(limits::kMaxCloudSamples) + ", got " +
+                     std::to_string(samples));
   std::mt19937_64 rng(stream_seed(seed, kCloudSalt, 0));
   std::vector<Eigen::Vector3d> pts(samples);
   for (int k = 0; k < samples; ++k) pts[k] = forward_kinematics(model, random_configuration(model, rng)).translation();
@@ -323,15 +380,22 @@ Eigen::VectorXd ReachabilityMap::indices() const {
 
 namespace {
 
-// A run: rows [start, start + length) of the centres, neighbouring voxels along a grid line.
-struct Run {
-  std::int64_t start, length;
+// A tile: voxels computed together by one thread, each starting from its neighbours' results.
+// `rows` index the centres in the order they are visited; `neighbours[k]` lists, for the k-th visited
+// voxel, the positions in `rows` of its neighbours in the tile (face neighbours first).
+struct Tile {
+  std::vector<std::int64_t> rows;
+  std::vector<std::vector<int>> neighbours;
 };
 
-VoxelEvaluation evaluate_runs(const ChainModel& model, const WorkspaceOptions& options,
-                              const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
-                              const std::vector<std::uint64_t>& stream_ids, const std::vector<Run>& runs,
-                              const ProgressCallback& progress, const PoseSolverFactory& factory_in) {
+// The sweep's strategy (see evaluate_tiles). Plain: every frame from random guesses with the full
+// budget, as Algorithm 1 states it (the independent reference of evaluate_voxels).
+enum class Strategy { Plain, Neighbours };
+
+VoxelEvaluation evaluate_tiles(const ChainModel& model, const WorkspaceOptions& options,
+                               const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& centres,
+                               const std::vector<std::uint64_t>& stream_ids, const std::vector<Tile>& tiles,
+                               Strategy strategy, const ProgressCallback& progress, const PoseSolverFactory& factory_in) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto total = static_cast<std::int64_t>(centres.rows());
   if (static_cast<std::int64_t>(stream_ids.size()) != total)
@@ -342,13 +406,15 @@ VoxelEvaluation evaluate_runs(const ChainModel& model, const WorkspaceOptions& o
   VoxelEvaluation out;
   out.tried = options.poses_per_voxel();
   out.solved.assign(total, 0);
+  const int bytes_per_voxel = reached_bytes_per_voxel(out.tried);
+  out.reached.assign(static_cast<std::size_t>(total) * bytes_per_voxel, 0);
   const std::vector<Eigen::Vector3d> dirs = fibonacci_directions(options.directions);
   const int n_rolls = options.free_roll ? 1 : options.rolls;
   const ReachBound bound(model, options);
   const double radius = 0.5 * options.voxel_size;
   int n_threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
   n_threads = static_cast<int>(
-      std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), static_cast<std::int64_t>(runs.size()))));
+      std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), static_cast<std::int64_t>(tiles.size()))));
   out.threads_used = n_threads;
   // Solvers are made here, so that a bad option fails before any thread starts.
   std::vector<std::unique_ptr<PoseSolver>> solvers;
@@ -360,103 +426,233 @@ VoxelEvaluation evaluate_runs(const ChainModel& model, const WorkspaceOptions& o
   std::condition_variable cv;
   std::exception_ptr failure;
 
-  // Dynamic scheduling (an atomic counter) balances voxels of very different cost; each voxel is
-  // computed start to finish by one thread, so the result does not depend on the thread count.
-  // One task is one run, computed start to finish by one thread: the result does not depend on the
-  // thread count. Dynamic scheduling (an atomic counter) balances runs of very different cost.
+  // One task is one tile, computed start to finish by one thread in a fixed order: the result does not
+  // depend on the thread count. Dynamic scheduling (an atomic counter) balances tiles of different cost.
   //
   // A voxel's "units" are what the index counts: its directions when any roll will do (the paper's
   // rule, and free roll), else its (direction, roll) frames. A unit is reached when one of its
-  // candidate frames is solved. Within a run, frame c of a voxel is frame c of its neighbour moved by
-  // one voxel, so the neighbour's solution is an excellent initial guess (a few Newton steps away).
-  // A forward pass tries each unit's frames, first the one the previous voxel solved (from its
-  // solution), the others from random guesses, until one is solved; a backward pass gives the units
-  // still unreached one more try from the next voxel's solution. Most reachable frames are thus
-  // found within a short budget; unreachable ones, which always cost the full budget, cost it about once.
+  // candidate frames is solved. Frame c of a voxel is frame c of its neighbour moved by one voxel, so
+  // a neighbour's solution is an excellent initial guess (a few Newton steps away when reachable).
+  //
+  // Unreachable frames dominate the cost: each spends the whole IK budget. Three things make them cheap:
+  // - a direction's rolled frames are not tried one by one from random guesses: one IK call with the
+  //   roll left free (a relaxation: it solves whenever one of the rolled frames can be solved) decides
+  //   first. When it fails, the direction is unreached without a call per roll; when it succeeds, the
+  //   rolled frames are tried from its solution, nearest roll first;
+  // - a voxel whose visited neighbours include one that failed a direction with the full budget, and
+  //   none that reached it, tests that direction with a short budget (unreachable regions are wide);
+  // - calls that start from a neighbour's solution get a short budget (reachable ones converge fast).
+  // What a short budget misses is recovered by propagation: a unit still unreached whose neighbour
+  // reached it is tried again from that neighbour's solution, until nothing changes.
   const int n_dirs = options.directions;
   const int per_unit = options.free_roll || !options.any_roll ? 1 : options.rolls;  // candidate frames
   const int units = options.poses_per_voxel();
-  const int frames_per_voxel = units * per_unit;  // = directions * n_rolls
+  const int frames_per_voxel = n_dirs * n_rolls;
+  // The free-roll test pays when it can replace more than one fixed-roll call per direction.
+  const bool probe_directions = strategy == Strategy::Neighbours && !options.free_roll && n_rolls > 1;
+  const bool neighbours_help = strategy == Strategy::Neighbours;
   auto work = [&](PoseSolver& solver) {
     std::int64_t my_calls = 0, my_cheap = 0;
     Eigen::VectorXd q_out(model.n_joints());
     std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets;
-    std::vector<char> possible;
-    std::vector<int> reached_by;  // per unit: the candidate that reached it, or -1
-    std::vector<Eigen::VectorXd> solutions, guesses;
-    std::vector<std::uint64_t> seeds;
-    auto attempt = [&](std::int64_t unit, int c, const Eigen::VectorXd& q_init, std::uint64_t seed) {
+    std::vector<char> possible, probe_possible;
+    // Per (voxel, direction) of the free-roll test, and per unit of what decides it without neighbours:
+    // 0 not tried, 1 solved, -1 failed with the full budget, -2 failed with a short one.
+    std::vector<signed char> probe_state, dir_state, no_roll;
+    std::vector<double> probe_roll;  // the roll of the free-roll solution (rad)
+    std::vector<int> reached_by;     // per unit: the candidate that reached it, or -1
+    std::vector<std::uint32_t> tried_from;  // per unit: neighbours (bit = position in the list) tried from
+    std::vector<Eigen::VectorXd> solutions, guesses, probe_q;
+    std::vector<std::uint64_t> seeds, probe_seeds;
+    std::vector<int> order(n_rolls);
+    auto attempt = [&](std::int64_t unit, int c, const Eigen::VectorXd& q_init, std::uint64_t seed, double budget) {
       const std::int64_t f = unit * per_unit + c;
       if (!possible[f]) return false;
       ++my_calls;
-      if (!solver.solve(targets[f], q_init, seed, q_out)) return false;
+      if (!solver.solve(targets[f], q_init, seed, budget, q_out)) return false;
       reached_by[unit] = c;
       solutions[unit] = q_out;
       return true;
     };
+    // Whether the visited neighbours of voxel `a` (tile position) say that direction `di` is unreachable:
+    // one failed it with the full budget and none reached it.
+    auto looks_unreachable = [&](const Tile& tile, int a, int di, const std::vector<char>& visited) {
+      if (!neighbours_help) return false;
+      bool full_failure = false;
+      for (int b : tile.neighbours[a]) {
+        if (!visited[b]) continue;
+        const signed char s = dir_state[static_cast<std::size_t>(b) * n_dirs + di];
+        if (s > 0) return false;
+        full_failure |= s == -1;
+      }
+      return full_failure;
+    };
+    // The free-roll test of direction `di` of the voxel at tile position `a`.
+    auto probe = [&](const Tile& tile, int a, int di, const std::vector<char>& visited) {
+      const std::int64_t dir = static_cast<std::int64_t>(a) * n_dirs + di;
+      if (probe_state[dir] != 0) return probe_state[dir] > 0;
+      probe_state[dir] = -1;
+      const std::int64_t f0 = dir * n_rolls;  // the roll-0 frame of the direction
+      if (!probe_possible[dir]) return false;
+      const bool brief = looks_unreachable(tile, a, di, visited);
+      // Start from a visited neighbour's free-roll solution of the same direction, else from a random guess.
+      const Eigen::VectorXd* start = &guesses[f0];
+      for (int b : tile.neighbours[a])
+        if (visited[b] && probe_state[static_cast<std::size_t>(b) * n_dirs + di] > 0) {
+          start = &probe_q[static_cast<std::size_t>(b) * n_dirs + di];
+          break;
+        }
+      ++my_calls;
+      if (!solver.solve_free_roll(targets[f0], *start, probe_seeds[dir], brief ? kBriefBudget : 1.0, q_out)) {
+        probe_state[dir] = dir_state[dir] = brief ? -2 : -1;
+        return false;
+      }
+      probe_state[dir] = dir_state[dir] = 1;
+      probe_q[dir] = q_out;
+      // Roll of the solution about the approach axis, relative to the roll-0 frame.
+      const Eigen::Matrix3d rel = targets[f0].linear().transpose() * forward_kinematics(model, q_out).linear();
+      probe_roll[dir] = options.approach == ApproachAxis::X ? std::atan2(rel(2, 1), rel(1, 1))
+                                                             : std::atan2(rel(1, 0), rel(0, 0));
+      return true;
+    };
     try {
-      for (std::int64_t t = next++; t < static_cast<std::int64_t>(runs.size()) && !stop.load(std::memory_order_relaxed);
+      for (std::int64_t t = next++; t < static_cast<std::int64_t>(tiles.size()) && !stop.load(std::memory_order_relaxed);
            t = next++) {
-        const Run run = runs[t];
-        const std::int64_t n_frames = run.length * frames_per_voxel;
+        const Tile& tile = tiles[t];
+        const auto n_vox = static_cast<std::int64_t>(tile.rows.size());
+        const std::int64_t n_frames = n_vox * frames_per_voxel;
+        const std::int64_t n_directions = n_vox * n_dirs;
         targets.resize(n_frames);
         possible.assign(n_frames, 0);
         guesses.resize(n_frames);
         seeds.resize(n_frames);
-        reached_by.assign(run.length * units, -1);
-        solutions.resize(run.length * units);
-        // Lines 11-15: the frames of every voxel of the run (frame index = (voxel, direction, roll)),
+        probe_possible.assign(n_directions, 0);
+        probe_state.assign(n_directions, 0);
+        probe_roll.assign(n_directions, 0.0);
+        probe_q.resize(n_directions);
+        probe_seeds.resize(n_directions);
+        reached_by.assign(n_vox * units, -1);
+        dir_state.assign(n_directions, 0);
+        no_roll.assign(n_directions, 0);
+        tried_from.assign(n_vox * units, 0);
+        solutions.resize(n_vox * units);
+        std::vector<char> visited(n_vox, 0);
+        // Lines 11-15: the frames of every voxel of the tile (frame index = (voxel, direction, roll)),
         // the cheap exits, and each frame's random guess and IK seed from the voxel's own stream.
-        for (std::int64_t l = 0; l < run.length; ++l) {
-          const Eigen::Vector3d c = centres.row(run.start + l).transpose();
-          std::mt19937_64 rng(stream_seed(options.seed, kVoxelSalt, stream_ids[run.start + l]));
+        for (std::int64_t a = 0; a < n_vox; ++a) {
+          const std::int64_t row = tile.rows[a];
+          const Eigen::Vector3d c = centres.row(row).transpose();
+          std::mt19937_64 rng(stream_seed(options.seed, kVoxelSalt, stream_ids[row]));
           // The whole sphere beyond the tip's reach: index 0 without looking at a single frame.
           const bool in_reach = c.norm() - radius <= bound.reach() + 1e-9;
           for (int di = 0; di < n_dirs; ++di) {
             const Eigen::Vector3d& d = dirs[di];
             const Eigen::Vector3d p = c + radius * d;
+            const std::int64_t dir = a * n_dirs + di;
+            probe_possible[dir] = in_reach && bound.possible_any_roll(p, d);
             for (int r = 0; r < n_rolls; ++r) {
-              const std::int64_t f = l * frames_per_voxel + di * n_rolls + r;
+              const std::int64_t f = dir * n_rolls + r;
               targets[f] = approach_frame(p, d, 2.0 * M_PI * r / n_rolls, options.approach);
-              possible[f] = in_reach && (options.free_roll ? bound.possible_any_roll(p, d) : bound.possible(targets[f]));
+              possible[f] = in_reach && (options.free_roll ? probe_possible[dir] : bound.possible(targets[f]));
               my_cheap += !possible[f];
               guesses[f] = random_configuration(model, rng);
               seeds[f] = rng();
             }
           }
+          for (int di = 0; di < n_dirs; ++di) probe_seeds[a * n_dirs + di] = rng();
         }
-        // Forward pass.
-        for (std::int64_t l = 0; l < run.length; ++l) {
+        // The rolled frames of a direction in the order to try them: nearest the free-roll solution's first.
+        auto roll_order = [&](std::int64_t dir) {
+          std::iota(order.begin(), order.end(), 0);
+          const double psi = probe_roll[dir];
+          auto gap = [&](int r) { return std::abs(std::remainder(2.0 * M_PI * r / n_rolls - psi, 2.0 * M_PI)); };
+          std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return gap(x) < gap(y); });
+        };
+        // Tries unit u of voxel a from the solutions of its neighbours that reached it (each at most once).
+        auto from_neighbours = [&](int a, int u, int most, bool later_only) {
+          const std::int64_t unit = static_cast<std::int64_t>(a) * units + u;
+          const auto& nb = tile.neighbours[a];
+          for (std::size_t k = 0; k < nb.size() && k < 32 && most > 0; ++k) {
+            const std::int64_t other = static_cast<std::int64_t>(nb[k]) * units + u;
+            if ((later_only && nb[k] < a) || reached_by[other] < 0 || (tried_from[unit] >> k) & 1U) continue;
+            tried_from[unit] |= 1U << k;
+            --most;
+            const int c = reached_by[other];
+            if (attempt(unit, c, solutions[other], splitmix64(seeds[unit * per_unit + c] ^ (kNeighbourSalt + k)),
+                        kNearBudget))
+              return true;
+          }
+          return false;
+        };
+        // First visit of every voxel, in the tile's order.
+        for (int a = 0; a < static_cast<int>(n_vox); ++a) {
           for (int u = 0; u < units; ++u) {
-            const std::int64_t unit = l * units + u;
-            const std::int64_t prev = unit - units;
-            int first = -1;
-            if (l > 0 && reached_by[prev] >= 0) {
-              first = reached_by[prev];
-              if (attempt(unit, first, solutions[prev], seeds[unit * per_unit + first])) continue;
+            const std::int64_t unit = static_cast<std::int64_t>(a) * units + u;
+            if (neighbours_help && from_neighbours(a, u, 1, false)) {
+              dir_state[static_cast<std::size_t>(a) * n_dirs + (options.any_roll || options.free_roll ? u : u / n_rolls)] = 1;
+              continue;
             }
-            for (int c = 0; c < per_unit; ++c) {
-              if (c == first) continue;
-              const std::int64_t f = unit * per_unit + c;
-              if (attempt(unit, c, guesses[f], seeds[f])) break;
+            if (!probe_directions) {
+              // Each candidate frame from its random guess (short budget where the neighbours say unreachable).
+              const int di = options.any_roll || options.free_roll ? u : u / n_rolls;
+              const bool brief = looks_unreachable(tile, a, di, visited);
+              for (int c = 0; c < per_unit; ++c) {
+                const std::int64_t f = unit * per_unit + c;
+                if (attempt(unit, c, guesses[f], seeds[f], brief ? kBriefBudget : 1.0)) break;
+              }
+              signed char& state = dir_state[static_cast<std::size_t>(a) * n_dirs + di];
+              if (reached_by[unit] >= 0) state = 1;
+              else if (state == 0) state = brief ? -2 : -1;
+              continue;
+            }
+            // Directions: unit u is direction u (any roll) or frame u of direction u / n_rolls (each roll).
+            const int di = options.any_roll ? u : u / n_rolls;
+            const std::int64_t dir = static_cast<std::int64_t>(a) * n_dirs + di;
+            if (!probe(tile, a, di, visited)) continue;
+            if (options.any_roll) {
+              roll_order(dir);
+              // Where a visited neighbour solved this direction with its roll free but at none of the rolls,
+              // and no visited neighbour reached it, only the nearest roll is tried.
+              bool rollless = false;
+              for (int b : tile.neighbours[a]) {
+                if (!visited[b]) continue;
+                if (reached_by[static_cast<std::int64_t>(b) * units + u] >= 0) {
+                  rollless = false;
+                  break;
+                }
+                rollless |= no_roll[static_cast<std::size_t>(b) * n_dirs + di] != 0;
+              }
+              int tried = 0;
+              for (int k = 0; k < n_rolls && tried < (rollless ? 1 : n_rolls); ++k) {
+                const int c = order[k];
+                if (!possible[unit * per_unit + c]) continue;
+                ++tried;
+                if (attempt(unit, c, probe_q[dir], seeds[unit * per_unit + c], kRollBudget)) break;
+              }
+              if (tried > 0 && reached_by[unit] < 0) no_roll[dir] = 1;
+            } else {
+              attempt(unit, 0, probe_q[dir], seeds[unit], kRollBudget);
             }
           }
+          visited[a] = 1;
         }
-        // Backward pass: second chances from the next voxel's solutions (seeds from another stream).
-        for (std::int64_t l = run.length - 2; l >= 0; --l) {
-          for (int u = 0; u < units; ++u) {
-            const std::int64_t unit = l * units + u, after = unit + units;
-            if (reached_by[unit] >= 0 || reached_by[after] < 0) continue;
-            const int c = reached_by[after];
-            attempt(unit, c, solutions[after], splitmix64(seeds[unit * per_unit + c] ^ kBackwardSalt));
-          }
-        }
-        for (std::int64_t l = 0; l < run.length; ++l) {
+        // Second chances, in reverse order: units still unreached are tried from a neighbour visited
+        // after them that reached them.
+        if (neighbours_help)
+          for (int a = static_cast<int>(n_vox) - 1; a >= 0; --a)
+            for (int u = 0; u < units; ++u)
+              if (reached_by[static_cast<std::int64_t>(a) * units + u] < 0) from_neighbours(a, u, 1, true);
+        for (std::int64_t a = 0; a < n_vox; ++a) {
           int count = 0;
-          for (int u = 0; u < units; ++u) count += reached_by[l * units + u] >= 0;
-          out.solved[run.start + l] = count;
+          std::uint8_t* bits = &out.reached[static_cast<std::size_t>(tile.rows[a]) * bytes_per_voxel];
+          for (int u = 0; u < units; ++u) {
+            if (reached_by[a * units + u] < 0) continue;
+            ++count;
+            bits[u / 8] |= static_cast<std::uint8_t>(1U << (u % 8));
+          }
+          out.solved[tile.rows[a]] = count;
         }
-        if ((done += run.length) == total) cv.notify_all();
+        if ((done += n_vox) == total) cv.notify_all();
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(mutex);
@@ -507,6 +703,38 @@ VoxelEvaluation evaluate_runs(const ChainModel& model, const WorkspaceOptions& o
   return out;
 }
 
+
+// The grid voxels whose centre lies inside a convex hull, ascending. The hull cuts a z-line in one
+// interval: bound it from the facet planes first, so that only a few voxels per line need the full
+// test (a grid of n^3 voxels costs n^2 * facets, not n^3 * facets).
+std::vector<std::int64_t> convex_voxels(const ConvexHull& hull, const VoxelGrid& grid) {
+  std::vector<std::int64_t> ids;
+  const int n = grid.n;
+  const double h = grid.voxel;
+  for (std::int64_t line = 0; line < static_cast<std::int64_t>(n) * n; ++line) {
+    const Eigen::Vector3d c0 = grid.centre_of(line * n);
+    double zlo = -std::numeric_limits<double>::infinity(), zhi = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < hull.n_facets() && zlo <= zhi; ++f) {
+      const double nz = hull.normals(f, 2);
+      const double rest = hull.normals(f, 0) * c0.x() + hull.normals(f, 1) * c0.y() + hull.offsets[f];
+      if (std::abs(nz) < 1e-12) {
+        if (rest > 1e-9) zlo = std::numeric_limits<double>::infinity();  // the line misses this facet's half-space
+      } else if (nz > 0) {
+        zhi = std::min(zhi, -rest / nz);
+      } else {
+        zlo = std::max(zlo, -rest / nz);
+      }
+    }
+    if (!(zlo <= zhi)) continue;
+    const int l_first = static_cast<int>(std::max(0.0, std::floor((zlo - grid.origin.z()) / h - 0.5) - 1));
+    const int l_last = static_cast<int>(std::min(n - 1.0, std::ceil((zhi - grid.origin.z()) / h - 0.5) + 1));
+    for (int l = l_first; l <= l_last; ++l) {
+      const std::int64_t k = line * n + l;
+      if (hull.contains(grid.centre_of(k))) ids.push_back(k);
+    }
+  }
+  return ids;
+}
 }  // namespace
 
 VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions& options,
@@ -514,9 +742,9 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
                                 const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress,
                                 const PoseSolverFactory& factory) {
   options.validate();
-  std::vector<Run> runs;
-  for (std::int64_t v = 0; v < centres.rows(); ++v) runs.push_back({v, 1});
-  return evaluate_runs(model, options, centres, stream_ids, runs, progress, factory);
+  std::vector<Tile> tiles(static_cast<std::size_t>(centres.rows()));
+  for (std::int64_t v = 0; v < centres.rows(); ++v) tiles[v].rows = {v}, tiles[v].neighbours = {{}};
+  return evaluate_tiles(model, options, centres, stream_ids, tiles, Strategy::Plain, progress, factory);
 }
 
 ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOptions& options,
@@ -531,60 +759,82 @@ ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOpt
   map.reach = model.reach();
   map.tried = options.poses_per_voxel();
 
-  // Lines 1-8 of Algorithm 1: the point cloud, its hull, the grid and the voxels inside the hull.
-  // Every shard computes the same cloud and hull (they depend on the seed only), so the in-hull
-  // list, and with it the split k % N, is the same in all shards.
-  const ConvexHull hull = ConvexHull::of(sample_tip_positions(model, options.cloud_samples, options.seed));
-  map.hull_facets = hull.n_facets();
+  // Lines 1-8 of Algorithm 1: the point cloud, its boundary (or hull), the grid and the voxels inside.
+  // Every shard computes the same cloud and boundary (they depend on the seed only), so the list of
+  // voxels inside, and with it the split into shards, is the same in all shards.
+  const std::vector<Eigen::Vector3d> cloud = sample_tip_positions(model, options.cloud_samples, options.seed);
   map.grid = VoxelGrid::around(Eigen::Vector3d::Zero(), 2.0 * model.reach(), options.voxel_size);
-  // The in-hull voxels in runs of neighbours along z (the grid's fastest index). Shard i of N takes
-  // the runs r with r % N == i: a run is never split, so every voxel sees the same neighbours in
-  // every shard and the merged shards equal the unsharded map.
-  std::vector<Run> runs;
-  map.hull_voxels = 0;
-  std::int64_t run_index = 0;
-  const int n = map.grid.n;
-  const double h = map.grid.voxel;
-  for (std::int64_t line = 0; line < static_cast<std::int64_t>(n) * n; ++line) {
-    // The hull cuts a z-line in one interval: bound it from the facet planes first, so that only a
-    // few voxels per line need the full test (a grid of n^3 voxels costs n^2 * facets, not n^3 * facets).
-    const Eigen::Vector3d c0 = map.grid.centre_of(line * n);
-    double zlo = -std::numeric_limits<double>::infinity(), zhi = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < hull.n_facets() && zlo <= zhi; ++f) {
-      const double nz = hull.normals(f, 2);
-      const double rest = hull.normals(f, 0) * c0.x() + hull.normals(f, 1) * c0.y() + hull.offsets[f];
-      if (std::abs(nz) < 1e-12) {
-        if (rest > 1e-9) zlo = std::numeric_limits<double>::infinity();  // the line misses this facet's half-space
-      } else if (nz > 0) {
-        zhi = std::min(zhi, -rest / nz);
-      } else {
-        zlo = std::max(zlo, -rest / nz);
-      }
-    }
-    if (!(zlo <= zhi)) continue;
-    const int l_first = static_cast<int>(std::max(0.0, std::floor((zlo - map.grid.origin.z()) / h - 0.5) - 1));
-    const int l_last = static_cast<int>(std::min(n - 1.0, std::ceil((zhi - map.grid.origin.z()) / h - 0.5) + 1));
-    std::int64_t previous = -2;
-    for (int l = l_first; l <= l_last; ++l) {
-      const std::int64_t k = line * n + l;
-      if (!hull.contains(map.grid.centre_of(k))) continue;
-      ++map.hull_voxels;
-      const bool starts_run = k != previous + 1;
-      previous = k;
-      if (starts_run) ++run_index;
-      if ((run_index - 1) % options.shard_count != options.shard_index) continue;
-      if (starts_run) runs.push_back({static_cast<std::int64_t>(map.voxel_ids.size()), 0});
-      map.voxel_ids.push_back(k);
-      ++runs.back().length;
-    }
+  std::vector<std::int64_t> inside;
+  if (options.hull == HullKind::Boundary) {
+    const AlphaShape shape = AlphaShape::boundary(cloud, options.shrink);
+    map.alpha = shape.alpha();
+    map.hull_facets = static_cast<int>(shape.n_boundary_facets());
+    inside = shape.voxels_inside(map.grid);
+  } else {
+    const ConvexHull hull = ConvexHull::of(cloud);
+    map.alpha = std::numeric_limits<double>::infinity();
+    map.hull_facets = hull.n_facets();
+    inside = convex_voxels(hull, map.grid);
   }
+  map.hull_voxels = static_cast<std::int64_t>(inside.size());
+  // Tiles: the voxels inside, in blocks of kTileLines x kTileLines lines along z. Shard i of N takes
+  // the tiles t with t % N == i: a tile is never split, so every voxel sees the same neighbours in
+  // every shard and the merged shards equal the unsharded map.
+  const int n = map.grid.n;
+  const int blocks = (n + kTileLines - 1) / kTileLines;
+  std::map<std::int64_t, std::vector<std::int64_t>> by_block;  // block -> grid ids, ascending
+  for (const std::int64_t k : inside) {
+    const std::int64_t i = k / (static_cast<std::int64_t>(n) * n), j = (k / n) % n;
+    by_block[(i / kTileLines) * blocks + j / kTileLines].push_back(k);
+  }
+  std::vector<std::vector<std::int64_t>> mine;
+  std::int64_t tile_index = 0;
+  for (auto& [block, ids] : by_block)
+    if (tile_index++ % options.shard_count == options.shard_index) mine.push_back(std::move(ids));
+  for (const auto& ids : mine) map.voxel_ids.insert(map.voxel_ids.end(), ids.begin(), ids.end());
+  std::sort(map.voxel_ids.begin(), map.voxel_ids.end());
   const auto total = static_cast<Eigen::Index>(map.voxel_ids.size());
   map.centres.resize(total, 3);
   for (Eigen::Index v = 0; v < total; ++v) map.centres.row(v) = map.grid.centre_of(map.voxel_ids[v]).transpose();
+  // Inside out: each tile is visited from the voxel nearest the cloud's centroid (where the tip is most
+  // often, and most directions are reachable) outwards, so that most voxels find solved neighbours.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : cloud) centroid += p / static_cast<double>(cloud.size());
+  std::vector<Tile> tiles;
+  for (auto& ids : mine) {
+    std::stable_sort(ids.begin(), ids.end(), [&](std::int64_t x, std::int64_t y) {
+      return (map.grid.centre_of(x) - centroid).squaredNorm() < (map.grid.centre_of(y) - centroid).squaredNorm();
+    });
+    std::map<std::int64_t, int> position;
+    for (std::size_t q = 0; q < ids.size(); ++q) position[ids[q]] = static_cast<int>(q);
+    Tile tile;
+    for (const std::int64_t k : ids) {
+      tile.rows.push_back(std::lower_bound(map.voxel_ids.begin(), map.voxel_ids.end(), k) - map.voxel_ids.begin());
+      const int i = static_cast<int>(k / (static_cast<std::int64_t>(n) * n)), j = static_cast<int>((k / n) % n),
+                l = static_cast<int>(k % n);
+      std::vector<std::pair<int, int>> nb;  // (|offset|_1, position)
+      for (int di = -1; di <= 1; ++di)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int dl = -1; dl <= 1; ++dl) {
+            const int a = i + di, b = j + dj, c = l + dl;
+            if ((di | dj | dl) == 0 || a < 0 || b < 0 || c < 0 || a >= n || b >= n || c >= n) continue;
+            const auto it = position.find((static_cast<std::int64_t>(a) * n + b) * n + c);
+            if (it != position.end()) nb.emplace_back(std::abs(di) + std::abs(dj) + std::abs(dl), it->second);
+          }
+      std::stable_sort(nb.begin(), nb.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      tile.neighbours.emplace_back();
+      for (const auto& e : nb) tile.neighbours.back().push_back(e.second);
+    }
+    tiles.push_back(std::move(tile));
+  }
+  // Largest tiles first, so that no thread is left with a big one at the end (the order of the tiles
+  // does not change the map).
+  std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& x, const Tile& y) { return x.rows.size() > y.rows.size(); });
 
   const std::vector<std::uint64_t> streams(map.voxel_ids.begin(), map.voxel_ids.end());
-  VoxelEvaluation e = evaluate_runs(model, options, map.centres, streams, runs, progress, factory);
+  VoxelEvaluation e = evaluate_tiles(model, options, map.centres, streams, tiles, Strategy::Neighbours, progress, factory);
   map.solved = std::move(e.solved);
+  map.reached = std::move(e.reached);
   map.ik_calls = e.ik_calls;
   map.cheap_exits = e.cheap_exits;
   map.threads_used = e.threads_used;
@@ -597,7 +847,8 @@ bool same_options(const WorkspaceOptions& a, const WorkspaceOptions& b) {
   return a.voxel_size == b.voxel_size && a.directions == b.directions &&
          (a.free_roll ? b.free_roll : !b.free_roll && a.rolls == b.rolls && a.any_roll == b.any_roll) && a.approach == b.approach &&
          a.timeout == b.timeout && a.epsilon == b.epsilon &&
-         a.cloud_samples == b.cloud_samples && a.seed == b.seed && a.shard_count == b.shard_count;
+         a.cloud_samples == b.cloud_samples && a.seed == b.seed && a.shard_count == b.shard_count &&
+         a.hull == b.hull && a.map_shrink() == b.map_shrink();
 }
 }  // namespace
 
@@ -616,13 +867,18 @@ ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards) {
     if (seen[i]) throw InputError("shard " + std::to_string(i) + "/" + std::to_string(n) + " given twice");
     seen[i] = true;
   }
-  std::map<std::int64_t, std::pair<Eigen::Vector3d, std::int32_t>> voxels;
+  // Rows of the merged map by grid index: (shard, row in that shard).
+  std::map<std::int64_t, std::pair<std::size_t, std::size_t>> voxels;
+  const bool with_bits = std::all_of(shards.begin(), shards.end(), [](const ReachabilityMap& s) {
+    return s.reached.size() == s.voxel_ids.size() * reached_bytes_per_voxel(s.tried);
+  });
   ReachabilityMap out = first;
   out.ik_calls = out.cheap_exits = 0;
   out.seconds = 0.0;
-  for (const auto& s : shards) {
+  for (std::size_t i = 0; i < shards.size(); ++i) {
+    const ReachabilityMap& s = shards[i];
     for (std::size_t v = 0; v < s.voxel_ids.size(); ++v)
-      if (!voxels.emplace(s.voxel_ids[v], std::make_pair(Eigen::Vector3d(s.centres.row(v).transpose()), s.solved[v])).second)
+      if (!voxels.emplace(s.voxel_ids[v], std::make_pair(i, v)).second)
         throw InputError("voxel " + std::to_string(s.voxel_ids[v]) + " appears in two shards");
     out.ik_calls += s.ik_calls;
     out.cheap_exits += s.cheap_exits;
@@ -635,34 +891,55 @@ ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards) {
   out.options.shard_count = 1;
   out.voxel_ids.clear();
   out.solved.clear();
+  out.reached.clear();
+  const int bytes = reached_bytes_per_voxel(first.tried);
   out.centres.resize(static_cast<Eigen::Index>(voxels.size()), 3);
   Eigen::Index row = 0;
-  for (const auto& [k, v] : voxels) {
+  for (const auto& [k, where] : voxels) {
+    const ReachabilityMap& s = shards[where.first];
+    const std::size_t v = where.second;
     out.voxel_ids.push_back(k);
-    out.centres.row(row++) = v.first.transpose();
-    out.solved.push_back(v.second);
+    out.centres.row(row++) = s.centres.row(static_cast<Eigen::Index>(v));
+    out.solved.push_back(s.solved[v]);
+    if (with_bits) out.reached.insert(out.reached.end(), s.reached.begin() + v * bytes, s.reached.begin() + (v + 1) * bytes);
   }
   return out;
 }
 
 void save_npz(const ReachabilityMap& map, const std::string& path, const std::string& command) {
   const auto m = static_cast<std::int64_t>(map.voxel_ids.size());
+  const int bytes = reached_bytes_per_voxel(map.tried);
+  if (map.tried < 1) throw InputError("a map tries at least one pose per voxel");
+  if (map.centres.rows() != m || static_cast<std::int64_t>(map.solved.size()) != m)
+    throw InputError("a map needs one centre and one solved count per voxel id");
+  if (!map.reached.empty() && static_cast<std::int64_t>(map.reached.size()) != m * bytes)
+    throw InputError("a map's per-direction results need " + std::to_string(bytes) + " bytes per voxel");
+  if (!std::is_sorted(map.voxel_ids.begin(), map.voxel_ids.end()))
+    throw InputError("a map's voxel ids must be ascending");
   NpzWriter w;
-  w.add_string("format", "snakehead-reachability-1");
+  w.add_string("format", kMapFormat);
   std::vector<double> centres(map.centres.data(), map.centres.data() + map.centres.size());
   w.add_f64("centers", centres, {m, 3});
   const Eigen::VectorXd d = map.indices();
   w.add_f64("indices", std::vector<double>(d.data(), d.data() + d.size()), {m});
   w.add_i32("solved", map.solved, {m});
   w.add_i64("voxel_ids", map.voxel_ids, {m});
+  if (!map.reached.empty()) w.add_u8("reached", map.reached, {m, bytes});
   w.add_scalar("tried", static_cast<std::int64_t>(map.tried));
+  const WorkspaceOptions& o = map.options;
+  // The directions of every voxel's sphere, so that a reader needs numpy alone.
+  std::vector<double> dirs;
+  for (const auto& v : fibonacci_directions(o.directions)) dirs.insert(dirs.end(), {v.x(), v.y(), v.z()});
+  w.add_f64("sphere_directions", dirs, {o.directions, 3});
   w.add_f64("grid_origin", {map.grid.origin.x(), map.grid.origin.y(), map.grid.origin.z()}, {3});
   w.add_scalar("grid_size", map.grid.side());
   w.add_i64("grid_shape", {map.grid.n, map.grid.n, map.grid.n}, {3});
   w.add_scalar("hull_voxels", map.hull_voxels);
   w.add_scalar("hull_facets", static_cast<std::int64_t>(map.hull_facets));
+  w.add_string("hull", hull_kind_name(o.hull));
+  w.add_scalar("shrink", o.map_shrink());
+  w.add_scalar("alpha", map.alpha);
   w.add_scalar("reach", map.reach);
-  const WorkspaceOptions& o = map.options;
   w.add_scalar("voxel_size", o.voxel_size);
   w.add_scalar("directions", static_cast<std::int64_t>(o.directions));
   w.add_scalar("rolls", static_cast<std::int64_t>(o.free_roll ? 0 : o.rolls));

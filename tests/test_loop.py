@@ -296,7 +296,7 @@ def disturbed(controller):
 
     scene = Scene.from_targets([(np.array([-0.0405, 0.5443, 0.3]), np.array([0.0, 1.0, 0.0]))], name="sphere",
                                hold_s=0.5)
-    loop = ClosedLoop(scene, controller=controller, speed=0.24, min_segment=1.0)
+    loop = ClosedLoop(scene, controller=controller)
     nominal = loop.straight_start()
     start = lc.compose(nominal, BasePlacement(0.0, 0.1, math.radians(20.0)))
     return loop, loop.run(start, believed_start=nominal)
@@ -391,5 +391,5 @@ def test_bad_loop_input(disturbed, controller):
         ClosedLoop(loop.scene, controller=controller, max_corrections=-1)
     with pytest.raises(TypeError, match="Tolerance"):
         ClosedLoop(loop.scene, controller=controller, tolerance=0.1)
-    with pytest.raises(ValueError, match="speed"):
-        ClosedLoop(loop.scene, controller=controller, speed=0.0)
+    with pytest.raises(TypeError, match="timing"):
+        ClosedLoop(loop.scene, controller=controller, timing=0.5)

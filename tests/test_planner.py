@@ -74,10 +74,10 @@ def test_hole(hole, controller):
 
 
 def test_bad_parameters(controller):
-    with pytest.raises(ValueError, match="speed"):
-        snakehead.plan(paper_scene("spheres"), controller=controller, speed=0.0)
-    with pytest.raises(ValueError, match="min_segment"):
-        snakehead.plan(paper_scene("spheres"), controller=controller, min_segment=-1.0)
+    with pytest.raises(ValueError, match="acceleration"):
+        snakehead.plan(paper_scene("spheres"), controller=controller, timing={"acceleration_limit": 0.0})
+    with pytest.raises(TypeError, match="timing"):
+        snakehead.plan(paper_scene("spheres"), controller=controller, timing=2.0)
     with pytest.raises(TypeError, match="controller"):
         snakehead.plan(paper_scene("spheres"), controller="no")
 

@@ -1,8 +1,10 @@
-"""Reachability maps (Algorithm 1): the sweep through the bindings, files, shards, Dask, workspace_gen, G0."""
+"""Reachability maps (Algorithm 1): the sweep through the bindings, the boundary, files (one writer; old files),
+shards, Dask, workspace_gen, G0."""
 from __future__ import annotations
 
 import shutil
 import subprocess
+import sysconfig
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -26,10 +28,15 @@ def small(robot):
     return ws.compute(robot, progress=False, **SMALL)
 
 
+DATA = Path(__file__).resolve().parent / "data"
+
+
 def workspace_gen() -> str:
-    exe = shutil.which("workspace_gen")
-    assert exe, "workspace_gen is not on PATH (the wheel installs it)"
-    return exe
+    """The workspace_gen installed with this interpreter's snakehead (PATH may lead to another install)."""
+    exe = Path(sysconfig.get_path("scripts")) / "workspace_gen"
+    found = str(exe) if exe.exists() else shutil.which("workspace_gen")
+    assert found, "workspace_gen is not installed (the wheel installs it)"
+    return found
 
 
 def gen_args(robot, out, **kw):
@@ -189,6 +196,14 @@ def test_workspace_gen_output_reads_with_numpy(robot, small, tmp_path):
     assert list(z["shard"]) == [0, 1] and list(z["grid_shape"]) == [small.grid_shape[0]] * 3
     assert "--voxel 0.15" in str(z["command"])
     assert ws.load(out).same_map_as(small)
+    # The same map written by Python's save: every array identical but the run's own records.
+    py = tmp_path / "py.npz"
+    small.save(py)
+    zp = np.load(py, allow_pickle=False)
+    assert sorted(zp.files) == sorted(z.files)
+    for key in z.files:
+        if key not in ("command", "seconds", "threads"):
+            assert z[key].dtype == zp[key].dtype and np.array_equal(z[key], zp[key]), key
     # A shard from workspace_gen merges with shards from Python.
     gen_shard = tmp_path / "s0.npz"
     subprocess.run(gen_args(robot, gen_shard, voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3,
@@ -196,6 +211,75 @@ def test_workspace_gen_output_reads_with_numpy(robot, small, tmp_path):
     assert list(np.load(gen_shard)["shard"]) == [0, 2]
     merged = ws.merge([ws.load(gen_shard), ws.compute(robot, progress=False, shard=(1, 2), **SMALL)])
     assert merged.same_map_as(small)
+
+
+def test_map_reads_with_numpy_alone(small, tmp_path):
+    path = tmp_path / "map.npz"
+    small.save(path)
+    z = np.load(path, allow_pickle=False)
+    assert str(z["format"]) == ws.FORMAT and str(z["hull"]) == "boundary" and 0 < float(z["alpha"]) < 1
+    # The per-direction bits: one per direction of each voxel, as many set as the voxel's solved count.
+    bits = np.unpackbits(z["reached"], axis=1, count=int(z["tried"]), bitorder="little")
+    np.testing.assert_array_equal(bits.sum(axis=1), z["solved"])
+    np.testing.assert_allclose(100 * bits.mean(axis=1), z["indices"])
+    np.testing.assert_allclose(z["sphere_directions"], ws.fibonacci_directions(6))
+
+
+def test_old_map_loads_and_says_what_it_lacks(robot, tmp_path):
+    # tests/data/map_format1.npz: written by the previous release's workspace_gen with SMALL's options.
+    old = ws.load(DATA / "map_format1.npz")
+    assert old.lacks == ("reached",) and old.reached is None and "lacks reached" in repr(old)
+    assert old.params["hull"] == "convex" and old.params["shrink"] == 0.0
+    assert old.tried == 6 and len(old) == old.hull_voxels > 50
+    with pytest.raises(ValueError, match="no per-direction results"):
+        old.reachable([0.2, 0.0, 0.0], [1.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="no per-direction results"):
+        old.inverse([0.2, 0.0, 0.0], [1.0, 0.0, 0.0])
+    # Written again (by the one writer) it stays what it was: a map without the bits.
+    path = tmp_path / "again.npz"
+    old.save(path)
+    again = ws.load(path)
+    assert again.same_map_as(old) and again.lacks == ("reached",) and "reached" not in np.load(path).files
+    # The convex hull is unchanged: this release's convex map of the same options has the same voxels.
+    convex = ws.compute(robot, progress=False, hull="convex", **SMALL)
+    np.testing.assert_array_equal(convex.voxel_ids, old.voxel_ids)
+    np.testing.assert_allclose(convex.centers, old.centers, rtol=0, atol=1e-15)
+    assert convex.hull_voxels == old.hull_voxels and convex.stats["hull_facets"] == old.stats["hull_facets"]
+
+
+def test_boundary_holds_the_deep_interior_and_leaves_empty_space_out(robot):
+    # The paper's boundary(P) against the convex hull of the same cloud: fewer voxels, all among the hull's; every
+    # voxel 0.1 m or more inside the hull where the cloud is dense is kept (the hull's interior also holds a few
+    # voxels near the head's own base that the tip hardly reaches, which the boundary leaves out); none is kept that
+    # no sample comes near: a point x of a tetrahedron (vertices v_i, samples) whose circumsphere (centre c,
+    # radius rho <= alpha) holds it is within rho of a vertex, since x - c = sum l_i (v_i - c) with l_i >= 0 summing
+    # to 1 gives (x - c).(v_i - c) >= |x - c|^2 for some i, so |x - v_i|^2 <= rho^2 - |x - c|^2.
+    from scipy.spatial import cKDTree
+
+    from snakehead import _core
+
+    kw = dict(voxel=0.05, directions=1, rolls=1, cloud_samples=20000, seed=2, timeout=1e-4)
+    boundary = ws.compute(robot, progress=False, **kw)
+    convex = ws.compute(robot, progress=False, hull="convex", **kw)
+    assert boundary.params["hull"] == "boundary" and convex.params["hull"] == "convex"
+    assert set(boundary.voxel_ids) < set(convex.voxel_ids) and len(boundary) > 0.6 * len(convex)
+    cloud = _core.sample_tip_positions(robot.head_chain.model, kw["cloud_samples"], kw["seed"])
+    hull = _core.convex_hull(cloud)
+    depth = -(convex.centers @ hull["normals"].T + hull["offsets"]).max(axis=1)  # distance inside the hull
+    tree = cKDTree(cloud)
+    dense = np.array([len(near) >= 10 for near in tree.query_ball_point(convex.centers, kw["voxel"])])
+    deep = convex.voxel_ids[(depth >= 0.1) & dense]
+    assert len(deep) > 1000 and set(deep) <= set(boundary.voxel_ids)
+    alpha = boundary.stats["alpha"]
+    assert 0 < alpha < 0.2 and convex.stats["alpha"] == np.inf
+    gap = tree.query(convex.centers)[0]
+    lonely = convex.voxel_ids[gap > alpha]
+    assert len(lonely) > 0 and not set(lonely) & set(boundary.voxel_ids)
+    # MATLAB's shrink factor: 1 is the tightest one-region boundary, 0 the hull of all tetrahedra.
+    tight = _core.boundary(cloud, 1.0)
+    loose = _core.boundary(cloud, 0.0)
+    assert tight["regions"] == 1 and tight["alpha"] == tight["critical_alpha"] <= alpha <= loose["alpha"]
+    assert tight["volume"] < _core.boundary(cloud, 0.5)["volume"] < loose["volume"] <= hull["volume"] + 1e-9
 
 
 def test_load_rejects_foreign_files(tmp_path):
@@ -212,6 +296,7 @@ def test_load_rejects_foreign_files(tmp_path):
     ({"directions": 0}, "directions"), ({"rolls": 0}, "rolls"), ({"timeout": 0.0}, "timeout"),
     ({"approach_axis": "y"}, "approach"), ({"shard": (3, 3)}, "shard"), ({"shard": "a/b"}, "shard"),
     ({"directions": 2.5}, "directions"), ({"seed": -1}, "seed"), ({"threads": -1}, "threads"),
+    ({"hull": "concave"}, "hull"), ({"shrink": 1.5}, "shrink"), ({"shrink": "half"}, "shrink"),
 ])
 def test_bad_arguments_are_value_errors(robot, kw, match):
     with pytest.raises(ValueError, match=match):
@@ -236,6 +321,7 @@ def test_bad_chain_and_output(robot, small, tmp_path):
     ({"voxel": 0}, "voxel size"), ({"voxel": -1}, "voxel size"), ({"directions": 0}, "directions"),
     ({"tip": "no_such_link"}, "no_such_link"), ({"base": "nope"}, "nope"), ({"shard": "2/2"}, "shard"),
     ({"approach_axis": "q"}, "approach"), ({"voxel": "abc"}, "expects a number"), ({"bogus": 1}, "unknown argument"),
+    ({"hull": "concave"}, "hull"), ({"shrink": 2}, "shrink"), ({"hull": "convex", "shrink": 0.3}, "--shrink"),
 ])
 def test_workspace_gen_bad_arguments_exit_nonzero(robot, tmp_path, kw, message):
     out = tmp_path / "m.npz"
@@ -314,11 +400,21 @@ def test_shipped_maps(robot_file):
     m = ws.map_for(robot)
     assert m.path == path
     assert m.chain_hash == robot.head_chain.hash
-    assert m.params["voxel_size"] == 0.05 and m.params["directions"] == 20 and m.params["rolls"] == 4
+    assert m.params["voxel_size"] == 0.05 and m.params["directions"] == 20 and m.params["rolls"] == 10
+    assert m.params["hull"] == "boundary" and m.params["shrink"] == 0.5 and m.lacks == ()
     assert m.command.startswith("workspace_gen ") and "--voxel 0.05" in m.command
     assert len(m) == m.hull_voxels > 1000 and m.indices.max() <= 100
     readme = (default_robot_file().with_name("README.md")).read_text()
     assert m.command in readme
+
+
+def test_shipped_poses_map(robot):
+    path = default_robot_file().with_name("snake16_head7_poses.npz")
+    assert path.stat().st_size < 1_000_000
+    m = ws.load(path)
+    assert m.chain_hash == robot.head_chain.hash and m.params["free_roll"] and m.params["directions"] == 60
+    assert m.voxel_ids.tolist() == ws.map_for(robot).voxel_ids.tolist()  # the same boundary
+    assert m.command in (default_robot_file().with_name("README.md")).read_text()
 
 
 def test_shipped_head_map_g0(robot):

@@ -3,10 +3,14 @@
 //   workspace_gen --urdf snake16.urdf --base neck_end --tip head_tip --voxel 0.05 --directions 20
 //       --rolls 4 --out map.npz
 //
-// Exit status: 0 on success, 2 for bad arguments (nothing is computed), 1 when the run fails.
+// Exit status: 0 on success; 2 for bad arguments or a bad robot description (nothing is written); 1 when
+// the run fails (e.g. the map cannot be written: any old file at --out is left as it was). Errors are one
+// line on stderr.
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +20,7 @@
 #include <thread>
 
 #include "snakehead/model.hpp"
+#include "snakehead/npz.hpp"
 #include "snakehead/workspace.hpp"
 
 namespace {
@@ -23,9 +28,10 @@ namespace {
 const char* kUsage = R"(usage: workspace_gen --urdf FILE --base LINK --tip LINK --out MAP.npz [options]
 
 Computes the reachability map of the chain BASE -> TIP (Algorithm 1 of the paper): voxels of the
-cube of side 2 * reach centred on BASE that lie inside the hull of random tip positions get the
+cube of side 2 * reach centred on BASE that lie inside the boundary of random tip positions get the
 index D = 100 * (points reached by TRAC-IK) / (points tried) over points spread on their inscribed
 sphere (a point is reached when one of its rolled frames is solved; --each-roll counts frames).
+The map keeps which points (or frames) were reached.
 
 required:
   --urdf FILE            the robot description
@@ -43,6 +49,9 @@ options:
   --timeout S            IK budget per call in seconds (default 0.0003)
   --epsilon E            IK tolerance (default 1e-5)
   --cloud-samples N      random configurations for the hull (default 50000)
+  --hull boundary|convex the voxels inside the cloud's boundary (the paper's boundary(P): an alpha
+                         shape chosen as MATLAB's boundary() does; default) or its convex hull
+  --shrink S             the boundary's shrink factor in [0, 1] (default 0.5, MATLAB's default)
   --seed N               random seed (default 1); the map is a function of the seed
   --threads N            worker threads (default: all cores); does not change the map
   --shard i/N            compute only shard i of N (0 <= i < N); merge the N files afterwards
@@ -86,21 +95,35 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-// Fails early (before a long sweep) when the output cannot be created; leaves no file behind.
+// Fails early (before a long sweep) when the output cannot be written; leaves no file behind.
 void check_writable(const std::string& path) {
-  const bool existed = access(path.c_str(), F_OK) == 0;
-  std::FILE* f = std::fopen(path.c_str(), "ab");
-  if (!f) throw UsageError("cannot write the output '" + path + "': " + std::strerror(errno));
-  std::fclose(f);
-  if (!existed) std::remove(path.c_str());
+  try {
+    snakehead::check_output_path(path);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("the output: ") + e.what());
+  }
+}
+
+// A progress line on a terminal has no newline yet; an error message must start on a line of its own.
+bool progress_line_open = false;
+
+void report(const char* kind, const std::string& what) {
+  std::string text = what;
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';  // one line, whatever the message holds
+  std::cerr << (progress_line_open ? "\n" : "") << "workspace_gen: " << kind << ": " << text << "\n";
+  progress_line_open = false;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A write beyond the file-size limit (ulimit -f) then fails with EFBIG and is reported (the old map is
+  // kept), instead of killing the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   std::string urdf, base, tip, out, command;
   snakehead::WorkspaceOptions opt;
-  bool quiet = false, rolls_given = false;
+  bool quiet = false, rolls_given = false, shrink_given = false;
   for (int k = 0; k < argc; ++k) command += (k ? " " : "") + shell_quote(k ? argv[k] : "workspace_gen");
   try {
     for (int k = 1; k < argc; ++k) {
@@ -139,6 +162,11 @@ int main(int argc, char** argv) {
         opt.epsilon = parse_double(a, value());
       } else if (a == "--cloud-samples") {
         opt.cloud_samples = parse_count(a, value());
+      } else if (a == "--hull") {
+        opt.hull = snakehead::parse_hull_kind(value());
+      } else if (a == "--shrink") {
+        opt.shrink = parse_double(a, value());
+        shrink_given = true;
       } else if (a == "--seed") {
         const long long s = parse_int(a, value());
         if (s < 0) throw UsageError("--seed must be >= 0");
@@ -161,10 +189,12 @@ int main(int argc, char** argv) {
       throw UsageError("--urdf, --base, --tip and --out are required (see --help)");
     if (opt.free_roll && (rolls_given || !opt.any_roll))
       throw UsageError("--free-roll leaves the roll free: it takes neither --rolls nor --each-roll");
+    if (shrink_given && opt.hull == snakehead::HullKind::Convex)
+      throw UsageError("--shrink sets the boundary's shrink factor: it does not go with --hull convex");
     opt.validate();
     check_writable(out);
   } catch (const std::exception& e) {
-    std::cerr << "workspace_gen: error: " << e.what() << "\n";
+    report("error", e.what());
     return 2;
   }
 
@@ -187,11 +217,18 @@ int main(int argc, char** argv) {
                                                 " s left").c_str()
                                              : "");
       std::cerr << (tty ? "\r" : "") << line << (tty ? "\x1b[K" : "\n") << std::flush;
+      progress_line_open = tty;
       return true;
     };
     const snakehead::ReachabilityMap map = snakehead::compute_reachability(model, opt, progress);
-    if (!quiet && tty) std::cerr << "\n";
-    snakehead::save_npz(map, out, command);
+    if (progress_line_open) std::cerr << "\n";
+    progress_line_open = false;
+    try {
+      snakehead::save_npz(map, out, command);
+    } catch (const std::exception& e) {  // the output was checked before the sweep: this is a failed run
+      report("failed", e.what());
+      return 1;
+    }
     if (!quiet) {
       const Eigen::VectorXd d = map.indices();
       std::fprintf(stderr,
@@ -202,10 +239,10 @@ int main(int argc, char** argv) {
                    map.threads_used, d.size() ? d.mean() : 0.0, out.c_str());
     }
   } catch (const snakehead::InputError& e) {
-    std::cerr << "\nworkspace_gen: error: " << e.what() << "\n";
+    report("error", e.what());  // bad input (the robot, an option the grid or the chain rejects)
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "\nworkspace_gen: failed: " << e.what() << "\n";
+    report("failed", e.what());  // e.g. the map could not be written (disk full); any old map is intact
     return 1;
   }
   return 0;

@@ -63,7 +63,10 @@ std::string urdf_root_link(const std::string& urdf);
 
 class ChainModel {
  public:
-  // `urdf` is either an XML document (its first non-blank character is '<') or a file path.
+  // `urdf` is either an XML document (its first non-blank character is '<') or a file path. The text is
+  // checked (urdf_input.hpp) before urdfdom parses it; malformed numbers anywhere, and invalid inertial or
+  // collision data of the chain's links (negative mass, an inertia that is not positive semidefinite, a box
+  // of size <= 0), are InputErrors naming the link and the element.
   static ChainModel from_urdf(const std::string& urdf, const std::string& base, const std::string& tip);
   static ChainModel from_urdf_string(const std::string& xml, const std::string& base, const std::string& tip);
   static ChainModel from_urdf_file(const std::string& path, const std::string& base, const std::string& tip);
@@ -84,8 +87,14 @@ class ChainModel {
   // Sum of the distances between consecutive joint axes' origins and to the tip: the chain's reach bound (m).
   double reach() const { return reach_; }
   // A hex digest of everything kinematic (joint types, frames, axes, limits): two models with
-  // the same hash have the same kinematics.
+  // the same hash have the same kinematics. Reachability maps record it (they depend on nothing else).
   const std::string& hash() const { return hash_; }
+  // A hex digest of the links' bodies (masses, centres of mass, inertias, collision boxes): with hash(),
+  // everything the model holds.
+  const std::string& body_hash() const { return body_hash_; }
+  // The sum of the link masses on the chain (kg). It may be 0 (a URDF without <inertial>): a caller that
+  // needs a centre of mass must check for that.
+  double total_mass() const { return total_mass_; }
 
   // Throws InputError unless q has n_joints finite entries.
   void check_configuration(const Eigen::Ref<const Eigen::VectorXd>& q, const char* what = "q") const;
@@ -99,7 +108,8 @@ class ChainModel {
   std::vector<SegmentGeometry> segments_;
   KDL::Chain chain_;
   double reach_ = 0.0;
-  std::string hash_;
+  double total_mass_ = 0.0;
+  std::string hash_, body_hash_;
 };
 
 }  // namespace snakehead

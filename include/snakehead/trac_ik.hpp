@@ -26,7 +26,8 @@
 // seed alone (no call counter), and the search is bounded by a budget of kinematics evaluations derived
 // from the timeout (kEvaluationsPerSecond in trac_ik.cpp) instead of the clock. A hard wall-clock guard of
 // max(10 x timeout, timeout + 50 ms) still applies so that no call can hang; it can only cut a seeded search
-// on a machine (or a sanitizer build) ten times slower than the nominal rate, and then results may differ.
+// on a machine ten times slower than the nominal rate, and then results may differ. (A sanitizer build,
+// tens of times slower, has a guard of 1000 x timeout.)
 #pragma once
 
 #include "snakehead/model.hpp"

@@ -1,22 +1,26 @@
 // Reachability maps: the paper's Algorithm 1 (Section 2.2), multithreaded over voxels.
 //
-// 1. Sample random configurations; their tip positions form a point cloud; take its convex hull.
+// 1. Sample random configurations; their tip positions form a point cloud; take its boundary: the
+//    paper's boundary(P), an alpha shape chosen as MATLAB's boundary() chooses it (alpha_shape.hpp),
+//    or its convex hull.
 // 2. A cubic grid of side 2 * reach centred on the chain's base frame; keep the voxels whose centre
-//    lies inside the hull.
+//    lies inside the boundary (or hull).
 // 3. For each kept voxel, N directions spread evenly on its inscribed sphere (a Fibonacci lattice);
 //    at each point a frame whose approach axis (the tip's x- or z-axis) runs from the sphere's centre
 //    to the point, rolled evenly R times about that axis (or with the roll left free: one IK call
 //    with the roll tolerance open); the reachability index D = 100 * solved / tried, where a point
 //    counts as solved when any of its frames is (the paper's rule; or each frame counts on its own).
+//    The map keeps which of them were solved (a bit per direction, or per frame), so that it can answer
+//    whether a pose is reachable, not only how reachable a voxel is.
 //
 // Unreachable poses dominate the cost (each spends the whole IK budget), so poses that distance
-// bounds prove unreachable get no IK call (ReachBound), and the voxels are swept in runs of
-// neighbours along a grid line, each pose's IK starting from the neighbouring voxel's solution of
-// the same pose when there is one (a forward and a backward pass): reachable poses are then found
-// within a short budget.
+// bounds prove unreachable get no IK call (ReachBound); a direction's rolled frames are first tested
+// together by one IK call with the roll left free; and the voxels are swept in tiles, inside out, each
+// pose's IK starting from a neighbouring voxel's solution when there is one, and getting a short
+// budget where the neighbours found the direction unreachable (compute_reachability).
 //
 // Results are deterministic for a given seed whatever the thread count: every voxel draws its
-// random numbers from its own stream (derived from the seed and the voxel's grid index), and a run
+// random numbers from its own stream (derived from the seed and the voxel's grid index), and a tile
 // is solved in a fixed order by one thread, each by a seeded TRAC-IK call (a pure function of
 // its inputs whose search is bounded by an evaluation budget derived from the timeout, not the clock).
 #pragma once
@@ -41,6 +45,13 @@ enum class ApproachAxis { X, Z };
 ApproachAxis parse_approach_axis(const std::string& s);  // "x" | "z"; throws InputError
 const char* approach_axis_name(ApproachAxis a);
 
+// Which voxels Algorithm 1 evaluates: those inside boundary(P) (the paper's line 6; an alpha shape)
+// or inside the convex hull of the cloud (this project's first releases).
+enum class HullKind { Boundary, Convex };
+
+HullKind parse_hull_kind(const std::string& s);  // "boundary" | "convex"; throws InputError
+const char* hull_kind_name(HullKind h);
+
 struct WorkspaceOptions {
   double voxel_size = 0.05;      // m, edge of the cubic voxels (> 0)
   int directions = 20;           // points on each voxel's inscribed sphere (>= 1)
@@ -54,6 +65,8 @@ struct WorkspaceOptions {
   double timeout = 0.0003;       // s per IK call (> 0); seeded TRAC-IK turns it into an evaluation budget
   double epsilon = 1e-5;         // IK tolerance on the pose error (> 0)
   int cloud_samples = 50000;     // random configurations for the hull (>= 100)
+  HullKind hull = HullKind::Boundary;
+  double shrink = 0.5;           // the boundary's shrink factor S in [0, 1] (MATLAB's default 0.5)
   std::uint64_t seed = 1;
   int threads = 0;               // worker threads; 0 = hardware concurrency
   int shard_index = 0;           // this run processes the in-hull voxels k with k % shard_count == shard_index
@@ -63,6 +76,8 @@ struct WorkspaceOptions {
   void validate() const;
   // What the index counts per voxel ("tried"): points, or (point, roll) frames when !any_roll.
   int poses_per_voxel() const { return free_roll || any_roll ? directions : directions * rolls; }
+  // The shrink factor that defines the map: S for a boundary, 0 for the convex hull (MATLAB's S = 0).
+  double map_shrink() const { return hull == HullKind::Convex ? 0.0 : shrink; }
 };
 
 // A cubic grid of n x n x n voxels; voxel (i, j, l) has linear index (i * n + j) * n + l and its
@@ -137,13 +152,26 @@ class ReachBound {
 class PoseSolver {
  public:
   virtual ~PoseSolver() = default;
+  // `budget` is the share of the options' timeout this call may spend (1 = all of it): the sweep gives
+  // calls that start next to a solution (a neighbour's, or the same point's at another roll) less.
   virtual bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, std::uint64_t call_seed,
-                     Eigen::VectorXd& q_out) = 0;
+                     double budget, Eigen::VectorXd& q_out) = 0;
+  // The same with the roll about the approach axis left free (the sweep's test of a direction).
+  // By default the fixed-roll solve: right for a stand-in whose answer does not depend on the roll.
+  virtual bool solve_free_roll(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init,
+                               std::uint64_t call_seed, double budget, Eigen::VectorXd& q_out) {
+    return solve(target, q_init, call_seed, budget, q_out);
+  }
 };
 using PoseSolverFactory = std::function<std::unique_ptr<PoseSolver>(const ChainModel&, const WorkspaceOptions&)>;
 
 // The project's TRAC-IK with the options' timeout and epsilon, the roll tolerance open when free_roll.
 PoseSolverFactory trac_ik_solver_factory();
+
+// Which poses of each voxel were solved: `bytes_per_voxel` bytes per voxel, bit u of voxel v in byte
+// v * bytes_per_voxel + u / 8 at bit u % 8 (numpy.unpackbits(..., bitorder="little")). Unit u is
+// direction u (any roll, free roll) or frame u = direction * rolls + roll (each roll counted).
+inline int reached_bytes_per_voxel(int units) { return (units + 7) / 8; }
 
 // A computed map (or one shard of it): the in-hull voxels this run evaluated, ascending by grid index.
 struct ReachabilityMap {
@@ -154,9 +182,11 @@ struct ReachabilityMap {
   std::vector<std::int64_t> voxel_ids;                                // grid linear indices
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> centres;  // m, chain base frame
   std::vector<std::int32_t> solved;                                   // poses solved per voxel
+  std::vector<std::uint8_t> reached;  // which poses: see reached_bytes_per_voxel (may be empty: unknown)
   int tried = 0;                                                      // poses per voxel
   std::int64_t hull_voxels = 0;  // in-hull voxels of the whole map (all shards)
-  int hull_facets = 0;
+  int hull_facets = 0;           // of the convex hull, or triangles of the boundary's surface
+  double alpha = 0.0;            // m, the boundary's alpha radius (infinity for the convex hull)
   // Statistics of this run (not part of the map's identity).
   std::int64_t ik_calls = 0, cheap_exits = 0;  // IK calls / frames rejected by a reach bound
   double seconds = 0.0;
@@ -175,11 +205,13 @@ class Cancelled : public std::runtime_error {
 };
 
 // Lines 9-21 of Algorithm 1 for voxels (spheres of diameter options.voxel_size) at any centres, each
-// on its own (random initial guesses only; no runs of neighbours): solved[k] of
-// options.poses_per_voxel() poses. Voxel k draws from the random stream
+// on its own and as the algorithm states it (every frame from a random initial guess with the full
+// budget; no neighbours, no free-roll test): solved[k] of options.poses_per_voxel() poses. The
+// independent reference the sweep is checked against. Voxel k draws from the random stream
 // stream_ids[k] (the grid index in a map). `factory` defaults to TRAC-IK.
 struct VoxelEvaluation {
   std::vector<std::int32_t> solved;
+  std::vector<std::uint8_t> reached;  // bits as in ReachabilityMap
   int tried = 0;
   std::int64_t ik_calls = 0, cheap_exits = 0;
   double seconds = 0.0;
@@ -190,8 +222,8 @@ VoxelEvaluation evaluate_voxels(const ChainModel& model, const WorkspaceOptions&
                                 const std::vector<std::uint64_t>& stream_ids, const ProgressCallback& progress = nullptr,
                                 const PoseSolverFactory& factory = nullptr);
 
-// Algorithm 1 over the voxels of options' shard (runs of neighbours along z, shard i of N taking
-// every N-th run). `factory` defaults to TRAC-IK.
+// Algorithm 1 over the voxels of options' shard (tiles of neighbours, shard i of N taking every N-th
+// tile). `factory` defaults to TRAC-IK.
 ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOptions& options,
                                      const ProgressCallback& progress = nullptr,
                                      const PoseSolverFactory& factory = nullptr);
@@ -199,8 +231,11 @@ ReachabilityMap compute_reachability(const ChainModel& model, const WorkspaceOpt
 // Exact union of the shards 0..N-1 of one map; throws InputError when they do not belong together.
 ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards);
 
-// Writes the map as an uncompressed .npz that numpy.load reads (keys in python/snakehead/workspace.py).
-// `command` records how the map was made. Throws InputError when the file cannot be written.
+// The one writer of map files (workspace_gen and Python's save both use it): an uncompressed .npz that
+// numpy.load reads (keys listed in python/snakehead/workspace.py). `command` records how the map was
+// made. Statistics that are not known (a map assembled elsewhere) are written as -1 (seconds: NaN).
+// Throws InputError when the map is inconsistent or the file cannot be written.
 void save_npz(const ReachabilityMap& map, const std::string& path, const std::string& command);
+inline constexpr const char* kMapFormat = "snakehead-reachability-2";
 
 }  // namespace snakehead

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, IO, Iterator
 
@@ -27,8 +26,9 @@ def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs: Any) -> Iter
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
     target = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=target.parent if str(target.parent) else ".", prefix=f".{target.name}.",
-                               suffix=".part")
+    if target.exists() and not target.is_file():  # the rename would replace a device, a FIFO, ...
+        raise OSError(f"{str(target)!r} exists and is not a regular file")
+    fd, tmp = _create_beside(target)
     try:
         with os.fdopen(fd, mode, **kwargs) as f:
             yield f
@@ -40,6 +40,19 @@ def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs: Any) -> Iter
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def _create_beside(target: Path) -> tuple[int, str]:
+    """A new file in ``target``'s folder, made by this call (O_EXCL), with the permissions a plain ``open`` would
+    give (0o666 less the umask; tempfile.mkstemp's 0o600 would end up on the destination)."""
+    folder = target.parent if str(target.parent) else Path(".")
+    for _ in range(100):
+        tmp = str(folder / f".{target.name}.{os.urandom(6).hex()}.part")
+        try:
+            return os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary name beside {str(target)!r}")
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> Path:

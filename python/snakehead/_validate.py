@@ -42,6 +42,25 @@ def unit_vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     return a / norm
 
 
+def position_direction_pairs(positions: npt.ArrayLike, directions: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Poses given as positions and directions, (3,) or (K, 3) each: (K, 3) positions, (K, 3) unit directions and
+    whether one pose was given. ValueError for wrong shapes, NaN or inf, unequal counts or a zero direction."""
+    p = finite_array(positions, "positions")
+    d = finite_array(directions, "directions")
+    single = p.ndim == 1 and d.ndim == 1
+    p, d = np.atleast_2d(p), np.atleast_2d(d)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"positions must have shape (3,) or (K, 3), got {np.shape(positions)}")
+    if d.ndim != 2 or d.shape[1] != 3:
+        raise ValueError(f"directions must have shape (3,) or (K, 3), got {np.shape(directions)}")
+    if len(p) != len(d):
+        raise ValueError(f"{len(p)} positions but {len(d)} directions; give one direction per position")
+    norm = np.linalg.norm(d, axis=1)
+    if np.any(norm < 1e-12):
+        raise ValueError(f"directions must be non-zero; direction {int(np.argmin(norm))} has zero length")
+    return p, d / norm[:, None], single
+
+
 def pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
     """A 4x4 homogeneous transform with an orthonormal, right-handed rotation."""
     a = finite_array(T, name, (4, 4))

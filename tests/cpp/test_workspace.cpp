@@ -5,10 +5,13 @@
 #include <atomic>
 #include <cstdio>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
 
+#include "snakehead/alpha_shape.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/npz.hpp"
 #include "snakehead/workspace.hpp"
@@ -39,7 +42,7 @@ WorkspaceOptions coarse() {
 // A stand-in solver with a known answer: a pose is "reachable" when its position's z >= 0. Counts calls.
 struct HalfSpaceSolver : PoseSolver {
   explicit HalfSpaceSolver(std::atomic<long>* calls) : calls(calls) {}
-  bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd&, std::uint64_t, Eigen::VectorXd&) override {
+  bool solve(const Eigen::Isometry3d& target, const Eigen::VectorXd&, std::uint64_t, double, Eigen::VectorXd&) override {
     ++*calls;
     return target.translation().z() >= 0.0;
   }
@@ -193,45 +196,120 @@ TEST(Sweep, VoxelBeyondReachHasIndexZeroWithoutIK) {
   EXPECT_EQ(t.ik_calls, 0);
 }
 
+// A stand-in that records every call: which pose, with the roll free or not, and the answer.
+struct RecordingSolver : PoseSolver {
+  struct Call {
+    Eigen::Isometry3d target;
+    bool free_roll, solved;
+  };
+  explicit RecordingSolver(std::vector<Call>* calls, std::mutex* m) : calls(calls), m(m) {}
+  bool solve(const Eigen::Isometry3d& t, const Eigen::VectorXd&, std::uint64_t, double, Eigen::VectorXd&) override {
+    return record(t, false);
+  }
+  bool solve_free_roll(const Eigen::Isometry3d& t, const Eigen::VectorXd&, std::uint64_t, double,
+                       Eigen::VectorXd&) override {
+    return record(t, true);
+  }
+  bool record(const Eigen::Isometry3d& t, bool free) {
+    const bool ok = t.translation().z() >= 0.0;
+    std::lock_guard<std::mutex> lock(*m);
+    calls->push_back({t, free, ok});
+    return ok;
+  }
+  std::vector<Call>* calls;
+  std::mutex* m;
+};
+
 TEST(Sweep, PlumbingAgainstAKnownSolver) {
-  // With the half-space stand-in, each voxel's count is the number of its sphere points with z >= 0
-  // (times the rolls) among those the reach bounds let through: an independent count.
+  // With the half-space stand-in (a pose is reachable when its point has z >= 0, whatever its roll),
+  // each voxel's count is the number of its (direction, roll) frames that the reach bounds let
+  // through and whose point has z >= 0: an independent count. And the calls follow the sweep's
+  // rules: none on a frame the bounds reject; at most one free-roll call per (voxel, direction); a
+  // fixed-roll call fails only when it starts from a neighbouring voxel that solved the same frame.
   const ChainModel& m = head7();
   WorkspaceOptions o = coarse();
   o.directions = 9;
   o.any_roll = false;  // every (direction, roll) frame counts
-  std::atomic<long> calls{0};
-  const ReachabilityMap map = compute_reachability(m, o, nullptr, half_space(&calls));
+  std::vector<RecordingSolver::Call> calls;
+  std::mutex mutex;
+  const ReachabilityMap map = compute_reachability(m, o, nullptr, [&](const ChainModel&, const WorkspaceOptions&) {
+    return std::make_unique<RecordingSolver>(&calls, &mutex);
+  });
   EXPECT_EQ(map.tried, 18);
   ASSERT_GT(map.voxel_ids.size(), 10u);
   const auto dirs = fibonacci_directions(o.directions);
   const ReachBound bound(m, o);
-  // Calls: one per pose the bounds let through, plus a second chance for each failed pose whose
-  // neighbour in +z (the next voxel of its run) solved the same pose.
-  auto pose_ok = [&](std::int64_t k, const Eigen::Vector3d& d, int r, bool& possible) {
-    const Eigen::Vector3d p = map.grid.centre_of(k) + 0.5 * o.voxel_size * d;
-    possible = bound.possible(approach_frame(p, d, 2 * M_PI * r / o.rolls, o.approach));
-    return possible && p.z() >= 0;
+  const double radius = 0.5 * o.voxel_size;
+  std::map<std::int64_t, std::size_t> row_of;
+  for (std::size_t v = 0; v < map.voxel_ids.size(); ++v) row_of[map.voxel_ids[v]] = v;
+  // Which voxel, direction and roll a call was about.
+  auto locate = [&](const Eigen::Isometry3d& t, std::int64_t& k, int& di, int& r) {
+    double best = 1e9;
+    for (int d = 0; d < o.directions; ++d) {
+      const Eigen::Vector3d c = t.translation() - radius * dirs[d];
+      const Eigen::Vector3d ijk = ((c - map.grid.origin) / o.voxel_size).array() - 0.5;
+      const Eigen::Vector3d rounded = ijk.array().round();
+      const double err = (ijk - rounded).norm() + (t.linear().col(0) - dirs[d]).norm();
+      if (err < best) {
+        best = err;
+        di = d;
+        k = (static_cast<std::int64_t>(rounded.x()) * map.grid.n + static_cast<std::int64_t>(rounded.y())) * map.grid.n +
+            static_cast<std::int64_t>(rounded.z());
+      }
+    }
+    r = -1;
+    for (int q = 0; q < o.rolls; ++q) {
+      const Eigen::Isometry3d f = approach_frame(t.translation(), dirs[di], 2 * M_PI * q / o.rolls, o.approach);
+      if ((f.linear() - t.linear()).norm() < 1e-9) r = q;
+    }
+    return best < 1e-6;
   };
-  const std::set<std::int64_t> ids(map.voxel_ids.begin(), map.voxel_ids.end());
-  long expected_calls = 0;
+  auto bit = [&](std::int64_t k, int unit) {
+    const auto it = row_of.find(k);
+    if (it == row_of.end()) return false;
+    return ((map.reached[it->second * reached_bytes_per_voxel(map.tried) + unit / 8] >> (unit % 8)) & 1) != 0;
+  };
+  std::set<std::pair<std::int64_t, int>> free_calls;
+  for (const auto& call : calls) {
+    std::int64_t k = 0;
+    int di = 0, r = 0;
+    ASSERT_TRUE(locate(call.target, k, di, r)) << "a call for a pose that is no voxel's";
+    ASSERT_TRUE(row_of.count(k));
+    const Eigen::Vector3d p = call.target.translation();
+    if (call.free_roll) {
+      EXPECT_TRUE(bound.possible_any_roll(p, dirs[di]));
+      EXPECT_TRUE(free_calls.emplace(k, di).second) << "two free-roll calls for one direction of a voxel";
+      continue;
+    }
+    ASSERT_GE(r, 0);
+    EXPECT_TRUE(bound.possible(call.target)) << "an IK call for a frame the reach bounds reject";
+    if (!call.solved) {
+      const int unit = di * o.rolls + r;
+      const std::int64_t n = map.grid.n;
+      bool neighbour_solved = false;
+      for (std::int64_t di3 = -1; di3 <= 1; ++di3)
+        for (std::int64_t dj = -1; dj <= 1; ++dj)
+          for (std::int64_t dl = -1; dl <= 1; ++dl)
+            if (di3 || dj || dl) neighbour_solved |= bit(k + (di3 * n + dj) * n + dl, unit);
+      EXPECT_TRUE(neighbour_solved) << "a failed fixed-roll call not started from a neighbour";
+    }
+  }
   for (std::size_t v = 0; v < map.voxel_ids.size(); ++v) {
     const std::int64_t k = map.voxel_ids[v];
     EXPECT_LT((map.grid.centre_of(k) - map.centres.row(v).transpose()).norm(), 1e-15);
-    const bool has_next = (k + 1) % map.grid.n != 0 && ids.count(k + 1);
-    int expected = 0;
-    for (const auto& d : dirs)
+    int expected = 0, bits = 0;
+    for (int di = 0; di < o.directions; ++di)
       for (int r = 0; r < o.rolls; ++r) {
-        bool possible = false, next_possible = false;
-        const bool ok = pose_ok(k, d, r, possible);
+        const Eigen::Vector3d p = map.grid.centre_of(k) + radius * dirs[di];
+        const bool ok = p.z() >= 0 && bound.possible(approach_frame(p, dirs[di], 2 * M_PI * r / o.rolls, o.approach));
         expected += ok;
-        expected_calls += possible;
-        if (possible && !ok && has_next && pose_ok(k + 1, d, r, next_possible)) ++expected_calls;
+        EXPECT_EQ(bit(k, di * o.rolls + r), ok);
+        bits += bit(k, di * o.rolls + r);
       }
     EXPECT_EQ(map.solved[v], expected);
+    EXPECT_EQ(bits, map.solved[v]);
   }
-  EXPECT_EQ(calls.load(), expected_calls);
-  EXPECT_EQ(map.ik_calls, expected_calls);
+  EXPECT_EQ(map.ik_calls, static_cast<std::int64_t>(calls.size()));
   const Eigen::VectorXd d = map.indices();
   EXPECT_GE(d.minCoeff(), 0.0);
   EXPECT_LE(d.maxCoeff(), 100.0);
@@ -296,6 +374,7 @@ TEST(Sweep, ShardsMergeExactly) {
   EXPECT_EQ(merged.voxel_ids, whole.voxel_ids);
   EXPECT_EQ(merged.solved, whole.solved);
   EXPECT_EQ(merged.centres, whole.centres);
+  EXPECT_EQ(merged.reached, whole.reached);
   EXPECT_EQ(merged.options.shard_count, 1);
   EXPECT_THROW(merge_shards({shards[0], shards[1]}), InputError);             // one missing
   EXPECT_THROW(merge_shards({shards[0], shards[1], shards[1]}), InputError);  // one twice
@@ -304,6 +383,60 @@ TEST(Sweep, ShardsMergeExactly) {
   other.shard_index = 2;
   other.shard_count = 3;
   EXPECT_THROW(merge_shards({shards[0], shards[1], compute_reachability(m, other)}), InputError);
+}
+
+TEST(Sweep, VoxelsInsideTheBoundaryOrTheConvexHull) {
+  // The map's voxels are exactly the grid voxels whose centre lies inside the chosen hull of the
+  // seed's cloud; the boundary's voxels are among the convex hull's, and fewer.
+  const ChainModel& m = head7();
+  WorkspaceOptions o = coarse();
+  o.voxel_size = 0.1;
+  std::atomic<long> calls{0};
+  o.hull = HullKind::Convex;
+  const ReachabilityMap convex = compute_reachability(m, o, nullptr, half_space(&calls));
+  o.hull = HullKind::Boundary;
+  const ReachabilityMap boundary = compute_reachability(m, o, nullptr, half_space(&calls));
+  const auto cloud = sample_tip_positions(m, o.cloud_samples, o.seed);
+  const ConvexHull hull = ConvexHull::of(cloud);
+  const AlphaShape shape = AlphaShape::boundary(cloud, 0.5);
+  std::vector<std::int64_t> in_hull, in_shape;
+  for (std::int64_t k = 0; k < convex.grid.count(); ++k) {
+    if (hull.contains(convex.grid.centre_of(k))) in_hull.push_back(k);
+    if (shape.contains(convex.grid.centre_of(k))) in_shape.push_back(k);
+  }
+  EXPECT_EQ(convex.voxel_ids, in_hull);
+  EXPECT_EQ(boundary.voxel_ids, in_shape);
+  EXPECT_TRUE(std::includes(in_hull.begin(), in_hull.end(), in_shape.begin(), in_shape.end()));
+  EXPECT_LT(in_shape.size(), in_hull.size());
+  EXPECT_GT(in_shape.size(), in_hull.size() / 2);
+  EXPECT_EQ(boundary.alpha, shape.alpha());
+  EXPECT_TRUE(std::isinf(convex.alpha));
+  EXPECT_EQ(boundary.hull_voxels, static_cast<std::int64_t>(in_shape.size()));
+  WorkspaceOptions bad = o;
+  bad.shrink = 1.5;
+  EXPECT_THROW(compute_reachability(m, bad), InputError);
+  EXPECT_EQ(parse_hull_kind("convex"), HullKind::Convex);
+  EXPECT_THROW(parse_hull_kind("concave"), InputError);
+}
+
+TEST(Sweep, ReachedBitsAgreeWithTheCounts) {
+  const ChainModel& m = head7();
+  for (bool any_roll : {true, false}) {
+    WorkspaceOptions o = coarse();
+    o.any_roll = any_roll;
+    const ReachabilityMap map = compute_reachability(m, o);
+    const int bytes = reached_bytes_per_voxel(map.tried);
+    ASSERT_EQ(map.reached.size(), map.voxel_ids.size() * bytes);
+    for (std::size_t v = 0; v < map.voxel_ids.size(); ++v) {
+      int count = 0;
+      for (int u = 0; u < bytes * 8; ++u) {
+        const bool on = (map.reached[v * bytes + u / 8] >> (u % 8)) & 1;
+        if (u >= map.tried) EXPECT_FALSE(on) << "a bit beyond the units";
+        count += on;
+      }
+      EXPECT_EQ(count, map.solved[v]);
+    }
+  }
 }
 
 TEST(Sweep, BadOptionsAreInputErrors) {
@@ -380,6 +513,17 @@ TEST(Npz, SaveMapAndUnwritablePath) {
   EXPECT_GT(bytes.size(), 1000u);
   EXPECT_NE(bytes.find("centers.npy"), std::string::npos);
   EXPECT_NE(bytes.find("chain_hash.npy"), std::string::npos);
+  for (const char* key : {"reached.npy", "sphere_directions.npy", "hull.npy", "shrink.npy", "alpha.npy"})
+    EXPECT_NE(bytes.find(key), std::string::npos) << key;
   std::remove(path.c_str());
   EXPECT_THROW(save_npz(map, "/nonexistent-dir/map.npz", "test"), InputError);
+  // An inconsistent map is refused before anything is written.
+  ReachabilityMap bad = map;
+  bad.reached.pop_back();
+  EXPECT_THROW(save_npz(bad, path, "test"), InputError);
+  bad = map;
+  bad.solved.pop_back();
+  EXPECT_THROW(save_npz(bad, path, "test"), InputError);
+  std::ifstream none(path);
+  EXPECT_FALSE(none.good());
 }

@@ -305,9 +305,7 @@ def _add_planning_options(p: argparse.ArgumentParser) -> None:
                    help="the head's reachability map (default: the robot file's; for a robot without one, a map "
                         "computed on the first run and cached)")
     p.add_argument("--fast", action="store_true",
-                   help=f"quicker run of the same pipeline: joints planned at {FAST['speed']} rad/s instead of "
-                        f"{NORMAL['speed']} with {FAST['min_segment']:g} s segments (shorter motions, so fewer 2 ms "
-                        f"samples to check and simulate) and {FAST['max_frames']}-frame animations")
+                   help=f"quicker outputs: {FAST['max_frames']}-frame animations instead of {NORMAL['max_frames']}")
 
 
 _OUTPUTS = """outputs (in DIR):

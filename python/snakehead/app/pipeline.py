@@ -27,8 +27,8 @@ if TYPE_CHECKING:
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
-FAST = {"speed": 0.24, "min_segment": 1.0, "max_frames": 30}
-NORMAL = {"speed": 0.12, "min_segment": 2.0, "max_frames": 100}
+FAST = {"max_frames": 30}
+NORMAL = {"max_frames": 100}
 
 
 class Progress:
@@ -76,8 +76,8 @@ class Settings:
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
-        return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "speed_rad_s": s["speed"],
-                "min_segment_s": s["min_segment"], "simulation": bool(self.simulate and mujoco_available())}
+        return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "animation_frames": s["max_frames"],
+                "simulation": bool(self.simulate and mujoco_available())}
 
 
 def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
@@ -90,7 +90,7 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
     name = scene.name
     label = scene.description or name
     with progress.stage(f"{name}: planning {label}"):
-        result = plan(scene, controller=controller, speed=s["speed"], min_segment=s["min_segment"])
+        result = plan(scene, controller=controller)
     progress.say(f"{name}: {'success' if result.success else 'NOT successful: ' + str(result.failure)}, "
                  f"{result.duration_s:.1f} s of motion, {len(result.t)} samples; targets: "
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
@@ -156,7 +156,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
 
     s = FAST if settings.fast else NORMAL
     name = scene.name
-    loop = ClosedLoop(scene, controller=controller, speed=s["speed"], min_segment=s["min_segment"])
+    loop = ClosedLoop(scene, controller=controller)
     if isinstance(start, str):
         if start != PAPER_START:
             raise ValueError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
@@ -178,7 +178,8 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
         files.append(rep.write_trajectory_csv(run.plan, out / f"{name}_trajectory.csv", controller.robot.joint_names)
                      .name)
     if settings.figures:
-        files += _loop_figures(scene, run, out, s, progress)
+        if run.phases:  # a loop that failed before its first phase has no path to draw
+            files += _loop_figures(scene, run, out, s, progress)
         if run.plan is not None:
             files += _plan_outputs(scene, run.plan, out, s, progress, solution_figure, controller.map)
             files += _dynamics_figures(scene, run.plan, run.head, out, progress)

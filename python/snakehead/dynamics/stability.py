@@ -5,7 +5,8 @@ Everything is in the world frame (z up, ground at z = 0). Where the base lies is
 body along +x).
 
 * :func:`center_of_mass` -- Eq. 23, for one configuration (16,) or a trajectory (T, 16).
-* :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts.
+* :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts; :func:`support_polygons` the same
+  for every configuration of a trajectory at once.
 * :func:`static_margin`, :func:`is_statically_stable` -- signed distance of the CoM's ground
   projection to the polygon's edge (positive inside).
 * :func:`momenta_from_velocities`, :func:`momenta` -- Eqs. 25-31, linear and angular momentum about the
@@ -407,17 +408,48 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 
-    The polygon is built once per distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's
-    round-off in a still base does not split it): the base joints decide the base's contacts; with
-    contact="ground" also the joints before the last link on the ground (those after it move nothing that
-    touches). ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
+    The polygons are those of :func:`support_polygons`, built once per distinct contact configuration.
+    ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
+    xy = finite_array(xy, "xy", (q.shape[0], 2))
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
+    return polygon_margin_many(pts[inv], active[inv], xy)
+
+
+def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *, contact: str = "endpoints",
+                     tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
+    ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
+
+    Row k holds its polygon's ``count[k]`` vertices counter-clockwise first (the rest is padding): 0 where no link
+    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per
+    distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's round-off in a still base does
+    not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
+    last link on the ground (those after it move nothing that touches). ``frames``: the world frames of ``q``
+    (T, n_links, 4, 4), when the caller has them.
+    """
+    robot = as_robot(robot)
+    base = as_base(base)
+    q, _ = _joint_matrix(robot, q)
+    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
+    hulls = [p[a][hull_indices(p[a])] if a.any() else np.zeros((0, 2)) for p, a in zip(pts, active)]
+    count = np.array([len(h) for h in hulls], int)
+    vertices = np.zeros((len(hulls), max(1, int(count.max())), 2))
+    for k, h in enumerate(hulls):
+        vertices[k, :len(h)] = h
+    return vertices[inv], count[inv]
+
+
+def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
+                    frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct contact configurations of q (T, n): their contact points (U, N, 2) and which touch (U, N), and
+    which of them each sample has (T,). ``frames``: q's world frames when the caller has them."""
     if frames is None or frames.shape != (q.shape[0], len(robot.link_names), 4, 4):
         frames = None
-    xy = finite_array(xy, "xy", (q.shape[0], 2))
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
@@ -437,4 +469,4 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
     sample_frames = robot.frames_many(q[first], base) if frames is None else frames[first]
     pts, active = _contact_points_many(robot, sample_frames, contact, tolerance)
-    return polygon_margin_many(pts[inv], active[inv], xy)
+    return pts, active, inv

@@ -2,7 +2,8 @@
 
 The sweep runs in the C++ core (``workspace.hpp``; also the standalone ``workspace_gen``): random
 configurations give a cloud of tip positions; voxels of a cube of side 2 * reach centred on the chain's
-base that lie inside the cloud's convex hull get the reachability index
+base that lie inside the cloud's boundary (the paper's ``boundary(P)``: an alpha shape chosen from a shrink
+factor as MATLAB's ``boundary`` chooses it, ``alpha_shape.hpp``; or the convex hull) get the reachability index
 
     D = 100 * (points reached) / (points tried)
 
@@ -12,7 +13,12 @@ to the point; the frame is rolled R times about it, and the point is reached whe
 rolled frames (the paper's rule; ``any_roll=False`` counts every frame instead), or with ``free_roll`` one
 IK call leaves the roll free. Everything is in the chain's base frame (for the head, ``neck_end``: B0).
 
-A map file is an ``.npz`` that ``numpy.load`` reads (``allow_pickle=False``); see ``save`` for its keys.
+A map keeps which directions (or frames) of each voxel were reached, so that it answers whether poses are
+reachable (:meth:`ReachabilityMap.reachable`) and where the head's base frame may be for a target
+(:meth:`ReachabilityMap.inverse`; ``map_queries.py``).
+
+A map file is an ``.npz`` that ``numpy.load`` reads (``allow_pickle=False``); see ``save`` for its keys. One
+writer makes them all: the C++ core's (``save_npz``), for ``workspace_gen`` and :func:`save` alike.
 """
 from __future__ import annotations
 
@@ -30,10 +36,13 @@ from ..model.chain import Chain
 
 if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
+    from .map_queries import BaseFrameCandidates
 
 import numpy.typing as npt
 
-FORMAT = "snakehead-reachability-1"
+FORMAT = "snakehead-reachability-2"
+#: Formats :func:`load` reads: the first lacks the per-direction results and the hull's kind (always convex).
+FORMATS = ("snakehead-reachability-1", FORMAT)
 #: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
 TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
 #: How many voxels the dexterous band must hold at least, as a share of the map's voxels (see
@@ -42,7 +51,7 @@ DEXTEROUS_MIN_SHARE = 0.01
 
 # Parameters that define a map (two maps, or shards, with the same values are parts of one computation).
 _PARAMS = ("voxel_size", "directions", "rolls", "any_roll", "free_roll", "approach_axis", "timeout", "epsilon",
-           "cloud_samples", "seed")
+           "cloud_samples", "seed", "hull", "shrink")
 _STATS = ("ik_calls", "cheap_exits", "seconds", "threads")
 
 
@@ -84,8 +93,13 @@ class ReachabilityMap:
     params: dict  # voxel_size, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, ...
     shard: tuple = (0, 1)  # (i, N)
     command: str = ""  # how the map was made
-    stats: dict = field(default_factory=dict)  # ik_calls, cheap_exits, seconds, threads, hull_facets, reach
+    stats: dict = field(default_factory=dict)  # ik_calls, cheap_exits, seconds, threads, hull_facets, reach, alpha
     path: Path | None = None  # the file it was loaded from or saved to, when there is one
+    # (M, ceil(tried / 8)) uint8: which units (directions, or frames) of each voxel were reached, bit u of unit u
+    # (numpy.unpackbits(..., bitorder="little")); None for a map file that predates them.
+    reached: np.ndarray | None = None
+    lacks: tuple = ()  # what an older map file does not hold (e.g. "reached"), said by load
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # --- the index --------------------------------------------------------------------------------
     @property
@@ -108,6 +122,40 @@ class ReachabilityMap:
         counts, _ = np.histogram(self.indices, bins=edges)  # numpy's last bin is closed
         pct = 100.0 * counts / max(len(self), 1)
         return counts, pct
+
+    @property
+    def sphere_directions(self) -> np.ndarray:
+        """(N, 3) the unit directions of every voxel's sphere (the sweep's Fibonacci lattice)."""
+        if "directions" not in self._cache:
+            self._cache["directions"] = fibonacci_directions(int(self.params["directions"]))
+        return self._cache["directions"]
+
+    def reached_units(self) -> np.ndarray:
+        """(M, tried) bool: which units of each voxel were reached (directions, or (direction, roll) frames
+        when every roll counted on its own). ValueError for a map file without them."""
+        if self.reached is None:
+            raise ValueError("this map holds no per-direction results (a map file of the first format); "
+                             "recompute it (workspace_gen or compute) to query poses")
+        return np.unpackbits(self.reached, axis=1, count=self.tried, bitorder="little").astype(bool)
+
+    def reachable(self, positions: npt.ArrayLike, directions: npt.ArrayLike, *,
+                  interpolate: bool = True) -> np.ndarray | bool:
+        """Whether the head's tip can be at each position pointing along each direction (any roll), by the map.
+
+        positions, directions: (3,) or (K, 3) in the map's base frame (directions need not be unit); returns a
+        bool, or (K,) bools. By default the neighbouring voxels and directions are blended
+        (``map_queries.reachability``); ``interpolate=False``: the nearest voxel and direction. See
+        ``map_queries.py``."""
+        from .map_queries import reachable
+
+        return reachable(self, positions, directions, interpolate=interpolate)
+
+    def inverse(self, position: npt.ArrayLike, direction: npt.ArrayLike, **options: Any) -> BaseFrameCandidates:
+        """Candidate poses of the map's base frame (B0) from which the head reaches a target; see
+        ``map_queries.inverse``."""
+        from .map_queries import inverse
+
+        return inverse(self, position, direction, **options)
 
     def index_at(self, points: npt.ArrayLike) -> np.ndarray:
         """Index of the voxel containing each point (0 outside the map's voxels), (k,) for (k, 3) points."""
@@ -224,13 +272,17 @@ class ReachabilityMap:
             and self.grid_shape == other.grid_shape
             and np.array_equal(self.voxel_ids, other.voxel_ids)
             and np.array_equal(self.solved, other.solved)
+            and (self.reached is None) == (other.reached is None)
+            and (self.reached is None or np.array_equal(self.reached, other.reached))
             and np.allclose(self.centers, other.centers, rtol=0, atol=1e-12)
         )
 
     def __repr__(self) -> str:
         s = "" if self.shard == (0, 1) else f", shard {self.shard[0]}/{self.shard[1]}"
-        return (f"ReachabilityMap({self.base!r} -> {self.tip!r}, {len(self)} voxels of {self.voxel_size} m, "
-                f"{self.params['directions']} directions{s}, mean index {self.indices.mean() if len(self) else 0:.1f})")
+        lacks = f", lacks {', '.join(self.lacks)}" if self.lacks else ""
+        return (f"ReachabilityMap({self.base!r} -> {self.tip!r}, {len(self)} voxels of {self.voxel_size} m "
+                f"inside the {self.params.get('hull', 'convex')} hull, {self.params['directions']} directions{s}, "
+                f"mean index {self.indices.mean() if len(self) else 0:.1f}{lacks})")
 
 
 def _param_equal(a: Any, b: Any) -> bool:
@@ -241,8 +293,8 @@ def _param_equal(a: Any, b: Any) -> bool:
 
 # --- computing -------------------------------------------------------------------------------------------
 def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: str,
-             timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any
-             ) -> _core.WorkspaceOptions:
+             timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any,
+             hull: str = "boundary", shrink: float = 0.5) -> _core.WorkspaceOptions:
     o = _core.WorkspaceOptions()
     for name, value in (("directions", directions), ("rolls", rolls), ("cloud_samples", cloud_samples),
                         ("seed", seed)):
@@ -255,6 +307,10 @@ def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_rol
             raise ValueError(f"{name} must be a number, got {value!r}")
     if not isinstance(approach_axis, str):
         raise ValueError(f"approach_axis must be 'x' or 'z', got {approach_axis!r}")
+    if hull not in ("boundary", "convex"):
+        raise ValueError(f"hull must be 'boundary' (the paper's boundary(P)) or 'convex', got {hull!r}")
+    if isinstance(shrink, bool) or not isinstance(shrink, (int, float, np.integer, np.floating)):
+        raise ValueError(f"shrink must be a number in [0, 1], got {shrink!r}")
     o.voxel_size = float(voxel)
     o.directions = int(directions)
     o.rolls = int(rolls)
@@ -264,6 +320,8 @@ def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_rol
     o.timeout = float(timeout)
     o.epsilon = float(epsilon)
     o.cloud_samples = int(cloud_samples)
+    o.hull = hull
+    o.shrink = float(shrink)
     o.seed = int(seed)
     o.threads = 0 if threads is None else int(threads)
     o.shard_index, o.shard_count = _parse_shard(shard)
@@ -302,8 +360,9 @@ def _resolve_chain(chain_or_robot: Chain | SnakeRobot) -> Chain:
 
 
 def _from_result(d: dict, o: _core.WorkspaceOptions, command: str) -> ReachabilityMap:
-    params = {p: getattr(o, "voxel_size" if p == "voxel_size" else p) for p in _PARAMS}
+    params = {p: getattr(o, p) for p in _PARAMS}
     params["rolls"] = 0 if o.free_roll else o.rolls
+    params["shrink"] = o.map_shrink  # 0 for the convex hull
     return ReachabilityMap(
         centers=np.asarray(d["centers"], dtype=float).reshape(-1, 3),
         solved=np.asarray(d["solved"], dtype=np.int32),
@@ -320,7 +379,9 @@ def _from_result(d: dict, o: _core.WorkspaceOptions, command: str) -> Reachabili
         shard=(o.shard_index, o.shard_count),
         command=command,
         stats={"ik_calls": int(d["ik_calls"]), "cheap_exits": int(d["cheap_exits"]), "seconds": float(d["seconds"]),
-               "threads": int(d["threads"]), "hull_facets": int(d["hull_facets"]), "reach": float(d["reach"])},
+               "threads": int(d["threads"]), "hull_facets": int(d["hull_facets"]), "reach": float(d["reach"]),
+               "alpha": float(d["alpha"])},
+        reached=np.asarray(d["reached"], dtype=np.uint8),
     )
 
 
@@ -334,17 +395,22 @@ def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, cou
 
 def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
             any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
-            epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, threads: int | None = None,
-            shard: Any = None, executor: Executor | None = None, shards: int | None = None,
+            epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, hull: str = "boundary",
+            shrink: float = 0.5, threads: int | None = None, shard: Any = None, executor: Executor | None = None,
+            shards: int | None = None,
             urdf: str | os.PathLike | None = None, progress: bool = True) -> ReachabilityMap:
     """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
+
+    hull: which voxels are evaluated: those inside the cloud's ``"boundary"`` (the paper's boundary(P): the
+    alpha shape MATLAB's ``boundary`` chooses for the shrink factor ``shrink``, 0.5 being MATLAB's default) or
+    inside its ``"convex"`` hull.
 
     voxel: voxel edge (m); directions: points per voxel sphere; rolls: frames about the approach axis per
     point; any_roll: a point counts when one of its rolls is solved (the paper) rather than each frame on its
     own; free_roll: one IK call per point with the roll free; approach_axis: 'x' (the head's direction) or
     'z'; timeout: TRAC-IK budget per call (s; seeded, so an evaluation budget: the map does not depend on
     the machine's load); seed: the map is a function of it; threads: worker threads (None: all cores; the
-    map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th run of voxels.
+    map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th tile of voxels.
 
     executor: any ``concurrent.futures.Executor`` (a process pool, Dask's ``client.get_executor()``...):
     the map is split into ``shards`` shards (default 4 per worker thread the executor reports, else 8),
@@ -356,7 +422,7 @@ def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directio
     chain = _resolve_chain(chain_or_robot)
     kwargs = dict(voxel=voxel, directions=directions, rolls=rolls, any_roll=any_roll, free_roll=free_roll,
                   approach_axis=approach_axis, timeout=timeout, epsilon=epsilon, cloud_samples=cloud_samples,
-                  seed=seed, threads=threads)
+                  seed=seed, threads=threads, hull=hull, shrink=shrink)
     options = _options(shard=shard, **kwargs)  # validates everything before any work
     if executor is None:
         if shards is not None:
@@ -407,10 +473,7 @@ def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str])
         raise ValueError("urdf must be a path or an XML string")
     if source.lstrip().startswith("<"):
         return source
-    try:
-        return Path(source).read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read the URDF {source!r}: {exc}") from None
+    return _core.read_urdf_file(source)  # ValueError unless a regular file of bounded size, as Chain.from_urdf
 
 
 def _bar(progress: bool, total: int, unit: str) -> Any:
@@ -445,7 +508,8 @@ def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMa
 def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = 0.05, directions: int = 20,
              rolls: int = 4, any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x",
              timeout: float = 3e-4, epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
-    """Reachability index of voxels at arbitrary centres, each on its own (random initial guesses only).
+    """Reachability index of voxels at arbitrary centres, each on its own and as Algorithm 1 states it (every
+    frame from a random initial guess with the full budget: none of the sweep's shortcuts).
 
     An independent check of a map (e.g. with a long timeout on a sample of its voxels), (k,) for (k, 3).
     """
@@ -461,67 +525,66 @@ def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxe
 
 # --- files -----------------------------------------------------------------------------------------------
 def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
-    """Write ``m`` as an uncompressed .npz with the keys ``workspace_gen`` writes.
+    """Write ``m`` as an uncompressed .npz, by the one map writer (the C++ core's, which ``workspace_gen`` uses).
 
-    centers (M,3), indices (M,), solved (M,), voxel_ids (M,), tried, grid_origin (3,), grid_size,
-    grid_shape (3,), hull_voxels, the parameters (voxel_size, directions, rolls, any_roll, free_roll,
-    approach_axis, timeout, epsilon, cloud_samples, seed), shard (2,), chain_hash, base, tip, command,
-    format, and the run's statistics (ik_calls, cheap_exits, seconds, threads, hull_facets, reach).
+    Keys: format, centers (M,3), indices (M,), solved (M,), voxel_ids (M,), reached (M, ceil(tried/8)) uint8
+    (absent when unknown), tried, sphere_directions (N,3), grid_origin (3,), grid_size, grid_shape (3,),
+    hull_voxels, hull_facets, hull ('boundary' or 'convex'), shrink (0 for the convex hull), alpha (m; inf for the
+    convex hull), reach, the parameters (voxel_size, directions, rolls, any_roll, free_roll, approach_axis,
+    timeout, epsilon, cloud_samples, seed), shard (2,), chain_hash, base, tip, command, and the run's statistics
+    (ik_calls, cheap_exits, seconds, threads; -1 or NaN when not known).
     """
     if not isinstance(m, ReachabilityMap):
         raise ValueError(f"expected a ReachabilityMap, got {type(m).__name__}")
-    arrays = {
-        "format": np.array(FORMAT), "centers": m.centers, "indices": m.indices, "solved": m.solved.astype(np.int32),
-        "voxel_ids": m.voxel_ids.astype(np.int64), "tried": np.int64(m.tried), "grid_origin": m.grid_origin,
-        "grid_size": np.float64(m.grid_size), "grid_shape": np.array(m.grid_shape, dtype=np.int64),
-        "hull_voxels": np.int64(m.hull_voxels), "shard": np.array(m.shard, dtype=np.int64),
-        "chain_hash": np.array(m.chain_hash), "base": np.array(m.base), "tip": np.array(m.tip),
-        "command": np.array(m.command),
-    }
-    for p in _PARAMS:
-        v = m.params[p]
-        arrays[p] = np.array(v) if isinstance(v, str) else np.bool_(v) if isinstance(v, (bool, np.bool_)) else (
-            np.float64(v) if isinstance(v, float) else np.int64(v))
-    arrays["seed"] = np.uint64(m.params["seed"])
-    for k in ("ik_calls", "cheap_exits", "threads", "hull_facets"):
-        if k in m.stats:
-            arrays[k] = np.int64(m.stats[k])
-    for k in ("seconds", "reach"):
-        if k in m.stats:
-            arrays[k] = np.float64(m.stats[k])
     path = os.fspath(path)
     if not path.endswith(".npz"):
         raise ValueError(f"a map file ends in .npz, got {path!r}")
-    from .._files import atomic_open
-
-    try:
-        with atomic_open(path, "wb") as f:  # a failed write leaves an existing map as it was
-            np.savez(f, **arrays)
-    except OSError as exc:
-        raise ValueError(f"cannot write the map to {path!r}: {exc}") from None
+    p = m.params
+    o = _options(p["voxel_size"], p["directions"], max(int(p["rolls"]), 1), p["any_roll"], p["free_roll"],
+                 p["approach_axis"], p["timeout"], p["epsilon"], p["cloud_samples"], p["seed"], None, m.shard,
+                 p.get("hull", "convex"), p.get("shrink", 0.0))
+    n = int(m.grid_shape[0])
+    stats = m.stats
+    _core.save_map(
+        path, m.command, o, np.ascontiguousarray(m.centers, dtype=float), m.solved.astype(np.int32),
+        m.voxel_ids.astype(np.int64), None if m.reached is None else np.ascontiguousarray(m.reached, dtype=np.uint8),
+        int(m.tried), np.asarray(m.grid_origin, dtype=float), float(m.grid_size) / n, n, int(m.hull_voxels),
+        int(stats.get("hull_facets", -1)), float(stats.get("alpha", math.inf if o.hull == "convex" else math.nan)),
+        float(stats.get("reach", math.nan)), m.chain_hash, m.base, m.tip, int(stats.get("ik_calls", -1)),
+        int(stats.get("cheap_exits", -1)), float(stats.get("seconds", math.nan)), int(stats.get("threads", -1)))
+    m.path = Path(path)
 
 
 def load(path: str | os.PathLike) -> ReachabilityMap:
-    """Read a map written by ``save`` or ``workspace_gen``. ValueError for a missing or foreign file."""
+    """Read a map written by ``save`` or ``workspace_gen`` (numpy alone reads the file; this only checks it).
+
+    A map file of the first format loads too: its voxels were those of the convex hull, and it lacks the
+    per-direction results (``m.lacks == ("reached",)``; queries then say so). ValueError for a missing or
+    foreign file."""
     path = os.fspath(path)
     try:
         z = np.load(path, allow_pickle=False)
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read the map {path!r}: {exc}") from None
     with z:
-        if "format" not in z.files or str(z["format"]) != FORMAT:
+        if "format" not in z.files or str(z["format"]) not in FORMATS:
             raise ValueError(f"{path!r} is not a snakehead reachability map (format {FORMAT})")
 
         def scalar(k: str, cast: Callable[[Any], Any]) -> Any:
             return cast(z[k][()])
 
-        params = {p: scalar(p, str if p == "approach_axis" else bool if p in ("any_roll", "free_roll")
-                            else float if p in ("voxel_size", "timeout", "epsilon") else int) for p in _PARAMS}
+        casts = {"approach_axis": str, "hull": str, "any_roll": bool, "free_roll": bool, "voxel_size": float,
+                 "timeout": float, "epsilon": float, "shrink": float}
+        old = {"hull": "convex", "shrink": 0.0}  # what the first format's maps were made with
+        params = {p: scalar(p, casts.get(p, int)) if p in z.files else old[p] for p in _PARAMS}
         stats = {}
         for k, cast in (("ik_calls", int), ("cheap_exits", int), ("seconds", float), ("threads", int),
-                        ("hull_facets", int), ("reach", float)):
+                        ("hull_facets", int), ("reach", float), ("alpha", float)):
             if k in z.files:
-                stats[k] = scalar(k, cast)
+                v = scalar(k, cast)
+                if not (v == -1 or (isinstance(v, float) and math.isnan(v))):  # -1 / NaN: not known
+                    stats[k] = v
+        reached = np.array(z["reached"], dtype=np.uint8) if "reached" in z.files else None
         m = ReachabilityMap(
             centers=np.array(z["centers"], dtype=float).reshape(-1, 3),
             solved=np.array(z["solved"], dtype=np.int32),
@@ -539,9 +602,15 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
             command=scalar("command", str),
             stats=stats,
             path=Path(path),
+            reached=reached,
+            lacks=() if reached is not None else ("reached",),
         )
         if m.tried < 1 or not np.allclose(m.indices, np.asarray(z["indices"], dtype=float), atol=1e-9):
             raise ValueError(f"{path!r}: the indices disagree with solved / tried")
+        if reached is not None:
+            bits = m.reached_units()
+            if reached.shape != (len(m), (m.tried + 7) // 8) or not np.array_equal(bits.sum(axis=1), m.solved):
+                raise ValueError(f"{path!r}: the per-direction results disagree with the solved counts")
     return m
 
 
@@ -573,7 +642,8 @@ def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
         raise ValueError(f"the shards hold {len(ids)} voxels; the map has {first.hull_voxels}")
     order = np.argsort(ids, kind="stable")
     stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in ("ik_calls", "cheap_exits", "seconds")}
-    stats.update({k: first.stats[k] for k in ("hull_facets", "reach") if k in first.stats})
+    stats.update({k: first.stats[k] for k in ("hull_facets", "reach", "alpha") if k in first.stats})
+    with_bits = all(p.reached is not None for p in parts)
     return ReachabilityMap(
         centers=np.concatenate([p.centers for p in parts])[order],
         solved=np.concatenate([p.solved for p in parts])[order],
@@ -582,6 +652,8 @@ def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
         grid_shape=first.grid_shape, hull_voxels=first.hull_voxels, chain_hash=first.chain_hash,
         base=first.base, tip=first.tip, params=dict(first.params), shard=(0, 1),
         command=f"snakehead.workspace.merge({n} shards)", stats=stats,
+        reached=np.concatenate([p.reached for p in parts])[order] if with_bits else None,
+        lacks=() if with_bits else ("reached",),
     )
 
 

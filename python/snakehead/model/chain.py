@@ -11,6 +11,15 @@ from .._validate import finite_array, joint_vector
 import numpy.typing as npt
 
 
+def _check_utf8(text: str, name: str) -> None:
+    # The core takes UTF-8; a str that cannot be encoded (lone surrogates) would fail pybind11's conversion
+    # with an "incompatible function arguments" TypeError that names no argument.
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise ValueError(f"{name} is not valid text: {exc.reason} at position {exc.start}") from None
+
+
 class Chain:
     """An immutable kinematic chain from ``base`` to ``tip``.
 
@@ -20,6 +29,8 @@ class Chain:
     """
 
     def __init__(self, model: _core.ChainModel, urdf: str | None = None) -> None:
+        if not isinstance(model, _core.ChainModel):
+            raise TypeError(f"model must be a snakehead._core.ChainModel (use Chain.from_urdf), got {type(model).__name__}")
         self._model = model
         #: The URDF the chain was read from (a path or the XML), when known: lets workers rebuild it.
         self.urdf = urdf
@@ -28,8 +39,12 @@ class Chain:
     def from_urdf(cls, urdf: str | os.PathLike, base: str, tip: str) -> "Chain":
         """Parse ``urdf`` (a path, or an XML string starting with ``<``) and take the chain base -> tip.
 
-        Raises ValueError for a missing file, malformed XML, unknown links, a base that is not an
-        ancestor of the tip, or invalid joint data (e.g. lower limit > upper limit).
+        Raises ValueError for a missing file, a path that is not a regular file (a directory, a FIFO,
+        /dev/zero) or a text larger than 8 MiB, elements nested more than 100 levels deep, malformed XML
+        (with urdfdom's own message, which is never printed), unknown links, a base that is not an ancestor
+        of the tip, invalid joint data (e.g. lower limit > upper limit), or invalid link bodies (a malformed
+        number, a negative mass, an inertia that is not positive semidefinite, a box of size <= 0),
+        naming the link and the element. TypeError when an argument is not a str (or a path).
         """
         if isinstance(urdf, os.PathLike):
             urdf = os.fspath(urdf)
@@ -37,6 +52,8 @@ class Chain:
             raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
         if not isinstance(base, str) or not isinstance(tip, str):
             raise TypeError("base and tip must be link names (str)")
+        for name, text in (("urdf", urdf), ("base", base), ("tip", tip)):
+            _check_utf8(text, name)
         return cls(_core.ChainModel.from_urdf(urdf, base, tip), urdf)
 
     # --- description -------------------------------------------------------------------------
@@ -88,6 +105,18 @@ class Chain:
     def hash(self) -> str:
         """Digest of the chain's kinematics; maps record it to know which chain they belong to."""
         return self._model.hash
+
+    @property
+    def body_hash(self) -> str:
+        """Digest of the links' bodies (masses, centres of mass, inertias, collision boxes), which ``hash``
+        leaves out: together they cover everything the chain holds."""
+        return self._model.body_hash
+
+    @property
+    def total_mass(self) -> float:
+        """Sum of the link masses on the chain (kg). 0 for a URDF without ``<inertial>``: whatever needs a
+        centre of mass must refuse such a chain."""
+        return self._model.total_mass
 
     def link_index(self, name: str) -> int:
         try:

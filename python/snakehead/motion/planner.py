@@ -16,7 +16,9 @@ cantilever beyond P0 they would tip the body, so they are curled over the base b
 arbitrary lying state into the bending state is a reconfiguration on the ground (the paper's rolling gait or
 turning in place) that is not part of these plans.
 
-Segment durations grow with the largest joint change (``speed``), with a floor (``min_segment``).
+The path through the waypoints is timed at the end by the time-optimal retiming (``motion.timing.retime``:
+TOPP-RA under joint velocity, acceleration and torque limits, the ZMP inside the support polygon by a margin and
+the ground's friction); the motion rests at every target.
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import joint_vector, positive
+from .._validate import joint_vector
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -44,11 +46,12 @@ if TYPE_CHECKING:
 
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
-DETOUR_MARGIN = 0.005  # m: static margin every planned configuration keeps
+DETOUR_MARGIN = 0.01  # m: static margin every planned configuration keeps (twice the ZMP margin: room for the motion)
 DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails)
 DENSIFY = 3  # configurations checked between consecutive waypoints of a move
 ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
@@ -58,8 +61,6 @@ BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the 
 #: How far choose_base tries stepping the base back from the targets, as shares of the body's length
 #: (0.05, 0.1, 0.15, 0.2 m on the default robot, 1.384 m long).
 BASE_STEP_SHARES = tuple(k * 0.05 / 1.384 for k in (1, 2, 3, 4))
-DEFAULT_SPEED = 0.12  # rad/s: the largest joint rate a segment is planned for
-DEFAULT_MIN_SEGMENT = 2.0  # s: the shortest segment
 
 
 @dataclass
@@ -113,6 +114,7 @@ class Plan:
     segments: list = field(default_factory=list)
     scene: Scene | None = None
     relocation: "Relocation | None" = None  # the change of base the targets need, before the plan (locomotion)
+    timing_failure: str | None = None  # why the path could not be timed within the limits, when it could not
 
     @property
     def min_zmp_margin_m(self) -> float:
@@ -137,6 +139,8 @@ class Plan:
         for tg in self.targets:
             if not tg.solved:
                 return f"target {tg.name!r} not solved: {tg.solution.message}"
+        if self.timing_failure is not None:
+            return self.timing_failure
         if self.min_zmp_margin_m < ZMP_MARGIN:
             k = self.stability.argmin
             where = "leaves the support polygon by" if self.min_zmp_margin_m < 0 else "comes within"
@@ -168,34 +172,48 @@ def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
 
 
 class _Waypoints:
-    """Accumulates waypoints (label, q) with durations, then samples them at the control period."""
+    """Accumulates the path's waypoints (label, q), the pauses and the stops, then times the whole path
+    (``motion.timing.retime``: TOPP-RA under the robot's limits and the ZMP) and samples it at the control period."""
 
-    def __init__(self, robot: SnakeRobot, base: BasePlacement, speed: float, min_segment: float,
-                 obstacles: Sequence[Any] = ()) -> None:
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, obstacles: Sequence[Any] = ()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
-        self.speed, self.min_segment = speed, min_segment
         self.labels: list[str] = []
         self.qs: list[np.ndarray] = []
-        self.times: list[float] = []
+        self.times: list[float] = []  # filled in by sample()
+        self.holds: dict[int, float] = {}  # segment index -> pause (s)
+        self.stops: list[int] = []  # waypoints where the motion comes to rest
         self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
+        self.timing_failure: str | None = None  # why the path could not be timed, when it could not
+        self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
+        self.lift_cache: dict | None = None  # timed lifts, kept by the controller
 
     def start(self, label: str, q: npt.ArrayLike) -> None:
-        self.labels, self.qs, self.times = [label], [np.asarray(q, float)], [0.0]
+        self.labels, self.qs = [label], [np.asarray(q, float)]
 
-    def move_joint(self, label: str, q: npt.ArrayLike, duration: float | None = None) -> None:
+    def _append(self, label: str, q: np.ndarray) -> None:
+        if np.abs(q - self.qs[-1]).max() <= 1e-12:  # the same configuration: nothing to move
+            self.labels[-1] = label
+            return
+        self.qs.append(q)
+        self.labels.append(label)
+
+    def stop(self) -> int:
+        """The motion comes to rest at the last waypoint (a target); its index."""
+        self.stops.append(len(self.qs) - 1)
+        return len(self.qs) - 1
+
+    def move_joint(self, label: str, q: npt.ArrayLike) -> None:
         """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
         the straight step is not safe throughout."""
         q = np.asarray(q, float)
         step = np.abs(q - self.qs[-1]).max()
         n = max(3, int(np.ceil(step / JOINT_STEP_CHECK)) + 1)
         s = np.linspace(0.0, 1.0, n)[:, None]
-        if duration is None and not self._feasible(self.qs[-1] + s * (q - self.qs[-1])).all():
+        if not self._feasible(self.qs[-1] + s * (q - self.qs[-1])).all():
             self.move(label, q)
             return
-        self.qs.append(q)
-        self.labels.append(label)
-        self.times.append(self.times[-1] + (duration or max(self.min_segment, step / self.speed)))
+        self._append(label, q)
 
     def move(self, label: str, q: npt.ArrayLike, n: int = 12) -> str:
         """A whole-body move from the last state to q (Section 3.2); returns the method used.
@@ -206,17 +224,16 @@ class _Waypoints:
         else a joint-space path through a safe detour waypoint (see ``_joint_path``).
         """
         q = np.asarray(q, float)
+        if np.abs(q - self.qs[-1]).max() <= 1e-12:
+            self._append(label, q)
+            return "none"
         path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
         if self._feasible(_densify(path.q)).all():
             qs, method = path.q, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
-        steps = np.abs(np.diff(qs, axis=0)).max(axis=1) / self.speed
-        floor = self.min_segment / (len(qs) - 1)
         for k in range(1, len(qs)):
-            self.qs.append(qs[k])
-            self.labels.append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})")
-            self.times.append(self.times[-1] + max(floor, steps[k - 1]))
+            self._append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})", qs[k])
         self.methods.append((label, method))
         return method
 
@@ -265,25 +282,85 @@ class _Waypoints:
         return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
 
     def hold(self, seconds: float) -> None:
-        self.move_joint(self.labels[-1] + " (hold)", self.qs[-1], seconds)
+        """A pause of ``seconds`` at the last waypoint (which becomes a stop)."""
+        if self.stops[-1:] != [len(self.qs) - 1]:
+            self.stop()
+        self.holds[len(self.qs) - 1] = float(seconds)
+        self.qs.append(self.qs[-1].copy())
+        self.labels.append(self.labels[-1] + " (hold)")
 
-    def sample(self, notes: list) -> interp.JointTrajectory:
-        """The multi-segment interpolation through the waypoints at 2 ms (``trajectory.MonotoneQuintic``:
-        dense Cartesian waypoints often sit on joint limits, and it never overshoots them)."""
-        traj = interp.joint_trajectory(np.array(self.times), np.array(self.qs), method="monotone")
-        lo, hi = self.robot.lower, self.robot.upper
-        over = float(max((lo - traj.q).max(), (traj.q - hi).max(), 0.0))
-        if over > 1e-9:
-            notes.append(f"the spline overshot a joint limit by up to {np.degrees(over):.3f} deg; clipped")
-            np.clip(traj.q, lo, hi, out=traj.q)
+    def sample(self, notes: list, timing: dict[str, Any]) -> interp.JointTrajectory:
+        """The fastest motion through the waypoints (``motion.timing.retime``, options ``timing``) at 2 ms; fills in
+        ``times`` (when each waypoint is reached)."""
+        from .timing import retime
+
+        hold_s = np.zeros(len(self.qs) - 1)
+        for k, seconds in self.holds.items():
+            hold_s[k] = seconds
+        Q = np.array(self.qs)
+        stops = sorted(set(self.stops))
+        try:
+            k = self.lift_index if self.lift_index is not None else -1
+            if 0 < k < len(Q) - 1 and self.lift_cache is not None:
+                # the lift from the bending state is the same for every target from this base: time it once
+                key = (self.base, Q[:k + 1].tobytes(), repr(sorted(timing.items())))
+                lift = self.lift_cache.get(key)
+                if lift is None:
+                    lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
+                                  stops=[i for i in stops if i <= k], **timing)
+                    if len(self.lift_cache) > 16:
+                        self.lift_cache.clear()
+                    self.lift_cache[key] = lift
+                rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
+                              **timing)
+                traj = _concatenate(lift, rest)
+            else:
+                traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
+        except ValueError as exc:
+            if any(key in str(exc) for key in timing):  # a bad option of the caller's, not the path's fault
+                raise
+            # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
+            # slow fixed pace so that the plan can still be looked at, and fail it
+            self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
+            times = np.concatenate([[0.0], np.cumsum(np.maximum(
+                np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1) / FALLBACK_SPEED, hold_s) + 1e-3)])
+            self.times = [float(x) for x in times]
+            return interp.joint_trajectory(times, np.array(self.qs), method="monotone")
+        self.times = [float(x) for x in traj.waypoint_times]
+        notes += list(traj.notes)
         return traj
 
 
+def _concatenate(a: Any, b: Any) -> Any:
+    """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
+    first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
+    first."""
+    from .timing import RetimedTrajectory
+
+    offset = float(a.t[-1])
+    dt = float(a.t[1] - a.t[0]) if len(a.t) > 1 else interp.CONTROL_PERIOD
+    t = interp.sample_times(0.0, offset + float(b.t[-1]), dt)
+    first = t <= offset
+    arrays = []
+    for nu in (0, 1, 2):
+        x = np.empty((len(t), a.q.shape[1]))
+        x[first] = a.spline(t[first], nu)
+        x[~first] = b.spline(t[~first] - offset, nu)
+        arrays.append(x)
+    arrays[0][-1] = b.q[-1]
+    return RetimedTrajectory(t, arrays[0], arrays[1], arrays[2], None,
+                             waypoint_times=np.concatenate([a.waypoint_times, b.waypoint_times[1:] + offset]),
+                             limits=b.limits, check=None, notes=tuple(a.notes) + tuple(b.notes),
+                             solve_time_s=b.solve_time_s)
+
+
 def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
-            notes: Sequence[str] = (), scene: Scene | None = None) -> Plan:
+            notes: Sequence[str] = (), scene: Scene | None = None, timing: dict[str, Any] | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
-    traj = plan.sample(notes)
+    traj = plan.sample(notes, timing or {})
+    for tg in targets:  # the waypoint each target was reached at -> when
+        tg.time_s = plan.times[tg.time_s]
     frames = robot.frames_many(traj.q, base)  # once, for every check below
     dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
     clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
@@ -294,7 +371,8 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
     states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
-                planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene)
+                planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene,
+                timing_failure=plan.timing_failure)
 
 
 def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
@@ -475,9 +553,9 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
 def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike, npt.ArrayLike]], *,
          robot: SnakeRobot | None = None, controller: HeadController | None = None,
          obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None,
-         method: str = "rotated", seed: int | None = 1, speed: float = DEFAULT_SPEED,
-         min_segment: float = DEFAULT_MIN_SEGMENT, allow_relocation: bool = True,
-         base_shape: npt.ArrayLike | None = None, start_q: npt.ArrayLike | None = None) -> Plan:
+         method: str = "rotated", seed: int | None = 1, allow_relocation: bool = True,
+         timing: dict[str, Any] | None = None, base_shape: npt.ArrayLike | None = None,
+         start_q: npt.ArrayLike | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -494,7 +572,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         False: then the base stays and the plan fails on the targets it cannot reach).
     method : the head IK: "rotated" (the paper's Fig. 9) or "free_roll".
     seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
-    speed : the largest joint rate a segment is planned for (rad/s). min_segment : the shortest segment (s).
+    timing : options of the time-optimal retiming (``motion.timing.retime``: ``acceleration_limit`` rad/s^2,
+        ``velocity_limit`` rad/s, ``torque_limit`` N m, ``zmp_margin`` m, ``friction``); its defaults otherwise.
     base_shape : a configuration (n,) whose base joints (and those of the neck's links that stay on the ground) give
         the base's flat shape at ``base`` (default: the controller's initial configuration's): a closed loop that
         curled the body into a relocation's shape plans on from it (``snakehead.sim.loop``).
@@ -508,7 +587,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     """
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
-    speed, min_segment = positive(speed, "speed"), positive(min_segment, "min_segment")
+    if timing is not None and not isinstance(timing, dict):
+        raise TypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
     if controller is not None:
         if not isinstance(controller, HeadController):
             raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
@@ -536,7 +616,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape)
     notes += base_notes
-    way = _Waypoints(robot, chosen, speed, min_segment, obstacles)
+    way = _Waypoints(robot, chosen, obstacles)
     if start_q is not None and relocation is not None:
         notes.append("start_q is not used: the plan starts at the relocated base, in its bending state")
         start_q = None
@@ -547,6 +627,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
             robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
         way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
+        way.lift_cache = controller.__dict__.setdefault("_timed_lifts", {})
     else:
         q = way.qs[-1]
     results: list[TargetResult] = []
@@ -562,8 +644,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
             way.move(tg.name, sol.q)
             q = sol.q
-            if not tg.via:
-                results.append(TargetResult(tg.name, tg.position, tg.direction, way.times[-1], sol))
+            if not tg.via:  # time_s holds the waypoint's index until the path is timed (_finish)
+                results.append(TargetResult(tg.name, tg.position, tg.direction, way.stop(), sol))
             if tg.hold_s > 0:
                 way.hold(tg.hold_s)
             k += 1
@@ -593,11 +675,12 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                 way.move_joint(label, sols[m].q)
             if line_target is not None:
                 if not line_target.via:
-                    results.append(TargetResult(line_target.name, line_target.position, line_target.direction, way.times[-1], sols[m]))
+                    results.append(TargetResult(line_target.name, line_target.position, line_target.direction,
+                                                way.stop(), sols[m]))
                 if line_target.hold_s > 0:
                     way.hold(line_target.hold_s)
         q = sols[-1].q
         k = end + 1
-    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene)
+    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing)
     plan.relocation = relocation
     return plan

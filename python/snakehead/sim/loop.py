@@ -22,8 +22,8 @@ the pose estimated after the last one, as the robot would do it.
    default robot: predicted by the friction model, followed by the estimate).
 4. **Re-plan** from the estimated pose with the base kept (``allow_relocation=False``, from the joints as measured):
    when the plan fails, back to 2 (a correction: uncurl, gaits, curl) with a tighter tolerance, or, when the body
-   is already as close to the goal as the gaits bring it, towards another goal nearby whose plan succeeds. Head
-   phases whose own ZMP check fails are first planned again at half the speed.
+   is already as close to the goal as the gaits bring it, towards another goal nearby whose plan succeeds. (The
+   planner times its paths under the ZMP constraint, so a slower plan would not pass where the timed one fails.)
 5. **The fix.** Dead reckoning drifts: by 2-5 % of the distance travelled with the friction odometry, tens of
    millimetres after a metre, far from the 2 mm the head must reach. The loop closes it the way the paper's
    simulation does ("the pose of the base frame of the neck part is obtained in time"): once the body rests in
@@ -59,7 +59,7 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
-from ..motion.planner import ZMP_MARGIN, Plan, as_scene, bending_state, plan
+from ..motion.planner import Plan, as_scene, bending_state, plan
 from ..scenes.scene import Scene
 from .compare import compare
 from .estimate import BodyPose, pose_error
@@ -73,8 +73,6 @@ PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
 #: tens of millimetres and lifts its base by centimetres; the ZMP grazing the edge at the first tick does not).
 CHECK_ZMP_OUTSIDE = 0.002
 CHECK_BASE_LIFT = 0.005
-#: Head phases that fail from where the body is are planned again this many times, each at half the speed.
-SLOWER_RETRIES = 1
 #: When the body is as close to its goal as the gaits bring it and the head phases still fail, the loop looks for
 #: another goal this far from it (m along and across, deg turned).
 NEARBY_STEP_M = 0.08
@@ -272,7 +270,7 @@ class ClosedLoop:
 
     scene: a :class:`~snakehead.scenes.Scene`, a scene file, or (position, direction) pairs. controller: the
     :class:`~snakehead.control.HeadController` (default: one for ``robot``, whose default is the scene's robot or
-    the shipped one). speed / min_segment: the planner's (rad/s, s). fix: the :class:`PoseFix` (None: no fix, the
+    the shipped one). timing: the planner's retiming options (:func:`snakehead.plan`'s ``timing``). fix: the :class:`PoseFix` (None: no fix, the
     head phases planned from dead reckoning alone). frequency: the gaits' (Hz). curl_speed: the curl's largest
     joint rate (rad/s). tolerance: the locomotion's (:class:`snakehead.motion.locomotion.Tolerance`).
     max_gait_runs: per correction; max_corrections: returns to step 2 after a curl before giving up.
@@ -282,7 +280,7 @@ class ClosedLoop:
     """
 
     def __init__(self, scene: Any, *, controller: HeadController | None = None, robot: SnakeRobot | None = None,
-                 speed: float = 0.12, min_segment: float = 2.0, fix: PoseFix | None = PoseFix(),
+                 timing: dict[str, Any] | None = None, fix: PoseFix | None = PoseFix(),
                  frequency: float = 0.5, curl_speed: float = 0.4, tolerance: lc.Tolerance = lc.Tolerance(),
                  max_gait_runs: int = 16, max_corrections: int = 3, method: str = "rotated", seed: int | None = 1,
                  dynamics_check: bool = True, **sim_options: Any) -> None:
@@ -298,7 +296,9 @@ class ClosedLoop:
             raise ValueError("give a robot or a controller (whose robot is used), not both")
         self.controller = controller
         self.robot = controller.robot
-        self.speed, self.min_segment = positive(speed, "speed"), positive(min_segment, "min_segment")
+        if timing is not None and not isinstance(timing, dict):
+            raise TypeError(f"timing must be a dict of the retiming's options, got {type(timing).__name__}")
+        self.timing = None if timing is None else dict(timing)
         if fix is not None and not isinstance(fix, PoseFix):
             raise TypeError(f"fix must be a PoseFix or None, got {type(fix).__name__}")
         if fix is not None and fix.frame is not None:
@@ -351,7 +351,7 @@ class ClosedLoop:
         for offset in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a)):
             candidate = lc.compose(goal, BasePlacement(*offset))
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
-                     base_shape=q_bend, speed=self.speed, min_segment=self.min_segment)
+                     base_shape=q_bend, timing=self.timing)
             if p.success:
                 return candidate
         return None
@@ -412,28 +412,17 @@ class ClosedLoop:
         def head_plan_here(label: str, dynamics_check: bool) -> Plan | None:
             """The head phases from the current estimate, the base kept, starting from the joints as they are
             (measured: they rest a few tenths of a degree from their commands, friction holding the links against
-            the servos, which moves P0 by millimetres), checked in dynamics when asked; at the loop's speed, then,
-            if the plan's own ZMP check fails, at half of it (a slower plan's ZMP is closer to its static one; a
-            body that tips in the dynamics check tips as well slower). None when it fails."""
+            the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails."""
             nonlocal planning
-            for k in range(SLOWER_RETRIES + 1):
-                speed, min_segment = self.speed / 2 ** k, self.min_segment * 2 ** k
-                t0 = time.perf_counter()
-                p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
-                         start_q=sim.joint_angles(), speed=speed, min_segment=min_segment)
-                planning += time.perf_counter() - t0
-                if p.failure is None:
-                    why = self._dynamics_check(p) if dynamics_check else None
-                    if why is None:
-                        return p
-                    notes.append(f"{label}: the head phases from {_fmt(est.base)} at {speed:.3g} rad/s fail ({why})")
-                    say(notes[-1])
-                    return None  # a body that tips in the dynamics check tips as well slower
-                notes.append(f"{label}: the head phases from {_fmt(est.base)} at {speed:.3g} rad/s fail "
-                             f"({p.failure})")
-                say(notes[-1])
-                if not (all(tg.solved for tg in p.targets) and p.min_zmp_margin_m < ZMP_MARGIN):
-                    return None  # not the ZMP of a fast motion: slower would not help
+            t0 = time.perf_counter()
+            p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
+                     start_q=sim.joint_angles(), timing=self.timing)
+            planning += time.perf_counter() - t0
+            why = p.failure if p.failure is not None else self._dynamics_check(p) if dynamics_check else None
+            if why is None:
+                return p
+            notes.append(f"{label}: the head phases from {_fmt(est.base)} fail ({why})")
+            say(notes[-1])
             return None
 
         while failure is None:
@@ -447,7 +436,7 @@ class ClosedLoop:
                 after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
                 t0 = time.perf_counter()
                 first = plan(self.scene, controller=self.controller, base=after_curl, allow_relocation=True,
-                             speed=self.speed, min_segment=self.min_segment)
+                             timing=self.timing)
                 planning += time.perf_counter() - t0
                 if not first.success:
                     failure = f"no plan reaches the targets from {_fmt(after_curl)}: {first.failure}"

@@ -10,6 +10,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._validate import finite_array, positive
+from ..dynamics.inverse_dynamics import LIFT_RAMP, carried_weights  # noqa: F401  (the one rule; re-exported)
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, SimModel, _mujoco, build_model
@@ -219,38 +220,6 @@ def check_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike) -> t
 
 #: Modes of gravity compensation in :func:`simulate`.
 GRAVITY_COMPENSATION = ("supported", "bias", "none")
-
-#: Ramp (m) of the support-aware compensation: a link whose lowest box corner is this high in the plan is
-#: fully carried by the joints; on the ground (height 0) not at all; linear in between.
-LIFT_RAMP = 0.005
-
-
-def carried_weights(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) -> np.ndarray:
-    """How much of each joint's distal links' weight the joint carries: W (T, n, n_links) in [0, 1].
-
-    frames (T, n_links, 4, 4): planned world poses. A link with a box is lifted by w = clip(h / ramp, 0, 1),
-    h the height of the lowest corner of its box's distal face (+x end; massless marker frames: w = 1). The
-    distal face, not the whole box: a link pitched up about its proximal joint still touches the ground with
-    its proximal edge, right under the joint's axis, where the ground's reaction has no moment about the
-    joint, so the joint carries the link from the first degrees of lift. Joint j carries link i (i at or after
-    j's child link in chain order) by the product of w over the links from j's child to i: the weight of the
-    lifted run of links that hangs from the joint, up to the first link resting on the ground, which the
-    ground carries instead.
-    """
-    L = len(robot.link_names)
-    boxed = np.all(robot.box_sizes > 0, axis=1)
-    B = frames[:, boxed] @ robot.box_origins[boxed]
-    half = 0.5 * robot.box_sizes[boxed]
-    low = (B[..., 2, 3] + B[..., 2, 0] * half[:, 0]
-           - np.abs(B[..., 2, 1]) * half[:, 1] - np.abs(B[..., 2, 2]) * half[:, 2])
-    w = np.ones((frames.shape[0], L))
-    w[:, boxed] = np.clip(low / ramp, 0.0, 1.0)
-    child = np.asarray(robot.body.model.joint_child_links, int)
-    W = np.zeros((frames.shape[0], robot.n_joints, L))
-    for j, c in enumerate(child):
-        W[:, j, c:] = np.cumprod(w[:, c:], axis=1)
-    return W
-
 
 def _compensated_mode(gravity_compensation: str) -> str:
     if gravity_compensation not in GRAVITY_COMPENSATION:

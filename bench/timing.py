@@ -1,0 +1,150 @@
+"""Time-optimal retiming of the paper's two scenarios (snakehead.motion.timing.retime) against the fixed speed.
+
+For each scenario (snakehead.scenes.paper_scene: "spheres", "hole") the planner's states (today timed at a fixed
+0.12 rad/s) are retimed under a sweep of limits; each retimed motion is simulated in MuJoCo
+(snakehead.sim.simulate_trajectory: PD + support-aware gravity compensation at 2 ms) and compared with the plan at
+its targets' retimed times (snakehead.sim.compare). Prints markdown tables: duration, what binds, the retiming's
+run time, the simulated head errors against the paper's, momentum errors, ZMP, base slide.
+
+    python3 bench/timing.py                       # the sweep below, both scenarios, MuJoCo for each
+    python3 bench/timing.py --accelerations 1 --velocity-shares 0.5 --no-sim
+    python3 bench/timing.py --accelerations 4 --velocity-shares 1 --zmp-margins 0.005 0.01 0.015 --interpolations
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+
+import snakehead
+from snakehead.dynamics import stability
+from snakehead.motion import timing
+from snakehead.scenes import paper_scene
+
+#: The paper's Section 4: durations (s) and simulated head errors (mm, deg).
+PAPER = {"spheres": dict(duration=36.0, position_mm=1.8, direction_deg=0.76),
+         "hole": dict(duration=23.0, position_mm=1.39, direction_deg=0.95)}
+
+
+def cpu_name() -> str:
+    try:
+        from snakehead.app.report import cpu_name as name
+
+        return name()
+    except Exception:  # pragma: no cover - the report's reader is optional here
+        return platform.processor() or "unknown CPU"
+
+
+def scenario(name: str) -> dict:
+    """The plan of a paper scenario: its states, their fixed-speed times, the reported targets and their states."""
+    clock = time.perf_counter()
+    plan = snakehead.plan(paper_scene(name))
+    labels = [label for label, _, _ in plan.states]
+    targets = [(labels.index(tg.name), tg.position, tg.direction) for tg in plan.targets]
+    return dict(plan=plan, q=np.array([q for _, _, q in plan.states]), times=np.array([t for _, t, _ in plan.states]),
+                targets=targets, plan_s=time.perf_counter() - clock)
+
+
+def run(name: str, sc: dict, *, simulate: bool, **limits) -> dict:
+    plan = sc["plan"]
+    holds = np.diff(sc["times"])  # the plan's pauses (repeated states) keep their length
+    stops = [k for k, _, _ in sc["targets"]]  # the head comes to rest at each reported target
+    clock = time.perf_counter()
+    traj = timing.retime(plan.robot, sc["q"], plan.base, hold_s=holds, stops=stops, **limits)
+    solve_s = time.perf_counter() - clock
+    dyn = stability.dynamic_stability(plan.robot, traj.t, traj.q, plan.base, traj.qd, contact="ground")
+    row = dict(duration=traj.duration, solve_s=solve_s, check=traj.check, zmp_planned_mm=1000 * dyn.min_margin,
+               notes=traj.notes)
+    if simulate:
+        from snakehead.sim import compare, simulate_trajectory
+
+        clock = time.perf_counter()
+        result = simulate_trajectory(plan.robot, traj.t, traj.q, plan.base, obstacles=list(plan.obstacles))
+        targets = [(float(traj.waypoint_times[k]), p, d) for k, p, d in sc["targets"]]
+        m = compare(plan.robot, traj.t, traj.q, result, targets=targets, base=plan.base)
+        row.update(sim_s=time.perf_counter() - clock, position_mm=1000 * m["position_error_m"],
+                   direction_deg=m["direction_error_deg"], zmp_inside=m["zmp_inside"],
+                   zmp_sim_mm=1000 * m["zmp_min_margin_m"], slide_mm=1000 * m["base_slide_m"],
+                   dP=m["max_linear_momentum_magnitude_error"], dL=m["max_angular_momentum_magnitude_error"],
+                   torque=m["max_torque_nm"])
+    return row
+
+
+def binds(check) -> str:
+    shares = sorted(check.binding.items(), key=lambda kv: -kv[1])
+    return ", ".join(f"{k} {100 * v:.0f} %" for k, v in shares if v >= 0.01) or "-"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenarios", nargs="+", default=["spheres", "hole"])
+    ap.add_argument("--accelerations", nargs="+", type=float, default=[0.5, 1.0, 2.0, 4.0],
+                    help="joint acceleration limits to sweep (rad/s^2)")
+    ap.add_argument("--velocity-shares", nargs="+", type=float, default=[0.5, 1.0],
+                    help="shares of the URDF's velocity limits to sweep")
+    ap.add_argument("--zmp-margins", nargs="+", type=float, default=[timing.ZMP_MARGIN], help="m, swept")
+    ap.add_argument("--friction", type=float, default=timing.FRICTION)
+    ap.add_argument("--no-sim", action="store_true", help="skip MuJoCo")
+    ap.add_argument("--interpolations", nargs="*", default=["monotone", "spline"],
+                    help="paths compared at the default limits")
+    args = ap.parse_args()
+    print(f"{time.strftime('%Y-%m-%d %H:%M')}, {cpu_name()} ({os.cpu_count()} CPU), load average "
+          f"{os.getloadavg()[0]:.1f}, Python {platform.python_version()}")
+    scenarios = {name: scenario(name) for name in args.scenarios}
+    for name, sc in scenarios.items():
+        line = (f"\n{name}: {len(sc['q'])} states, fixed-speed plan {sc['plan'].duration_s:.1f} s "
+                f"(planned in {sc['plan_s']:.1f} s)")
+        if not args.no_sim:
+            fixed = snakehead.simulate(sc["plan"])
+            line += (f", simulated head error {1000 * fixed.position_error_m:.2f} mm / "
+                     f"{fixed.direction_error_deg:.3f} deg, ZMP inside {fixed.zmp_inside}")
+        print(line + f"; the paper's {PAPER[name]['duration']:.0f} s, {PAPER[name]['position_mm']} mm / "
+              f"{PAPER[name]['direction_deg']} deg", flush=True)
+
+    print(f"\n### Limits swept (monotone path; torque {timing.TORQUE_SHARE} x URDF effort; friction {args.friction})\n")
+    head = ("| scenario | acc (rad/s^2) | vel (x URDF) | ZMP margin (mm) | duration (s) | retime (s) | binds | planned ZMP (mm) |"
+            + ("" if args.no_sim else " head error (mm / deg) | sim ZMP inside (min mm) | slide (mm) | "
+               "dP / dL error | max torque (N m) | within the paper's |"))
+    print(head)
+    print("|" + "|".join("---" for _ in head.split("|")[1:-1]) + "|")
+    for name, sc in scenarios.items():
+        for zm in args.zmp_margins:
+            for vs in args.velocity_shares:
+                for acc in args.accelerations:
+                    row = run(name, sc, simulate=not args.no_sim, acceleration_limit=acc,
+                              velocity_limit=vs * sc["plan"].robot.velocity_limit, zmp_margin=zm,
+                              friction=args.friction)
+                    line = (f"| {name} | {acc:g} | {vs:g} | {1000 * zm:g} | {row['duration']:.2f} | "
+                            f"{row['solve_s']:.1f} | {binds(row['check'])} | {row['zmp_planned_mm']:.1f} |")
+                    if not args.no_sim:
+                        p = PAPER[name]
+                        ok = (row["duration"] <= p["duration"] and row["position_mm"] <= p["position_mm"]
+                              and row["direction_deg"] <= p["direction_deg"] and row["zmp_inside"])
+                        line += (f" {row['position_mm']:.2f} / {row['direction_deg']:.3f} | "
+                                 f"{'yes' if row['zmp_inside'] else 'no'} ({row['zmp_sim_mm']:.2f}) | "
+                                 f"{row['slide_mm']:.2f} | {row['dP']:.3f} / {row['dL']:.4f} | {row['torque']:.2f} | "
+                                 f"{'yes' if ok else 'no'} |")
+                    print(line, flush=True)
+
+    if not args.interpolations:
+        return
+    print("\n### Path through the waypoints (default limits)\n")
+    print("| scenario | path | duration (s) | retime (s) | worst velocity / acceleration / torque (x limit) |")
+    print("|---|---|---|---|---|")
+    for name, sc in scenarios.items():
+        for interp in args.interpolations:
+            try:
+                row = run(name, sc, simulate=False, interpolation=interp)
+            except ValueError as exc:
+                print(f"| {name} | {interp} | - | - | {exc} |")
+                continue
+            c = row["check"]
+            print(f"| {name} | {interp} | {row['duration']:.2f} | {row['solve_s']:.1f} | "
+                  f"{c.velocity_ratio:.3f} / {c.acceleration_ratio:.3f} / {c.torque_ratio:.3f} |")
+
+
+if __name__ == "__main__":
+    main()

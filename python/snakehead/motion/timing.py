@@ -1,0 +1,655 @@
+"""Time-optimal retiming of a whole-body path (issue 11, item 3): TOPP-RA under the robot's limits and the ZMP.
+
+:func:`retime` takes waypoints (K, n) -- the states of a plan, or the dense configurations of a Cartesian move --
+joins them by a smooth path q(s) through every one of them that never leaves the range of two neighbouring
+waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018, with the
+``toppra`` package's ``seidel`` solver) that keeps, at every gridpoint (and, the grid refined where needed, between
+them: at every sample):
+
+* each joint's velocity within ``velocity_limit`` (default :data:`VELOCITY_SHARE` of the URDF's);
+* each joint's acceleration within ``acceleration_limit`` (URDFs have none: default :data:`ACCELERATION_LIMIT`);
+* each joint's torque within ``torque_limit`` (default :data:`TORQUE_SHARE` of the URDF's effort): the torques of
+  :func:`snakehead.dynamics.inverse_dynamics.inverse_dynamics`, links resting on the ground carried by it;
+* the ZMP (Eqs. 39-40, p_z = 0) inside the support polygon of the links on the ground
+  (``stability.support_polygons(..., contact="ground")``) by ``zmp_margin`` m;
+* the horizontal momentum rate within the friction the ground can give the base,
+  |dP_xy/dt| <= ``friction`` (M g + dP_z/dt) (default :data:`FRICTION`: a share of the simulation's 0.8), since a
+  snake's base slides when it is pushed; and the ground pushing, M g + dP_z/dt >= :data:`MIN_NORMAL_SHARE` M g.
+
+Why the ZMP is a linear constraint: with w = (dP/dt, dL/dt) (Eqs. 33-34, L about the world origin), the ZMP
+lies on the inner side of a polygon edge n . p >= d + m exactly when, multiplied through by M g + dP_z/dt > 0,
+n_x (M g c_x - dL_y/dt) + n_y (M g c_y + dL_x/dt) - (d + m)(M g + dP_z/dt) >= 0 -- linear in w. Along a path q(s)
+the momenta are P = A(q) q' s', so w = a(s) s'' + b(s) s'^2 with a = (P, L)(q, q') and
+b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (:func:`~snakehead.dynamics.inverse_dynamics.momentum_rates`):
+exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count by repeating an edge.
+
+Where the centre of mass itself is closer than twice ``zmp_margin`` to the polygon's edge (a barely stable path),
+the ZMP is asked to keep half the CoM's margin instead (at rest the ZMP is the CoM's projection, so no motion can
+do better there); the result's ``notes`` say where. A waypoint repeated (a zero-length segment) is a pause of
+``hold_s`` s; the motion comes to rest there, at ``stops``, at both ends and where the path turns back on itself
+(every joint reverses or stops at a waypoint).
+
+:func:`check_limits` measures any sampled trajectory against the same limits (the retimed one is checked at every
+2 ms sample); the result says what binds.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import numpy.typing as npt
+from scipy.interpolate import CubicSpline
+
+from .._validate import finite_array, finite_float, positive
+from ..dynamics import stability
+from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates, newton_euler
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
+
+#: q(s) and its derivatives: f(s (N,), order 0, 1 or 2) -> (N, n).
+PathFunction = Callable[[np.ndarray, int], np.ndarray]
+
+#: Share of the URDF's joint velocity limits used by default.
+VELOCITY_SHARE = 0.5
+#: rad/s^2: joint acceleration limit by default (URDFs give none). bench/timing.py measures the paper's scenarios
+#: from 0.5 to 4 rad/s^2: at 2 both are within the paper's durations and simulated errors with the simulated ZMP
+#: inside by millimetres; at 4 the simulated ZMP comes within a millimetre of the base's edge.
+ACCELERATION_LIMIT = 2.0
+#: Share of the URDF's joint effort limits used by default: room for the PD controller's corrections.
+TORQUE_SHARE = 0.8
+#: m: how far inside the support polygon the ZMP stays by default.
+ZMP_MARGIN = 0.005
+#: The friction coefficient of the MuJoCo model (snakehead.sim: friction=0.8).
+SIM_FRICTION = 0.8
+#: Friction coefficient the retiming allows the base by default: half the simulation's, since the contacts are
+#: unevenly loaded and some slide before the total reaches mu times the total load.
+FRICTION = 0.5 * SIM_FRICTION
+#: The ground must push with at least this share of the weight (M g + dP_z/dt >= MIN_NORMAL_SHARE M g).
+MIN_NORMAL_SHARE = 0.1
+#: Sides of the polygon inscribed in the friction circle |dP_xy/dt| <= mu N (a linear constraint).
+FRICTION_SIDES = 8
+#: s: a repeated waypoint's pause by default.
+HOLD_S = 1.0
+#: rad: the largest step of the path (Euclidean length in joint space) between two TOPP-RA gridpoints.
+GRID_STEP = 0.01
+#: Gridpoints per segment between two waypoints, at least.
+MIN_GRID_PER_SEGMENT = 8
+#: rad: two waypoints closer than this (largest joint difference) are the same: a hold.
+SAME_WAYPOINT = 1e-9
+#: Where the path stands still (a cusp: every joint turns back or stops at a waypoint) the joint velocity limits do
+#: not bound the path's speed s' (rad of joint-space path per s); it is capped at this multiple of the norm of the
+#: velocity limits (each taken at most MAX_JOINT_SPEED rad/s). Elsewhere |q'(s)| is about 1 and the limits bind.
+PATH_SPEED_FACTOR = 10.0
+MAX_JOINT_SPEED = 100.0
+#: TOPP-RA is given this share of the velocity, acceleration, torque and friction limits, and the ZMP margin plus
+#: SOLVE_ZMP_EXTRA_M: the room that the path's curvature between gridpoints takes, so that the limits themselves hold
+#: at every sample without many refinement rounds.
+SOLVE_SHARE = 0.995
+SOLVE_ZMP_EXTRA_M = 2e-4
+#: Rounds of grid refinement: stages that break a limit between their gridpoints are cut in four (their neighbours
+#: in two) and the path is solved again.
+REFINE_ROUNDS = 4
+#: m: how far the ZMP may come inside its required margin between gridpoints before the stage is halved (less is
+#: round-off of the path's curvature, not worth a finer grid).
+REFINE_ZMP_M = 1e-5
+#: The refinement stops when the grid would grow beyond this multiple of its first size plus REFINE_EXTRA_POINTS.
+REFINE_GROWTH = 3.0
+REFINE_EXTRA_POINTS = 1000
+#: Points probed inside each stage for the refinement.
+PROBES = 5
+#: The paths :func:`retime` can join the waypoints with.
+INTERPOLATIONS = ("monotone", "spline")
+#: How close (share of the limit) a sample must come to a limit to count as binding in :class:`LimitCheck`.
+BINDING_SHARE = 0.97
+#: m: how close the ZMP must come to its required margin to count as binding.
+BINDING_ZMP_M = 0.001
+
+
+# ------------------------------------------------------------------------------------------------
+# limits
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RetimingLimits:
+    """The limits a retimed motion keeps: per joint velocity (rad/s), acceleration (rad/s^2) and torque (N m),
+    (n,) each (inf: none); the ZMP's margin (m) inside the support polygon; the friction coefficient."""
+
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    torque: np.ndarray
+    zmp_margin: float
+    friction: float
+
+
+def _joint_limit(value: npt.ArrayLike | None, n: int, name: str, default: np.ndarray | None = None) -> np.ndarray:
+    """A per-joint limit from a number or (n,) array; zeros in ``default`` (URDF gives none) become inf."""
+    if value is None:
+        assert default is not None, name
+        limit = np.where(default > 0, default, np.inf)
+    else:
+        try:
+            limit = np.asarray(value, float)
+        except (TypeError, ValueError):
+            raise TypeError(f"{name} must be a number or an array of {n} numbers, got {type(value).__name__}") from None
+        if limit.ndim == 0:
+            limit = np.full(n, float(limit))
+        if limit.shape != (n,):
+            raise ValueError(f"{name} must be a number or shape ({n},), got shape {limit.shape}")
+    if np.any(np.isnan(limit)) or np.any(limit <= 0):
+        raise ValueError(f"{name} must be positive (inf for none), got {np.asarray(limit).tolist()}")
+    return limit
+
+
+def resolve_limits(robot: SnakeRobot, *, velocity_limit: npt.ArrayLike | None = None,
+                   acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT, torque_limit: npt.ArrayLike | None = None,
+                   zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION) -> RetimingLimits:
+    """The limits :func:`retime` uses, from its keywords (see there); ValueError/TypeError for bad ones."""
+    robot = as_robot(robot)
+    n = robot.n_joints
+    vel = _joint_limit(velocity_limit, n, "velocity_limit", VELOCITY_SHARE * robot.velocity_limit)
+    if acceleration_limit is None:
+        raise ValueError("acceleration_limit is needed (URDFs give none); e.g. "
+                         f"{ACCELERATION_LIMIT} rad/s^2, the default")
+    acc = _joint_limit(acceleration_limit, n, "acceleration_limit")
+    tau = _joint_limit(torque_limit, n, "torque_limit", TORQUE_SHARE * robot.effort)
+    margin = finite_float(zmp_margin, "zmp_margin")
+    if margin < 0:
+        raise ValueError(f"zmp_margin must be >= 0 m, got {zmp_margin!r}")
+    mu = positive(friction, "friction")
+    return RetimingLimits(vel, acc, tau, margin, mu)
+
+
+# ------------------------------------------------------------------------------------------------
+# the stability constraint: ZMP in the support polygon, friction, the ground pushing
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Support:
+    """The ground support of configurations q (N, n), computed once: each polygon's edges (padded to one count by
+    repeating the first) as inward unit normals (N, E, 2) and offsets d (N, E) (inside: n . p >= d); the centre of
+    mass (N, 3); its static margin (N,) m; the margin (N,) m the ZMP must keep there (:func:`required_margins`)."""
+
+    normal: np.ndarray
+    offset: np.ndarray
+    com: np.ndarray
+    static: np.ndarray
+    required: np.ndarray
+
+    @classmethod
+    def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float) -> "Support":
+        V, count = stability.support_polygons(robot, q, base, contact="ground")
+        if np.any(count < 3):
+            k = int(np.argmax(count < 3))
+            raise ValueError(f"the links on the ground span no polygon at path point {k} ({count[k]} distinct "
+                             "contact points): the body cannot stand there")
+        h = np.arange(V.shape[1])[None, :]
+        start = np.where(h < count[:, None], h, 0)  # padding repeats the first edge
+        stop = np.where(start + 1 < count[:, None], start + 1, 0)
+        a = np.take_along_axis(V, start[..., None], axis=1)
+        e = np.take_along_axis(V, stop[..., None], axis=1) - a
+        normal = np.stack([-e[..., 1], e[..., 0]], axis=-1) / np.linalg.norm(e, axis=-1, keepdims=True)  # inside
+        offset = (normal * a).sum(-1)
+        com = stability.center_of_mass(robot, q, base)
+        static = ((normal * com[:, None, :2]).sum(-1) - offset).min(axis=1)
+        return cls(normal, offset, com, static, required_margins(static, zmp_margin))
+
+    def margins(self, xy: np.ndarray) -> np.ndarray:
+        """Signed distance (m) of points xy (N, 2) inside each polygon: exact inside (the nearest edge), negative
+        outside (by the edge line crossed most)."""
+        return ((self.normal * xy[:, None, :]).sum(-1) - self.offset).min(axis=1)
+
+
+def required_margins(static: npt.ArrayLike, zmp_margin: float) -> np.ndarray:
+    """The margin (m) the ZMP must keep inside the support polygon where the CoM keeps ``static`` m:
+    ``zmp_margin``, or half the CoM's own margin where that is less than twice it."""
+    return np.minimum(zmp_margin, 0.5 * np.asarray(static, float))
+
+
+def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, extra_margin: float = 0.0
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The stability constraints at N configurations as F w <= g on w = (dP/dt, dL/dt) (N, 6):
+    F (N, E + FRICTION_SIDES + 1, 6), g (N, E + FRICTION_SIDES + 1).
+
+    Rows: one per support-polygon edge (the ZMP at least the margin that ``limits.zmp_margin`` requires
+    (:func:`required_margins`), plus ``extra_margin`` m (at most 90 % of the CoM's own margin), inside it,
+    multiplied through by
+    M g + dP_z/dt), the friction polygon inscribed in |dP_xy/dt| <= mu (M g + dP_z/dt), and
+    M g + dP_z/dt >= MIN_NORMAL_SHARE M g.
+    """
+    Mg = robot.total_mass * stability.GRAVITY
+    N, E = support.offset.shape
+    margin = np.minimum(required_margins(support.static, limits.zmp_margin) + extra_margin, 0.9 * support.static)
+    off = support.offset + margin[:, None]
+    normal = support.normal
+    F_zmp = np.zeros((N, E, 6))
+    F_zmp[..., 2] = off  # (d + m) dP_z/dt - n_y dL_x/dt + n_x dL_y/dt <= M g (n . c - d - m)
+    F_zmp[..., 3] = -normal[..., 1]
+    F_zmp[..., 4] = normal[..., 0]
+    g_zmp = Mg * ((normal * support.com[:, None, :2]).sum(-1) - off)
+    theta = 2 * np.pi * np.arange(FRICTION_SIDES) / FRICTION_SIDES
+    mu = limits.friction * np.cos(np.pi / FRICTION_SIDES)  # the inscribed polygon's apothem
+    F_fr = np.zeros((FRICTION_SIDES + 1, 6))
+    F_fr[:-1, 0], F_fr[:-1, 1], F_fr[:-1, 2] = np.cos(theta), np.sin(theta), -mu  # u . dP_xy/dt <= mu N
+    F_fr[-1, 2] = -1.0  # -dP_z/dt <= (1 - MIN_NORMAL_SHARE) M g
+    g_fr = np.r_[np.full(FRICTION_SIDES, mu * Mg), (1.0 - MIN_NORMAL_SHARE) * Mg]
+    F = np.concatenate([F_zmp, np.broadcast_to(F_fr, (N,) + F_fr.shape)], axis=1)
+    g = np.concatenate([g_zmp, np.broadcast_to(g_fr, (N, len(g_fr)))], axis=1)
+    return F, g
+
+
+def momentum_rate_coefficients(robot: SnakeRobot, q: npt.ArrayLike, dq: npt.ArrayLike, ddq: npt.ArrayLike,
+                               base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """w = (dP/dt, dL/dt) along a path q(s) as a s'' + b s'^2: a, b (N, 6) at points q, dq = q'(s), ddq = q''(s)
+    (N, n) each. a = (P, L)(q, q'); b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (Eqs. 25-31, 33-34)."""
+    P, L = stability.momenta_from_velocities(robot, np.asarray(q, float), np.asarray(dq, float), base)
+    Pb, Lb = momentum_rates(robot, q, dq, ddq, base)
+    return np.hstack([P, L]), np.hstack([Pb, Lb])
+
+
+# ------------------------------------------------------------------------------------------------
+# checking a sampled trajectory against the limits
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LimitCheck:
+    """How a sampled trajectory meets :class:`RetimingLimits` (worst over its samples).
+
+    velocity_ratio, acceleration_ratio, torque_ratio: max over samples and joints of |value| / limit (<= 1 keeps it).
+    zmp_margin_m: the least signed distance (m) of the ZMP inside its sample's support polygon; zmp_slack_m: the
+    least of that minus the required margin (>= 0 keeps it). friction_ratio: max |dP_xy/dt| / (mu (M g + dP_z/dt)).
+    binding: for each of "velocity", "acceleration", "torque", "zmp", "friction", the share of the moving samples
+    at which it is within BINDING_SHARE of its limit (the ZMP: within BINDING_ZMP_M of its margin).
+    """
+
+    velocity_ratio: float
+    acceleration_ratio: float
+    torque_ratio: float
+    zmp_margin_m: float
+    zmp_slack_m: float
+    friction_ratio: float
+    binding: dict = field(default_factory=dict)
+
+    def within(self, tolerance: float = 1e-3, zmp_tolerance_m: float = 1e-4) -> bool:
+        """Every limit kept, ratios up to 1 + ``tolerance`` and the ZMP's margin to ``zmp_tolerance_m`` m."""
+        ratios = (self.velocity_ratio, self.acceleration_ratio, self.torque_ratio, self.friction_ratio)
+        return max(ratios) <= 1.0 + tolerance and self.zmp_slack_m >= -zmp_tolerance_m
+
+
+def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
+            qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
+    """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
+    used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
+    dyn = newton_euler(robot, q, qd, qdd, base)  # torques and exact momentum rates
+    tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
+    Mg = robot.total_mass * stability.GRAVITY
+    normal_force = Mg + Pdot[:, 2]
+    lifting = normal_force > 0  # else the ground would have to pull: no ZMP
+    safe = np.where(lifting, normal_force, 1.0)
+    com = support.com
+    zmp = np.column_stack([(Mg * com[:, 0] - Ldot[:, 1]) / safe,  # Eqs. 39-40 with p_z = 0
+                           (Mg * com[:, 1] + Ldot[:, 0]) / safe])
+    margin = np.where(lifting, support.margins(zmp), -np.inf)
+    return {"velocity": (np.abs(qd) / limits.velocity).max(axis=1),
+            "acceleration": (np.abs(qdd) / limits.acceleration).max(axis=1),
+            "torque": (np.abs(tau) / limits.torque).max(axis=1),
+            "friction": np.where(lifting, np.hypot(Pdot[:, 0], Pdot[:, 1]) / (limits.friction * safe), np.inf),
+            "zmp_margin": margin, "zmp_slack": margin - support.required}
+
+
+def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike, base: BasePlacement | None,
+                 limits: RetimingLimits) -> LimitCheck:
+    """Measure samples q, qd, qdd (T, n) of a trajectory against ``limits``: joint velocities and accelerations, the
+    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler (exact; the
+    retiming's constraint takes them from the paper's momenta instead) in the ground support polygon of each sample,
+    and the base's friction."""
+    robot = as_robot(robot)
+    base = as_base(base)
+    if not isinstance(limits, RetimingLimits):
+        raise TypeError(f"limits must be RetimingLimits, got {type(limits).__name__}")
+    q = finite_array(q, "q", (None, robot.n_joints))
+    qd = finite_array(qd, "qd", q.shape)
+    qdd = finite_array(qdd, "qdd", q.shape)
+    r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin), q, qd, qdd)
+    moving = np.abs(qd).max(axis=1) > 0
+
+    def share(hit: np.ndarray) -> float:
+        return float(np.mean(hit[moving])) if moving.any() else 0.0
+
+    binding = {key: share(r[key] >= BINDING_SHARE) for key in ("velocity", "acceleration", "torque", "friction")}
+    binding["zmp"] = share(r["zmp_slack"] <= BINDING_ZMP_M)
+    return LimitCheck(float(r["velocity"].max()), float(r["acceleration"].max()), float(r["torque"].max()),
+                      float(r["zmp_margin"].min()), float(r["zmp_slack"].min()), float(r["friction"].max()), binding)
+
+
+# ------------------------------------------------------------------------------------------------
+# the retimed trajectory
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RetimedTrajectory(JointTrajectory):
+    """A :class:`~snakehead.motion.interpolation.JointTrajectory` from :func:`retime`: t, q, qd, qdd sampled every
+    dt (``spline(t, nu)`` evaluates it anywhere), and
+
+    waypoint_times (K,) s: when it passes each waypoint (after a hold: when the pause ends); limits: the
+    :class:`RetimingLimits` it keeps; check: the :class:`LimitCheck` of its samples (what binds); notes: what the
+    retiming had to relax; solve_time_s: the retiming's own run time.
+    """
+
+    waypoint_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    limits: RetimingLimits | None = None
+    check: LimitCheck | None = None
+    notes: tuple[str, ...] = ()
+    solve_time_s: float = 0.0
+
+    @property
+    def duration(self) -> float:
+        """s, from the first sample to the last."""
+        return float(self.t[-1] - self.t[0])
+
+
+class _Timeline:
+    """The retimed motion as a function of time: rest-to-rest pieces along their paths, and pauses."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self.items: list[dict[str, Any]] = []
+        self.end = 0.0
+
+    def add_piece(self, f: PathFunction, s: np.ndarray, sd: np.ndarray) -> np.ndarray:
+        ds = np.diff(s)
+        mean = 0.5 * (sd[:-1] + sd[1:])
+        dt = ds / mean  # constant path acceleration over each stage
+        u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2 * ds)
+        t = self.end + np.r_[0.0, np.cumsum(dt)]
+        self.items.append(dict(kind="piece", t=t, s=s, sd=sd, u=u, f=f))
+        self.end = float(t[-1])
+        return t
+
+    def add_pause(self, q: np.ndarray, seconds: float) -> None:
+        self.items.append(dict(kind="pause", t=np.array([self.end, self.end + seconds]), q=q))
+        self.end += seconds
+
+    def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, float))
+        out = np.zeros((len(t), self.n))
+        for k, item in enumerate(self.items):
+            last = k == len(self.items) - 1
+            tt = item["t"]
+            mask = (t >= tt[0]) & ((t <= tt[-1]) if last else (t < tt[-1]))
+            if k == 0:
+                mask |= t < tt[0]
+            if last:
+                mask |= t > tt[-1]
+            if not mask.any():
+                continue
+            if item["kind"] == "pause":
+                if nu == 0:
+                    out[mask] = item["q"]
+                continue
+            i = np.clip(np.searchsorted(tt, t[mask], side="right") - 1, 0, len(tt) - 2)
+            tau = np.clip(t[mask] - tt[i], 0.0, tt[i + 1] - tt[i])
+            s = np.clip(item["s"][i] + item["sd"][i] * tau + 0.5 * item["u"][i] * tau ** 2, item["s"][i],
+                        item["s"][i + 1])
+            sd = np.maximum(item["sd"][i] + item["u"][i] * tau, 0.0)
+            f = item["f"]
+            if nu == 0:
+                out[mask] = f(s, 0)
+            elif nu == 1:
+                out[mask] = f(s, 1) * sd[:, None]
+            elif nu == 2:
+                out[mask] = f(s, 1) * item["u"][i][:, None] + f(s, 2) * (sd ** 2)[:, None]
+            else:
+                raise ValueError("nu must be 0, 1 or 2")
+        return out
+
+
+def _path_function(s: np.ndarray, waypoints: np.ndarray, interpolation: str) -> PathFunction:
+    """q(s) through the waypoints at path positions s (knots): f(s, order) -> (N, n)."""
+    if interpolation == "monotone":
+        return MonotoneQuintic(s, waypoints)
+    spline = CubicSpline(s, waypoints, bc_type="not-a-knot", axis=0)  # as toppra's SplineInterpolator
+
+    def f(x: np.ndarray, order: int = 0) -> np.ndarray:
+        return np.asarray(spline(x, order))
+
+    return f
+
+
+def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
+              ) -> tuple[list[tuple[str, int, int]], np.ndarray]:
+    """The schedule: ("piece", i0, i1) runs of moving segments between rests, ("pause", k) holds; and the pause
+    of each segment (K-1,)."""
+    K = len(waypoints)
+    same = np.abs(np.diff(waypoints, axis=0)).max(axis=1) <= SAME_WAYPOINT
+    holds = finite_array(hold_s, "hold_s")
+    if holds.ndim == 0:
+        holds = np.full(K - 1, float(holds))
+    if holds.shape != (K - 1,):
+        raise ValueError(f"hold_s must be a number or one per segment ({K - 1},), got shape {holds.shape}")
+    if np.any(holds < 0):
+        raise ValueError("hold_s must be >= 0 s")
+    rest = np.zeros(K, bool)
+    rest[[0, -1]] = True
+    # a cusp: every joint turns back or stops at the waypoint, so the path stands still there (q'(s) = 0 on the
+    # monotone path): the motion comes to rest there anyway, and a piece ends there (TOPP-RA is ill-conditioned at
+    # a standstill inside a path)
+    step = np.diff(waypoints, axis=0)
+    rest[1:-1] |= np.all(step[:-1] * step[1:] <= 0.0, axis=1) & ~same[:-1] & ~same[1:]
+    for k in stops:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+            raise TypeError(f"stops must be waypoint indices (int), got {k!r}")
+        if not -K <= k < K:
+            raise ValueError(f"stop {k} is not a waypoint index (there are {K} waypoints)")
+        rest[k] = True
+    schedule = []
+    start = None
+    for k in range(K - 1):
+        if same[k]:
+            if start is not None:
+                schedule.append(("piece", start, k))
+                start = None
+            schedule.append(("pause", k, k + 1))
+            continue
+        if start is None:
+            start = k
+        if rest[k + 1]:
+            schedule.append(("piece", start, k + 1))
+            start = None
+    return schedule, holds
+
+
+def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | None = None, *,
+           velocity_limit: npt.ArrayLike | None = None, acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
+           torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION,
+           dt: float = CONTROL_PERIOD, hold_s: npt.ArrayLike = HOLD_S, stops: Sequence[int] = (),
+           interpolation: str = "monotone", grid_step: float = GRID_STEP) -> RetimedTrajectory:
+    """The fastest motion through ``waypoints`` that keeps the robot's limits and its balance.
+
+    Parameters
+    ----------
+    robot : the snake; base : where its base lies (default placement).
+    waypoints : (K, n) joint vectors (rad) within the joint limits, K >= 2. The motion passes through every one,
+        starts and ends at rest, and rests at each waypoint index in ``stops``.
+    velocity_limit : rad/s, a number or (n,); default :data:`VELOCITY_SHARE` of the URDF's (none where it gives 0).
+    acceleration_limit : rad/s^2, a number or (n,); default :data:`ACCELERATION_LIMIT`.
+    torque_limit : N m, a number or (n,); default :data:`TORQUE_SHARE` of the URDF's effort (none where it gives 0).
+    zmp_margin : m the ZMP keeps inside the ground support polygon (see the module's note on barely stable paths).
+    friction : the friction coefficient the base may use (default :data:`FRICTION`).
+    dt : s between samples (the 2 ms control period). hold_s : s, the pause at a repeated waypoint; a number or one
+        per segment (K-1,) (used where the segment has zero length).
+    interpolation : the path through the waypoints: "monotone" (default: the piecewise quintic
+        :class:`~snakehead.motion.interpolation.MonotoneQuintic`, which never leaves the range of two neighbouring
+        waypoints) or "spline" (a not-a-knot cubic spline, toppra's own; it may overshoot: ValueError if it leaves
+        the joint limits).
+    grid_step : rad of path between TOPP-RA's gridpoints (at most; at least MIN_GRID_PER_SEGMENT per segment).
+
+    Returns a :class:`RetimedTrajectory` (a JointTrajectory with ``duration``, ``waypoint_times``, ``check``).
+    Raises ValueError when no motion along the path keeps the limits (the CoM outside the support polygon, the
+    torque to hold still beyond the limit, ...), saying where.
+    """
+    clock = time.perf_counter()
+    robot = as_robot(robot)
+    base = as_base(base)
+    n = robot.n_joints
+    W = finite_array(waypoints, "waypoints")
+    if W.ndim != 2 or W.shape[1] != n:
+        raise ValueError(f"waypoints has shape {W.shape}; expected (K, {n})")
+    if W.shape[0] < 2:
+        raise ValueError(f"waypoints needs at least two configurations, got {W.shape[0]}")
+    out = (W < robot.lower - 1e-9) | (W > robot.upper + 1e-9)
+    if out.any():
+        k, j = np.argwhere(out)[0]
+        raise ValueError(f"waypoint {k} has joint {robot.joint_names[j]} at {W[k, j]:.4f} rad, outside its limits "
+                         f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]")
+    limits = resolve_limits(robot, velocity_limit=velocity_limit, acceleration_limit=acceleration_limit,
+                            torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
+    dt = positive(dt, "dt")
+    grid_step = positive(grid_step, "grid_step")
+    if interpolation not in INTERPOLATIONS:
+        raise ValueError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
+    schedule, holds = _segments(W, stops, hold_s)
+
+    from . import _topp  # toppra imports pyplot: only when a path is retimed
+
+    big = 1e6  # toppra needs finite limits; "none" is a limit no motion here comes near
+    # the path is parametrised by its length in joint space (rad): its speed s' is about the joints' speed, which
+    # their limits bound; where the path stands still they do not, and PATH_SPEED_FACTOR times their norm does
+    path_speed = PATH_SPEED_FACTOR * np.linalg.norm(np.minimum(limits.velocity, MAX_JOINT_SPEED))
+    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big), float(path_speed) ** 2)
+    acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
+    tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
+    solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
+                                  SOLVE_SHARE * limits.friction)
+
+    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
+        zero = np.zeros_like(q)
+        return (inverse_dynamics(robot, q, zero, dq, base, gravity="none"),
+                inverse_dynamics(robot, q, dq, ddq, base, gravity="none"),
+                inverse_dynamics(robot, q, zero, zero, base))
+
+    supports: dict[int, tuple[np.ndarray, Support]] = {}
+
+    def stability_params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
+        a, b = momentum_rate_coefficients(robot, q, dq, ddq, base)
+        support = supports.get(q.shape[0])
+        if support is None or not np.array_equal(support[0], q):
+            supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin))
+        F, g = stability_rows(robot, support[1], solve_limits, SOLVE_ZMP_EXTRA_M)
+        return a, b, np.zeros_like(a), F, g
+
+    tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
+    stab_c = _topp.PointwiseLinearConstraint(stability_params, n, identical=False, name="ZMP and friction")
+    constraints = [vel_c, acc_c, tau_c, stab_c]
+    timeline = _Timeline(n)
+    times = np.zeros(len(W))
+    notes: list[str] = []
+    for item in schedule:
+        if item[0] == "pause":
+            k = item[1]
+            timeline.add_pause(W[k + 1], float(holds[k]))
+            times[k + 1] = timeline.end
+            continue
+        _, i0, i1 = item
+        pts = W[i0:i1 + 1]
+        knots = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
+        f = _path_function(knots, pts, interpolation)
+        steps = np.maximum(MIN_GRID_PER_SEGMENT, np.ceil(np.diff(knots) / grid_step).astype(int))
+        grid = np.concatenate([np.linspace(knots[k], knots[k + 1], steps[k] + 1)[:-1] for k in range(len(steps))]
+                              + [knots[-1:]])
+        qg = f(grid, 0)
+        if interpolation == "spline":
+            over = np.maximum(robot.lower - qg, qg - robot.upper).max()
+            if over > 1e-9:
+                raise ValueError(f"the spline through waypoints {i0}..{i1} overshoots a joint limit by "
+                                 f"{np.degrees(over):.2f} deg; use interpolation='monotone'")
+        support = Support.of(robot, qg, base, limits.zmp_margin)
+        supports[len(grid)] = (qg, support)
+
+        def near(k: int) -> int:  # the waypoint at or before gridpoint k
+            return i0 + int(np.searchsorted(knots, grid[k], side="right")) - 1
+
+        _precheck(robot, base, limits, qg, support, near)
+        if np.any(support.required < limits.zmp_margin):
+            k = int(np.argmin(support.static))
+            notes.append(f"the CoM is only {1000 * support.static[k]:.1f} mm inside the support polygon near waypoint "
+                         f"{near(k)}: the ZMP keeps half that there instead of {1000 * limits.zmp_margin:.1f} mm")
+        path = _topp.GeometricPath(f, knots[-1], n)
+        first_size = len(grid)
+        for refinement in range(REFINE_ROUNDS + 1):
+            sd, K = _topp.solve(path, constraints, grid)
+            if sd is None:
+                bad = np.flatnonzero(np.isnan(K).any(axis=1))
+                k = int(bad.max()) if bad.size else 0
+                raise ValueError(f"no motion along the path keeps every limit near waypoint {near(k)} (between "
+                                 f"waypoints {i0} and {i1}); loosen the limits or the ZMP margin there")
+            if refinement == REFINE_ROUNDS:
+                break
+            split = _stages_over(robot, base, limits, f, grid, sd, supports[len(grid)][1])
+            if not split.any():
+                break
+            refined = _refined(grid, split)
+            if len(refined) > REFINE_GROWTH * first_size + REFINE_EXTRA_POINTS:  # not a local defect: say so rather than grow on
+                notes.append(f"waypoints {i0}..{i1}: {split.sum()} of {len(split)} stages still break a limit between "
+                             "gridpoints after refining; see check")
+                break
+            grid = refined
+        assert sd is not None  # the loop raised otherwise
+        t_grid = timeline.add_piece(f, grid, sd)
+        times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
+    t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
+    q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
+    q[0], q[-1] = W[0], W[-1]
+    check = check_limits(robot, q, qd, qdd, base, limits)
+    return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
+                             notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
+
+
+def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:
+    """The grid with each stage in ``split`` cut in four and its neighbours in two."""
+    ds = np.diff(grid)
+    near = split.copy()
+    near[1:] |= split[:-1]
+    near[:-1] |= split[1:]
+    new = [grid[:-1][near] + 0.5 * ds[near]]
+    new += [grid[:-1][split] + f * ds[split] for f in (0.25, 0.75)]
+    return np.unique(np.concatenate([grid] + new))
+
+
+def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f: PathFunction, grid: np.ndarray,
+                 sd: np.ndarray, support: Support) -> np.ndarray:
+    """(N-1,) bool: the stages of a solution that break a limit between their gridpoints (TOPP-RA keeps the limits
+    at the gridpoints only). Probed at PROBES points inside each stage, with its constant path acceleration; the
+    ZMP against the support polygon of the nearer gridpoint."""
+    x = sd ** 2
+    ds = np.diff(grid)
+    u = (x[1:] - x[:-1]) / (2 * ds)
+    frac = (np.arange(PROBES) + 0.5) / PROBES
+    stage = np.repeat(np.arange(len(ds)), PROBES)
+    fr = np.tile(frac, len(ds))
+    s = grid[stage] + fr * ds[stage]
+    xs = np.maximum(x[stage] + 2 * u[stage] * (s - grid[stage]), 0.0)
+    dq, ddq = f(s, 1), f(s, 2)
+    q, qd, qdd = f(s, 0), dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
+    nearer = np.where(fr < 0.5, stage, stage + 1)
+    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base),
+                  support.static[nearer], support.required[nearer])
+    r = _ratios(robot, base, limits, sub, q, qd, qdd)
+    over = np.zeros(len(s), bool)
+    for key in ("velocity", "acceleration", "torque", "friction"):
+        over |= r[key] > 1.0
+    over |= r["zmp_slack"] < -REFINE_ZMP_M
+    bad = np.zeros(len(ds), bool)
+    bad[stage[over]] = True
+    return bad
+
+
+def _precheck(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, q: np.ndarray, support: Support,
+              near: Callable[[int], int]) -> None:
+    """Clear errors for paths no timing can follow: holding still there already breaks a limit."""
+    if np.any(support.static <= 0):
+        k = int(np.argmin(support.static))
+        raise ValueError(f"the centre of mass is {-1000 * support.static[k]:.1f} mm outside the support polygon near "
+                         f"waypoint {near(k)}: no motion along this path is stable there")
+    hold = np.abs(inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base)) / limits.torque
+    if hold.max() > 1.0:
+        k, j = (int(i) for i in np.unravel_index(int(np.argmax(hold)), hold.shape))
+        raise ValueError(f"joint {robot.joint_names[j]} needs {hold[k, j] * limits.torque[j]:.2f} N m to hold the body "
+                         f"still near waypoint {near(k)}; its torque limit is {limits.torque[j]:.2f} N m")
