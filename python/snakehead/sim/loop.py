@@ -412,11 +412,14 @@ class ClosedLoop:
         def head_plan_here(label: str, dynamics_check: bool) -> Plan | None:
             """The head phases from the current estimate, the base kept, starting from the joints as they are
             (measured: they rest a few tenths of a degree from their commands, friction holding the links against
-            the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails."""
+            the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails.
+            A joint commanded to its limit rests a fraction of a milliradian past it (the servo's error): the
+            measured joints are clipped to the limits, which the retiming requires of every waypoint."""
             nonlocal planning
             t0 = time.perf_counter()
+            q_measured = np.clip(sim.joint_angles(), robot.lower, robot.upper)
             p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
-                     start_q=sim.joint_angles(), timing=self.timing)
+                     start_q=q_measured, timing=self.timing)
             planning += time.perf_counter() - t0
             why = p.failure if p.failure is not None else self._dynamics_check(p) if dynamics_check else None
             if why is None:
