@@ -230,7 +230,9 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
     label = scene.description or name
     files = []
     with progress.stage(f"{name}: figures"):
-        if solution_figure and result.targets:
+        # the figure draws the paper's segmented solve (Fig. 8); a target solved by another stage of the whole-body
+        # solve (e.g. continued from the previous joints) has none to draw
+        if solution_figure and result.targets and getattr(result.targets[0].solution, "desired_frame", None) is not None:
             files.append(save(body.plot_head_solution(robot, result.targets[0].solution),
                               out / f"{name}_solution.png").name)
         cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3

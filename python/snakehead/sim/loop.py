@@ -10,7 +10,8 @@ the pose estimated after the last one, as the robot would do it.
 
 1. **Where the base must go.** ``plan(..., allow_relocation=True)`` from where the curl into the bending state would
    leave the base (:func:`snakehead.motion.locomotion.curl_displacement`, the quasi-static friction model): that
-   placement when the plan succeeds from it, else the relocation's (the plan then starts there). The placement of a
+   placement when the plan succeeds from it, else the relocation's (the plan then starts there); when that plan
+   fails, the same from the scene's own placement. The placement of a
    successful plan is the loop's goal.
 2. **Locomotion** (when the curl from here would not leave the base at the goal, within
    :class:`~snakehead.motion.locomotion.Tolerance`): the body uncurls if it is curled, then gait runs
@@ -435,14 +436,23 @@ class ClosedLoop:
                            "corrections")
                 break
             if goal is None:
-                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be
+                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be;
+                # when that fails (a relocation is found for the targets one by one, and the path between them
+                # may still tip the body), the scene's own placement (the default one for a scene without)
                 after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-                t0 = time.perf_counter()
-                first = plan(self.scene, controller=self.controller, base=after_curl, allow_relocation=True,
-                             timing=self.timing)
-                planning += time.perf_counter() - t0
+                tried = []
+                for candidate in (after_curl, as_base(self.scene.base)):
+                    t0 = time.perf_counter()
+                    first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
+                                 timing=self.timing)
+                    planning += time.perf_counter() - t0
+                    if first.success:
+                        break
+                    tried.append(f"from {_fmt(candidate)}: {first.failure}")
+                    notes.append(f"the plan from {_fmt(candidate)} fails ({first.failure})")
+                    say(notes[-1])
                 if not first.success:
-                    failure = f"no plan reaches the targets from {_fmt(after_curl)}: {first.failure}"
+                    failure = "no plan reaches the targets " + "; nor ".join(tried)
                     break
                 goal, q_bend = first.base, first.states[0][2].copy()
                 if first.relocation is not None:
