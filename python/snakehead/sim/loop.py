@@ -10,8 +10,9 @@ the pose estimated after the last one, as the robot would do it.
 
 1. **Where the base must go.** ``plan(..., allow_relocation=True)`` from where the curl into the bending state would
    leave the base (:func:`snakehead.motion.locomotion.curl_displacement`, the quasi-static friction model): that
-   placement when the plan succeeds from it, else the relocation's (the plan then starts there); when that plan
-   fails, the same from the scene's own placement. The placement of a
+   placement when the plan succeeds from it, else the relocation's (the plan then starts there), checked in
+   dynamics as in 6; when that fails, the same from the scene's own placement, then placements near a plan that
+   passed its own checks but tipped in dynamics. The placement of a
    successful plan is the loop's goal.
 2. **Locomotion** (when the curl from here would not leave the base at the goal, within
    :class:`~snakehead.motion.locomotion.Tolerance`): the body uncurls if it is curled, then gait runs
@@ -345,15 +346,22 @@ class ClosedLoop:
                     f"{1000 * -check['zmp_min_margin_m']:.1f} mm and the base lifts {1000 * check['base_lift_m']:.1f} mm")
         return None
 
+    def _goal_failure(self, p: Plan) -> str | None:
+        """Why the head phases planned at a candidate goal would fail: the plan's own failure, else its dynamics
+        check (when the loop checks); None when they pass."""
+        if p.failure is not None:
+            return p.failure
+        return self._dynamics_check(p) if self.dynamics_check else None
+
     def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
         """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
-        phases are planned successfully, the nearest first; None if there is none."""
+        phases are planned successfully and pass the dynamics check, the nearest first; None if there is none."""
         d, a = NEARBY_STEP_M, math.radians(NEARBY_STEP_DEG)
         for offset in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a)):
             candidate = lc.compose(goal, BasePlacement(*offset))
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
                      base_shape=q_bend, timing=self.timing)
-            if p.success:
+            if self._goal_failure(p) is None:
                 return candidate
         return None
 
@@ -436,27 +444,35 @@ class ClosedLoop:
                            "corrections")
                 break
             if goal is None:
-                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be;
-                # when that fails (a relocation is found for the targets one by one, and the path between them
-                # may still tip the body), the scene's own placement (the default one for a scene without)
+                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be,
+                # checked in dynamics at its own start (a relocated base's plan can pass its static checks and still
+                # tip the body in MuJoCo: then every attempt to reach that goal fails); when it fails, the scene's
+                # own placement (the default one for a scene without); then placements near a plan that tipped
                 after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-                tried = []
+                tried, tipped = [], None
+                t0 = time.perf_counter()
                 for candidate in (after_curl, as_base(self.scene.base)):
-                    t0 = time.perf_counter()
                     first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
                                  timing=self.timing)
-                    planning += time.perf_counter() - t0
-                    if first.success:
+                    why = self._goal_failure(first)
+                    if why is None:
+                        goal, q_bend = first.base, first.states[0][2].copy()
                         break
-                    tried.append(f"from {_fmt(candidate)}: {first.failure}")
-                    notes.append(f"the plan from {_fmt(candidate)} fails ({first.failure})")
+                    if first.failure is None and tipped is None:
+                        tipped = first
+                    tried.append(f"from {_fmt(candidate)}: {why}")
+                    notes.append(f"the plan from {_fmt(candidate)} fails ({why})")
                     say(notes[-1])
-                if not first.success:
+                if goal is None and tipped is not None:
+                    goal = self._nearby_goal(tipped.base, tipped.states[0][2])
+                    if goal is not None:
+                        q_bend = tipped.states[0][2].copy()
+                planning += time.perf_counter() - t0
+                if goal is None:
                     failure = "no plan reaches the targets " + "; nor ".join(tried)
                     break
-                goal, q_bend = first.base, first.states[0][2].copy()
-                if first.relocation is not None:
-                    say(f"the base must go to {_fmt(goal)} ({first.relocation.reason})")
+                if goal != after_curl:
+                    say(f"the base must go to {_fmt(goal)}")
             else:  # a correction: closer to the goal than last time, or to another goal nearby
                 tolerance = tolerance.tighter()
                 straight_here = lc.compose(lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend)),
