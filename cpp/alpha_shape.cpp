@@ -9,12 +9,9 @@
 #include <numeric>
 #include <string>
 
-extern "C" {
-#include <libqhull_r/qhull_ra.h>
-}
-
 #include "snakehead/model.hpp"
 #include "snakehead/workspace.hpp"
+#include "qhull_run.hpp"
 
 namespace snakehead {
 namespace {
@@ -64,18 +61,9 @@ AlphaShape AlphaShape::boundary(const std::vector<Eigen::Vector3d>& points, doub
 
   // Delaunay triangulation: the lower hull of the points lifted onto a paraboloid (qhull "d").
   // Qbb scales the lifted coordinate for precision; Qt triangulates, so every facet is a tetrahedron.
-  std::vector<coordT> coords(points.size() * 3);
-  for (std::size_t k = 0; k < points.size(); ++k)
-    for (int d = 0; d < 3; ++d) coords[3 * k + d] = points[k][d];
-  qhT qh_storage;
-  qhT* qh = &qh_storage;
-  std::FILE* err = std::tmpfile();
-  qh_zero(qh, err ? err : stderr);
-  char flags[] = "qhull d Qbb Qt";
-  const int status = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, flags, nullptr,
-                                  err ? err : stderr);
-  std::string message;
-  if (status == 0) {
+  QhullRun run(points, "qhull d Qbb Qt");
+  qhT* qh = run.qh;
+  if (run.ok()) {
     std::vector<int> tet_of(qh->facet_id, -1);  // qhull facet id -> tetrahedron index
     facetT* facet;
     vertexT *vertex, **vertexp;
@@ -106,18 +94,9 @@ AlphaShape AlphaShape::boundary(const std::vector<Eigen::Vector3d>& points, doub
           if (std::find(uv.begin(), uv.end(), tv[i]) == uv.end()) s.neighbours_[t][i] = u;
       }
     }
-  } else if (err) {
-    std::rewind(err);
-    char buf[512];
-    while (std::fgets(buf, sizeof buf, err) && message.size() < 400) message += buf;
   }
-  qh_freeqhull(qh, !qh_ALL);
-  int curlong = 0, totlong = 0;
-  qh_memfreeshort(qh, &curlong, &totlong);
-  if (err) std::fclose(err);
-  if (status != 0 || s.tets_.empty())
-    throw InputError("the tip's point cloud spans no volume, so it has no boundary (qhull: " +
-                     message.substr(0, message.find('\n')) + ")");
+  if (!run.ok() || s.tets_.empty())
+    throw InputError("the tip's point cloud spans no volume, so it has no boundary (qhull: " + run.error() + ")");
 
   s.radius_.resize(s.tets_.size());
   for (std::size_t t = 0; t < s.tets_.size(); ++t) {

@@ -15,15 +15,12 @@
 #include <random>
 #include <thread>
 
-extern "C" {
-#include <libqhull_r/qhull_ra.h>
-}
-
 #include "snakehead/alpha_shape.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
 #include "snakehead/trac_ik.hpp"
+#include "qhull_run.hpp"
 
 namespace snakehead {
 namespace {
@@ -257,21 +254,10 @@ Eigen::Vector3d VoxelGrid::centre_of(std::int64_t k) const {
 
 ConvexHull ConvexHull::of(const std::vector<Eigen::Vector3d>& points) {
   if (points.size() < 4) throw InputError("a convex hull in 3-D needs at least 4 points");
-  std::vector<coordT> coords(points.size() * 3);
-  for (std::size_t k = 0; k < points.size(); ++k)
-    for (int d = 0; d < 3; ++d) coords[3 * k + d] = points[k][d];
-
-  qhT qh_storage;
-  qhT* qh = &qh_storage;
-  // Qhull reports errors by printing them; keep them for the exception message.
-  std::FILE* err = std::tmpfile();
-  qh_zero(qh, err ? err : stderr);
-  char flags[] = "qhull Qt";  // Qt: triangulated output (simplicial facets, planes as computed)
-  const int status = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, flags, nullptr,
-                                  err ? err : stderr);
+  QhullRun run(points, "qhull Qt");  // Qt: triangulated output (simplicial facets, planes as computed)
+  qhT* qh = run.qh;
   ConvexHull hull;
-  std::string message;
-  if (status == 0) {
+  if (run.ok()) {
     std::vector<Eigen::Vector3d> normals;
     std::vector<double> offsets;
     facetT* facet;
@@ -288,18 +274,9 @@ ConvexHull ConvexHull::of(const std::vector<Eigen::Vector3d>& points) {
     hull.n_vertices = qh->num_vertices;
     qh_getarea(qh, qh->facet_list);
     hull.volume = qh->totvol;
-  } else if (err) {
-    std::rewind(err);
-    char buf[512];
-    while (std::fgets(buf, sizeof buf, err) && message.size() < 400) message += buf;
   }
-  qh_freeqhull(qh, !qh_ALL);
-  int curlong = 0, totlong = 0;
-  qh_memfreeshort(qh, &curlong, &totlong);
-  if (err) std::fclose(err);
-  if (status != 0)
-    throw InputError("the tip's point cloud spans no volume, so it has no convex hull (qhull: " +
-                     message.substr(0, message.find('\n')) + ")");
+  if (!run.ok())
+    throw InputError("the tip's point cloud spans no volume, so it has no convex hull (qhull: " + run.error() + ")");
   return hull;
 }
 

@@ -6,6 +6,7 @@ import pytest
 import snakehead
 from snakehead import SnakeRobot
 from snakehead.control.controller import HeadController
+from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.motion import planner
 from snakehead.scenes import paper_scene
@@ -40,6 +41,9 @@ def check(result, robot):
         T = robot.head_pose(result.q[k], result.base)
         assert np.linalg.norm(T[:3, 3] - tg.position) <= 1e-4
         assert np.degrees(np.arccos(np.clip(T[:3, 0] @ tg.direction, -1, 1))) <= 0.05
+        # a target's state keeps the static margin the moves to and from it keep (else no path leaves it stably)
+        margin = stability.static_margin(robot, result.q[k], result.base, contact="ground")
+        assert margin >= planner.DETOUR_MARGIN - 1e-6, (tg.name, margin)
     assert result.stability.inside.all(), f"ZMP outside at t = {result.t[result.stability.argmin]:.3f} s"
     below = coll.below_ground(robot, result.q, result.base)
     assert not below.any()

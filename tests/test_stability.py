@@ -107,6 +107,27 @@ def test_ground_contact_model_counts_every_link_lying_down(robot):
                                st.support_polygon(robot, q, contact="footprint"), atol=1e-12)
 
 
+@pytest.mark.parametrize("pitch", [-0.005, -0.01, -0.02, -0.05])
+def test_ground_contact_counts_only_the_corners_that_touch(robot, pitch):
+    """A link tilted up off the ground rests on its lowest edge: the corners it holds in the air do not support the
+    body (counting them moved the polygon's edge out by a link's length and made it jump as the link lifted).
+    Independent: scipy's convex hull of every box corner within the contact tolerance of the ground."""
+    from scipy.spatial import ConvexHull
+
+    q = np.zeros(16)
+    q[7] = pitch  # the neck's first pitch joint lifts the neck and head a little
+    corners = robot.box_corners(robot.frames(q)[None], robot.boxed_links)[0].reshape(-1, 3)
+    touching = corners[corners[:, 2] <= st.CONTACT_TOLERANCE, :2]
+    hull = touching[ConvexHull(touching).vertices]
+    poly = st.support_polygon(robot, q, contact="ground")
+    assert len(poly) == len(hull)
+    for v in hull:
+        assert np.min(np.linalg.norm(poly - v, axis=1)) < 1e-9
+    # a tilted link's far corners are in the air: the polygon ends before the lifted link's far end
+    far_end = robot.frames(q)[-1, 0, 3]
+    assert poly[:, 0].max() < far_end - 0.1
+
+
 def test_static_margin_closed_form(robot):
     # straight robot: CoM at x = 0.692 > 0.646 (end of the base): outside by 0.046 m
     assert st.static_margin(robot, np.zeros(16)) == pytest.approx(-(0.692 - 0.646), abs=1e-12)

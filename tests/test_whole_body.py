@@ -90,6 +90,25 @@ def test_gradients_match_finite_differences(default):
         np.testing.assert_allclose(np.atleast_2d(e[jac]), fd, atol=1e-6)
 
 
+def test_segment_closest_matches_dense_sampling():
+    """The capsules' closest points (Ericson 5.1.9), against a brute-force search over both segments; parallel,
+    crossing and degenerate (point) segments included."""
+    rng = np.random.default_rng(7)
+    p1, q1, p2, q2 = (rng.normal(size=(60, 3)) for _ in range(4))
+    q2[:10] = p2[:10] + 2.0 * (q1[:10] - p1[:10])  # parallel
+    q1[10:15] = p1[10:15]  # a point against a segment
+    q2[15:20], q1[15:20] = p2[15:20], p1[15:20]  # two points
+    s, t = coll.segment_closest(p1, q1, p2, q2)
+    assert np.all((0 <= s) & (s <= 1) & (0 <= t) & (t <= 1))
+    found = np.linalg.norm(p1 + s[:, None] * (q1 - p1) - p2 - t[:, None] * (q2 - p2), axis=1)
+    u = np.linspace(0.0, 1.0, 401)
+    a = p1[:, None] + u[None, :, None] * (q1 - p1)[:, None]  # (60, 401, 3)
+    b = p2[:, None] + u[None, :, None] * (q2 - p2)[:, None]
+    brute = np.linalg.norm(a[:, :, None] - b[:, None], axis=-1).min(axis=(1, 2))
+    assert np.all(found <= brute + 1e-12)
+    assert np.all(found >= brute - 2e-2 * np.linalg.norm(q1 - p1, axis=1).clip(1e-3))
+
+
 def test_hull_indices_match_qhull():
     from scipy.spatial import ConvexHull
 

@@ -172,6 +172,19 @@ TEST(AlphaShape, BadClouds) {
   std::vector<Eigen::Vector3d> flat;
   for (int k = 0; k < 50; ++k) flat.emplace_back(k % 7, k / 7, 0.0);
   EXPECT_THROW(AlphaShape::boundary(flat, 0.5), InputError);
+  // A flat cloud reaches qhull, which fails: the error says why in one line, for both kinds of hull.
+  for (int kind = 0; kind < 2; ++kind) {
+    try {
+      if (kind == 0) AlphaShape::boundary(flat, 0.5);
+      else ConvexHull::of(flat);
+      ADD_FAILURE() << "no error for a flat cloud";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("spans no volume"), std::string::npos) << what;
+      EXPECT_NE(what.find("(qhull: Q"), std::string::npos) << what;  // qhull's own message, e.g. "QH6154 ..."
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
   EXPECT_THROW(AlphaShape::boundary({Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()}, 0.5), InputError);
   auto cloud = random_cloud(50, 1);
   cloud[3].x() = std::nan("");

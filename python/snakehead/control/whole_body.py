@@ -234,24 +234,6 @@ class BodyProblem:
         return margin, g
 
 
-def _segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> Any:
-    """Closest points of segments [p1, q1], [p2, q2] (arrays (..., 3)): (s, t) parameters (Ericson 5.1.9)."""
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a = np.sum(d1 * d1, -1)
-    e = np.sum(d2 * d2, -1)
-    f = np.sum(d2 * r, -1)
-    c = np.sum(d1 * r, -1)
-    b = np.sum(d1 * d2, -1)
-    den = a * e - b * b
-    eps = 1e-18
-    s = np.where(den > eps, np.clip((b * f - c * e) / np.where(den > eps, den, 1.0), 0.0, 1.0), 0.0)
-    t = np.where(e > eps, (b * s + f) / np.where(e > eps, e, 1.0), 0.0)
-    t_c = np.clip(t, 0.0, 1.0)
-    s_c = np.where(a > eps, np.clip((t_c * b - c) / np.where(a > eps, a, 1.0), 0.0, 1.0), 0.0)
-    s = np.where((t < 0.0) | (t > 1.0), s_c, s)
-    return s, t_c
-
-
 def _direction_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors orthogonal to d and to each other."""
     helper = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
@@ -286,7 +268,7 @@ class _Objective:
         F = prob.frames(self.q_template, base0)
         ends = prob.capsules(F)
         i, j = prob.pairs[:, 0], prob.pairs[:, 1]
-        s_, t_ = _segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
+        s_, t_ = coll.segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
         gap = np.linalg.norm(ends[i, 0] + s_[:, None] * (ends[i, 1] - ends[i, 0])
                              - ends[j, 0] - t_[:, None] * (ends[j, 1] - ends[j, 0]), axis=1)
         ground = np.isin(prob.boxed[i], prob.ground_links) & np.isin(prob.boxed[j], prob.ground_links)
@@ -353,7 +335,7 @@ class _Objective:
         # self: capsule distances of the pairs
         ends = prob.capsules(F)
         i, j = self.pairs[:, 0], self.pairs[:, 1]
-        s, t = _segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
+        s, t = coll.segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
         pa = ends[i, 0] + s[:, None] * (ends[i, 1] - ends[i, 0])
         pb = ends[j, 0] + t[:, None] * (ends[j, 1] - ends[j, 0])
         diff = pa - pb

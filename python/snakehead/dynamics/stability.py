@@ -91,7 +91,10 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     low = np.take_along_axis(world, order[..., None], axis=2)  # (T, k, 4, 3)
     T = frames.shape[0]
     pts = low[..., :2].reshape(T, -1, 2)
-    active = np.repeat(on_ground, 4, axis=1)
+    # a corner supports only where it touches: a link tilted up off the ground (a neck link rising from it) rests on
+    # its lowest edge, not on the corners it holds in the air (counting those would move the polygon's edge out by
+    # the link's length and make it jump as the link lifts)
+    active = (low[..., 2] <= tolerance).reshape(T, -1)
     return pts, active
 
 

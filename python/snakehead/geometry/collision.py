@@ -157,9 +157,10 @@ def _point_box_distance(p: np.ndarray, c: np.ndarray, R: np.ndarray, h: np.ndarr
     return np.linalg.norm(np.maximum(np.abs(loc) - h, 0.0), axis=-1)
 
 
-def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Distance between segments [p1, q1] and [p2, q2], arrays (..., 3) (Ericson, Real-Time Collision
-    Detection, 5.1.9), vectorised, degenerate segments included."""
+def segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Parameters (s, t) in [0, 1] of the closest points p1 + s (q1 - p1) and p2 + t (q2 - p2) of segments
+    [p1, q1] and [p2, q2], arrays (..., 3) (Ericson, Real-Time Collision Detection, 5.1.9), vectorised,
+    degenerate segments included."""
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
     a = np.sum(d1 * d1, -1)
     e = np.sum(d2 * d2, -1)
@@ -174,10 +175,13 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     # t outside [0, 1]: clamp it and recompute s
     t_c = np.clip(t, 0.0, 1.0)
     s_c = np.where(a > eps, np.clip((t_c * b - c) / np.where(a > eps, a, 1.0), 0.0, 1.0), 0.0)
-    redo = (t < 0.0) | (t > 1.0)
-    s = np.where(redo, s_c, s)
-    t = t_c
-    diff = (p1 + s[..., None] * d1) - (p2 + t[..., None] * d2)
+    return np.where((t < 0.0) | (t > 1.0), s_c, s), t_c
+
+
+def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Distance between segments [p1, q1] and [p2, q2], arrays (..., 3)."""
+    s, t = segment_closest(p1, q1, p2, q2)
+    diff = (p1 + s[..., None] * (q1 - p1)) - (p2 + t[..., None] * (q2 - p2))
     return np.linalg.norm(diff, axis=-1)
 
 

@@ -478,7 +478,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
             return "the start", None
         for t in targets:
             sol = solve_target(controller, t.position, t.direction, q_prev=q_shape, base=b, obstacles=obstacles,
-                               allow_base_move=False, problem=controller.body_problem)
+                               allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
             if not sol.success:
                 return t, sol
         return None, None
@@ -496,7 +496,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
     for t in order:
         sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
-                           allow_base_move=True, problem=controller.body_problem)
+                           allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
         if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
                                                                    q0[:robot.lift_joints.start])):
             continue
@@ -527,7 +527,7 @@ def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarr
     from ..control.whole_body import solve_target
 
     sol = solve_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
-                       allow_base_move=False, problem=controller.body_problem, near=near)
+                       allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN, near=near)
     if not sol.success:
         notes.append(f"{name}: {sol.message}")
     return sol
