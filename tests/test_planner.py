@@ -99,6 +99,14 @@ def test_wall_stands_on_the_ground():
     assert wall.distance_to_points((HOLE_CENTRE + [0, 0, -0.05])[None])[0] == 0.0
 
 
+def test_bending_state_of_a_base_with_no_stable_curl(controller):
+    """A straight base has no support polygon with an interior (its contact points are collinear): no curl is
+    stable on it. The bending state says so (it failed on an empty array before, and crashed the planner's choice
+    of a base for a random target)."""
+    with pytest.raises(ValueError, match="no curl of the neck and head"):
+        planner.bending_state(controller, np.zeros(controller.robot.n_joints))
+
+
 def test_bending_state(controller):
     robot = controller.robot
     q = planner.bending_state(controller)

@@ -415,7 +415,8 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
     margin = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
     order = np.argsort(-margin)
-    for chunk in np.array_split(order[margin[order] > 0], max(1, int(np.sum(margin > 0)) // 500 + 1)):
+    stable = order[margin[order] > 0]
+    for chunk in np.array_split(stable, max(1, stable.size // 500 + 1)) if stable.size else []:
         ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
         if ok.any():
             cache[key] = qs[chunk[np.argmax(ok)]]
@@ -473,8 +474,13 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
                     > OBSTACLE_CLEARANCE)
 
     def failing(b: Any, q_shape: Any) -> Any:
-        """The first target not solved from this base (None: all are), or the start state in an obstacle."""
-        if not clear(bending_state(controller, q_shape), b):
+        """The first target not solved from this base (None: all are), or why the start state is not usable
+        ("no curl": the base's shape holds no stable curl of the neck and head; "the start": it is in an obstacle)."""
+        try:
+            q_bend = bending_state(controller, q_shape)
+        except ValueError:
+            return "no curl", None
+        if not clear(q_bend, b):
             return "the start", None
         for t in targets:
             sol = solve_target(controller, t.position, t.direction, q_prev=q_shape, base=b, obstacles=obstacles,
@@ -490,10 +496,11 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     if first is None:
         return start, q0.copy(), None, []
     reason = ("the start state touches an obstacle" if first == "the start" else
+              "no curl of the neck and head on the ground is stable on the start's base" if first == "no curl" else
               f"target {first.name!r} is not reached from the start ({why.reason})")
     if not allow_relocation:
         return start, q0.copy(), None, [f"the base is kept (no relocation allowed): {reason}"]
-    order = ([first] if first != "the start" else []) + [t for t in targets if t is not first]
+    order = ([first] if first not in ("the start", "no curl") else []) + [t for t in targets if t is not first]
     for t in order:
         sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
                            allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
