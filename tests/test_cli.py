@@ -251,6 +251,13 @@ BAD = [
     (["plan", "--scene", "{file}", "--position", "0", "0.5", "0.3", "--out", "{tmp}/o"], "not both"),
     (["plan", "--out", "{tmp}/o"], "--position"),
     (["workspace", "--out", "{tmp}/map.npz", "--shard", "3/2", "--quiet"], "shard"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "1", "0", "--start", "0", "nan", "0", "--out",
+      "{tmp}/o"], "finite"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "1", "0", "--start", "0", "0", "--out",
+      "{tmp}/o"], "expected 3 arguments"),
+    (["plan", "--position", "0", "0.5", "0.3", "--direction", "0", "1", "0", "--start", "0", "0", "0", "--no-sim",
+      "--out", "{tmp}/o"], "--no-sim"),
+    (["demo", "--out", "{tmp}/o", "--start", "1", "2"], "X Y YAW"),
 ]
 
 

@@ -166,6 +166,27 @@ def _settings(args: argparse.Namespace) -> Any:
     return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)
 
 
+def _start(args: argparse.Namespace, paper_default: bool) -> Any:
+    """What --start asks for: None (not given), the pipeline's PAPER_START (demo's bare --start) or the tail's
+    placement (X Y YAW); a usage error without the simulation the loop runs in."""
+    from ..model.robot import BasePlacement
+    from .pipeline import PAPER_START, mujoco_available
+
+    values = getattr(args, "start", None)
+    if values is None:
+        return None
+    if args.no_sim:
+        raise UsageError("--start runs the closed loop in MuJoCo (gaits, the curl, the head phases): drop --no-sim")
+    if not mujoco_available():
+        raise UsageError("--start needs MuJoCo, which is not installed (pip install snakehead[sim])")
+    if len(values) == 0 and paper_default:
+        return PAPER_START
+    if len(values) != 3:
+        raise UsageError(f"--start takes X Y YAW (the tail's position in m and the body's heading in rad), got "
+                         f"{len(values)} value{'' if len(values) == 1 else 's'}")
+    return BasePlacement(*values)
+
+
 def _done(command: str, out: Path, report: dict, progress: Any) -> int:
     entries = report["scenarios"]
     ok = all(e["success"] for e in entries.values())
@@ -181,10 +202,12 @@ def _demo(args: argparse.Namespace) -> int:
     from ..scenes import paper_scene
     from .pipeline import Progress, run_scenes
 
+    start = _start(args, paper_default=True)
     out = _writable_dir(args.out)
     robot = _robot(args)
     progress = Progress()
-    progress.say(f"snakehead demo -> {out}{' (--fast)' if args.fast else ''}")
+    progress.say(f"snakehead demo -> {out}{' (--fast)' if args.fast else ''}"
+                 f"{'' if start is None else ' from lying straight (--start)'}")
     notes = ["the simulated wall is boxes: the round hole is a staircase of strips inscribed in it "
              "(sim.obstacle_boxes), standing on the ground",
              "planned errors are the head's by forward kinematics of the planned joints; the simulated ones are "
@@ -192,7 +215,7 @@ def _demo(args: argparse.Namespace) -> int:
              "(our max_*_momentum_magnitude_error), ours without 'magnitude' are of the vector difference"]
     report = run_scenes([paper_scene("spheres"), paper_scene("hole")], out, robot=robot,
                         workspace_map=_map(args, robot), settings=_settings(args), progress=progress,
-                        command="demo", notes=notes)
+                        command="demo", notes=notes, start=start)
     return _done("demo", out, report, progress)
 
 
@@ -213,6 +236,7 @@ def _plan(args: argparse.Namespace) -> int:
         scene = load_scene(args.scene)
     if args.robot is None and scene.robot_file is not None:
         args.robot = scene.robot_file
+    start = _start(args, paper_default=False)
     out = _writable_dir(args.out)
     robot = _robot(args)
     progress = Progress()
@@ -220,7 +244,7 @@ def _plan(args: argparse.Namespace) -> int:
             f"{np.round(scene.targets[0].direction, 4).tolist()}" if args.scene is None else f"scene {scene.name!r}")
     progress.say(f"snakehead plan: {what} -> {out}")
     report = run_scenes([scene], out, robot=robot, workspace_map=_map(args, robot), settings=_settings(args),
-                        progress=progress, command="plan", solution_figure=True)
+                        progress=progress, command="plan", solution_figure=True, start=start)
     return _done("plan", out, report, progress)
 
 
@@ -311,6 +335,8 @@ _OUTPUTS = """outputs (in DIR):
   NAME.html                 the interactive 3-D viewer of the motion: opens from disk, no server, no network
   NAME_viewer.npz           what the viewer shows (link boxes per frame, targets, obstacles, ZMP, the head's map);
                             snakehead view DIR serves it
+  NAME_path.png             with --start: the tail's path over the ground with the phases, from above
+  NAME_loop.gif             with --start: the whole sequence (gaits, curl, lift, targets) as MuJoCo ran it
 """
 
 
@@ -334,11 +360,17 @@ def build_parser() -> argparse.ArgumentParser:
     _add_robot_option(p)
     p.set_defaults(func=_info)
 
-    _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",
+    demo = _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",
                      "Plan the paper's two scenarios (catching two spheres, Section 4.1; getting the head through a "
                      "hole in a wall, Section 4.2; on the default robot unless --robot), check them in MuJoCo (the "
                      "hole's wall included), and write a report, trajectories, figures and animations. NAME is "
                      "spheres and hole.")
+    demo.add_argument("--start", type=_finite_float, nargs="*", default=None, metavar="X Y YAW",
+                      help="start from the body lying straight, as the paper does (its 'current state'), and run "
+                           "the closed loop in MuJoCo (gaits, the curl into the bending state, the head phases): "
+                           "bare --start lies where the curl alone brings the base to the scene's placement; "
+                           "--start X Y YAW puts the tail at (X, Y) m with the body along YAW rad. Adds "
+                           "NAME_path.png and NAME_loop.gif, and phases to the report")
     p = _planning_parser(sub, "plan", _plan, "head targets: --position/--direction, or a scene file",
                          "Plan the head from the bending state on the ground to POSITION pointing along DIRECTION "
                          "(world frame, z up, ground at z = 0), or through the targets of a scene file (--scene; "
@@ -351,6 +383,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scene", default=None, metavar="SCENE.toml",
                    help="a scene file: targets (name, position, direction, hold_s, ...) and obstacles; its robot "
                         "file is used unless --robot is given")
+    p.add_argument("--start", type=_finite_float, nargs=3, default=None, metavar=("X", "Y", "YAW"),
+                   help="start from the body lying straight with its tail at (X, Y) m and its body along YAW rad "
+                        "(world) and run the closed loop in MuJoCo: gaits that move the body where the targets need "
+                        "its base, the curl into the bending state, the head phases. Adds NAME_path.png and "
+                        "NAME_loop.gif, and phases to the report")
 
     p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
                        description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "

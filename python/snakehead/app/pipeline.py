@@ -21,8 +21,9 @@ from . import report as rep
 if TYPE_CHECKING:
     from ..control.controller import HeadController
     from ..kinematics.workspace import ReachabilityMap
-    from ..model.robot import SnakeRobot
+    from ..model.robot import BasePlacement, SnakeRobot
     from ..scenes.scene import Scene
+    from ..sim.loop import LoopRun
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
@@ -133,6 +134,91 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
     return entry
 
 
+#: ``start`` of :func:`run_scenes` for the paper's "current state": lying straight where the curl into the bending
+#: state alone brings the base to the scene's placement (Fig. 17a before 17b).
+PAPER_START = "paper"
+
+#: What every report of a closed loop says about how it closes (snakehead.sim.loop, step 5).
+LOOP_ASSUMPTION = ("closed loop: gaits and curls are steered by dead reckoning (joint angles, one IMU, friction-balance "
+                   "contact odometry); once the body rests in the bending state, an outside measurement of the pose of "
+                   "the neck's base frame (the paper's 'obtained in time'; here MuJoCo's, with {noise}) fixes the "
+                   "base's placement before the head phases are planned")
+
+
+def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress,
+                   start: BasePlacement | str, *, solution_figure: bool = False) -> dict:
+    """One scene from the body lying straight at ``start`` (a placement of its tail, or :data:`PAPER_START`) by the
+    closed loop (:class:`snakehead.sim.loop.ClosedLoop`): gaits, the curl, the head phases, all in MuJoCo. Its report
+    entry has what :func:`run_scene`'s has for the head phases, and ``phases``, ``sim.base_travel_m``,
+    ``estimate``, ``start``, ``total_time_s``; the files add ``NAME_path.png`` (the path from above) and
+    ``NAME_loop.gif`` (the whole sequence)."""
+    from ..sim.loop import ClosedLoop
+
+    s = FAST if settings.fast else NORMAL
+    name = scene.name
+    loop = ClosedLoop(scene, controller=controller)
+    if isinstance(start, str):
+        if start != PAPER_START:
+            raise ValueError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
+        begin = loop.straight_start()
+    else:
+        begin = start
+    with progress.stage(f"{name}: closed loop from lying straight, tail at ({begin.x:.3f}, {begin.y:.3f}) m, "
+                        f"heading {begin.yaw:.3f} rad"):
+        run = loop.run(begin, progress=lambda text: progress.say(f"{name}: {text}"))
+    if run.metrics is not None:
+        m = run.metrics
+        progress.say(f"{name}: simulated head error {1000 * m['position_error_m']:.2f} mm / "
+                     f"{m['direction_error_deg']:.2f} deg; ZMP inside: {m['zmp_inside']}; the tail travelled "
+                     f"{run.base_travel_m:.2f} m in {run.total_time_s:.1f} s")
+    else:
+        progress.say(f"{name}: the loop did not reach the head phases: {run.failure}")
+    files: list[str] = []
+    if run.plan is not None:
+        files.append(rep.write_trajectory_csv(run.plan, out / f"{name}_trajectory.csv", controller.robot.joint_names)
+                     .name)
+    if settings.figures:
+        if run.phases:  # a loop that failed before its first phase has no path to draw
+            files += _loop_figures(scene, run, out, s, progress)
+        if run.plan is not None:
+            files += _plan_outputs(scene, run.plan, out, s, progress, solution_figure, controller.map)
+            files += _dynamics_figures(scene, run.plan, run.head, out, progress)
+    return loop_entry(run, files)
+
+
+def loop_entry(run: LoopRun, files: Sequence[str] = ()) -> dict:
+    """The report entry of a closed loop (see :func:`run_loop_scene`)."""
+    part = run.report()
+    if run.plan is not None:
+        entry = rep.scenario_entry(run.plan, run.metrics)
+    else:  # the loop never got to plan the head phases
+        entry = {"success": False, "failure": run.failure, "targets": [], "min_zmp_margin_m": None,
+                 "min_ground_clearance_m": None, "planning_time_s": run.planning_time_s, "sim": None,
+                 "duration_s": None, "samples": 0, "control_period_s": None,
+                 "base": part["start"], "notes": []}
+    entry["sim"] = {**(entry.get("sim") or {}), **part.pop("sim")}
+    entry.update(part)
+    entry["success"] = bool(entry["success"] and run.success)
+    entry["failure"] = run.failure or entry.get("failure")
+    noise = ("no fix" if run.fix is None else
+             f"{1000 * run.fix.position_noise_m:g} mm and {run.fix.yaw_noise_deg:g} deg of noise")
+    entry["notes"] = list(entry.get("notes") or []) + list(run.notes) + [LOOP_ASSUMPTION.format(noise=noise)]
+    entry["files"] = list(files)
+    return rep.jsonable(entry)
+
+
+def _loop_figures(scene: Scene, run: LoopRun, out: Path, s: dict, progress: Progress) -> list[str]:
+    """The path from above and the animation of the whole sequence."""
+    from ..viz import loop as loop_plots
+    from ..viz import save
+
+    name = scene.name
+    with progress.stage(f"{name}: the path from above and the animation of the whole sequence"):
+        files = [save(loop_plots.plot_ground_path(run), out / f"{name}_path.png").name]
+        files.append(loop_plots.animate_loop(run, max_frames=s["max_frames"]).save(out / f"{name}_loop.gif").name)
+    return files
+
+
 def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progress, solution_figure: bool,
                   workspace_map: ReachabilityMap | None = None) -> list[str]:
     """What needs only the plan: the solution figure (plan), the snapshots, the GIF, the 3-D viewer's files."""
@@ -145,7 +231,9 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
     label = literal(scene.description or name)  # shown as it is in the titles (a "$" is not math)
     files = []
     with progress.stage(f"{name}: figures"):
-        if solution_figure and result.targets:
+        # the figure draws the paper's segmented solve (Fig. 8); a target solved by another stage of the whole-body
+        # solve (e.g. continued from the previous joints) has none to draw
+        if solution_figure and result.targets and getattr(result.targets[0].solution, "desired_frame", None) is not None:
             files.append(save(body.plot_head_solution(robot, result.targets[0].solution),
                               out / f"{name}_solution.png").name)
         cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3
@@ -232,10 +320,13 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any)
 def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController | None = None,
                robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
                settings: Settings | None = None, progress: Progress | None = None, command: str = "plan",
-               notes: Sequence[str] = (), solution_figure: bool = False, on_controller: Callable | None = None) -> dict:
+               notes: Sequence[str] = (), solution_figure: bool = False, on_controller: Callable | None = None,
+               start: BasePlacement | str | None = None) -> dict:
     """Every scene through :func:`run_scene` with one controller; writes ``report.json`` and ``summary.md`` into
     ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
-    file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed)."""
+    file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed). ``start``: run
+    every scene from the body lying there instead (:func:`run_loop_scene`: a placement of the tail, or
+    :data:`PAPER_START`)."""
     from ..control.controller import HeadController
     from ..kinematics import workspace
     from ..model.robot import SnakeRobot
@@ -262,6 +353,10 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
         on_controller(controller)
     entries = {}
     for scene in scenes:
+        if start is not None:
+            entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
+                                                 solution_figure=solution_figure)
+            continue
         entries[scene.name] = run_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
     robot = controller.robot
     report = {"command": command, "scenarios": entries,

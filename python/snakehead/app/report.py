@@ -7,7 +7,11 @@ The JSON report holds, per scenario under ``scenarios.<name>`` (see :func:`scena
 * ``sim``: null when the dynamics check did not run, else ``position_error_m``, ``direction_error_deg``,
   ``max_linear_momentum_error`` (kg m/s), ``max_angular_momentum_error`` (kg m^2/s), ``zmp_inside`` and the
   other numbers of :func:`snakehead.sim.compare`;
-* ``paper``: the paper's reported figures for the scenario, when it has them.
+* ``paper``: the paper's reported figures for the scenario, when it has them;
+* from lying straight (``--start``, :func:`snakehead.app.pipeline.run_loop_scene`): ``phases`` (list of ``name``,
+  ``kind`` one of gait/curl/lift/move/hold, ``t0_s``, ``t1_s``), ``sim.base_travel_m`` (the tail's path length over
+  the ground), ``estimate`` (the pose estimate's error after every ground phase and at the fix), ``start``,
+  ``total_time_s``, ``corrections``.
 
 Units are SI (m, s, kg) unless a key names them (``_deg``, ``_mm``). Non-finite floats are written as null, so
 the file is strict JSON.
@@ -214,6 +218,7 @@ def summary_markdown(report: dict) -> str:
             ("min ground clearance of neck and head (mm)", sc["min_ground_clearance_m"], None, None, 1000, 1),
             ("min distance to the obstacles (mm)", sc.get("min_obstacle_distance_m"), None, None, 1000, 1),
             ("base slide in simulation (mm)", None, s.get("base_slide_m"), None, 1000, 2),
+            ("the tail's travel over the ground, whole sequence (m)", None, s.get("base_travel_m"), None, 1, 2),
             ("max joint torque in simulation (N m)", None, s.get("max_torque_nm"), None, 1, 2),
             ("motion duration (s)", sc.get("duration_s"), None, paper.get("duration_s"), 1, 1),
         ]
@@ -224,6 +229,12 @@ def summary_markdown(report: dict) -> str:
                          f"{_fmt(pap, scale, digits)} |")
         if sim is None:
             lines += ["", "No dynamics check (MuJoCo not installed, --no-sim, or the simulation failed)."]
+        if sc.get("phases"):
+            lines += ["", f"From lying straight (closed loop): {_fmt(sc.get('total_time_s'), 1, 1)} s in all, "
+                      f"{sc.get('corrections', 0)} correction(s).", "", "| phase | kind | from (s) | to (s) |",
+                      "|---|---|---|---|"]
+            lines += [f"| {ph['name']} | {ph['kind']} | {_fmt(ph['t0_s'], 1, 1)} | {_fmt(ph['t1_s'], 1, 1)} |"
+                      for ph in sc["phases"]]
         notes = list(sc.get("notes") or [])
         if notes:
             lines += ["", "Notes:", ""] + [f"- {n}" for n in notes]

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import integer
+from .._validate import integer, joint_vector
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -452,11 +452,14 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
 
 
 def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = (),
-                allow_relocation: bool = True) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
+                allow_relocation: bool = True,
+                base_shape: npt.ArrayLike | None = None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
-    one first) from which every target is solved. Returns the placement, a configuration with the base's shape
+    one first) from which every target is solved. ``base_shape``: a configuration whose base joints (and those of
+    the neck's links that stay on the ground) give the base's flat shape at the controller's placement (default:
+    the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
     from ..control.whole_body import solve_target
 
@@ -487,6 +490,8 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
         return None, None
 
     start, q0 = controller.base, controller.q_initial
+    if base_shape is not None:
+        q0 = _shape_of(robot, joint_vector(base_shape, robot.n_joints, "base_shape"), q0)
     first, why = failing(start, q0)
     if first is None:
         return start, q0.copy(), None, []
@@ -581,7 +586,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
          robot: SnakeRobot | None = None, controller: HeadController | None = None,
          obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None,
          method: str = "rotated", seed: int | None = 1, allow_relocation: bool = True,
-         timing: dict[str, Any] | None = None) -> Plan:
+         timing: dict[str, Any] | None = None, base_shape: npt.ArrayLike | None = None,
+         start_q: npt.ArrayLike | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -600,6 +606,13 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     seed : the head TRAC-IK's seed (the plan is a function of it); None for unseeded.
     timing : options of the time-optimal retiming (``motion.timing.retime``: ``acceleration_limit`` rad/s^2,
         ``velocity_limit`` rad/s, ``torque_limit`` N m, ``zmp_margin`` m, ``friction``); its defaults otherwise.
+    base_shape : a configuration (n,) whose base joints (and those of the neck's links that stay on the ground) give
+        the base's flat shape at ``base`` (default: the controller's initial configuration's): a closed loop that
+        curled the body into a relocation's shape plans on from it (``snakehead.sim.loop``).
+    start_q : the configuration (n,) the plan starts from instead of the bending state it would choose: the body as
+        it lies (measured) in a bending state on the ground, so that the plan starts where the robot is (a closed
+        loop, ``snakehead.sim.loop``). Its base shape is ``base_shape``'s default. Used when the base stays (no
+        relocation); a note says so otherwise.
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
@@ -638,10 +651,18 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     notes: list[str] = []
     if controller.dexterous_threshold < 100.0:
         notes.append(controller.dexterous_note)
-    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation)
+    if start_q is not None:
+        start_q = joint_vector(start_q, robot.n_joints, "start_q")
+        if base_shape is None:
+            base_shape = start_q
+    chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
+                                                          base_shape)
     notes += base_notes
     way = _Waypoints(robot, chosen, obstacles)
-    way.start("bending state", bending_state(controller, q_shape))
+    if start_q is not None and relocation is not None:
+        notes.append("start_q is not used: the plan starts at the relocated base, in its bending state")
+        start_q = None
+    way.start("bending state", bending_state(controller, q_shape) if start_q is None else start_q)
     # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
     # state there; else the lift goes straight to the first target
     q = _shape_of(robot, q_shape, controller.q_initial)

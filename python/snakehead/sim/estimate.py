@@ -5,19 +5,23 @@ orientation of one link (an IMU's attitude), never the simulator's positions.
   kinematics from the IMU link).
 * Shape: the body's points (each box's centre) in world axes, relative to the root frame's origin.
 * Height: the body rests on the ground, so its lowest box corner is at z = 0.
-* Planar position, by contact odometry: a box that touches the ground (its lowest corner within
-  ``contact_height`` of it) is assumed not to slip, so its contact point -- the middle of its corners that are
-  lowest, a material point of the box -- stays where it is on the ground; between two updates the body is moved
-  by the average displacement that keeps the contact points of the boxes touching at both updates in place.
+* Planar position, by contact odometry: the boxes that touch the ground (their lowest corner within
+  ``contact_height`` of it) hold it through their contact points -- the middle of a box's corners that are
+  lowest, a material point of the box. Between two updates the body is moved by the translation that balances
+  the friction of those contact points (``odometry="friction"``, the default: the weighted geometric median of
+  the shifts that would keep each still, loads the links' masses, :func:`snakehead.dynamics.sliding.
+  balance_translation`; contacts slip where the others outpull them, and stay put where they hold), or by the
+  average of those shifts (``odometry="no-slip"``: every contact assumed not to slip).
 * The virtual chassis (:func:`snakehead.motion.gaits.virtual_chassis`, after Rollinson and Choset, "Virtual
   Chassis for Snake Robots", IROS 2011): a frame at the centroid of the body's points whose x-axis is the principal
   axis of the shape (its direction kept from update to update, towards the head when the body is straight) and
   z-axis the third principal axis turned upwards. It moves smoothly while a gait's joints cycle, so it says where
   "the body" is better than any one link.
 
-What it cannot see: a contact that slips. In MuJoCo the contact patches of a gait slip by a few centimetres per
-cycle (friction 0.8), and the estimate's position error is that slip (bench/RESULTS.md); the orientation is the
-IMU's.
+What it cannot see: how the load is really spread over the contacts, and inertia. In MuJoCo the contact patches
+of a gait slip by a few centimetres per cycle (friction 0.8); the friction balance follows most of that slip in
+sidewinding, turning and the curl on the ground, no-slip odometry none of it (bench/RESULTS.md, "Gaits"); rolling,
+whose contacts roll rather than slip, is the exception. The orientation is the IMU's.
 
 :class:`BodyPoseEstimator` keeps that estimate; :class:`BodyPose` is a pose of the body (estimated or true) and
 :func:`pose_error` compares two.
@@ -30,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import finite_array, joint_vector, rotation_matrix
+from ..dynamics.sliding import balance_translation
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..motion.gaits import virtual_chassis
 
@@ -39,6 +44,8 @@ import numpy.typing as npt
 CONTACT_HEIGHT = 0.003
 #: Corners within this height (m) of a box's lowest corner make its contact patch.
 PATCH_HEIGHT = 0.001
+#: How the estimate moves the body between updates (see the module).
+ODOMETRY = ("friction", "no-slip")
 
 
 @dataclass(frozen=True)
@@ -91,12 +98,13 @@ class BodyPoseEstimator:
     """The body's pose from joint angles and one link's orientation (see the module).
 
     robot: the snake; imu_link: the frame that carries the IMU (default: the boxed link nearest the middle of the
-    body); contact_height / patch_height: m (see the module). Call :meth:`reset` with the known starting pose,
-    then :meth:`update` at every control tick with the measured joint angles and the IMU's world orientation.
+    body); contact_height / patch_height: m; odometry: one of ODOMETRY (see the module). Call :meth:`reset` with
+    the known starting pose, then :meth:`update` at every control tick with the measured joint angles and the
+    IMU's world orientation.
     """
 
     def __init__(self, robot: SnakeRobot, imu_link: str | None = None, *, contact_height: float = CONTACT_HEIGHT,
-                 patch_height: float = PATCH_HEIGHT) -> None:
+                 patch_height: float = PATCH_HEIGHT, odometry: str = "friction") -> None:
         self.robot = as_robot(robot)
         boxed = self.robot.boxed_links
         if imu_link is None:
@@ -110,6 +118,10 @@ class BodyPoseEstimator:
                 raise ValueError(f"{name} must be a positive number of metres, got {value!r}")
         self.contact_height = float(contact_height)
         self.patch_height = float(patch_height)
+        if odometry not in ODOMETRY:
+            raise ValueError(f"odometry must be one of {ODOMETRY}, got {odometry!r}")
+        self.odometry = odometry
+        self._masses = self.robot.masses[boxed]
         self._boxed = boxed
         self._half = 0.5 * self.robot.box_sizes[boxed]  # (k, 3)
         signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
@@ -186,7 +198,7 @@ class BodyPoseEstimator:
 
     def update(self, q: np.ndarray, R_imu: npt.ArrayLike) -> None:
         """The body moved to joint angles q (n,) with the IMU at world orientation R_imu (3, 3): move the estimate
-        so that the contact points of the last update stay where they were on the ground (:meth:`pose` reads it)."""
+        by the contact odometry (see the module; :meth:`pose` reads it)."""
         if self._W is None:
             raise RuntimeError("call reset() with the starting pose before update()")
         W, R_root = self._boxes(q, R_imu)
@@ -195,6 +207,9 @@ class BodyPoseEstimator:
         origin = self._origin.copy()
         if boxes.size:
             shift = self._world_points(self._W, boxes, local) - self._world_points(W, boxes, local)
-            origin[:2] += weights @ shift[:, :2] / weights.sum()
+            if self.odometry == "friction":
+                origin[:2] += balance_translation(shift[:, :2], weights * self._masses[boxes])
+            else:
+                origin[:2] += weights @ shift[:, :2] / weights.sum()
         origin[2] = -corners[..., 2].min()
         self._remember(W, R_root, origin, corners)

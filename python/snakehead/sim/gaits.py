@@ -12,6 +12,9 @@ the next phase starts and whose ``estimate`` is the body's pose as the robot kno
     run = simulator.run(state, make_gait("sidewinding", direction=+1), cycles=2)
     run.estimate.base, run.estimate_error, run.state
 
+``run_path(state, q_path, duration_s)`` runs any joint path on the ground the same way (a curl of the body from one
+flat shape to another, which slides it: :mod:`snakehead.dynamics.sliding`).
+
 Control: the same PD servos as :func:`snakehead.sim.simulate_trajectory` (gains derived per joint,
 :mod:`snakehead.sim.gains`), without gravity compensation (the body lies on the ground); the reference is the gait's
 joint trajectory at the 2 ms control period.
@@ -23,42 +26,31 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_float, joint_vector
+from .._validate import finite_array, finite_float, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..motion.gaits import Gait, virtual_chassis
 from .estimate import BodyPose, BodyPoseEstimator, pose_error
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
-from .tracking import _gains
+from .tracking import SimState, _gains
 
 import numpy.typing as npt
 from typing import Any
 
 
 @dataclass
-class SimState:
-    """A snapshot of the simulated robot: MuJoCo's qpos and qvel, and the simulated time (s)."""
-
-    qpos: np.ndarray
-    qvel: np.ndarray
-    time: float = 0.0
-
-    def copy(self) -> "SimState":
-        return SimState(self.qpos.copy(), self.qvel.copy(), float(self.time))
-
-
-@dataclass
 class GaitRun:
-    """What a gait run did.
+    """What a gait run (or a joint path run on the ground: ``gait`` None) did.
 
-    state: the simulated state at its end (start the next phase here); estimate / truth: the body's pose at the end
-    (:class:`~snakehead.sim.estimate.BodyPose`), estimated and true; start_truth: the true pose at the start.
-    t (T,) s, q / q_ref (T, n) rad: recorded every ``record_every`` control ticks; chassis_truth / chassis_estimate
-    (T, 3) m: the virtual chassis' origin; heading_truth / heading_estimate (T,) rad; height (T,) m: the highest
-    point of any box above the ground; contact_fraction (T,): the share of the boxes touching the ground.
+    name: the gait's, or the path's; state: the simulated state at its end (start the next phase here); estimate /
+    truth: the body's pose at the end (:class:`~snakehead.sim.estimate.BodyPose`), estimated and true; start_truth:
+    the true pose at the start. t (T,) s, q / q_ref (T, n) rad: recorded every ``record_every`` control ticks;
+    chassis_truth / chassis_estimate (T, 3) m: the virtual chassis' origin; heading_truth / heading_estimate (T,)
+    rad; height (T,) m: the highest point of any box above the ground; contact_fraction (T,): the share of the boxes
+    touching the ground; root_truth / root_estimate (T, 4, 4): the root frame's world pose.
     """
 
-    gait: Gait
+    gait: Gait | None
     cycles: float
     state: SimState
     estimate: BodyPose
@@ -74,6 +66,10 @@ class GaitRun:
     height: np.ndarray
     contact_fraction: np.ndarray
     settings: dict = field(default_factory=dict)
+    name: str = ""
+    root_truth: np.ndarray | None = None
+    root_estimate: np.ndarray | None = None
+    start_estimate: BodyPose | None = None
 
     @property
     def estimate_error(self) -> dict:
@@ -114,12 +110,14 @@ class GaitSimulator:
     kp, kd: PD gains (default: derived per joint, :func:`snakehead.sim.gains.default_gains`); imu_link: the frame
     carrying the IMU of the pose estimate (default: mid-body); imu_yaw_drift_deg_per_s: a gyro's heading drift
     (deg/s; the IMU reads the link's true orientation turned by drift x time about the vertical; default 0, a
-    perfect attitude); other keywords (friction, torque_limit, obstacles,
-    armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
+    perfect attitude); odometry: the estimate's (:data:`snakehead.sim.estimate.ODOMETRY`); other keywords
+    (friction, torque_limit, obstacles, armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
     """
 
-    def __init__(self, robot: SnakeRobot, *, kp: float | None = None, kd: float | None = None, imu_link: str | None = None,
-                 imu_yaw_drift_deg_per_s: float = 0.0, control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP, **model_options: Any) -> None:
+    def __init__(self, robot: SnakeRobot, *, kp: float | None = None, kd: float | None = None,
+                 imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
+                 control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
+                 odometry: str = "friction", **model_options: Any) -> None:
         self._mj = _mujoco()
         self.robot = as_robot(robot)
         n = self.robot.n_joints
@@ -139,7 +137,7 @@ class GaitSimulator:
             raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
         self.control_dt = float(control_dt)
         self.data = self._mj.MjData(m)
-        self.estimator = BodyPoseEstimator(self.robot, imu_link)
+        self.estimator = BodyPoseEstimator(self.robot, imu_link, odometry=odometry)
         self.imu_yaw_drift = math.radians(finite_float(imu_yaw_drift_deg_per_s, "imu_yaw_drift_deg_per_s"))
         self.time = 0.0  # simulated time (s) of the state in ``data``
         self._imu_body = int(self.sim.body_ids[self.estimator.imu_index])
@@ -169,13 +167,8 @@ class GaitSimulator:
         if not isinstance(state, SimState):
             raise TypeError(f"state must be a SimState (from GaitSimulator.lying or a GaitRun), got "
                             f"{type(state).__name__}")
-        d = self.data
-        if state.qpos.shape != d.qpos.shape or state.qvel.shape != d.qvel.shape:
-            raise ValueError("state belongs to another robot's model")
-        d.qpos[:] = state.qpos
-        d.qvel[:] = state.qvel
+        state.load(self.sim, self.data)
         self.time = float(state.time)
-        self._mj.mj_forward(self.sim.model, d)
 
     def _step(self, q_ref: np.ndarray, qd_ref: np.ndarray) -> None:
         """One control period; then the positions of everything (what the sensors read) for the new state."""
@@ -230,26 +223,69 @@ class GaitSimulator:
         cycles = finite_float(cycles, "cycles")
         if cycles <= 0:
             raise ValueError(f"cycles must be > 0, got {cycles!r}")
+        gait.check(self.robot)
+        _, q_plan = gait.trajectory(self.robot, cycles, self.control_dt)
+        return self._run(state, q_plan, gait.name, rest_s, record_every, start_estimate, gait=gait, cycles=cycles)
+
+    def run_path(self, state: SimState, q_path: npt.ArrayLike, duration_s: float, *, rest_s: float = 0.5, record_every: int = 5,
+                 start_estimate: BodyPose | None = None, name: str = "path") -> GaitRun:
+        """Run the joint path ``q_path`` (K, n) rad from ``state``: its configurations evenly spread over
+        ``duration_s`` s and joined by a smooth-step in time (zero joint velocity at both ends), linear in the joints
+        between them; then ``rest_s`` holding the last. The reference starts from the joints' angles in ``state``
+        when they differ from q_path[0] (it is not a jump: the path is prefixed with them). Otherwise as :meth:`run`
+        (``cycles`` is 1 in the result)."""
+        n = self.robot.n_joints
+        q_path = finite_array(q_path, "q_path")
+        q_path = finite_array(q_path[None] if q_path.ndim == 1 else q_path, "q_path", (None, n))
+        if len(q_path) == 0:
+            raise ValueError("q_path must hold at least one configuration")
+        outside = (q_path < self.robot.lower - 1e-9) | (q_path > self.robot.upper + 1e-9)
+        if outside.any():
+            k, j = np.argwhere(outside)[0]
+            raise ValueError(f"q_path[{k}, {j}] = {q_path[k, j]:.4g} rad is outside the joint limits of "
+                             f"{self.robot.joint_names[j]!r}")
+        duration_s = finite_float(duration_s, "duration_s")
+        if duration_s <= 0:
+            raise ValueError(f"duration_s must be > 0, got {duration_s!r}")
+        self.restore(state)
+        q_now = self.joint_angles()
+        if np.abs(q_path[0] - q_now).max() > 1e-9:
+            q_path = np.vstack([q_now, q_path])
+        ticks = max(int(round(duration_s / self.control_dt)), 1)
+        s = np.arange(1, ticks + 1) / ticks
+        u = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)  # smooth step: rest to rest
+        x = u * (len(q_path) - 1)
+        i = np.minimum(np.floor(x).astype(int), len(q_path) - 2) if len(q_path) > 1 else np.zeros(ticks, int)
+        if len(q_path) == 1:
+            q_plan = np.repeat(q_path, ticks, axis=0)
+        else:
+            f = (x - i)[:, None]
+            q_plan = q_path[i] + f * (q_path[i + 1] - q_path[i])
+        return self._run(state, q_plan, name, rest_s, record_every, start_estimate, gait=None, cycles=1.0)
+
+    def _run(self, state: SimState, q_plan: np.ndarray, name: str, rest_s: float, record_every: int,
+             start_estimate: BodyPose | None, *, gait: Gait | None, cycles: float) -> GaitRun:
+        """Track the reference q_plan (one row per control tick) from ``state``, then rest; record and estimate."""
         rest_s = finite_float(rest_s, "rest_s")
         if rest_s < 0:
             raise ValueError(f"rest_s must be >= 0, got {rest_s!r}")
         if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
             raise ValueError(f"record_every must be a positive integer, got {record_every!r}")
-        gait.check(self.robot)
+        if start_estimate is not None and not isinstance(start_estimate, BodyPose):
+            raise TypeError(f"start_estimate must be a BodyPose, got {type(start_estimate).__name__}")
         self.restore(state)
-        t, q_plan = gait.trajectory(self.robot, cycles, self.control_dt)
         n_rest = int(round(rest_s / self.control_dt))
         q_plan = np.vstack([q_plan, np.repeat(q_plan[-1:], n_rest, axis=0)])
         t = self.control_dt * np.arange(len(q_plan))
-        qd_plan = np.gradient(q_plan, self.control_dt, axis=0)
+        qd_plan = np.gradient(q_plan, self.control_dt, axis=0) if len(q_plan) > 1 else np.zeros_like(q_plan)
         qd_plan[len(q_plan) - n_rest:] = 0.0
 
         start_truth = truth = self.true_pose()
         est0 = start_truth if start_estimate is None else start_estimate
-        if not isinstance(est0, BodyPose):
-            raise TypeError(f"start_estimate must be a BodyPose, got {type(est0).__name__}")
         self.estimator.reset(self.joint_angles(), self.imu_orientation(), est0.root[:2, 3], est0.base.yaw)
-        rec = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact")}
+        estimate = self.estimator.pose()
+        rec: dict[str, list] = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact", "rt",
+                                                "re")}
         for k in range(len(q_plan)):
             self._step(q_plan[k], qd_plan[k])
             self.time = state.time + (k + 1) * self.control_dt
@@ -267,8 +303,10 @@ class GaitSimulator:
                 rec["he"].append(estimate.heading)
                 rec["height"].append(h)
                 rec["contact"].append(c)
+                rec["rt"].append(truth.root)
+                rec["re"].append(estimate.root)
             if not np.all(np.isfinite(self.data.qpos)):
-                raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {gait.name} gait")
+                raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {name} run")
         end = self._snapshot(self.time)
         arr = {k: np.asarray(v) for k, v in rec.items()}
         # headings unwrapped from the start's, so that turns beyond half a revolution count in full
@@ -280,4 +318,7 @@ class GaitSimulator:
                        heading_estimate=heading_estimate, height=arr["height"], contact_fraction=arr["contact"],
                        settings=dict(imu_link=self.estimator.imu_link, control_dt=self.control_dt,
                                      imu_yaw_drift_deg_per_s=math.degrees(self.imu_yaw_drift),
-                                     rest_s=float(rest_s), kp=self.kp.tolist(), kd=self.kd.tolist()))
+                                     odometry=self.estimator.odometry, rest_s=float(rest_s), kp=self.kp.tolist(),
+                                     kd=self.kd.tolist()),
+                       name=name, root_truth=arr["rt"], root_estimate=arr["re"], start_estimate=est0)
+

@@ -105,6 +105,31 @@ def center_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray:
 # simulation
 # ------------------------------------------------------------------------------------------------
 @dataclass
+class SimState:
+    """A snapshot of the simulated robot: MuJoCo's qpos and qvel, and the simulated time (s). Any model of the same
+    robot takes it (obstacles and ground settings add no state): a gait run, a curl and a head plan continue from
+    one another's states (:class:`snakehead.sim.GaitSimulator`, :func:`simulate_trajectory` with ``state=``)."""
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    time: float = 0.0
+
+    def copy(self) -> "SimState":
+        return SimState(self.qpos.copy(), self.qvel.copy(), float(self.time))
+
+    def load(self, sim: SimModel, data: Any) -> None:
+        """Put ``data`` (of ``sim``'s model) in this state and compute its kinematics."""
+        if self.qpos.shape != data.qpos.shape or self.qvel.shape != data.qvel.shape:
+            raise ValueError(f"the state (qpos {self.qpos.shape}) belongs to another robot's model (qpos "
+                             f"{data.qpos.shape})")
+        if not (np.all(np.isfinite(self.qpos)) and np.all(np.isfinite(self.qvel))):
+            raise ValueError("the state contains NaN or inf")
+        data.qpos[:] = self.qpos
+        data.qvel[:] = self.qvel
+        _mujoco().mj_forward(sim.model, data)
+
+
+@dataclass
 class SimResult:
     """What :func:`simulate` recorded, one row per control tick (``control_dt`` apart), after settling.
 
@@ -113,7 +138,8 @@ class SimResult:
     the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground forces (NaN if airborne);
     contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the robot-floor contacts;
     base_positions (N, nb, 3) world origins of the base-part frames; base_slide_m / base_lift_m the largest
-    horizontal / upward displacement of any of them from the first tick (m).
+    horizontal / upward displacement of any of them from the first tick (m). root_pose (N, 4, 4): the root frame's
+    world pose at every tick; end_state: the simulated state after the last tick (continue from it).
     """
 
     t: np.ndarray
@@ -132,6 +158,8 @@ class SimResult:
     base: BasePlacement
     torque_limit: np.ndarray
     settings: dict = field(default_factory=dict)
+    root_pose: np.ndarray | None = None
+    end_state: SimState | None = None
 
     @property
     def head_position(self) -> np.ndarray:
@@ -225,7 +253,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                         torque_limit: npt.ArrayLike | None = None, friction: float = 0.8,
                         joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (),
                         hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
-                        drop: float = 2e-4) -> SimResult:
+                        drop: float = 2e-4, state: SimState | None = None) -> SimResult:
     """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
@@ -233,7 +261,10 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     kp (N m/rad, > 0) and kd (N m s/rad, >= 0): scalars or (n,); None (default): derived per joint from its load
     (:func:`snakehead.sim.gains.default_gains`). ``control_dt`` (s): the control period (2 ms,
     the paper's), a whole multiple of the physics ``timestep`` (1 ms). ``settle`` s: the robot is first put at
-    q[0], ``drop`` m above its resting height, and held there with the same controller before t[0]; ``hold`` s:
+    q[0], ``drop`` m above its resting height, and held there with the same controller before t[0] (with ``state``,
+    a :class:`SimState` of the same robot, e.g. where a gait or a curl left it: the simulation continues from that
+    state instead, wherever the body lies; ``base`` is then where the plan believes the base is, used for nothing
+    but the result's record, and the time goes on from ``state.time``); ``hold`` s:
     after t[-1] the last configuration is held and recorded. ``gravity_compensation``: "supported" (default: each joint
     carries the lifted run of links hanging from it, judged from the planned configuration, see
     :func:`carried_weights`), "bias" (MuJoCo's ``qfrc_bias`` on every joint: gravity and Coriolis as if the tail
@@ -274,7 +305,13 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     m.actuator_biasprm[:, 1] = -kp
     m.actuator_biasprm[:, 2] = -kd
     d = mj.MjData(m)
-    sim.set_state(d, q[0], base, lift=float(drop))
+    if state is None:
+        sim.set_state(d, q[0], base, lift=float(drop))
+    elif isinstance(state, SimState):
+        state.load(sim, d)
+    else:
+        raise TypeError(f"state must be a SimState (from GaitSimulator or a SimResult's end_state), got "
+                        f"{type(state).__name__}")
 
     qdot_plan = np.gradient(q, t, axis=0)
     qa, da = sim.qpos_adr, sim.dof_adr
@@ -313,6 +350,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     rec = {k: np.zeros((N, 3)) for k in ("P", "L", "com")}
     qs, qds, taus = np.zeros((N, n)), np.zeros((N, n)), np.zeros((N, n))
     head = np.zeros((N, 4, 4))
+    root = np.zeros((N, 4, 4))
     basepos = np.zeros((N, len(base_frames), 3))
     zmp = np.zeros((N, 2))
     cpts, cfrc = [], []
@@ -324,6 +362,9 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
         head[k, :3, :3] = d.xmat[hb].reshape(3, 3)
         head[k, :3, 3] = d.xpos[hb]
         head[k, 3, 3] = 1.0
+        root[k, :3, :3] = d.xmat[sim.root_body].reshape(3, 3)
+        root[k, :3, 3] = d.xpos[sim.root_body]
+        root[k, 3, 3] = 1.0
         basepos[k] = d.xpos[base_frames]
         rec["P"][k], rec["L"][k] = momenta_of_state(sim, d)
         rec["com"][k] = d.subtree_com[sim.root_body]
@@ -342,7 +383,10 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     settings = dict(kp=kp.tolist(), kd=kd.tolist(), control_dt=control_dt, timestep=timestep,
                     settle=float(settle), hold=float(hold), gravity_compensation=mode,
                     friction=float(friction), joint_damping=float(joint_damping), armature=float(armature),
-                    n_obstacles=len(obstacles), self_collision=bool(self_collision))
+                    n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
+    # the state's clock: the plan's without ``state``, else going on from the state's time
+    t_end = (ts[-1] if state is None else float(state.time) + float(settle) + ts[-1] - t[0]) + control_dt
     return SimResult(t=ts, q=qs, qdot=qds, q_ref=q_ref, tau=taus, head_pose=head, P=rec["P"], L=rec["L"],
                      com=rec["com"], zmp=zmp, contact_points=cpts, contact_forces=cfrc, base_positions=basepos,
-                     base=base, torque_limit=sim.torque_limit, settings=settings)
+                     base=base, torque_limit=sim.torque_limit, settings=settings, root_pose=root,
+                     end_state=SimState(d.qpos.copy(), d.qvel.copy(), t_end))
