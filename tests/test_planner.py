@@ -44,6 +44,10 @@ def check(result, robot):
         # a target's state keeps the static margin the moves to and from it keep (else no path leaves it stably)
         margin = stability.static_margin(robot, result.q[k], result.base, contact="ground")
         assert margin >= planner.DETOUR_MARGIN - 1e-6, (tg.name, margin)
+        # ... and keeps it on the base alone: a pose that stands only because a lifted link rests on the ground
+        # cannot be reached from the air
+        base_margin = stability.static_margin(robot, result.q[k], result.base, contact="footprint")
+        assert base_margin >= planner.DETOUR_MARGIN - 1e-6, (tg.name, base_margin)
     assert result.stability.inside.all(), f"ZMP outside at t = {result.t[result.stability.argmin]:.3f} s"
     below = coll.below_ground(robot, result.q, result.base)
     assert not below.any()

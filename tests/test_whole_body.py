@@ -109,6 +109,29 @@ def test_segment_closest_matches_dense_sampling():
     assert np.all(found >= brute - 2e-2 * np.linalg.norm(q1 - p1, axis=1).clip(1e-3))
 
 
+def test_checked_margin_ignores_lifted_links_resting_on_the_ground(default):
+    """With the body problem, check_solution's static margin is the smaller of the ground contact's (every corner
+    that touches) and the base's own (here the links before the lift, lying flat: the 'footprint' model); a pose
+    whose neck rests on the ground is judged by the base alone. Independent: stability.static_margin."""
+    robot, controller, prob = default
+    assert np.array_equal(prob.ground_links, np.arange(robot.parts.base.stop + 1))  # the base's links
+    rng = np.random.default_rng(4)
+    lifted = np.arange(robot.lift_joints.start, robot.n_joints)
+    touching = 0
+    for _ in range(40):
+        q = controller.q_initial.copy()
+        q[lifted] += rng.normal(0.0, 0.5, len(lifted))
+        q = np.clip(q, robot.lower, robot.upper)
+        base = controller.base
+        H = robot.head_pose(q, base)
+        chk = wb.check_solution(robot, q, base, H[:3, 3], H[:3, 0], problem=prob)
+        ground = stability.static_margin(robot, q, base, contact="ground")
+        footprint = stability.static_margin(robot, q, base, contact="footprint")
+        assert chk["static_margin_m"] == pytest.approx(min(ground, footprint), abs=1e-9)
+        touching += ground > footprint + 1e-6
+    assert touching > 0  # some poses do lean on a lifted link: the case the check is for
+
+
 def test_hull_indices_match_qhull():
     from scipy.spatial import ConvexHull
 

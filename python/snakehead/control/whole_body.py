@@ -403,15 +403,22 @@ def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[n
 
 def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
                    obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
-                   obstacle_clearance: float = OBSTACLE_CLEARANCE) -> dict:
+                   obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None) -> dict:
     """Exact checks of a configuration: head errors, static margin (support polygon of the boxes lying on the
     ground), lowest lifted box corner, separating-axis self clearance, obstacle clearance, and the verdict
-    (None or one of ``REASONS``)."""
+    (None or one of ``REASONS``).
+
+    With ``problem``, the static margin is also taken without the lifted links (only the links that lie on the
+    ground whatever the pose: ``BodyProblem.ground_links``), and the smaller one counts: a pose that stands only
+    because a lifted link rests on the ground cannot be reached from the air (the body tips just before the link
+    touches down), so a planner must not be given one."""
     robot = as_robot(robot)
     H = robot.head_pose(q, base)
     pe = float(np.linalg.norm(H[:3, 3] - position))
     de = float(np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1.0, 1.0))))
     margin = float(stability.static_margin(robot, q, base, contact="ground"))
+    if problem is not None:
+        margin = min(margin, float(problem.margin_and_gradient(problem.frames(q, base), base)[0]))
     ground = float(coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min())
     selfc = float(coll.self_clearance(robot, q, base)[0])
     obst = None
@@ -584,7 +591,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     obstacles = list(obstacles)
 
     def check(q: np.ndarray, b: Any) -> Any:
-        return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin)
+        return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin, problem=prob)
 
     def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: int) -> Any:
         return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
