@@ -563,3 +563,20 @@ def test_wrong_kinds_of_numbers_are_type_errors(call, error, message):
     """timeout=10**400 raised OverflowError; "1" and True were accepted as 1 s; None became NaN."""
     with pytest.raises(error, match=re.escape(message)):
         call()
+
+
+def test_huge_finite_directions_are_normalised_not_zeroed():
+    """Hypothesis found it: a direction of (1e300, 1e300, 1e300) is finite, but its norm overflowed to inf, so it
+    became the zero vector (a silent wrong answer). Directions are scaled before they are normalised."""
+    from snakehead._validate import position_direction_pairs, unit_vector3
+    from snakehead.scenes.scene import scene_from_dict
+
+    expected = np.full(3, 1.0 / np.sqrt(3.0))
+    np.testing.assert_allclose(unit_vector3([1e300, 1e300, 1e300], "direction"), expected, rtol=1e-15)
+    _, d, _ = position_direction_pairs([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]], [[1e300, 0.0, 1e300], [0.0, 3.0, 4.0]])
+    np.testing.assert_allclose(d, [[2 ** -0.5, 0.0, 2 ** -0.5], [0.0, 0.6, 0.8]], rtol=1e-15)
+    scene = scene_from_dict({"name": "huge", "targets": [{"name": "a", "position": [0.0, 0.5, 0.3],
+                                                           "direction": [1e300, 1e300, 1e300]}]})
+    np.testing.assert_allclose(scene.targets[0].direction, expected, rtol=1e-15)
+    with pytest.raises(ValueError, match="zero length"):
+        unit_vector3([0.0, 0.0, 0.0], "direction")

@@ -97,10 +97,11 @@ def vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
 
 def unit_vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     a = vector3(v, name)
-    norm = float(np.linalg.norm(a))
-    if norm < 1e-12:
+    scale = float(np.abs(a).max())  # divided out first: the norm of a huge finite vector overflows to inf
+    if scale * float(np.linalg.norm(a / scale)) < 1e-12 if scale > 0 else True:
         raise ValueError(f"{name} has zero length; a direction is needed")
-    return a / norm
+    a = a / scale
+    return a / np.linalg.norm(a)
 
 
 def position_direction_pairs(positions: npt.ArrayLike, directions: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -116,9 +117,11 @@ def position_direction_pairs(positions: npt.ArrayLike, directions: npt.ArrayLike
         raise ValueError(f"directions must have shape (3,) or (K, 3), got {np.shape(directions)}")
     if len(p) != len(d):
         raise ValueError(f"{len(p)} positions but {len(d)} directions; give one direction per position")
+    scale = np.abs(d).max(axis=1)  # divided out first: the norm of a huge finite vector overflows to inf
+    d = d / np.where(scale > 0, scale, 1.0)[:, None]
     norm = np.linalg.norm(d, axis=1)
-    if np.any(norm < 1e-12):
-        raise ValueError(f"directions must be non-zero; direction {int(np.argmin(norm))} has zero length")
+    if np.any(scale * norm < 1e-12):
+        raise ValueError(f"directions must be non-zero; direction {int(np.argmin(scale * norm))} has zero length")
     return p, d / norm[:, None], single
 
 

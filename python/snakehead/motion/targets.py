@@ -2,7 +2,8 @@
 
 A target is *reachable by construction* when it is the head pose of a whole-body configuration that the robot
 can hold: statically stable (the centre of mass inside the support polygon of the links on the ground by
-``min_margin``), every neck and head link above the ground, no two links touching. Three kinds (``KINDS``):
+``min_margin``, and inside the base's own: a neck or head link resting on the ground does not hold the body up),
+every neck and head link above the ground, no two links touching. Three kinds (``KINDS``):
 
 * ``"same"`` -- the base keeps the planner's initial configuration (its optimised arc) at the planner's
   placement; the neck and head joints are drawn uniformly within their limits;
@@ -65,7 +66,10 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
             x, y = rng.uniform(-reach, reach, 2)
             base = BasePlacement(float(controller.base.x + x), float(controller.base.y + y),
                                  float(rng.uniform(-np.pi, np.pi)))
-        if stability.static_margin(robot, q, base, contact="ground") <= min_margin:
+        # stable on the links that lie on the ground whatever the pose: a neck or head link resting on the ground
+        # does not count (the pose must keep them above it)
+        if min(stability.static_margin(robot, q, base, contact="ground"),
+               stability.static_margin(robot, q, base, contact="footprint")) <= min_margin:
             continue
         if coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min() < 0.0:
             continue
