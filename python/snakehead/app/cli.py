@@ -288,9 +288,9 @@ def _view(args: argparse.Namespace) -> int:
     if not directory.is_dir():
         raise UsageError(f"{args.dir!r} is not a directory (give the --out folder of 'snakehead plan' or 'demo')")
     shown = viewer.serve(directory, host=args.host, port=args.port)
-    print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from "
-          f"{directory.resolve()}; Ctrl-C stops", flush=True)
-    try:
+    try:  # from here on Ctrl-C is how the viewer ends (the line below tells the user so, and may be interrupted)
+        print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from "
+              f"{directory.resolve()}; Ctrl-C stops", flush=True)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
