@@ -12,6 +12,17 @@ def head6_robot():
     return SnakeRobot.from_file(default_robot_file().with_name("snake16_head6.toml"))
 
 
+def pitch_first():
+    """A generated snake unlike the default: 13 joints starting with a pitch joint, 10 cm modules, 6 cm section,
+    0.3 kg per module."""
+    from snakehead import SnakeRobot
+    from snakehead.model.generate import SnakeSpec, snake_urdf
+
+    urdf = snake_urdf(SnakeSpec(n_joints=13, module_length=0.10, section=0.06, mass_per_module=0.3,
+                                first_axis="pitch", markers={"p0": 6, "b0": 7}))
+    return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
+
+
 @pytest.fixture(scope="session")
 def mixed_urdf() -> str:
     """A chain with revolute, continuous, prismatic and fixed joints (tests/data/mixed_chain.urdf)."""

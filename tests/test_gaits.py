@@ -11,12 +11,7 @@ from snakehead.backbone import initial_configuration
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.motion.gaits import GAITS, Gait, Wave, make_gait, virtual_chassis
 
-
-def pitch_first():
-    """13 joints starting with a pitch joint, 10 cm modules, 6 cm section, 0.3 kg per module."""
-    urdf = snake_urdf(SnakeSpec(n_joints=13, module_length=0.10, section=0.06, mass_per_module=0.3,
-                                first_axis="pitch", markers={"p0": 6, "b0": 7}))
-    return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
+from conftest import pitch_first
 
 
 @pytest.fixture(scope="module")
