@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
 import tempfile
 import time
@@ -446,6 +447,9 @@ def main(argv: list[str] | None = None) -> int:
         command = f"snakehead {args.command}"
         return int(args.func(args))
     except KeyboardInterrupt:
+        if argv is None:  # the program (not a call from Python) exits now: a Ctrl-C that arrives while the
+            # interpreter shuts down (threads joined, files closed) would kill it by the signal instead of 130
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
         print(f"{command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except (UsageError, ValueError, TypeError, OSError) as exc:  # what the user gave (or where outputs go) is wrong
