@@ -122,7 +122,7 @@ class HeadController:
               allow_base_move: bool | None = None) -> HeadSolution:
         """All joint angles that put the head at ``position`` (3,) m pointing along ``direction`` (3,).
 
-        ``q_prev`` (16,): the current joints, within the joint limits (ValueError otherwise: the base would keep
+        ``q_prev`` (n_joints,): the current joints, within the joint limits (ValueError otherwise: the base would keep
         them); the base keeps its shape from it and the neck and head start from it (and, with the rotated-frames
         method, the solution closest to it is kept). ``base``: the base placement to start from (default: the
         controller's).

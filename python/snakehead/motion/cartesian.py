@@ -18,10 +18,24 @@ from typing import Any
 
 
 @dataclass(frozen=True)
-class CartesianInterpolation:
+class TrackingInterpolation:
+    """Result of :func:`tracking_interpolation`: q (n_samples, n) rad; s (n_samples,) Eq. 41's t_j; points
+    (n_samples, m, 3) the interpolated joint positions; actual (n_samples, m, 3) where the joints are; deviation
+    (n_samples,) the largest distance between the two (m) and max_deviation its maximum."""
+
+    q: np.ndarray
+    s: np.ndarray
+    points: np.ndarray
+    actual: np.ndarray
+    deviation: np.ndarray
+    max_deviation: float
+
+
+@dataclass(frozen=True)
+class CartesianInterpolation(TrackingInterpolation):
     """Result of :func:`cartesian_interpolation` with ``full_output=True``.
 
-    q (n, 16) rad; s (n,) the interpolation parameters t_j of Eq. 41; points (n, m, 3) the interpolated joint
+    q (n, n_joints) rad; s (n,) the interpolation parameters t_j of Eq. 41; points (n, m, 3) the interpolated joint
     positions p_ij (m = neck + head joints + 1: from the neck's first joint to the head tip), actual (n, m, 3)
     where the recovered configuration puts them; deviation (n,) the largest distance between the two per
     sample (m), max_deviation its maximum; direction_error (n,) the largest angle (rad) between a recovered
@@ -30,12 +44,6 @@ class CartesianInterpolation:
     poses shortens the segments (chords), while the links keep their length.
     """
 
-    q: np.ndarray
-    s: np.ndarray
-    points: np.ndarray
-    actual: np.ndarray
-    deviation: np.ndarray
-    max_deviation: float
     direction_error: np.ndarray
     clipped: np.ndarray
 
@@ -194,20 +202,6 @@ TRACKING_CLEARANCE = 0.002
 TRACKING_GROUND_WEIGHT = 10.0
 #: Weight (m per rad) of each lifted joint's change from the previous sample in the tracking fit.
 TRACKING_CONTINUITY = 0.03
-
-
-@dataclass(frozen=True)
-class TrackingInterpolation:
-    """Result of :func:`tracking_interpolation`: q (n_samples, n) rad; s (n_samples,) Eq. 41's t_j; points
-    (n_samples, m, 3) the interpolated joint positions; actual (n_samples, m, 3) where the joints are; deviation
-    (n_samples,) the largest distance between the two (m) and max_deviation its maximum."""
-
-    q: np.ndarray
-    s: np.ndarray
-    points: np.ndarray
-    actual: np.ndarray
-    deviation: np.ndarray
-    max_deviation: float
 
 
 def tracked_points(robot: SnakeRobot) -> np.ndarray:
