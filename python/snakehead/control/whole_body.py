@@ -33,7 +33,7 @@ from ..geometry import collision as coll
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -561,7 +561,8 @@ def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, po
 def solve_target(controller: HeadController, position: npt.ArrayLike, direction: npt.ArrayLike, *,
                  q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None, obstacles: Sequence[Any] = (),
                  allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
-                 problem: BodyProblem | None = None, seed: int = 0, near: bool = False) -> WholeBodySolution:
+                 problem: BodyProblem | None = None, seed: int = 0, near: bool = False,
+                 shape_ok: Callable[[np.ndarray], bool] | None = None) -> WholeBodySolution:
     """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
 
     Stages, the first that passes every exact check wins:
@@ -577,6 +578,11 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     With ``near`` (for poses close to the previous one, e.g. along a line), a first attempt continues from
     ``q_prev``: the lifted chain's IK started from its joints with the roll free, kept when it passes every check
     (stage "whole-body, base kept"), so that consecutive poses stay on one branch of solutions.
+
+    ``shape_ok``: a test of a moved base's flat shape (called with a configuration; only its joints before the
+    lift count) that a solution of stage 3 must pass, e.g. the planner's: the shape holds a stable curl of the
+    neck and head on the ground to lift them from. Shapes that fail it are not started from, and solutions whose
+    shape fails it are not accepted (the search goes on).
 
     The result says which stage solved it, or why the best attempt fails (``REASONS``).
     """
@@ -647,6 +653,24 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     if not allow_base_move:
         return best
     # 3. the base moved
+    rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
+
+    def shape_passes(q: np.ndarray) -> bool:
+        key = q[:robot.lift_joints.start].tobytes()
+        if key in rejected_shapes:
+            return False
+        if shape_ok is not None and not shape_ok(q):
+            rejected_shapes.add(key)
+            return False
+        return True
+
+    def moved(q: np.ndarray, b: Any, starts: int) -> Any:
+        """consider() for a moved base, whose shape must pass ``shape_ok`` too (asked only of a configuration that
+        passes every other check; one whose shape fails is not kept as the best attempt either)."""
+        if shape_ok is not None and check(q, b)["reason"] is None and not shape_passes(q):
+            return None
+        return consider(q, b, STAGES[2], starts)
+
     moved_starts = []
     for qb in [q_now[robot.parts.base]] + _base_shapes(controller):
         q = q_now.copy()
@@ -656,12 +680,14 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
                                          controller.slack, robot.body_axis_height)
         if placed is not None:
             s = controller.solve(position, direction, q_prev=q, base=placed, allow_base_move=False)
-            if s.success and (found := consider(s.q, placed, STAGES[2], 0)):
+            if s.success and (found := moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
         for b in [placed] * (placed is not None) + placements(prob, P0_local, position, direction):
+            if q[:robot.lift_joints.start].tobytes() in rejected_shapes:
+                break
             for qc in lifted_candidates(prob, q, b, position, direction, seed):
-                if found := consider(qc, b, STAGES[2], 0):
+                if found := moved(qc, b, 0):
                     return found
             if time.perf_counter() - t0 > time_budget:
                 break
@@ -671,7 +697,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
         if time.perf_counter() - t0 > time_budget:
             break
         q, b = refine(prob, q0, b0, position, direction, move_base=True, obstacles=obstacles, min_margin=min_margin)
-        if found := consider(np.clip(q, robot.lower, robot.upper), b, STAGES[2], len(moved_starts)):
+        if found := moved(np.clip(q, robot.lower, robot.upper), b, len(moved_starts)):
             return found
     return best
 

@@ -52,7 +52,10 @@ DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypo
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
 FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails)
-DENSIFY = 3  # configurations checked between consecutive waypoints of a move
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move, at least
+MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
+MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
+DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
 ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
@@ -160,6 +163,29 @@ class Plan:
         return self.failure is None
 
 
+def _split_steps(qs: np.ndarray, most: float = MAX_WAYPOINT_STEP) -> np.ndarray:
+    """The path of waypoints qs (K, n) with every step whose largest joint change exceeds ``most`` rad split into
+    equal joint-space steps (the same straight segments, more waypoints)."""
+    qs = np.asarray(qs, float)
+    out = [qs[:1]]
+    for a, b in zip(qs[:-1], qs[1:]):
+        pieces = max(1, int(np.ceil(np.abs(b - a).max() / most - 1e-9)))
+        out.append(a + (np.arange(1, pieces + 1) / pieces)[:, None] * (b - a))
+    return np.concatenate(out)
+
+
+def _checked(qs: np.ndarray, step: float = MOVE_CHECK_STEP) -> np.ndarray:
+    """The configurations a path of waypoints qs (K, n) is checked at: every waypoint and, along the straight
+    segment between two, as many evenly spaced ones as keep each joint's change below ``step`` rad (at least
+    DENSIFY)."""
+    qs = np.asarray(qs, float)
+    out = [qs[:1]]
+    for a, b in zip(qs[:-1], qs[1:]):
+        pieces = max(DENSIFY + 1, int(np.ceil(np.abs(b - a).max() / step - 1e-9)))
+        out.append(a + (np.arange(1, pieces + 1) / pieces)[:, None] * (b - a))
+    return np.concatenate(out)
+
+
 def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
     """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
     (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
@@ -221,15 +247,18 @@ class _Waypoints:
         First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
         ``motion.cartesian.tracking_interpolation``), kept when every configuration is safe (above the ground, clear
         of itself and the obstacles, statically stable with DETOUR_MARGIN); else the straight joint-space path;
-        else a joint-space path through a safe detour waypoint (see ``_joint_path``).
+        else a joint-space path through a safe detour waypoint (see ``_joint_path``). Steps longer than
+        MAX_WAYPOINT_STEP are split (:func:`_split_steps`) and every path is checked at least every
+        MOVE_CHECK_STEP (:func:`_checked`): the timed motion passes near the straight segments between the
+        waypoints only when they are short (a fit that cannot follow the points to q ends in one long jump).
         """
         q = np.asarray(q, float)
         if np.abs(q - self.qs[-1]).max() <= 1e-12:
             self._append(label, q)
             return "none"
-        path = tracking_interpolation(self.robot, self.qs[-1], q, n, self.base)
-        if self._feasible(_densify(path.q)).all():
-            qs, method = path.q, "cartesian (Eq. 41, tracked)"
+        path = _split_steps(tracking_interpolation(self.robot, self.qs[-1], q, n, self.base).q)
+        if self._feasible(_checked(path)).all():
+            qs, method = path, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
         for k in range(1, len(qs)):
@@ -239,16 +268,26 @@ class _Waypoints:
 
     def _margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
-        link lying on the ground (``contact="ground"``; once the head is up, the base's footprint)."""
-        com = stability.center_of_mass(self.robot, qs, self.base)
-        return stability.support_margins(self.robot, qs, com[:, :2], self.base, contact="ground")
+        link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
+        the smaller of that and the base's own (``contact="footprint"``): a motion must not lean on a neck or head
+        link that touches the ground at a checked configuration and may leave it in between."""
+        com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
+        margin = stability.support_margins(self.robot, qs, com, self.base, contact="ground")
+        if self.lift_index is not None:
+            margin = np.minimum(margin, stability.support_margins(self.robot, qs, com, self.base, contact="footprint"))
+        return margin
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
-        """(m,) bool: above the ground, no two non-neighbouring links overlapping, clear of the obstacles, and
-        statically stable with DETOUR_MARGIN to spare."""
+        """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links
+        overlapping, and clear of the obstacles (the cheap checks first: the others only where those pass)."""
         clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
-        ok = ((clearance >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(self.robot, qs, self.base) > 0.0)
-              & (self._margins(qs) >= DETOUR_MARGIN))
+        ok = clearance >= -coll.GROUND_TOLERANCE
+        if ok.any():
+            rows = np.flatnonzero(ok)
+            ok[rows] = self._margins(qs[rows]) >= DETOUR_MARGIN
+        if ok.any():
+            rows = np.flatnonzero(ok)
+            ok[rows] = coll.self_clearance(self.robot, qs[rows], self.base) > 0.0
         if self.obstacles and ok.any():
             rows = np.flatnonzero(ok)
             d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
@@ -260,11 +299,13 @@ class _Waypoints:
 
         The straight path when it does; else the shortest of DETOUR_TRIALS two-piece paths through a waypoint
         drawn around the midpoint (neck and head joints perturbed, seeded: plans are reproducible) whose every
-        configuration passes; else the one with the largest worst margin (the scenario's checks report it).
+        configuration passes (tried shortest first, DETOUR_BATCH at a time, each screened at DENSIFY
+        configurations per step and then checked as densely as a move); else the one with the largest worst
+        margin (the scenario's checks report it).
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
-        straight = qa + s * (qb - qa)
-        if self._feasible(_densify(straight)).all():
+        straight = _split_steps(qa + s * (qb - qa))
+        if self._feasible(_checked(straight)).all():
             return straight, "joint space"
         movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -272,14 +313,18 @@ class _Waypoints:
         W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
         W = np.clip(W, self.robot.lower, self.robot.upper)
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
+        length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
+        order = np.argsort(length, kind="stable")
+        for batch in np.array_split(order, max(1, len(order) // DETOUR_BATCH)):
+            flat = _densify(paths[batch]).reshape(-1, qa.size)
+            ok = self._feasible(flat).reshape(len(batch), -1).all(axis=1)
+            for k in batch[ok]:
+                path = _split_steps(paths[k])
+                if self._feasible(_checked(path)).all():
+                    return path, "joint space via a stable detour"
         flat = _densify(paths).reshape(-1, qa.size)
-        ok = self._feasible(flat).reshape(len(W), -1).all(axis=1)
-        if ok.any():
-            length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
-            k = int(np.argmin(np.where(ok, length, np.inf)))
-            return paths[k], "joint space via a stable detour"
         worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
-        return paths[int(np.argmax(worst))], "joint space (no stable detour found)"
+        return _split_steps(paths[int(np.argmax(worst))]), "joint space (no stable detour found)"
 
     def hold(self, seconds: float) -> None:
         """A pause of ``seconds`` at the last waypoint (which becomes a stop)."""
@@ -500,10 +545,26 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
               f"target {first.name!r} is not reached from the start ({why.reason})")
     if not allow_relocation:
         return start, q0.copy(), None, [f"the base is kept (no relocation allowed): {reason}"]
+    # a relocated base must hold a stable curl of the neck and head (the bending state the plan lifts them from):
+    # the whole-body solve is told so, and looks further than a shape (e.g. a straight base) that holds none
+    no_curl = controller.__dict__.setdefault("_shapes_without_curl", set())
+
+    def has_curl(q: np.ndarray) -> bool:
+        key = np.round(q[:robot.lift_joints.start], 12).tobytes()
+        if key in no_curl:
+            return False
+        try:
+            bending_state(controller, q)
+        except ValueError:
+            no_curl.add(key)
+            return False
+        return True
+
     order = ([first] if first not in ("the start", "no curl") else []) + [t for t in targets if t is not first]
     for t in order:
         sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
-                           allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
+                           allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN,
+                           shape_ok=has_curl)
         if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
                                                                    q0[:robot.lift_joints.start])):
             continue
