@@ -1,0 +1,149 @@
+"""Plans of head targets reachable by construction (``motion.targets``) that the planner once failed, each now
+planned and its motion checked by independent computations (FK, support polygons, ground and self clearance at
+every 2 ms sample); and the pieces of the planner that fixed them: a relocated base holds a stable curl of the
+neck and head (``choose_base``), long steps of a move are split and every move is checked densely, and after the
+lift a move's static margin is the base's own (``planner._Waypoints``)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import snakehead
+from snakehead.control import whole_body as wb
+from snakehead.dynamics import stability
+from snakehead.geometry import collision as coll
+from snakehead.motion import planner
+from snakehead.motion.targets import reachable_targets
+
+
+@pytest.fixture(scope="module")
+def controller():
+    # as bench/targets.py makes it
+    return snakehead.HeadController(snakehead.SnakeRobot.default(), method="free_roll", seed=1)
+
+
+def verify_plan(plan, position, direction):
+    """Every check of a successful plan, recomputed from its samples."""
+    robot, base = plan.robot, plan.base
+    assert plan.success, plan.failure
+    (tg,) = plan.targets
+    k = int(np.argmin(np.abs(plan.t - tg.time_s)))
+    H = robot.head_pose(plan.q[k], base)  # whole-body FK of the planned joints when the plan arrives
+    assert np.linalg.norm(H[:3, 3] - position) <= 1e-4
+    assert np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1.0, 1.0))) <= 0.05
+    dt = np.diff(plan.t)  # the 2 ms control period (the last step to the end may be shorter)
+    assert np.all(dt[:-1] == pytest.approx(0.002)) and 0 < dt[-1] <= 0.002 + 1e-12
+    assert np.all(plan.q >= robot.lower - 1e-9) and np.all(plan.q <= robot.upper + 1e-9)
+    # the ZMP from finite differences of the samples (not the plan's own velocities) inside by the plan's margin,
+    # up to the difference between the two derivatives
+    dyn = stability.dynamic_stability(robot, plan.t, plan.q, base, contact="ground")
+    assert dyn.min_margin >= planner.ZMP_MARGIN - 1e-3, dyn.min_margin
+    assert coll.ground_clearance(robot, plan.q, base)[:, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
+    assert coll.self_clearance(robot, plan.q[::2], base).min() > 0.0
+    # the base lies still on the ground throughout
+    assert np.abs(plan.q[:, :robot.lift_joints.start] - plan.q[0, :robot.lift_joints.start]).max() < 1e-9
+
+
+def test_long_step_of_a_tracked_move_is_no_longer_trusted(controller):
+    """Target 1 of ``reachable_targets(controller, "same", 8, default_rng(0))``: the tracked Cartesian move ended
+    in a 3.1 rad jump (its fit stuck at joint limits) that three checked configurations per step did not see
+    dipping to 7 mm of static margin; the plan failed ("the centre of mass is 0.5 mm outside the support polygon
+    near waypoint 10"). Now planned; the path's steps are at most MAX_WAYPOINT_STEP."""
+    t = reachable_targets(controller, "same", 8, np.random.default_rng(0))[1]
+    plan = snakehead.plan([(t.position, t.direction)], controller=controller)
+    verify_plan(plan, t.position, t.direction)
+    Q = np.array([q for _, _, q in plan.states])
+    assert np.abs(np.diff(Q, axis=0)).max() <= planner.MAX_WAYPOINT_STEP + 1e-9
+
+
+def test_relocated_base_holds_a_stable_curl(controller):
+    """Target 44 of ``reachable_targets(controller, "shape", 100, default_rng(1))`` is reached only from another
+    base. The whole-body solve with the base moved finds it first with a straight base, where no curl of the neck
+    and head is stable (the bending state every plan lifts from), so the planner kept the start's base and failed
+    ("out of reach"). With ``shape_ok`` the solve goes on to a shape that holds one; the plan succeeds."""
+    robot = controller.robot
+    t = reachable_targets(controller, "shape", 100, np.random.default_rng(1))[44]
+    prob = controller.body_problem
+    plain = wb.solve_target(controller, t.position, t.direction, problem=prob, min_margin=planner.DETOUR_MARGIN)
+    assert plain.success and plain.stage == wb.STAGES[2]
+    with pytest.raises(ValueError, match="no curl"):  # the case: the first base found holds no curl
+        planner.bending_state(controller, plain.q)
+
+    plan = snakehead.plan([(t.position, t.direction)], controller=controller)
+    verify_plan(plan, t.position, t.direction)
+    assert plan.relocation is not None
+    # independent: the plan starts with the neck and head lying flat on the ground (every pitch joint 0) over the
+    # relocated base, stable on the base's own footprint and clear of itself
+    q_bend = plan.q[0]
+    pitch = np.array([k == "pitch" for k in robot.joint_kinds])
+    np.testing.assert_allclose(q_bend[pitch], 0.0, atol=1e-12)
+    assert stability.static_margin(robot, q_bend, plan.base, contact="footprint") > 0.0
+    assert coll.self_clearance(robot, q_bend[None], plan.base)[0] > 0.0
+
+
+def test_shape_ok_is_obeyed(controller):
+    """solve_target's ``shape_ok``: a solution with the base moved has a shape that passes it (here: every yaw
+    joint of the base bent by more than 0.1 rad); the solution passes every check, recomputed independently."""
+    robot = controller.robot
+    t = reachable_targets(controller, "shape", 100, np.random.default_rng(1))[44]
+    yaw = np.flatnonzero(controller.body_problem.ground_yaw)
+    refused = []
+
+    def bent(q):
+        ok = bool(np.abs(q[yaw]).min() > 0.1)
+        refused.extend([] if ok else [q.copy()])
+        return ok
+
+    sol = wb.solve_target(controller, t.position, t.direction, problem=controller.body_problem,
+                          min_margin=planner.DETOUR_MARGIN, shape_ok=bent)
+    assert sol.success and sol.stage == wb.STAGES[2] and np.abs(sol.q[yaw]).min() > 0.1
+    assert refused  # a straight shape was found first and refused
+    H = robot.head_pose(sol.q, sol.base)
+    assert np.linalg.norm(H[:3, 3] - t.position) <= 1e-4
+    assert np.degrees(np.arccos(np.clip(H[:3, 0] @ t.direction, -1.0, 1.0))) <= 0.05
+    assert min(stability.static_margin(robot, sol.q, sol.base, contact=c) for c in ("ground", "footprint")) \
+        >= planner.DETOUR_MARGIN - 1e-9
+    assert coll.ground_clearance(robot, sol.q, sol.base)[0, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
+    assert coll.self_clearance(robot, sol.q[None], sol.base)[0] > 0.0
+
+
+def test_split_steps_and_checked_configurations():
+    qs = np.array([[0.0, 0.0], [0.3, -0.1], [1.3, 0.9], [1.3, 0.9]])
+    split = planner._split_steps(qs, most=0.5)
+    # the same straight segments: 1 + 2 + 1 steps, none longer than 0.5 rad, the waypoints kept
+    assert len(split) == 1 + 1 + 2 + 1
+    assert np.abs(np.diff(split, axis=0)).max() <= 0.5 + 1e-12
+    for q in qs:
+        assert np.min(np.abs(split - q).max(axis=1)) < 1e-12
+    np.testing.assert_allclose(split[2], [0.8, 0.4])
+    checked = planner._checked(qs, step=0.05)
+    assert np.abs(np.diff(checked, axis=0)).max() <= 0.05 + 1e-12
+    assert len(checked) == 1 + 6 + 20 + planner.DENSIFY + 1
+
+
+def test_after_the_lift_a_move_stands_on_the_base(controller):
+    """Once the head is up, ``_Waypoints._feasible`` takes the smaller of the ground contact's margin and the
+    base's own: a configuration that keeps DETOUR_MARGIN only because a neck or head link rests on the ground is
+    refused after the lift (and accepted before it). Independent: stability.static_margin with both models."""
+    robot = controller.robot
+    rng = np.random.default_rng(4)
+    lifted = np.arange(robot.lift_joints.start, robot.n_joints)
+    way = planner._Waypoints(robot, controller.base)
+    found = 0
+    for _ in range(400):
+        q = controller.q_initial.copy()
+        q[lifted] += rng.normal(0.0, 0.6, len(lifted))
+        q = np.clip(q, robot.lower, robot.upper)
+        ground = stability.static_margin(robot, q, controller.base, contact="ground")
+        footprint = stability.static_margin(robot, q, controller.base, contact="footprint")
+        if not (ground >= planner.DETOUR_MARGIN > footprint):
+            continue
+        if (coll.ground_clearance(robot, q, controller.base)[0, robot.lifted_links].min() < -coll.GROUND_TOLERANCE
+                or coll.self_clearance(robot, q[None], controller.base)[0] <= 0):
+            continue
+        way.lift_index = None
+        assert way._feasible(q[None])[0]
+        way.lift_index = 15
+        assert not way._feasible(q[None])[0]
+        found += 1
+    assert found > 0  # the case the check is for was drawn
