@@ -147,3 +147,75 @@ def test_after_the_lift_a_move_stands_on_the_base(controller):
         assert not way._feasible(q[None])[0]
         found += 1
     assert found > 0  # the case the check is for was drawn
+
+
+def base_only_margin(robot, q, base):
+    """Independent of the planner's code: the CoM's signed distance to the convex hull (scipy's qhull) of the
+    bottom corners of the boxes of the links before the first lifted one (those lie flat on the ground)."""
+    from scipy.spatial import ConvexHull
+
+    first_lifted = robot.body.model.joint_child_links[robot.lift_joints.start]
+    links = robot.boxed_links[robot.boxed_links < first_lifted]
+    corners = robot.box_corners(robot.frames(q, base)[None], links)[0].reshape(-1, 3)
+    bottom = corners[corners[:, 2] < 1e-9][:, :2]
+    hull = ConvexHull(bottom)
+    c = stability.center_of_mass(robot, q, base)[:2]
+    return -float(np.max(hull.equations[:, :2] @ c + hull.equations[:, 2]))
+
+
+@pytest.fixture(scope="module")
+def generated():
+    """A generated snake unlike the default: 13 joints starting with a pitch joint, 10 cm modules, 6 cm section,
+    parts named by link frames (the base ends at a real link, not a marker), a 1-joint neck, a 6-DOF head."""
+    from snakehead.kinematics import workspace as ws
+    from snakehead.model.generate import SnakeSpec, snake_urdf
+
+    spec = SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
+                     link_prefix="seg", joint_prefix="j", tip_name="nose")
+    robot = snakehead.SnakeRobot.from_urdf(snake_urdf(spec), base_end="seg6", neck_end="seg7", head_tip="nose")
+    m = ws.compute(robot, progress=False, voxel=1.5 * ws.default_map_options(robot)["voxel"], directions=12, rolls=2)
+    return snakehead.HeadController(robot, m, method="free_roll", seed=1)
+
+
+def test_targets_stand_on_the_links_that_stay_on_the_ground(generated):
+    """Every reachable-by-construction target of a generated snake stands on the links that stay on the ground by
+    the targets' margin (scipy's hull), and keeps its neck and head above the ground."""
+    robot = generated.robot
+    for kind in ("same", "shape", "place"):
+        for t in reachable_targets(generated, kind, 5, np.random.default_rng(3)):
+            assert base_only_margin(robot, t.q, t.base) > 0.005
+            assert coll.ground_clearance(robot, t.q, t.base)[0, robot.lifted_links].min() >= 0.0
+            H = robot.head_pose(t.q, t.base)
+            np.testing.assert_allclose(H[:3, 3], t.position, atol=1e-12)
+
+
+def test_generated_snake_plans_other_shapes(generated):
+    """A generated snake (13 joints, pitch first) plans targets that need another base shape: relocated, every
+    check recomputed, and after the lift every planned waypoint stands on the links that stay on the ground by
+    DETOUR_MARGIN (scipy's hull), as ``_Waypoints._feasible`` asks."""
+    for t in reachable_targets(generated, "shape", 3, np.random.default_rng(0)):
+        plan = snakehead.plan([(t.position, t.direction)], controller=generated)
+        verify_plan(plan, t.position, t.direction)
+        lifted = [q for label, _, q in plan.states if not label.startswith(("bending", "initial"))]
+        assert lifted
+        assert min(base_only_margin(plan.robot, q, plan.base) for q in lifted) >= planner.DETOUR_MARGIN - 1e-9
+
+
+def test_margins_after_the_lift_on_a_generated_snake(generated):
+    """``_Waypoints._margins`` after the lift: the smaller of the ground contact's margin and that over the links
+    that stay on the ground (here the base's last link is a real link, not a marker: the 'footprint' model leaves
+    it out, the planner must not). Independent: stability.static_margin and scipy's hull."""
+    robot = generated.robot
+    rng = np.random.default_rng(2)
+    way = planner._Waypoints(robot, snakehead.BasePlacement(0.2, -0.1, 0.7))
+    way.lift_index = 1
+    lifted = np.arange(robot.lift_joints.start, robot.n_joints)
+    qs = np.tile(generated.q_initial, (30, 1))
+    qs[:, lifted] += rng.normal(0.0, 0.4, (30, len(lifted)))
+    qs[15:, :robot.lift_joints.start] *= 0.5  # a second base shape
+    qs = np.clip(qs, robot.lower, robot.upper)
+    expected = [min(stability.static_margin(robot, q, way.base, contact="ground"), base_only_margin(robot, q, way.base))
+                for q in qs]
+    np.testing.assert_allclose(way._margins(qs), expected, atol=1e-9)
+    footprint = [stability.static_margin(robot, q, way.base, contact="footprint") for q in qs]
+    assert np.max(np.array(expected) - footprint) > 0.01  # the case: the footprint model would refuse far more

@@ -213,6 +213,7 @@ class _Waypoints:
         self.timing_failure: str | None = None  # why the path could not be timed, when it could not
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: dict | None = None  # timed lifts, kept by the controller
+        self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
 
     def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs = [label], [np.asarray(q, float)]
@@ -270,12 +271,30 @@ class _Waypoints:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
         link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
         the smaller of that and the base's own (``contact="footprint"``): a motion must not lean on a neck or head
-        link that touches the ground at a checked configuration and may leave it in between."""
+        link that touches the ground at a checked configuration and may leave it in between (``_base_margins``)."""
         com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
         margin = stability.support_margins(self.robot, qs, com, self.base, contact="ground")
         if self.lift_index is not None:
-            margin = np.minimum(margin, stability.support_margins(self.robot, qs, com, self.base, contact="footprint"))
+            margin = np.minimum(margin, self._base_margins(qs, com))
         return margin
+
+    def _base_margins(self, qs: np.ndarray, com_xy: np.ndarray) -> np.ndarray:
+        """Static margins (m) of configurations qs (m, n) with CoM projections com_xy (m, 2) over the support of the
+        links that lie on the ground whatever the pose (``control.whole_body.BodyProblem.ground_links``: the base's
+        and the neck's before it lifts, flat: their boxes' bottom corners), as ``check_solution`` takes it."""
+        from ..control.whole_body import BodyProblem
+
+        if self._problem is None:
+            self._problem = BodyProblem(self.robot)
+        prob, start = self._problem, self.robot.lift_joints.start
+        shapes, which = np.unique(np.round(qs[:, :start], 12), axis=0, return_inverse=True)
+        pts = []
+        for shape in shapes:  # those links move with the joints before the lift only
+            q = np.zeros(self.robot.n_joints)
+            q[:start] = shape
+            pts.append(prob.contact_points(prob.frames(q, self.base))[0][:, :2])
+        pts = np.stack(pts)[np.asarray(which).reshape(-1)]
+        return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com_xy)
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
         """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links

@@ -3,7 +3,10 @@
 A target is *reachable by construction* when it is the head pose of a whole-body configuration that the robot
 can hold: statically stable (the centre of mass inside the support polygon of the links on the ground by
 ``min_margin``, and inside the base's own: a neck or head link resting on the ground does not hold the body up),
-every neck and head link above the ground, no two links touching. Three kinds (``KINDS``):
+every neck and head link above the ground, no two links touching. The base's own support is that of the links
+lying on the ground whatever the pose (``control.whole_body.BodyProblem.ground_links``: the base's, and on a neck
+that begins with yaw joints the links before it lifts), as the whole-body solve checks its solutions
+(``check_solution(problem=)``). Three kinds (``KINDS``):
 
 * ``"same"`` -- the base keeps the planner's initial configuration (its optimised arc) at the planner's
   placement; the neck and head joints are drawn uniformly within their limits;
@@ -50,6 +53,7 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0:
         raise ValueError(f"count must be an integer >= 0, got {count!r}")
     robot = controller.robot
+    prob = controller.body_problem
     rng = np.random.default_rng() if rng is None else rng
     lift = np.arange(robot.lift_joints.start, robot.n_joints)
     ground_yaw = np.array([j for j in range(robot.lift_joints.start) if robot.joint_kinds[j] == "yaw"], int)
@@ -66,10 +70,11 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
             x, y = rng.uniform(-reach, reach, 2)
             base = BasePlacement(float(controller.base.x + x), float(controller.base.y + y),
                                  float(rng.uniform(-np.pi, np.pi)))
-        # stable on the links that lie on the ground whatever the pose: a neck or head link resting on the ground
-        # does not count (the pose must keep them above it)
+        # stable on the links that lie on the ground whatever the pose (the base's, and the neck's before it
+        # lifts: the body problem's ground links, as the whole-body solve's check takes them): a neck or head link
+        # resting on the ground does not count (the pose must keep them above it)
         if min(stability.static_margin(robot, q, base, contact="ground"),
-               stability.static_margin(robot, q, base, contact="footprint")) <= min_margin:
+               prob.margin_and_gradient(prob.frames(q, base), base)[0]) <= min_margin:
             continue
         if coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min() < 0.0:
             continue
