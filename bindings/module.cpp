@@ -15,6 +15,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
   snakehead::bindings::bind_support(m);
+  snakehead::bindings::bind_dynamics(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");
