@@ -143,7 +143,7 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     W0 = robot.root_pose(base)
     R0, p0 = W0[:3, :3], W0[:3, 3]
     g_root = R0.T @ np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)  # in the root frame
-    share = lift_shares(robot, W0 @ F, ramp) if gravity == "carried" else None  # (T, L)
+    share = lift_shares(robot, robot.frames_many(qs, base), ramp) if gravity == "carried" else None  # (T, L)
     # the pass itself (C++ core, per sample): forward, the links' angular velocities and accelerations and their
     # frames' accelerations from the root; backward, the wrench each link's parent exerts on it and on everything
     # beyond it, the weight's part scaled link by link by the lifted share

@@ -69,36 +69,31 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
     if links.size == 0:
         raise ValueError("the base part has no links with a collision box; no support polygon")
-    on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
     if contact == "endpoints":
         # Eq. 24: p_i are the endpoints of the base links, i.e. the origins of consecutive frames (each
         # link's frame is at its proximal joint; the next frame in chain order is at its distal end). A point
         # touches the ground when a link it ends lies on the ground.
+        on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
         idx = np.unique(np.r_[links, links + 1])
         pts = frames[:, idx][..., :2, 3]  # (T, N, 2)
         active = np.zeros((frames.shape[0], len(idx)), bool)
         active[:, np.searchsorted(idx, links)] |= on_ground
         active[:, np.searchsorted(idx, links + 1)] |= on_ground
         return pts, active
-    # footprint / ground: the four bottom corners of each box (its face nearest the ground).
-    B = frames[:, links] @ robot.box_origins[links]  # (T, k, 4, 4)
-    half = 0.5 * robot.box_sizes[links]  # (k, 3)
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
-    local = signs[None, :, :] * half[:, None, :]  # (k, 8, 3)
-    # keep the 4 lowest corners of each box (its bottom face when the link lies flat): their heights first, then
-    # the world position of those four only
-    z = np.einsum("tkj,kcj->tkc", B[..., 2, :3], local) + B[..., 2, None, 3]  # (T, k, 8)
-    order = np.argsort(z, axis=2, kind="stable")[..., :4]
-    corners = local[np.arange(len(links))[None, :, None], order]  # (T, k, 4, 3)
-    low = np.empty(order.shape + (3,))
-    low[..., :2] = np.einsum("tkij,tkcj->tkci", B[..., :2, :3], corners) + B[..., None, :2, 3]
-    low[..., 2] = np.take_along_axis(z, order, axis=2)
+    # footprint / ground: the four bottom corners of each box (its face nearest the ground when the link lies flat;
+    # the C++ core picks them by height)
+    xy, z = _core.lowest_box_corners(np.ascontiguousarray(frames), robot.box_origins, 0.5 * robot.box_sizes,
+                                     links.astype(np.int32))
+    if contact == "ground":  # only the links that touch in some sample can give a contact point
+        keep = (z[..., 0] <= tolerance).any(axis=0)
+        keep[0] |= not keep.any()  # (one link, none of its points active: no polygon, but the shapes stay)
+        xy, z = xy[:, keep], z[:, keep]
     T = frames.shape[0]
-    pts = low[..., :2].reshape(T, -1, 2)
+    pts = xy.reshape(T, -1, 2)
     # a corner supports only where it touches: a link tilted up off the ground (a neck link rising from it) rests on
     # its lowest edge, not on the corners it holds in the air (counting those would move the polygon's edge out by
     # the link's length and make it jump as the link lifts)
-    active = (low[..., 2] <= tolerance).reshape(T, -1)
+    active = (z <= tolerance).reshape(T, -1)
     return pts, active
 
 
