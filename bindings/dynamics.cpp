@@ -30,7 +30,7 @@ void bind_dynamics(py::module_& m) {
   m.def(
       "newton_euler",
       [](Array frames, Array qd, Array qdd, std::vector<int> joint_child, Array axes, Array masses, Array coms,
-         Array inertias, std::optional<Array> share, Eigen::Vector3d gravity_root) {
+         Array inertias, std::optional<Array> share, Eigen::Vector3d gravity) {
         expect_shape(frames, {-1, -1, 4, 4}, "frames (T, L, 4, 4)");
         const long T = static_cast<long>(frames.shape(0)), L = static_cast<long>(frames.shape(1));
         const long n = static_cast<long>(joint_child.size());
@@ -57,14 +57,15 @@ void bind_dynamics(py::module_& m) {
         const double* sp = share ? share->data() : nullptr;
         {
           py::gil_scoped_release release;
-          newton_euler(chain, frames.data(), qd.data(), qdd.data(), sp, gravity_root, T, L, tp, fp, mp);
+          newton_euler(chain, frames.data(), qd.data(), qdd.data(), sp, gravity, T, L, tp, fp, mp);
         }
         return py::make_tuple(tau, force, moment);
       },
       py::arg("frames"), py::arg("qd"), py::arg("qdd"), py::arg("joint_child"), py::arg("axes"), py::arg("masses"),
-      py::arg("coms"), py::arg("inertias"), py::arg("share"), py::arg("gravity_root"),
+      py::arg("coms"), py::arg("inertias"), py::arg("share"), py::arg("gravity"),
       "Newton-Euler with the root link still: joint torques (T, n) and the inertial wrench across the first joint "
-      "(force (T, 3), moment about the root origin (T, 3), root axes)");
+      "(force (T, 3), moment about the frames' origin (T, 3), in their axes; frames in an inertial frame where the "
+      "root link is still)");
 }
 
 }  // namespace snakehead::bindings

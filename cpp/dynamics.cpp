@@ -19,7 +19,7 @@ void RigidBodyChain::validate() const {
 }
 
 void newton_euler(const RigidBodyChain& chain, const double* frames, const double* qd, const double* qdd,
-                  const double* share, const Eigen::Vector3d& gravity_root, long T, long L, double* tau,
+                  const double* share, const Eigen::Vector3d& gravity, long T, long L, double* tau,
                   double* force, double* moment) {
   chain.validate();
   const long n = static_cast<long>(chain.joint_child.size());
@@ -28,7 +28,7 @@ void newton_euler(const RigidBodyChain& chain, const double* frames, const doubl
   std::vector<int> joint_of(static_cast<std::size_t>(L), -1);
   for (long j = 0; j < n; ++j) joint_of[static_cast<std::size_t>(chain.joint_child[j])] = static_cast<int>(j);
   const int first = n > 0 ? chain.joint_child[0] : static_cast<int>(L);  // links before it: the still root
-  const bool weighed = gravity_root.squaredNorm() > 0.0;
+  const bool weighed = gravity.squaredNorm() > 0.0;
   std::vector<Eigen::Matrix3d> R(L);
   std::vector<Eigen::Vector3d> p(L), omega(L), alpha(L), acc(L), z(L);
   for (long t = 0; t < T; ++t) {
@@ -80,7 +80,7 @@ void newton_euler(const RigidBodyChain& chain, const double* frames, const doubl
         f_in += m * ac;
         n_in += I * alpha[k] + omega[k].cross(Iw) + rc.cross(m * ac);
         if (weighed) {
-          const Eigen::Vector3d hold = -m * gravity_root;  // holds the link against gravity
+          const Eigen::Vector3d hold = -m * gravity;  // holds the link against gravity
           f_g += hold;
           n_g += rc.cross(hold);
         }

@@ -20,12 +20,13 @@ struct RigidBodyChain {
   void validate() const;                  // throws InputError naming what is inconsistent
 };
 
-// One pass for T samples. frames: T x L x 4 x 4 (row-major) link poses in the root frame; qd, qdd: T x n;
-// share: T x L lifted shares in [0, 1] (nullptr: every link's weight counts in full); gravity_root: gravity in the
-// root frame (zero: inertial terms only). Out: tau (T x n) joint torques; force (T x 3) and moment (T x 3) the
-// inertial wrench across the first joint, moment about the root frame's origin, root axes (the momentum rates).
+// One pass for T samples. frames: T x L x 4 x 4 (row-major) link poses in an inertial frame in which the root link
+// is still (the world, or the root's own); qd, qdd: T x n; share: T x L lifted shares in [0, 1] (nullptr: every
+// link's weight counts in full); gravity: gravity in that frame (zero: inertial terms only). Out: tau (T x n)
+// joint torques; force (T x 3) and moment (T x 3) the inertial wrench across the first joint, moment about that
+// frame's origin, in its axes (the momentum rates).
 void newton_euler(const RigidBodyChain& chain, const double* frames, const double* qd, const double* qdd,
-                  const double* share, const Eigen::Vector3d& gravity_root, long T, long L, double* tau,
+                  const double* share, const Eigen::Vector3d& gravity, long T, long L, double* tau,
                   double* force, double* moment);
 
 }  // namespace snakehead

@@ -109,8 +109,8 @@ def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | No
 
 
 def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
-                     base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
-                     ) -> np.ndarray:
+                     base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP,
+                     frames: np.ndarray | None = None) -> np.ndarray:
     """Joint torques (N m) that move the body along q, qd, qdd with the root link lying still on the ground.
 
     q (rad), qd (rad/s), qdd (rad/s^2): (T, n) each, or (n,) each (-> (n,)). ``base``: where the root lies (its
@@ -119,16 +119,19 @@ def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd
     the ground), "full" (every link's weight: the body as a fixed-base arm) or "none" (inertial terms only).
     Inertial terms (the links' accelerations, Coriolis and centrifugal terms) always count in full.
 
+    ``frames``: the world frames of q (T, n_links, 4, 4) when the caller has them (``robot.frames_many(q, base)``).
+
     Returns tau (T, n) N m (or (n,)). :func:`newton_euler` returns the momentum rates too.
     """
-    return newton_euler(robot, q, qd, qdd, base, gravity=gravity, ramp=ramp).tau
+    return newton_euler(robot, q, qd, qdd, base, gravity=gravity, ramp=ramp, frames=frames).tau
 
 
 def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
-                 base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
-                 ) -> InverseDynamics:
+                 base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP,
+                 frames: np.ndarray | None = None) -> InverseDynamics:
     """:func:`inverse_dynamics`'s pass, returning the joint torques and the momentum rates (Eqs. 33-34) of the
-    body: an :class:`InverseDynamics` (arrays of one sample when q, qd, qdd are (n,))."""
+    body: an :class:`InverseDynamics` (arrays of one sample when q, qd, qdd are (n,)). ``frames``: as for
+    :func:`inverse_dynamics`."""
     robot = as_robot(robot)
     base = as_base(base)
     if gravity not in GRAVITY_MODELS:
@@ -139,22 +142,20 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     qds = _samples(robot, qd, "qd", T)
     qdds = _samples(robot, qdd, "qdd", T)
 
-    F = robot.body.fk_all_many(qs)  # (T, L, 4, 4), root frame
-    W0 = robot.root_pose(base)
-    R0, p0 = W0[:3, :3], W0[:3, 3]
-    g_root = R0.T @ np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)  # in the root frame
-    share = lift_shares(robot, robot.frames_many(qs, base), ramp) if gravity == "carried" else None  # (T, L)
+    # in the world frame: the root link is still, so its frame is as good as any inertial one, and the momentum rates
+    # come out about the world origin (Eqs. 33-34) directly
+    shape = (T, len(robot.link_names), 4, 4)
+    F = robot.frames_many(qs, base) if frames is None or np.shape(frames) != shape else np.asarray(frames, float)
+    g = np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)
+    share = lift_shares(robot, F, ramp) if gravity == "carried" else None  # (T, L)
     # the pass itself (C++ core, per sample): forward, the links' angular velocities and accelerations and their
     # frames' accelerations from the root; backward, the wrench each link's parent exerts on it and on everything
-    # beyond it, the weight's part scaled link by link by the lifted share
-    tau, f_in, n_origin = _core.newton_euler(F, qds, qdds, list(robot.body.model.joint_child_links),
-                                             robot.body.model.joint_axes, robot.masses, robot.coms, robot.inertias,
-                                             share, g_root)
+    # beyond it, the weight's part scaled link by link by the lifted share. The inertial wrench across the first
+    # joint (its moment about the world origin) is the momentum rate: the root link does not move
+    tau, Pdot, Ldot = _core.newton_euler(F, qds, qdds, list(robot.body.model.joint_child_links),
+                                         robot.body.model.joint_axes, robot.masses, robot.coms, robot.inertias,
+                                         share, g)
     tau = tau[0] if single else tau
-    # the inertial wrench across the first joint (about the root frame's origin) is the momentum rate (the root link
-    # does not move): to the world, about the world origin
-    Pdot = f_in @ R0.T
-    Ldot = n_origin @ R0.T + np.cross(p0, Pdot)
     if single:
         Pdot, Ldot = Pdot[0], Ldot[0]
     return InverseDynamics(tau, Pdot, Ldot)

@@ -117,24 +117,30 @@ def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.Ar
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
-def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
+def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
+                   frames: np.ndarray | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
 
-    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3).
+    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3). ``frames``: the world frames of q (T, n_links, 4, 4) when
+    the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)
     qs, single = _joint_matrix(robot, q)
-    frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
+    world = frames is not None and np.shape(frames) == (qs.shape[0], len(robot.link_names), 4, 4)
+    if not world:
+        frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
+    assert frames is not None
     m = robot.masses
     # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product
     W = np.zeros((len(m), 3, 4, 3))
     for i in range(3):
         W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
         W[:, i, 3, i] = m  # coefficient of p_l[i]
-    c = (frames[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
-    W = robot.root_pose(base)
-    c = c @ W[:3, :3].T + W[:3, 3]
+    c = (np.asarray(frames)[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
+    if not world:
+        W = robot.root_pose(base)
+        c = c @ W[:3, :3].T + W[:3, 3]
     return c[0] if single else c
 
 

@@ -178,8 +178,11 @@ class Support:
     required: np.ndarray
 
     @classmethod
-    def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float) -> "Support":
-        V, count = stability.support_polygons(robot, q, base, contact="ground")
+    def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float,
+           frames: np.ndarray | None = None) -> "Support":
+        """``frames``: the world frames of q, when the caller has them."""
+        frames = robot.frames_many(q, base) if frames is None else frames
+        V, count = stability.support_polygons(robot, q, base, contact="ground", frames=frames)
         if np.any(count < 3):
             k = int(np.argmax(count < 3))
             raise ValueError(f"the links on the ground span no polygon at path point {k} ({count[k]} distinct "
@@ -191,7 +194,7 @@ class Support:
         e = np.take_along_axis(V, stop[..., None], axis=1) - a
         normal = np.stack([-e[..., 1], e[..., 0]], axis=-1) / np.linalg.norm(e, axis=-1, keepdims=True)  # inside
         offset = (normal * a).sum(-1)
-        com = stability.center_of_mass(robot, q, base)
+        com = stability.center_of_mass(robot, q, base, frames=frames)
         static = ((normal * com[:, None, :2]).sum(-1) - offset).min(axis=1)
         return cls(normal, offset, com, static, required_margins(static, zmp_margin))
 
@@ -277,10 +280,10 @@ class LimitCheck:
 
 
 def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
-            qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
+            qd: np.ndarray, qdd: np.ndarray, frames: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
     used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
-    dyn = newton_euler(robot, q, qd, qdd, base)  # torques and exact momentum rates
+    dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
     tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
     Mg = robot.total_mass * stability.GRAVITY
     normal_force = Mg + Pdot[:, 2]
@@ -310,7 +313,8 @@ def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     q = finite_array(q, "q", (None, robot.n_joints))
     qd = finite_array(qd, "qd", q.shape)
     qdd = finite_array(qdd, "qdd", q.shape)
-    r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin), q, qd, qdd)
+    frames = robot.frames_many(q, base)
+    r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin, frames), q, qd, qdd, frames)
     moving = np.abs(qd).max(axis=1) > 0
 
     def share(hit: np.ndarray) -> float:
@@ -531,9 +535,10 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
 
     def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
         zero = np.zeros_like(q)
-        return (inverse_dynamics(robot, q, zero, dq, base, gravity="none"),
-                inverse_dynamics(robot, q, dq, ddq, base, gravity="none"),
-                inverse_dynamics(robot, q, zero, zero, base))
+        F = robot.frames_many(q, base)
+        return (inverse_dynamics(robot, q, zero, dq, base, gravity="none", frames=F),
+                inverse_dynamics(robot, q, dq, ddq, base, gravity="none", frames=F),
+                inverse_dynamics(robot, q, zero, zero, base, frames=F))
 
     supports: dict[int, tuple[np.ndarray, Support]] = {}
 
@@ -641,9 +646,10 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     dq, ddq = f(s, 1), f(s, 2)
     q, qd, qdd = f(s, 0), dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
     nearer = np.where(fr < 0.5, stage, stage + 1)
-    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base),
+    frames = robot.frames_many(q, base)
+    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base, frames=frames),
                   support.static[nearer], support.required[nearer])
-    r = _ratios(robot, base, limits, sub, q, qd, qdd)
+    r = _ratios(robot, base, limits, sub, q, qd, qdd, frames)
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
         over |= r[key] > 1.0
