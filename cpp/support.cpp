@@ -97,4 +97,26 @@ std::vector<double> hull_margins(const double* points, const unsigned char* acti
   return out;
 }
 
+void convex_hulls(const double* points, const unsigned char* active, long T, long N, int* vertex, int* count) {
+  if (T < 0 || N < 0) throw InputError("convex_hulls: negative sizes");
+  Points buffer(N, 2);
+  std::vector<int> index(static_cast<std::size_t>(N));
+  for (long t = 0; t < T; ++t) {
+    long m = 0;
+    for (long i = 0; i < N; ++i) {
+      if (!active[t * N + i]) continue;
+      buffer(m, 0) = points[(t * N + i) * 2];
+      buffer(m, 1) = points[(t * N + i) * 2 + 1];
+      index[static_cast<std::size_t>(m)] = static_cast<int>(i);
+      ++m;
+    }
+    if (!buffer.topRows(m).allFinite()) throw InputError("convex_hulls: points must be finite");
+    const std::vector<int> h = convex_hull(buffer.topRows(m));
+    int* row = vertex + t * N;
+    std::fill(row, row + N, -1);
+    for (std::size_t k = 0; k < h.size(); ++k) row[k] = index[static_cast<std::size_t>(h[k])];
+    count[t] = static_cast<int>(h.size());
+  }
+}
+
 }  // namespace snakehead

@@ -24,4 +24,8 @@ double hull_margin(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 
 std::vector<double> hull_margins(const double* points, const unsigned char* active, const double* xy, long T,
                                  long N);
 
+// convex_hull for T samples (layout as hull_margins): each sample's hull vertices, counter-clockwise, as
+// indices into its N points, in `vertex` (T x N, -1 after the count) and the vertex count in `count` (T).
+void convex_hulls(const double* points, const unsigned char* active, long T, long N, int* vertex, int* count);
+
 }  // namespace snakehead

@@ -85,10 +85,14 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     half = 0.5 * robot.box_sizes[links]  # (k, 3)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
     local = signs[None, :, :] * half[:, None, :]  # (k, 8, 3)
-    world = np.einsum("tkij,kcj->tkci", B[..., :3, :3], local) + B[..., None, :3, 3]  # (T, k, 8, 3)
-    # keep the 4 lowest corners of each box (its bottom face when the link lies flat)
-    order = np.argsort(world[..., 2], axis=2, kind="stable")[..., :4]
-    low = np.take_along_axis(world, order[..., None], axis=2)  # (T, k, 4, 3)
+    # keep the 4 lowest corners of each box (its bottom face when the link lies flat): their heights first, then
+    # the world position of those four only
+    z = np.einsum("tkj,kcj->tkc", B[..., 2, :3], local) + B[..., 2, None, 3]  # (T, k, 8)
+    order = np.argsort(z, axis=2, kind="stable")[..., :4]
+    corners = local[np.arange(len(links))[None, :, None], order]  # (T, k, 4, 3)
+    low = np.empty(order.shape + (3,))
+    low[..., :2] = np.einsum("tkij,tkcj->tkci", B[..., :2, :3], corners) + B[..., None, :2, 3]
+    low[..., 2] = np.take_along_axis(z, order, axis=2)
     T = frames.shape[0]
     pts = low[..., :2].reshape(T, -1, 2)
     # a corner supports only where it touches: a link tilted up off the ground (a neck link rising from it) rests on
@@ -411,7 +415,8 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 
-    The polygons are those of :func:`support_polygons`, built once per distinct contact configuration.
+    The polygons are those of :func:`support_polygons`, built once per run of samples with one contact
+    configuration.
     ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
@@ -429,9 +434,9 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
 
     Row k holds its polygon's ``count[k]`` vertices counter-clockwise first (the rest is padding): 0 where no link
-    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per
-    distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's round-off in a still base does
-    not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
+    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per run
+    of consecutive samples with one contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    round-off in a still base does not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
     last link on the ground (those after it move nothing that touches). ``frames``: the world frames of ``q``
     (T, n_links, 4, 4), when the caller has them.
     """
@@ -439,12 +444,11 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
-    hulls = [p[a][hull_indices(p[a])] if a.any() else np.zeros((0, 2)) for p, a in zip(pts, active)]
-    count = np.array([len(h) for h in hulls], int)
-    vertices = np.zeros((len(hulls), max(1, int(count.max())), 2))
-    for k, h in enumerate(hulls):
-        vertices[k, :len(h)] = h
-    return vertices[inv], count[inv]
+    vertex, count = _core.convex_hulls(np.ascontiguousarray(pts), np.ascontiguousarray(active))
+    width = max(1, int(count.max()))
+    vertices = np.take_along_axis(pts, np.maximum(vertex[:, :width], 0)[..., None], axis=1)
+    vertices[np.arange(width)[None, :] >= count[:, None]] = 0.0
+    return vertices[inv], count[inv].astype(int)
 
 
 def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
@@ -466,10 +470,11 @@ def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, conta
         key = np.column_stack([key, last])
     else:
         key = np.round(q[:, robot.parts.base], 12)
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    first = np.zeros(len(uniq), int)
-    first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
+    # runs of samples with the same contact configuration (a trajectory changes it rarely; a configuration that
+    # comes back later is built again, which costs less than sorting the samples to find it)
+    change = np.r_[True, np.any(key[1:] != key[:-1], axis=1)]
+    first = np.flatnonzero(change)  # the first sample of each run
+    inv = np.cumsum(change) - 1
     sample_frames = robot.frames_many(q[first], base) if frames is None else frames[first]
     pts, active = _contact_points_many(robot, sample_frames, contact, tolerance)
     return pts, active, inv

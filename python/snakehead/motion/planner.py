@@ -294,6 +294,9 @@ class _Waypoints:
         ``times`` (when each waypoint is reached)."""
         from .timing import retime
 
+        # the plan checks its 2 ms samples itself (_finish: the ZMP by the paper's momenta, the ground, obstacles);
+        # the retiming keeps the joint limits between its gridpoints by refining them
+        timing = dict(timing, check_samples=False)
         hold_s = np.zeros(len(self.qs) - 1)
         for k, seconds in self.holds.items():
             hold_s[k] = seconds
@@ -302,8 +305,9 @@ class _Waypoints:
         try:
             k = self.lift_index if self.lift_index is not None else -1
             if 0 < k < len(Q) - 1 and self.lift_cache is not None:
-                # the lift from the bending state is the same for every target from this base: time it once
-                key = (self.base, Q[:k + 1].tobytes(), repr(sorted(timing.items())))
+                # the lift from the bending state is the same for every target from a base of this shape, wherever
+                # it lies (retime does not depend on the placement): time it once
+                key = (np.round(Q[:k + 1], 9).tobytes(), repr(sorted(timing.items())))  # round-off apart
                 lift = self.lift_cache.get(key)
                 if lift is None:
                     lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
@@ -317,7 +321,7 @@ class _Waypoints:
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
         except ValueError as exc:
-            if any(key in str(exc) for key in timing):  # a bad option of the caller's, not the path's fault
+            if any(key in str(exc) for key in TIMING_OPTIONS if key in timing):  # a bad option of the caller's
                 raise
             # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
             # slow fixed pace so that the plan can still be looked at, and fail it

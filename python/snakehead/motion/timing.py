@@ -73,7 +73,7 @@ FRICTION_SIDES = 8
 #: s: a repeated waypoint's pause by default.
 HOLD_S = 1.0
 #: rad: the largest step of the path (Euclidean length in joint space) between two TOPP-RA gridpoints.
-GRID_STEP = 0.01
+GRID_STEP = 0.02
 #: Gridpoints per segment between two waypoints, at least.
 MIN_GRID_PER_SEGMENT = 8
 #: The most gridpoints of one retimed path (a path of 1000 rad at the default step): a larger grid is a mistake.
@@ -462,12 +462,13 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
            velocity_limit: npt.ArrayLike | None = None, acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
            torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION,
            dt: float = CONTROL_PERIOD, hold_s: npt.ArrayLike = HOLD_S, stops: Sequence[int] = (),
-           interpolation: str = "monotone", grid_step: float = GRID_STEP) -> RetimedTrajectory:
+           interpolation: str = "monotone", grid_step: float = GRID_STEP, check_samples: bool = True
+           ) -> RetimedTrajectory:
     """The fastest motion through ``waypoints`` that keeps the robot's limits and its balance.
 
     Parameters
     ----------
-    robot : the snake; base : where its base lies (default placement).
+    robot : the snake; base : where its base lies (default placement; the result is the same for any).
     waypoints : (K, n) joint vectors (rad) within the joint limits, K >= 2. The motion passes through every one,
         starts and ends at rest, and rests at each waypoint index in ``stops``.
     velocity_limit : rad/s, a number or (n,); default :data:`VELOCITY_SHARE` of the URDF's (none where it gives 0).
@@ -482,6 +483,9 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         waypoints) or "spline" (a not-a-knot cubic spline, toppra's own; it may overshoot: ValueError if it leaves
         the joint limits).
     grid_step : rad of path between TOPP-RA's gridpoints (at most; at least MIN_GRID_PER_SEGMENT per segment).
+    check_samples : measure every sample against the limits (:func:`check_limits`: the result's ``check``); False
+        leaves ``check`` None, for a caller that checks the samples itself (the refined grid keeps the limits
+        between gridpoints either way).
 
     Returns a :class:`RetimedTrajectory` (a JointTrajectory with ``duration``, ``waypoint_times``, ``check``).
     Raises ValueError when no motion along the path keeps the limits (the CoM outside the support polygon, the
@@ -489,7 +493,11 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     """
     clock = time.perf_counter()
     robot = as_robot(robot)
-    base = as_base(base)
+    as_base(base)  # validated; the timing does not depend on it:
+    # gravity is vertical and the ground flat, so the limits and the balance are the same wherever the base lies
+    # (the friction polygon is taken in the base's frame): the path is timed at the default placement, and one
+    # timing serves every placement (the planner times a lift once per base shape)
+    base = BasePlacement()
     n = robot.n_joints
     W = finite_array(waypoints, "waypoints")
     if W.ndim != 2 or W.shape[1] != n:
@@ -601,7 +609,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
     q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
     q[0], q[-1] = W[0], W[-1]
-    check = check_limits(robot, q, qd, qdd, base, limits)
+    check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
     return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
                              notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
 
