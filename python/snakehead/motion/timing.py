@@ -19,9 +19,10 @@ them: at every sample):
 Why the ZMP is a linear constraint: with w = (dP/dt, dL/dt) (Eqs. 33-34, L about the world origin), the ZMP
 lies on the inner side of a polygon edge n . p >= d + m exactly when, multiplied through by M g + dP_z/dt > 0,
 n_x (M g c_x - dL_y/dt) + n_y (M g c_y + dL_x/dt) - (d + m)(M g + dP_z/dt) >= 0 -- linear in w. Along a path q(s)
-the momenta are P = A(q) q' s', so w = a(s) s'' + b(s) s'^2 with a = (P, L)(q, q') and
-b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (:func:`~snakehead.dynamics.inverse_dynamics.momentum_rates`):
-exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count by repeating an edge.
+the joint velocities are q' s' and the accelerations q' s'' + q'' s'^2, so w = a(s) s'' + b(s) s'^2 with a the
+momentum rate of Newton-Euler at (q, 0, q') and b at (q, q', q'') (:func:`momentum_rate_coefficients`; the joint
+torques split the same way): exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count by
+repeating an edge.
 
 Where the centre of mass itself is closer than twice ``zmp_margin`` to the polygon's edge (a barely stable path),
 the ZMP is asked to keep half the CoM's margin instead (at rest the ZMP is the CoM's projection, so no motion can
@@ -44,7 +45,7 @@ from scipy.interpolate import CubicSpline
 
 from .._validate import finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
-from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates, newton_euler
+from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
 
@@ -243,12 +244,23 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, 
 
 
 def momentum_rate_coefficients(robot: SnakeRobot, q: npt.ArrayLike, dq: npt.ArrayLike, ddq: npt.ArrayLike,
-                               base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
+                               base: BasePlacement | None = None, frames: np.ndarray | None = None
+                               ) -> tuple[np.ndarray, np.ndarray]:
     """w = (dP/dt, dL/dt) along a path q(s) as a s'' + b s'^2: a, b (N, 6) at points q, dq = q'(s), ddq = q''(s)
-    (N, n) each. a = (P, L)(q, q'); b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (Eqs. 25-31, 33-34)."""
-    P, L = stability.momenta_from_velocities(robot, np.asarray(q, float), np.asarray(dq, float), base)
-    Pb, Lb = momentum_rates(robot, q, dq, ddq, base)
-    return np.hstack([P, L]), np.hstack([Pb, Lb])
+    (N, n) each. With qd = q' s' and qdd = q' s'' + q'' s'^2, the momentum rates of Newton-Euler (inertial part:
+    :func:`~snakehead.dynamics.inverse_dynamics.newton_euler`) split into a = w(q, 0, q') and b = w(q, q', q'').
+    ``frames``: the world frames of q when the caller has them."""
+    a, b = _path_dynamics(robot, np.asarray(q, float), np.asarray(dq, float), np.asarray(ddq, float), base, frames)
+    return np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot])
+
+
+def _path_dynamics(robot: SnakeRobot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, base: BasePlacement | None,
+                   frames: np.ndarray | None = None) -> tuple[Any, Any]:
+    """Newton-Euler's inertial terms along q(s): (the pass at (q, 0, q'), the pass at (q, q', q'')); their torques
+    and momentum rates are the coefficients of s'' and of s'^2."""
+    zero = np.zeros_like(q)
+    return (newton_euler(robot, q, zero, dq, base, gravity="none", frames=frames),
+            newton_euler(robot, q, dq, ddq, base, gravity="none", frames=frames))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -303,9 +315,9 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
 def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike, base: BasePlacement | None,
                  limits: RetimingLimits) -> LimitCheck:
     """Measure samples q, qd, qdd (T, n) of a trajectory against ``limits``: joint velocities and accelerations, the
-    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler (exact; the
-    retiming's constraint takes them from the paper's momenta instead) in the ground support polygon of each sample,
-    and the base's friction."""
+    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler in the ground
+    support polygon of each sample, and the base's friction. (An independent check of the ZMP, from the paper's
+    momenta of Eqs. 25-31 and their finite differences: ``stability.dynamic_stability``.)"""
     robot = as_robot(robot)
     base = as_base(base)
     if not isinstance(limits, RetimingLimits):
@@ -533,22 +545,31 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
                                   SOLVE_SHARE * limits.friction)
 
-    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
-        zero = np.zeros_like(q)
-        F = robot.frames_many(q, base)
-        return (inverse_dynamics(robot, q, zero, dq, base, gravity="none", frames=F),
-                inverse_dynamics(robot, q, dq, ddq, base, gravity="none", frames=F),
-                inverse_dynamics(robot, q, zero, zero, base, frames=F))
-
+    # the torque and the stability constraints of one grid share its frames, Newton-Euler passes and support
     supports: dict[int, tuple[np.ndarray, Support]] = {}
+    passes: dict[int, tuple[np.ndarray, Any]] = {}
+
+    def at_grid(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[Any, Any, np.ndarray, Support]:
+        hit = passes.get(q.shape[0])
+        if hit is None or not np.array_equal(hit[0], q):
+            F = robot.frames_many(q, base)
+            a, b = _path_dynamics(robot, q, dq, ddq, base, F)
+            hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=F)
+            support = supports.get(q.shape[0])
+            if support is None or not np.array_equal(support[0], q):
+                supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin, F))
+            passes[q.shape[0]] = hit = (q, (a, b, hold, support[1]))
+        return hit[1]
+
+    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
+        a, b, hold, _ = at_grid(q, dq, ddq)  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
+        return a.tau, b.tau, hold
 
     def stability_params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
-        a, b = momentum_rate_coefficients(robot, q, dq, ddq, base)
-        support = supports.get(q.shape[0])
-        if support is None or not np.array_equal(support[0], q):
-            supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin))
-        F, g = stability_rows(robot, support[1], solve_limits, SOLVE_ZMP_EXTRA_M)
-        return a, b, np.zeros_like(a), F, g
+        a, b, _, support = at_grid(q, dq, ddq)  # w = (dP/dt, dL/dt) = a s'' + b s'^2
+        wa, wb = np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot])
+        F, g = stability_rows(robot, support, solve_limits, SOLVE_ZMP_EXTRA_M)
+        return wa, wb, np.zeros_like(wa), F, g
 
     tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
     stab_c = _topp.PointwiseLinearConstraint(stability_params, n, identical=False, name="ZMP and friction")
