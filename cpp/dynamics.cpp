@@ -99,4 +99,45 @@ void newton_euler(const RigidBodyChain& chain, const double* frames, const doubl
   }
 }
 
+void momenta(const RigidBodyChain& chain, const double* frames, const double* qd, long T, long L, double* linear,
+             double* angular, double* com) {
+  chain.validate();
+  const long n = static_cast<long>(chain.joint_child.size());
+  if (L != static_cast<long>(chain.mass.size())) throw InputError("momenta: frames hold another number of links");
+  if (T < 0) throw InputError("momenta: negative sample count");
+  double total = 0.0;
+  for (double m : chain.mass) total += m;
+  if (!(total > 0.0)) throw InputError("momenta: the body has no mass");
+  using M4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+  for (long t = 0; t < T; ++t) {
+    const double* F = frames + t * L * 16;
+    const double* v = qd + t * n;
+    Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // sum of z_i qd_i over the joints passed so far (Eq. 26)
+    Eigen::Vector3d wxo = Eigen::Vector3d::Zero();    // sum of (z_i qd_i) x o_i over the same joints
+    Eigen::Vector3d P = Eigen::Vector3d::Zero(), Lm = Eigen::Vector3d::Zero(), mc = Eigen::Vector3d::Zero();
+    long j = 0;
+    for (long k = 0; k < L; ++k) {
+      const Eigen::Map<const M4> M(F + k * 16);
+      while (j < n && chain.joint_child[j] <= k) {  // joint j moves this link and every later one
+        const Eigen::Map<const M4> J(F + chain.joint_child[j] * 16);
+        const Eigen::Vector3d w = J.topLeftCorner<3, 3>() * chain.axis[j] * v[j];
+        omega += w;
+        wxo += w.cross(J.topRightCorner<3, 1>());
+        ++j;
+      }
+      const double m = chain.mass[k];
+      if (m <= 0.0) continue;  // marker frames carry no mass
+      const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
+      const Eigen::Vector3d c = M.topRightCorner<3, 1>() + R * chain.com[k];
+      const Eigen::Vector3d Pk = m * (omega.cross(c) - wxo);  // Eqs. 25, 27, 28
+      P += Pk;                                                 // Eq. 29
+      Lm += c.cross(Pk) + R * (chain.inertia[k] * (R.transpose() * omega));  // Eqs. 30, 31
+      mc += m * c;
+    }
+    Eigen::Map<Eigen::Vector3d>(linear + 3 * t) = P;
+    Eigen::Map<Eigen::Vector3d>(angular + 3 * t) = Lm;
+    Eigen::Map<Eigen::Vector3d>(com + 3 * t) = mc / total;
+  }
+}
+
 }  // namespace snakehead

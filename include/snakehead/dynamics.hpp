@@ -29,4 +29,11 @@ void newton_euler(const RigidBodyChain& chain, const double* frames, const doubl
                   const double* share, const Eigen::Vector3d& gravity, long T, long L, double* tau,
                   double* force, double* moment);
 
+// The paper's momenta (Eqs. 25-31) for T samples: linear momentum P, angular momentum L about the frames' origin,
+// and the centre of mass (Eq. 23), each T x 3, from the links' frames (T x L x 4 x 4, an inertial frame in which
+// the root link is still) and the joint velocities qd (T x n). Each massive link's CoM velocity is the sum over
+// the joints before it of (z_i qd_i) x (c - o_i) (Eqs. 25, 27); L sums c x m c_dot and R I R^T omega (Eqs. 30-31).
+void momenta(const RigidBodyChain& chain, const double* frames, const double* qd, long T, long L, double* linear,
+             double* angular, double* com);
+
 }  // namespace snakehead

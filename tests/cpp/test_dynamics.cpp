@@ -52,6 +52,20 @@ TEST(NewtonEuler, PendulumMatchesItsClosedForm) {
   }
 }
 
+TEST(Momenta, PendulumMatchesItsClosedForm) {
+  const double m = 0.7, r = 0.3, q = 0.9, qd = -1.7;
+  const auto chain = pendulum(m, r);
+  const std::vector<double> f = frames(q);
+  double P[3], L[3], c[3];
+  snakehead::momenta(chain, f.data(), &qd, 1, 2, P, L, c);
+  EXPECT_NEAR(P[0], -m * r * qd * std::sin(q), 1e-14);
+  EXPECT_NEAR(P[1], m * r * qd * std::cos(q), 1e-14);
+  EXPECT_NEAR(P[2], 0.0, 1e-14);
+  EXPECT_NEAR(L[2], m * r * r * qd, 1e-14);
+  EXPECT_NEAR(c[0], r * std::cos(q), 1e-14);
+  EXPECT_NEAR(c[1], r * std::sin(q), 1e-14);
+}
+
 TEST(NewtonEuler, InconsistentChainsAreRejected) {
   auto chain = pendulum(1.0, 0.1);
   chain.joint_child = {0};  // the root link cannot be a joint's child

@@ -242,60 +242,20 @@ def joint_velocities(t: np.ndarray, q: npt.ArrayLike) -> np.ndarray:
     return np.gradient(q, t, axis=0, edge_order=2 if len(t) > 2 else 1)
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of (3, T) arrays (component-major: contiguous and fast)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement
+def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement, frames: np.ndarray | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Eqs. 25-31 for q, qd (T, n): P (T, 3), L about the world origin (T, 3) and the CoM (T, 3), world.
 
-    Computed in the root link's frame and moved to the world at the end (the root is fixed, so only a
-    rigid change of frame: P_w = R0 P, L_w = R0 L + p0 x P_w, c_w = R0 c + p0). The arrays are laid out
-    component-major, (3, T), so each step is a contiguous vector operation over all samples; the Python
-    loop runs over the links (20), never over time.
+    Each massive link's CoM velocity is the sum over the joints before it of (z_i qdot_i) x (c_j - o_i)
+    (Eqs. 25, 27), i.e. omega_j x c_j - sum_i (z_i qdot_i) x o_i; P sums m_j cdot_j (Eqs. 28-29), L sums
+    c_j x m_j cdot_j + R_j Ibar_j R_j^T omega_j (Eqs. 30-31). The sums run in the C++ core, sample by sample, on
+    the world frames (``frames`` when the caller has them), so P, L and c come out in the world directly.
     """
+    if frames is None or np.shape(frames) != (q.shape[0], len(robot.link_names), 4, 4):
+        frames = robot.frames_many(q, base)
     model = robot.body.model
-    child = np.asarray(model.joint_child_links)  # joint j's frame is link_names[child[j]] (chain order)
-    axes = np.asarray(model.joint_axes, float)  # (n, 3), joint axis in that frame
-    masses, coms, inertias = robot.masses, robot.coms, robot.inertias
-    T = q.shape[0]
-    F = robot.body.fk_all_many(q)  # (T, L, 4, 4) in the root frame
-    G = np.ascontiguousarray(F[:, :, :3, :].transpose(1, 2, 3, 0))  # (L, 3, 4, T)
-    qdT = np.ascontiguousarray(qd.T)  # (n, T)
-    omega = np.zeros((3, T))  # sum of z_i qdot_i over the joints passed so far (Eq. 26 unrolled)
-    wxo = np.zeros((3, T))  # sum of (z_i qdot_i) x o_i over the same joints
-    P = np.zeros((3, T))
-    L = np.zeros((3, T))
-    mc = np.zeros((3, T))
-    j = 0
-    for link in range(G.shape[0]):
-        while j < len(child) and child[j] <= link:  # joint j moves this link and every later one
-            Rj, oj = G[child[j], :, :3], G[child[j], :, 3]
-            w = (Rj * axes[j][None, :, None]).sum(axis=1) * qdT[j]  # 0z_j qdot_j
-            omega += w
-            wxo += _cross(w, oj)
-            j += 1
-        if masses[link] <= 0.0:
-            continue  # marker frames carry no mass
-        R, o = G[link, :, :3], G[link, :, 3]
-        c = o + (R * coms[link][None, :, None]).sum(axis=1)  # 0c_j = 0p_j + 0R_j cbar_j
-        # Eqs. 25, 27: velocity of c_j = sum_i z_i qdot_i x (c_j - o_i) = omega_j x c_j - sum_i (z_i qdot_i) x o_i
-        cdot = _cross(omega, c) - wxo
-        Pj = masses[link] * cdot  # Eq. 28
-        P += Pj  # Eq. 29
-        local = (R * omega[:, None, :]).sum(axis=0)  # R_j^T omega_j
-        Iw = (R * (inertias[link] @ local)[None, :, :]).sum(axis=1)  # R_j Ibar_j R_j^T omega_j
-        L += _cross(c, Pj) + Iw  # Eqs. 30, 31
-        mc += masses[link] * c
-    com = mc / masses.sum()
-    W = robot.root_pose(base)
-    R0, p0 = W[:3, :3], W[:3, 3]
-    Pw = (R0 @ P).T
-    Lw = (R0 @ L).T + np.cross(p0, Pw)
-    cw = (R0 @ com).T + p0
-    return Pw, Lw, cw
+    return _core.momenta(frames, qd, list(model.joint_child_links), model.joint_axes, robot.masses, robot.coms,
+                         robot.inertias)
 
 
 def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement | None = None
@@ -343,11 +303,11 @@ def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz:
     return np.stack([px, py], axis=1)
 
 
-def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None
-         ) -> tuple[np.ndarray, ...]:
+def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None,
+         frames: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
-    P, L, com = _momenta(robot, q, qd, base)
+    P, L, com = _momenta(robot, q, qd, base, frames)
     edge = 2 if len(t) > 2 else 1
     Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
     Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
@@ -400,7 +360,7 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
     robot = as_robot(robot)
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
-    p, P, L, com, q = _zmp(robot, t, q, base, qd)
+    p, P, L, com, q = _zmp(robot, t, q, base, qd, frames)
     flying = ~np.all(np.isfinite(p), axis=1)
     margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance,
                              frames=frames)
