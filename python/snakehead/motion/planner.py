@@ -232,10 +232,14 @@ class _Waypoints:
             qs, method = path.q, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
+        self.append_path(label, qs, method)
+        return method
+
+    def append_path(self, label: str, qs: np.ndarray, method: str) -> None:
+        """The configurations qs[1:] of a checked path from the last state (qs[0]), made by ``method``."""
         for k in range(1, len(qs)):
             self._append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})", qs[k])
         self.methods.append((label, method))
-        return method
 
     def _margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
@@ -672,7 +676,19 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     q = _shape_of(robot, q_shape, controller.q_initial)
     if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
             robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
-        way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        # the lift's path, like its timing, is the same for every plan from a base of this shape wherever it lies
+        # (obstacles apart: with them it is checked again)
+        lifts = controller.__dict__.setdefault("_lift_paths", {})
+        key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
+        if not obstacles and key in lifts:
+            way.append_path("initial state (head lifted)", *lifts[key])
+        else:
+            first = len(way.qs) - 1
+            method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+            if not obstacles:
+                if len(lifts) > 16:
+                    lifts.clear()
+                lifts[key] = (np.array(way.qs[first:]), method)
         way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
         way.lift_cache = controller.__dict__.setdefault("_timed_lifts", {})
     else:
