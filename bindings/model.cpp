@@ -7,6 +7,8 @@
 #include "snakehead/model.hpp"
 #include "snakehead/urdf_input.hpp"
 
+#include <optional>
+
 namespace py = pybind11;
 
 namespace snakehead::bindings {
@@ -141,7 +143,7 @@ void bind_model(py::module_& m) {
            },
            py::arg("q"))
       .def("fk_all_many",
-           [](const ChainModel& c, const Eigen::Ref<const RowMat>& qs) {
+           [](const ChainModel& c, const Eigen::Ref<const RowMat>& qs, std::optional<Eigen::Matrix4d> origin) {
              if (qs.cols() != c.n_joints())
                throw InputError("configurations have " + std::to_string(qs.cols()) + " columns; the chain has " +
                                 std::to_string(c.n_joints()) + " joints");
@@ -152,16 +154,19 @@ void bind_model(py::module_& m) {
              {
                py::gil_scoped_release release;
                Frames f;
+               const Eigen::Matrix4d O = origin ? *origin : Eigen::Matrix4d::Identity();
                for (Eigen::Index t = 0; t < qs.rows(); ++t) {
                  link_frames(c, qs.row(t).transpose(), f);
                  for (py::ssize_t k = 0; k < n_links; ++k)
                    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(data + (t * n_links + k) * 16) =
-                       f[k].matrix();
+                       O * f[k].matrix();
                }
              }
              return out;
            },
-           py::arg("qs"))
+           py::arg("qs"), py::arg("origin") = py::none(),
+           "Every link's pose (T, n_links, 4, 4) for configurations qs (T, n), in the chain's base frame or, given "
+           "origin (the base frame's pose, 4x4), in origin's frame")
       .def("jacobian",
            [](const ChainModel& c, ConstVec q) {
              c.check_configuration(q);

@@ -137,3 +137,37 @@ def test_bad_input():
         inverse_dynamics(robot, q, q, q, base=(0, 0, 0))
     with pytest.raises(ValueError, match="ramp"):
         inverse_dynamics(robot, q, q, q, ramp=0.0)
+
+
+def test_core_passes_from_many_threads_and_bad_shapes():
+    """The core's Newton-Euler and momenta release the GIL and keep no state: from 8 threads at once they give what
+    one thread gives; arrays of the wrong shape are a ValueError from the binding, not a crash."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from snakehead import _core
+    from snakehead.dynamics import stability
+
+    robot = snakehead.SnakeRobot.default()
+    rng = np.random.default_rng(11)
+    q = np.array([robot.random_configuration(rng) for _ in range(400)])
+    qd, qdd = rng.normal(size=q.shape), rng.normal(size=q.shape)
+    expected = newton_euler(robot, q, qd, qdd)
+    expected_P = stability.momenta_from_velocities(robot, q, qd)[0]
+
+    def run(_):
+        ne = newton_euler(robot, q, qd, qdd)
+        return ne.tau, ne.Ldot, stability.momenta_from_velocities(robot, q, qd)[0]
+
+    with ThreadPoolExecutor(8) as pool:
+        for tau, Ldot, P in pool.map(run, range(16)):
+            assert np.array_equal(tau, expected.tau) and np.array_equal(Ldot, expected.Ldot)
+            assert np.array_equal(P, expected_P)
+    model = robot.body.model
+    frames = robot.frames_many(q[:3])
+    args = (list(model.joint_child_links), model.joint_axes, robot.masses, robot.coms, robot.inertias)
+    with pytest.raises(ValueError, match="qd"):
+        _core.newton_euler(frames, qd[:2], qdd[:3], *args, None, np.zeros(3))
+    with pytest.raises(ValueError, match="frames"):
+        _core.momenta(frames[:, :, :3], qd[:3], *args)
+    with pytest.raises(ValueError, match="child"):
+        _core.newton_euler(frames, qd[:3], qdd[:3], [0] * robot.n_joints, *args[1:], None, np.zeros(3))

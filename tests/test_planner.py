@@ -140,3 +140,23 @@ def test_self_clearance_detects_overlap(controller):
 def test_self_clearance_bad_input(controller, qs):
     with pytest.raises(ValueError):
         coll.self_clearance(controller.robot, qs)
+
+
+def test_lift_kept_per_base_shape_gives_the_plan_a_fresh_controller_gives(controller):
+    """The controller keeps the lift's checked path and its timing per base shape (they do not depend on where the
+    base lies): a plan that reuses them, at another placement, equals the plan of a fresh controller there, and
+    its lift is the default placement's in joint space."""
+    robot = controller.robot
+    moved = snakehead.BasePlacement(0.4, -0.3, 0.8)
+    H = robot.head_pose(controller.q_initial, moved)
+    target = [(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])]
+    snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
+                   controller=controller)  # the default placement: fills the caches
+    assert controller.__dict__.get("_lift_paths") and controller.__dict__.get("_timed_lifts")
+    reused = snakehead.plan(target, controller=controller, base=moved, allow_relocation=False)
+    fresh = snakehead.plan(target, controller=HeadController(robot, method="free_roll", seed=0), base=moved,
+                           allow_relocation=False)
+    assert reused.success and fresh.success, (reused.failure, fresh.failure)
+    assert reused.base == moved and fresh.base == moved
+    assert reused.q.shape == fresh.q.shape and np.abs(reused.q - fresh.q).max() < 1e-9
+    assert [lab for lab, _, _ in reused.states] == [lab for lab, _, _ in fresh.states]

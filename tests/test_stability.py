@@ -128,6 +128,36 @@ def test_ground_contact_counts_only_the_corners_that_touch(robot, pitch):
     assert poly[:, 0].max() < far_end - 0.1
 
 
+@pytest.mark.parametrize("which", ["default", "generated"])
+def test_lowest_box_corners_are_the_four_lowest_of_the_eight(robot, which):
+    """The core's lowest corners (the ground contact points) against every corner computed in numpy
+    (robot.box_corners), on random configurations at a random placement, and on a generated snake."""
+    from snakehead import _core
+    from snakehead.model.generate import SnakeSpec, snake_urdf
+
+    if which == "generated":
+        spec = SnakeSpec(n_joints=11, module_length=0.09, section=0.06, first_axis="pitch", markers={"p0": 5, "b0": 7},
+                         tip_name="tip", name="gen11")
+        robot = snakehead.SnakeRobot.from_urdf(snake_urdf(spec), base_end="p0", neck_end="b0", head_tip="tip")
+    rng = np.random.default_rng(5)
+    qs = np.array([robot.random_configuration(rng) for _ in range(50)])
+    frames = robot.frames_many(qs, snakehead.BasePlacement(0.3, -0.2, 1.1))
+    links = robot.boxed_links
+    xy, z = _core.lowest_box_corners(frames, robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
+    every = robot.box_corners(frames, links)  # (T, k, 8, 3)
+    expected_z = np.sort(every[..., 2], axis=2)[..., :4]
+    np.testing.assert_allclose(z, expected_z, atol=1e-12)
+    for t, k in [(0, 0), (7, 3), (49, len(links) - 1)]:
+        for c in range(4):  # each returned corner is one of the box's corners, at its height
+            d = np.linalg.norm(every[t, k, :, :2] - xy[t, k, c], axis=1) + np.abs(every[t, k, :, 2] - z[t, k, c])
+            assert d.min() < 1e-12
+    with pytest.raises(ValueError, match="out of range"):
+        _core.lowest_box_corners(frames, robot.box_origins, 0.5 * robot.box_sizes, np.array([len(robot.link_names)],
+                                                                                             np.int32))
+    with pytest.raises(ValueError, match="shape"):
+        _core.lowest_box_corners(frames[:, :3], robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
+
+
 def test_static_margin_closed_form(robot):
     # straight robot: CoM at x = 0.692 > 0.646 (end of the base): outside by 0.046 m
     assert st.static_margin(robot, np.zeros(16)) == pytest.approx(-(0.692 - 0.646), abs=1e-12)

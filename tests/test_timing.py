@@ -117,6 +117,20 @@ def test_retimed_lift_is_faster_and_time_optimal(lift):
     assert not faster.within(0.02, 1e-4), faster
 
 
+def test_timing_does_not_depend_on_the_placement(lift):
+    """The planner times a lift once per base shape: at another placement the same waypoints get the same motion,
+    and that motion keeps the ZMP inside there too (checked by stability in the world frame of that placement)."""
+    name, robot, W, traj = lift
+    moved = snakehead.BasePlacement(0.7, -1.3, 2.4)
+    again = timing.retime(robot, W, moved)
+    assert again.q.shape == traj.q.shape and np.abs(again.q - traj.q).max() < 1e-9
+    assert np.abs(again.waypoint_times - traj.waypoint_times).max() < 1e-9
+    dyn = stability.dynamic_stability(robot, again.t, again.q, moved, again.qd, contact="ground")
+    assert dyn.stable and dyn.min_margin > 0.5 * traj.limits.zmp_margin, dyn.min_margin
+    assert np.abs(dyn.zmp - stability.dynamic_stability(robot, traj.t, traj.q, None, traj.qd, contact="ground").zmp
+                  @ np.array([[np.cos(2.4), np.sin(2.4)], [-np.sin(2.4), np.cos(2.4)]]) - [0.7, -1.3]).max() < 1e-6
+
+
 def test_retimed_lift_tracks_in_mujoco(lift):
     pytest.importorskip("mujoco")
     from snakehead.sim import compare, simulate_trajectory

@@ -1,6 +1,7 @@
 // Support polygons: the convex hull and the signed margin of a point, against closed forms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -65,6 +66,30 @@ TEST(HullMargins, ManySamplesWithActiveMasks) {
   const auto m = snakehead::hull_margins(pts.data(), active.data(), xy, 2, 7);
   EXPECT_DOUBLE_EQ(m[0], 1.0);
   EXPECT_DOUBLE_EQ(m[1], -0.5);
+}
+
+TEST(ConvexHulls, ManySamplesIndexTheirOwnPoints) {
+  const Points p = square_with_inside_and_edge_points();
+  std::vector<double> pts;
+  for (int s = 0; s < 3; ++s)
+    for (int i = 0; i < 7; ++i) pts.insert(pts.end(), {p(i, 0), p(i, 1)});
+  std::vector<unsigned char> active(21, 1);
+  for (int i = 0; i < 7; ++i) {
+    active[7 + i] = (i == 2 || i == 4 || i == 6) ? 1 : 0;  // sample 1: a triangle of points 2, 4, 6
+    active[14 + i] = 0;                                        // sample 2: nothing touches
+  }
+  std::vector<int> vertex(21), count(3);
+  snakehead::convex_hulls(pts.data(), active.data(), 3, 7, vertex.data(), count.data());
+  EXPECT_EQ(count[0], 4);
+  EXPECT_EQ(count[1], 3);
+  EXPECT_EQ(count[2], 0);
+  const std::vector<int> h = snakehead::convex_hull(p);  // sample 0: the single hull's indices
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(vertex[k], h[static_cast<std::size_t>(k)]);
+  EXPECT_EQ(vertex[4], -1);
+  std::vector<int> tri(vertex.begin() + 7, vertex.begin() + 10);
+  std::sort(tri.begin(), tri.end());
+  EXPECT_EQ(tri, (std::vector<int>{2, 4, 6}));  // indices into the sample's own 7 points
+  EXPECT_EQ(vertex[14], -1);
 }
 
 }  // namespace

@@ -15,8 +15,9 @@ of links that hangs from the joint, up to the first link resting on the ground. 
 * :func:`lift_shares`, :func:`carried_weights` -- the lifted shares; the same rule drives the gravity compensation
   of the MuJoCo controller (:mod:`snakehead.sim.tracking`).
 
-All arrays are laid out component-major inside, (3, T), so that each step is one contiguous vector operation over
-the samples; the Python loops run over the links, never over time.
+The pass runs in the C++ core (``snakehead._core.newton_euler``, sample by sample, without the GIL) from the links'
+frames that FK gives and the lifted shares computed here; the tests hold it against pinocchio's RNEA, the lifted
+share sums and the momenta's finite differences.
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from .. import _core
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .stability import GRAVITY
@@ -94,11 +96,6 @@ class InverseDynamics:
     Ldot: np.ndarray
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of (3, T) arrays."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | None) -> np.ndarray:
     a = finite_array(x, name)
     n = robot.n_joints
@@ -112,8 +109,8 @@ def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | No
 
 
 def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
-                     base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
-                     ) -> np.ndarray:
+                     base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP,
+                     frames: np.ndarray | None = None) -> np.ndarray:
     """Joint torques (N m) that move the body along q, qd, qdd with the root link lying still on the ground.
 
     q (rad), qd (rad/s), qdd (rad/s^2): (T, n) each, or (n,) each (-> (n,)). ``base``: where the root lies (its
@@ -122,16 +119,19 @@ def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd
     the ground), "full" (every link's weight: the body as a fixed-base arm) or "none" (inertial terms only).
     Inertial terms (the links' accelerations, Coriolis and centrifugal terms) always count in full.
 
+    ``frames``: the world frames of q (T, n_links, 4, 4) when the caller has them (``robot.frames_many(q, base)``).
+
     Returns tau (T, n) N m (or (n,)). :func:`newton_euler` returns the momentum rates too.
     """
-    return newton_euler(robot, q, qd, qdd, base, gravity=gravity, ramp=ramp).tau
+    return newton_euler(robot, q, qd, qdd, base, gravity=gravity, ramp=ramp, frames=frames).tau
 
 
 def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike,
-                 base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP
-                 ) -> InverseDynamics:
+                 base: BasePlacement | None = None, *, gravity: str = "carried", ramp: float = LIFT_RAMP,
+                 frames: np.ndarray | None = None) -> InverseDynamics:
     """:func:`inverse_dynamics`'s pass, returning the joint torques and the momentum rates (Eqs. 33-34) of the
-    body: an :class:`InverseDynamics` (arrays of one sample when q, qd, qdd are (n,))."""
+    body: an :class:`InverseDynamics` (arrays of one sample when q, qd, qdd are (n,)). ``frames``: as for
+    :func:`inverse_dynamics`."""
     robot = as_robot(robot)
     base = as_base(base)
     if gravity not in GRAVITY_MODELS:
@@ -142,78 +142,20 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     qds = _samples(robot, qd, "qd", T)
     qdds = _samples(robot, qdd, "qdd", T)
 
-    model = robot.body.model
-    child = np.asarray(model.joint_child_links, int)  # joint j turns link_names[child[j]] about its frame's origin
-    axes = np.asarray(model.joint_axes, float)  # (n, 3) in the child link's frame
-    masses, coms, inertias = robot.masses, robot.coms, robot.inertias
-    F = robot.body.fk_all_many(qs)  # (T, L, 4, 4), root frame
-    L = F.shape[1]
-    G = np.ascontiguousarray(F[:, :, :3, :].transpose(1, 2, 3, 0))  # (L, 3, 4, T)
-    W0 = robot.root_pose(base)
-    R0, p0 = W0[:3, :3], W0[:3, 3]
-    g_root = R0.T @ np.array([0.0, 0.0, -GRAVITY])  # gravity in the root frame
-    share = None
-    if gravity == "carried":
-        share = lift_shares(robot, W0 @ F, ramp).T  # (L, T)
-    joint_of = np.full(L, -1)
-    joint_of[child] = np.arange(len(child))
-
-    # forward pass: angular velocity and acceleration of each link, acceleration of each frame's origin
-    omega = np.zeros((L, 3, T))
-    alpha = np.zeros((L, 3, T))
-    acc = np.zeros((L, 3, T))
-    z = np.zeros((L, 3, T))
-    first = int(child[0])  # links before the first joint's child are the root link(s): still
-    for link in range(first, L):
-        r = G[link, :, 3] - G[link - 1, :, 3]
-        w_prev, a_prev = omega[link - 1], alpha[link - 1]
-        acc[link] = acc[link - 1] + _cross(a_prev, r) + _cross(w_prev, _cross(w_prev, r))
-        j = joint_of[link]
-        if j >= 0:
-            z[link] = (G[link, :, :3] * axes[j][None, :, None]).sum(axis=1)  # the axis in the root frame
-            wz = z[link] * qds[:, j]
-            omega[link] = w_prev + wz
-            alpha[link] = a_prev + z[link] * qdds[:, j] + _cross(w_prev, wz)
-        else:
-            omega[link], alpha[link] = w_prev, a_prev
-
-    # backward pass: force and moment (about the frame's origin) that each link's parent exerts on it and on
-    # everything beyond it; the weight's part separately, scaled link by link by the lifted share
-    f_in, n_in = np.zeros((3, T)), np.zeros((3, T))  # inertial
-    f_g, n_g = np.zeros((3, T)), np.zeros((3, T))  # holding the weight
-    tau = np.zeros((T, len(child)))
-    for link in range(L - 1, first - 1, -1):
-        o = G[link, :, 3]
-        if link + 1 < L:  # move the distal link's wrench to this frame's origin
-            d = G[link + 1, :, 3] - o
-            n_in = n_in + _cross(d, f_in)
-            n_g = n_g + _cross(d, f_g)
-        m = masses[link]
-        if m > 0.0:
-            R = G[link, :, :3]
-            rc = (R * coms[link][None, :, None]).sum(axis=1)  # CoM offset from the origin, root axes
-            w, a = omega[link], alpha[link]
-            ac = acc[link] + _cross(a, rc) + _cross(w, _cross(w, rc))
-            Iw = (R * (inertias[link] @ (R * w[:, None, :]).sum(axis=0))[None]).sum(axis=1)  # R I R^T omega
-            Ia = (R * (inertias[link] @ (R * a[:, None, :]).sum(axis=0))[None]).sum(axis=1)
-            f_in = f_in + m * ac
-            n_in = n_in + Ia + _cross(w, Iw) + _cross(rc, m * ac)
-            if gravity != "none":
-                hold = -m * g_root[:, None] * np.ones((1, T))  # the force that holds the link against gravity
-                f_g = f_g + hold
-                n_g = n_g + _cross(rc, hold)
-        if share is not None:
-            f_g = f_g * share[link]
-            n_g = n_g * share[link]
-        j = joint_of[link]
-        if j >= 0:
-            tau[:, j] = ((n_in + n_g) * z[link]).sum(axis=0)
+    # in the world frame: the root link is still, so its frame is as good as any inertial one, and the momentum rates
+    # come out about the world origin (Eqs. 33-34) directly
+    shape = (T, len(robot.link_names), 4, 4)
+    F = robot.frames_many(qs, base) if frames is None or np.shape(frames) != shape else np.asarray(frames, float)
+    g = np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)
+    share = lift_shares(robot, F, ramp) if gravity == "carried" else None  # (T, L)
+    # the pass itself (C++ core, per sample): forward, the links' angular velocities and accelerations and their
+    # frames' accelerations from the root; backward, the wrench each link's parent exerts on it and on everything
+    # beyond it, the weight's part scaled link by link by the lifted share. The inertial wrench across the first
+    # joint (its moment about the world origin) is the momentum rate: the root link does not move
+    tau, Pdot, Ldot = _core.newton_euler(F, qds, qdds, list(robot.body.model.joint_child_links),
+                                         robot.body.model.joint_axes, robot.masses, robot.coms, robot.inertias,
+                                         share, g)
     tau = tau[0] if single else tau
-    # the inertial wrench across the first joint is the momentum rate (the root link does not move): moved from
-    # the first joint's frame origin to the root frame's, then to the world (about the world origin)
-    n_origin = n_in + _cross(G[first, :, 3], f_in)
-    Pdot = (R0 @ f_in).T
-    Ldot = (R0 @ n_origin).T + np.cross(p0, Pdot)
     if single:
         Pdot, Ldot = Pdot[0], Ldot[0]
     return InverseDynamics(tau, Pdot, Ldot)

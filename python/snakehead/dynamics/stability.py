@@ -69,32 +69,31 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
     if links.size == 0:
         raise ValueError("the base part has no links with a collision box; no support polygon")
-    on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
     if contact == "endpoints":
         # Eq. 24: p_i are the endpoints of the base links, i.e. the origins of consecutive frames (each
         # link's frame is at its proximal joint; the next frame in chain order is at its distal end). A point
         # touches the ground when a link it ends lies on the ground.
+        on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
         idx = np.unique(np.r_[links, links + 1])
         pts = frames[:, idx][..., :2, 3]  # (T, N, 2)
         active = np.zeros((frames.shape[0], len(idx)), bool)
         active[:, np.searchsorted(idx, links)] |= on_ground
         active[:, np.searchsorted(idx, links + 1)] |= on_ground
         return pts, active
-    # footprint / ground: the four bottom corners of each box (its face nearest the ground).
-    B = frames[:, links] @ robot.box_origins[links]  # (T, k, 4, 4)
-    half = 0.5 * robot.box_sizes[links]  # (k, 3)
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
-    local = signs[None, :, :] * half[:, None, :]  # (k, 8, 3)
-    world = np.einsum("tkij,kcj->tkci", B[..., :3, :3], local) + B[..., None, :3, 3]  # (T, k, 8, 3)
-    # keep the 4 lowest corners of each box (its bottom face when the link lies flat)
-    order = np.argsort(world[..., 2], axis=2, kind="stable")[..., :4]
-    low = np.take_along_axis(world, order[..., None], axis=2)  # (T, k, 4, 3)
+    # footprint / ground: the four bottom corners of each box (its face nearest the ground when the link lies flat;
+    # the C++ core picks them by height)
+    xy, z = _core.lowest_box_corners(np.ascontiguousarray(frames), robot.box_origins, 0.5 * robot.box_sizes,
+                                     links.astype(np.int32))
+    if contact == "ground":  # only the links that touch in some sample can give a contact point
+        keep = (z[..., 0] <= tolerance).any(axis=0)
+        keep[0] |= not keep.any()  # (one link, none of its points active: no polygon, but the shapes stay)
+        xy, z = xy[:, keep], z[:, keep]
     T = frames.shape[0]
-    pts = low[..., :2].reshape(T, -1, 2)
+    pts = xy.reshape(T, -1, 2)
     # a corner supports only where it touches: a link tilted up off the ground (a neck link rising from it) rests on
     # its lowest edge, not on the corners it holds in the air (counting those would move the polygon's edge out by
     # the link's length and make it jump as the link lifts)
-    active = (low[..., 2] <= tolerance).reshape(T, -1)
+    active = (z <= tolerance).reshape(T, -1)
     return pts, active
 
 
@@ -118,24 +117,30 @@ def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.Ar
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
-def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
+def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
+                   frames: np.ndarray | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
 
-    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3).
+    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3). ``frames``: the world frames of q (T, n_links, 4, 4) when
+    the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)
     qs, single = _joint_matrix(robot, q)
-    frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
+    world = frames is not None and np.shape(frames) == (qs.shape[0], len(robot.link_names), 4, 4)
+    if not world:
+        frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
+    assert frames is not None
     m = robot.masses
     # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product
     W = np.zeros((len(m), 3, 4, 3))
     for i in range(3):
         W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
         W[:, i, 3, i] = m  # coefficient of p_l[i]
-    c = (frames[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
-    W = robot.root_pose(base)
-    c = c @ W[:3, :3].T + W[:3, 3]
+    c = (np.asarray(frames)[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
+    if not world:
+        W = robot.root_pose(base)
+        c = c @ W[:3, :3].T + W[:3, 3]
     return c[0] if single else c
 
 
@@ -237,60 +242,20 @@ def joint_velocities(t: np.ndarray, q: npt.ArrayLike) -> np.ndarray:
     return np.gradient(q, t, axis=0, edge_order=2 if len(t) > 2 else 1)
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of (3, T) arrays (component-major: contiguous and fast)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement
+def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement, frames: np.ndarray | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Eqs. 25-31 for q, qd (T, n): P (T, 3), L about the world origin (T, 3) and the CoM (T, 3), world.
 
-    Computed in the root link's frame and moved to the world at the end (the root is fixed, so only a
-    rigid change of frame: P_w = R0 P, L_w = R0 L + p0 x P_w, c_w = R0 c + p0). The arrays are laid out
-    component-major, (3, T), so each step is a contiguous vector operation over all samples; the Python
-    loop runs over the links (20), never over time.
+    Each massive link's CoM velocity is the sum over the joints before it of (z_i qdot_i) x (c_j - o_i)
+    (Eqs. 25, 27), i.e. omega_j x c_j - sum_i (z_i qdot_i) x o_i; P sums m_j cdot_j (Eqs. 28-29), L sums
+    c_j x m_j cdot_j + R_j Ibar_j R_j^T omega_j (Eqs. 30-31). The sums run in the C++ core, sample by sample, on
+    the world frames (``frames`` when the caller has them), so P, L and c come out in the world directly.
     """
+    if frames is None or np.shape(frames) != (q.shape[0], len(robot.link_names), 4, 4):
+        frames = robot.frames_many(q, base)
     model = robot.body.model
-    child = np.asarray(model.joint_child_links)  # joint j's frame is link_names[child[j]] (chain order)
-    axes = np.asarray(model.joint_axes, float)  # (n, 3), joint axis in that frame
-    masses, coms, inertias = robot.masses, robot.coms, robot.inertias
-    T = q.shape[0]
-    F = robot.body.fk_all_many(q)  # (T, L, 4, 4) in the root frame
-    G = np.ascontiguousarray(F[:, :, :3, :].transpose(1, 2, 3, 0))  # (L, 3, 4, T)
-    qdT = np.ascontiguousarray(qd.T)  # (n, T)
-    omega = np.zeros((3, T))  # sum of z_i qdot_i over the joints passed so far (Eq. 26 unrolled)
-    wxo = np.zeros((3, T))  # sum of (z_i qdot_i) x o_i over the same joints
-    P = np.zeros((3, T))
-    L = np.zeros((3, T))
-    mc = np.zeros((3, T))
-    j = 0
-    for link in range(G.shape[0]):
-        while j < len(child) and child[j] <= link:  # joint j moves this link and every later one
-            Rj, oj = G[child[j], :, :3], G[child[j], :, 3]
-            w = (Rj * axes[j][None, :, None]).sum(axis=1) * qdT[j]  # 0z_j qdot_j
-            omega += w
-            wxo += _cross(w, oj)
-            j += 1
-        if masses[link] <= 0.0:
-            continue  # marker frames carry no mass
-        R, o = G[link, :, :3], G[link, :, 3]
-        c = o + (R * coms[link][None, :, None]).sum(axis=1)  # 0c_j = 0p_j + 0R_j cbar_j
-        # Eqs. 25, 27: velocity of c_j = sum_i z_i qdot_i x (c_j - o_i) = omega_j x c_j - sum_i (z_i qdot_i) x o_i
-        cdot = _cross(omega, c) - wxo
-        Pj = masses[link] * cdot  # Eq. 28
-        P += Pj  # Eq. 29
-        local = (R * omega[:, None, :]).sum(axis=0)  # R_j^T omega_j
-        Iw = (R * (inertias[link] @ local)[None, :, :]).sum(axis=1)  # R_j Ibar_j R_j^T omega_j
-        L += _cross(c, Pj) + Iw  # Eqs. 30, 31
-        mc += masses[link] * c
-    com = mc / masses.sum()
-    W = robot.root_pose(base)
-    R0, p0 = W[:3, :3], W[:3, 3]
-    Pw = (R0 @ P).T
-    Lw = (R0 @ L).T + np.cross(p0, Pw)
-    cw = (R0 @ com).T + p0
-    return Pw, Lw, cw
+    return _core.momenta(frames, qd, list(model.joint_child_links), model.joint_axes, robot.masses, robot.coms,
+                         robot.inertias)
 
 
 def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement | None = None
@@ -338,11 +303,11 @@ def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz:
     return np.stack([px, py], axis=1)
 
 
-def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None
-         ) -> tuple[np.ndarray, ...]:
+def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: npt.ArrayLike | None,
+         frames: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
-    P, L, com = _momenta(robot, q, qd, base)
+    P, L, com = _momenta(robot, q, qd, base, frames)
     edge = 2 if len(t) > 2 else 1
     Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
     Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
@@ -395,7 +360,7 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
     robot = as_robot(robot)
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
-    p, P, L, com, q = _zmp(robot, t, q, base, qd)
+    p, P, L, com, q = _zmp(robot, t, q, base, qd, frames)
     flying = ~np.all(np.isfinite(p), axis=1)
     margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance,
                              frames=frames)
@@ -411,7 +376,8 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
 
-    The polygons are those of :func:`support_polygons`, built once per distinct contact configuration.
+    The polygons are those of :func:`support_polygons`, built once per run of samples with one contact
+    configuration.
     ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
@@ -429,9 +395,9 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
 
     Row k holds its polygon's ``count[k]`` vertices counter-clockwise first (the rest is padding): 0 where no link
-    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per
-    distinct contact configuration (joints rounded to 1e-12 rad, so that a spline's round-off in a still base does
-    not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
+    touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per run
+    of consecutive samples with one contact configuration (joints rounded to 1e-12 rad, so that a spline's
+    round-off in a still base does not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
     last link on the ground (those after it move nothing that touches). ``frames``: the world frames of ``q``
     (T, n_links, 4, 4), when the caller has them.
     """
@@ -439,12 +405,11 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
-    hulls = [p[a][hull_indices(p[a])] if a.any() else np.zeros((0, 2)) for p, a in zip(pts, active)]
-    count = np.array([len(h) for h in hulls], int)
-    vertices = np.zeros((len(hulls), max(1, int(count.max())), 2))
-    for k, h in enumerate(hulls):
-        vertices[k, :len(h)] = h
-    return vertices[inv], count[inv]
+    vertex, count = _core.convex_hulls(np.ascontiguousarray(pts), np.ascontiguousarray(active))
+    width = max(1, int(count.max()))
+    vertices = np.take_along_axis(pts, np.maximum(vertex[:, :width], 0)[..., None], axis=1)
+    vertices[np.arange(width)[None, :] >= count[:, None]] = 0.0
+    return vertices[inv], count[inv].astype(int)
 
 
 def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
@@ -466,10 +431,11 @@ def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, conta
         key = np.column_stack([key, last])
     else:
         key = np.round(q[:, robot.parts.base], 12)
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    first = np.zeros(len(uniq), int)
-    first[inv[::-1]] = np.arange(len(inv))[::-1]  # a sample of each distinct base configuration
+    # runs of samples with the same contact configuration (a trajectory changes it rarely; a configuration that
+    # comes back later is built again, which costs less than sorting the samples to find it)
+    change = np.r_[True, np.any(key[1:] != key[:-1], axis=1)]
+    first = np.flatnonzero(change)  # the first sample of each run
+    inv = np.cumsum(change) - 1
     sample_frames = robot.frames_many(q[first], base) if frames is None else frames[first]
     pts, active = _contact_points_many(robot, sample_frames, contact, tolerance)
     return pts, active, inv

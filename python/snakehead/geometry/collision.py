@@ -6,7 +6,9 @@
 * :func:`collision_check` -- the links' boxes against :mod:`snakehead.geometry.obstacles`.
 * :func:`box_box_sat`, :func:`box_box_distance`, :func:`box_wall_collision` -- the box tests they use.
 
-Everything is vectorised over the time samples (numpy); Python loops run over links or box features.
+Everything is vectorised over the time samples (numpy); Python loops run over links or box features. The
+separating-axis test runs in the C++ core (``snakehead._core.box_pair_gaps`` and ``box_pair_min_gaps``,
+include/snakehead/box_collision.hpp).
 """
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _core
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .obstacles import BoxObstacle, WallWithHole
@@ -103,9 +106,8 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
     base = as_base(base)
     qs = _trajectory(robot, qs)
     links, c, R, h = _link_boxes(robot, qs, base)
-    i, j = np.triu_indices(len(links), k=2)  # boxed links two or more apart in the chain
-    gaps = box_box_sat(c[:, i], R[:, i], h[i], c[:, j], R[:, j], h[j])  # (T, pairs)
-    return gaps.min(axis=1)
+    pairs = np.stack(np.triu_indices(len(links), k=2), axis=1)  # boxed links two or more apart in the chain
+    return _core.box_pair_min_gaps(c, R, h, pairs)  # +inf with fewer than three boxed links: no pair can meet
 
 
 def _broadcast_boxes(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, Rb: np.ndarray, hb: np.ndarray) -> list[np.ndarray]:
@@ -129,26 +131,14 @@ def box_box_sat(ca: np.ndarray, Ra: np.ndarray, ha: np.ndarray, cb: np.ndarray, 
     each gap divided by its axis' length so that it is in metres).
     """
     ca, Ra, ha, cb, Rb, hb = _broadcast_boxes(ca, Ra, ha, cb, Rb, hb)
-    RbT = np.swapaxes(Rb, -1, -2)
-    C = RbT @ Ra  # column i: A's axis i in B's frame
-    t = (RbT @ (ca - cb)[..., None])[..., 0]  # A's centre in B's frame
-    absC = np.abs(C)
-    gaps = []
-    for j in range(3):  # B's face normals
-        gaps.append(np.abs(t[..., j]) - hb[..., j] - (absC[..., j, :] * ha).sum(-1))
-    for i in range(3):  # A's face normals
-        gaps.append(np.abs((C[..., :, i] * t).sum(-1)) - ha[..., i] - (absC[..., :, i] * hb).sum(-1))
-    for i in range(3):  # A's edge i x B's edge j
-        i1, i2 = (i + 1) % 3, (i + 2) % 3
-        for j in range(3):
-            j1, j2 = (j + 1) % 3, (j + 2) % 3
-            length = np.sqrt(np.maximum(1.0 - C[..., j, i] ** 2, 0.0))
-            proj = np.abs(t[..., j2] * C[..., j1, i] - t[..., j1] * C[..., j2, i])
-            ra = ha[..., i1] * absC[..., j, i2] + ha[..., i2] * absC[..., j, i1]
-            rb = hb[..., j1] * absC[..., j2, i] + hb[..., j2] * absC[..., j1, i]
-            ok = length > 1e-9  # parallel edges give no axis
-            gaps.append(np.where(ok, (proj - ra - rb) / np.where(ok, length, 1.0), -np.inf))
-    return np.max(np.stack(gaps, axis=-1), axis=-1)
+    batch = ca.shape[:-1]
+    n = int(np.prod(batch))
+    # The C++ core's batch entry: the n boxes A then the n boxes B as one sample of 2n boxes, paired (i, n + i).
+    centres = np.concatenate([ca.reshape(n, 3), cb.reshape(n, 3)])[None]
+    rotations = np.concatenate([Ra.reshape(n, 3, 3), Rb.reshape(n, 3, 3)])[None]
+    half_extents = np.concatenate([ha.reshape(n, 3), hb.reshape(n, 3)])
+    pairs = np.stack([np.arange(n), n + np.arange(n)], axis=1)
+    return _core.box_pair_gaps(centres, rotations, half_extents, pairs).reshape(batch)
 
 
 def _point_box_distance(p: np.ndarray, c: np.ndarray, R: np.ndarray, h: np.ndarray) -> np.ndarray:

@@ -133,10 +133,13 @@ class Chain:
         """Poses of every link of ``link_names`` in the base frame, (n_links, 4, 4)."""
         return self._model.fk_all(joint_vector(q, self.n_joints))
 
-    def fk_all_many(self, qs: npt.ArrayLike) -> np.ndarray:
-        """``fk_all`` for many configurations: qs (T, n) -> (T, n_links, 4, 4)."""
+    def fk_all_many(self, qs: npt.ArrayLike, origin: npt.ArrayLike | None = None) -> np.ndarray:
+        """``fk_all`` for many configurations: qs (T, n) -> (T, n_links, 4, 4); with ``origin`` (the pose (4, 4) of
+        the chain's base frame) in origin's frame: origin @ fk_all(q), multiplied in the core."""
         qs = finite_array(qs, "qs", (None, self.n_joints))
-        return self._model.fk_all_many(np.ascontiguousarray(qs))
+        if origin is not None:
+            origin = finite_array(origin, "origin", (4, 4))
+        return self._model.fk_all_many(np.ascontiguousarray(qs), origin)
 
     def jacobian(self, q: npt.ArrayLike) -> np.ndarray:
         """Geometric Jacobian of the tip, (6, n): rows (v, omega) in the base frame, point at the tip."""

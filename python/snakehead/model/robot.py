@@ -468,9 +468,12 @@ class SnakeRobot:
         A box of half-extents h, centre c and rotation R reaches down to c_z - sum_k |R[2, k]| h_k.
         """
         links = self.boxed_links if links is None else np.asarray(links)
-        B = self.box_poses(frames, links)
-        half = 0.5 * self.box_sizes[links]
-        return B[..., 2, 3] - np.einsum("tkj,kj->tk", np.abs(B[..., 2, :3]), half)
+        frames = np.asarray(frames, float)
+        if frames.ndim != 4 or frames.shape[1:] != (len(self.link_names), 4, 4):
+            raise ValueError(f"frames has shape {frames.shape}; expected (T, {len(self.link_names)}, 4, 4)")
+        _, z = _core.lowest_box_corners(np.ascontiguousarray(frames), self.box_origins, 0.5 * self.box_sizes,
+                                        links.astype(np.int32).reshape(-1))  # the lowest corner first
+        return z[..., 0]
 
     # --- whole-body kinematics ---------------------------------------------------------------------------
     def joint_axes_world(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -516,7 +519,7 @@ class SnakeRobot:
 
     def frames_many(self, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
         """``frames`` along a trajectory: qs (T, n) -> (T, n_links, 4, 4)."""
-        return self.root_pose(base) @ self.body.fk_all_many(qs)
+        return self.body.fk_all_many(qs, self.root_pose(base))
 
     def frame(self, q: np.ndarray, name: str, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of one named frame (a link or a marker)."""

@@ -262,10 +262,14 @@ class _Waypoints:
             qs, method = path, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
+        self.append_path(label, qs, method)
+        return method
+
+    def append_path(self, label: str, qs: np.ndarray, method: str) -> None:
+        """The configurations qs[1:] of a checked path from the last state (qs[0]), made by ``method``."""
         for k in range(1, len(qs)):
             self._append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})", qs[k])
         self.methods.append((label, method))
-        return method
 
     def _margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
@@ -358,6 +362,9 @@ class _Waypoints:
         ``times`` (when each waypoint is reached)."""
         from .timing import retime
 
+        # the plan checks its 2 ms samples itself (_finish: the ZMP by the paper's momenta, the ground, obstacles);
+        # the retiming keeps the joint limits between its gridpoints by refining them
+        timing = dict(timing, check_samples=False)
         hold_s = np.zeros(len(self.qs) - 1)
         for k, seconds in self.holds.items():
             hold_s[k] = seconds
@@ -366,8 +373,9 @@ class _Waypoints:
         try:
             k = self.lift_index if self.lift_index is not None else -1
             if 0 < k < len(Q) - 1 and self.lift_cache is not None:
-                # the lift from the bending state is the same for every target from this base: time it once
-                key = (self.base, Q[:k + 1].tobytes(), repr(sorted(timing.items())))
+                # the lift from the bending state is the same for every target from a base of this shape, wherever
+                # it lies (retime does not depend on the placement): time it once
+                key = (np.round(Q[:k + 1], 9).tobytes(), repr(sorted(timing.items())))  # round-off apart
                 lift = self.lift_cache.get(key)
                 if lift is None:
                     lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
@@ -381,7 +389,7 @@ class _Waypoints:
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
         except ValueError as exc:
-            if any(key in str(exc) for key in timing):  # a bad option of the caller's, not the path's fault
+            if any(key in str(exc) for key in TIMING_OPTIONS if key in timing):  # a bad option of the caller's
                 raise
             # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
             # slow fixed pace so that the plan can still be looked at, and fail it
@@ -748,7 +756,19 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     q = _shape_of(robot, q_shape, controller.q_initial)
     if way._feasible(q[None])[0] and (not obstacles or coll.collision_check(
             robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
-        way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        # the lift's path, like its timing, is the same for every plan from a base of this shape wherever it lies
+        # (obstacles apart: with them it is checked again)
+        lifts = controller.__dict__.setdefault("_lift_paths", {})
+        key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
+        if not obstacles and key in lifts:
+            way.append_path("initial state (head lifted)", *lifts[key])
+        else:
+            first = len(way.qs) - 1
+            method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+            if not obstacles:
+                if len(lifts) > 16:
+                    lifts.clear()
+                lifts[key] = (np.array(way.qs[first:]), method)
         way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
         way.lift_cache = controller.__dict__.setdefault("_timed_lifts", {})
     else:

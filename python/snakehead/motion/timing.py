@@ -19,9 +19,10 @@ them: at every sample):
 Why the ZMP is a linear constraint: with w = (dP/dt, dL/dt) (Eqs. 33-34, L about the world origin), the ZMP
 lies on the inner side of a polygon edge n . p >= d + m exactly when, multiplied through by M g + dP_z/dt > 0,
 n_x (M g c_x - dL_y/dt) + n_y (M g c_y + dL_x/dt) - (d + m)(M g + dP_z/dt) >= 0 -- linear in w. Along a path q(s)
-the momenta are P = A(q) q' s', so w = a(s) s'' + b(s) s'^2 with a = (P, L)(q, q') and
-b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (:func:`~snakehead.dynamics.inverse_dynamics.momentum_rates`):
-exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count by repeating an edge.
+the joint velocities are q' s' and the accelerations q' s'' + q'' s'^2, so w = a(s) s'' + b(s) s'^2 with a the
+momentum rate of Newton-Euler at (q, 0, q') and b at (q, q', q'') (:func:`momentum_rate_coefficients`; the joint
+torques split the same way): exactly TOPP-RA's form, one row per edge. Polygons are padded to one edge count by
+repeating an edge.
 
 Where the centre of mass itself is closer than twice ``zmp_margin`` to the polygon's edge (a barely stable path),
 the ZMP is asked to keep half the CoM's margin instead (at rest the ZMP is the CoM's projection, so no motion can
@@ -44,7 +45,7 @@ from scipy.interpolate import CubicSpline
 
 from .._validate import finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
-from ..dynamics.inverse_dynamics import inverse_dynamics, momentum_rates, newton_euler
+from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
 
@@ -73,7 +74,7 @@ FRICTION_SIDES = 8
 #: s: a repeated waypoint's pause by default.
 HOLD_S = 1.0
 #: rad: the largest step of the path (Euclidean length in joint space) between two TOPP-RA gridpoints.
-GRID_STEP = 0.01
+GRID_STEP = 0.02
 #: Gridpoints per segment between two waypoints, at least.
 MIN_GRID_PER_SEGMENT = 8
 #: The most gridpoints of one retimed path (a path of 1000 rad at the default step): a larger grid is a mistake.
@@ -178,8 +179,11 @@ class Support:
     required: np.ndarray
 
     @classmethod
-    def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float) -> "Support":
-        V, count = stability.support_polygons(robot, q, base, contact="ground")
+    def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float,
+           frames: np.ndarray | None = None) -> "Support":
+        """``frames``: the world frames of q, when the caller has them."""
+        frames = robot.frames_many(q, base) if frames is None else frames
+        V, count = stability.support_polygons(robot, q, base, contact="ground", frames=frames)
         if np.any(count < 3):
             k = int(np.argmax(count < 3))
             raise ValueError(f"the links on the ground span no polygon at path point {k} ({count[k]} distinct "
@@ -191,7 +195,7 @@ class Support:
         e = np.take_along_axis(V, stop[..., None], axis=1) - a
         normal = np.stack([-e[..., 1], e[..., 0]], axis=-1) / np.linalg.norm(e, axis=-1, keepdims=True)  # inside
         offset = (normal * a).sum(-1)
-        com = stability.center_of_mass(robot, q, base)
+        com = stability.center_of_mass(robot, q, base, frames=frames)
         static = ((normal * com[:, None, :2]).sum(-1) - offset).min(axis=1)
         return cls(normal, offset, com, static, required_margins(static, zmp_margin))
 
@@ -240,12 +244,23 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, 
 
 
 def momentum_rate_coefficients(robot: SnakeRobot, q: npt.ArrayLike, dq: npt.ArrayLike, ddq: npt.ArrayLike,
-                               base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
+                               base: BasePlacement | None = None, frames: np.ndarray | None = None
+                               ) -> tuple[np.ndarray, np.ndarray]:
     """w = (dP/dt, dL/dt) along a path q(s) as a s'' + b s'^2: a, b (N, 6) at points q, dq = q'(s), ddq = q''(s)
-    (N, n) each. a = (P, L)(q, q'); b = (P, L)(q, q'') + d/ds (P, L)(q(s), v) at v = q' (Eqs. 25-31, 33-34)."""
-    P, L = stability.momenta_from_velocities(robot, np.asarray(q, float), np.asarray(dq, float), base)
-    Pb, Lb = momentum_rates(robot, q, dq, ddq, base)
-    return np.hstack([P, L]), np.hstack([Pb, Lb])
+    (N, n) each. With qd = q' s' and qdd = q' s'' + q'' s'^2, the momentum rates of Newton-Euler (inertial part:
+    :func:`~snakehead.dynamics.inverse_dynamics.newton_euler`) split into a = w(q, 0, q') and b = w(q, q', q'').
+    ``frames``: the world frames of q when the caller has them."""
+    a, b = _path_dynamics(robot, np.asarray(q, float), np.asarray(dq, float), np.asarray(ddq, float), base, frames)
+    return np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot])
+
+
+def _path_dynamics(robot: SnakeRobot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, base: BasePlacement | None,
+                   frames: np.ndarray | None = None) -> tuple[Any, Any]:
+    """Newton-Euler's inertial terms along q(s): (the pass at (q, 0, q'), the pass at (q, q', q'')); their torques
+    and momentum rates are the coefficients of s'' and of s'^2."""
+    zero = np.zeros_like(q)
+    return (newton_euler(robot, q, zero, dq, base, gravity="none", frames=frames),
+            newton_euler(robot, q, dq, ddq, base, gravity="none", frames=frames))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -277,10 +292,10 @@ class LimitCheck:
 
 
 def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
-            qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
+            qd: np.ndarray, qdd: np.ndarray, frames: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
     used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
-    dyn = newton_euler(robot, q, qd, qdd, base)  # torques and exact momentum rates
+    dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
     tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
     Mg = robot.total_mass * stability.GRAVITY
     normal_force = Mg + Pdot[:, 2]
@@ -300,9 +315,9 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
 def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike, base: BasePlacement | None,
                  limits: RetimingLimits) -> LimitCheck:
     """Measure samples q, qd, qdd (T, n) of a trajectory against ``limits``: joint velocities and accelerations, the
-    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler (exact; the
-    retiming's constraint takes them from the paper's momenta instead) in the ground support polygon of each sample,
-    and the base's friction."""
+    torques of :func:`inverse_dynamics`, the ZMP of Eqs. 39-40 from the momentum rates of Newton-Euler in the ground
+    support polygon of each sample, and the base's friction. (An independent check of the ZMP, from the paper's
+    momenta of Eqs. 25-31 and their finite differences: ``stability.dynamic_stability``.)"""
     robot = as_robot(robot)
     base = as_base(base)
     if not isinstance(limits, RetimingLimits):
@@ -310,7 +325,8 @@ def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     q = finite_array(q, "q", (None, robot.n_joints))
     qd = finite_array(qd, "qd", q.shape)
     qdd = finite_array(qdd, "qdd", q.shape)
-    r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin), q, qd, qdd)
+    frames = robot.frames_many(q, base)
+    r = _ratios(robot, base, limits, Support.of(robot, q, base, limits.zmp_margin, frames), q, qd, qdd, frames)
     moving = np.abs(qd).max(axis=1) > 0
 
     def share(hit: np.ndarray) -> float:
@@ -462,12 +478,13 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
            velocity_limit: npt.ArrayLike | None = None, acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
            torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION,
            dt: float = CONTROL_PERIOD, hold_s: npt.ArrayLike = HOLD_S, stops: Sequence[int] = (),
-           interpolation: str = "monotone", grid_step: float = GRID_STEP) -> RetimedTrajectory:
+           interpolation: str = "monotone", grid_step: float = GRID_STEP, check_samples: bool = True
+           ) -> RetimedTrajectory:
     """The fastest motion through ``waypoints`` that keeps the robot's limits and its balance.
 
     Parameters
     ----------
-    robot : the snake; base : where its base lies (default placement).
+    robot : the snake; base : where its base lies (default placement; the result is the same for any).
     waypoints : (K, n) joint vectors (rad) within the joint limits, K >= 2. The motion passes through every one,
         starts and ends at rest, and rests at each waypoint index in ``stops``.
     velocity_limit : rad/s, a number or (n,); default :data:`VELOCITY_SHARE` of the URDF's (none where it gives 0).
@@ -482,6 +499,9 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         waypoints) or "spline" (a not-a-knot cubic spline, toppra's own; it may overshoot: ValueError if it leaves
         the joint limits).
     grid_step : rad of path between TOPP-RA's gridpoints (at most; at least MIN_GRID_PER_SEGMENT per segment).
+    check_samples : measure every sample against the limits (:func:`check_limits`: the result's ``check``); False
+        leaves ``check`` None, for a caller that checks the samples itself (the refined grid keeps the limits
+        between gridpoints either way).
 
     Returns a :class:`RetimedTrajectory` (a JointTrajectory with ``duration``, ``waypoint_times``, ``check``).
     Raises ValueError when no motion along the path keeps the limits (the CoM outside the support polygon, the
@@ -489,7 +509,11 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     """
     clock = time.perf_counter()
     robot = as_robot(robot)
-    base = as_base(base)
+    as_base(base)  # validated; the timing does not depend on it:
+    # gravity is vertical and the ground flat, so the limits and the balance are the same wherever the base lies
+    # (the friction polygon is taken in the base's frame): the path is timed at the default placement, and one
+    # timing serves every placement (the planner times a lift once per base shape)
+    base = BasePlacement()
     n = robot.n_joints
     W = finite_array(waypoints, "waypoints")
     if W.ndim != 2 or W.shape[1] != n:
@@ -521,21 +545,31 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
                                   SOLVE_SHARE * limits.friction)
 
-    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
-        zero = np.zeros_like(q)
-        return (inverse_dynamics(robot, q, zero, dq, base, gravity="none"),
-                inverse_dynamics(robot, q, dq, ddq, base, gravity="none"),
-                inverse_dynamics(robot, q, zero, zero, base))
-
+    # the torque and the stability constraints of one grid share its frames, Newton-Euler passes and support
     supports: dict[int, tuple[np.ndarray, Support]] = {}
+    passes: dict[int, tuple[np.ndarray, Any]] = {}
+
+    def at_grid(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[Any, Any, np.ndarray, Support]:
+        hit = passes.get(q.shape[0])
+        if hit is None or not np.array_equal(hit[0], q):
+            F = robot.frames_many(q, base)
+            a, b = _path_dynamics(robot, q, dq, ddq, base, F)
+            hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=F)
+            support = supports.get(q.shape[0])
+            if support is None or not np.array_equal(support[0], q):
+                supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin, F))
+            passes[q.shape[0]] = hit = (q, (a, b, hold, support[1]))
+        return hit[1]
+
+    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
+        a, b, hold, _ = at_grid(q, dq, ddq)  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
+        return a.tau, b.tau, hold
 
     def stability_params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
-        a, b = momentum_rate_coefficients(robot, q, dq, ddq, base)
-        support = supports.get(q.shape[0])
-        if support is None or not np.array_equal(support[0], q):
-            supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin))
-        F, g = stability_rows(robot, support[1], solve_limits, SOLVE_ZMP_EXTRA_M)
-        return a, b, np.zeros_like(a), F, g
+        a, b, _, support = at_grid(q, dq, ddq)  # w = (dP/dt, dL/dt) = a s'' + b s'^2
+        wa, wb = np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot])
+        F, g = stability_rows(robot, support, solve_limits, SOLVE_ZMP_EXTRA_M)
+        return wa, wb, np.zeros_like(wa), F, g
 
     tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
     stab_c = _topp.PointwiseLinearConstraint(stability_params, n, identical=False, name="ZMP and friction")
@@ -601,7 +635,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
     q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
     q[0], q[-1] = W[0], W[-1]
-    check = check_limits(robot, q, qd, qdd, base, limits)
+    check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
     return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
                              notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
 
@@ -633,9 +667,10 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     dq, ddq = f(s, 1), f(s, 2)
     q, qd, qdd = f(s, 0), dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
     nearer = np.where(fr < 0.5, stage, stage + 1)
-    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base),
+    frames = robot.frames_many(q, base)
+    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base, frames=frames),
                   support.static[nearer], support.required[nearer])
-    r = _ratios(robot, base, limits, sub, q, qd, qdd)
+    r = _ratios(robot, base, limits, sub, q, qd, qdd, frames)
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
         over |= r[key] > 1.0
