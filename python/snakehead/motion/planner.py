@@ -274,8 +274,8 @@ class _Waypoints:
     def _margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
         link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
-        the smaller of that and the base's own (``contact="footprint"``): a motion must not lean on a neck or head
-        link that touches the ground at a checked configuration and may leave it in between (``_base_margins``)."""
+        the smaller of that and the base's own (:meth:`_base_margins`): a motion must not lean on a neck or head
+        link that touches the ground at a checked configuration and may leave it in between."""
         com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
         margin = stability.support_margins(self.robot, qs, com, self.base, contact="ground")
         if self.lift_index is not None:
@@ -529,7 +529,8 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
-    one first) from which every target is solved. ``base_shape``: a configuration whose base joints (and those of
+    one first) from which every target is solved, among the bases whose flat shape holds a stable curl of the neck
+    and head (:func:`bending_state`: the plan lifts them from it; a straight base, e.g., may hold none). ``base_shape``: a configuration whose base joints (and those of
     the neck's links that stay on the ground) give the base's flat shape at the controller's placement (default:
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
