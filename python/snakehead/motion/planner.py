@@ -292,12 +292,12 @@ class _Waypoints:
             self._problem = BodyProblem(self.robot)
         prob, start = self._problem, self.robot.lift_joints.start
         shapes, which = np.unique(np.round(qs[:, :start], 12), axis=0, return_inverse=True)
-        pts = []
+        polygons = []
         for shape in shapes:  # those links move with the joints before the lift only
             q = np.zeros(self.robot.n_joints)
             q[:start] = shape
-            pts.append(prob.contact_points(prob.frames(q, self.base))[0][:, :2])
-        pts = np.stack(pts)[np.asarray(which).reshape(-1)]
+            polygons.append(prob.contact_points(prob.frames(q, self.base))[0][:, :2])
+        pts = np.stack(polygons)[np.asarray(which).reshape(-1)]
         return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com_xy)
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
