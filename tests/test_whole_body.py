@@ -198,3 +198,29 @@ def test_bad_input(default):
         wb.solve_whole_body(robot, [0.1, 0.5, 0.3], [0, 1, 0], [])
     with pytest.raises(TypeError):
         wb.BodyProblem("robot")
+
+
+@pytest.mark.parametrize("which", ["default", "generated"])
+def test_beyond_the_lifted_chain_reach_is_out_of_reach_without_ik(default, generated, which, monkeypatch):
+    """The pre-check that skips the base-kept stages: the lifted chain's reach bounds the head tip's distance from
+    the frame the neck lifts from (checked on random configurations), and a target beyond it is out of reach with the
+    base kept without any IK run (the segmented solve and the lifted chain's IK are replaced by failing stubs)."""
+    robot, controller = (default[0], default[1]) if which == "default" else (generated[0], generated[1])
+    rng = np.random.default_rng(3)
+    reach = robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach
+    for _ in range(300):
+        q = robot.random_configuration(rng)
+        F = robot.frames(q)
+        assert np.linalg.norm(F[robot.link_index(robot.parts.head_tip), :3, 3]
+                              - F[robot.link_index(robot.lift_frame), :3, 3]) <= reach + 1e-12
+    origin = robot.frame(controller.q_initial, robot.lift_frame, controller.base)[:3, 3]
+    far = origin + [reach + 0.05, 0.0, 0.0]
+
+    def no_ik(*args, **kwargs):
+        raise AssertionError("no IK should run for a target beyond the reach")
+
+    monkeypatch.setattr(controller, "solve", no_ik)
+    monkeypatch.setattr(wb, "lifted_candidates", no_ik)
+    sol = wb.solve_target(controller, far, [1.0, 0.0, 0.0], allow_base_move=False)
+    assert not sol.success and sol.reason == "out of reach" and sol.base == controller.base
+    assert sol.position_error_m > 0.05

@@ -626,18 +626,27 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
             best = sol
         return sol if sol.success else None
 
-    if near and q_prev is not None:
+    # with the base kept, the frame the neck lifts from stays where it is, and no point of the lifted chain gets
+    # farther from it than the chain's reach: beyond that (by more than the position tolerance) stages 1 and 2
+    # cannot succeed, and their IK would spend its whole time budget finding so
+    lift_origin = robot.frame(q_now, robot.lift_frame, base)[:3, 3]
+    beyond = np.linalg.norm(position - lift_origin) > robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach \
+        + POSITION_TOLERANCE
+    if beyond:
+        consider(q_now, base, STAGES[1], 0)  # the attempt to report: out of reach
+    if near and q_prev is not None and not beyond:
         q = _continue_from(prob, q_now, base, position, direction, seed)
         if q is not None and (found := consider(q, base, STAGES[1], 1)):
             return found
     # 1. the paper's segmented solve
-    seg = controller.solve(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
-                           allow_base_move=False)
-    seg_holder[0] = seg
-    if found := consider(seg.q, seg.base, STAGES[0], 0):
-        return found
+    if not beyond:
+        seg = controller.solve(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
+                               allow_base_move=False)
+        seg_holder[0] = seg
+        if found := consider(seg.q, seg.base, STAGES[0], 0):
+            return found
     # 2. the base kept
-    for k, q in enumerate(lifted_candidates(prob, q_now, base, position, direction, seed)):
+    for k, q in enumerate(lifted_candidates(prob, q_now, base, position, direction, seed) if not beyond else []):
         if found := consider(q, base, STAGES[1], k + 1):
             return found
     # refine only what reached the head but failed stability or clearance: from there a local optimisation can

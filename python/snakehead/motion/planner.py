@@ -524,8 +524,8 @@ def _shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.
 
 
 def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = (),
-                allow_relocation: bool = True,
-                base_shape: npt.ArrayLike | None = None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
+                allow_relocation: bool = True, base_shape: npt.ArrayLike | None = None, *,
+                solved: dict | None = None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -533,7 +533,8 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     and head (:func:`bending_state`: the plan lifts them from it; a straight base, e.g., may hold none). ``base_shape``: a configuration whose base joints (and those of
     the neck's links that stay on the ground) give the base's flat shape at the controller's placement (default:
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
-    (the initial configuration's otherwise), the relocation (None when the base stays) and notes."""
+    (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: a
+    dict that keeps the solves with the base kept (:func:`_solve_kept`) for the plan to reuse."""
     from ..control.whole_body import solve_target
 
     robot = controller.robot
@@ -556,8 +557,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
         if not clear(q_bend, b):
             return "the start", None
         for t in targets:
-            sol = solve_target(controller, t.position, t.direction, q_prev=q_shape, base=b, obstacles=obstacles,
-                               allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
+            sol = _solve_kept(controller, t.position, t.direction, q_shape, b, obstacles, solved)
             if not sol.success:
                 return t, sol
         return None, None
@@ -640,13 +640,29 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     return [a.position + (s / length) * d for s in steps] if length > 0 else [b.position.copy()]
 
 
-def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
-           base: BasePlacement | None, obstacles: Sequence[Any], name: str, notes: list, near: bool = False) -> Any:
-    """One target with the base kept: ``control.whole_body.solve_target``; a note when it fails."""
+def _solve_kept(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
+                base: BasePlacement, obstacles: Sequence[Any], solved: dict | None, near: bool = False) -> Any:
+    """``control.whole_body.solve_target`` with the base kept, kept in ``solved`` (one plan's: its obstacles are
+    fixed) so that choose_base's solves of the chosen base are not repeated by the plan (the solve is
+    deterministic: the same inputs give the same solution)."""
     from ..control.whole_body import solve_target
 
+    key = (np.asarray(position, float).tobytes(), np.asarray(direction, float).tobytes(),
+           np.asarray(q_prev, float).tobytes(), base, near)
+    if solved is not None and key in solved:
+        return solved[key]
     sol = solve_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
                        allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN, near=near)
+    if solved is not None:
+        solved[key] = sol
+    return sol
+
+
+def _solve(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
+           base: BasePlacement, obstacles: Sequence[Any], name: str, notes: list, near: bool = False,
+           solved: dict | None = None) -> Any:
+    """One target with the base kept (:func:`_solve_kept`); a note when it fails."""
+    sol = _solve_kept(controller, position, direction, q_prev, base, obstacles, solved, near)
     if not sol.success:
         notes.append(f"{name}: {sol.message}")
     return sol
@@ -744,8 +760,9 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         start_q = joint_vector(start_q, robot.n_joints, "start_q")
         if base_shape is None:
             base_shape = start_q
+    solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
-                                                          base_shape)
+                                                          base_shape, solved=solved)
     notes += base_notes
     way = _Waypoints(robot, chosen, obstacles)
     if start_q is not None and relocation is not None:
@@ -784,7 +801,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             end += 1
         if end == k:
             tg = scene_targets[k]
-            sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes)
+            sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes, solved=solved)
             way.move(tg.name, sol.q)
             q = sol.q
             if not tg.via:  # time_s holds the waypoint's index until the path is timed (_finish)
