@@ -224,3 +224,16 @@ def test_beyond_the_lifted_chain_reach_is_out_of_reach_without_ik(default, gener
     sol = wb.solve_target(controller, far, [1.0, 0.0, 0.0], allow_base_move=False)
     assert not sol.success and sol.reason == "out of reach" and sol.base == controller.base
     assert sol.position_error_m > 0.05
+
+
+def test_margin_alone_equals_margin_and_gradient(default, generated):
+    """BodyProblem.margin (the checks') is margin_and_gradient's margin, on random configurations of two robots."""
+    for robot, _, prob in (default, (generated[0], generated[1], wb.BodyProblem(generated[0]))):
+        rng = np.random.default_rng(8)
+        base = BasePlacement(0.2, -0.4, 0.9)
+        for _ in range(40):
+            q = robot.random_configuration(rng)
+            F = prob.frames(q, base)
+            expected = prob.margin_and_gradient(F, base)[0]
+            got = prob.margin(F)
+            assert got == expected or abs(got - expected) < 1e-12, (got, expected)

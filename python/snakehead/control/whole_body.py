@@ -193,6 +193,18 @@ class BodyProblem:
         J = self.point_jacobians(F, base, c_i, heavy)
         return (m[heavy, None] * c_i).sum(0) / M, np.einsum("l,lij->ij", m[heavy], J) / M
 
+    def margin(self, F: np.ndarray) -> float:
+        """:meth:`margin_and_gradient`'s margin alone (no Jacobians: for checks)."""
+        r = self.robot
+        heavy = np.flatnonzero(r.masses > 0)
+        c = F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
+        c = (r.masses[heavy, None] * c).sum(0) / r.masses[heavy].sum()
+        pts, _ = self.contact_points(F)
+        if len(stability.hull_indices(pts[:, :2])) < 3:
+            return -np.inf
+        # the same signed distance: inside, to the nearest edge; outside, to the polygon
+        return float(stability.polygon_margin_many(pts[None, :, :2], np.ones((1, len(pts)), bool), c[None, :2])[0])
+
     def margin_and_gradient(self, F: np.ndarray, base: BasePlacement) -> tuple[float, np.ndarray]:
         """Signed distance of the CoM's ground projection to the support polygon's nearest edge (> 0 inside) and
         its gradient (n + 3,) through the active edge."""
@@ -418,7 +430,7 @@ def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, positi
     de = float(np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1.0, 1.0))))
     margin = float(stability.static_margin(robot, q, base, contact="ground"))
     if problem is not None:
-        margin = min(margin, float(problem.margin_and_gradient(problem.frames(q, base), base)[0]))
+        margin = min(margin, problem.margin(problem.frames(q, base)))
     ground = float(coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min())
     selfc = float(coll.self_clearance(robot, q, base)[0])
     obst = None
@@ -615,10 +627,11 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     best = None
     seg_holder = [None]
 
-    def consider(q: np.ndarray, b: Any, stage: str, starts: int) -> Any:
-        """Check a configuration; keep the best attempt; return the solution when it passes."""
+    def consider(q: np.ndarray, b: Any, stage: str, starts: int, chk: dict | None = None) -> Any:
+        """Check a configuration (unless its check ``chk`` is given); keep the best attempt; return the solution
+        when it passes."""
         nonlocal best
-        chk = check(q, b)
+        chk = check(q, b) if chk is None else chk
         sol = solution(q, b, chk, stage, starts)
         sol.segmented = seg_holder[0]
         sol.desired_frame = None if seg_holder[0] is None else seg_holder[0].desired_frame
@@ -676,9 +689,10 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     def moved(q: np.ndarray, b: Any, starts: int) -> Any:
         """consider() for a moved base, whose shape must pass ``shape_ok`` too (asked only of a configuration that
         passes every other check; one whose shape fails is not kept as the best attempt either)."""
-        if shape_ok is not None and check(q, b)["reason"] is None and not shape_passes(q):
+        chk = check(q, b)
+        if shape_ok is not None and chk["reason"] is None and not shape_passes(q):
             return None
-        return consider(q, b, STAGES[2], starts)
+        return consider(q, b, STAGES[2], starts, chk)
 
     moved_starts = []
     for qb in [q_now[robot.parts.base]] + _base_shapes(controller):
