@@ -9,7 +9,7 @@ check that failed), the stage that solved it, whether the base had to be relocat
 sample of the successful plans is executed in MuJoCo (``snakehead.simulate``) with the head errors at the target
 and the ZMP check.
 
-    python3 bench/targets.py [--count 50] [--sim 20] [--robot ROBOT.toml] [--seed 0] [--write]
+    python3 bench/targets.py [--count 50] [--sim 20] [--robot ROBOT.toml | --generated NAME] [--seed 0] [--write]
 
 Prints tables; with --write, puts them in bench/RESULTS.md (section "Targets") with the date and the machine.
 """
@@ -76,12 +76,27 @@ def main() -> int:
     ap.add_argument("--count", type=int, default=50, help="targets per set (default 50)")
     ap.add_argument("--sim", type=int, default=20, help="successful plans executed in MuJoCo (default 20)")
     ap.add_argument("--robot", default=None, help="a robot file (default: the shipped robot)")
+    ap.add_argument("--generated", default=None, help="a generated snake of bench/_robots.py (e.g. twenty, "
+                    "pitch_first), with a coarse map computed here (voxel twice the default, 6 directions, 1 roll)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--sets", default=",".join(KINDS + ("random",)), help="comma-separated sets to run")
     ap.add_argument("--write", action="store_true", help="write the tables into bench/RESULTS.md")
     args = ap.parse_args()
-    robot = snakehead.SnakeRobot.default() if args.robot is None else snakehead.SnakeRobot.from_file(args.robot)
-    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
+    if args.generated is not None:
+        from _robots import ROBOTS  # bench/_robots.py
+
+        from snakehead.kinematics import workspace as ws
+
+        if args.generated not in ROBOTS:
+            ap.error(f"--generated must be one of {', '.join(ROBOTS)}")
+        robot = ROBOTS[args.generated][1]()
+        print(f"computing a coarse map for {args.generated} ({ROBOTS[args.generated][0]})", file=sys.stderr)
+        coarse = ws.compute(robot, voxel=2 * ws.default_map_options(robot)["voxel"], directions=6, rolls=1,
+                            progress=False)
+        controller = snakehead.HeadController(robot, coarse, method="free_roll", seed=1)
+    else:
+        robot = snakehead.SnakeRobot.default() if args.robot is None else snakehead.SnakeRobot.from_file(args.robot)
+        controller = snakehead.HeadController(robot, method="free_roll", seed=1)
     rng = np.random.default_rng(args.seed)
     sim_left, sim_rows, results = [args.sim], [], []
     snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
@@ -95,9 +110,10 @@ def main() -> int:
         results.append(run_set(controller, name, targets, sim_left, sim_rows))
     load1 = os.getloadavg()[0]
 
-    lines = [f"`python3 bench/targets.py --count {args.count} --sim {args.sim} --seed {args.seed}` on "
+    which = f" --generated {args.generated}" if args.generated else f" --robot {args.robot}" if args.robot else ""
+    lines = [f"`python3 bench/targets.py --count {args.count} --sim {args.sim} --seed {args.seed}{which}` on "
              f"{datetime.date.today()}, {cpu_name()} ({os.cpu_count()} cores), load {load0:.1f} -> {load1:.1f}; "
-             f"robot {robot.source or robot.urdf}.", "",
+             f"robot {args.generated or robot.source or robot.urdf}.", "",
              "| set | planned | median plan time (s) | worst (s) | median motion (s) | stages | relocated | failures |",
              "|---|---|---|---|---|---|---|---|"]
     for r in results:
