@@ -25,6 +25,21 @@ double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, cons
   return (p - (a + u * e)).norm();
 }
 
+// Sample t's active points (of N, layout as hull_margins) into the first rows of `buffer`, their indices among
+// the N into `index` (when given); returns how many.
+long gather_active(const double* points, const unsigned char* active, long t, long N, Points& buffer,
+                   std::vector<int>* index) {
+  long m = 0;
+  for (long i = 0; i < N; ++i) {
+    if (!active[t * N + i]) continue;
+    buffer(m, 0) = points[(t * N + i) * 2];
+    buffer(m, 1) = points[(t * N + i) * 2 + 1];
+    if (index != nullptr) (*index)[static_cast<std::size_t>(m)] = static_cast<int>(i);
+    ++m;
+  }
+  return m;
+}
+
 }  // namespace
 
 std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
@@ -86,13 +101,7 @@ std::vector<double> hull_margins(const double* points, const unsigned char* acti
   std::vector<double> out(static_cast<std::size_t>(T));
   Points buffer(N, 2);
   for (long t = 0; t < T; ++t) {
-    long m = 0;
-    for (long i = 0; i < N; ++i) {
-      if (!active[t * N + i]) continue;
-      buffer(m, 0) = points[(t * N + i) * 2];
-      buffer(m, 1) = points[(t * N + i) * 2 + 1];
-      ++m;
-    }
+    const long m = gather_active(points, active, t, N, buffer, nullptr);
     out[static_cast<std::size_t>(t)] = hull_margin(buffer.topRows(m), Eigen::Vector2d(xy[2 * t], xy[2 * t + 1]));
   }
   return out;
@@ -103,14 +112,7 @@ void convex_hulls(const double* points, const unsigned char* active, long T, lon
   Points buffer(N, 2);
   std::vector<int> index(static_cast<std::size_t>(N));
   for (long t = 0; t < T; ++t) {
-    long m = 0;
-    for (long i = 0; i < N; ++i) {
-      if (!active[t * N + i]) continue;
-      buffer(m, 0) = points[(t * N + i) * 2];
-      buffer(m, 1) = points[(t * N + i) * 2 + 1];
-      index[static_cast<std::size_t>(m)] = static_cast<int>(i);
-      ++m;
-    }
+    const long m = gather_active(points, active, t, N, buffer, &index);
     if (!buffer.topRows(m).allFinite()) throw InputError("convex_hulls: points must be finite");
     const std::vector<int> h = convex_hull(buffer.topRows(m));
     int* row = vertex + t * N;
