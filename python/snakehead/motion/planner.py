@@ -778,8 +778,9 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         # (obstacles apart: with them it is checked again)
         lifts = controller.__dict__.setdefault("_lift_paths", {})
         key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
-        if not obstacles and key in lifts:
-            way.append_path("initial state (head lifted)", *lifts[key])
+        kept = lifts.get(key) if not obstacles else None  # (one lookup: another thread may clear the dict)
+        if kept is not None:
+            way.append_path("initial state (head lifted)", *kept)
         else:
             first = len(way.qs) - 1
             method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
