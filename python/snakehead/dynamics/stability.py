@@ -64,8 +64,8 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     """
     if contact not in CONTACT_MODELS:
         raise ValueError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
-    end = robot.link_index(robot.parts.base_end) + 1  # base links: link_names[:end - 1]; their ends: [:end]
-    links = np.arange(0, end - 1) if contact != "ground" else np.arange(len(robot.link_names))
+    # the base part's links (the robot's own: those before base_end), or with "ground" every link
+    links = np.asarray(robot.base_links, int) if contact != "ground" else np.arange(len(robot.link_names))
     links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
     if links.size == 0:
         raise ValueError("the base part has no links with a collision box; no support polygon")
