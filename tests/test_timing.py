@@ -243,6 +243,7 @@ def test_bad_input():
         (dict(stops=["1"]), TypeError, "stops"),
         (dict(interpolation="linear"), ValueError, "interpolation"),
         (dict(base="here"), TypeError, "base"),
+        (dict(check_samples="yes"), TypeError, "check_samples"),
     ]
     for kw, error, match in cases:
         args = dict(waypoints=W)

@@ -529,6 +529,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
                             torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
     dt = positive(dt, "dt")
     grid_step = positive(grid_step, "grid_step")
+    if not isinstance(check_samples, (bool, np.bool_)):
+        raise TypeError(f"check_samples must be True or False, got {check_samples!r}")
     if interpolation not in INTERPOLATIONS:
         raise ValueError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
     schedule, holds = _segments(W, stops, hold_s)
