@@ -142,6 +142,8 @@ void lowest_box_corners(const double* frames, const double* box_origins, const d
         z[c] = B.row(2).head<3>().dot(local[c]) + B(2, 3);
         order[c] = c;
       }
+      if (!B.allFinite() || !h.allFinite())  // (a NaN would also break the sort's ordering)
+        throw InputError("lowest_box_corners: frames, box origins and sizes must be finite");
       std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return z[a] < z[b]; });
       for (int c = 0; c < 4; ++c) {
         const Eigen::Vector3d& p = local[order[c]];

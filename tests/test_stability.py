@@ -156,6 +156,10 @@ def test_lowest_box_corners_are_the_four_lowest_of_the_eight(robot, which):
                                                                                              np.int32))
     with pytest.raises(ValueError, match="shape"):
         _core.lowest_box_corners(frames[:, :3], robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
+    bad = frames.copy()
+    bad[3, links[0], 2, 3] = np.nan
+    with pytest.raises(ValueError, match="finite"):
+        _core.lowest_box_corners(bad, robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
 
 
 def test_static_margin_closed_form(robot):
