@@ -189,6 +189,31 @@ def test_plan_writes_the_same_kinds_of_files(plan):
     assert data.shape == (sc["samples"], 17)
 
 
+@pytest.mark.skipif(not HAVE_MUJOCO, reason="--start runs the closed loop in MuJoCo")
+def test_plan_from_lying_straight_end_to_end(tmp_path):
+    """``snakehead plan --start X Y YAW`` from the shell: the closed loop in MuJoCo (gaits, the curl, the head
+    phases) from the body lying straight 0.3 m behind the default placement, its files, its phases in order, and
+    the simulated head at the target within 2 mm and 1 deg with the ZMP inside (about a minute of simulated
+    motion; some 30-60 s here)."""
+    out = tmp_path / "out"
+    proc = run("plan", "--position", "0.15", "0.51", "0.40", "--direction", "0", "1", "0", "--start", "-0.3", "0",
+               "0", "--out", str(out), "--fast")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    for f in ["report.json", "summary.md", "target_path.png", "target_loop.gif"] + \
+            [f.format("target") for f in SCENARIO_FILES]:
+        assert (out / f).is_file(), f
+    sc = json.loads((out / "report.json").read_text())["scenarios"]["target"]
+    assert sc["success"] and sc["loop_failure"] is None, (sc["failure"], sc["loop_failure"])
+    assert (sc["start"]["x_m"], sc["start"]["y_m"], sc["start"]["yaw_rad"]) == (-0.3, 0.0, 0.0)
+    assert np.allclose(sc["start"]["q_rad"], 0.0)  # lying straight
+    phases = sc["phases"]
+    assert phases and all(a["t1_s"] <= b["t0_s"] + 1e-9 for a, b in zip(phases, phases[1:]))
+    assert phases[0]["kind"] == "gait" and sc["total_time_s"] >= phases[-1]["t1_s"] - 1e-9
+    sim = sc["sim"]
+    assert sim["position_error_m"] <= 2e-3 and sim["direction_error_deg"] <= 1.0 and sim["zmp_inside"], sim
+    assert "from lying straight" in (out / "summary.md").read_text()
+
+
 # ------------------------------------------------------------------------------------------------
 # workspace, help, bad arguments
 # ------------------------------------------------------------------------------------------------
