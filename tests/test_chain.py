@@ -125,6 +125,17 @@ def test_fk_all_many_equals_fk_all():
     many = robot.body.fk_all_many(qs)
     for k in range(5):
         np.testing.assert_array_equal(many[k], robot.body.fk_all(qs[k]))
+    # into a given origin frame (multiplied in the core): origin @ fk_all, and a bad origin is a ValueError
+    origin = np.eye(4)
+    origin[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    origin[:3, 3] = [0.3, -0.2, 0.05]
+    moved = robot.body.fk_all_many(qs, origin)
+    for k in range(5):
+        np.testing.assert_allclose(moved[k], origin @ robot.body.fk_all(qs[k]), atol=1e-14)
+    with pytest.raises(ValueError, match="origin"):
+        robot.body.fk_all_many(qs, np.eye(3))
+    with pytest.raises(ValueError, match="origin"):
+        robot.body.fk_all_many(qs, np.full((4, 4), np.nan))
 
 
 def test_urdf_as_string_and_pathlike(tmp_path):

@@ -184,21 +184,24 @@ class BodyProblem:
         low = np.take_along_axis(corners, order[..., None], axis=1)  # (k, 4, 3)
         return low.reshape(-1, 3), np.repeat(self.ground_links, 4)
 
-    def com_and_jacobian(self, F: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray]:
+    def _link_coms(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The links that have a mass (k,) and their centres of mass (k, 3), world, from frames F (n_links, 4, 4)."""
         r = self.robot
-        m = r.masses
-        heavy = np.flatnonzero(m > 0)
-        c_i = F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
+        heavy = np.flatnonzero(r.masses > 0)
+        return heavy, F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
+
+    def com_and_jacobian(self, F: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray]:
+        m = self.robot.masses
+        heavy, c_i = self._link_coms(F)
         M = m[heavy].sum()
         J = self.point_jacobians(F, base, c_i, heavy)
         return (m[heavy, None] * c_i).sum(0) / M, np.einsum("l,lij->ij", m[heavy], J) / M
 
     def margin(self, F: np.ndarray) -> float:
         """:meth:`margin_and_gradient`'s margin alone (no Jacobians: for checks)."""
-        r = self.robot
-        heavy = np.flatnonzero(r.masses > 0)
-        c = F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
-        c = (r.masses[heavy, None] * c).sum(0) / r.masses[heavy].sum()
+        m = self.robot.masses
+        heavy, c_i = self._link_coms(F)
+        c = (m[heavy, None] * c_i).sum(0) / m[heavy].sum()
         pts, _ = self.contact_points(F)
         if len(stability.hull_indices(pts[:, :2])) < 3:
             return -np.inf

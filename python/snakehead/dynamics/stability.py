@@ -4,7 +4,7 @@ Everything is in the world frame (z up, ground at z = 0). Where the base lies is
 ``base`` (a :class:`~snakehead.robot.BasePlacement`, default ``BasePlacement()``: tail at the origin,
 body along +x).
 
-* :func:`center_of_mass` -- Eq. 23, for one configuration (16,) or a trajectory (T, 16).
+* :func:`center_of_mass` -- Eq. 23, for one configuration (n,) or a trajectory (T, n).
 * :func:`support_polygon` -- Eq. 24, convex hull of the base's ground contacts; :func:`support_polygons` the same
   for every configuration of a trajectory at once.
 * :func:`static_margin`, :func:`is_statically_stable` -- signed distance of the CoM's ground
@@ -121,7 +121,7 @@ def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None 
                    frames: np.ndarray | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
 
-    q: (16,) -> (3,), or a trajectory (T, 16) -> (T, 3). ``frames``: the world frames of q (T, n_links, 4, 4) when
+    q: (n,) -> (3,), or a trajectory (T, n) -> (T, 3). ``frames``: the world frames of q (T, n_links, 4, 4) when
     the caller has them.
     """
     robot = as_robot(robot)
@@ -262,7 +262,7 @@ def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, ba
                             ) -> tuple[np.ndarray, np.ndarray]:
     """Linear momentum P (kg m/s) and angular momentum L about the world origin (kg m^2/s), Eqs. 25-31.
 
-    q, qd: joint positions (rad) and velocities (rad/s), (T, 16) each (or (16,) each -> (3,), (3,)).
+    q, qd: joint positions (rad) and velocities (rad/s), (T, n) each (or (n,) each -> (3,), (3,)).
     The root link is fixed to the ground at ``base`` (it does not move).
     """
     robot = as_robot(robot)
@@ -277,7 +277,7 @@ def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, ba
 
 def momenta(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None,
             qd: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Momenta along a sampled trajectory, Eqs. 25-31: t (T,) s, q (T, 16) rad -> P (T, 3), L (T, 3).
+    """Momenta along a sampled trajectory, Eqs. 25-31: t (T,) s, q (T, n) rad -> P (T, 3), L (T, 3).
 
     P in kg m/s; L in kg m^2/s about the world origin. The joint velocities are ``qd`` when given (e.g. a
     spline's exact derivative), otherwise :func:`joint_velocities` of the samples (np.gradient).

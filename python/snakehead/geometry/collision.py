@@ -41,7 +41,7 @@ def _trajectory(robot: SnakeRobot, qs: npt.ArrayLike) -> np.ndarray:
 def ground_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
     """Height (m) of the lowest corner of every link's collision box above the ground: (T, n_links).
 
-    qs (T, 16) (or (16,) -> (1, n_links)). Negative values are below the ground. The base links lying flat are
+    qs (T, n) (or (n,) -> (1, n_links)). Negative values are below the ground. The base links lying flat are
     at 0 (touching); frames without a box (markers) get +inf.
     """
     robot = as_robot(robot)
@@ -100,7 +100,7 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
     """Self-collision of the body along a trajectory: (T,) the smallest separating-axis gap (m) between the
     collision boxes of any two links that are not neighbours in the chain (neighbours share a joint and
     always touch there). > 0: no two such boxes meet (and this is a lower bound of their distance); <= 0: some
-    overlap. qs (T, 16) or (16,) -> (1,).
+    overlap. qs (T, n) or (n,) -> (1,).
     """
     robot = as_robot(robot)
     base = as_base(base)
@@ -256,7 +256,7 @@ class CollisionReport:
 
 def collision_check(robot: SnakeRobot, qs: np.ndarray, obstacles: Sequence[Any], base: BasePlacement | None = None, *,
                     exact_within: float = 0.05, spacing: float = 0.004) -> CollisionReport:
-    """Collisions of every link's collision box with obstacles along a trajectory qs (T, 16).
+    """Collisions of every link's collision box with obstacles along a trajectory qs (T, n).
 
     The collision flags are exact. The distances are exact wherever they are below ``exact_within`` m; pairs
     that the separating-axis test already puts farther apart report that test's gap, a lower bound that is

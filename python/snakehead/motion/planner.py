@@ -56,6 +56,7 @@ DENSIFY = 3  # configurations checked between consecutive waypoints of a move, a
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
 DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
+KEPT_LIFTS = 16  # lifts (checked paths, timed motions) a controller keeps, one per base shape
 ZMP_MARGIN = 0.005  # m: the least distance of the ZMP inside the support polygon a successful plan keeps
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
@@ -163,27 +164,28 @@ class Plan:
         return self.failure is None
 
 
-def _split_steps(qs: np.ndarray, most: float = MAX_WAYPOINT_STEP) -> np.ndarray:
-    """The path of waypoints qs (K, n) with every step whose largest joint change exceeds ``most`` rad split into
-    equal joint-space steps (the same straight segments, more waypoints)."""
+def _subdivide(qs: np.ndarray, step: float, least: int = 1) -> np.ndarray:
+    """The waypoints qs (K, n) with each straight segment between two cut into equal pieces, as many as keep every
+    joint's change within ``step`` rad and at least ``least``."""
     qs = np.asarray(qs, float)
     out = [qs[:1]]
     for a, b in zip(qs[:-1], qs[1:]):
-        pieces = max(1, int(np.ceil(np.abs(b - a).max() / most - 1e-9)))
+        pieces = max(least, int(np.ceil(np.abs(b - a).max() / step - 1e-9)))
         out.append(a + (np.arange(1, pieces + 1) / pieces)[:, None] * (b - a))
     return np.concatenate(out)
+
+
+def _split_steps(qs: np.ndarray, most: float = MAX_WAYPOINT_STEP) -> np.ndarray:
+    """The path of waypoints qs (K, n) with every step whose largest joint change exceeds ``most`` rad split into
+    equal joint-space steps (the same straight segments, more waypoints)."""
+    return _subdivide(qs, most)
 
 
 def _checked(qs: np.ndarray, step: float = MOVE_CHECK_STEP) -> np.ndarray:
     """The configurations a path of waypoints qs (K, n) is checked at: every waypoint and, along the straight
     segment between two, as many evenly spaced ones as keep each joint's change below ``step`` rad (at least
     DENSIFY)."""
-    qs = np.asarray(qs, float)
-    out = [qs[:1]]
-    for a, b in zip(qs[:-1], qs[1:]):
-        pieces = max(DENSIFY + 1, int(np.ceil(np.abs(b - a).max() / step - 1e-9)))
-        out.append(a + (np.arange(1, pieces + 1) / pieces)[:, None] * (b - a))
-    return np.concatenate(out)
+    return _subdivide(qs, step, DENSIFY + 1)
 
 
 def _densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
@@ -380,7 +382,7 @@ class _Waypoints:
                 if lift is None:
                     lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
                                   stops=[i for i in stops if i <= k], **timing)
-                    if len(self.lift_cache) > 16:
+                    if len(self.lift_cache) > KEPT_LIFTS:
                         self.lift_cache.clear()
                     self.lift_cache[key] = lift
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
@@ -785,7 +787,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             first = len(way.qs) - 1
             method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
             if not obstacles:
-                if len(lifts) > 16:
+                if len(lifts) > KEPT_LIFTS:
                     lifts.clear()
                 lifts[key] = (np.array(way.qs[first:]), method)
         way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
