@@ -128,6 +128,23 @@ void bind_model(py::module_& m) {
                                for (const auto& l : c.links()) f.push_back(l.box_origin);
                                return frames_to_array(f);
                              })
+      .def_property_readonly(
+          "link_collisions",
+          [](const ChainModel& c) {
+            static const char* kinds[] = {"box", "cylinder", "sphere", "mesh"};
+            py::list out;
+            for (const auto& l : c.links()) {
+              py::list shapes;
+              for (const CollisionElement& e : l.collisions)
+                shapes.append(py::make_tuple(kinds[static_cast<int>(e.kind)], Eigen::Matrix4d(e.origin.matrix()),
+                                             Eigen::Vector3d(e.size), e.filename));
+              out.append(shapes);
+            }
+            return out;
+          },
+          "per link (link_names order) its <collision> elements as (kind, origin 4x4 in the link frame, size, mesh "
+          "filename): kind 'box' (size = extents), 'cylinder' (radius, length, 0; axis z), 'sphere' (radius, 0, 0) "
+          "or 'mesh' (size = scale; filename as written in the URDF)")
       .def("fk",
            [](const ChainModel& c, ConstVec q) {
              c.check_configuration(q);

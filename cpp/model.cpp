@@ -72,7 +72,47 @@ void check_collision(const std::string& link, const urdf::Collision& collision) 
     if (!positive(c.radius) || !positive(c.length))
       throw InputError(where + "a cylinder's radius and length must be positive, got " + number_text(c.radius) + " and " +
                        number_text(c.length));
+  } else if (g.type == urdf::Geometry::MESH) {
+    const auto& m = static_cast<const urdf::Mesh&>(g);
+    if (m.filename.empty()) throw InputError(where + "a mesh needs a filename");
+    if (!positive(m.scale.x) || !positive(m.scale.y) || !positive(m.scale.z))
+      throw InputError(where + "a mesh scale must be three positive numbers, got " +
+                       vector_text(m.scale.x, m.scale.y, m.scale.z));
   }
+}
+
+// A checked <collision> element as the model keeps it.
+CollisionElement collision_element(const urdf::Collision& collision) {
+  CollisionElement e;
+  e.origin = to_isometry(collision.origin);
+  e.size.setZero();
+  const urdf::Geometry& g = *collision.geometry;
+  switch (g.type) {
+    case urdf::Geometry::BOX: {
+      const auto& d = static_cast<const urdf::Box&>(g).dim;
+      e.kind = CollisionKind::Box;
+      e.size = Eigen::Vector3d(d.x, d.y, d.z);
+      break;
+    }
+    case urdf::Geometry::CYLINDER: {
+      const auto& c = static_cast<const urdf::Cylinder&>(g);
+      e.kind = CollisionKind::Cylinder;
+      e.size = Eigen::Vector3d(c.radius, c.length, 0.0);
+      break;
+    }
+    case urdf::Geometry::SPHERE:
+      e.kind = CollisionKind::Sphere;
+      e.size = Eigen::Vector3d(static_cast<const urdf::Sphere&>(g).radius, 0.0, 0.0);
+      break;
+    case urdf::Geometry::MESH: {
+      const auto& m = static_cast<const urdf::Mesh&>(g);
+      e.kind = CollisionKind::Mesh;
+      e.size = Eigen::Vector3d(m.scale.x, m.scale.y, m.scale.z);
+      e.filename = m.filename;
+      break;
+    }
+  }
+  return e;
 }
 
 void fill_inertial(const urdf::Link& link, LinkInfo& info) {
@@ -95,6 +135,7 @@ void fill_inertial(const urdf::Link& link, LinkInfo& info) {
   for (const auto& collision : link.collision_array) {
     if (!collision) continue;
     check_collision(link.name, *collision);
+    if (collision->geometry) info.collisions.push_back(collision_element(*collision));
     if (!info.has_box && collision->geometry && collision->geometry->type == urdf::Geometry::BOX) {
       const auto* box = static_cast<const urdf::Box*>(collision->geometry.get());
       info.has_box = true;
@@ -293,6 +334,10 @@ ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::strin
       for (int c = r; c < 3; ++c) bodies << l.inertia(r, c) << ' ';
     bodies << l.has_box << ' ' << l.box_size.transpose() << ' ';
     append(bodies, l.box_origin);
+    for (const CollisionElement& e : l.collisions) {
+      bodies << static_cast<int>(e.kind) << ' ' << e.size.transpose() << ' ' << e.filename << ' ';
+      append(bodies, e.origin);
+    }
   }
   m.body_hash_ = digest(bodies.str());
   return m;

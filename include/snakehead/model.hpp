@@ -33,6 +33,17 @@ struct JointInfo {
   double velocity;  // rad/s or m/s; 0 when the URDF gives none
 };
 
+// One <collision> element of a link, as the URDF gives it.
+enum class CollisionKind { Box, Cylinder, Sphere, Mesh };
+struct CollisionElement {
+  CollisionKind kind;
+  Eigen::Isometry3d origin;  // the shape's frame in the link frame
+  // Box: full extents; cylinder: (radius, length, 0), axis along the shape frame's z; sphere: (radius, 0, 0);
+  // mesh: its scale.
+  Eigen::Vector3d size;
+  std::string filename;  // mesh only: the filename attribute as written (package://..., file://..., relative)
+};
+
 // One link on the path from base to tip (moving or attached by fixed joints), with its frame
 // located relative to the chain: frame(link) = (tip frame of segment `segment`) * offset, where
 // segment = -1 means the chain's base frame.
@@ -46,6 +57,7 @@ struct LinkInfo {
   bool has_box;               // a <collision> box is given
   Eigen::Vector3d box_size;   // m
   Eigen::Isometry3d box_origin;  // the box centre's pose in the link frame
+  std::vector<CollisionElement> collisions;  // every <collision> element with a geometry, in file order
 };
 
 // Precomputed form of one moving segment for the fast kinematics path:

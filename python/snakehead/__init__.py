@@ -14,6 +14,7 @@ The C++ core (``snakehead._core``) does kinematics, TRAC-IK and the workspace sw
 
 Start with ``SnakeRobot.default()``.
 """
+from ._errors import InputError
 from .control.controller import HeadController, HeadSolution
 from .geometry.obstacles import BoxObstacle, WallWithHole
 from .kinematics.ik import TracIK
@@ -26,7 +27,7 @@ from .motion.planner import Plan, TargetResult, plan
 from .scenes.scene import Scene, Target, load_scene
 from .sim.plan import PlanSimulation, simulate
 
-__all__ = ["SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
+__all__ = ["InputError", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
            "ReachabilityMap", "compute_map", "load_map", "plan", "Plan", "TargetResult", "simulate",
            "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "WallWithHole", "default_robot_file",
            "default_urdf_path"]

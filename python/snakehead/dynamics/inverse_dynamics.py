@@ -46,20 +46,18 @@ def lift_shares(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) 
     """How much of each link's weight the joints carry: w (T, n_links) in [0, 1] from world frames
     (T, n_links, 4, 4).
 
-    A link with a box: w = clip(h / ramp, 0, 1), h the height of the lowest corner of its box's distal face (+x
-    end). The distal face, not the whole box: a link pitched up about its proximal joint still touches the ground
-    with its proximal edge, right under the joint's axis, where the ground's reaction has no moment about the joint,
-    so the joint carries the link from the first degrees of lift. Links without a box (marker frames): w = 1.
+    A link with collision shapes: w = clip(h / ramp, 0, 1), h the height of the lowest of its distal points (the
+    points of its shapes farthest along the body: a box's distal face, a cylinder's distal rim). The distal end,
+    not the whole link: a link pitched up about its proximal joint still touches the ground with its proximal edge,
+    right under the joint's axis, where the ground's reaction has no moment about the joint, so the joint carries
+    the link from the first degrees of lift. Links without shapes (marker frames): w = 1.
     """
     ramp = positive(ramp, "ramp")
     L = len(robot.link_names)
-    boxed = np.all(robot.box_sizes > 0, axis=1)
-    Bz = np.einsum("tkj,kjl->tkl", frames[:, boxed, 2, :], robot.box_origins[boxed])  # the boxes' poses' z rows
-    half = 0.5 * robot.box_sizes[boxed]
-    low = (Bz[..., 3] + Bz[..., 0] * half[:, 0]
-           - np.abs(Bz[..., 1]) * half[:, 1] - np.abs(Bz[..., 2]) * half[:, 2])
+    links, points = robot.distal_points  # (k,), (k, M, 3) in the link frames
+    z = np.einsum("tkj,kmj->tkm", frames[:, links, 2, :3], points) + frames[:, links, 2, 3][..., None]
     w = np.ones((frames.shape[0], L))
-    w[:, boxed] = np.clip(low / ramp, 0.0, 1.0)
+    w[:, links] = np.clip(z.min(axis=2) / ramp, 0.0, 1.0)
     return w
 
 

@@ -145,18 +145,22 @@ def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.Arr
 
 
 def resting_contacts(robot: SnakeRobot, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """Where a body lying flat with joints ``q`` (n,) touches the ground: the centres (k, 2) of its boxes in the
-    root frame's ground plane (m), and their loads (the links' masses, kg). ValueError unless every box rests on
-    the ground (its bottom within RESTING_HEIGHT of the lowest): the model is for flat shapes."""
+    """Where a body lying flat with joints ``q`` (n,) touches the ground: the centres (k, 2) of its links' collision
+    capsules in the body frame's ground plane (m), and their loads (the links' masses, kg). ValueError unless every
+    link with shapes rests on the ground (its bottom within RESTING_HEIGHT of the lowest): the model is for flat
+    shapes."""
     robot = as_robot(robot)
-    F = robot.body.fk_all(np.asarray(q, float))[None]
-    low = robot.lowest_box_z(F)[0]
+    F = robot.frames(np.asarray(q, float), BasePlacement())[None]  # the default placement: the body frame
+    low = robot.lowest_z(F)[0]
+    links = robot.shaped_links
     if low.max() > low.min() + RESTING_HEIGHT:
         k = int(np.argmax(low))
-        raise ValueError(f"the shape is not flat on the ground: the box of {robot.link_names[robot.boxed_links[k]]!r} "
+        raise ValueError(f"the shape is not flat on the ground: the link {robot.link_names[links[k]]!r} "
                          f"is {1000 * (low[k] - low.min()):.1f} mm above the lowest (keep the pitch joints at 0)")
-    centres = robot.box_poses(F)[0, :, :2, 3]
-    return centres, robot.masses[robot.boxed_links]
+    ends, _ = robot.link_capsules
+    mid = 0.5 * (ends[links, 0] + ends[links, 1])  # (k, 3) in the link frames
+    centres = np.einsum("kij,kj->ki", F[0, links, :3, :3], mid) + F[0, links, :3, 3]
+    return centres[:, :2], robot.masses[links]
 
 
 def predict_slide(robot: SnakeRobot, q_path: npt.ArrayLike, start: BasePlacement | None = None

@@ -66,35 +66,30 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
         raise ValueError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
     # the base part's links (the robot's own: those before base_end), or with "ground" every link
     links = np.asarray(robot.base_links, int) if contact != "ground" else np.arange(len(robot.link_names))
-    links = links[np.all(robot.box_sizes[links] > 0.0, axis=1)]
+    links = links[np.isin(links, robot.shaped_links)]
     if links.size == 0:
-        raise ValueError("the base part has no links with a collision box; no support polygon")
+        raise ValueError("the base part has no links with collision shapes; no support polygon")
     if contact == "endpoints":
         # Eq. 24: p_i are the endpoints of the base links, i.e. the origins of consecutive frames (each
         # link's frame is at its proximal joint; the next frame in chain order is at its distal end). A point
         # touches the ground when a link it ends lies on the ground.
-        on_ground = robot.lowest_box_z(frames, links) <= tolerance  # (T, k)
+        on_ground = robot.lowest_z(frames, links) <= tolerance  # (T, k)
         idx = np.unique(np.r_[links, links + 1])
         pts = frames[:, idx][..., :2, 3]  # (T, N, 2)
         active = np.zeros((frames.shape[0], len(idx)), bool)
         active[:, np.searchsorted(idx, links)] |= on_ground
         active[:, np.searchsorted(idx, links + 1)] |= on_ground
         return pts, active
-    # footprint / ground: the four bottom corners of each box (its face nearest the ground when the link lies flat;
-    # the C++ core picks them by height)
-    xy, z = _core.lowest_box_corners(np.ascontiguousarray(frames), robot.box_origins, 0.5 * robot.box_sizes,
-                                     links.astype(np.int32))
     if contact == "ground":  # only the links that touch in some sample can give a contact point
-        keep = (z[..., 0] <= tolerance).any(axis=0)
+        keep = (robot.lowest_z(frames, links) <= tolerance).any(axis=0)
         keep[0] |= not keep.any()  # (one link, none of its points active: no polygon, but the shapes stay)
-        xy, z = xy[:, keep], z[:, keep]
-    T = frames.shape[0]
-    pts = xy.reshape(T, -1, 2)
-    # a corner supports only where it touches: a link tilted up off the ground (a neck link rising from it) rests on
-    # its lowest edge, not on the corners it holds in the air (counting those would move the polygon's edge out by
-    # the link's length and make it jump as the link lifts)
-    active = (z <= tolerance).reshape(T, -1)
-    return pts, active
+        links = links[keep]
+    # footprint / ground: each shape's lowest candidate points (box corners, cylinder rims, sphere bottoms, hull
+    # vertices; the C++ core picks them by height). A point supports only where it touches: a link tilted up off
+    # the ground (a neck link rising from it) rests on its lowest edge, not on the points it holds in the air
+    # (counting those would move the polygon's edge out by the link's length and make it jump as the link lifts)
+    pts, _ = robot.lowest_points(frames, links)
+    return np.ascontiguousarray(pts[..., :2]), pts[..., 2] <= tolerance
 
 
 def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.ArrayLike) -> np.ndarray:
@@ -421,9 +416,9 @@ def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, conta
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     if contact == "ground":
         lowest = np.full((len(q), len(robot.link_names)), np.inf)
-        boxed = robot.boxed_links
+        shaped = robot.shaped_links
         frames = robot.frames_many(q, base) if frames is None else frames
-        lowest[:, boxed] = robot.lowest_box_z(frames, boxed)
+        lowest[:, shaped] = robot.lowest_z(frames, shaped)
         touching = lowest <= tolerance
         last = np.where(touching.any(axis=1), len(robot.link_names) - 1 - np.argmax(touching[:, ::-1], axis=1), -1)
         child = np.asarray(robot.body.model.joint_child_links)

@@ -1,15 +1,30 @@
 """The obstacles of a scene, one model for planning (:mod:`snakehead.geometry.collision`) and simulation
-(:mod:`snakehead.sim`): boxes and a wall with a round hole. Scene files (:mod:`snakehead.scenes`) describe them.
+(:mod:`snakehead.sim`): boxes, a wall with a round hole and meshes (their convex hulls). Scene files
+(:mod:`snakehead.scenes`) describe them. Each obstacle gives its convex :meth:`shapes` in the world (the wall as
+convex pieces around a polygon inscribed in its hole, so that collisions with it err on the safe side).
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from .._validate import finite_array, finite_float, positive, rotation_matrix, unit_vector3, vector3
+from .shapes import Shape
 
 import numpy.typing as npt
+
+#: Sides of the polygon inscribed in a wall's hole: the pieces of the wall's solid meet the hole's circle at the
+#: polygon's vertices and stand into it by at most r (1 - cos(pi / 32)) = 0.5 % of its radius.
+WALL_HOLE_SIDES = 32
+
+
+def _pose(rotation: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = rotation, centre
+    return T
 
 
 @dataclass(frozen=True)
@@ -27,6 +42,10 @@ class BoxObstacle:
             raise ValueError(f"box size must be positive, got {size.tolist()}")
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "rotation", rotation_matrix(self.rotation, "box rotation"))
+
+    def shapes(self) -> list[Shape]:
+        """The box as a world shape (frame 0: the world)."""
+        return [Shape("box", 0, _pose(self.rotation, self.centre), self.size)]
 
     @classmethod
     def from_yaw(cls, centre: npt.ArrayLike, size: npt.ArrayLike, yaw: float = 0.0) -> "BoxObstacle":
@@ -102,6 +121,28 @@ class WallWithHole:
         R = self.rotation
         return BoxObstacle(self.centre + R[:, :2] @ self.hole_offset, self.size, R)
 
+    def shapes(self) -> list[Shape]:
+        """The wall's solid as convex world shapes: one prism per side of a polygon of :data:`WALL_HOLE_SIDES`
+        sides inscribed in the hole, reaching out to the wall's rectangle along the rays through the polygon's
+        vertices (each piece the region of one angular sector, convex since the sector is under 180 degrees)."""
+        half = self.size / 2
+        r = self.hole_diameter / 2
+        angles = 2 * np.pi * np.arange(WALL_HOLE_SIDES + 1) / WALL_HOLE_SIDES
+        lo, hi = self.hole_offset - half[:2], self.hole_offset + half[:2]  # the rectangle, hole coordinates
+        corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+        corner_angles = np.mod(np.arctan2(corners[:, 1], corners[:, 0]), 2 * np.pi)
+        out = []
+        for a, b in zip(angles[:-1], angles[1:]):
+            ring = [r * np.array([np.cos(a), np.sin(a)]), r * np.array([np.cos(b), np.sin(b)]),
+                    _ray_to_rectangle(b, lo, hi)]
+            inside = (corner_angles > a) & (corner_angles < b)
+            ring += [c for _, c in sorted(zip(corner_angles[inside], corners[inside]), key=lambda t: -t[0])]
+            ring.append(_ray_to_rectangle(a, lo, hi))
+            flat = np.array(ring)
+            v = np.concatenate([np.c_[flat, np.full(len(flat), -half[2])], np.c_[flat, np.full(len(flat), half[2])]])
+            out.append(Shape("convex", 0, _pose(self.rotation, self.centre), np.ones(3), vertices=v))
+        return out
+
     def distance_to_points(self, x: np.ndarray) -> np.ndarray:
         """Exact distance (m) of world points x (..., 3) to the wall's solid (0 inside it).
 
@@ -119,3 +160,54 @@ class WallWithHole:
         in_hole = np.maximum(self.hole_diameter / 2 - rho, 0.0)
         d_plane = np.where(outside_rect > 0, outside_rect, in_hole)
         return np.hypot(d_plane, dw)
+
+
+def _ray_to_rectangle(angle: float, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Where the ray from the origin at ``angle`` leaves the rectangle [lo, hi] (which holds the origin)."""
+    d = np.array([np.cos(angle), np.sin(angle)])
+    t = np.inf
+    for k in range(2):
+        if d[k] > 1e-12:
+            t = min(t, hi[k] / d[k])
+        elif d[k] < -1e-12:
+            t = min(t, lo[k] / d[k])
+    return t * d
+
+
+@dataclass(frozen=True, eq=False)
+class MeshObstacle:
+    """A mesh file's convex hull (STL, OBJ, DAE... through trimesh), scaled by ``scale`` and placed at ``pose``
+    (4, 4) in the world. ``vertices`` (V, 3): the hull's vertices in the mesh's frame, scaled (loaded once)."""
+
+    path: Path
+    pose: np.ndarray
+    scale: np.ndarray
+    vertices: np.ndarray
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, position: npt.ArrayLike, yaw: float = 0.0,
+             scale: npt.ArrayLike = (1.0, 1.0, 1.0), where: str = "mesh obstacle") -> "MeshObstacle":
+        """A mesh obstacle from a file, standing at ``position`` (m), turned by ``yaw`` rad about the world z."""
+        from ..model.description import convex_hull_vertices
+
+        scale_v = vector3(scale, "mesh scale")
+        if np.any(scale_v <= 0):
+            raise ValueError(f"{where}: mesh scale must be positive, got {scale_v.tolist()}")
+        yaw = finite_float(yaw, "mesh yaw")
+        c, s = np.cos(yaw), np.sin(yaw)
+        pose = _pose(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), vector3(position, "mesh position"))
+        vertices = convex_hull_vertices(Path(path), scale_v, where)
+        return cls(Path(path), pose, scale_v, vertices)
+
+    def shapes(self) -> list[Shape]:
+        """The mesh's convex hull as a world shape."""
+        return [Shape("convex", 0, self.pose, np.ones(3), vertices=self.vertices, source=os.fspath(self.path))]
+
+    @property
+    def world_vertices(self) -> np.ndarray:
+        """(V, 3) the hull's vertices in the world."""
+        return self.vertices @ self.pose[:3, :3].T + self.pose[:3, 3]
+
+
+#: The kinds of obstacle (one model for planning and simulation).
+OBSTACLE_TYPES = (BoxObstacle, WallWithHole, MeshObstacle)

@@ -11,9 +11,14 @@ A robot is a URDF plus three frames (links or fixed marker frames) along one ser
 * neck = the joints from ``base_end`` to ``neck_end`` (B0, the head part's base frame);
 * head = the joints from ``neck_end`` to ``head_tip`` (the head link frame; its x-axis is the head's direction).
 
-The snake lies straight along the root frame's x-axis at q = 0, and each joint turns about the root frame's
-z-axis (a *yaw* joint: it bends the body in the ground plane while the body lies flat) or its y-axis (a *pitch*
-joint: it lifts the body off the ground).
+The snake lies straight at q = 0: every frame on one line, the *body axis*, whatever way the URDF's link frames
+turn (modules along their x, y or z, a rotated dummy root). The *body frame* has its x-axis along that line
+towards the head and its z-axis up; up is the joint-axis direction nearest the root frame's z (then x, then y).
+Each joint turns about the body frame's z-axis (a *yaw* joint: it bends the body in the ground plane while the
+body lies flat) or its y-axis (a *pitch* joint: it lifts the body off the ground). Frames whose orientation the
+planner reads (base_end, neck_end, the lift frame and head_tip) are given aligned twins when the URDF's are not
+(x along the body, z up at q = 0; the head tip's x along its ``head_axis``), added to the URDF as fixed marker
+frames named ``NAME__aligned``.
 """
 from __future__ import annotations
 
@@ -25,18 +30,31 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
+from .._errors import InputError
 from .._validate import finite_array, joint_vector
 from .chain import Chain, _check_utf8
+from .description import (Description, MeshResolver, add_fixed_frames, continuous_joints, convex_hull_vertices,
+                          read_description, with_joint_limits)
 
 import numpy.typing as npt
-from typing import Any
+from typing import TYPE_CHECKING, Any, Mapping
+
+if TYPE_CHECKING:  # the geometry layer imports this module
+    from ..geometry.shapes import ShapeSet
 
 YAW = "yaw"
 PITCH = "pitch"
 
-#: How far (rad) a joint axis may be from the root frame's y- or z-axis, and how far (m) a frame may be from the
-#: root frame's x-axis at q = 0, for the body to count as a straight snake with yaw and pitch joints.
-STRAIGHT_TOLERANCE = 1e-6
+#: How far (rad) a joint axis may be from the body frame's y- or z-axis, and how far (m) a frame may be from the
+#: body axis at q = 0, for the body to count as a straight snake with yaw and pitch joints (URDFs write pi/2 as
+#: 1.5708: 4e-6 rad off).
+STRAIGHT_TOLERANCE = 1e-4
+
+#: The suffix of the aligned twin of a frame (see the module's docstring).
+ALIGNED_SUFFIX = "__aligned"
+
+#: The head frame's axes that may point where the head looks (the robot file's ``head_axis``).
+HEAD_AXES = {"x": 0, "y": 1, "z": 2, "-x": 0, "-y": 1, "-z": 2}
 
 
 def default_robot_file() -> Path:
@@ -54,10 +72,11 @@ def default_urdf_path() -> Path:
 
 @dataclass(frozen=True)
 class BasePlacement:
-    """Where the base lies on the ground: the root link's frame at planar position (x, y), turned by ``yaw``.
+    """Where the base lies on the ground: the body frame (:attr:`SnakeRobot.body_in_root`; the root link's frame
+    for snakes written along x) at planar position (x, y), turned by ``yaw``.
 
     x, y in m (world), yaw in rad about the world z-axis. The root frame's height is the robot's
-    (:attr:`SnakeRobot.body_axis_height`: the base's boxes rest on the ground), so a placement fits any robot:
+    (:attr:`SnakeRobot.body_axis_height`: the base's shapes rest on the ground), so a placement fits any robot:
     ``robot.root_pose(base)`` is the 4x4 world pose. The default puts the root frame (the tail end) at the origin
     with the body along world +x.
     """
@@ -120,55 +139,57 @@ class SnakeRobot:
     """
 
     def __init__(self, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
-                 root: str | None = None, map_path: str | os.PathLike | None = None, source: str | None = None) -> None:
-        self.urdf = _urdf_source(urdf)
-        base_end = _frame_name(base_end, "base_end")
-        neck_end = _frame_name(neck_end, "neck_end")
-        head_tip = _frame_name(head_tip, "head_tip")
-        root = _core.urdf_root_link(self.urdf) if root is None else _frame_name(root, "root")
+                 root: str | None = None, map_path: str | os.PathLike | None = None, source: str | None = None,
+                 head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
+                 limits: Mapping[str, tuple[float, float]] | None = None,
+                 xacro_args: Mapping[str, object] | None = None) -> None:
+        description = read_description(_urdf_source(urdf), xacro_args)
+        names = {"base_end": _frame_name(base_end, "base_end"), "neck_end": _frame_name(neck_end, "neck_end"),
+                 "head_tip": _frame_name(head_tip, "head_tip")}
+        if head_axis not in HEAD_AXES:
+            raise InputError(f"head_axis must be one of {', '.join(HEAD_AXES)}, got {head_axis!r}")
+        #: The head tip frame's axis that points where the head looks (in the URDF's head_tip frame).
+        self.head_axis = head_axis
+        #: The frames as the user named them (``parts`` may name their aligned twins).
+        self.user_frames = dict(names)
         #: The head's reachability map file named by the robot file (None: none given).
         self.map_path = None if map_path is None else Path(map_path)
         #: Where the robot came from (a robot file's path), for messages and reports.
-        self.source = source
-        try:
-            self.body = Chain.from_urdf(self.urdf, root, head_tip)
-        except ValueError as exc:
-            raise ValueError(f"the robot's body (root {root!r} -> head_tip {head_tip!r}): {exc}") from None
-        names = self.body.link_names
-        order = [("root", root), ("base_end", base_end), ("neck_end", neck_end), ("head_tip", head_tip)]
-        for key, name in order:
-            if name not in names:
-                raise ValueError(f"{key} {name!r} is not a frame on the chain from the root {root!r} to the head tip "
-                                 f"{head_tip!r} (frames: {', '.join(names)})")
-        idx = [names.index(name) for _, name in order]
-        for (ka, na), (kb, nb), a, b in zip(order, order[1:], idx, idx[1:]):
-            if not a < b:
-                raise ValueError(f"frames out of order: {kb} {nb!r} must come after {ka} {na!r} along the body "
-                                 "(root -> base_end -> neck_end -> head_tip)")
-        joints_before = self._joints_before
-        slices = []
-        for (ka, na), (kb, nb), a, b in zip(order, order[1:], idx, idx[1:]):
-            start, stop = joints_before(a), joints_before(b)
-            part = {"base_end": "base", "neck_end": "neck", "head_tip": "head"}[kb]
-            if stop <= start:
-                raise ValueError(f"the {part} part ({ka} {na!r} -> {kb} {nb!r}) has no joint")
-            slices.append(slice(start, stop))
-        self.parts = RobotParts(base=slices[0], neck=slices[1], head=slices[2], root=root, base_end=base_end,
-                                neck_end=neck_end, head_tip=head_tip)
+        self.source = source or description.source
+        self._meshes = MeshResolver(description.folder, {k: Path(v) for k, v in (packages or {}).items()})
+        text = _with_limits(description, limits or {})
+        root = _core.urdf_root_link(text) if root is None else _frame_name(root, "root")
+        raw = _body_chain(text, root, names["head_tip"])
+        parts = _part_slices(raw, root, names)
+        body_in_root = _body_frame(raw)
+        aligned, text = _aligned_frames(text, raw, body_in_root, parts, names, head_axis)
+        #: The URDF text the core reads: the description with limits and aligned frames (a path when unchanged).
+        self.urdf = text
+        self.body = raw if aligned == names else _body_chain(text, root, aligned["head_tip"])
+        self._body_in_root = body_in_root
+        self.parts = RobotParts(base=parts[0], neck=parts[1], head=parts[2], root=root, base_end=aligned["base_end"],
+                                neck_end=aligned["neck_end"], head_tip=aligned["head_tip"])
         self._chains: dict[tuple[str, str], Chain] = {}
         self._check_snake()
 
     # --- construction ---------------------------------------------------------------------------
     @classmethod
     def from_urdf(cls, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
-                  root: str | None = None) -> "SnakeRobot":
-        """A robot from a URDF (a path, or the XML itself starting with ``<``) and the frames that bound its parts.
+                  root: str | None = None, head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
+                  limits: Mapping[str, tuple[float, float]] | None = None,
+                  xacro_args: Mapping[str, object] | None = None) -> "SnakeRobot":
+        """A robot from a description (a URDF or ``.xacro`` path, or the URDF XML itself starting with ``<``) and
+        the frames that bound its parts.
 
-        ``root`` defaults to the URDF's root link. Any link or fixed marker frame may be named. Raises ValueError
-        for frames that are missing or out of order, a part without joints, or a body that is not a snake
-        (straight along x at q = 0, revolute joints about the root frame's y or z, collision boxes on the base).
+        ``root`` defaults to the URDF's root link. Any link or fixed marker frame may be named. ``head_axis``: the
+        head_tip frame's axis that points where the head looks. ``packages``: NAME -> folder for
+        ``package://NAME/...`` meshes. ``limits``: joint -> (lower, upper) rad, needed for ``continuous`` joints.
+        ``xacro_args``: the arguments of a xacro file. Raises :class:`~snakehead.InputError` for frames that are
+        missing or out of order, a part without joints, or a body that is not a snake (straight at q = 0,
+        revolute joints about two perpendicular axes across it, collision shapes on the base).
         """
-        return cls(urdf, base_end=base_end, neck_end=neck_end, head_tip=head_tip, root=root)
+        return cls(urdf, base_end=base_end, neck_end=neck_end, head_tip=head_tip, root=root, head_axis=head_axis,
+                   packages=packages, limits=limits, xacro_args=xacro_args)
 
     @classmethod
     def from_file(cls, path: str | os.PathLike) -> "SnakeRobot":
@@ -177,7 +198,8 @@ class SnakeRobot:
 
         spec = read_robot_file(path)
         return cls(spec.urdf, base_end=spec.base_end, neck_end=spec.neck_end, head_tip=spec.head_tip,
-                   root=spec.root, map_path=spec.map, source=os.fspath(path))
+                   root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
+                   packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args)
 
     @classmethod
     def default(cls) -> "SnakeRobot":
@@ -186,29 +208,25 @@ class SnakeRobot:
 
     def _joints_before(self, link_index: int) -> int:
         """How many joints lie between the root and the frame ``link_names[link_index]``."""
-        child = np.asarray(self.body.model.joint_child_links)
-        return int(np.sum(child <= link_index))
+        return _joints_before(self.body, link_index)
 
     def _check_snake(self) -> None:
-        types = set(self.body.joint_types)
-        if types - {"revolute"}:
-            raise ValueError(f"a snake robot's joints are revolute with limits; this body has {sorted(types)} joints")
-        F = self.body.fk_all(np.zeros(self.n_joints))
-        p = F[:, :3, 3]
-        if np.abs(p[:, 1:]).max() > STRAIGHT_TOLERANCE or np.any(np.diff(p[:, 0]) < -STRAIGHT_TOLERANCE):
-            raise ValueError("the body does not lie straight along the root frame's x-axis at q = 0 (every frame on "
-                             "the x-axis, in order); snakehead's snakes do")
         for j, a in enumerate(self.joint_axes):
             if not (np.allclose(np.abs(a), (0, 0, 1), atol=STRAIGHT_TOLERANCE)
                     or np.allclose(np.abs(a), (0, 1, 0), atol=STRAIGHT_TOLERANCE)):
-                raise ValueError(f"joint {self.joint_names[j]!r} turns about {np.round(a, 6).tolist()} in the root frame; "
-                                 "a snake's joints turn about its z-axis (yaw) or y-axis (pitch)")
-        if len(self.base_links) == 0 or not np.all(self.box_sizes[self.base_links] > 0):
-            missing = [self.link_names[i] for i in self.base_links if not np.all(self.box_sizes[i] > 0)]
-            raise ValueError("every base link needs a collision box (the base lies on the ground on them); "
-                             f"missing on {missing or 'the base'}")
+                raise InputError(f"joint {self.joint_names[j]!r} turns about {np.round(a, 4).tolist()} in the body "
+                                 "frame (x along the body, z up); a snake's joints turn about its z-axis (yaw) or "
+                                 "y-axis (pitch)")
+        shaped = set(self.shaped_links.tolist())
+        segments: dict[int, list[int]] = {}  # the base's rigid segments: links between the same two joints
+        for i in self.base_links.tolist():
+            segments.setdefault(self._joints_before(i), []).append(i)
+        bare = [self.link_names[i] for links in segments.values() if not shaped & set(links) for i in links]
+        if not segments or bare:
+            raise InputError("every rigid segment of the base needs a <collision> shape (the base lies on the ground "
+                             f"on them); none on {bare or 'the base'}")
         if not self.total_mass > 0:
-            raise ValueError("the robot has no mass (no <inertial> on its links): stability needs the masses")
+            raise InputError("the robot has no mass (no <inertial> on its links): stability needs the masses")
 
     # --- parts -------------------------------------------------------------------------------------
     @property
@@ -317,24 +335,32 @@ class SnakeRobot:
         return self._bodies(self._part_links(self.parts.neck_end, None))
 
     def _bodies(self, links: np.ndarray) -> np.ndarray:
-        keep = (self.masses[links] > 0) | np.all(self.box_sizes[links] > 0, axis=1)
+        keep = (self.masses[links] > 0) | np.isin(links, self.shaped_links)
         return links[keep]
 
     @cached_property
     def lifted_links(self) -> np.ndarray:
-        """Indices (link_names) of the boxed links after the base (neck and head): those that lift off the ground."""
-        return self.boxed_links[self.boxed_links >= self.link_index(self.parts.base_end)]
+        """Indices (link_names) of the links with collision shapes after the base (neck and head): those that lift
+        off the ground."""
+        return self.shaped_links[self.shaped_links >= self.link_index(self.parts.base_end)]
 
-    # --- shape at q = 0 (the body straight along the root frame's x-axis) ------------------------------------
+    # --- shape at q = 0 (the body straight along the body frame's x-axis) --------------------------------------
     @cached_property
     def _straight_frames(self) -> np.ndarray:
-        F = self.body.fk_all(np.zeros(self.n_joints))
+        """Every frame at q = 0 in the body frame (the body along its x-axis from the origin, z up)."""
+        F = np.linalg.inv(self._body_in_root) @ self.body.fk_all(np.zeros(self.n_joints))
         F.setflags(write=False)
         return F
 
+    @property
+    def body_in_root(self) -> np.ndarray:
+        """The body frame (4, 4) in the root frame: x along the straight body towards the head, z up (the root
+        frame itself for snakes written along x with z up)."""
+        return self._body_in_root.copy()
+
     @cached_property
     def joint_axes(self) -> np.ndarray:
-        """(n, 3) each joint's axis in the root frame at q = 0."""
+        """(n, 3) each joint's axis in the body frame at q = 0."""
         F = self._straight_frames
         child = np.asarray(self.body.model.joint_child_links)
         local = np.asarray(self.body.model.joint_axes, float)
@@ -351,7 +377,7 @@ class SnakeRobot:
 
     @cached_property
     def joint_kinds(self) -> tuple[str, ...]:
-        """Each joint's kind: ``"yaw"`` (axis +-z of the root frame) or ``"pitch"`` (+-y)."""
+        """Each joint's kind: ``"yaw"`` (axis +-z of the body frame) or ``"pitch"`` (+-y)."""
         return tuple(YAW if abs(a[2]) > 0.5 else PITCH for a in self.joint_axes)
 
     @cached_property
@@ -370,6 +396,11 @@ class SnakeRobot:
         """A frame's distance from the root frame along the straight body (m)."""
         F = self._straight_frames
         return float(F[self.link_index(name), 0, 3] - F[0, 0, 3])
+
+    def arc_length_of_user_frame(self, name: str) -> float:
+        """:meth:`frame_arc_length` of a frame named as in the description (its aligned twin, if it has one)."""
+        aligned = name + ALIGNED_SUFFIX
+        return self.frame_arc_length(aligned if aligned in self.link_names else name)
 
     @property
     def body_length(self) -> float:
@@ -409,10 +440,9 @@ class SnakeRobot:
 
     @cached_property
     def body_axis_height(self) -> float:
-        """Height (m) of the root frame above the ground when the base lies on it: the base links' boxes rest on
-        the ground (their lowest corners at z = 0) with every pitch joint of the base at zero."""
-        corners = self.box_corners(self._straight_frames[None], self.base_links)[0]
-        return float(-corners[..., 2].min())
+        """Height (m) of the body axis above the ground when the base lies on it: the base links' collision shapes
+        rest on the ground (their lowest points at z = 0) with every joint at zero."""
+        return float(-self.geometry.lowest_z(self._straight_frames[None], self.base_links)[0].min())
 
     # --- mass and geometry (per entry of link_names) ---------------------------------------------------------
     @property
@@ -434,46 +464,94 @@ class SnakeRobot:
         """(n_links, 3, 3) inertia about each link's centre of mass, link-frame axes (kg m^2)."""
         return self.body.model.link_inertias
 
-    @property
-    def box_sizes(self) -> np.ndarray:
-        """(n_links, 3) collision box extents (m); zeros for links without a box (marker frames)."""
-        return self.body.model.link_box_sizes
+    @cached_property
+    def geometry(self) -> ShapeSet:
+        """The collision shapes of the links (every URDF <collision> element: boxes, cylinders, spheres, meshes as
+        their convex hulls), on the frames of :attr:`link_names`."""
+        from ..geometry.shapes import Shape, ShapeSet
 
-    @property
-    def box_origins(self) -> np.ndarray:
-        """(n_links, 4, 4) pose of each collision box's centre in its link frame."""
-        return self.body.model.link_box_origins
+        shapes = []
+        for k, elements in enumerate(self.body.model.link_collisions):
+            for kind, origin, size, filename in elements:
+                where = f"link {self.link_names[k]!r} <collision>"
+                if kind == "mesh":
+                    path = self._meshes.resolve(filename, where)
+                    shapes.append(Shape("convex", k, origin, size, convex_hull_vertices(path, size, where),
+                                        source=os.fspath(path)))
+                else:
+                    shapes.append(Shape(kind, k, origin, size))
+        return ShapeSet(tuple(shapes), len(self.link_names))
 
     @cached_property
-    def boxed_links(self) -> np.ndarray:
-        """Indices (link_names) of the frames that have a collision box."""
-        return np.flatnonzero(np.all(self.box_sizes > 0.0, axis=1))
+    def shaped_links(self) -> np.ndarray:
+        """Indices (link_names) of the frames that have collision shapes, ascending."""
+        return self.geometry.frames_with_shapes
 
-    def box_poses(self, frames: np.ndarray, links: np.ndarray | None = None) -> np.ndarray:
-        """World poses of the collision boxes' centres, (T, k, 4, 4), from frames (T, n_links, 4, 4)."""
-        links = self.boxed_links if links is None else np.asarray(links)
-        return frames[:, links] @ self.box_origins[links]
+    @cached_property
+    def distal_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """The shaped links (k,) and, in each link's frame, the points (k, M, 3) of its shapes farthest along the
+        body at q = 0 (a box's distal face, a cylinder's distal rim; padded by repetition): where a link pitched up
+        about its proximal joint leaves the ground last."""
+        from ..geometry.shapes import shape_points
 
-    def box_corners(self, frames: np.ndarray, links: np.ndarray | None = None) -> np.ndarray:
-        """The eight corners of the collision boxes of ``links`` (default: every boxed link), (T, k, 8, 3) world,
-        from frames (T, n_links, 4, 4) (e.g. :meth:`frames_many`)."""
-        links = self.boxed_links if links is None else np.asarray(links)
-        B = self.box_poses(frames, links)
-        local = _BOX_SIGNS[None, :, :] * (0.5 * self.box_sizes[links])[:, None, :]  # (k, 8, 3)
-        return np.einsum("tkij,kcj->tkci", B[..., :3, :3], local) + B[..., None, :3, 3]
+        links = self.shaped_links
+        F = self._straight_frames
+        chosen = []
+        for k in links:
+            pts = np.concatenate([shape_points(s) for s in self.geometry.shapes if s.frame == k])
+            axial = pts @ (F[k, :3, :3].T @ np.array([1.0, 0.0, 0.0]))
+            chosen.append(pts[axial >= axial.max() - STRAIGHT_TOLERANCE])
+        width = max(len(c) for c in chosen)
+        out = np.array([np.concatenate([c, np.repeat(c[:1], width - len(c), axis=0)]) for c in chosen])
+        out.setflags(write=False)
+        return links, out
 
-    def lowest_box_z(self, frames: np.ndarray, links: np.ndarray | None = None) -> np.ndarray:
-        """Lowest z (m) of the collision boxes of ``links`` (default every boxed link): (T, k).
+    @cached_property
+    def self_collision_pairs(self) -> np.ndarray:
+        """(P, 2) the pairs of shapes (indices into ``geometry.shapes``) that self-collision checks: on links two or
+        more joints apart (links one joint apart touch at it; links of one rigid module never move apart)."""
+        segment = np.array([self._joints_before(int(f)) for f in self.geometry.shape_frames], dtype=np.int64)
+        i, j = np.triu_indices(len(segment), k=1)
+        keep = np.abs(segment[i] - segment[j]) >= 2
+        pairs = np.stack([i[keep], j[keep]], axis=1).astype(np.int64)
+        pairs.setflags(write=False)
+        return pairs
 
-        A box of half-extents h, centre c and rotation R reaches down to c_z - sum_k |R[2, k]| h_k.
-        """
-        links = self.boxed_links if links is None else np.asarray(links)
+    def lowest_z(self, frames: np.ndarray, links: np.ndarray | None = None) -> np.ndarray:
+        """Lowest world z (m) of the collision shapes of ``links`` (default every shaped link): (T, k), from frames
+        (T, n_links, 4, 4) (e.g. :meth:`frames_many`)."""
+        links = self.shaped_links if links is None else np.asarray(links)
         frames = np.asarray(frames, float)
         if frames.ndim != 4 or frames.shape[1:] != (len(self.link_names), 4, 4):
             raise ValueError(f"frames has shape {frames.shape}; expected (T, {len(self.link_names)}, 4, 4)")
-        _, z = _core.lowest_box_corners(np.ascontiguousarray(frames), self.box_origins, 0.5 * self.box_sizes,
-                                        links.astype(np.int32).reshape(-1))  # the lowest corner first
-        return z[..., 0]
+        return self.geometry.lowest_z(frames, links)
+
+    def lowest_points(self, frames: np.ndarray, links: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The lowest candidate ground-contact points of the shapes of ``links`` (default every shaped link):
+        world points (T, N, 3) and the link (N,) of each (box corners, cylinder rims, sphere bottoms, mesh hull
+        vertices; see :meth:`ShapeSet.lowest_points`)."""
+        links = self.shaped_links if links is None else np.asarray(links)
+        return self.geometry.lowest_points(np.asarray(frames, float), links)
+
+    @cached_property
+    def link_capsules(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per frame of :attr:`link_names`, a capsule around its collision shapes along the body's direction at
+        q = 0: end points (n_links, 2, 3) in the link frame and radius (n_links,) m (0 and a point for frames
+        without shapes). The whole-body solve's smooth collision terms use them."""
+        from ..geometry.shapes import shape_points
+
+        n = len(self.link_names)
+        ends, radii = np.zeros((n, 2, 3)), np.zeros(n)
+        F = self._straight_frames
+        for k in self.shaped_links:
+            pts = np.concatenate([shape_points(s) for s in self.geometry.shapes if s.frame == k])
+            axis = F[k, :3, :3].T @ np.array([1.0, 0.0, 0.0])  # the body's direction in the link frame
+            centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
+            t = (pts - centre) @ axis
+            r = np.linalg.norm((pts - centre) - np.outer(t, axis), axis=1)
+            ends[k] = [centre + t.min() * axis, centre + t.max() * axis]
+            radii[k] = r.max()
+        return ends, radii
 
     # --- whole-body kinematics ---------------------------------------------------------------------------
     def joint_axes_world(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -501,16 +579,20 @@ class SnakeRobot:
         J[:, 0, :n] = (a[None, :, 1] * r[..., 2] - a[None, :, 2] * r[..., 1]) * moved
         J[:, 1, :n] = (a[None, :, 2] * r[..., 0] - a[None, :, 0] * r[..., 2]) * moved
         J[:, 2, :n] = (a[None, :, 0] * r[..., 1] - a[None, :, 1] * r[..., 0]) * moved
-        root = frames[0, :3, 3]
+        root = (frames[0] @ self._body_in_root)[:3, 3]  # the placement's pivot: the body frame's origin
         J[:, 0, n] = 1.0
         J[:, 1, n + 1] = 1.0
         J[:, 0, n + 2] = -(points[:, 1] - root[1])  # e_z x (p - root)
         J[:, 1, n + 2] = points[:, 0] - root[0]
         return J
 
+    def body_pose(self, base: BasePlacement | None = None) -> np.ndarray:
+        """World pose (4, 4) of the body frame when the base lies on the ground at ``base`` (default placement)."""
+        return as_base(base).matrix(self.body_axis_height)
+
     def root_pose(self, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of the root frame when the base lies on the ground at ``base`` (default placement)."""
-        return as_base(base).matrix(self.body_axis_height)
+        return self.body_pose(base) @ np.linalg.inv(self._body_in_root)
 
     def frames(self, q: npt.ArrayLike, base: BasePlacement | None = None) -> np.ndarray:
         """World poses of every frame in ``link_names`` at joint vector ``q`` (n,): (n_links, 4, 4)."""
@@ -540,7 +622,153 @@ class SnakeRobot:
                 f"neck {self.parts.neck.stop - self.parts.neck.start}, head {self.parts.head.stop - self.parts.head.start})")
 
 
-_BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)  # (8, 3)
+
+
+# ------------------------------------------------------------------------------------------------
+# construction steps
+# ------------------------------------------------------------------------------------------------
+def _with_limits(description: Description, limits: Mapping[str, tuple[float, float]]) -> str:
+    """The description's URDF text with its continuous joints bounded by ``limits`` (the text unchanged, or the
+    file's path, when it has none and none are given)."""
+    checked = {}
+    for name, pair in limits.items():
+        try:
+            lo, hi = (float(v) for v in pair)
+        except (TypeError, ValueError):
+            raise InputError(f"limits of {name!r} must be [lower, upper] in rad, got {pair!r}") from None
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise InputError(f"limits of {name!r} must be finite with lower < upper, got [{lo}, {hi}]")
+        checked[str(name)] = (lo, hi)
+    text = description.text
+    if not _is_xml_text(text):
+        _check_utf8(text, "urdf")
+        if not checked and b"continuous" not in Path(text).read_bytes():
+            return text  # the core reads the file itself
+        text = Path(text).read_text(encoding="utf-8")
+    where = description.source
+    cont = continuous_joints(text, where)
+    if not checked and not cont:
+        return text
+    return with_joint_limits(text, checked, where, needed=cont)
+
+
+def _is_xml_text(text: str) -> bool:
+    return text.lstrip().startswith("<")
+
+
+def _body_chain(text: str, root: str, head_tip: str) -> Chain:
+    try:
+        return Chain.from_urdf(text, root, head_tip)
+    except ValueError as exc:
+        raise InputError(f"the robot's body (root {root!r} -> head_tip {head_tip!r}): {exc}") from None
+
+
+def _joints_before(body: Chain, link_index: int) -> int:
+    """How many joints lie between the root and the frame ``link_names[link_index]``."""
+    child = np.asarray(body.model.joint_child_links)
+    return int(np.sum(child <= link_index))
+
+
+def _part_slices(body: Chain, root: str, names: Mapping[str, str]) -> list[slice]:
+    """The joint slices of the base, neck and head parts (InputError for frames missing or out of order, or a
+    part without joints)."""
+    link_names = body.link_names
+    order = [("root", root)] + [(key, names[key]) for key in ("base_end", "neck_end", "head_tip")]
+    for key, name in order:
+        if name not in link_names:
+            raise InputError(f"{key} {name!r} is not a frame on the chain from the root {root!r} to the head tip "
+                             f"{names['head_tip']!r} (frames: {', '.join(link_names)})")
+    idx = [link_names.index(name) for _, name in order]
+    slices = []
+    for (ka, na), (kb, nb), a, b in zip(order, order[1:], idx, idx[1:]):
+        if not a < b:
+            raise InputError(f"frames out of order: {kb} {nb!r} must come after {ka} {na!r} along the body "
+                             "(root -> base_end -> neck_end -> head_tip)")
+        start, stop = _joints_before(body, a), _joints_before(body, b)
+        part = {"base_end": "base", "neck_end": "neck", "head_tip": "head"}[kb]
+        if stop <= start:
+            raise InputError(f"the {part} part ({ka} {na!r} -> {kb} {nb!r}) has no joint")
+        slices.append(slice(start, stop))
+    return slices
+
+
+def _body_frame(body: Chain) -> np.ndarray:
+    """The body frame (4, 4) in the root frame: x along the straight body's line towards the head, z the
+    joint-axis direction nearest the root frame's z (then x, then y), origin the root's projection on the line.
+    InputError when the body is not straight at q = 0 or a joint axis is not across it."""
+    if set(body.joint_types) - {"revolute"}:
+        raise InputError(f"a snake robot's joints are revolute with limits; this body has "
+                         f"{sorted(set(body.joint_types))} joints (give continuous joints limits in the robot file's "
+                         "[limits] table)")
+    F = body.fk_all(np.zeros(body.n_joints))
+    p = F[:, :3, 3]
+    d = p[-1] - p[0]
+    if not np.linalg.norm(d) > STRAIGHT_TOLERANCE:
+        raise InputError("the head tip lies on the root at q = 0: the body has no length")
+    d /= np.linalg.norm(d)
+    s = (p - p[0]) @ d
+    off = np.linalg.norm((p - p[0]) - np.outer(s, d), axis=1)
+    if off.max() > STRAIGHT_TOLERANCE or np.any(np.diff(s) < -STRAIGHT_TOLERANCE):
+        k = int(np.argmax(off)) if off.max() > STRAIGHT_TOLERANCE else int(np.argmin(np.diff(s))) + 1
+        raise InputError(f"the body does not lie straight at q = 0: frame {body.link_names[k]!r} is "
+                         f"{1000 * off[k]:.2f} mm off the line from the root to the head tip (or out of order); a "
+                         "snake's frames lie on one line, in order, when its joints are at zero")
+    child = np.asarray(body.model.joint_child_links)
+    axes = np.einsum("jik,jk->ji", F[child, :3, :3], np.asarray(body.model.joint_axes, float))
+    across = axes - np.outer(axes @ d, d)
+    up = None
+    for hint in np.eye(3)[[2, 0, 1]]:
+        h = hint - (hint @ d) * d
+        if np.linalg.norm(h) < 0.5 or len(axes) == 0:
+            continue
+        k = int(np.argmax(np.abs(across @ h)))
+        if abs(across[k] @ h) > 0.5 * np.linalg.norm(h):
+            up = np.sign(across[k] @ h) * across[k] / np.linalg.norm(across[k])
+            break
+    if up is None:
+        up = np.eye(3)[2] - d[2] * d
+        up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0.5 else np.cross(d, np.eye(3)[1])
+    T = np.eye(4)
+    T[:3, 0], T[:3, 1], T[:3, 2] = d, np.cross(up, d), up
+    T[:3, 3] = p[0] - (p[0] @ d) * d
+    return T
+
+
+def _aligned_rotation(R_frame: np.ndarray, axis: str | None) -> np.ndarray:
+    """The rotation (in the frame R_frame's coordinates) of its aligned twin: the body frame's orientation at
+    q = 0 (R_frame is the frame's orientation in the body frame); with ``axis``, the twin's x is that axis of
+    the frame and its z the body's up made perpendicular to it."""
+    if axis is None:
+        return R_frame.T
+    sign = -1.0 if axis.startswith("-") else 1.0
+    x = sign * np.eye(3)[HEAD_AXES[axis]]
+    up = R_frame.T @ np.array([0.0, 0.0, 1.0])  # the body's up in the frame's coordinates
+    z = up - (up @ x) * x
+    if np.linalg.norm(z) < 1e-6:  # looking straight up or down: keep the body's x as the twin's -z... any normal
+        z = R_frame.T @ np.array([-1.0, 0.0, 0.0]) * np.sign(up @ x)
+        z = z - (z @ x) * x
+    z /= np.linalg.norm(z)
+    return np.stack([x, np.cross(z, x), z], axis=1)
+
+
+def _aligned_frames(text: str, body: Chain, body_in_root: np.ndarray, parts: list[slice], names: dict[str, str],
+                    head_axis: str) -> tuple[dict[str, str], str]:
+    """The frames the planner uses for base_end, neck_end and head_tip (the URDF's where they are aligned, else
+    twins added to the text) and the text."""
+    F = np.linalg.inv(body_in_root) @ body.fk_all(np.zeros(body.n_joints))  # frames in the body frame at q = 0
+    out = dict(names)
+    twins = []
+    for key in ("base_end", "neck_end", "head_tip"):
+        R = F[body.link_index(names[key]), :3, :3]
+        axis = head_axis if key == "head_tip" else None
+        Ra = _aligned_rotation(R, axis)
+        if np.allclose(Ra, np.eye(3), atol=STRAIGHT_TOLERANCE):
+            continue
+        out[key] = names[key] + ALIGNED_SUFFIX
+        twins.append((names[key], out[key], Ra))
+    if twins:
+        text = add_fixed_frames(text if _is_xml_text(text) else Path(text).read_text(encoding="utf-8"), twins)
+    return out, text
 
 
 def as_robot(robot: SnakeRobot) -> SnakeRobot:

@@ -3,17 +3,28 @@
 ::
 
     # my_snake.toml
-    urdf = "my_snake.urdf"        # path relative to this file (required)
+    urdf = "my_snake.urdf"        # path relative to this file (required); a .xacro file is expanded
+    xacro_args = { modules = 12 } # optional: the xacro file's arguments
     root = "tail"                 # optional: the URDF's root link by default
     base_end = "base_end"         # the frame that ends the base part (P0)
     neck_end = "neck_end"         # the frame that ends the neck part (B0, the head's base frame)
-    head_tip = "head_tip"         # the head link frame (its x-axis is the head's direction)
+    head_tip = "head_tip"         # the head link frame
+    head_axis = "x"               # optional: head_tip's axis that points where the head looks ("x", "y", "z", "-z"...)
     map = "my_snake_head.npz"     # optional: the head's reachability map (relative to this file)
 
-Any link or fixed marker frame of the URDF may be named. ``SnakeRobot.from_file(path)`` reads one.
+    [packages]                    # optional: package://NAME/... mesh paths (relative to this file); then
+    my_snake_description = "."    # ROS_PACKAGE_PATH
+
+    [limits]                      # optional; needed for continuous joints: [lower, upper] rad
+    joint_3 = [-1.57, 1.57]
+
+Any link or fixed marker frame of the URDF may be named. The parts are the joints between the frames: base =
+root -> base_end, neck = base_end -> neck_end, head = neck_end -> head_tip (a frame named by a link's name sits at
+that link's origin, which is on the joint that moves it). ``SnakeRobot.from_file(path)`` reads one.
 """
 from __future__ import annotations
 
+import math
 import os
 import tomllib
 from dataclasses import dataclass
@@ -22,11 +33,12 @@ from pathlib import Path
 
 from typing import Sequence
 
+from .._errors import InputError
 from .._validate import input_file
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
-OPTIONAL_KEYS = ("root", "map")
+OPTIONAL_KEYS = ("root", "map", "head_axis", "xacro_args", "packages", "limits")
 
 #: A robot file is a few lines; anything larger is not one.
 MAX_FILE_BYTES = 64 * 1024
@@ -43,6 +55,10 @@ class RobotFile:
     head_tip: str
     root: str | None = None
     map: Path | None = None
+    head_axis: str = "x"
+    xacro_args: dict | None = None
+    packages: dict | None = None
+    limits: dict | None = None
 
 
 def read_toml(path: str | os.PathLike, what: str) -> dict:
@@ -95,7 +111,48 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
             raise ValueError(f"{where}: its map {os.fspath(map_path)!r} does not exist")
     return RobotFile(path=Path(path), urdf=os.fspath(urdf), base_end=_string(data, "base_end", where),
                      neck_end=_string(data, "neck_end", where), head_tip=_string(data, "head_tip", where),
-                     root=_string(data, "root", where) if "root" in data else None, map=map_path)
+                     root=_string(data, "root", where) if "root" in data else None, map=map_path,
+                     head_axis=_string(data, "head_axis", where) if "head_axis" in data else "x",
+                     xacro_args=_xacro_args(data, where), packages=_packages(data, folder, where),
+                     limits=_limits(data, where))
+
+
+def _table(data: dict, key: str, where: str) -> dict:
+    v = data.get(key, {})
+    if not isinstance(v, dict):
+        raise InputError(f"{where}: {key!r} must be a table, got {v!r}")
+    return v
+
+
+def _xacro_args(data: dict, where: str) -> dict | None:
+    args = _table(data, "xacro_args", where)
+    for k, v in args.items():
+        if isinstance(v, bool) or not isinstance(v, (str, int, float)):
+            raise InputError(f"{where}: xacro_args.{k} must be a string or a number, got {v!r}")
+    return dict(args) or None
+
+
+def _packages(data: dict, folder: Path, where: str) -> dict | None:
+    out = {}
+    for name, value in _table(data, "packages", where).items():
+        if not isinstance(value, str) or not value:
+            raise InputError(f"{where}: packages.{name} must be a folder (a non-empty string), got {value!r}")
+        path = folder / value
+        if not path.is_dir():
+            raise InputError(f"{where}: packages.{name} = {value!r}: {os.fspath(path)!r} is not a folder")
+        out[name] = path
+    return out or None
+
+
+def _limits(data: dict, where: str) -> dict | None:
+    out = {}
+    for joint, value in _table(data, "limits", where).items():
+        ok = isinstance(value, list) and len(value) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        if not ok or not (math.isfinite(value[0]) and math.isfinite(value[1]) and value[0] < value[1]):
+            raise InputError(f"{where}: limits.{joint} must be [lower, upper] in rad with lower < upper, got {value!r}")
+        out[joint] = (float(value[0]), float(value[1]))
+    return out or None
 
 
 def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_end: str, neck_end: str,

@@ -16,10 +16,13 @@ it), generated from the robot's own data, not from the URDF importer:
   nested in chain order, placed with the relative poses of ``robot.body.fk_all(0)``; a free joint on the root
   link (``link_0``), a hinge per revolute joint with the robot's axis and limits;
 * each link's mass, centre of mass and full inertia tensor (``robot.masses/coms/inertias``), and its collision
-  box (``robot.box_sizes/box_origins``);
+  shapes (``robot.geometry``, any number per link: :func:`shape_geom`): a box, cylinder or sphere as MuJoCo's own
+  primitive, a mesh as a mesh asset of its convex hull's vertices (MuJoCo collides a mesh as its convex hull);
+* the root link placed where ``robot.root_pose(base)`` says (:meth:`SimModel.set_state`): the body frame at the
+  placement, whatever axis the URDF's links run along;
 * a ground plane at z = 0 (Coulomb friction ``friction``, default 0.8) and the scene's obstacles
   (:mod:`snakehead.geometry.obstacles`; a wall's round hole becomes a staircase of boxes inscribed in it,
-  :func:`obstacle_boxes`). Robot boxes collide with the ground and the
+  :func:`obstacle_boxes`). The robot's shapes collide with the ground and the
   obstacles; not with each other unless ``self_collision=True`` (parent/child pairs never);
 * timestep 1 ms (physics) under the 2 ms control period of the paper; integrator ``implicitfast``;
   contact ``solref = (0.005 s, 1)`` (stiff: the resting body sinks ~1 um into the ground);
@@ -202,6 +205,38 @@ def _check_moving_masses(robot: SnakeRobot) -> None:
                              "link (give it an <inertial> with a positive definite inertia)")
 
 
+def shape_geom(shape: Any) -> dict:
+    """How a collision shape (:class:`snakehead.geometry.shapes.Shape`) becomes a MuJoCo geom: ``type`` (the
+    ``mjtGeom`` name), ``size`` (MuJoCo's: a box's half extents; a cylinder's radius and half length, its axis the
+    geom frame's z as in URDF; a sphere's radius; unused for a mesh), ``pos`` and ``quat`` (w, x, y, z) in the link
+    frame. A mesh's vertices are the shape's own (its frame's coordinates)."""
+    s = np.asarray(shape.size, float)
+    size = {"box": 0.5 * s, "cylinder": np.array([s[0], 0.5 * s[1], 0.0]), "sphere": np.array([s[0], 0.0, 0.0]),
+            "convex": np.zeros(3)}[shape.kind]
+    kind = {"box": "mjGEOM_BOX", "cylinder": "mjGEOM_CYLINDER", "sphere": "mjGEOM_SPHERE",
+            "convex": "mjGEOM_MESH"}[shape.kind]
+    return {"type": kind, "size": size, "pos": np.asarray(shape.origin, float)[:3, 3].copy(),
+            "quat": _quat_array(np.asarray(shape.origin, float)[:3, :3])}
+
+
+def add_shape_geom(spec: Any, body: Any, robot: SnakeRobot, k: int, **options: Any) -> Any:
+    """Add the ``k``-th shape of ``robot.geometry`` to the MjSpec ``body`` as geom ``shape_<k>`` (a convex mesh:
+    with its asset ``hull_<k>``, the hull's vertices; MuJoCo takes their hull); ``options`` (contype, friction...)
+    go to the geom. Returns the geom."""
+    mj = _mujoco()
+    shape = robot.geometry.shapes[k]
+    g = shape_geom(shape)
+    extra = {}
+    if shape.kind == "convex":
+        if shape.vertices is None or len(shape.vertices) < 4:
+            raise ValueError(f"the mesh shape {k} ({shape.source}) has fewer than 4 hull vertices")
+        mesh = spec.add_mesh(name=f"hull_{k}", uservert=np.asarray(shape.vertices, float).reshape(-1).tolist())
+        mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+        extra["meshname"] = mesh.name
+    return body.add_geom(name=f"shape_{k}", type=getattr(mj.mjtGeom, g["type"]), size=g["size"], pos=g["pos"],
+                         quat=g["quat"], **extra, **options)
+
+
 #: MuJoCo's smallest mass or principal moment of a moving body (mjMINVAL).
 _MUJOCO_MINVAL = 1e-15
 
@@ -215,7 +250,8 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     ``MjModel``; ``spec.to_xml()`` its MJCF text, for reading only).
 
     Names: bodies are ``robot.link_names``; hinges ``robot.body.joint_names``; the free joint ``root``;
-    a site ``site_<frame>`` at every frame's origin (axes of the frame); a geom ``box_<frame>`` per collision box;
+    a site ``site_<frame>`` at every frame's origin (axes of the frame); a geom ``shape_<i>`` per collision shape
+    (``i`` its index in ``robot.geometry.shapes``; a mesh's asset ``hull_<i>``);
     actuators ``act_<joint>`` (affine: force = ctrl - kp q - kd qdot, gains set by the caller); the floor geom
     ``floor``; obstacle geoms ``obstacle_<k>``. Names are data: characters that mean something in XML are kept
     as they are and cannot add elements. Units SI; ``timestep`` s, ``friction`` the sliding coefficient,
@@ -261,6 +297,9 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
         world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
                        quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
                        conaffinity=1, **surface)
+    shapes_on: dict[int, list[int]] = {}
+    for k, shape in enumerate(robot.geometry.shapes):
+        shapes_on.setdefault(int(shape.frame), []).append(k)
     parent = world
     for i, name in enumerate(names):
         if i == 0:
@@ -285,11 +324,8 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
             body.ipos = robot.coms[i]
             body.fullinertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
             body.explicitinertial = True
-        if np.all(robot.box_sizes[i] > 0):
-            B = robot.box_origins[i]
-            body.add_geom(name=f"box_{name}", type=mj.mjtGeom.mjGEOM_BOX, size=0.5 * robot.box_sizes[i],
-                          pos=B[:3, 3], quat=_quat_array(B[:3, :3]), contype=1,
-                          conaffinity=1 if self_collision else 0, **surface)
+        for k in shapes_on.get(i, ()):
+            add_shape_geom(spec, body, robot, k, contype=1, conaffinity=1 if self_collision else 0, **surface)
         body.add_site(name=f"site_{name}")
         parent = body
     for j in range(n):
@@ -305,7 +341,8 @@ class SimModel:
     """A compiled MuJoCo model of a robot and the indices that map it back to the robot.
 
     ``body_ids[i]`` is the MuJoCo body of ``robot.link_names[i]``; ``qpos_adr`` / ``dof_adr`` (n,) the joint
-    addresses; ``root_body`` the free-floating link; ``robot_geoms`` the ids of the robot's boxes.
+    addresses; ``root_body`` the free-floating link; ``robot_geoms`` the ids of the robot's geoms;
+    ``shape_geoms`` (S,) the geom of each shape of ``robot.geometry.shapes``.
     """
 
     robot: SnakeRobot
@@ -318,6 +355,7 @@ class SimModel:
     floor_geom: int
     robot_geoms: np.ndarray
     torque_limit: np.ndarray
+    shape_geoms: np.ndarray | None = None
     spec: object = None  #: the mujoco.MjSpec it was compiled from (``spec.to_xml()`` to read it)
 
     def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
@@ -357,10 +395,11 @@ def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
     body_ids = ids(mj.mjtObj.mjOBJ_BODY, names)
     site_ids = ids(mj.mjtObj.mjOBJ_SITE, ["site_" + nm for nm in names])
     jids = ids(mj.mjtObj.mjOBJ_JOINT, robot.body.joint_names)
-    robot_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] != 0])
+    robot_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] != 0], int)
+    shape_geoms = ids(mj.mjtObj.mjOBJ_GEOM, [f"shape_{k}" for k in range(len(robot.geometry.shapes))])
     return SimModel(robot=robot, model=model, body_ids=body_ids, site_ids=site_ids,
                     qpos_adr=model.jnt_qposadr[jids].copy(), dof_adr=model.jnt_dofadr[jids].copy(),
                     root_body=int(body_ids[0]),
                     floor_geom=mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, FLOOR),
-                    robot_geoms=robot_geoms,
+                    robot_geoms=robot_geoms, shape_geoms=shape_geoms,
                     torque_limit=_torque_limits(robot, kwargs.get("torque_limit")), spec=spec)

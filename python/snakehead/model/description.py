@@ -1,0 +1,226 @@
+"""A robot description as it is published, made ready for the core: xacro expanded, ``continuous`` joints given
+limits, mesh paths resolved and collision meshes loaded as their convex hulls.
+
+* :func:`read_description` -- the URDF text of a ``.urdf`` file, a ``.xacro`` file (expanded without ROS by the
+  ``xacro`` package, with arguments) or the XML itself, and the folder its relative paths start from.
+* :func:`with_joint_limits` -- ``continuous`` joints turned into revolute ones with the limits a robot file gives
+  (a snake's planner needs bounded joints; a continuous joint without limits is an error naming it).
+* :class:`MeshResolver` -- ``package://NAME/...``, ``file://...`` and relative mesh paths to files: the robot file's
+  ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`convex_hull_vertices` loads one with trimesh.
+
+Errors are :class:`snakehead.InputError` naming the file and the element.
+"""
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+
+from typing import Mapping
+
+#: A collision mesh larger than this is not a snake module's (and would stall the hull).
+MAX_MESH_BYTES = 64 * 1024 * 1024
+
+
+@dataclass(frozen=True)
+class Description:
+    """A description's URDF text and the folder its relative mesh paths start from (None for XML given inline)."""
+
+    text: str
+    folder: Path | None
+    source: str
+
+
+def _is_xml(urdf: str) -> bool:
+    return urdf.lstrip().startswith("<")
+
+
+def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, object] | None = None) -> Description:
+    """The URDF text of ``urdf``: a path to a ``.urdf`` or ``.xacro`` file, or the XML itself."""
+    if isinstance(urdf, os.PathLike):
+        urdf = os.fspath(urdf)
+    if not isinstance(urdf, str):
+        raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+    if _is_xml(urdf):
+        if xacro_args:
+            raise InputError("xacro_args are given but the description is URDF text, not a .xacro file")
+        return Description(urdf, None, "<URDF text>")
+    path = Path(urdf)
+    if path.suffix == ".xacro":
+        return Description(expand_xacro(path, xacro_args or {}), path.resolve().parent, os.fspath(path))
+    if xacro_args:
+        raise InputError(f"xacro_args are given but {os.fspath(path)!r} is not a .xacro file")
+    # the core reads URDF files itself (with its own checks); only the folder is needed here
+    return Description(os.fspath(path), path.resolve().parent, os.fspath(path))
+
+
+def expand_xacro(path: Path, args: Mapping[str, object]) -> str:
+    """Expand a xacro file with the ``xacro`` package (no ROS needed; ``$(find ...)`` is not available)."""
+    try:
+        import xacro
+    except ImportError:  # pragma: no cover - a dependency of the package
+        raise InputError(f"{os.fspath(path)!r} is a xacro file and the 'xacro' package is not installed") from None
+    if not path.is_file():
+        raise InputError(f"xacro file {os.fspath(path)!r} does not exist")
+    mappings = {}
+    for key, value in args.items():
+        if not isinstance(value, (str, int, float, bool)):
+            raise InputError(f"xacro argument {key!r} must be a string or a number, got {value!r}")
+        mappings[str(key)] = str(value).lower() if isinstance(value, bool) else str(value)
+    try:
+        doc = xacro.process_file(os.fspath(path), mappings=mappings)
+        return str(doc.toxml())
+    except Exception as exc:  # xacro raises its own and the XML parser's exceptions; all mean a bad file
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        raise InputError(f"xacro file {os.fspath(path)!r}: {message}") from None
+
+
+def _xml_root(text: str, where: str) -> ET.Element:
+    try:
+        return ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise InputError(f"malformed URDF ({where}): {exc}") from None
+
+
+def continuous_joints(text: str, where: str) -> list[str]:
+    """Names of the ``continuous`` joints of a URDF text."""
+    return [j.get("name", "") for j in _xml_root(text, where).iter("joint") if j.get("type") == "continuous"]
+
+
+def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], where: str,
+                      needed: list[str] | None = None) -> str:
+    """The URDF text with ``continuous`` joints made revolute within ``limits`` (joint -> (lower, upper) rad) and
+    the limits of other named joints replaced. ``needed``: the continuous joints that must get limits (those on
+    the robot's body); others keep no limit. Effort and velocity are kept (0 where none is written)."""
+    root = _xml_root(text, where)
+    joints = {j.get("name", ""): j for j in root.iter("joint")}
+    unknown = sorted(set(limits) - set(joints))
+    if unknown:
+        raise InputError(f"{where}: [limits] names joints the URDF does not have: {', '.join(map(repr, unknown))}")
+    missing = [name for name in (needed or []) if name not in limits]
+    if missing:
+        raise InputError(f"{where}: continuous joint{'s' if len(missing) > 1 else ''} {', '.join(map(repr, missing))} "
+                         "need limits: add them to the robot file's [limits] table (joint = [lower, upper] in rad)")
+    for name, (lower, upper) in limits.items():
+        joint = joints[name]
+        if joint.get("type") not in ("revolute", "continuous"):
+            raise InputError(f"{where}: [limits] gives limits to {name!r}, a {joint.get('type')} joint")
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit")
+        limit.set("lower", repr(float(lower)))
+        limit.set("upper", repr(float(upper)))
+        limit.set("effort", limit.get("effort", "0"))
+        limit.set("velocity", limit.get("velocity", "0"))
+    return ET.tostring(root, encoding="unicode")
+
+
+def _origin_matrix(joint: ET.Element) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    T = np.eye(4)
+    origin = joint.find("origin")
+    if origin is not None:
+        T[:3, 3] = [float(v) for v in origin.get("xyz", "0 0 0").split()]
+        T[:3, :3] = Rotation.from_euler("xyz", [float(v) for v in origin.get("rpy", "0 0 0").split()]).as_matrix()
+    return T
+
+
+def _set_origin(joint: ET.Element, T: np.ndarray) -> None:
+    from scipy.spatial.transform import Rotation
+
+    origin = joint.find("origin")
+    if origin is None:
+        origin = ET.SubElement(joint, "origin")
+    origin.set("xyz", " ".join(repr(float(v)) for v in T[:3, 3]))
+    origin.set("rpy", " ".join(repr(float(v)) for v in Rotation.from_matrix(T[:3, :3]).as_euler("xyz")))
+
+
+def add_fixed_frames(text: str, frames: list[tuple[str, str, np.ndarray]]) -> str:
+    """The URDF text with fixed marker frames put in line: for each (parent, name, R), a link ``name`` on a fixed
+    joint ``name + "_joint"`` at the parent's origin turned by R (3, 3), and the joints that hung from the parent
+    hung from it instead (their origins turned back, so that nothing else moves)."""
+    root = _xml_root(text, "adding aligned frames")
+    for parent, name, R in frames:
+        T = np.eye(4)
+        T[:3, :3] = R
+        inv = np.linalg.inv(T)
+        for joint in root.iter("joint"):
+            p = joint.find("parent")
+            if p is not None and p.get("link") == parent:
+                p.set("link", name)
+                _set_origin(joint, inv @ _origin_matrix(joint))
+        ET.SubElement(root, "link", {"name": name})
+        joint = ET.SubElement(root, "joint", {"name": name + "_joint", "type": "fixed"})
+        ET.SubElement(joint, "parent", {"link": parent})
+        ET.SubElement(joint, "child", {"link": name})
+        _set_origin(joint, T)
+    return ET.tostring(root, encoding="unicode")
+
+
+@dataclass(frozen=True)
+class MeshResolver:
+    """Where mesh files are: ``package://NAME/rest`` in ``packages[NAME]`` (a robot file's ``[packages]``), then in
+    ``ROS_PACKAGE_PATH`` (``DIR/NAME/rest``); ``file://`` paths as they are; relative paths from ``folder`` (the
+    URDF's)."""
+
+    folder: Path | None = None
+    packages: Mapping[str, Path] = field(default_factory=dict)
+
+    def resolve(self, filename: str, where: str) -> Path:
+        if filename.startswith("package://"):
+            rest = filename[len("package://"):]
+            name, _, inside = rest.partition("/")
+            if not name or not inside:
+                raise InputError(f"{where}: mesh {filename!r} is not package://NAME/path")
+            for folder in self._package_folders(name):
+                return folder / inside
+            raise InputError(f"{where}: mesh {filename!r}: package {name!r} is not known; add {name} = \"folder\" to "
+                             "the robot file's [packages] table (or put it on ROS_PACKAGE_PATH)")
+        if filename.startswith("file://"):
+            return Path(filename[len("file://"):])
+        path = Path(filename)
+        if not path.is_absolute():
+            if self.folder is None:
+                raise InputError(f"{where}: mesh {filename!r} is a relative path, but the URDF was given as text "
+                                 "(no folder to resolve it from)")
+            path = self.folder / path
+        return path
+
+    def _package_folders(self, name: str) -> list[Path]:
+        if name in self.packages:
+            return [Path(self.packages[name])]
+        for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
+            if entry and (Path(entry) / name).is_dir():
+                return [Path(entry) / name]
+        return []
+
+
+def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarray:
+    """The vertices (V, 3) of the convex hull of the mesh file ``path`` (STL, OBJ, DAE, PLY... through trimesh),
+    scaled. A missing, unreadable, empty or flat mesh is an InputError naming ``where`` and the path."""
+    import trimesh
+
+    if not path.is_file():
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} does not exist")
+    if path.stat().st_size > MAX_MESH_BYTES:
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} is larger than {MAX_MESH_BYTES} bytes")
+    try:
+        loaded = trimesh.load(os.fspath(path), force="mesh", process=False)
+        vertices = np.asarray(loaded.vertices, float)
+    except Exception as exc:  # trimesh raises many kinds for a bad file
+        raise InputError(f"{where}: cannot read mesh file {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None
+    vertices = vertices[np.all(np.isfinite(vertices), axis=1)] * np.asarray(scale, float)
+    if len(vertices) < 4 or np.linalg.matrix_rank(vertices - vertices.mean(axis=0), tol=1e-9) < 3:
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has no volume (empty or flat: "
+                         f"{len(vertices)} vertices)")
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(vertices)
+    return np.ascontiguousarray(vertices[hull.vertices])
