@@ -150,8 +150,9 @@ def write_robot(style: str, folder: str | os.PathLike, **overrides: Any) -> Path
 
 # --- XML pieces --------------------------------------------------------------------------------------------------
 def _num(x: float) -> str:
-    # 17 significant digits: the text reads back as the same double, so two writers of one snake agree exactly.
-    return f"{x:.17g}"
+    # Python's shortest text that reads back as the same double: two writers of one snake agree exactly.
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def _vec(v: Vec3) -> str:
