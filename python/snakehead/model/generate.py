@@ -26,6 +26,15 @@ from typing import Any
 GRAVITY = 9.80665
 
 
+def holding_effort(mass_per_metre: float, body_length: float) -> float:
+    """A servo effort (N m) that can hold half of a uniform body (``mass_per_metre`` kg/m, ``body_length`` m)
+    straight out as a cantilever, with 50 % to spare, and at least 10 N m: lifting a neck and head needs about
+    that at the neck's first joint. Every generated snake (here and in :mod:`snakehead.model.published`) uses it."""
+    weight_per_metre = mass_per_metre * GRAVITY
+    half = body_length / 2
+    return max(10.0, round(1.5 * weight_per_metre * half * half / 2, 1))
+
+
 @dataclass(frozen=True)
 class SnakeSpec:
     """The numbers of a snake robot (SI units; angles in degrees where the name says ``_deg``).
@@ -102,11 +111,8 @@ class SnakeSpec:
         return self.mass_per_module * self.length / self.module_length
 
     def default_effort(self) -> float:
-        """A servo effort (N m) that can hold half the body straight out as a cantilever, with 50 % to spare,
-        and at least 10 N m: lifting a neck and head needs about that at the neck's first joint."""
-        w = self.mass_per_module / self.module_length * GRAVITY  # N per m of body
-        half = self.length / 2
-        return max(10.0, round(1.5 * w * half * half / 2, 1))
+        """The servo effort (N m) of :func:`holding_effort` for this snake's body."""
+        return holding_effort(self.mass_per_module / self.module_length, self.length)
 
     def axis(self, joint: int) -> str:
         """"yaw" or "pitch" for joint ``joint`` (1-based)."""
