@@ -1,9 +1,22 @@
-"""The robots the simulation benchmarks run (bench/sim_gains.py, bench/gaits.py): the default one and generated
-snakes from light and short to heavy and long, their parts marked by fixed frames p0 (base end) and b0 (neck end)."""
+"""The robots the benchmarks run (bench/targets.py, bench/sim_gains.py, bench/gaits.py): the default one, generated
+snakes from light and short to heavy and long (their parts marked by fixed frames p0 (base end) and b0 (neck end)),
+and snakes written the way published ones are (snakehead.model.published: cylinders, meshes, xacro, modules along
+z behind a rotated root, several links per module, a one-joint neck, a 6-DOF head)."""
 from __future__ import annotations
 
+import tempfile
+from pathlib import Path
+
 from snakehead import SnakeRobot
+from snakehead.model import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
+
+_FOLDER = Path(tempfile.mkdtemp(prefix="snakehead-bench-robots-"))
+
+
+def published_style(style: str) -> SnakeRobot:
+    """A published-style sample robot, written to a temporary folder and loaded from its robot file."""
+    return SnakeRobot.from_file(published.write_robot(style, _FOLDER / style))
 
 
 def generated(n_joints, module, section, mass, first_axis="yaw", head=7, neck=2) -> SnakeRobot:
@@ -22,3 +35,5 @@ ROBOTS = {
     "heavy": ("30 joints, 15 cm, 8 cm, 0.5 kg", lambda: generated(30, 0.15, 0.08, 0.5)),
     "light": ("8 joints, 5 cm, 3 cm, 0.1 kg", lambda: generated(8, 0.05, 0.03, 0.1, head=6, neck=1)),
 }
+ROBOTS.update({f"published:{style}": (f"published style {style!r}", lambda style=style: published_style(style))
+               for style in published.STYLES})

@@ -7,6 +7,7 @@ import stat
 import subprocess
 import sys
 
+import matplotlib.colors
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -15,6 +16,7 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
+from snakehead.geometry.shapes import shape_mesh
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.motion.planner import Plan
 from snakehead.viz import animation, body, dynamics, save, viewer
@@ -111,10 +113,14 @@ def test_body_geometry_of_a_generated_snake(snake, plan):
         assert {colors[i] for i in links} == {color}
     F = snake.frames(plan.q[-1], plan.base)
     faces, face_colors = body.body_faces(snake, F)
-    assert faces.shape == (6 * len(snake.boxed_links), 4, 3) and len(face_colors) == len(faces)
-    # the faces' corners are the robot's box corners
-    corners = snake.box_corners(F[None])[0].reshape(-1, 3)
-    np.testing.assert_allclose(np.unique(faces.reshape(-1, 3).round(12), axis=0),
+    # a box is drawn as its six faces, each a quad
+    assert all(s.kind == "box" for s in snake.geometry.shapes)
+    assert len(faces) == 6 * len(snake.geometry.shapes) and len(face_colors) == len(faces)
+    assert {len(f) for f in faces} == {4}
+    # the faces' corners are the boxes' corners (the shapes' meshes, placed by their links' frames)
+    corners = np.concatenate([shape_mesh(s)[0] @ F[s.frame, :3, :3].T + F[s.frame, :3, 3]
+                              for s in snake.geometry.shapes])
+    np.testing.assert_allclose(np.unique(np.concatenate(faces).round(12), axis=0),
                                np.unique(corners.round(12), axis=0), atol=1e-12)
     # points along the body: the root, each joint (its frame's origin) and the nose
     P = body.body_points(snake, F)
@@ -124,6 +130,35 @@ def test_body_geometry_of_a_generated_snake(snake, plan):
     # consecutive joints are one module apart (the body's links are rigid)
     gaps = np.linalg.norm(np.diff(P[1:-1], axis=0), axis=1)
     np.testing.assert_allclose(gaps, 0.07, atol=1e-12)
+
+
+def test_snapshots_draw_box_obstacles_and_target_arrows(plan):
+    """A user's report: the snapshot figures drew neither box obstacles nor the targets' arrows. Every panel draws
+    the box (its six faces) and one arrow per target, ending at the target."""
+    from dataclasses import replace
+
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    from snakehead.motion.planner import TargetResult
+
+    tip = plan.robot.head_pose(plan.q[-1], plan.base)
+    targets = [TargetResult("reached", tip[:3, 3], tip[:3, 0], 4.0, None)]
+    fig = body.plot_snapshots(replace(plan, targets=targets), columns=3)
+    box = plan.obstacles[1]
+    panels = [ax for ax in fig.axes if ax.name == "3d"]
+    assert panels
+    for ax in panels:
+        polys = [c for c in ax.collections if isinstance(c, Poly3DCollection)]
+        drawn = [np.asarray(p) for c in polys for p in c.get_paths()]
+        assert any(len(c.get_paths()) == 6 and np.allclose(c.get_facecolor()[0][:3],
+                   matplotlib.colors.to_rgb(body.OBSTACLE_COLOR)) for c in polys), "no box obstacle drawn"
+        arrows = [c for c in ax.collections if isinstance(c, Line3DCollection)]
+        assert len(arrows) == len(targets)
+        assert drawn
+    np.testing.assert_allclose(np.unique(body.box_faces(box).reshape(-1, 3).round(12), axis=0),
+                               np.unique((box.centre + (np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5)
+                                                                   for z in (-.5, .5)]) * box.size) @ box.rotation.T
+                                          ).round(12), axis=0), atol=1e-12)
 
 
 def test_wall_faces_tile_the_wall_minus_the_hole(plan):
@@ -191,22 +226,26 @@ def test_viewer_scene_of_a_generated_snake(plan, tmp_path):
     assert data.n_frames == 9 and data.times[0] == 0.0 and data.times[-1] == 4.0
     robot = plan.robot
     F = robot.frames_many(plan.q[[0, -1]], plan.base)
-    B = robot.box_poses(F)
-    np.testing.assert_allclose(data.box_positions[[0, -1]], B[..., :3, 3], atol=1e-12)
-    # the quaternions turn the boxes like their rotation matrices
+    shapes = robot.geometry.shapes
+    B = F[:, [s.frame for s in shapes]] @ np.array([s.origin for s in shapes])  # the shapes' frames
+    np.testing.assert_allclose(data.shape_positions[[0, -1]], B[..., :3, 3], atol=1e-12)
+    # the quaternions turn the shapes like their rotation matrices
     from scipy.spatial.transform import Rotation
 
-    w, xyz = data.box_wxyz[-1][:, :1], data.box_wxyz[-1][:, 1:]
+    w, xyz = data.shape_wxyz[-1][:, :1], data.shape_wxyz[-1][:, 1:]
     np.testing.assert_allclose(Rotation.from_quat(np.hstack([xyz, w])).as_matrix(), B[-1, :, :3, :3], atol=1e-12)
-    np.testing.assert_array_equal(data.box_sizes, robot.box_sizes[robot.boxed_links])
+    # every box is the one unit cube, scaled by the box's size
+    np.testing.assert_array_equal(data.shape_scales, [s.size for s in shapes])
+    assert set(data.shape_mesh.tolist()) == {0} and len(data.mesh_vertex_starts) == 2
+    np.testing.assert_allclose(np.abs(data.mesh_vertices), 0.5)
     assert len(data.voxel_centers) == 0  # no map given
     assert data.obstacle_centres.shape == (1, 3) and data.hole_rims.shape == (1, 65, 3)
     assert data.wall_triangles.max() < len(data.wall_vertices)
     # the map's frame is the head's base frame (neck_end = b0) at every frame
     np.testing.assert_allclose(data.map_frame_positions[-1], F[-1, robot.link_index("b0"), :3, 3], atol=1e-12)
-    # the camera sees the whole scene: every box centre within the field of view
+    # the camera sees the whole scene: every shape's centre within the field of view
     eye, look_at = data.camera()
-    d = data.box_positions.reshape(-1, 3) - eye
+    d = data.shape_positions.reshape(-1, 3) - eye
     axis = (look_at - eye) / np.linalg.norm(look_at - eye)
     angle = np.degrees(np.arccos(d @ axis / np.linalg.norm(d, axis=1)))
     assert angle.max() < viewer.CAMERA_FOV_DEG / 2

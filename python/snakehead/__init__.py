@@ -16,7 +16,7 @@ Start with ``SnakeRobot.default()``.
 """
 from ._errors import InputError
 from .control.controller import HeadController, HeadSolution
-from .geometry.obstacles import BoxObstacle, WallWithHole
+from .geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .kinematics.ik import TracIK
 from .kinematics.workspace import ReachabilityMap
 from .kinematics.workspace import compute as compute_map
@@ -29,6 +29,6 @@ from .sim.plan import PlanSimulation, simulate
 
 __all__ = ["InputError", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
            "ReachabilityMap", "compute_map", "load_map", "plan", "Plan", "TargetResult", "simulate",
-           "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "WallWithHole", "default_robot_file",
+           "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "MeshObstacle", "WallWithHole", "default_robot_file",
            "default_urdf_path"]
 __version__ = "0.2.0"

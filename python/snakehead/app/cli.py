@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .pipeline import FAST, NORMAL
+from .pipeline import FAST, NORMAL, outcome_line
 
 from typing import TYPE_CHECKING, Any, Callable
 
@@ -140,22 +140,16 @@ def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
 # info
 # ----------------------------------------------------------------------------------------------
 def _info(args: argparse.Namespace) -> int:
+    from .robot_check import check_lines, check_robot
+
     robot = _robot(args)
-    p = robot.parts
-    print(f"robot: {robot.source or robot.urdf}")
-    print(f"urdf: {robot.urdf}")
-    print(f"joints: {robot.n_joints} ({', '.join(k[0] for k in robot.joint_kinds)}: y = yaw, p = pitch), "
-          f"mass {robot.total_mass:.3f} kg, length {robot.body_length:.4f} m, body axis "
-          f"{1000 * robot.body_axis_height:.1f} mm above the ground")
-    for name, sl, a, b in (("base", p.base, p.root, p.base_end), ("neck", p.neck, p.base_end, p.neck_end),
-                           ("head", p.head, p.neck_end, p.head_tip)):
-        names = robot.joint_names[sl]
-        print(f"{name}: {a} -> {b}, {len(names)} joints ({names[0]} .. {names[-1]})")
-    print(f"head's map: {robot.map_path if robot.map_path is not None else 'none (plan computes and caches one)'}")
+    check = check_robot(robot, suggest=not args.quick)
+    for line in check_lines(robot, check):
+        print(line)
     np.set_printoptions(precision=4, suppress=True)
-    print("head_tip at q = 0 (world):")
+    print("head_tip at q = 0 (world; its x-axis is the head's direction):")
     print(robot.head_pose(np.zeros(robot.n_joints)))
-    return 0
+    return 0 if not check.problems else 1
 
 
 # ----------------------------------------------------------------------------------------------
@@ -164,7 +158,8 @@ def _info(args: argparse.Namespace) -> int:
 def _settings(args: argparse.Namespace) -> Any:
     from .pipeline import Settings
 
-    return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim)
+    return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim,
+                    relocation=not args.no_relocation)
 
 
 def _start(args: argparse.Namespace, paper_default: bool) -> Any:
@@ -195,7 +190,7 @@ def _done(command: str, out: Path, report: dict, progress: Any) -> int:
     print(f"snakehead {command}: wrote report.json, summary.md and "
           f"{sum(len(e['files']) for e in entries.values())} other files to {out.resolve()}")
     for name, e in entries.items():
-        print(f"  {name}: {'success' if e['success'] else 'NOT successful: ' + str(e.get('failure'))}")
+        print(f"  {name}: {outcome_line(e['success'], e.get('failure'), e.get('relocation'))}")
     return 0 if ok else 1
 
 
@@ -269,7 +264,8 @@ def _workspace(args: argparse.Namespace) -> int:
     voxel = args.voxel if args.voxel is not None else defaults["voxel"]
     t0 = time.perf_counter()
     print(f"snakehead workspace: head chain {chain.base} -> {chain.tip} ({chain.n_joints} joints), voxel {voxel} m, "
-          f"{args.directions} directions x {args.rolls} rolls", file=sys.stderr, flush=True)
+          f"{args.directions} directions x {'free roll' if args.free_roll else f'{args.rolls} rolls'}",
+          file=sys.stderr, flush=True)
     m = workspace.compute(chain, voxel=voxel, directions=args.directions, rolls=args.rolls,
                           free_roll=args.free_roll, timeout=args.timeout, seed=args.seed, threads=args.threads,
                           shard=args.shard, progress=not args.quiet)
@@ -313,6 +309,9 @@ def _add_planning_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if needed)")
     _add_robot_option(p)
     p.add_argument("--no-sim", action="store_true", help="skip the MuJoCo dynamics check")
+    p.add_argument("--no-relocation", action="store_true",
+                   help="keep the base where it lies: a target it cannot reach from there fails instead of moving "
+                        "the base first (by locomotion)")
     p.add_argument("--seed", type=_seed, default=1, metavar="N",
                    help="seed of the head's TRAC-IK (the plan is a function of it; default 1)")
     p.add_argument("--method", choices=("rotated", "free_roll"), default="rotated",
@@ -356,9 +355,13 @@ def build_parser() -> argparse.ArgumentParser:
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     p: argparse.ArgumentParser = sub.add_parser(
-        "info", help="describe a robot and print its head pose at q = 0",
-        description="Describe a robot (its parts, joints, mass, map) and print its head pose at q = 0.")
+        "info", help="check a robot: its parts, whether its design can work, a split of the parts that does",
+        description="Check a robot: each part's frames (where they sit along the body), length, mass and joints; "
+                    "its collision shapes; whether the base can hold the lifted neck and head (an initial state and a "
+                    "bending state exist); its head's map; and when something cannot work, a split of the parts "
+                    "(base_end, neck_end) that passes, found by trying. Exits 1 when the design has a problem.")
     _add_robot_option(p)
+    p.add_argument("--quick", action="store_true", help="do not search for a split of the parts that works")
     p.set_defaults(func=_info)
 
     demo = _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",

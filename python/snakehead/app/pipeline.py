@@ -65,7 +65,8 @@ def mujoco_available() -> bool:
 class Settings:
     """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
     figures: write figures, the animation and the 3-D viewer's page; parallel: draw what needs only the plan in a
-    second process while MuJoCo simulates (Linux)."""
+    second process while MuJoCo simulates (Linux); relocation: let the plan move the base (by locomotion, first)
+    when the targets need it."""
 
     method: str = "rotated"
     seed: int | None = 1
@@ -73,11 +74,27 @@ class Settings:
     simulate: bool = True
     figures: bool = True
     parallel: bool = True
+    relocation: bool = True
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
         return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "animation_frames": s["max_frames"],
+                "relocation": bool(self.relocation),
                 "simulation": bool(self.simulate and mujoco_available())}
+
+
+def _relocation_dict(result: Any) -> dict | None:
+    return None if result.relocation is None else result.relocation.as_dict()
+
+
+def outcome_line(success: bool, failure: str | None, relocation: dict | None) -> str:
+    """A scenario's outcome in a few words: success (saying so when the base had to move first) or the failure."""
+    if not success:
+        return f"NOT successful: {failure}"
+    if relocation is None:
+        return "success"
+    return (f"success after relocating the base {relocation['distance_m']:.2f} m "
+            f"({relocation['reason']}; --no-relocation forbids it)")
 
 
 def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
@@ -90,8 +107,8 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
     name = scene.name
     label = scene.description or name
     with progress.stage(f"{name}: planning {label}"):
-        result = plan(scene, controller=controller)
-    progress.say(f"{name}: {'success' if result.success else 'NOT successful: ' + str(result.failure)}, "
+        result = plan(scene, controller=controller, allow_relocation=settings.relocation)
+    progress.say(f"{name}: {outcome_line(result.success, result.failure, _relocation_dict(result))}, "
                  f"{result.duration_s:.1f} s of motion, {len(result.t)} samples; targets: "
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))

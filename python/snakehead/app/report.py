@@ -33,6 +33,13 @@ from typing import Any
 
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
 #: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
+def _is_default_robot(robot: Any) -> bool:
+    from ..model.robot import default_robot_file
+
+    source = getattr(robot, "source", None)
+    return source is not None and Path(source).resolve() == default_robot_file().resolve()
+
+
 PAPER: dict[str, dict[str, Any]] = {
     "spheres": {"section": "4.1 (Figs. 17-20)", "position_error_m": 1.8e-3, "direction_error_deg": 0.76,
                 "max_angular_momentum_magnitude_error": 0.0383, "max_linear_momentum_magnitude_error": 0.216,
@@ -105,7 +112,7 @@ def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict 
         "relocation": None if result.relocation is None else result.relocation.as_dict(),
         "notes": list(result.notes),
     }
-    if result.name in PAPER:
+    if result.name in PAPER and _is_default_robot(result.robot):  # the paper's numbers are its robot's
         entry["paper"] = dict(PAPER[result.name])
     if extra:
         entry.update(extra)

@@ -231,7 +231,9 @@ def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: Bas
         if margin > best_margin:
             best, best_margin = bb, margin
     if best is None:
-        raise ValueError(f"no up-curve shape fits this robot ({first_error}); give a shape that does")
+        raise ValueError(f"no up-curve shape fits this robot ({first_error}): the neck and head cannot rise over its "
+                         "base; 'snakehead info --robot FILE' suggests a split of the parts (base_end, neck_end in the "
+                         "robot file) that works")
     return best
 
 

@@ -154,13 +154,13 @@ class HeadController:
             raise TypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
         desired = head_ik.frame_from_direction(position, direction)
         P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
-        check = nk.accepted_range(position, P0_frame[:3, 3], self.Lc, self.neck_length, self.slack)
+        check = self._accepted_range(position, P0_frame)
         solution = self._solve_from(base, q, desired, q_prev is not None, accept)
         if not check.accepted:
             note = f"the target is outside the accepted range from the given base ({check.reason})"
             move = self.allow_base_move if allow_base_move is None else bool(allow_base_move)
-            if not (solution.success and solution.static_stable) and move:
-                P0_local = np.linalg.inv(self.robot.root_pose(base)) @ P0_frame
+            if not (solution.success and solution.static_stable) and move and self.neck_length > 0:
+                P0_local = np.linalg.inv(self.robot.body_pose(base)) @ P0_frame
                 moved = nk.base_move_into_range(position, P0_local, base, self.Lc, self.neck_length, self.slack,
                                                      self.robot.body_axis_height)
                 if moved is not None:
@@ -174,6 +174,14 @@ class HeadController:
             solution.message += f" ({note})"
         solution.timings["total"] = time.perf_counter() - t_start
         return solution
+
+    def _accepted_range(self, position: np.ndarray, P0_frame: np.ndarray) -> nk.RangeCheck:
+        """Step 3's accepted range from the lift frame P0_frame; a neck without a pitch joint lifts nothing, so no
+        target is in its range (the whole-body solve may still reach it)."""
+        if self.neck_length > 0:
+            return nk.accepted_range(position, P0_frame[:3, 3], self.Lc, self.neck_length, self.slack)
+        return nk.RangeCheck(False, float("nan"), 0.0, 0.0, "the neck has no pitch joint: it cannot lift the head's "
+                             "base (name a base_end before a pitch joint to give the neck one)")
 
     def _solve_from(self, base: BasePlacement, q: np.ndarray, desired: np.ndarray, keep_close: bool,
                     accept: Callable[..., bool] | None = None) -> HeadSolution:

@@ -194,8 +194,8 @@ def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: Bas
                          slack: float, height: float) -> BasePlacement | None:
     """The planar move of the base (as the rolling gait or turning in place would give) that brings P_hd in range.
 
-    ``P0_local`` (4, 4) is P0's pose relative to the root frame (fixed while the base keeps its shape);
-    ``height`` the root frame's height above the ground (``SnakeRobot.body_axis_height``). The base turns so that P0's body axis points horizontally at the target, then slides along it
+    ``P0_local`` (4, 4) is P0's pose relative to the body frame (fixed while the base keeps its shape);
+    ``height`` the body frame's height above the ground (``SnakeRobot.body_axis_height``). The base turns so that P0's body axis points horizontally at the target, then slides along it
     so that the neck must span the middle of the accepted band. Returns None when no placement can do it
     (the target is too high for the neck and head to reach from the ground).
     """

@@ -42,6 +42,8 @@ if TYPE_CHECKING:
 MIN_MARGIN = 0.005
 #: Default least gap between the boxes of two links that are not neighbours (m), and from obstacles.
 SELF_CLEARANCE = 0.002
+#: A ground link's shape points within this height (m) of its lowest point touch the ground (its support).
+CONTACT_BAND = 1e-3
 OBSTACLE_CLEARANCE = 0.002
 #: Tolerances of a solution: head position (m) and direction (rad).
 POSITION_TOLERANCE = 1e-4
@@ -124,21 +126,21 @@ class BodyProblem:
         #: free joints: the ground links' yaw joints (the base's flat shape) and every lifted joint
         self.free = ~self.flat
         self.ground_yaw = ground_joint & ~self.flat
-        boxed = robot.boxed_links
-        self.ground_links = boxed[boxed < first_lifted_link]
-        self.lifted_links = boxed[boxed >= first_lifted_link]
-        self.boxed = boxed
-        half = 0.5 * robot.box_sizes[boxed]
-        # capsules along each box's x-axis (the body axis), radius the smaller half-section, inside the box's length
-        self.radius = np.minimum(half[:, 1], half[:, 2])
-        self.half_len = np.maximum(half[:, 0] - self.radius, 0.0)
-        #: how far the box's corners stick out of its capsule (sqrt(2) - 1 of the radius for a square section)
-        self.corner_excess = np.hypot(half[:, 1], half[:, 2]) - self.radius
-        i, j = np.triu_indices(len(boxed), k=2)  # links at least two apart in the chain (neighbours always touch)
-        both_ground = np.isin(boxed[i], self.ground_links) & np.isin(boxed[j], self.ground_links)
-        # links lying flat on the ground next to each other cannot meet by turning yaw joints only if far apart in
-        # the chain: keep every pair, except ground pairs of consecutive boxed links (a marker in between)
-        self.pairs = np.column_stack([i, j])[~(both_ground & (j - i < 2))]
+        shaped = robot.shaped_links
+        self.ground_links = shaped[shaped < first_lifted_link]
+        self.lifted_links = shaped[shaped >= first_lifted_link]
+        self.shaped = shaped
+        ends, radius, excess = robot.link_capsules
+        # a capsule inside each link's shapes along the body (radius the smallest half-width across it)
+        self.capsule_ends = ends[shaped]
+        self.radius = radius[shaped]
+        #: how far the shapes stick out of their capsule (sqrt(2) - 1 of the radius for a box of square section)
+        self.corner_excess = excess[shaped]
+        segment = np.array([robot._joints_before(int(k)) for k in shaped])
+        i, j = np.triu_indices(len(shaped), k=1)
+        # links two or more joints apart (links one joint apart touch at it; a module's links never move apart)
+        far = segment[j] - segment[i] >= 2
+        self.pairs = np.column_stack([i, j])[far]
         self.axis_local = np.asarray(robot.body.model.joint_axes, float)
         self.head_index = robot.link_index(robot.parts.head_tip)
         self._iks: dict = {}
@@ -169,20 +171,21 @@ class BodyProblem:
         J[:, n + 2] = np.cross([0.0, 0.0, 1.0], v)
         return J
 
-    def capsules(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def capsules(self, F: np.ndarray) -> np.ndarray:
         """World end points (k, 2, 3) of the links' capsule axes."""
-        B = self.robot.box_poses(F[None], self.boxed)[0]
-        c, x = B[:, :3, 3], B[:, :3, 0]
-        ends = np.stack([c - self.half_len[:, None] * x, c + self.half_len[:, None] * x], axis=1)
-        return ends
+        G = F[self.shaped]
+        return np.einsum("kij,kej->kei", G[:, :3, :3], self.capsule_ends) + G[:, None, :3, 3]
 
     # --- the support polygon and the static margin ---------------------------------------------------------
     def contact_points(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """World (P, 3) bottom corners of the ground links' boxes and their links (P,)."""
-        corners = self.robot.box_corners(F[None], self.ground_links)[0]  # (k, 8, 3)
-        order = np.argsort(corners[..., 2], axis=1)[:, :4]
-        low = np.take_along_axis(corners, order[..., None], axis=1)  # (k, 4, 3)
-        return low.reshape(-1, 3), np.repeat(self.ground_links, 4)
+        """World (P, 3) bottom points of the ground links' shapes (within CONTACT_BAND of each link's lowest: a
+        box's bottom corners, a cylinder's bottom line) and their links (P,)."""
+        pts, owner = self.robot.lowest_points(F[None], self.ground_links)
+        pts = pts[0]
+        lowest = np.full(len(self.robot.link_names), np.inf)
+        np.minimum.at(lowest, owner, pts[:, 2])
+        keep = pts[:, 2] <= lowest[owner] + CONTACT_BAND
+        return pts[keep], owner[keep]
 
     def _link_coms(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The links that have a mass (k,) and their centres of mass (k, 3), world, from frames F (n_links, 4, 4)."""
@@ -286,7 +289,7 @@ class _Objective:
         s_, t_ = coll.segment_closest(ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1])
         gap = np.linalg.norm(ends[i, 0] + s_[:, None] * (ends[i, 1] - ends[i, 0])
                              - ends[j, 0] - t_[:, None] * (ends[j, 1] - ends[j, 0]), axis=1)
-        ground = np.isin(prob.boxed[i], prob.ground_links) & np.isin(prob.boxed[j], prob.ground_links)
+        ground = np.isin(prob.shaped[i], prob.ground_links) & np.isin(prob.shaped[j], prob.ground_links)
         keep = gap < PAIR_RANGE
         if not move_base:
             keep &= ~ground
@@ -337,12 +340,10 @@ class _Objective:
         margin, g = prob.margin_and_gradient(F, base)
         out["margin"], out["margin_jac"] = margin, g[cols]
         ineq, ineq_jac = [np.array([margin - self.min_margin])], [g[cols][None]]
-        # ground: the lowest corner of every lifted box above the ground
+        # ground: the lowest point of every lifted link's shapes above the ground
         lifted = prob.lifted_links
         if len(lifted):
-            corners = r.box_corners(F[None], lifted)[0]  # (k, 8, 3)
-            k_low = np.argmin(corners[..., 2], axis=1)
-            low = corners[np.arange(len(lifted)), k_low]
+            low = r.lowest_point_per_link(F, lifted)
             Jg = prob.point_jacobians(F, base, low, lifted)[:, 2, :][:, cols]
             ineq.append(low[:, 2])
             ineq_jac.append(Jg)
@@ -357,7 +358,7 @@ class _Objective:
         dist = np.linalg.norm(diff, axis=1)
         u = diff / np.maximum(dist, 1e-12)[:, None]
         need = prob.radius[i] + prob.radius[j] + prob.corner_excess[i] + prob.corner_excess[j] + self.self_gap
-        links = prob.boxed
+        links = prob.shaped
         JA = prob.point_jacobians(F, base, pa, links[i])
         JB = prob.point_jacobians(F, base, pb, links[j])
         ineq.append(dist - need)
@@ -701,9 +702,9 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     for qb in [q_now[robot.parts.base]] + _base_shapes(controller):
         q = q_now.copy()
         q[robot.parts.base] = qb
-        P0_local = np.linalg.inv(robot.root_pose(base)) @ robot.frame(q, robot.lift_frame, base)
-        placed = nk.base_move_into_range(position, P0_local, base, controller.Lc, controller.neck_length,
-                                         controller.slack, robot.body_axis_height)
+        P0_local = np.linalg.inv(robot.body_pose(base)) @ robot.frame(q, robot.lift_frame, base)
+        placed = None if controller.neck_length <= 0 else nk.base_move_into_range(
+            position, P0_local, base, controller.Lc, controller.neck_length, controller.slack, robot.body_axis_height)
         if placed is not None:
             s = controller.solve(position, direction, q_prev=q, base=placed, allow_base_move=False)
             if s.success and (found := moved(s.q, placed, 0)):

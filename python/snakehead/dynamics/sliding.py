@@ -157,10 +157,7 @@ def resting_contacts(robot: SnakeRobot, q: npt.ArrayLike) -> tuple[np.ndarray, n
         k = int(np.argmax(low))
         raise ValueError(f"the shape is not flat on the ground: the link {robot.link_names[links[k]]!r} "
                          f"is {1000 * (low[k] - low.min()):.1f} mm above the lowest (keep the pitch joints at 0)")
-    ends, _ = robot.link_capsules
-    mid = 0.5 * (ends[links, 0] + ends[links, 1])  # (k, 3) in the link frames
-    centres = np.einsum("kij,kj->ki", F[0, links, :3, :3], mid) + F[0, links, :3, 3]
-    return centres[:, :2], robot.masses[links]
+    return robot.link_centres(F)[0, :, :2], robot.masses[links]
 
 
 def predict_slide(robot: SnakeRobot, q_path: npt.ArrayLike, start: BasePlacement | None = None

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -207,6 +208,18 @@ class MeshObstacle:
     def world_vertices(self) -> np.ndarray:
         """(V, 3) the hull's vertices in the world."""
         return self.vertices @ self.pose[:3, :3].T + self.pose[:3, 3]
+
+    @cached_property
+    def _planes(self) -> np.ndarray:
+        from scipy.spatial import ConvexHull
+
+        return np.asarray(ConvexHull(self.world_vertices).equations)  # (F, 4): n . x + d, n outward
+
+    def distance_to_points(self, x: np.ndarray) -> np.ndarray:
+        """Signed distance (m) of world points x (..., 3) to the hull by its face planes: exact inside (< 0) and
+        where a face is closest; elsewhere outside a lower bound (the largest plane distance)."""
+        P = self._planes
+        return (np.asarray(x, float) @ P[:, :3].T + P[:, 3]).max(axis=-1)
 
 
 #: The kinds of obstacle (one model for planning and simulation).

@@ -191,6 +191,11 @@ class ReachabilityMap:
             raise ValueError(f"min_voxels must be >= 1, got {min_voxels!r}")
         need = min(need, len(self))
         levels = np.sort(self.indices)[::-1]  # descending
+        if not levels[need - 1] > 0:
+            hint = ("" if self.params.get("free_roll") else "; a head of fewer than 6 joints cannot turn about its own axis: compute "
+                    "the map with free roll (snakehead workspace --free-roll)")
+            raise ValueError(f"the map's best band has index {levels[need - 1]:.1f}: the head reaches none of its "
+                             f"directions from {need} or more voxels, so it has no dexterous workspace{hint}")
         return float(min(100.0, levels[need - 1]))
 
     def summary(self) -> str:

@@ -143,6 +143,8 @@ class SnakeRobot:
                  head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
                  limits: Mapping[str, tuple[float, float]] | None = None,
                  xacro_args: Mapping[str, object] | None = None) -> None:
+        self._arguments = {"urdf": urdf, "root": root, "head_axis": head_axis, "packages": packages, "limits": limits,
+                           "xacro_args": xacro_args, "source": source}
         description = read_description(_urdf_source(urdf), xacro_args)
         names = {"base_end": _frame_name(base_end, "base_end"), "neck_end": _frame_name(neck_end, "neck_end"),
                  "head_tip": _frame_name(head_tip, "head_tip")}
@@ -200,6 +202,18 @@ class SnakeRobot:
         return cls(spec.urdf, base_end=spec.base_end, neck_end=spec.neck_end, head_tip=spec.head_tip,
                    root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
                    packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args)
+
+    def with_parts(self, base_end: str | None = None, neck_end: str | None = None,
+                   head_tip: str | None = None) -> "SnakeRobot":
+        """The same description split into parts at other frames (the URDF's names; None keeps the frame); the head's
+        map is kept when the head is the same."""
+        frames = {"base_end": base_end or self.user_frames["base_end"],
+                  "neck_end": neck_end or self.user_frames["neck_end"],
+                  "head_tip": head_tip or self.user_frames["head_tip"]}
+        same_head = (frames["neck_end"], frames["head_tip"]) == (self.user_frames["neck_end"],
+                                                                  self.user_frames["head_tip"])
+        return SnakeRobot(**self._arguments, **frames,  # type: ignore[arg-type]
+                          map_path=self.map_path if same_head else None)
 
     @classmethod
     def default(cls) -> "SnakeRobot":
@@ -492,17 +506,13 @@ class SnakeRobot:
         """The shaped links (k,) and, in each link's frame, the points (k, M, 3) of its shapes farthest along the
         body at q = 0 (a box's distal face, a cylinder's distal rim; padded by repetition): where a link pitched up
         about its proximal joint leaves the ground last."""
-        from ..geometry.shapes import shape_points
-
-        links = self.shaped_links
+        links, local = self.link_points
         F = self._straight_frames
-        chosen = []
-        for k in links:
-            pts = np.concatenate([shape_points(s) for s in self.geometry.shapes if s.frame == k])
+        out = np.empty_like(local)
+        for c, (k, pts) in enumerate(zip(links, local)):
             axial = pts @ (F[k, :3, :3].T @ np.array([1.0, 0.0, 0.0]))
-            chosen.append(pts[axial >= axial.max() - STRAIGHT_TOLERANCE])
-        width = max(len(c) for c in chosen)
-        out = np.array([np.concatenate([c, np.repeat(c[:1], width - len(c), axis=0)]) for c in chosen])
+            far = pts[axial >= axial.max() - STRAIGHT_TOLERANCE]
+            out[c] = far[np.arange(len(pts)) % len(far)]
         out.setflags(write=False)
         return links, out
 
@@ -534,24 +544,70 @@ class SnakeRobot:
         return self.geometry.lowest_points(np.asarray(frames, float), links)
 
     @cached_property
-    def link_capsules(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per frame of :attr:`link_names`, a capsule around its collision shapes along the body's direction at
-        q = 0: end points (n_links, 2, 3) in the link frame and radius (n_links,) m (0 and a point for frames
-        without shapes). The whole-body solve's smooth collision terms use them."""
+    def link_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """The shaped links (k,) and points (k, M, 3) in each link's frame whose convex hull is the link's shapes
+        (cylinders and spheres as polygons of 16 sides; padded by repetition): for bounds, centres and drawing."""
         from ..geometry.shapes import shape_points
 
+        links = self.shaped_links
+        pts = [np.concatenate([shape_points(s) for s in self.geometry.shapes if s.frame == k]) for k in links]
+        width = max(len(p) for p in pts)
+        out = np.array([np.concatenate([p, np.repeat(p[:1], width - len(p), axis=0)]) for p in pts])
+        out.setflags(write=False)
+        return links, out
+
+    def hull_points(self, frames: np.ndarray) -> np.ndarray:
+        """World points (T, k, M, 3) of :attr:`link_points` for frames (T, n_links, 4, 4)."""
+        links, local = self.link_points
+        F = np.asarray(frames)[:, links]
+        return np.einsum("tkij,kmj->tkmi", F[..., :3, :3], local) + F[:, :, None, :3, 3]
+
+    def link_centres(self, frames: np.ndarray) -> np.ndarray:
+        """World centres (T, k, 3) of the shaped links' capsules (their shapes' middle along the body)."""
+        links = self.shaped_links
+        ends = self.link_capsules[0][links]
+        mid = 0.5 * (ends[:, 0] + ends[:, 1])
+        F = np.asarray(frames)[:, links]
+        return np.einsum("tkij,kj->tki", F[..., :3, :3], mid) + F[..., :3, 3]
+
+    def lowest_point_per_link(self, frames: np.ndarray, links: np.ndarray) -> np.ndarray:
+        """The lowest world point (k, 3) of each link's shapes, from the frames (n_links, 4, 4) of one
+        configuration (box corner, cylinder rim point, sphere bottom, hull vertex)."""
+        links = np.asarray(links, dtype=np.int64)
+        pts, owner = self.lowest_points(np.asarray(frames)[None], links)
+        pts = pts[0]
+        out = np.empty((len(links), 3))
+        for c, k in enumerate(links):
+            mine = pts[owner == k]
+            out[c] = mine[np.argmin(mine[:, 2])]
+        return out
+
+    @cached_property
+    def link_capsules(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per frame of :attr:`link_names`, a capsule inside its collision shapes along the body's direction at
+        q = 0: end points (n_links, 2, 3) in the link frame, radius (n_links,) m (the shapes' smallest half-width
+        across the body, so that the capsule stays inside a box) and excess (n_links,) m (how far the shapes stick
+        out of the capsule: a box's corners). Zeros for frames without shapes. The whole-body solve's smooth
+        collision terms use them; a box's capsule is its x-axis segment shortened by the radius at both ends."""
         n = len(self.link_names)
-        ends, radii = np.zeros((n, 2, 3)), np.zeros(n)
+        ends, radii, excess = np.zeros((n, 2, 3)), np.zeros(n), np.zeros(n)
+        links, local = self.link_points
         F = self._straight_frames
-        for k in self.shaped_links:
-            pts = np.concatenate([shape_points(s) for s in self.geometry.shapes if s.frame == k])
-            axis = F[k, :3, :3].T @ np.array([1.0, 0.0, 0.0])  # the body's direction in the link frame
+        across = np.array([[0.0, np.cos(a), np.sin(a)] for a in np.linspace(0, np.pi, 16, endpoint=False)])
+        for k, pts in zip(links, local):
+            R = F[k, :3, :3]
+            axis = R.T @ np.array([1.0, 0.0, 0.0])  # the body's direction in the link frame
             centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
             t = (pts - centre) @ axis
-            r = np.linalg.norm((pts - centre) - np.outer(t, axis), axis=1)
-            ends[k] = [centre + t.min() * axis, centre + t.max() * axis]
-            radii[k] = r.max()
-        return ends, radii
+            radial = (pts - centre) - np.outer(t, axis)
+            support = np.abs(radial @ (R.T @ across.T)).max(axis=0)  # half-widths across the body
+            r_in = float(support.min())
+            half = max(0.5 * (t.max() - t.min()) - r_in, 0.0)
+            mid = centre + 0.5 * (t.max() + t.min()) * axis
+            ends[k] = [mid - half * axis, mid + half * axis]
+            radii[k] = r_in
+            excess[k] = float(np.linalg.norm(radial, axis=1).max()) - r_in
+        return ends, radii, excess
 
     # --- whole-body kinematics ---------------------------------------------------------------------------
     def joint_axes_world(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -734,6 +790,18 @@ def _body_frame(body: Chain) -> np.ndarray:
     return T
 
 
+def _lift_frame_name(body: Chain, F: np.ndarray, neck: slice) -> str | None:
+    """The frame just before the neck's first pitch joint (``SnakeRobot.lift_frame``), from frames F at q = 0 in
+    the body frame; None when the neck has no pitch joint."""
+    child = np.asarray(body.model.joint_child_links)
+    local = np.asarray(body.model.joint_axes, float)
+    for j in range(neck.start, neck.stop):
+        axis = F[child[j], :3, :3] @ local[j]
+        if abs(axis[2]) <= 0.5:  # pitch: across the body and horizontal
+            return body.link_names[child[j] - 1]
+    return None
+
+
 def _aligned_rotation(R_frame: np.ndarray, axis: str | None) -> np.ndarray:
     """The rotation (in the frame R_frame's coordinates) of its aligned twin: the body frame's orientation at
     q = 0 (R_frame is the frame's orientation in the body frame); with ``axis``, the twin's x is that axis of
@@ -758,14 +826,18 @@ def _aligned_frames(text: str, body: Chain, body_in_root: np.ndarray, parts: lis
     F = np.linalg.inv(body_in_root) @ body.fk_all(np.zeros(body.n_joints))  # frames in the body frame at q = 0
     out = dict(names)
     twins = []
-    for key in ("base_end", "neck_end", "head_tip"):
-        R = F[body.link_index(names[key]), :3, :3]
+    frames = dict(names)
+    lift = _lift_frame_name(body, F, parts[1])
+    if lift is not None and lift not in names.values():
+        frames["lift_frame"] = lift  # Eqs. 18-22 pivot on it and read its direction
+    for key in frames:
+        R = F[body.link_index(frames[key]), :3, :3]
         axis = head_axis if key == "head_tip" else None
         Ra = _aligned_rotation(R, axis)
         if np.allclose(Ra, np.eye(3), atol=STRAIGHT_TOLERANCE):
             continue
-        out[key] = names[key] + ALIGNED_SUFFIX
-        twins.append((names[key], out[key], Ra))
+        out[key] = frames[key] + ALIGNED_SUFFIX
+        twins.append((frames[key], out[key], Ra))
     if twins:
         text = add_fixed_frames(text if _is_xml_text(text) else Path(text).read_text(encoding="utf-8"), twins)
     return out, text

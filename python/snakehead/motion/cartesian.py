@@ -246,9 +246,8 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
             F = robot.frames(qj, base)
             r = (F[pts_idx, :3, 3] - P[j]).reshape(-1)
             J = robot.point_jacobians(F, F[pts_idx, :3, 3], pts_idx)[:, :, lift].reshape(-1, len(lift))
-            # the ground as a stiff one-sided spring on the lifted boxes' lowest corners: stay TRACKING_CLEARANCE up
-            corners = robot.box_corners(F[None], lifted)[0]  # (k, 8, 3)
-            low = corners[np.arange(len(lifted)), np.argmin(corners[..., 2], axis=1)]
+            # the ground as a stiff one-sided spring on the lifted links' lowest points: stay TRACKING_CLEARANCE up
+            low = robot.lowest_point_per_link(F, lifted)
             below = low[:, 2] < TRACKING_CLEARANCE
             if below.any():
                 Jz = robot.point_jacobians(F, low[below], lifted[below])[:, 2, lift]

@@ -180,15 +180,15 @@ class Gait:
         return q * robot.joint_signs[None, :]
 
     def shape_height(self, robot: SnakeRobot, samples: int = 40) -> float:
-        """How high (m) the gait's shape reaches over one cycle at full amplitude: the largest extent of the boxes'
-        corners across the plane of the body (along the virtual chassis' z-axis). Resting on that plane, no link
+        """How high (m) the gait's shape reaches over one cycle at full amplitude: the largest extent of the links'
+        collision shapes across the plane of the body (along the virtual chassis' z-axis). Resting on that plane, no link
         rises higher than this; sidewinding and turning lift links by design, to about this height."""
         robot = as_robot(robot)
         samples = integer(samples, "samples", least=1, most=10_000)
         t = self.ramp_s + np.linspace(0.0, self.period_s, samples, endpoint=False)
         F = robot.frames_many(self.joint_angles(robot, t, 1.0))
-        corners = robot.box_corners(F)  # (T, k, 8, 3)
-        centres = robot.box_poses(F)[..., :3, 3]  # (T, k, 3)
+        corners = robot.hull_points(F)  # (T, k, M, 3)
+        centres = robot.link_centres(F)  # (T, k, 3)
         height = 0.0
         for c, pts in zip(centres, corners):
             normal = virtual_chassis(c)[:3, 2]

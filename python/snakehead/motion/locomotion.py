@@ -115,10 +115,11 @@ def straight_pose_for(robot: SnakeRobot, base: BasePlacement, q_curled: npt.Arra
 # gaits towards a goal
 # ------------------------------------------------------------------------------------------------
 def chassis_offset(robot: SnakeRobot) -> BasePlacement:
-    """The virtual chassis of the straight body in its root frame: its middle, x along the body."""
+    """The virtual chassis of the straight body in its body frame (the base placement's): its middle, x along the
+    body."""
     robot = as_robot(robot)
-    F = robot.body.fk_all(np.zeros(robot.n_joints))[None]
-    centres = robot.box_poses(F)[0, :, :3, 3]
+    F = robot.frames(np.zeros(robot.n_joints), BasePlacement())[None]  # the default placement: the body frame
+    centres = robot.link_centres(F)[0]
     T = virtual_chassis(centres, forward=centres[-1] - centres[0])
     return BasePlacement(float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
 

@@ -42,7 +42,7 @@ import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Sequence
 
 if TYPE_CHECKING:
-    from ..geometry.obstacles import BoxObstacle, WallWithHole
+    from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
@@ -437,7 +437,7 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
         tg.time_s = plan.times[tg.time_s]
     frames = robot.frames_many(traj.q, base)  # once, for every check below
     dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
-    clearance = robot.lowest_box_z(frames, robot.lifted_links).min(axis=1)
+    clearance = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
@@ -463,8 +463,13 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     shape = controller.q_initial if q_shape is None else np.asarray(q_shape, float)
     key = shape[:robot.lift_joints.start].tobytes()
     cache = controller.__dict__.setdefault("_bending_states", {})
-    if key in cache:
-        return cache[key].copy()
+    if key not in cache:
+        cache[key] = ground_curl(robot, shape)
+    return cache[key].copy()
+
+
+def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
+    """:func:`bending_state` for the base shape of ``shape`` (n,), uncached. ValueError when no curl is stable."""
     q = np.zeros(robot.n_joints)
     # the base, and the links before the first pitch joint of the neck, which cannot leave the ground: their yaw
     # joints keep the shape's angles, or the lift would sweep those links across the ground and the friction would
@@ -474,8 +479,7 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     up = np.arange(robot.parts.neck.start, robot.parts.head.stop)
     yaw = np.array([j for j in up if robot.joint_kinds[j] == "yaw" and j > first_pitch], int)  # bend when flat
     if len(yaw) == 0:
-        cache[key] = q
-        return q.copy()
+        return q
     # the finest grid (at most BENDING_GRID_DEG) with at most BENDING_COMBINATIONS curls
     per_joint = max(3, min(int(round(180.0 / BENDING_GRID_DEG)) + 1,
                            int(np.floor(BENDING_COMBINATIONS ** (1.0 / len(yaw)) + 1e-9))))
@@ -493,9 +497,9 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     for chunk in np.array_split(stable, max(1, stable.size // 500 + 1)) if stable.size else []:
         ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
         if ok.any():
-            cache[key] = qs[chunk[np.argmax(ok)]]
-            return cache[key].copy()
-    raise ValueError("no curl of the neck and head on the ground keeps their mass over the base")
+            return qs[chunk[np.argmax(ok)]]
+    raise ValueError("no curl of the neck and head on the ground keeps their mass over the base (the base is too "
+                     "short or light for them: 'snakehead info --robot FILE' suggests a split of the parts that works)")
 
 
 
@@ -691,7 +695,7 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
 
 def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike, npt.ArrayLike]], *,
          robot: SnakeRobot | None = None, controller: HeadController | None = None,
-         obstacles: Sequence[BoxObstacle | WallWithHole] = (), base: BasePlacement | None = None,
+         obstacles: Sequence[BoxObstacle | WallWithHole | MeshObstacle] = (), base: BasePlacement | None = None,
          method: str = "rotated", seed: int | None = 1, allow_relocation: bool = True,
          timing: dict[str, Any] | None = None, base_shape: npt.ArrayLike | None = None,
          start_q: npt.ArrayLike | None = None) -> Plan:

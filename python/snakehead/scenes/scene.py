@@ -31,6 +31,11 @@ A scene file is TOML::
     size = [0.7, 0.58, 0.01]                # width, height, thickness (m)
     hole_diameter = 0.07
 
+    [[obstacles]]
+    kind = "mesh"                           # a mesh file's convex hull (STL, OBJ, DAE...; path relative to the
+    file = "rock.stl"                       #   scene file), its origin at position (m), turned by yaw (rad,
+    position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
+
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
 """
 from __future__ import annotations
@@ -44,7 +49,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, vector3
-from ..geometry.obstacles import BoxObstacle, WallWithHole
+from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, read_toml
 
@@ -125,8 +130,9 @@ class Scene:
             raise ValueError(f"scene {self.name!r}: target names must differ, got {names}")
         obstacles = sequence(self.obstacles, f"scene {self.name!r} obstacles")
         for ob in obstacles:
-            if not isinstance(ob, (BoxObstacle, WallWithHole)):
-                raise TypeError(f"scene obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
+            if not isinstance(ob, OBSTACLE_TYPES):
+                raise TypeError("scene obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got "
+                                f"{type(ob).__name__}")
         object.__setattr__(self, "targets", targets)
         object.__setattr__(self, "obstacles", obstacles)
         if self.base is not None and not isinstance(self.base, BasePlacement):
@@ -163,6 +169,7 @@ _BASE_KEYS = ((), ("x", "y", "yaw"))
 _OBSTACLE_KEYS = {
     "box": (("kind", "centre", "size"), ("yaw",)),
     "wall_with_hole": (("kind", "hole_centre", "normal", "size", "hole_diameter"), ()),
+    "mesh": (("kind", "file", "position"), ("yaw", "scale")),
 }
 
 
@@ -210,13 +217,19 @@ def _target_from(entry: Any, where: str) -> Target:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _obstacle_from(entry: Any, where: str) -> BoxObstacle | WallWithHole:
+def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObstacle | WallWithHole | MeshObstacle:
     entry = _table(entry, where)
     kind = entry.get("kind")
     if kind not in _OBSTACLE_KEYS:
         raise ValueError(f"{where}: kind must be one of {sorted(_OBSTACLE_KEYS)}, got {kind!r}")
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
+        if kind == "mesh":
+            if not isinstance(entry["file"], str) or not entry["file"]:
+                raise ValueError(f"file must be a mesh file's path, got {entry['file']!r}")
+            return MeshObstacle.load((folder or Path(".")) / entry["file"], _number_list(entry["position"], "position"),
+                                     _number(entry.get("yaw", 0.0), "yaw"),
+                                     _number_list(entry.get("scale", [1.0, 1.0, 1.0]), "scale"), where="mesh")
         if kind == "box":
             return BoxObstacle.from_yaw(_number_list(entry["centre"], "centre"),
                                         _number_list(entry["size"], "size"),
@@ -239,7 +252,7 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     raw_obstacles = data.get("obstacles", [])
     if not isinstance(raw_obstacles, list):
         raise ValueError(f"{where}: obstacles must be an array of tables ([[obstacles]])")
-    obstacles = tuple(_obstacle_from(e, f"{where}, obstacles[{k}]") for k, e in enumerate(raw_obstacles))
+    obstacles = tuple(_obstacle_from(e, f"{where}, obstacles[{k}]", folder) for k, e in enumerate(raw_obstacles))
     base = None
     if "base" in data:
         b = _table(data["base"], f"{where}: base")

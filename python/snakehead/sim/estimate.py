@@ -3,11 +3,13 @@ orientation of one link (an IMU's attitude), never the simulator's positions.
 
 * Orientation: the IMU link's world orientation and the joint angles give every link's orientation (forward
   kinematics from the IMU link).
-* Shape: the body's points (each box's centre) in world axes, relative to the root frame's origin.
-* Height: the body rests on the ground, so its lowest box corner is at z = 0.
-* Planar position, by contact odometry: the boxes that touch the ground (their lowest corner within
-  ``contact_height`` of it) hold it through their contact points -- the middle of a box's corners that are
-  lowest, a material point of the box. Between two updates the body is moved by the translation that balances
+* Shape: the body's points (the middle of each link's collision shapes: a box's centre) in world axes, relative
+  to the root frame's origin.
+* Height: the body rests on the ground, so the lowest point of its collision shapes is at z = 0.
+* Planar position, by contact odometry: the links that touch the ground (the lowest point of their shapes within
+  ``contact_height`` of it) hold it through their contact points -- the middle of the link's shape points (box
+  corners, cylinder rims, sphere and hull vertices: :class:`ShapePoints`) that are lowest, a material point of the
+  link. Between two updates the body is moved by the translation that balances
   the friction of those contact points (``odometry="friction"``, the default: the weighted geometric median of
   the shifts that would keep each still, loads the links' masses, :func:`snakehead.dynamics.sliding.
   balance_translation`; contacts slip where the others outpull them, and stay put where they hold), or by the
@@ -29,7 +31,7 @@ whose contacts roll rather than slip, is the exception. The orientation is the I
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -40,9 +42,9 @@ from ..motion.gaits import virtual_chassis
 
 import numpy.typing as npt
 
-#: A box whose lowest corner is within this height (m) of the ground touches it.
+#: A link whose lowest shape point is within this height (m) of the ground touches it.
 CONTACT_HEIGHT = 0.003
-#: Corners within this height (m) of a box's lowest corner make its contact patch.
+#: A link's shape points within this height (m) of its lowest make its contact patch.
 PATCH_HEIGHT = 0.001
 #: How the estimate moves the body between updates (see the module).
 ODOMETRY = ("friction", "no-slip")
@@ -52,19 +54,26 @@ ODOMETRY = ("friction", "no-slip")
 class BodyPose:
     """Where the body is.
 
-    root: world pose (4, 4) of the root frame (the tail link's; ``BasePlacement``'s frame);
-    chassis: world pose (4, 4) of the virtual chassis.
+    root: world pose (4, 4) of the root frame (the tail link's); chassis: world pose (4, 4) of the virtual chassis;
+    body_in_root: the body frame in the root frame (:attr:`SnakeRobot.body_in_root`; identity for snakes written
+    along x), so that :attr:`body` is the body frame's world pose, the frame ``BasePlacement`` places.
     """
 
     root: np.ndarray
     chassis: np.ndarray
+    body_in_root: np.ndarray = field(default_factory=lambda: np.eye(4))
+
+    @property
+    def body(self) -> np.ndarray:
+        """World pose (4, 4) of the body frame (x along the body towards the head at q = 0, z up)."""
+        return self.root @ self.body_in_root
 
     @property
     def base(self) -> BasePlacement:
-        """The root frame's planar pose (x, y m; yaw rad of its x-axis seen from above), as the planner places
+        """The body frame's planar pose (x, y m; yaw rad of its x-axis seen from above), as the planner places
         the base."""
-        x = self.root[:3, 0]
-        return BasePlacement(float(self.root[0, 3]), float(self.root[1, 3]), math.atan2(x[1], x[0]))
+        B = self.body
+        return BasePlacement(float(B[0, 3]), float(B[1, 3]), math.atan2(B[1, 0], B[0, 0]))
 
     @property
     def heading(self) -> float:
@@ -74,8 +83,8 @@ class BodyPose:
 
     @property
     def tilt_deg(self) -> float:
-        """Angle (deg) between the root frame's z-axis and the world's: 0 when the tail lies upright."""
-        return math.degrees(math.acos(float(np.clip(self.root[2, 2], -1.0, 1.0))))
+        """Angle (deg) between the body frame's z-axis and the world's: 0 when the tail lies upright."""
+        return math.degrees(math.acos(float(np.clip(self.body[2, 2], -1.0, 1.0))))
 
 
 def _wrap(angle: float) -> float:
@@ -83,21 +92,66 @@ def _wrap(angle: float) -> float:
 
 
 def pose_error(estimate: BodyPose, truth: BodyPose) -> dict:
-    """How far ``estimate`` is from ``truth``: ``position_error_m`` (the root frame's origin, in the ground
-    plane), ``yaw_error_deg`` (the root frame's heading), ``chassis_position_error_m`` (the virtual chassis'
-    origin, 3-D), ``chassis_heading_error_deg``."""
+    """How far ``estimate`` is from ``truth``: ``position_error_m`` (the body frame's origin -- the base
+    placement's -- in the ground plane), ``yaw_error_deg`` (the body frame's heading), ``chassis_position_error_m``
+    (the virtual chassis' origin, 3-D), ``chassis_heading_error_deg``."""
     return {
-        "position_error_m": float(np.linalg.norm(estimate.root[:2, 3] - truth.root[:2, 3])),
+        "position_error_m": float(np.linalg.norm(estimate.body[:2, 3] - truth.body[:2, 3])),
         "yaw_error_deg": abs(math.degrees(_wrap(estimate.base.yaw - truth.base.yaw))),
         "chassis_position_error_m": float(np.linalg.norm(estimate.chassis[:3, 3] - truth.chassis[:3, 3])),
         "chassis_heading_error_deg": abs(math.degrees(_wrap(estimate.heading - truth.heading))),
     }
 
 
+class ShapePoints:
+    """Points of the robot's collision shapes, fixed in their links: box corners, cylinder rims, the vertices of a
+    sphere's and a hull's mesh (:func:`snakehead.geometry.shapes.shape_points`), for the links ``links`` (default
+    the robot's shaped links), in contiguous runs per link. ``local`` (P, 3) in the link frames, ``link`` (P,) the
+    position in ``links`` of each point's link, ``starts`` (k,) where each link's run begins; ``centres`` (k, 3)
+    the middle of each link's shapes (the centre of their bounding box in the link frame; a box's centre)."""
+
+    def __init__(self, robot: SnakeRobot, links: np.ndarray | None = None, segments: int = 16) -> None:
+        from ..geometry.shapes import shape_points
+
+        self.links = np.asarray(robot.shaped_links if links is None else links, dtype=np.intp).reshape(-1)
+        geometry = robot.geometry
+        local, owner = [], []
+        for c, link in enumerate(self.links):
+            for k in geometry.shapes_of([link]):
+                pts = shape_points(geometry.shapes[int(k)], segments)
+                local.append(pts)
+                owner.append(np.full(len(pts), c))
+        if not local:
+            raise ValueError("the robot has no collision shapes on these links")
+        self.local = np.concatenate(local)
+        self.link = np.concatenate(owner)
+        self.starts = np.searchsorted(self.link, np.arange(len(self.links)))
+        hi = np.maximum.reduceat(self.local, self.starts, axis=0)
+        lo = np.minimum.reduceat(self.local, self.starts, axis=0)
+        self.centres = 0.5 * (hi + lo)
+
+    def world(self, frames: np.ndarray) -> np.ndarray:
+        """The points (P, 3) for poses ``frames`` (k, 4, 4) of the links (world, or any common frame)."""
+        F = frames[self.link]
+        return np.einsum("pij,pj->pi", F[:, :3, :3], self.local) + F[:, :3, 3]
+
+    def lowest(self, z: np.ndarray) -> np.ndarray:
+        """Each link's lowest value (k,) of per-point heights ``z`` (P,)."""
+        return np.minimum.reduceat(z, self.starts)
+
+    def highest(self, z: np.ndarray) -> np.ndarray:
+        """Each link's highest value (k,) of per-point heights ``z`` (P,)."""
+        return np.maximum.reduceat(z, self.starts)
+
+    def centre_points(self, frames: np.ndarray) -> np.ndarray:
+        """The middle (k, 3) of each link's shapes for poses ``frames`` (k, 4, 4)."""
+        return np.einsum("kij,kj->ki", frames[:, :3, :3], self.centres) + frames[:, :3, 3]
+
+
 class BodyPoseEstimator:
     """The body's pose from joint angles and one link's orientation (see the module).
 
-    robot: the snake; imu_link: the frame that carries the IMU (default: the boxed link nearest the middle of the
+    robot: the snake; imu_link: the frame that carries the IMU (default: the shaped link nearest the middle of the
     body); contact_height / patch_height: m; odometry: one of ODOMETRY (see the module). Call :meth:`reset` with
     the known starting pose, then :meth:`update` at every control tick with the measured joint angles and the
     IMU's world orientation.
@@ -106,11 +160,12 @@ class BodyPoseEstimator:
     def __init__(self, robot: SnakeRobot, imu_link: str | None = None, *, contact_height: float = CONTACT_HEIGHT,
                  patch_height: float = PATCH_HEIGHT, odometry: str = "friction") -> None:
         self.robot = as_robot(robot)
-        boxed = self.robot.boxed_links
+        shaped = self.robot.shaped_links
+        self._body_in_root = self.robot.body_in_root
         if imu_link is None:
-            F0 = self.robot.body.fk_all(np.zeros(self.robot.n_joints))
-            middle = 0.5 * self.robot.body_length
-            imu_link = self.robot.link_names[int(boxed[np.argmin(np.abs(F0[boxed, 0, 3] - middle))])]
+            F0 = np.linalg.inv(self._body_in_root) @ self.robot.body.fk_all(np.zeros(self.robot.n_joints))
+            middle = F0[0, 0, 3] + 0.5 * self.robot.body_length  # along the straight body, in the body frame
+            imu_link = self.robot.link_names[int(shaped[np.argmin(np.abs(F0[shaped, 0, 3] - middle))])]
         self.imu_link = imu_link
         self.imu_index = self.robot.link_index(imu_link)  # ValueError for a frame that is not on the body
         for name, value in (("contact_height", contact_height), ("patch_height", patch_height)):
@@ -121,12 +176,9 @@ class BodyPoseEstimator:
         if odometry not in ODOMETRY:
             raise ValueError(f"odometry must be one of {ODOMETRY}, got {odometry!r}")
         self.odometry = odometry
-        self._masses = self.robot.masses[boxed]
-        self._boxed = boxed
-        self._half = 0.5 * self.robot.box_sizes[boxed]  # (k, 3)
-        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
-        self._corners_local = signs[None, :, :] * self._half[:, None, :]  # (k, 8, 3) in each box's frame
-        self._W = None  # box poses relative to the root origin, world axes, at the last update
+        self._points = ShapePoints(self.robot, shaped)
+        self._masses = self.robot.masses[shaped]
+        self._W = None  # link poses relative to the root origin, world axes, at the last update
         self._R_root = None
         self._origin = None  # the root frame's estimated world position
         self._chassis = None
@@ -134,38 +186,40 @@ class BodyPoseEstimator:
         self._heading_correction = np.eye(3)  # turns the IMU's heading onto the known one (set by reset)
 
     # --- the body in world axes, relative to the root origin --------------------------------------
-    def _boxes(self, q: npt.ArrayLike, R_imu: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """Box poses (k, 4, 4) relative to the root origin in world axes, and the root's world rotation."""
+    def _links(self, q: npt.ArrayLike, R_imu: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Shaped links' poses (k, 4, 4) relative to the root origin in world axes, and the root's world rotation."""
         q = joint_vector(q, self.robot.n_joints)
         R_imu = self._heading_correction @ rotation_matrix(R_imu, "IMU orientation")
         F = self.robot.body.fk_all(q)  # in the root frame
         R_root = R_imu @ F[self.imu_index, :3, :3].T
-        B = F[self._boxed] @ self.robot.box_origins[self._boxed]
+        B = F[self._points.links]
         W = np.empty_like(B)
         W[:, :3, :3] = R_root @ B[:, :3, :3]
         W[:, :3, 3] = B[:, :3, 3] @ R_root.T
         W[:, 3] = (0.0, 0.0, 0.0, 1.0)
         return W, R_root
 
-    def _corners(self, W: np.ndarray) -> np.ndarray:
-        return np.einsum("kij,kcj->kci", W[:, :3, :3], self._corners_local) + W[:, None, :3, 3]  # (k, 8, 3)
-
-    def _contact_points(self, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The boxes that touch the ground: their indices (m,), contact points in their box frames (m, 3) and
-        weights (m,) falling linearly from 1 on the ground to 0 at ``contact_height``."""
-        low = corners[..., 2].min(axis=1)  # relative to the root origin
+    def _contact_points(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The links that touch the ground: their positions in the shaped links (m,), contact points in their link
+        frames (m, 3) and weights (m,) falling linearly from 1 on the ground to 0 at ``contact_height``."""
+        P = self._points
+        z = points[:, 2]
+        low = P.lowest(z)  # relative to the root origin
         above = low - low.min()
         touching = np.flatnonzero(above < self.contact_height)
-        patch = corners[touching, :, 2] - low[touching, None] <= self.patch_height  # (m, 8)
-        local = np.einsum("mc,mcj->mj", patch, self._corners_local[touching]) / patch.sum(axis=1)[:, None]
+        patch = (above[P.link] < self.contact_height) & (z - low[P.link] <= self.patch_height)
+        sums = np.zeros((len(P.links), 3))
+        np.add.at(sums, P.link[patch], P.local[patch])
+        counts = np.bincount(P.link[patch], minlength=len(P.links))
+        local = sums[touching] / counts[touching, None]
         return touching, local, 1.0 - above[touching] / self.contact_height
 
-    def _world_points(self, W: np.ndarray, boxes: np.ndarray, local: np.ndarray) -> np.ndarray:
-        return np.einsum("mij,mj->mi", W[boxes, :3, :3], local) + W[boxes, :3, 3]
+    def _world_points(self, W: np.ndarray, links: np.ndarray, local: np.ndarray) -> np.ndarray:
+        return np.einsum("mij,mj->mi", W[links, :3, :3], local) + W[links, :3, 3]
 
-    def _remember(self, W: np.ndarray, R_root: np.ndarray, origin: np.ndarray, corners: np.ndarray) -> None:
+    def _remember(self, W: np.ndarray, R_root: np.ndarray, origin: np.ndarray, points: np.ndarray) -> None:
         self._W, self._R_root, self._origin = W, R_root, origin
-        self._contacts = self._contact_points(corners)
+        self._contacts = self._contact_points(points)
 
     def pose(self) -> BodyPose:
         """The estimated pose now."""
@@ -174,26 +228,30 @@ class BodyPoseEstimator:
         root = np.eye(4)
         root[:3, :3] = self._R_root
         root[:3, 3] = self._origin
-        points = self._W[:, :3, 3] + self._origin
+        points = self._points.centre_points(self._W) + self._origin
         self._chassis = virtual_chassis(points, self._chassis, points[-1] - points[0])
-        return BodyPose(root=root, chassis=self._chassis)
+        return BodyPose(root=root, chassis=self._chassis, body_in_root=self._body_in_root)
 
     # --- the estimate ----------------------------------------------------------------------------------
-    def reset(self, q: np.ndarray, R_imu: npt.ArrayLike, root_xy: npt.ArrayLike, root_yaw: float | None = None) -> BodyPose:
-        """Start from joint angles q (n,), the IMU's world orientation (3, 3) and the root frame's known planar
-        position (x, y) m; with ``root_yaw`` (rad, the known heading of the root frame's x-axis), the IMU's heading
-        is corrected onto it from now on (a gyro's heading is only relative)."""
-        root_xy = finite_array(root_xy, "root_xy", (2,))
+    def reset(self, q: np.ndarray, R_imu: npt.ArrayLike, body_xy: npt.ArrayLike, body_yaw: float | None = None) -> BodyPose:
+        """Start from joint angles q (n,), the IMU's world orientation (3, 3) and the body frame's known planar
+        position (x, y) m (a :class:`BasePlacement`'s x and y); with ``body_yaw`` (rad, the known heading of the
+        body frame's x-axis: the placement's yaw), the IMU's heading is corrected onto it from now on (a gyro's
+        heading is only relative)."""
+        body_xy = finite_array(body_xy, "body_xy", (2,))
         self._heading_correction = np.eye(3)
-        if root_yaw is not None:
-            _, R_root = self._boxes(q, R_imu)
-            a = float(finite_array(root_yaw, "root_yaw", ())) - math.atan2(R_root[1, 0], R_root[0, 0])
+        if body_yaw is not None:
+            _, R_root = self._links(q, R_imu)
+            R_body = R_root @ self._body_in_root[:3, :3]
+            a = float(finite_array(body_yaw, "body_yaw", ())) - math.atan2(R_body[1, 0], R_body[0, 0])
             self._heading_correction = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0],
                                                  [0.0, 0.0, 1.0]])
-        W, R_root = self._boxes(q, R_imu)
-        corners = self._corners(W)
+        W, R_root = self._links(q, R_imu)
+        points = self._points.world(W)
+        offset = R_root @ self._body_in_root[:3, 3]  # the body frame's origin from the root's, world axes
         self._chassis = None
-        self._remember(W, R_root, np.array([root_xy[0], root_xy[1], -corners[..., 2].min()]), corners)
+        self._remember(W, R_root, np.array([body_xy[0] - offset[0], body_xy[1] - offset[1], -points[:, 2].min()]),
+                       points)
         return self.pose()
 
     def update(self, q: np.ndarray, R_imu: npt.ArrayLike) -> None:
@@ -201,15 +259,15 @@ class BodyPoseEstimator:
         by the contact odometry (see the module; :meth:`pose` reads it)."""
         if self._W is None:
             raise RuntimeError("call reset() with the starting pose before update()")
-        W, R_root = self._boxes(q, R_imu)
-        corners = self._corners(W)
-        boxes, local, weights = self._contacts
+        W, R_root = self._links(q, R_imu)
+        points = self._points.world(W)
+        links, local, weights = self._contacts
         origin = self._origin.copy()
-        if boxes.size:
-            shift = self._world_points(self._W, boxes, local) - self._world_points(W, boxes, local)
+        if links.size:
+            shift = self._world_points(self._W, links, local) - self._world_points(W, links, local)
             if self.odometry == "friction":
-                origin[:2] += balance_translation(shift[:, :2], weights * self._masses[boxes])
+                origin[:2] += balance_translation(shift[:, :2], weights * self._masses[links])
             else:
                 origin[:2] += weights @ shift[:, :2] / weights.sum()
-        origin[2] = -corners[..., 2].min()
-        self._remember(W, R_root, origin, corners)
+        origin[2] = -points[:, 2].min()
+        self._remember(W, R_root, origin, points)

@@ -50,7 +50,7 @@ def joint_gravity_torques(robot: SnakeRobot) -> np.ndarray:
     out horizontally (q = 0): g sum_i m_i r_ij, r_ij the distance of link i's centre of mass from the axis."""
     robot = as_robot(robot)
     n = robot.n_joints
-    F = robot.body.fk_all(np.zeros(n))  # frames in the root frame
+    F = np.linalg.inv(robot.body_in_root) @ robot.body.fk_all(np.zeros(n))  # frames in the body frame (joint_axes')
     child = np.asarray(robot.body.model.joint_child_links, int)
     masses = np.asarray(robot.masses, float)
     com = np.einsum("lij,lj->li", F[:, :3, :3], robot.coms) + F[:, :3, 3]

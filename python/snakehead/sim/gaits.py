@@ -29,7 +29,7 @@ import numpy as np
 from .._validate import finite_array, finite_float, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..motion.gaits import Gait, virtual_chassis
-from .estimate import BodyPose, BodyPoseEstimator, pose_error
+from .estimate import BodyPose, BodyPoseEstimator, ShapePoints, pose_error
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
 from .tracking import SimState, _gains
@@ -46,8 +46,9 @@ class GaitRun:
     truth: the body's pose at the end (:class:`~snakehead.sim.estimate.BodyPose`), estimated and true; start_truth:
     the true pose at the start. t (T,) s, q / q_ref (T, n) rad: recorded every ``record_every`` control ticks;
     chassis_truth / chassis_estimate (T, 3) m: the virtual chassis' origin; heading_truth / heading_estimate (T,)
-    rad; height (T,) m: the highest point of any box above the ground; contact_fraction (T,): the share of the boxes
-    touching the ground; root_truth / root_estimate (T, 4, 4): the root frame's world pose.
+    rad; height (T,) m: the highest point of the collision shapes above the ground; contact_fraction (T,): the share of
+    the links with shapes touching the ground (within 3 mm); root_truth / root_estimate (T, 4, 4): the root frame's
+    world pose.
     """
 
     gait: Gait | None
@@ -141,7 +142,8 @@ class GaitSimulator:
         self.imu_yaw_drift = math.radians(finite_float(imu_yaw_drift_deg_per_s, "imu_yaw_drift_deg_per_s"))
         self.time = 0.0  # simulated time (s) of the state in ``data``
         self._imu_body = int(self.sim.body_ids[self.estimator.imu_index])
-        self._box_bodies = self.sim.body_ids[self.robot.boxed_links]
+        self._points = ShapePoints(self.robot)
+        self._shape_bodies = self.sim.body_ids[self._points.links]
 
     # --- states -------------------------------------------------------------------------------------
     def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
@@ -197,20 +199,24 @@ class GaitSimulator:
         rb = self.sim.root_body
         root[:3, :3] = d.xmat[rb].reshape(3, 3)
         root[:3, 3] = d.xpos[rb]
-        points = d.xpos[self._box_bodies] + np.einsum(
-            "kij,kj->ki", d.xmat[self._box_bodies].reshape(-1, 3, 3),
-            self.robot.box_origins[self.robot.boxed_links][:, :3, 3])
+        points = self._points.centre_points(self._shape_frames())
         chassis = virtual_chassis(points, None if previous is None else previous.chassis, points[-1] - points[0])
-        return BodyPose(root=root, chassis=chassis)
+        return BodyPose(root=root, chassis=chassis, body_in_root=self.robot.body_in_root)
 
-    def _box_heights(self) -> tuple[float, float]:
-        """(highest point of any box above the ground (m), share of boxes within 3 mm of it)."""
+    def _shape_frames(self) -> np.ndarray:
+        """World poses (k, 4, 4) of the links with collision shapes, now."""
         d = self.data
-        R = d.geom_xmat[self.sim.robot_geoms].reshape(-1, 3, 3)
-        half = self.sim.model.geom_size[self.sim.robot_geoms]
-        reach = np.einsum("kj,kj->k", np.abs(R[:, 2, :]), half)
-        z = d.geom_xpos[self.sim.robot_geoms, 2]
-        return float((z + reach).max()), float(np.mean(z - reach < 0.003))
+        F = np.zeros((len(self._shape_bodies), 4, 4))
+        F[:, :3, :3] = d.xmat[self._shape_bodies].reshape(-1, 3, 3)
+        F[:, :3, 3] = d.xpos[self._shape_bodies]
+        F[:, 3, 3] = 1.0
+        return F
+
+    def _shape_heights(self) -> tuple[float, float]:
+        """(highest point of the collision shapes above the ground (m), share of the shaped links whose lowest
+        point is within 3 mm of it)."""
+        z = self._points.world(self._shape_frames())[:, 2]
+        return float(z.max()), float(np.mean(self._points.lowest(z) < 0.003))
 
     # --- running a gait -----------------------------------------------------------------------------------
     def run(self, state: SimState, gait: Gait, cycles: float, *, rest_s: float = 0.5, record_every: int = 5,
@@ -282,7 +288,7 @@ class GaitSimulator:
 
         start_truth = truth = self.true_pose()
         est0 = start_truth if start_estimate is None else start_estimate
-        self.estimator.reset(self.joint_angles(), self.imu_orientation(), est0.root[:2, 3], est0.base.yaw)
+        self.estimator.reset(self.joint_angles(), self.imu_orientation(), (est0.base.x, est0.base.y), est0.base.yaw)
         estimate = self.estimator.pose()
         rec: dict[str, list] = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact", "rt",
                                                 "re")}
@@ -293,7 +299,7 @@ class GaitSimulator:
             if k % record_every == 0 or k == len(q_plan) - 1:
                 estimate = self.estimator.pose()
                 truth = self.true_pose(truth)
-                h, c = self._box_heights()
+                h, c = self._shape_heights()
                 rec["t"].append(self.time)
                 rec["q"].append(self.joint_angles())
                 rec["q_ref"].append(q_plan[k])

@@ -114,9 +114,9 @@ class PoseFix:
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = Rz @ R, p
         q = simulator.joint_angles()
-        root = T @ np.linalg.inv(robot.body.fk_all(q)[k])
-        yaw = math.atan2(root[1, 0], root[0, 0])
-        return simulator.estimator.reset(q, simulator.imu_orientation(), root[:2, 3], yaw)
+        body = T @ np.linalg.inv(robot.body.fk_all(q)[k]) @ robot.body_in_root  # the body frame's world pose
+        yaw = math.atan2(body[1, 0], body[0, 0])
+        return simulator.estimator.reset(q, simulator.imu_orientation(), body[:2, 3], yaw)
 
 
 @dataclass
@@ -368,7 +368,7 @@ class ClosedLoop:
     # --- running ---------------------------------------------------------------------------------------
     def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *, believed_start: BasePlacement | None = None,
             progress: Callable[[str], None] | None = None) -> LoopRun:
-        """Run the loop from the body lying at ``start`` (the root frame's placement) with joints ``q_start``
+        """Run the loop from the body lying at ``start`` (the body frame's placement) with joints ``q_start``
         (default straight; a flat shape: pitch joints 0). The loop knows where the body starts
         (``believed_start``, default ``start``; give another to start from a wrong belief). ``progress``: called
         with a line of text at every step."""

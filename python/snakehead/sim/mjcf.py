@@ -22,7 +22,7 @@ it), generated from the robot's own data, not from the URDF importer:
   placement, whatever axis the URDF's links run along;
 * a ground plane at z = 0 (Coulomb friction ``friction``, default 0.8) and the scene's obstacles
   (:mod:`snakehead.geometry.obstacles`; a wall's round hole becomes a staircase of boxes inscribed in it,
-  :func:`obstacle_boxes`). The robot's shapes collide with the ground and the
+  :func:`obstacle_boxes`; a mesh obstacle is a mesh of its convex hull). The robot's shapes collide with the ground and the
   obstacles; not with each other unless ``self_collision=True`` (parent/child pairs never);
 * timestep 1 ms (physics) under the 2 ms control period of the paper; integrator ``implicitfast``;
   contact ``solref = (0.005 s, 1)`` (stiff: the resting body sinks ~1 um into the ground);
@@ -59,7 +59,7 @@ from typing import Sequence
 import numpy as np
 
 from .._validate import duration, finite_array, non_negative, positive
-from ..geometry.obstacles import BoxObstacle, WallWithHole
+from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from .gains import default_torque_limits
 
@@ -95,7 +95,8 @@ DEFAULT_HOLE_SLICES = 32
 
 
 def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLICES) -> list[BoxObstacle]:
-    """The scene's obstacles as MuJoCo can collide them: boxes.
+    """The scene's box-like obstacles as MuJoCo can collide them: boxes (a
+    :class:`~snakehead.geometry.obstacles.MeshObstacle` is left out: :func:`build_spec` adds it as a mesh of its hull).
 
     A :class:`~snakehead.geometry.obstacles.WallWithHole` becomes the boxes of the wall around its hole, the round
     hole approximated by ``hole_slices`` strips across it, each leaving the narrowest chord of the circle in its
@@ -110,8 +111,8 @@ def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLI
             out.append(ob)
         elif isinstance(ob, WallWithHole):
             out += _wall_boxes(ob, int(hole_slices))
-        else:
-            raise TypeError(f"obstacles must be BoxObstacle or WallWithHole, got {type(ob).__name__}")
+        elif not isinstance(ob, MeshObstacle):
+            raise TypeError(f"obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got {type(ob).__name__}")
     return out
 
 
@@ -297,6 +298,11 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
         world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
                        quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
                        conaffinity=1, **surface)
+    for k, ob in enumerate(o for o in obstacles if isinstance(o, MeshObstacle)):
+        mesh = spec.add_mesh(name=f"obstacle_hull_{k}", uservert=np.asarray(ob.vertices, float).reshape(-1).tolist())
+        mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+        world.add_geom(name=f"obstacle_{len(boxes) + k}", type=mj.mjtGeom.mjGEOM_MESH, meshname=mesh.name,
+                       pos=ob.pose[:3, 3], quat=_quat_array(ob.pose[:3, :3]), contype=0, conaffinity=1, **surface)
     shapes_on: dict[int, list[int]] = {}
     for k, shape in enumerate(robot.geometry.shapes):
         shapes_on.setdefault(int(shape.frame), []).append(k)
@@ -359,7 +365,8 @@ class SimModel:
     spec: object = None  #: the mujoco.MjSpec it was compiled from (``spec.to_xml()`` to read it)
 
     def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
-        """Put the root at ``base`` (raised by ``lift`` m) and the joints at ``q``; zero velocities; kinematics."""
+        """Put the body frame at ``base`` (the root link at ``robot.root_pose(base)``, raised by ``lift`` m) and the
+        joints at ``q``; zero velocities; kinematics."""
         mj = _mujoco()
         T = self.robot.root_pose(base)
         data.qpos[:] = 0.0

@@ -345,8 +345,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     Wref = carried_weights(robot, robot.frames_many(q_ref, base)) if mode == "supported" else None
 
     head_k = robot.body.link_index(robot.parts.head_tip)
-    base_last = int(robot.body.model.joint_child_links[robot.parts.base.stop - 1])
-    base_frames = sim.body_ids[:base_last + 2]  # base links and the base_end marker (distal end of the last)
+    base_frames = sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]  # the base's frames up to base_end (P0)
     rec = {k: np.zeros((N, 3)) for k in ("P", "L", "com")}
     qs, qds, taus = np.zeros((N, n)), np.zeros((N, n)), np.zeros((N, n))
     head = np.zeros((N, 4, 4))

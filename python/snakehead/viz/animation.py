@@ -1,4 +1,4 @@
-"""A plan's motion as an animated GIF: the body's collision boxes moving through the scene.
+"""A plan's motion as an animated GIF: the body's collision shapes moving through the scene.
 
 :func:`animate` returns a :class:`BodyAnimation`; :func:`snakehead.viz.save` writes it (``NAME.gif``).
 

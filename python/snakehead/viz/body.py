@@ -1,4 +1,4 @@
-"""Figures of the body in 3-D: its collision boxes coloured by part, with the scene's targets and obstacles.
+"""Figures of the body in 3-D: its collision shapes coloured by part, with the scene's targets and obstacles.
 
 * :func:`plot_snapshots` -- Figs. 17 and 22: the whole body at a plan's key states, one panel per state.
 * :func:`plot_head_solution` -- one :class:`~snakehead.control.HeadController` solution: the robot at it and the
@@ -6,14 +6,18 @@
 * :func:`plot_interpolation_comparison` -- Fig. 11 against Fig. 13: a joint-space interpolation that drives the
   head into the ground beside the Cartesian interpolation of Eqs. 41-44 that does not.
 
-The geometry the figures, the animation and the 3-D viewer share: :func:`body_faces` (the boxes' faces),
-:func:`wall_faces` (a wall with a hole), :func:`part_colors` (base grey, neck orange, head blue).
+The geometry the figures, the animation and the 3-D viewer share: :func:`body_faces` (the faces of every collision
+shape: boxes, cylinders, spheres, mesh hulls, from :func:`snakehead.geometry.shapes.shape_mesh`, coplanar triangles
+merged into one polygon, so that a box is drawn as its six faces), :func:`shape_footprints` (the shapes seen from
+above), :func:`box_faces` and :func:`mesh_obstacle_faces` (obstacles), :func:`wall_faces` (a wall with a hole), :func:`part_colors` (base grey,
+neck orange, head blue).
 
 Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`. Positions in
 m, times in s, world frame with z up and the ground at z = 0.
 """
 from __future__ import annotations
 
+import weakref
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
@@ -21,11 +25,17 @@ import numpy.typing as npt
 from matplotlib.figure import Figure
 
 from ..geometry import collision as coll
-from ..geometry.obstacles import WallWithHole
+from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
+from ..geometry.shapes import shape_mesh
 from ..model.robot import BasePlacement, SnakeRobot
 from ..motion.cartesian import cartesian_interpolation
 from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, literal, new_figure,
                       setup_axes3d)
+
+#: Colour of box obstacles in the figures.
+OBSTACLE_COLOR = "#8d6e63"
+#: Segments around a cylinder's or a sphere's axis in the figures.
+FIGURE_SEGMENTS = 16
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -40,9 +50,6 @@ Sphere = tuple[npt.ArrayLike, float]
 _JOINT_SPACE = "#c0392b"
 _CARTESIAN = "#1f77b4"
 
-# unit cube corners (8, 3) and its faces (6, 4) as corner indices
-_CORNERS = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
-_FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -56,18 +63,144 @@ def part_colors(robot: SnakeRobot) -> list[str]:
     return [BASE_COLOR if i <= base_end else NECK_COLOR if i <= neck_end else HEAD_COLOR for i in range(len(names))]
 
 
-def body_faces(robot: SnakeRobot, frames: npt.ArrayLike) -> tuple[np.ndarray, list[str]]:
-    """The faces of every collision box: (B * 6, 4, 3) world corners (m) and one colour per face.
+def convex_facets(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
+    """The faces of a convex triangle mesh as polygons: each plane's triangles merged into one polygon, its corners
+    (indices into ``vertices``) in order around it, points inside it or on its edges left out (a box's 12 triangles
+    are its 6 faces; a cylinder's caps are two polygons)."""
+    v = np.asarray(vertices, float)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    scale = max(float(np.ptp(v, axis=0).max()) if len(v) else 0.0, 1e-12)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(b - a, c - a)
+    norm = np.linalg.norm(n, axis=1)
+    good = norm > 1e-12 * scale * scale
+    f, n, a = f[good], n[good] / norm[good, None], a[good]
+    n *= np.where(np.einsum("ij,ij->i", n, a - v.mean(axis=0)) < 0, -1.0, 1.0)[:, None]  # outward, whatever the winding
+    d = np.einsum("ij,ij->i", n, a)
+    planes: list[tuple[np.ndarray, float, list[int]]] = []
+    for i in range(len(f)):
+        for pn, pd, members in planes:
+            if np.abs(pn - n[i]).max() < 1e-6 and abs(pd - d[i]) < 1e-6 * scale:
+                members.append(i)
+                break
+        else:
+            planes.append((n[i], float(d[i]), [i]))
+    out = []
+    for pn, _, members in planes:
+        idx = np.unique(f[members])
+        u = np.cross(pn, [1.0, 0.0, 0.0] if abs(pn[0]) < 0.9 else [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        w = np.cross(pn, u)
+        out.append(idx[_hull_2d(np.column_stack([v[idx] @ u, v[idx] @ w]), 1e-9 * scale)])
+    return out
 
-    frames (L, 4, 4): world poses of ``robot.link_names`` (``robot.frames``); frames without a box are skipped.
+
+def _hull_2d(p: np.ndarray, tol: float) -> np.ndarray:
+    """Indices of the corners of the convex hull of 2-D points (k, 2), in order around it (monotone chain)."""
+    order = np.lexsort((p[:, 1], p[:, 0]))
+
+    def half(seq: np.ndarray) -> list[int]:
+        chain: list[int] = []
+        for i in seq:
+            while len(chain) >= 2:
+                o, a = p[chain[-2]], p[chain[-1]]
+                if (a[0] - o[0]) * (p[i][1] - o[1]) - (a[1] - o[1]) * (p[i][0] - o[0]) > tol * tol:
+                    break
+                chain.pop()
+            chain.append(int(i))
+        return chain
+
+    lower, upper = half(order), half(order[::-1])
+    return np.array(lower[:-1] + upper[:-1] if len(order) > 2 else list(order), dtype=np.int64)
+
+
+class _BodyDrawing:
+    """The polygons of every collision shape of a robot in its link frames (made once per robot: see
+    :func:`_drawing`): ``vertices`` (V, 3), the frame of each (``vertex_frame`` (V,)), ``polygons`` (index arrays
+    into the vertices) and the shape of each polygon (``polygon_shape``)."""
+
+    def __init__(self, robot: SnakeRobot, segments: int) -> None:
+        geometry = robot.geometry
+        verts, frames, polys, owner, shape_vertices = [], [], [], [], []
+        start = 0
+        for k, shape in enumerate(geometry.shapes):
+            v, f = shape_mesh(shape, segments, hull=geometry, index=k)
+            for poly in convex_facets(v, f):
+                polys.append(poly + start)
+                owner.append(k)
+            verts.append(v)
+            frames.append(np.full(len(v), shape.frame))
+            shape_vertices.append(np.arange(start, start + len(v)))
+            start += len(v)
+        self.vertices = np.concatenate(verts) if verts else np.zeros((0, 3))
+        self.vertex_frame = np.concatenate(frames) if frames else np.zeros(0, np.int64)
+        self.polygons = polys
+        self.polygon_shape = np.array(owner, dtype=np.int64)
+        self.shape_vertices = shape_vertices
+        self.shape_frames = np.array([s.frame for s in geometry.shapes], dtype=np.int64)
+
+    def world(self, frames: np.ndarray) -> np.ndarray:
+        F = frames[self.vertex_frame]
+        return np.einsum("vij,vj->vi", F[:, :3, :3], self.vertices) + F[:, :3, 3]
+
+
+_DRAWINGS: "weakref.WeakKeyDictionary[SnakeRobot, dict[int, _BodyDrawing]]" = weakref.WeakKeyDictionary()
+
+
+def _drawing(robot: SnakeRobot, segments: int = FIGURE_SEGMENTS) -> _BodyDrawing:
+    per_robot = _DRAWINGS.setdefault(robot, {})
+    if segments not in per_robot:
+        per_robot[segments] = _BodyDrawing(robot, segments)
+    return per_robot[segments]
+
+
+def body_faces(robot: SnakeRobot, frames: npt.ArrayLike) -> tuple[list[np.ndarray], list[str]]:
+    """The faces of every collision shape (boxes, cylinders, spheres, mesh hulls): a list of polygons, each (k, 3)
+    world corners (m), and one colour per polygon (its link's part). A box gives its 6 faces, a cylinder its
+    :data:`FIGURE_SEGMENTS` sides and two caps.
+
+    frames (L, 4, 4): world poses of ``robot.link_names`` (``robot.frames``); frames without shapes draw nothing.
     """
     frames = np.asarray(frames, float)
-    boxed = robot.boxed_links
-    B = frames[boxed] @ robot.box_origins[boxed]  # (B, 4, 4)
-    corners = B[:, None, :3, 3] + np.einsum("bij,bkj->bki", B[:, :3, :3], _CORNERS[None] * robot.box_sizes[boxed, None])
-    faces = corners[:, _FACES].reshape(-1, 4, 3)
+    drawing = _drawing(robot)
+    W = drawing.world(frames)
     colors = part_colors(robot)
-    return faces, [colors[i] for i in boxed for _ in range(6)]
+    shape_color = [colors[int(f)] for f in drawing.shape_frames]
+    return [W[p] for p in drawing.polygons], [shape_color[int(k)] for k in drawing.polygon_shape]
+
+
+def shape_footprints(robot: SnakeRobot, frames: npt.ArrayLike, links: npt.ArrayLike | None = None) -> list[np.ndarray]:
+    """Each collision shape of ``links`` (default all) seen from above: its outline (k, 2) m in the ground plane,
+    in order around it, at ``frames`` (L, 4, 4)."""
+    frames = np.asarray(frames, float)
+    drawing = _drawing(robot)
+    W = drawing.world(frames)
+    keep = np.arange(len(drawing.shape_frames)) if links is None else \
+        np.flatnonzero(np.isin(drawing.shape_frames, np.asarray(links)))
+    out = []
+    for k in keep:
+        xy = W[drawing.shape_vertices[int(k)], :2]
+        scale = max(float(np.ptp(xy, axis=0).max()), 1e-12)
+        out.append(xy[_hull_2d(xy, 1e-9 * scale)])
+    return out
+
+
+_BOX_CORNERS = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+_BOX_QUADS = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
+
+
+def mesh_obstacle_faces(mesh: MeshObstacle) -> list[np.ndarray]:
+    """A mesh obstacle's hull as its faces: a list of polygons (k, 3) of world corners (m)."""
+    from scipy.spatial import ConvexHull
+
+    v = mesh.world_vertices
+    return [v[p] for p in convex_facets(v, ConvexHull(v).simplices)]
+
+
+def box_faces(box: BoxObstacle) -> np.ndarray:
+    """A box obstacle's six faces: (6, 4, 3) world corners (m)."""
+    corners = box.centre + (_BOX_CORNERS * np.asarray(box.size, float)) @ np.asarray(box.rotation, float).T
+    return corners[_BOX_QUADS]
 
 
 def wall_faces(wall: WallWithHole, n: int = 64) -> np.ndarray:
@@ -132,6 +265,10 @@ def scene_bounds(plan: Plan, spheres: Sequence[Sphere] = (), margin: float = 0.0
             half = ob.size[:2] / 2
             corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half + ob.hole_offset
             extra.append(ob.centre + corners @ R[:, :2].T)
+        elif isinstance(ob, BoxObstacle):
+            extra.append(box_faces(ob).reshape(-1, 3))
+        elif isinstance(ob, MeshObstacle):
+            extra.append(ob.world_vertices)
     allp = np.vstack(extra)
     return allp.min(axis=0) - margin, allp.max(axis=0) + margin
 
@@ -142,7 +279,8 @@ def view_angles(plan: Plan) -> tuple[float, float]:
 
 
 def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: bool = True) -> None:
-    """The spheres, the plan's walls (with the hole's rim) and, with ``arrows``, each target along its direction."""
+    """The spheres, the plan's obstacles (boxes; walls with the hole's rim) and, with ``arrows``, each target as an
+    arrow along its direction ending at the target."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     for centre, diameter in spheres:
@@ -153,20 +291,26 @@ def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: b
             ax.add_collection3d(Poly3DCollection(wall_faces(ob), facecolor=WALL_COLOR, edgecolor="none", alpha=0.35))
             rim = hole_rim(ob)
             ax.plot(rim[:, 0], rim[:, 1], rim[:, 2], "-", color="k", lw=1.0)
+        elif isinstance(ob, (BoxObstacle, MeshObstacle)):
+            faces = box_faces(ob) if isinstance(ob, BoxObstacle) else mesh_obstacle_faces(ob)
+            ax.add_collection3d(Poly3DCollection(faces, facecolor=OBSTACLE_COLOR, edgecolor="k", linewidths=0.3,
+                                                 alpha=0.45), autolim=False)  # faces of several sizes: no autoscale
     if arrows:
         for tg in plan.targets:
-            p, d = tg.position, 0.08 * tg.direction
+            d = 0.08 * np.asarray(tg.direction, float)
+            p = np.asarray(tg.position, float) - d  # the arrow ends at the target
             ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.0, arrow_length_ratio=0.3)
 
 
 def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
-    """The collision boxes at ``frames`` (L, 4, 4) as one collection (returned, so that it can be moved)."""
+    """The collision shapes at ``frames`` (L, 4, 4) as one collection of polygons (returned, so that it can be
+    moved: ``set_verts(body_faces(robot, frames)[0])``)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     faces, colors = body_faces(robot, frames)
-    boxes = Poly3DCollection(faces, facecolors=colors, edgecolors="k", linewidths=0.15, alpha=alpha)
-    ax.add_collection3d(boxes)
-    return boxes
+    shapes = Poly3DCollection(faces, facecolors=colors, edgecolors="k", linewidths=0.15, alpha=alpha)
+    ax.add_collection3d(shapes, autolim=False)  # polygons of several sizes (NaN-padded): the caller sets the limits
+    return shapes
 
 
 def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
@@ -179,6 +323,8 @@ def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
     wall = next((o for o in plan.obstacles if isinstance(o, WallWithHole)), None)
     if wall is not None:
         handles.append(Patch(color=WALL_COLOR, alpha=0.35, label=f"wall, hole {1000 * wall.hole_diameter:.0f} mm"))
+    if any(isinstance(o, (BoxObstacle, MeshObstacle)) for o in plan.obstacles):
+        handles.append(Patch(color=OBSTACLE_COLOR, alpha=0.45, label="obstacles"))
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
 
 
@@ -209,9 +355,9 @@ def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np
 def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_panels: int = 12, columns: int = 4,
                    title: str = "") -> Figure:
     """Figs. 17 / 22: the body in 3-D at up to ``n_panels`` states of ``plan`` (see :func:`snapshot_states`),
-    base grey, neck orange, head blue (collision boxes), with the scenery: ``spheres`` [(centre (3,) m, diameter
-    m)] (default: the plan's scene's, :func:`plan_spheres`), the plan's walls, and each head target as an arrow
-    along its direction. Equal axis scales."""
+    base grey, neck orange, head blue (collision shapes), with the scenery: ``spheres`` [(centre (3,) m, diameter
+    m)] (default: the plan's scene's, :func:`plan_spheres`), the plan's obstacles (boxes and walls), and each head
+    target as an arrow along its direction. Equal axis scales."""
     robot = plan.robot
     spheres = plan_spheres(plan) if spheres is None else list(spheres)
     picks = snapshot_states(plan, n_panels)
@@ -222,7 +368,7 @@ def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_pan
     for k, (label, time, q) in enumerate(picks):
         ax = fig.add_subplot(rows, columns, k + 1, projection="3d", computed_zorder=False)
         setup_axes3d(ax, lo, hi, elev, azim, labels=False, zoom=1.2)
-        draw_scenery(ax, plan, spheres, arrows=not spheres and not plan.obstacles)
+        draw_scenery(ax, plan, spheres)
         draw_body(ax, robot, robot.frames(q, plan.base))
         tip = robot.head_pose(q, plan.base)[:3, 3]
         ax.scatter(*tip, color="k", s=6)
@@ -341,21 +487,22 @@ def _draw_snapshots(ax: Axes3D, robot: SnakeRobot, qs: np.ndarray, base: BasePla
     worst_i = int(np.argmin(worst))
     p = pts[worst_i, n_base:]
     ax.plot(p[:, 0], p[:, 1], p[:, 2], "-", color=color, lw=3.5, label=f"lowest ({1000 * worst[worst_i]:.0f} mm)")
-    # box corners below the ground, over the whole motion
+    # the shapes' lowest points below the ground, over the whole motion
     below = clear < -coll.GROUND_TOLERANCE
     if below.any():
-        ti, li = np.nonzero(below)
-        corners = robot.box_corners(frames, np.arange(len(robot.link_names)))[ti, li].reshape(-1, 3)
-        corners = corners[corners[:, 2] < 0]
-        ax.scatter(corners[:, 0], corners[:, 1], corners[:, 2], s=2, color="k", alpha=0.3,
-                   label="box corners in the ground")
+        ti = np.unique(np.nonzero(below)[0])
+        points, _ = robot.lowest_points(frames[ti])
+        points = points.reshape(-1, 3)
+        points = points[points[:, 2] < -coll.GROUND_TOLERANCE]
+        ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=2, color="k", alpha=0.3,
+                   label="shape points in the ground")
     return picks
 
 
 def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, *,
                                   base: BasePlacement | None = None, n: int = 200) -> Figure:
     """Fig. 11 vs Fig. 13: the same start and end (n,) rad, interpolated in joint space (left) and by Eqs. 41-44
-    (middle) in ``n`` steps; right: the lowest point of the neck's and head's collision boxes over the motion."""
+    (middle) in ``n`` steps; right: the lowest point of the neck's and head's collision shapes over the motion."""
     base = BasePlacement() if base is None else base
     q_start = np.asarray(q_start, float)
     q_end = np.asarray(q_end, float)
@@ -371,8 +518,8 @@ def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_e
     lo, hi = allp.min(axis=0) - 0.05, allp.max(axis=0) + 0.05
     span = (hi - lo).max()
     for k, (qs, color, title) in enumerate([
-            (q_joint, _JOINT_SPACE, f"Fig. 11: joint-space interpolation\nlowest box point {1000 * cj.min():.0f} mm"),
-            (q_cart, _CARTESIAN, f"Fig. 13: Cartesian interpolation (Eqs. 41-44)\nlowest box point "
+            (q_joint, _JOINT_SPACE, f"Fig. 11: joint-space interpolation\nlowest shape point {1000 * cj.min():.0f} mm"),
+            (q_cart, _CARTESIAN, f"Fig. 13: Cartesian interpolation (Eqs. 41-44)\nlowest shape point "
                                  f"{1000 * cc.min():.1f} mm, joints stray <= {1000 * res.max_deviation:.0f} mm")]):
         ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
         X, Y = np.meshgrid(np.linspace(lo[0], lo[0] + span, 2), np.linspace(lo[1], lo[1] + span, 2))
@@ -394,7 +541,7 @@ def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_e
     ax.axhline(0, color=GROUND_COLOR, lw=1.5)
     ax.fill_between(s, 1000 * np.minimum(cj, 0), 0, color=_JOINT_SPACE, alpha=0.2, label="in the ground")
     ax.set_xlabel("interpolation parameter $t_j$ (Eq. 41)")
-    ax.set_ylabel("lowest point of neck and head boxes (mm)")
+    ax.set_ylabel("lowest point of neck and head shapes (mm)")
     ax.set_title("clearance of the neck and head above the ground", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=9)
@@ -402,6 +549,6 @@ def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_e
     return fig
 
 
-__all__ = ["part_colors", "body_faces", "wall_faces", "hole_rim", "plan_spheres", "scene_bounds", "view_angles",
-           "draw_scenery", "draw_body", "body_points", "snapshot_states", "plot_snapshots", "plot_head_solution",
-           "plot_interpolation_comparison"]
+__all__ = ["part_colors", "body_faces", "convex_facets", "shape_footprints", "box_faces", "mesh_obstacle_faces",
+           "wall_faces", "hole_rim", "plan_spheres", "scene_bounds", "view_angles", "draw_scenery", "draw_body",
+           "body_points", "snapshot_states", "plot_snapshots", "plot_head_solution", "plot_interpolation_comparison"]

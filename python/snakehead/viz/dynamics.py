@@ -72,13 +72,10 @@ def plot_momenta(t: npt.ArrayLike, P: npt.ArrayLike, L: npt.ArrayLike, *, simula
 
 
 def _base_footprint(ax: Any, robot: SnakeRobot, frames: np.ndarray) -> None:
-    """The base's boxes seen from above (grey)."""
-    for li in robot.base_links:
-        if not np.all(robot.box_sizes[li] > 0):
-            continue
-        B = frames[li] @ robot.box_origins[li]
-        h = robot.box_sizes[li] / 2
-        xy = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * h[:2] @ B[:2, :2].T + B[:2, 3]
+    """The base's collision shapes seen from above (grey)."""
+    from .body import shape_footprints
+
+    for xy in shape_footprints(robot, frames, robot.base_links):
         ax.fill(xy[:, 0], xy[:, 1], color="0.85", ec="0.6", lw=0.8, zorder=1)
 
 

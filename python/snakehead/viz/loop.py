@@ -26,21 +26,23 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .._files import atomic_open
+from .body import body_faces
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
 KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41"}
 PART_COLORS = ("#7f8c8d", "#e67e22", "#2e86c1")  # base, neck, head
 TARGET_COLOR = "#c0392b"
 
-# faces of a box as indices of the corners in robot.box_corners' order (x, y, z signs: -,-,- first, z fastest)
-_FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
+def _part_colors(robot: SnakeRobot, per_polygon: bool = False) -> list[str]:
+    """A colour per collision shape (of ``robot.geometry``), or per polygon of
+    :func:`snakehead.viz.body.body_faces` (this module's palette)."""
+    from .body import _drawing
 
-
-def _part_colors(robot: SnakeRobot) -> list[str]:
     names = robot.link_names
     base_end, neck_end = names.index(robot.parts.base_end), names.index(robot.parts.neck_end)
-    return [PART_COLORS[0] if i <= base_end else PART_COLORS[1] if i <= neck_end else PART_COLORS[2]
-            for i in robot.boxed_links]
+    d = _drawing(robot)
+    frame = d.shape_frames[d.polygon_shape] if per_polygon else d.shape_frames
+    return [PART_COLORS[0] if i <= base_end else PART_COLORS[1] if i <= neck_end else PART_COLORS[2] for i in frame]
 
 
 def _frames(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -48,10 +50,11 @@ def _frames(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
     return root[:, None] @ robot.body.fk_all_many(q)
 
 
-def _footprint(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
-    """The boxes' outlines seen from above, (k, 4, 2): each box's bottom face."""
-    corners = robot.box_corners(frames[None])[0]  # (k, 8, 3)
-    return corners[:, [0, 2, 6, 4], :2]  # the -z face, in order around it
+def _footprint(robot: SnakeRobot, frames: np.ndarray) -> list[np.ndarray]:
+    """The collision shapes' outlines seen from above: one (k, 2) polygon per shape."""
+    from .body import shape_footprints
+
+    return shape_footprints(robot, frames)
 
 
 def _check(run: Any) -> None:
@@ -150,8 +153,7 @@ class LoopAnimation:
         canvas = FigureCanvasAgg(self.figure)
         body, clock = self._artists
         for k in range(len(self)):
-            corners = self._robot.box_corners(self._frames[k][None])[0]
-            body.set_verts(corners[:, _FACES].reshape(-1, 4, 3))
+            body.set_verts(body_faces(self._robot, self._frames[k])[0])
             clock.set_text(self._labels[k])
             canvas.draw()
             w, h = canvas.get_width_height()
@@ -197,7 +199,8 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
         ph = next((p for p in run.phases if p.t0_s - 1e-9 <= t[k] <= p.t1_s + 1e-9), run.phases[-1])
         labels.append(f"{run.scene.name}: t = {t[k]:5.1f} s, {ph.kind}: {ph.name}  (x{speedup:.0f} speed)")
     # the scene's extent: every body position and the targets, the ground up to the highest point
-    pts = robot.box_corners(frames).reshape(-1, 3)
+    pts = robot.lowest_points(frames)[0].reshape(-1, 3)
+    pts = np.vstack([pts, frames[:, :, :3, 3].reshape(-1, 3)])
     pts = np.vstack([pts] + [tg.position[None] for tg in run.scene.targets])
     lo, hi = pts.min(axis=0) - 0.05, pts.max(axis=0) + 0.05
     lo[2] = 0.0
@@ -217,11 +220,9 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
     ax.plot(path[:, 0], path[:, 1], np.zeros(len(path)), ":", color="k", lw=0.8)
     for tg in run.scene.targets:
         ax.scatter(*tg.position, color=TARGET_COLOR, s=12, depthshade=False)
-    colors = np.repeat(_part_colors(robot), len(_FACES))
-    corners = robot.box_corners(frames[:1])[0]
-    body = Poly3DCollection(corners[:, _FACES].reshape(-1, 4, 3), facecolors=colors, edgecolors="k",
+    body = Poly3DCollection(body_faces(robot, frames[0])[0], facecolors=_part_colors(robot, per_polygon=True), edgecolors="k",
                             linewidths=0.2, alpha=0.95)
-    ax.add_collection3d(body)
+    ax.add_collection3d(body, autolim=False)  # the limits are set above
     clock = fig.text(0.5, 0.97, labels[0], ha="center", va="top", fontsize=7)
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.95)
     return LoopAnimation(figure=fig, times=t[idx], fps=fps, _frames=frames, _labels=labels, _artists=(body, clock),

@@ -1,6 +1,7 @@
 """The interactive 3-D viewer (viser): a plan's motion in a web browser.
 
-What it shows: the robot's collision boxes (base grey, neck orange, head blue) moving along the planned motion,
+What it shows: the robot's collision shapes (boxes, cylinders, spheres, mesh hulls; base grey, neck orange, head
+blue) moving along the planned motion,
 with play/pause and a time slider; the targets (spheres or arrows along the desired direction); the obstacles; the
 support polygon and the zero-moment point's trace on the ground (with the ZMP and the centre of mass's ground
 projection now); the head tip's path; and the head's reachability map as voxels coloured by their index (the
@@ -33,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Sequence
 import numpy as np
 
 from .._files import atomic_open, read_npz, write_text_atomic
-from ..geometry.obstacles import BoxObstacle, WallWithHole
+from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
 
 if TYPE_CHECKING:
@@ -45,7 +46,7 @@ if TYPE_CHECKING:
 #: What :func:`save_viewer_scene` appends to a scenario's name.
 SCENE_SUFFIX = "_viewer.npz"
 #: Format of ``NAME_viewer.npz`` (stored in the file; :func:`load_viewer_scene` refuses other versions).
-SCENE_FORMAT = 1
+SCENE_FORMAT = 2
 #: s: default spacing of the viewer's frames along the motion (five frames per second of motion).
 FRAME_STEP_S = 0.2
 #: Colours (RGB 0-255) of what the viewer draws besides the robot (its parts: viz.body.part_colors).
@@ -64,31 +65,42 @@ CAMERA_VIEW_DEG = (24.0, -60.0)
 _CUBE_VERTICES = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)], np.float32)
 _CUBE_TRIANGLES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
                             [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], np.uint32)
+#: Segments around a cylinder's or a sphere's axis in the viewer.
+VIEWER_SEGMENTS = 24
 
 
 @dataclass
 class ViewerScene:
     """Everything the viewer draws, as arrays (m, s, world frame, z up; quaternions w, x, y, z).
 
-    Frames: ``times`` (F,) s; the K collision boxes' ``box_positions`` (F, K, 3) and ``box_wxyz`` (F, K, 4), with
-    ``box_sizes`` (K, 3) and ``box_colors`` (K, 3) RGB 0-255; ``head_tip`` (F, 3); ``map_frame_positions`` (F, 3)
+    Frames: ``times`` (F,) s; the K collision shapes' frames ``shape_positions`` (F, K, 3) and ``shape_wxyz``
+    (F, K, 4), each drawn as mesh ``shape_mesh`` (K,) scaled by ``shape_scales`` (K, 3) along its axes, in
+    ``shape_colors`` (K, 3) RGB 0-255; the G meshes in their own frames: ``mesh_vertices`` (MV, 3) and
+    ``mesh_triangles`` (MT, 3) (vertex indices within the mesh), mesh g's rows from ``mesh_vertex_starts[g]`` and
+    ``mesh_triangle_starts[g]`` to the next entries (G + 1,) (a unit cube for boxes, a unit cylinder of radius and
+    length 1 for cylinders, a unit sphere, each mesh's hull); ``head_tip`` (F, 3); ``map_frame_positions`` (F, 3)
     and ``map_frame_wxyz`` (F, 4): the head's base frame, in which the map's ``voxel_centers`` (V, 3) lie (edge
     ``voxel_size``; ``voxel_indices`` (V,) 0-100; V = 0 without a map). ``zmp`` (F, 2) and ``com`` (F, 3) at the
     frames; ``zmp_path`` (Z, 2): the planned ZMP along the whole motion. ``polygons`` (P, M, 2): the distinct
     support polygons, NaN-padded to M vertices; ``polygon_of_frame`` (F,) which one each frame stands on.
     Targets: ``target_positions`` / ``target_directions`` (N, 3), ``target_names`` (N,), ``target_diameters`` (N,)
     (NaN: drawn as an arrow). Obstacles: boxes ``obstacle_centres`` / ``obstacle_sizes`` (B, 3),
-    ``obstacle_wxyz`` (B, 4); walls as triangles ``wall_vertices`` (W, 3), ``wall_triangles`` (T, 3) and the holes'
-    rims ``hole_rims`` (H, 65, 3).
+    ``obstacle_wxyz`` (B, 4); walls (and mesh obstacles' hulls) as triangles ``wall_vertices`` (W, 3),
+    ``wall_triangles`` (T, 3) and the holes' rims ``hole_rims`` (H, 65, 3).
     """
 
     name: str
     title: str
     times: np.ndarray
-    box_positions: np.ndarray
-    box_wxyz: np.ndarray
-    box_sizes: np.ndarray
-    box_colors: np.ndarray
+    shape_positions: np.ndarray
+    shape_wxyz: np.ndarray
+    shape_scales: np.ndarray
+    shape_colors: np.ndarray
+    shape_mesh: np.ndarray
+    mesh_vertices: np.ndarray
+    mesh_triangles: np.ndarray
+    mesh_vertex_starts: np.ndarray
+    mesh_triangle_starts: np.ndarray
     head_tip: np.ndarray
     map_frame_positions: np.ndarray
     map_frame_wxyz: np.ndarray
@@ -117,7 +129,7 @@ class ViewerScene:
 
     def bounds(self, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners (3,) m of what the scene shows (without the map), with the ground (z = 0)."""
-        pts = [self.box_positions.reshape(-1, 3), self.target_positions, np.zeros((1, 3))]
+        pts = [self.shape_positions.reshape(-1, 3), self.target_positions, np.zeros((1, 3))]
         if len(self.wall_vertices):
             pts.append(self.wall_vertices)
         if len(self.obstacle_centres):
@@ -152,6 +164,46 @@ def _rgb(color: str) -> tuple[int, int, int]:
     return round(255 * r), round(255 * g), round(255 * b)
 
 
+def robot_meshes(robot: Any) -> dict[str, np.ndarray]:
+    """How the viewer draws the robot's collision shapes (``robot.geometry``): per shape its mesh, the scale of the
+    mesh along the shape frame's axes and the shape frame in its link (``origins`` (K, 4, 4)); the meshes in their
+    own frames (the :class:`ViewerScene` fields ``shape_mesh``, ``shape_scales``, ``mesh_*``). Boxes share a unit
+    cube, cylinders a unit cylinder, spheres a unit sphere; a mesh's hull is a mesh of its own."""
+    from ..geometry.shapes import Shape, shape_mesh
+
+    unit = {"box": Shape("box", 0, np.eye(4), (1.0, 1.0, 1.0)),
+            "cylinder": Shape("cylinder", 0, np.eye(4), (1.0, 1.0, 0.0)),
+            "sphere": Shape("sphere", 0, np.eye(4), (1.0, 0.0, 0.0))}
+    meshes: list[tuple[np.ndarray, np.ndarray]] = []
+    mesh_of: dict[str, int] = {}
+    which, scales = [], []
+    geometry = robot.geometry
+    for k, shape in enumerate(geometry.shapes):
+        if shape.kind == "convex":
+            v, f = shape_mesh(shape, VIEWER_SEGMENTS, hull=geometry, index=k)
+            R, p = shape.origin[:3, :3], shape.origin[:3, 3]
+            meshes.append(((v - p) @ R, f))  # back into the shape's own frame
+            which.append(len(meshes) - 1)
+            scales.append((1.0, 1.0, 1.0))
+            continue
+        if shape.kind not in mesh_of:
+            meshes.append(shape_mesh(unit[shape.kind], VIEWER_SEGMENTS))
+            mesh_of[shape.kind] = len(meshes) - 1
+        which.append(mesh_of[shape.kind])
+        size = np.asarray(shape.size, float)
+        scales.append({"box": size, "cylinder": (size[0], size[0], size[1]),
+                       "sphere": (size[0], size[0], size[0])}[shape.kind])
+    vstarts = np.cumsum([0] + [len(v) for v, _ in meshes])
+    tstarts = np.cumsum([0] + [len(f) for _, f in meshes])
+    return dict(
+        shape_mesh=np.array(which, np.int32), shape_scales=np.array(scales, float).reshape(-1, 3),
+        mesh_vertices=np.concatenate([v for v, _ in meshes]).reshape(-1, 3) if meshes else np.zeros((0, 3)),
+        mesh_triangles=(np.concatenate([f for _, f in meshes]).reshape(-1, 3).astype(np.int32) if meshes
+                        else np.zeros((0, 3), np.int32)),
+        mesh_vertex_starts=vstarts.astype(np.int64), mesh_triangle_starts=tstarts.astype(np.int64),
+        origins=np.array([s.origin for s in geometry.shapes], float).reshape(-1, 4, 4))
+
+
 def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, spheres: Sequence[Sphere] | None = None,
                  frame_step_s: float = FRAME_STEP_S, max_frames: int = 2000, title: str = "",
                  contact: str = "ground") -> ViewerScene:
@@ -171,8 +223,10 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     idx = np.unique(np.r_[np.searchsorted(t, np.linspace(t[0], t[-1], max(n, 2))), len(t) - 1].clip(0, len(t) - 1))
     q = plan.q[idx]
     frames = robot.frames_many(q, plan.base)
-    boxed = robot.boxed_links
-    B = robot.box_poses(frames, boxed)
+    meshes = robot_meshes(robot)
+    origins = meshes.pop("origins")
+    links = robot.geometry.shape_frames
+    B = frames[:, links] @ origins  # (F, K, 4, 4) the shapes' frames
     colors = part_colors(robot)
     map_frame = frames[:, robot.link_index(robot.parts.neck_end)]
 
@@ -220,10 +274,17 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
         base_idx = offset + 4 * np.arange(len(qd))[:, None]
         tris.append(np.concatenate([base_idx + [0, 1, 2], base_idx + [0, 2, 3]]))
         offset += 4 * len(qd)
+    for mesh in (o for o in plan.obstacles if isinstance(o, MeshObstacle)):  # drawn with the walls: triangles
+        from scipy.spatial import ConvexHull
+
+        v = mesh.world_vertices
+        wall_vertices = np.concatenate([wall_vertices, v])
+        tris.append(ConvexHull(v).simplices + offset)
+        offset += len(v)
     return ViewerScene(
         name=plan.name, title=title or plan.name, times=t[idx],
-        box_positions=B[..., :3, 3], box_wxyz=_wxyz(B[..., :3, :3]), box_sizes=robot.box_sizes[boxed].copy(),
-        box_colors=np.array([_rgb(colors[i]) for i in boxed], np.uint8),
+        shape_positions=B[..., :3, 3], shape_wxyz=_wxyz(B[..., :3, :3]),
+        shape_colors=np.array([_rgb(colors[i]) for i in links], np.uint8).reshape(-1, 3), **meshes,
         head_tip=frames[:, robot.link_index(robot.parts.head_tip), :3, 3],
         map_frame_positions=map_frame[:, :3, 3], map_frame_wxyz=_wxyz(map_frame[:, :3, :3]),
         voxel_centers=voxels, voxel_indices=indices, voxel_size=voxel_size,
@@ -258,11 +319,14 @@ def save_viewer_scene(scene: ViewerScene, path: str | Path) -> Path:
 MAX_SCENE_BYTES = 512 << 20
 
 #: Each array of a viewer scene: its dtype kind ("f" numbers, "i" integers, "U" text) and its shape, in symbols
-#: that must agree across arrays (F frames, K boxes, V voxels, Z ZMP samples, P polygons of M vertices, N targets,
-#: B obstacle boxes, W wall vertices, T wall triangles, H hole rims of R points).
+#: that must agree across arrays (F frames, K shapes, G1 = G + 1 for G meshes of MV vertices and MT triangles, V voxels,
+#: Z ZMP samples, P polygons of M vertices, N targets, B obstacle boxes, W wall vertices, T wall triangles, H hole rims
+#: of R points).
 _SCENE_ARRAYS = {
-    "name": ("U", ()), "title": ("U", ()), "times": ("f", ("F",)), "box_positions": ("f", ("F", "K", 3)),
-    "box_wxyz": ("f", ("F", "K", 4)), "box_sizes": ("f", ("K", 3)), "box_colors": ("i", ("K", 3)),
+    "name": ("U", ()), "title": ("U", ()), "times": ("f", ("F",)), "shape_positions": ("f", ("F", "K", 3)),
+    "shape_wxyz": ("f", ("F", "K", 4)), "shape_scales": ("f", ("K", 3)), "shape_colors": ("i", ("K", 3)),
+    "shape_mesh": ("i", ("K",)), "mesh_vertices": ("f", ("MV", 3)), "mesh_triangles": ("i", ("MT", 3)),
+    "mesh_vertex_starts": ("i", ("G1",)), "mesh_triangle_starts": ("i", ("G1",)),
     "head_tip": ("f", ("F", 3)), "map_frame_positions": ("f", ("F", 3)), "map_frame_wxyz": ("f", ("F", 4)),
     "voxel_centers": ("f", ("V", 3)), "voxel_indices": ("f", ("V",)), "voxel_size": ("f", ()),
     "zmp": ("f", ("F", 2)), "com": ("f", ("F", 3)), "zmp_path": ("f", ("Z", 2)), "polygons": ("f", ("P", "M", 2)),
@@ -296,6 +360,18 @@ def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
         a = values[key]
         if a.size and (a.min() < 0 or a.max() >= sizes[bound]):
             raise ValueError(f"{where}: {key} points outside its {sizes[bound]} entries")
+    vs, ts = values["mesh_vertex_starts"], values["mesh_triangle_starts"]
+    if (sizes["G1"] < 1 or vs[0] != 0 or ts[0] != 0 or vs[-1] != sizes["MV"] or ts[-1] != sizes["MT"]
+            or np.any(np.diff(vs) < 0) or np.any(np.diff(ts) < 0)):
+        raise ValueError(f"{where}: mesh_vertex_starts / mesh_triangle_starts must run in order from 0 to the number "
+                         "of mesh vertices / triangles")
+    mesh = values["shape_mesh"]
+    if mesh.size and (mesh.min() < 0 or mesh.max() >= sizes["G1"] - 1):
+        raise ValueError(f"{where}: shape_mesh points outside its {sizes['G1'] - 1} meshes")
+    for g in range(sizes["G1"] - 1):
+        tri = values["mesh_triangles"][ts[g]:ts[g + 1]]
+        if tri.size and (tri.min() < 0 or tri.max() >= vs[g + 1] - vs[g]):
+            raise ValueError(f"{where}: mesh_triangles of mesh {g} point outside its {vs[g + 1] - vs[g]} vertices")
     if np.any((values["voxel_indices"] < 0) | (values["voxel_indices"] > 100)) or not values["voxel_size"] >= 0:
         raise ValueError(f"{where}: voxel_indices must be within [0, 100] and voxel_size >= 0")
 
@@ -351,10 +427,20 @@ class SceneNodes:
         centre = 0.5 * (lo + hi)
         self.ground = s.add_grid(f"{root}/ground", width=size, height=size, plane="xy", cell_size=0.1,
                                  section_size=0.5, position=(centre[0], centre[1], 0.0))
-        self.robot = s.add_batched_meshes_simple(
-            f"{root}/robot", _CUBE_VERTICES, _CUBE_TRIANGLES, batched_wxyzs=data.box_wxyz[0],
-            batched_positions=data.box_positions[0], batched_scales=data.box_sizes, batched_colors=data.box_colors,
-            lod="off", flat_shading=True)
+        # the robot: one batch of instances per mesh (every box one unit cube scaled, ...), moved together per frame
+        self.robot = s.add_frame(f"{root}/robot", show_axes=False)
+        self.robot_meshes = []
+        vs, ts = data.mesh_vertex_starts, data.mesh_triangle_starts
+        for g in range(len(vs) - 1):
+            which = np.flatnonzero(data.shape_mesh == g)
+            if not which.size:
+                continue
+            handle = s.add_batched_meshes_simple(
+                f"{root}/robot/mesh {g}", data.mesh_vertices[vs[g]:vs[g + 1]].astype(np.float32),
+                data.mesh_triangles[ts[g]:ts[g + 1]].astype(np.uint32), batched_wxyzs=data.shape_wxyz[0, which],
+                batched_positions=data.shape_positions[0, which], batched_scales=data.shape_scales[which],
+                batched_colors=data.shape_colors[which], lod="off", flat_shading=True)
+            self.robot_meshes.append((handle, which))
         self.map_frame = s.add_frame(f"{root}/head base frame", show_axes=True, axes_length=0.05, axes_radius=0.002,
                                      position=data.map_frame_positions[0], wxyz=data.map_frame_wxyz[0])
         self.voxels = None
@@ -417,8 +503,9 @@ class SceneNodes:
             return
         before = self.frame
         self.frame = k
-        self.robot.batched_positions = d.box_positions[k]
-        self.robot.batched_wxyzs = d.box_wxyz[k]
+        for handle, which in self.robot_meshes:
+            handle.batched_positions = d.shape_positions[k, which]
+            handle.batched_wxyzs = d.shape_wxyz[k, which]
         self.map_frame.position = d.map_frame_positions[k]
         self.map_frame.wxyz = d.map_frame_wxyz[k]
         self.zmp.position = (d.zmp[k, 0], d.zmp[k, 1], 0.0)

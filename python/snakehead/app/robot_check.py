@@ -1,0 +1,200 @@
+"""The robot check behind ``snakehead info``: what the parts are, whether the design can work, and when it cannot,
+a split of the parts that does (computed, by trying it).
+
+* :func:`describe_parts` -- each part's frames (where they sit along the body, on which joint), length, mass and
+  joints.
+* :func:`design_problems` -- the checks the planner's first steps make: an up curve that lifts the neck and head
+  over the base (Section 3.3 (1)), a curl of the neck and head on the ground that the base holds, the head's map.
+* :func:`suggest_split` -- other ``base_end`` / ``neck_end`` frames tried in turn; the first that passes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.robot import ALIGNED_SUFFIX, SnakeRobot
+
+#: How far (joints) a suggested split moves base_end and neck_end from the robot file's.
+SPLIT_SEARCH = (1, -1, 2, -2, 3, -3)
+
+
+@dataclass(frozen=True)
+class PartReport:
+    """One part: its name, first and last frame (the URDF's names), where they sit (m along the body), its
+    joints (names and kinds), length (m) and mass (kg)."""
+
+    name: str
+    start_frame: str
+    end_frame: str
+    start_m: float
+    end_m: float
+    joints: list[str]
+    kinds: list[str]
+    mass_kg: float
+
+    @property
+    def length_m(self) -> float:
+        return self.end_m - self.start_m
+
+
+@dataclass
+class RobotCheck:
+    """The check of one robot: its parts, its shapes, what cannot work and what would."""
+
+    parts: list[PartReport]
+    shapes: dict[str, int]
+    problems: list[str] = field(default_factory=list)
+    suggestion: str | None = None
+    map_line: str = ""
+
+
+def _user_name(name: str) -> str:
+    return name[:-len(ALIGNED_SUFFIX)] if name.endswith(ALIGNED_SUFFIX) else name
+
+
+def frame_position(robot: SnakeRobot, name: str) -> str:
+    """Where a frame sits along the body, in words: on which joint, or how far after one."""
+    s = robot.frame_arc_length(name)
+    arcs = robot.joint_arc_lengths
+    on = np.flatnonzero(np.abs(arcs - s) < 1e-6)
+    if len(on):
+        return f"{s:.4f} m, on {robot.joint_names[int(on[0])]}"
+    before = np.flatnonzero(arcs < s)
+    if len(before) == 0:
+        return f"{s:.4f} m, before the first joint"
+    j = int(before[-1])
+    return f"{s:.4f} m, {s - arcs[j]:.4f} m after {robot.joint_names[j]}"
+
+
+def describe_parts(robot: SnakeRobot) -> list[PartReport]:
+    """The base, neck and head: frames, positions, joints, length and mass."""
+    p = robot.parts
+    out = []
+    for name, sl, a, b, links in (("base", p.base, p.root, p.base_end, robot.base_links),
+                                  ("neck", p.neck, p.base_end, p.neck_end, robot.neck_links),
+                                  ("head", p.head, p.neck_end, p.head_tip, robot.head_links)):
+        out.append(PartReport(name, _user_name(a), _user_name(b), robot.frame_arc_length(a), robot.frame_arc_length(b),
+                              robot.joint_names[sl], list(robot.joint_kinds[sl]),
+                              float(robot.masses[links].sum())))
+    return out
+
+
+def design_problems(robot: SnakeRobot) -> list[str]:
+    """What keeps the planner from starting on this robot (empty when nothing does)."""
+    from ..backbone.initial import initial_configuration
+    from ..motion.planner import ground_curl
+
+    problems = []
+    if robot.lift_length <= 0:
+        problems.append("the neck has no pitch joint: it cannot lift the head's base")
+    try:
+        q = initial_configuration(robot)
+    except ValueError as exc:
+        problems.append(f"no initial state: {exc}")
+        q = None
+    if q is not None:
+        try:
+            ground_curl(robot, q)
+        except ValueError as exc:
+            problems.append(f"no bending state: {exc}")
+    return problems
+
+
+def _boundary_frame(robot: SnakeRobot, joints_before: int) -> str | None:
+    """The URDF frame that ends a part after ``joints_before`` joints: the frame just before the next joint's
+    link (a marker at the distal end of the last link, or that link itself)."""
+    if not 0 < joints_before < robot.n_joints:
+        return None
+    child = int(robot.joint_frames[joints_before])
+    return _user_name(robot.link_names[child - 1])
+
+
+def suggest_split(robot: SnakeRobot) -> tuple[str, SnakeRobot] | None:
+    """The first of :data:`SPLIT_SEARCH`'s moves of base_end (neck_end moved alike, then kept) whose robot passes
+    :func:`design_problems`: a robot-file change in words and the robot; None when none does."""
+    p = robot.parts
+    tried = set()
+    for shift in SPLIT_SEARCH:
+        for move_neck in (True, False):
+            base_end = _boundary_frame(robot, p.base.stop + shift)
+            neck_end = _boundary_frame(robot, p.neck.stop + shift) if move_neck else robot.user_frames["neck_end"]
+            if base_end is None or neck_end is None or (base_end, neck_end) in tried:
+                continue
+            tried.add((base_end, neck_end))
+            try:
+                candidate = robot.with_parts(base_end=base_end, neck_end=neck_end)
+            except ValueError:
+                continue
+            if not design_problems(candidate):
+                change = f'base_end = "{base_end}"'
+                if neck_end != robot.user_frames["neck_end"]:
+                    change += f', neck_end = "{neck_end}"'
+                c = candidate.parts
+                return (f"{change} (base {c.base.stop - c.base.start} joints, neck {c.neck.stop - c.neck.start}, "
+                        f"head {c.head.stop - c.head.start})", candidate)
+    return None
+
+
+def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
+    """A line about the head's map (the robot file's, if any) and a problem with it (None when there is none)."""
+    from ..kinematics import workspace
+
+    if robot.map_path is None:
+        return "none (plan computes one and caches it)", None
+    m = workspace.load(robot.map_path)
+    if m.chain_hash != robot.head_chain.hash:
+        return f"{robot.map_path}", "the map was made for another head chain: compute one (snakehead workspace)"
+    roll = "free roll" if m.params.get("free_roll") else f"{m.params.get('rolls')} rolls"
+    line = f"{robot.map_path}: {len(m)} voxels, {m.params.get('directions')} directions x {roll}, " \
+           f"best index {m.indices.max():.1f}"
+    try:
+        t = m.dexterous_threshold()
+    except ValueError as exc:
+        return line, str(exc)
+    return line + f", dexterous workspace index >= {t:.1f}", None
+
+
+def check_robot(robot: SnakeRobot, suggest: bool = True) -> RobotCheck:
+    """The whole check (see the module)."""
+    shapes: dict[str, int] = {}
+    for s in robot.geometry.shapes:
+        shapes[s.kind] = shapes.get(s.kind, 0) + 1
+    check = RobotCheck(describe_parts(robot), shapes, design_problems(robot))
+    check.map_line, map_problem = map_summary(robot)
+    if map_problem:
+        check.problems.append(f"head map: {map_problem}")
+    if suggest and any(not p.startswith("head map") for p in check.problems):
+        found = suggest_split(robot)
+        check.suggestion = None if found is None else found[0]
+    return check
+
+
+def check_lines(robot: SnakeRobot, check: RobotCheck) -> list[str]:
+    """The check as the lines ``snakehead info`` prints."""
+    lines = [f"robot: {robot.source}",
+             f"joints: {robot.n_joints} ({', '.join(k[0] for k in robot.joint_kinds)}: y = yaw, p = pitch), "
+             f"mass {robot.total_mass:.3f} kg, length {robot.body_length:.4f} m, body axis "
+             f"{1000 * robot.body_axis_height:.1f} mm above the ground",
+             "collision shapes: " + ", ".join(f"{n} {k}" for k, n in sorted(check.shapes.items()))]
+    for part in check.parts:
+        lines.append(f"{part.name}: {part.start_frame} ({frame_position(robot, _frame(robot, part.start_frame))}) -> "
+                     f"{part.end_frame} ({frame_position(robot, _frame(robot, part.end_frame))}); "
+                     f"{part.length_m:.4f} m, {part.mass_kg:.3f} kg, {len(part.joints)} joints "
+                     f"({' '.join(f'{j}:{k[0]}' for j, k in zip(part.joints, part.kinds))})")
+    lines.append(f"head's map: {check.map_line}")
+    if not check.problems:
+        lines.append("design: the base holds the lifted neck and head (an initial state and a bending state exist)")
+    for problem in check.problems:
+        lines.append(f"PROBLEM: {problem}")
+    if check.suggestion:
+        lines.append(f"SUGGESTION: in the robot file, {check.suggestion} passes these checks")
+    elif any(not p.startswith("head map") for p in check.problems):
+        lines.append("no split within 3 joints of this one passes: the base is too short or light for the neck and "
+                     "head (lengthen the base, or lighten the head)")
+    return lines
+
+
+def _frame(robot: SnakeRobot, user_name: str) -> str:
+    aligned = user_name + ALIGNED_SUFFIX
+    return aligned if aligned in robot.link_names else user_name
