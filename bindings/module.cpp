@@ -12,12 +12,14 @@ namespace py = pybind11;
 PYBIND11_MODULE(_core, m) {
   m.doc() =
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
+      "convex-shape distances (FCL), "
       "inverse dynamics";
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
   snakehead::bindings::bind_support(m);
   snakehead::bindings::bind_box_collision(m);
+  snakehead::bindings::bind_shape_set(m);
   snakehead::bindings::bind_dynamics(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
