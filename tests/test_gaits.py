@@ -136,7 +136,7 @@ def test_estimate_of_a_body_rolling_over_its_edge(robot):
 
     est = BodyPoseEstimator(robot, imu_link="link_8")
     q = np.zeros(robot.n_joints)
-    start = est.reset(q, np.eye(3), (0.2, 0.1), root_yaw=0.0)
+    start = est.reset(q, np.eye(3), (0.2, 0.1), body_yaw=0.0)
     np.testing.assert_allclose(start.root[:3, 3], (0.2, 0.1, 0.0215), atol=1e-12)
     for a in np.radians(np.linspace(0.5, 90.0, 180)):
         est.update(q, _rot_x(a))  # + about x: the top goes towards -y, the body rolls over its -y edge
@@ -155,7 +155,7 @@ def test_estimate_stays_put_while_only_lifted_joints_move(robot):
     imu = robot.link_names[robot.base_links[3]]
     est = BodyPoseEstimator(robot, imu_link=imu)
     world = lambda q: robot.frames(q, base)[robot.link_index(imu), :3, :3]  # noqa: E731 - a perfect IMU
-    start = est.reset(q1, world(q1), (base.x, base.y), root_yaw=base.yaw)
+    start = est.reset(q1, world(q1), (base.x, base.y), body_yaw=base.yaw)
     np.testing.assert_allclose(start.root, robot.root_pose(base), atol=1e-12)
     head = np.arange(robot.n_joints) >= robot.parts.head.start
     for s in np.linspace(0.0, 1.0, 50):

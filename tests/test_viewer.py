@@ -2,7 +2,7 @@
 
 The browser tests drive Debian's headless Chromium (``chromium``, ``chromedriver``; installed by .ci/setup) with
 Selenium; WebGL runs on SwiftShader (``--use-angle=swiftshader``). They check what a person would see: the
-robot's links where the camera model puts them (pixels of the links' colours at the projected box centres), and
+robot's links where the camera model puts them (pixels of the links' colours at the projected shape centres), and
 the robot somewhere else after the time slider is moved. Locally, without Chromium, they are skipped; under CI
 (``CI`` set) a missing browser is a failure.
 """
@@ -52,17 +52,18 @@ def test_the_pipeline_writes_the_viewer_scene_and_page(planned, scene):
     # nothing fetched at run time: no URL the page would load (links in the client's about box aside)
     assert "src=\"http" not in page and "href=\"http" not in page.split("</head>")[0]
     F = scene.n_frames
-    K = len(robot.boxed_links)
-    assert scene.box_positions.shape == (F, K, 3) and scene.box_wxyz.shape == (F, K, 4)
-    np.testing.assert_allclose(np.linalg.norm(scene.box_wxyz, axis=-1), 1.0, atol=1e-9)
+    K = len(robot.geometry.shapes)
+    assert scene.shape_positions.shape == (F, K, 3) and scene.shape_wxyz.shape == (F, K, 4)
+    np.testing.assert_allclose(np.linalg.norm(scene.shape_wxyz, axis=-1), 1.0, atol=1e-9)
     assert np.all(np.diff(scene.times) > 0) and F >= 10
     # the frames are the plan's: the last one is the head at the target (planned to the micrometre)
     np.testing.assert_allclose(scene.head_tip[-1], np.array(POSITION, float), atol=1e-4)
     # the boxes' centres at the first frame are the robot's, by forward kinematics of the CSV's first row
     q0 = np.loadtxt(planned / "target_trajectory.csv", delimiter=",", skiprows=1, max_rows=1)[1:]
     base = scene_base(planned)
-    B = robot.box_poses(robot.frames(q0, base)[None])[0]
-    np.testing.assert_allclose(scene.box_positions[0], B[:, :3, 3], atol=1e-6)  # the CSV rounds
+    shapes = robot.geometry.shapes
+    B = robot.frames(q0, base)[[s.frame for s in shapes]] @ np.array([s.origin for s in shapes])
+    np.testing.assert_allclose(scene.shape_positions[0], B[:, :3, 3], atol=1e-6)  # the CSV rounds
     # the map is the robot's head map, in the head's base frame (neck_end), which moves with the neck
     m = load_map(robot.map_path)
     assert len(scene.voxel_centers) == len(m) and scene.voxel_size == m.voxel_size
@@ -85,7 +86,7 @@ def scene_base(out: Path):
 def test_viewer_scene_round_trip_and_bad_files(tmp_path, scene):
     path = viewer.save_viewer_scene(scene, tmp_path / f"copy{viewer.SCENE_SUFFIX}")
     again = viewer.load_viewer_scene(path)
-    for name in ("times", "box_positions", "voxel_indices", "polygons", "target_names"):
+    for name in ("times", "shape_positions", "voxel_indices", "polygons", "target_names"):
         np.testing.assert_array_equal(getattr(again, name), getattr(scene, name))
     assert again.name == scene.name and again.voxel_size == scene.voxel_size
     bad = tmp_path / f"bad{viewer.SCENE_SUFFIX}"
@@ -180,13 +181,13 @@ def _robot_seen(img: np.ndarray, scene: viewer.ViewerScene, k: int, rect) -> tup
     it, and the mask of all pixels of those colours in the canvas."""
     left, top, width, height = rect
     eye, look_at = scene.camera()
-    px = project(scene.box_positions[k], eye, look_at, width, height, viewer.CAMERA_FOV_DEG) + [left, top]
-    coloured = [i for i, c in enumerate(scene.box_colors) if colorsys.rgb_to_hsv(*(c / 255.0))[1] > 0.5]
-    masks = {tuple(c): _hue_mask(img, c) for c in {tuple(scene.box_colors[i]) for i in coloured}}
+    px = project(scene.shape_positions[k], eye, look_at, width, height, viewer.CAMERA_FOV_DEG) + [left, top]
+    coloured = [i for i, c in enumerate(scene.shape_colors) if colorsys.rgb_to_hsv(*(c / 255.0))[1] > 0.5]
+    masks = {tuple(c): _hue_mask(img, c) for c in {tuple(scene.shape_colors[i]) for i in coloured}}
     found = 0
     for i in coloured:
         x, y = np.round(px[i]).astype(int)
-        window = masks[tuple(scene.box_colors[i])][max(y - 6, 0):y + 7, max(x - 6, 0):x + 7]
+        window = masks[tuple(scene.shape_colors[i])][max(y - 6, 0):y + 7, max(x - 6, 0):x + 7]
         found += window.sum() >= 8
     canvas = np.zeros(img.shape[:2], bool)
     canvas[int(top):int(top + height), int(left):int(left + width)] = True
