@@ -104,7 +104,7 @@ def test_a_missing_collision_mesh_names_the_link_and_the_path(tmp_path: Path) ->
 
 def test_an_unknown_package_says_how_to_give_it(tmp_path: Path) -> None:
     path = published.write_robot("sea", tmp_path / "s")
-    _edit(path, "sea_snake =", "other_package =")
+    _edit(path, '"sea_snake" =', '"other_package" =')
     with pytest.raises(InputError, match=r"package 'sea_snake' is not known; add sea_snake = .* \[packages\]"):
         SnakeRobot.from_file(path).geometry
 
@@ -126,8 +126,8 @@ def test_a_continuous_joint_without_limits_names_the_joint(tmp_path: Path) -> No
     start = text.index("[limits]")
     first = text[start:].splitlines()[1]
     path.write_text(text.replace(first + "\n", ""))
-    joint = first.split("=")[0].strip()
-    with pytest.raises(InputError, match=rf"continuous joint '{joint}' need"):
+    joint = first.split("=")[0].strip().strip('"')
+    with pytest.raises(InputError, match=rf"continuous joint '{joint}' needs limits"):
         SnakeRobot.from_file(path)
 
 

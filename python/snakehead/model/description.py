@@ -13,6 +13,7 @@ Errors are :class:`snakehead.InputError` naming the file and the element.
 from __future__ import annotations
 
 import os
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -105,7 +106,7 @@ def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], wher
     missing = [name for name in (needed or []) if name not in limits]
     if missing:
         raise InputError(f"{where}: continuous joint{'s' if len(missing) > 1 else ''} {', '.join(map(repr, missing))} "
-                         "need limits: add them to the robot file's [limits] table (joint = [lower, upper] in rad)")
+                         f"{'need' if len(missing) > 1 else 'needs'} limits: add them to the robot file's [limits] table (joint = [lower, upper] in rad)")
     for name, (lower, upper) in limits.items():
         joint = joints[name]
         if joint.get("type") not in ("revolute", "continuous"):
@@ -139,7 +140,10 @@ def _set_origin(joint: ET.Element, T: np.ndarray) -> None:
     if origin is None:
         origin = ET.SubElement(joint, "origin")
     origin.set("xyz", " ".join(repr(float(v)) for v in T[:3, 3]))
-    origin.set("rpy", " ".join(repr(float(v)) for v in Rotation.from_matrix(T[:3, :3]).as_euler("xyz")))
+    with warnings.catch_warnings():  # at a gimbal lock scipy picks one of the equal decompositions, and says so
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")
+    origin.set("rpy", " ".join(repr(float(v)) for v in rpy))
 
 
 def add_fixed_frames(text: str, frames: list[tuple[str, str, np.ndarray]]) -> str:
