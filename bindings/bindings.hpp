@@ -8,7 +8,6 @@ void bind_model(pybind11::module_& m);
 void bind_trac_ik(pybind11::module_& m);
 void bind_workspace(pybind11::module_& m);
 void bind_support(pybind11::module_& m);
-void bind_box_collision(pybind11::module_& m);
 void bind_shape_set(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
 }  // namespace snakehead::bindings

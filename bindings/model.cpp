@@ -86,7 +86,7 @@ void bind_model(py::module_& m) {
       .def_property_readonly("reach", &ChainModel::reach)
       .def_property_readonly("hash", &ChainModel::hash, "digest of the kinematics (what maps depend on)")
       .def_property_readonly("body_hash", &ChainModel::body_hash,
-                             "digest of the links' masses, centres of mass, inertias and collision boxes")
+                             "digest of the links' masses, centres of mass, inertias and collision shapes")
       .def_property_readonly("total_mass", &ChainModel::total_mass, "sum of the link masses (kg); may be 0")
       .def_property_readonly("link_names",
                              [](const ChainModel& c) {
@@ -115,18 +115,6 @@ void bind_model(py::module_& m) {
                                  for (int r = 0; r < 3; ++r)
                                    for (int s = 0; s < 3; ++s) v(k, r, s) = c.links()[k].inertia(r, s);
                                return out;
-                             })
-      .def_property_readonly("link_box_sizes",
-                             [](const ChainModel& c) {
-                               RowMat v(c.links().size(), 3);
-                               for (std::size_t k = 0; k < c.links().size(); ++k) v.row(k) = c.links()[k].box_size;
-                               return v;
-                             })
-      .def_property_readonly("link_box_origins",
-                             [](const ChainModel& c) {
-                               Frames f;
-                               for (const auto& l : c.links()) f.push_back(l.box_origin);
-                               return frames_to_array(f);
                              })
       .def_property_readonly(
           "link_collisions",

@@ -18,7 +18,6 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
   snakehead::bindings::bind_support(m);
-  snakehead::bindings::bind_box_collision(m);
   snakehead::bindings::bind_shape_set(m);
   snakehead::bindings::bind_dynamics(m);
 

@@ -55,33 +55,6 @@ void bind_support(py::module_& m) {
       py::arg("points"), py::arg("active"),
       "Each sample's counter-clockwise convex hull of its active points: vertex indices (T, N), -1 after the "
       "count, and the counts (T,)");
-  m.def(
-      "lowest_box_corners",
-      [](py::array_t<double, py::array::c_style | py::array::forcecast> frames,
-         py::array_t<double, py::array::c_style | py::array::forcecast> box_origins,
-         py::array_t<double, py::array::c_style | py::array::forcecast> half,
-         py::array_t<int, py::array::c_style | py::array::forcecast> links) {
-        if (frames.ndim() != 4 || frames.shape(2) != 4 || frames.shape(3) != 4)
-          throw InputError("frames must have shape (T, L, 4, 4)");
-        const long T = static_cast<long>(frames.shape(0)), L = static_cast<long>(frames.shape(1));
-        if (box_origins.ndim() != 3 || box_origins.shape(0) != L || box_origins.shape(1) != 4 ||
-            box_origins.shape(2) != 4)
-          throw InputError("box_origins must have shape (L, 4, 4) like frames' links");
-        if (half.ndim() != 2 || half.shape(0) != L || half.shape(1) != 3)
-          throw InputError("half must have shape (L, 3) like frames' links");
-        if (links.ndim() != 1) throw InputError("links must be a 1-D array of link indices");
-        const long k = static_cast<long>(links.shape(0));
-        py::array_t<double> xy({static_cast<py::ssize_t>(T), static_cast<py::ssize_t>(k), py::ssize_t{4}, py::ssize_t{2}});
-        py::array_t<double> z({static_cast<py::ssize_t>(T), static_cast<py::ssize_t>(k), py::ssize_t{4}});
-        double *xp = xy.mutable_data(), *zp = z.mutable_data();
-        {
-          py::gil_scoped_release release;
-          lowest_box_corners(frames.data(), box_origins.data(), half.data(), links.data(), T, L, k, xp, zp);
-        }
-        return py::make_tuple(xy, z);
-      },
-      py::arg("frames"), py::arg("box_origins"), py::arg("half"), py::arg("links"),
-      "The four lowest corners of the links' collision boxes: world x, y (T, k, 4, 2) and heights (T, k, 4)");
 }
 
 }  // namespace snakehead::bindings

@@ -129,19 +129,10 @@ void fill_inertial(const urdf::Link& link, LinkInfo& info) {
     info.com = origin.translation();
     info.inertia = origin.linear() * local * origin.linear().transpose();
   }
-  info.has_box = false;
-  info.box_size.setZero();
-  info.box_origin = Eigen::Isometry3d::Identity();
   for (const auto& collision : link.collision_array) {
     if (!collision) continue;
     check_collision(link.name, *collision);
     if (collision->geometry) info.collisions.push_back(collision_element(*collision));
-    if (!info.has_box && collision->geometry && collision->geometry->type == urdf::Geometry::BOX) {
-      const auto* box = static_cast<const urdf::Box*>(collision->geometry.get());
-      info.has_box = true;
-      info.box_size = Eigen::Vector3d(box->dim.x, box->dim.y, box->dim.z);
-      info.box_origin = to_isometry(collision->origin);
-    }
   }
 }
 
@@ -332,8 +323,6 @@ ChainModel ChainModel::from_urdf_string(const std::string& xml, const std::strin
     bodies << l.mass << ' ' << l.com.transpose() << ' ';
     for (int r = 0; r < 3; ++r)
       for (int c = r; c < 3; ++c) bodies << l.inertia(r, c) << ' ';
-    bodies << l.has_box << ' ' << l.box_size.transpose() << ' ';
-    append(bodies, l.box_origin);
     for (const CollisionElement& e : l.collisions) {
       bodies << static_cast<int>(e.kind) << ' ' << e.size.transpose() << ' ' << e.filename << ' ';
       append(bodies, e.origin);

@@ -122,38 +122,4 @@ void convex_hulls(const double* points, const unsigned char* active, long T, lon
   }
 }
 
-void lowest_box_corners(const double* frames, const double* box_origins, const double* half, const int* links,
-                        long T, long L, long k, double* corners_xy, double* corners_z) {
-  if (T < 0 || L < 0 || k < 0) throw InputError("lowest_box_corners: negative sizes");
-  for (long i = 0; i < k; ++i)
-    if (links[i] < 0 || links[i] >= L) throw InputError("lowest_box_corners: a link index is out of range");
-  using M4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
-  std::array<Eigen::Vector3d, 8> local;
-  std::array<double, 8> z;
-  std::array<int, 8> order;
-  for (long t = 0; t < T; ++t) {
-    for (long i = 0; i < k; ++i) {
-      const int link = links[i];
-      const Eigen::Matrix4d B = Eigen::Map<const M4>(frames + (t * L + link) * 16) *
-                                Eigen::Map<const M4>(box_origins + link * 16);
-      const Eigen::Map<const Eigen::Vector3d> h(half + 3 * link);
-      for (int c = 0; c < 8; ++c) {  // corner c: signs (x, y, z) from its bits 2, 1, 0 (-1 for 0)
-        local[c] = Eigen::Vector3d((c & 4) ? h.x() : -h.x(), (c & 2) ? h.y() : -h.y(), (c & 1) ? h.z() : -h.z());
-        z[c] = B.row(2).head<3>().dot(local[c]) + B(2, 3);
-        order[c] = c;
-      }
-      if (!B.allFinite() || !h.allFinite())  // (a NaN would also break the sort's ordering)
-        throw InputError("lowest_box_corners: frames, box origins and sizes must be finite");
-      std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return z[a] < z[b]; });
-      for (int c = 0; c < 4; ++c) {
-        const Eigen::Vector3d& p = local[order[c]];
-        const long o = (t * k + i) * 4 + c;
-        corners_xy[2 * o] = B.row(0).head<3>().dot(p) + B(0, 3);
-        corners_xy[2 * o + 1] = B.row(1).head<3>().dot(p) + B(1, 3);
-        corners_z[o] = z[order[c]];
-      }
-    }
-  }
-}
-
 }  // namespace snakehead

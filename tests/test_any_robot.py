@@ -93,7 +93,7 @@ def test_plan_and_simulate(setup):
     assert plan.success, plan.failure
     # independent checks of the plan: the base rests on the ground, FK reaches the target, nothing in the ground
     F = robot.frames_many(plan.q, plan.base)
-    low = robot.lowest_box_z(F, robot.base_links)
+    low = robot.lowest_z(F, robot.base_links)
     assert np.abs(low.min(axis=1)).max() < 1e-4  # lowest base box corner at z = 0 within 0.1 mm
     tg = plan.targets[0]
     k = int(np.argmin(np.abs(plan.t - tg.time_s)))

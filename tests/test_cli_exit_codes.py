@@ -168,9 +168,13 @@ def test_view_stops_with_ctrl_c_and_0(tmp_path):
     """view runs until Ctrl-C: that is how it ends, with 0."""
     from snakehead.viz import viewer
 
-    scene = viewer.ViewerScene(name="s", title="s", times=np.zeros(1), box_positions=np.zeros((1, 1, 3)),
-                               box_wxyz=np.array([[[1.0, 0, 0, 0]]]), box_sizes=np.full((1, 3), 0.1),
-                               box_colors=np.zeros((1, 3), np.uint8), head_tip=np.zeros((1, 3)),
+    scene = viewer.ViewerScene(name="s", title="s", times=np.zeros(1), shape_positions=np.zeros((1, 1, 3)),
+                               shape_wxyz=np.array([[[1.0, 0, 0, 0]]]), shape_scales=np.full((1, 3), 0.1),
+                               shape_colors=np.zeros((1, 3), np.uint8), shape_mesh=np.zeros(1, np.int32),
+                               mesh_vertices=viewer._CUBE_VERTICES.astype(float),
+                               mesh_triangles=viewer._CUBE_TRIANGLES.astype(np.int32),
+                               mesh_vertex_starts=np.array([0, 8]), mesh_triangle_starts=np.array([0, 12]),
+                               head_tip=np.zeros((1, 3)),
                                map_frame_positions=np.zeros((1, 3)), map_frame_wxyz=np.array([[1.0, 0, 0, 0]]),
                                voxel_centers=np.zeros((0, 3)), voxel_indices=np.zeros(0), voxel_size=0.05,
                                zmp=np.zeros((1, 2)), com=np.zeros((1, 3)), zmp_path=np.zeros((1, 2)),

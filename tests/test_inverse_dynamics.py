@@ -79,8 +79,7 @@ def test_lying_flat_the_ground_carries_everything():
     robot = snakehead.SnakeRobot.default()
     flat = np.zeros((1, robot.n_joints))
     w = lift_shares(robot, robot.frames_many(flat))
-    boxed = robot.boxed_links
-    assert np.all(w[0, boxed] == 0.0)
+    assert np.all(w[0, robot.shaped_links] == 0.0)
     assert np.abs(inverse_dynamics(robot, flat, flat, flat)).max() == 0.0
     # lift the head part about a pitch joint of the neck: the joints from there on carry it, the base joints not
     q = flat[0].copy()

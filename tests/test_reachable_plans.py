@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import snakehead
+from shape_reference import box_corners
 from snakehead.control import whole_body as wb
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
@@ -151,12 +152,12 @@ def test_after_the_lift_a_move_stands_on_the_base(controller):
 
 def base_only_margin(robot, q, base):
     """Independent of the planner's code: the CoM's signed distance to the convex hull (scipy's qhull) of the
-    bottom corners of the boxes of the links before the first lifted one (those lie flat on the ground)."""
+    bottom corners (tests/shape_reference.py) of the boxes of the links before the first lifted one (those lie flat on the ground)."""
     from scipy.spatial import ConvexHull
 
     first_lifted = robot.body.model.joint_child_links[robot.lift_joints.start]
-    links = robot.boxed_links[robot.boxed_links < first_lifted]
-    corners = robot.box_corners(robot.frames(q, base)[None], links)[0].reshape(-1, 3)
+    links = robot.shaped_links[robot.shaped_links < first_lifted]
+    corners = box_corners(robot, robot.frames(q, base)[None], links)[0]
     bottom = corners[corners[:, 2] < 1e-9][:, :2]
     hull = ConvexHull(bottom)
     c = stability.center_of_mass(robot, q, base)[:2]

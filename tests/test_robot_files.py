@@ -62,7 +62,7 @@ def test_generated_robot_with_link_frames(pitch_first):
     # the base lies on the ground: its lowest box corners at z = 0 wherever it is placed
     base = BasePlacement(0.3, -0.2, 1.0)
     F = robot.frames(np.zeros(robot.n_joints), base)
-    low = robot.lowest_box_z(F[None], robot.base_links)[0]
+    low = robot.lowest_z(F[None], robot.base_links)[0]
     np.testing.assert_allclose(low, 0.0, atol=1e-12)
     # seg6 (the frame at P0) begins the neck: its body lies after P0
     assert robot.link_names[robot.neck_links[0]] == "seg6"

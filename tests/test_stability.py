@@ -6,6 +6,7 @@ import pytest
 from scipy.spatial import ConvexHull
 
 import snakehead
+from shape_reference import box_corners, lowest_z_by_sampling
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability as st
 
@@ -116,7 +117,7 @@ def test_ground_contact_counts_only_the_corners_that_touch(robot, pitch):
 
     q = np.zeros(16)
     q[7] = pitch  # the neck's first pitch joint lifts the neck and head a little
-    corners = robot.box_corners(robot.frames(q)[None], robot.boxed_links)[0].reshape(-1, 3)
+    corners = box_corners(robot, robot.frames(q)[None], robot.shaped_links)[0]
     touching = corners[corners[:, 2] <= st.CONTACT_TOLERANCE, :2]
     hull = touching[ConvexHull(touching).vertices]
     poly = st.support_polygon(robot, q, contact="ground")
@@ -128,38 +129,33 @@ def test_ground_contact_counts_only_the_corners_that_touch(robot, pitch):
     assert poly[:, 0].max() < far_end - 0.1
 
 
-@pytest.mark.parametrize("which", ["default", "generated"])
-def test_lowest_box_corners_are_the_four_lowest_of_the_eight(robot, which):
-    """The core's lowest corners (the ground contact points) against every corner computed in numpy
-    (robot.box_corners), on random configurations at a random placement, and on a generated snake."""
-    from snakehead import _core
+@pytest.mark.parametrize("which", ["default", "generated", "sea", "head6", "mesh", "rsnake"])
+def test_lowest_points_against_sampled_surfaces(robot, which, tmp_path):
+    """The core's lowest z and lowest candidate points (the ground contacts) of every shape kind against densely
+    sampled surfaces in numpy, on random configurations at a random placement: boxes (the default robot, a generated
+    snake), cylinders and a mesh tail (sea), spheres (head6), STL/OBJ hulls (mesh), offset cylinders (rsnake)."""
+    from snakehead.model import published
     from snakehead.model.generate import SnakeSpec, snake_urdf
 
     if which == "generated":
         spec = SnakeSpec(n_joints=11, module_length=0.09, section=0.06, first_axis="pitch", markers={"p0": 5, "b0": 7},
                          tip_name="tip", name="gen11")
         robot = snakehead.SnakeRobot.from_urdf(snake_urdf(spec), base_end="p0", neck_end="b0", head_tip="tip")
+    elif which != "default":
+        robot = snakehead.SnakeRobot.from_file(published.write_robot(which, tmp_path))
     rng = np.random.default_rng(5)
-    qs = np.array([robot.random_configuration(rng) for _ in range(50)])
+    qs = np.array([robot.random_configuration(rng) for _ in range(20)])
     frames = robot.frames_many(qs, snakehead.BasePlacement(0.3, -0.2, 1.1))
-    links = robot.boxed_links
-    xy, z = _core.lowest_box_corners(frames, robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
-    every = robot.box_corners(frames, links)  # (T, k, 8, 3)
-    expected_z = np.sort(every[..., 2], axis=2)[..., :4]
-    np.testing.assert_allclose(z, expected_z, atol=1e-12)
-    for t, k in [(0, 0), (7, 3), (49, len(links) - 1)]:
-        for c in range(4):  # each returned corner is one of the box's corners, at its height
-            d = np.linalg.norm(every[t, k, :, :2] - xy[t, k, c], axis=1) + np.abs(every[t, k, :, 2] - z[t, k, c])
-            assert d.min() < 1e-12
-    with pytest.raises(ValueError, match="out of range"):
-        _core.lowest_box_corners(frames, robot.box_origins, 0.5 * robot.box_sizes, np.array([len(robot.link_names)],
-                                                                                             np.int32))
-    with pytest.raises(ValueError, match="shape"):
-        _core.lowest_box_corners(frames[:, :3], robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
-    bad = frames.copy()
-    bad[3, links[0], 2, 3] = np.nan
-    with pytest.raises(ValueError, match="finite"):
-        _core.lowest_box_corners(bad, robot.box_origins, 0.5 * robot.box_sizes, links.astype(np.int32))
+    links = robot.shaped_links
+    low = robot.lowest_z(frames, links)
+    cylinders = any(s.kind in ("cylinder", "sphere") for s in robot.geometry.shapes)
+    for c, k in enumerate(links):
+        sampled = lowest_z_by_sampling(robot, frames, k)
+        assert np.all(low[:, c] <= sampled + 1e-12)  # never above a point of the surface
+        np.testing.assert_allclose(low[:, c], sampled, atol=2e-3 if cylinders else 1e-12)
+    pts, owner = robot.lowest_points(frames, links)
+    for c, k in enumerate(links):  # each link's lowest candidate is its lowest point
+        np.testing.assert_allclose(pts[:, owner == k, 2].min(axis=1), low[:, c], atol=1e-12)
 
 
 def test_static_margin_closed_form(robot):

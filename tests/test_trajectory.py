@@ -8,6 +8,7 @@ from scipy.spatial.transform import Rotation
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.geometry import collision as coll
 from snakehead.geometry import obstacles as obs
+from snakehead.geometry.shapes import Shape, ShapeSet, pair_distances
 from snakehead.motion import cartesian as cart
 from snakehead.motion import interpolation as interp
 
@@ -281,9 +282,9 @@ def test_cartesian_interpolation_bad_input(robot):
 def test_ground_clearance_closed_form(robot):
     q = np.zeros(16)
     c = coll.ground_clearance(robot, q)
-    boxed = np.all(robot.box_sizes > 0, axis=1)
-    np.testing.assert_allclose(c[0, boxed], 0.0, atol=1e-15)
-    assert np.all(np.isinf(c[0, ~boxed]))
+    shaped = np.isin(np.arange(len(robot.link_names)), robot.shaped_links)
+    np.testing.assert_allclose(c[0, shaped], 0.0, atol=1e-15)
+    assert np.all(np.isinf(c[0, ~shaped]))
     # raise the neck by theta with joint 8 (pitch): link_8's lowest corner is its distal bottom edge... no:
     # rotating up about the joint, the proximal bottom corner goes to z = 0.0215 - 0.0215 cos(theta) and the
     # distal bottom corner higher, so the lowest point of link_8 is h/2 (1 - cos theta) above the ground
@@ -328,53 +329,43 @@ def brute_box_distance(ca, Ra, ha, cb, Rb, hb):
     return np.linalg.norm(A @ r.x - (cb - ca))
 
 
+def box_shapes(c, R, h):
+    """Boxes (centres (n, 3), rotations (n, 3, 3), half extents (n, 3)) as a shape set: one box per frame, and the
+    frames (1, n, 4, 4) that place them."""
+    n = len(c)
+    frames = np.tile(np.eye(4), (1, n, 1, 1))
+    frames[0, :, :3, :3], frames[0, :, :3, 3] = R, c
+    return frames, ShapeSet(tuple(Shape("box", k, np.eye(4), 2 * h[k]) for k in range(n)), n)
+
+
 def test_box_box_distance_against_optimisation():
+    """The geometry layer's signed distance of boxes (FCL's GJK apart, the separating-axis depth overlapping)
+    against bounded least squares (apart) and a shared point (overlapping)."""
     rng = np.random.default_rng(0)
-    ca, Ra, ha = random_boxes(rng, 200)
-    cb, Rb, hb = random_boxes(rng, 200)
-    d = coll.box_box_distance(ca, Ra, ha, cb, Rb, hb)
-    sat = coll.box_box_sat(ca, Ra, ha, cb, Rb, hb)
+    Fa, A = box_shapes(*random_boxes(rng, 200))
+    Fb, B = box_shapes(*random_boxes(rng, 200))
+    pairs = np.stack([np.arange(200), np.arange(200)], axis=1)
+    d = pair_distances(Fa, A, Fb, B, pairs)[0]
     n_apart = 0
     for k in range(200):
-        ref = brute_box_distance(ca[k], Ra[k], ha[k], cb[k], Rb[k], hb[k])
+        ca, Ra, ha = Fa[0, k, :3, 3], Fa[0, k, :3, :3], A.shapes[k].size / 2
+        cb, Rb, hb = Fb[0, k, :3, 3], Fb[0, k, :3, :3], B.shapes[k].size / 2
+        ref = brute_box_distance(ca, Ra, ha, cb, Rb, hb)
         if d[k] > 0:
             n_apart += 1
-            assert d[k] == pytest.approx(ref, abs=1e-9)
-            assert sat[k] <= d[k] + 1e-12  # the separating gap is a lower bound
+            assert d[k] == pytest.approx(ref, abs=1e-7)
         else:
             assert ref < 1e-9  # they do intersect
     assert n_apart > 30 and 200 - n_apart > 5  # both cases were exercised
 
 
-def test_box_box_sat_against_generic_projection():
-    """The closed-form gaps in B's frame equal projections of both boxes on the 15 axes computed directly."""
-    rng = np.random.default_rng(9)
-    ca, Ra, ha = random_boxes(rng, 100)
-    cb, Rb, hb = random_boxes(rng, 100)
-    got = coll.box_box_sat(ca, Ra, ha, cb, Rb, hb)
-    for k in range(100):
-        axes = [Ra[k][:, i] for i in range(3)] + [Rb[k][:, j] for j in range(3)]
-        axes += [np.cross(Ra[k][:, i], Rb[k][:, j]) for i in range(3) for j in range(3)]
-        gaps = []
-        for L in axes:
-            if np.linalg.norm(L) < 1e-9:
-                continue
-            L = L / np.linalg.norm(L)
-            va = ca[k] + (coll._SIGNS * ha[k]) @ Ra[k].T  # the 8 corners
-            vb = cb[k] + (coll._SIGNS * hb[k]) @ Rb[k].T
-            pa, pb = va @ L, vb @ L
-            gaps.append(max(pb.min() - pa.max(), pa.min() - pb.max()))
-        assert got[k] == pytest.approx(max(gaps), abs=1e-12)
-
-
 def test_box_box_penetration_depth_closed_form():
     # two axis-aligned unit cubes overlapping by 0.1 along x: depth 0.1
     I = np.eye(3)
-    h = np.full(3, 0.5)
-    assert coll.box_box_distance([0, 0, 0], I, h, [0.9, 0.2, 0], I, h) == pytest.approx(-0.1)
-    assert coll.box_box_distance([0, 0, 0], I, h, [1.3, 0.0, 0], I, h) == pytest.approx(0.3)
-    # corner to corner along the diagonal
-    assert coll.box_box_distance([0, 0, 0], I, h, [1.5, 1.5, 1.5], I, h) == pytest.approx(np.sqrt(3) * 0.5)
+    h = np.full((2, 3), 0.5)
+    for other, expected in (([0.9, 0.2, 0], -0.1), ([1.3, 0.0, 0], 0.3), ([1.5, 1.5, 1.5], np.sqrt(3) * 0.5)):
+        F, S = box_shapes(np.array([[0.0, 0, 0], other]), np.stack([I, I]), h)
+        assert pair_distances(F, S, F, S, np.array([[0, 1]]))[0, 0] == pytest.approx(expected, abs=1e-9)
 
 
 def wall_solid_contains(wall, p):
@@ -385,6 +376,8 @@ def wall_solid_contains(wall, p):
 
 
 def test_box_wall_collision_against_dense_sampling():
+    """Boxes against a wall's convex pieces (its hole an inscribed polygon) against points sampled in the boxes:
+    a sampled point in the solid means a collision; a collision without one is a sliver (the polygon's safe side)."""
     rng = np.random.default_rng(1)
     wall = obs.WallWithHole([0.2, 0.5, 0.4], [0, 1, 0], (0.7, 0.58, 0.01), 0.07)
     n = 200
@@ -393,7 +386,15 @@ def test_box_wall_collision_against_dense_sampling():
     R = Rotation.random(n, random_state=rng).as_matrix()
     R[: n // 2] = Rotation.from_euler("z", rng.normal(90, 8, (n // 2, 1)), degrees=True).as_matrix()  # along the axis
     h = np.array([0.0865, 0.043, 0.043]) / 2
-    got = coll.box_wall_collision(c, R, np.broadcast_to(h, (n, 3)), wall)
+
+    def collides(c, R):
+        F, S = box_shapes(np.atleast_2d(c), np.reshape(R, (-1, 3, 3)), np.tile(h, (len(np.atleast_2d(c)), 1)))
+        W, owner = coll.obstacle_shapes([wall])
+        pairs = np.stack(np.meshgrid(np.arange(S.n_frames), np.arange(len(owner)), indexing="ij"), -1).reshape(-1, 2)
+        d = pair_distances(F, S, np.eye(4)[None, None], W, pairs)[0].reshape(S.n_frames, -1)
+        return d.min(axis=1) <= 0
+
+    got = collides(c, R)
     g = np.linspace(-1, 1, 31)
     grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     n_hit = 0
@@ -403,15 +404,15 @@ def test_box_wall_collision_against_dense_sampling():
         if ref:
             assert got[k]  # a sampled point inside the solid: it collides
         n_hit += got[k]
-        if got[k] and not ref:  # the sampling may miss a sliver: then the overlap must be tiny
-            dist = wall.distance_to_points(pts)
-            assert dist.min() < 0.003
+        if got[k] and not ref:  # the sampling may miss a sliver, or the polygon's corner: then the overlap is tiny
+            r = wall.hole_diameter / 2
+            assert wall.distance_to_points(pts).min() < 0.003 + r * (1 - np.cos(np.pi / obs.WALL_HOLE_SIDES))
     assert 20 < n_hit < n - 20
     # boxes passing straight through the middle of the hole do not collide; one beside it does
     Rx = np.column_stack([[0, 1, 0], [-1, 0, 0], [0, 0, 1]])
-    assert not coll.box_wall_collision(wall.centre, Rx, h, wall)
-    assert coll.box_wall_collision(wall.centre + [0.03, 0, 0], Rx, h, wall)
-    assert not coll.box_wall_collision(wall.centre + [0.0, 0.2, 0], Rx, h, wall)  # in front of the wall
+    assert not collides(wall.centre, Rx)[0]
+    assert collides(wall.centre + [0.03, 0, 0], Rx)[0]
+    assert not collides(wall.centre + [0.0, 0.2, 0], Rx)[0]  # in front of the wall
 
 
 def test_wall_point_distance_closed_form():
@@ -440,15 +441,13 @@ def test_collision_check_on_the_robot(robot):
     # consistent with ground_clearance for the ground box (distance = clearance for boxes above it)
     clear = coll.ground_clearance(robot, qs)[:, rep.links]
     np.testing.assert_allclose(np.maximum(rep.link_distance[..., 1], 0), np.maximum(clear, 0), atol=1e-12)
-    # a wall: sampled distance is an upper bound within the spacing of the exact clearance to the slab
+    # a wall: the distance to its convex pieces against points sampled on the links' shapes (an upper bound)
     wall = obs.WallWithHole([0.6, 0.4, 0.2], [1, 0, 0], (0.4, 0.3, 0.01), 0.07)  # beyond the body (x < 0.23)
-    rep2 = coll.collision_check(robot, qs, wall, spacing=0.004, exact_within=1.0)
+    rep2 = coll.collision_check(robot, qs, wall, exact_within=1.0)
     assert not rep2.collides.any()
-    slab = wall.slab()
-    links, c, R, h = coll._link_boxes(robot, qs, BasePlacement())
-    exact = coll.box_box_distance(c, R, h[None], slab.centre, slab.rotation, slab.size / 2)
-    near = exact.min(1)
-    assert np.all(rep2.distance >= near - 1e-12) and np.all(rep2.distance <= near + 0.004)
+    sampled = wall.distance_to_points(robot.hull_points(robot.frames_many(qs)).reshape(len(qs), -1, 3)).min(axis=1)
+    slab = coll.collision_check(robot, qs, wall.slab(), exact_within=np.inf).distance  # the wall without its hole
+    assert np.all(rep2.distance <= sampled + 1e-9) and np.all(rep2.distance >= slab - 1e-9)
     # with the default band, distances beyond it are lower bounds above it; inside it they are exact
     rep3 = coll.collision_check(robot, qs, [box, ground_box], exact_within=0.05)
     exact3 = rep.link_distance

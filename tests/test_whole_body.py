@@ -66,7 +66,7 @@ def independent_checks(robot, sol, position, direction, base_start, q_start):
     flat = wb.BodyProblem(robot).flat
     np.testing.assert_array_equal(sol.q[flat], 0.0)
     F = robot.frames(sol.q, sol.base)
-    assert np.abs(robot.lowest_box_z(F[None], robot.base_links)).max() < 1e-9
+    assert np.abs(robot.lowest_z(F[None], robot.base_links)).max() < 1e-9
     if sol.stage in ("segmented", "whole-body, base kept"):
         assert sol.base == base_start
         np.testing.assert_array_equal(sol.q[robot.parts.base], q_start[robot.parts.base])

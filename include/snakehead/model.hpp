@@ -54,9 +54,6 @@ struct LinkInfo {
   double mass;                // kg (0 for a link without <inertial>)
   Eigen::Vector3d com;        // m, in the link frame
   Eigen::Matrix3d inertia;    // kg m^2, about the com, axes of the link frame
-  bool has_box;               // a <collision> box is given
-  Eigen::Vector3d box_size;   // m
-  Eigen::Isometry3d box_origin;  // the box centre's pose in the link frame
   std::vector<CollisionElement> collisions;  // every <collision> element with a geometry, in file order
 };
 
@@ -101,7 +98,7 @@ class ChainModel {
   // A hex digest of everything kinematic (joint types, frames, axes, limits): two models with
   // the same hash have the same kinematics. Reachability maps record it (they depend on nothing else).
   const std::string& hash() const { return hash_; }
-  // A hex digest of the links' bodies (masses, centres of mass, inertias, collision boxes): with hash(),
+  // A hex digest of the links' bodies (masses, centres of mass, inertias, collision shapes): with hash(),
   // everything the model holds.
   const std::string& body_hash() const { return body_hash_; }
   // The sum of the link masses on the chain (kg). It may be 0 (a URDF without <inertial>): a caller that

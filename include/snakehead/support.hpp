@@ -28,11 +28,5 @@ std::vector<double> hull_margins(const double* points, const unsigned char* acti
 // indices into its N points, in `vertex` (T x N, -1 after the count) and the vertex count in `count` (T).
 void convex_hulls(const double* points, const unsigned char* active, long T, long N, int* vertex, int* count);
 
-// The four lowest corners of collision boxes for T samples: frames (T x L x 4 x 4, world poses of the L links),
-// box_origins (L x 4 x 4, each box's centre in its link frame), half (L x 3, half extents); for the k links in
-// `links`: corners_xy (T x k x 4 x 2, world x, y of each box's four lowest corners, lowest first, ties in corner
-// order (-,-,-), (-,-,+), (-,+,-), ... of the box's axes) and corners_z (T x k x 4, their heights).
-void lowest_box_corners(const double* frames, const double* box_origins, const double* half, const int* links,
-                        long T, long L, long k, double* corners_xy, double* corners_z);
 
 }  // namespace snakehead

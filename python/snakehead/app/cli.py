@@ -333,7 +333,7 @@ _OUTPUTS = """outputs (in DIR):
   NAME_zmp.png              the ZMP in the support polygon (Figs. 20 / 25)
   NAME.gif                  an animation of the motion
   NAME.html                 the interactive 3-D viewer of the motion: opens from disk, no server, no network
-  NAME_viewer.npz           what the viewer shows (link boxes per frame, targets, obstacles, ZMP, the head's map);
+  NAME_viewer.npz           what the viewer shows (link collision shapes per frame, targets, obstacles, ZMP, the head's map);
                             snakehead view DIR serves it
   NAME_path.png             with --start: the tail's path over the ground with the phases, from above
   NAME_loop.gif             with --start: the whole sequence (gaits, curl, lift, targets) as MuJoCo ran it

@@ -201,13 +201,17 @@ class ReachabilityMap:
     def summary(self) -> str:
         """A few lines: the chain, the grid, Table 2's bands, the dexterous band and its centre G0."""
         _, pct = self.histogram()
-        t = self.dexterous_threshold() if len(self) else float("nan")
         lines = [repr(self),
-                 "Table 2 bands [0,20) [20,40) [40,60) [60,80) [80,100]: " + " ".join(f"{p:.2f} %" for p in pct),
-                 f"max index {self.indices.max() if len(self) else 0:.1f}; dexterous workspace: "
-                 + ("index 100 (the paper's)" if t >= 100.0 else
-                    f"no voxel reaches 100 in enough number, so the best band, index >= {t:.1f}")
-                 + f" ({int(np.sum(self.indices >= t - 1e-9))} voxels)"]
+                 "Table 2 bands [0,20) [20,40) [40,60) [60,80) [80,100]: " + " ".join(f"{p:.2f} %" for p in pct)]
+        try:
+            t = self.dexterous_threshold()
+        except ValueError as exc:  # the map is what it is; the summary says what it lacks
+            lines.append(f"max index {self.indices.max() if len(self) else 0:.1f}; {exc}")
+            return "\n".join(lines)
+        lines.append(f"max index {self.indices.max():.1f}; dexterous workspace: "
+                     + ("index 100 (the paper's)" if t >= 100.0 else
+                        f"no voxel reaches 100 in enough number, so the best band, index >= {t:.1f}")
+                     + f" ({int(np.sum(self.indices >= t - 1e-9))} voxels)")
         try:
             lines.append(f"G0 = {np.round(self.center(), 4).tolist()} m in the {self.base!r} frame")
         except ValueError as exc:
