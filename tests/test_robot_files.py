@@ -154,7 +154,7 @@ def test_bad_robots(tmp_path):
     with pytest.raises(ValueError, match="straight"):
         SnakeRobot.from_urdf(bent, base_end="p0", neck_end="b0", head_tip="head_tip")
     no_boxes = URDF.replace("<collision>", "<!--").replace("</collision>", "-->")
-    with pytest.raises(ValueError, match="collision box"):
+    with pytest.raises(ValueError, match="collision> shape"):
         SnakeRobot.from_urdf(no_boxes, base_end="p0", neck_end="b0", head_tip="head_tip")
     with pytest.raises(ValueError, match="base_end"):
         SnakeRobot.from_urdf(URDF, base_end="nothing", neck_end="b0", head_tip="head_tip")

@@ -45,6 +45,7 @@ class RobotCheck:
     parts: list[PartReport]
     shapes: dict[str, int]
     problems: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
     suggestion: str | None = None
     map_line: str = ""
 
@@ -86,8 +87,6 @@ def design_problems(robot: SnakeRobot) -> list[str]:
     from ..motion.planner import ground_curl
 
     problems = []
-    if robot.lift_length <= 0:
-        problems.append("the neck has no pitch joint: it cannot lift the head's base")
     try:
         q = initial_configuration(robot)
     except ValueError as exc:
@@ -148,11 +147,7 @@ def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
     roll = "free roll" if m.params.get("free_roll") else f"{m.params.get('rolls')} rolls"
     line = f"{robot.map_path}: {len(m)} voxels, {m.params.get('directions')} directions x {roll}, " \
            f"best index {m.indices.max():.1f}"
-    try:
-        t = m.dexterous_threshold()
-    except ValueError as exc:
-        return line, str(exc)
-    return line + f", dexterous workspace index >= {t:.1f}", None
+    return line + f", dexterous workspace index >= {m.dexterous_threshold():.1f}", m.quality_problem()
 
 
 def check_robot(robot: SnakeRobot, suggest: bool = True) -> RobotCheck:
@@ -161,6 +156,10 @@ def check_robot(robot: SnakeRobot, suggest: bool = True) -> RobotCheck:
     for s in robot.geometry.shapes:
         shapes[s.kind] = shapes.get(s.kind, 0) + 1
     check = RobotCheck(describe_parts(robot), shapes, design_problems(robot))
+    if robot.lift_length <= 0:
+        check.notes.append("the neck has no pitch joint: the segmented method (Eqs. 18-22) cannot lift the head's "
+                           "base, so every target goes to the whole-body solve (name a base_end before a pitch joint "
+                           "to give the neck one)")
     check.map_line, map_problem = map_summary(robot)
     if map_problem:
         check.problems.append(f"head map: {map_problem}")
@@ -185,6 +184,8 @@ def check_lines(robot: SnakeRobot, check: RobotCheck) -> list[str]:
     lines.append(f"head's map: {check.map_line}")
     if not check.problems:
         lines.append("design: the base holds the lifted neck and head (an initial state and a bending state exist)")
+    for note in check.notes:
+        lines.append(f"note: {note}")
     for problem in check.problems:
         lines.append(f"PROBLEM: {problem}")
     if check.suggestion:

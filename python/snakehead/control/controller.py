@@ -100,6 +100,8 @@ class HeadController:
                                if self.dexterous_threshold >= 100.0 else
                                f"the head reaches index 100 in too few voxels; G0 is the centre of its best band, "
                                f"index >= {self.dexterous_threshold:.1f}")
+        if self.map.quality_problem():
+            self.dexterous_note += f" ({self.map.quality_problem()})"
         self.G0_local = vector3(self.map.center(threshold=self.dexterous_threshold), "dexterous centre G0")
         self.Lc = nk.dexterous_distance(self.G0_local)
         self.base = base_pose if base_pose is not None else BasePlacement()

@@ -191,27 +191,33 @@ class ReachabilityMap:
             raise ValueError(f"min_voxels must be >= 1, got {min_voxels!r}")
         need = min(need, len(self))
         levels = np.sort(self.indices)[::-1]  # descending
-        if not levels[need - 1] > 0:
-            hint = ("" if self.params.get("free_roll") else "; a head of fewer than 6 joints cannot turn about its own axis: compute "
-                    "the map with free roll (snakehead workspace --free-roll)")
-            raise ValueError(f"the map's best band has index {levels[need - 1]:.1f}: the head reaches none of its "
-                             f"directions from {need} or more voxels, so it has no dexterous workspace{hint}")
         return float(min(100.0, levels[need - 1]))
+
+    def quality_problem(self) -> str | None:
+        """Why the map's dexterous band says little (None when it is fine): a best band of index 0 (the head reaches
+        none of its directions from enough voxels; G0 is then the middle of every reached voxel), with what to do."""
+        if len(self) == 0 or self.dexterous_threshold() > 0:
+            return None
+        hint = ("" if self.params.get("free_roll") else "; a head of fewer than 6 joints cannot turn about its own "
+                "axis to the rolls tried: compute the map with free roll (snakehead workspace --free-roll)")
+        return ("the map's best band has index 0: the head reaches none of its directions from enough voxels, so "
+                f"its dexterous workspace is every voxel it reaches{hint}")
 
     def summary(self) -> str:
         """A few lines: the chain, the grid, Table 2's bands, the dexterous band and its centre G0."""
         _, pct = self.histogram()
         lines = [repr(self),
                  "Table 2 bands [0,20) [20,40) [40,60) [60,80) [80,100]: " + " ".join(f"{p:.2f} %" for p in pct)]
-        try:
-            t = self.dexterous_threshold()
-        except ValueError as exc:  # the map is what it is; the summary says what it lacks
-            lines.append(f"max index {self.indices.max() if len(self) else 0:.1f}; {exc}")
+        if len(self) == 0:
+            lines.append("no voxels")
             return "\n".join(lines)
+        t = self.dexterous_threshold()
         lines.append(f"max index {self.indices.max():.1f}; dexterous workspace: "
                      + ("index 100 (the paper's)" if t >= 100.0 else
                         f"no voxel reaches 100 in enough number, so the best band, index >= {t:.1f}")
                      + f" ({int(np.sum(self.indices >= t - 1e-9))} voxels)")
+        if self.quality_problem():
+            lines.append(f"note: {self.quality_problem()}")
         try:
             lines.append(f"G0 = {np.round(self.center(), 4).tolist()} m in the {self.base!r} frame")
         except ValueError as exc:

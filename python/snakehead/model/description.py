@@ -21,8 +21,12 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError
+from .._validate import input_file
 
 from typing import Mapping
+
+#: A URDF or xacro file larger than this is not a snake's description.
+MAX_DESCRIPTION_BYTES = 16 * 1024 * 1024
 
 #: A collision mesh larger than this is not a snake module's (and would stall the hull).
 MAX_MESH_BYTES = 64 * 1024 * 1024
@@ -51,7 +55,7 @@ def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, obje
         if xacro_args:
             raise InputError("xacro_args are given but the description is URDF text, not a .xacro file")
         return Description(urdf, None, "<URDF text>")
-    path = Path(urdf)
+    path = input_file(urdf, "the robot's description", MAX_DESCRIPTION_BYTES)
     if path.suffix == ".xacro":
         return Description(expand_xacro(path, xacro_args or {}), path.resolve().parent, os.fspath(path))
     if xacro_args:

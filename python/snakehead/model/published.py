@@ -608,10 +608,10 @@ def _write_mesh(spec: StyleSpec, folder: Path) -> Path:
 
 
 # --- "one_joint_neck" and "head6": the default convention --------------------------------------------------------
-def _snake_spec(spec: StyleSpec) -> SnakeSpec:
+def _snake_spec(spec: StyleSpec, first_axis: str = "yaw") -> SnakeSpec:
     return SnakeSpec(n_joints=spec.n_joints, module_length=spec.module_length, section=spec.thickness,
                      mass_per_module=spec.mass_per_module, joint_limit_deg=spec.joint_limit_deg, effort=spec.effort,
-                     velocity=spec.velocity, name=spec.name,
+                     velocity=spec.velocity, name=spec.name, first_axis=first_axis,
                      markers={"base_end": spec.base_joints, "neck_end": spec.base_joints + spec.neck_joints})
 
 
@@ -623,7 +623,9 @@ def _default_robot_file(folder: Path, stem: str, urdf: str, comment: str) -> Pat
 
 def _write_one_joint_neck(spec: StyleSpec, folder: Path) -> Path:
     urdf = folder / "snake_one_joint_neck.urdf"
-    urdf.write_text(snake_urdf(_snake_spec(spec)), encoding="utf-8")
+    # the neck's one joint pitches (it lifts the head's base): the axes alternate from whichever joint 1 needs
+    first = "pitch" if spec.base_joints % 2 == 0 else "yaw"
+    urdf.write_text(snake_urdf(_snake_spec(spec, first)), encoding="utf-8")
     return _default_robot_file(folder, "snake_one_joint_neck", urdf.name, "default convention, one-joint neck")
 
 

@@ -696,8 +696,9 @@ def _with_limits(description: Description, limits: Mapping[str, tuple[float, flo
             raise InputError(f"limits of {name!r} must be finite with lower < upper, got [{lo}, {hi}]")
         checked[str(name)] = (lo, hi)
     text = description.text
+    _check_utf8(text, "urdf")
+    _core.urdf_root_link(text)  # the core's checks of the text (size, depth, numbers) before Python parses it
     if not _is_xml_text(text):
-        _check_utf8(text, "urdf")
         if not checked and b"continuous" not in Path(text).read_bytes():
             return text  # the core reads the file itself
         text = Path(text).read_text(encoding="utf-8")
