@@ -181,6 +181,6 @@ def collision_check(robot: SnakeRobot, qs: np.ndarray, obstacles: Sequence[Any],
     dist = np.full((len(qs), len(links) * len(obstacles)), np.inf)
     for g in np.unique(group):  # a link's distance to an obstacle: its closest pair of shapes
         dist[:, g] = d[:, group == g].min(axis=1)
-    dist = dist.reshape(len(qs), len(links), len(obstacles))
-    hit = dist <= 0.0
-    return CollisionReport(dist.min(axis=(1, 2)), np.asarray(hit.any(axis=(1, 2))), dist, hit, links)
+    per_link = dist.reshape(len(qs), len(links), len(obstacles))
+    hit = per_link <= 0.0
+    return CollisionReport(per_link.min(axis=(1, 2)), np.asarray(hit.any(axis=(1, 2))), per_link, hit, links)

@@ -206,8 +206,9 @@ def shape_mesh(shape: Shape, segments: int = DRAW_SEGMENTS, hull: ShapeSet | Non
         else:
             from scipy.spatial import ConvexHull
 
+            assert shape.vertices is not None  # a convex shape has them (its constructor's contract)
             h = ConvexHull(shape.vertices)
-            v, f = shape.vertices, h.simplices
+            v, f = np.asarray(shape.vertices), h.simplices
     R, p = shape.origin[:3, :3], shape.origin[:3, 3]
     return v @ R.T + p, np.asarray(f, dtype=np.int64)
 

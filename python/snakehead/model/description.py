@@ -23,7 +23,7 @@ import numpy as np
 from .._errors import InputError
 from .._validate import input_file
 
-from typing import Mapping
+from typing import Any, Mapping
 
 #: A URDF or xacro file larger than this is not a snake's description.
 MAX_DESCRIPTION_BYTES = 16 * 1024 * 1024
@@ -220,8 +220,8 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
     if path.stat().st_size > MAX_MESH_BYTES:
         raise InputError(f"{where}: mesh file {os.fspath(path)!r} is larger than {MAX_MESH_BYTES} bytes")
     try:
-        loaded = trimesh.load(os.fspath(path), force="mesh", process=False)
-        vertices = np.asarray(loaded.vertices, float)
+        loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
+        vertices = np.asarray(loaded.vertices, dtype=float)
     except Exception as exc:  # trimesh raises many kinds for a bad file
         raise InputError(f"{where}: cannot read mesh file {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None
     vertices = vertices[np.all(np.isfinite(vertices), axis=1)] * np.asarray(scale, float)

@@ -298,11 +298,12 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
         world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
                        quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
                        conaffinity=1, **surface)
-    for k, ob in enumerate(o for o in obstacles if isinstance(o, MeshObstacle)):
-        mesh = spec.add_mesh(name=f"obstacle_hull_{k}", uservert=np.asarray(ob.vertices, float).reshape(-1).tolist())
+    meshes: list[MeshObstacle] = [o for o in obstacles if isinstance(o, MeshObstacle)]
+    for k, rock in enumerate(meshes):
+        mesh = spec.add_mesh(name=f"obstacle_hull_{k}", uservert=np.asarray(rock.vertices, dtype=float).reshape(-1).tolist())
         mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
         world.add_geom(name=f"obstacle_{len(boxes) + k}", type=mj.mjtGeom.mjGEOM_MESH, meshname=mesh.name,
-                       pos=ob.pose[:3, 3], quat=_quat_array(ob.pose[:3, :3]), contype=0, conaffinity=1, **surface)
+                       pos=rock.pose[:3, 3], quat=_quat_array(rock.pose[:3, :3]), contype=0, conaffinity=1, **surface)
     shapes_on: dict[int, list[int]] = {}
     for k, shape in enumerate(robot.geometry.shapes):
         shapes_on.setdefault(int(shape.frame), []).append(k)

@@ -171,12 +171,13 @@ def robot_meshes(robot: Any) -> dict[str, np.ndarray]:
     cube, cylinders a unit cylinder, spheres a unit sphere; a mesh's hull is a mesh of its own."""
     from ..geometry.shapes import Shape, shape_mesh
 
-    unit = {"box": Shape("box", 0, np.eye(4), (1.0, 1.0, 1.0)),
-            "cylinder": Shape("cylinder", 0, np.eye(4), (1.0, 1.0, 0.0)),
-            "sphere": Shape("sphere", 0, np.eye(4), (1.0, 0.0, 0.0))}
+    unit = {"box": Shape("box", 0, np.eye(4), np.array([1.0, 1.0, 1.0])),
+            "cylinder": Shape("cylinder", 0, np.eye(4), np.array([1.0, 1.0, 0.0])),
+            "sphere": Shape("sphere", 0, np.eye(4), np.array([1.0, 0.0, 0.0]))}
     meshes: list[tuple[np.ndarray, np.ndarray]] = []
     mesh_of: dict[str, int] = {}
-    which, scales = [], []
+    which: list[int] = []
+    scales: list[tuple[float, float, float]] = []
     geometry = robot.geometry
     for k, shape in enumerate(geometry.shapes):
         if shape.kind == "convex":
@@ -191,8 +192,9 @@ def robot_meshes(robot: Any) -> dict[str, np.ndarray]:
             mesh_of[shape.kind] = len(meshes) - 1
         which.append(mesh_of[shape.kind])
         size = np.asarray(shape.size, float)
-        scales.append({"box": size, "cylinder": (size[0], size[0], size[1]),
-                       "sphere": (size[0], size[0], size[0])}[shape.kind])
+        r = float(size[0])
+        scales.append((float(size[0]), float(size[1]), float(size[2])) if shape.kind == "box" else
+                      (r, r, float(size[1])) if shape.kind == "cylinder" else (r, r, r))
     vstarts = np.cumsum([0] + [len(v) for v, _ in meshes])
     tstarts = np.cumsum([0] + [len(f) for _, f in meshes])
     return dict(
