@@ -34,7 +34,9 @@ sphere (a point is reached when one of its rolled frames is solved; --each-roll 
 The map keeps which points (or frames) were reached.
 
 required:
-  --urdf FILE            the robot description
+  --urdf FILE            the robot description: a URDF file (xacro is not expanded here, and the
+                         frames are the URDF's own: for a robot file, xacro or aligned frames use
+                         snakehead workspace --robot ROBOT.toml)
   --base LINK            the chain's base link (the map's frame)
   --tip LINK             the chain's tip link
   --out FILE             output .npz (numpy.load reads it)
@@ -187,6 +189,10 @@ int main(int argc, char** argv) {
     }
     if (urdf.empty() || base.empty() || tip.empty() || out.empty())
       throw UsageError("--urdf, --base, --tip and --out are required (see --help)");
+    const std::string xacro = ".xacro";
+    if (urdf.size() >= xacro.size() && urdf.compare(urdf.size() - xacro.size(), xacro.size(), xacro) == 0)
+      throw UsageError("--urdf " + urdf + " is a xacro file: workspace_gen reads URDF only; use snakehead workspace "
+                       "--robot ROBOT.toml (it expands xacro), or expand it first (xacro FILE > FILE.urdf)");
     if (opt.free_roll && (rolls_given || !opt.any_roll))
       throw UsageError("--free-roll leaves the roll free: it takes neither --rolls nor --each-roll");
     if (shrink_given && opt.hull == snakehead::HullKind::Convex)
