@@ -202,6 +202,46 @@ TRACKING_CLEARANCE = 0.002
 TRACKING_GROUND_WEIGHT = 10.0
 #: Weight (m per rad) of each lifted joint's change from the previous sample in the tracking fit.
 TRACKING_CONTINUITY = 0.03
+#: The tracking fit keeps the shapes of links two or more joints apart (``robot.self_collision_pairs``) this far
+#: apart (m), with the ground's weight: thick links (e.g. cylinders wider than a module is long) folded by the
+#: interpolated points would otherwise overlap, and the planner would fall back to a detour for the whole move.
+TRACKING_SELF_CLEARANCE = 0.005
+#: Step (rad) of the finite differences of the self-clearance term's distances.
+TRACKING_SELF_STEP = 1e-6
+
+
+def _self_pairs(robot: SnakeRobot, lift: np.ndarray) -> np.ndarray:
+    """The self-collision pairs (P, 2) of shapes that the lifted joints ``lift`` move apart: one shape on a link
+    that they move, the other not on the same rigid run of links."""
+    pairs = robot.self_collision_pairs
+    if pairs.size == 0 or lift.size == 0:
+        return pairs.reshape(0, 2)
+    first = int(np.asarray(robot.body.model.joint_child_links)[lift[0]])
+    frame = robot.geometry.shape_frames
+    return pairs[(frame[pairs[:, 0]] >= first) | (frame[pairs[:, 1]] >= first)]
+
+
+def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,
+               F: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The tracking fit's self-clearance rows: residuals (c,) and their Jacobian (c, len(lift)) of the pairs closer
+    than TRACKING_SELF_CLEARANCE (exact signed distances of the shapes; forward differences in the lifted joints),
+    or None when none is."""
+    from ..geometry.shapes import pair_distances
+
+    if pairs.size == 0:
+        return None
+    geom = robot.geometry
+    d = pair_distances(F[None], geom, F[None], geom, pairs, 2 * TRACKING_SELF_CLEARANCE)[0]
+    close = d < TRACKING_SELF_CLEARANCE
+    if not close.any():
+        return None
+    near = pairs[close]
+    steps = np.tile(qj, (len(lift), 1))
+    steps[np.arange(len(lift)), lift] += TRACKING_SELF_STEP
+    Fs = robot.frames_many(steps, base)
+    ds = pair_distances(Fs, geom, Fs, geom, near)  # (len(lift), c)
+    J = ((ds - d[close][None, :]) / TRACKING_SELF_STEP).T
+    return TRACKING_GROUND_WEIGHT * (d[close] - TRACKING_SELF_CLEARANCE), TRACKING_GROUND_WEIGHT * J
 
 
 def tracked_points(robot: SnakeRobot) -> np.ndarray:
@@ -218,8 +258,10 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     to all those points at once by damped least squares (Levenberg-Marquardt steps, warm-started from the previous
     sample, within the joint limits), instead of Eqs. 42-44's link-by-link directions, which drift off the points
     when they are closer together than the links are long. The ground enters the fit as a stiff one-sided term on
-    the lifted boxes' lowest corners (``TRACKING_CLEARANCE``, ``TRACKING_GROUND_WEIGHT``). The joints before the lift interpolate linearly in joint
-    space (the base stays on the ground). The first and last samples are q_start and q_end exactly.
+    the lifted boxes' lowest corners (``TRACKING_CLEARANCE``, ``TRACKING_GROUND_WEIGHT``), and so does the body
+    itself: links two or more joints apart are kept ``TRACKING_SELF_CLEARANCE`` apart. The joints before the lift
+    interpolate linearly in joint space (the base stays on the ground). The first and last samples are q_start and
+    q_end exactly.
 
     Where the interpolated points cannot be met (a straight line between two poses shortens the chain, while links
     keep their lengths), the fit is the closest in the least-squares sense; ``deviation`` says how far it is.
@@ -237,6 +279,7 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # joints before the lift, and the starting guesses
     lo, hi = robot.lower[lift], robot.upper[lift]
     lifted = robot.lifted_links
+    pairs = _self_pairs(robot, lift)
     lam2 = TRACKING_DAMPING ** 2
     current = q_start[lift].copy()
     for j in range(1, len(s) - 1):
@@ -253,6 +296,11 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
                 Jz = robot.point_jacobians(F, low[below], lifted[below])[:, 2, lift]
                 r = np.concatenate([r, TRACKING_GROUND_WEIGHT * (low[below, 2] - TRACKING_CLEARANCE)])
                 J = np.vstack([J, TRACKING_GROUND_WEIGHT * Jz])
+            # and itself: links two or more joints apart stay TRACKING_SELF_CLEARANCE apart
+            selfc = _self_term(robot, qj, lift, pairs, base, F)
+            if selfc is not None:
+                r = np.concatenate([r, selfc[0]])
+                J = np.vstack([J, selfc[1]])
             # continuity: every joint's change from the previous sample costs TRACKING_CONTINUITY m per rad, so
             # the fit follows one branch instead of jumping between distant ones
             r = np.concatenate([r, TRACKING_CONTINUITY * (qj[lift] - current)])

@@ -323,7 +323,9 @@ class _Waypoints:
         """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
 
         The straight path when it does; else the shortest of DETOUR_TRIALS two-piece paths through a waypoint
-        drawn around the midpoint (neck and head joints perturbed, seeded: plans are reproducible) whose every
+        drawn around the midpoint (the joints from the neck's first lifting joint on perturbed, seeded: plans are
+        reproducible; the joints before it keep their straight path, since their links lie on the ground and a
+        detour would sweep them across it, the ground's friction pushing the base) whose every
         configuration passes (tried shortest first, DETOUR_BATCH at a time, each screened at DENSIFY
         configurations per step and then checked as densely as a move); else the one with the largest worst
         margin (the scenario's checks report it).
@@ -332,7 +334,7 @@ class _Waypoints:
         straight = _split_steps(qa + s * (qb - qa))
         if self._feasible(_checked(straight)).all():
             return straight, "joint space"
-        movable = np.arange(self.robot.parts.neck.start, self.robot.parts.head.stop)
+        movable = np.arange(self.robot.lift_joints.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
         W = np.tile(0.5 * (qa + qb), (DETOUR_TRIALS, 1))
         W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
