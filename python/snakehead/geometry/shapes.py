@@ -26,9 +26,10 @@ from typing import Sequence
 
 KINDS = ("box", "cylinder", "sphere", "convex")
 
-#: How many lowest candidate points of a shape count as its possible ground contacts: a box's face has 4, an
-#: upright cylinder's rim is drawn as 8 (+ its exact lowest point), a mesh hull may have many.
-CONTACT_POINTS_PER_SHAPE = 10
+#: How many lowest candidate points of a shape of each kind count as its possible ground contacts: a box rests on a
+#: face of 4 corners, a sphere on one point, a cylinder on its two rims' lowest points or (upright) on its rim drawn
+#: as 8 points; a mesh hull on up to 10 of its vertices. A set takes the largest its shapes need.
+CONTACT_POINTS = {"box": 4, "sphere": 1, "cylinder": 10, "convex": 10}
 
 #: Segments of a cylinder's or sphere's drawn mesh around its axis.
 DRAW_SEGMENTS = 24
@@ -106,6 +107,11 @@ class ShapeSet:
         """Indices of the shapes on the given frames, in shape order."""
         return np.flatnonzero(np.isin(self.shape_frames, np.asarray(frames, dtype=np.int64)))
 
+    @cached_property
+    def contact_points_per_shape(self) -> int:
+        """How many lowest candidate points :meth:`lowest_points` keeps per shape (:data:`CONTACT_POINTS`)."""
+        return max((CONTACT_POINTS[s.kind] for s in self.shapes), default=1)
+
     def lowest_z(self, frames: np.ndarray, on: np.ndarray) -> np.ndarray:
         """Lowest world z (m) of the shapes on each frame of ``on``: (T, k); +inf for a frame without shapes.
         ``frames`` (T, n_frames, 4, 4) world poses."""
@@ -115,22 +121,35 @@ class ShapeSet:
         if idx.size == 0:
             return out
         z = _core.shape_lowest_z(np.ascontiguousarray(frames, float), self.core, idx)  # (T, s)
-        column = {int(f): c for c, f in enumerate(on)}
-        owner = np.array([column[int(f)] for f in self.shape_frames[idx]])
-        for c in np.unique(owner):  # a frame's lowest point is its lowest shape's
-            out[:, c] = z[:, owner == c].min(axis=1)
+        _reduce_to_frames(z, self.shape_frames[idx], on, out)
         return out
 
     def lowest_points(self, frames: np.ndarray, on: np.ndarray,
-                      per_shape: int = CONTACT_POINTS_PER_SHAPE) -> tuple[np.ndarray, np.ndarray]:
+                      per_shape: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The lowest candidate ground points of the shapes on the frames ``on``: points (T, N, 3) world and the
-        frame (N,) each belongs to; N = shapes x ``per_shape``, each shape's sorted lowest first."""
+        frame (N,) each belongs to; N = shapes x ``per_shape`` (default :attr:`contact_points_per_shape`), each
+        shape's sorted lowest first (``per_shape=1``: each shape's lowest point)."""
+        per_shape = self.contact_points_per_shape if per_shape is None else per_shape
         idx = self.shapes_of(on)
         T = frames.shape[0]
         if idx.size == 0:
             return np.zeros((T, 0, 3)), np.zeros(0, dtype=np.int64)
         pts = _core.shape_lowest_points(np.ascontiguousarray(frames, float), self.core, idx, per_shape)
         return pts.reshape(T, -1, 3), np.repeat(self.shape_frames[idx], per_shape)
+
+
+def _reduce_to_frames(values: np.ndarray, owner_frames: np.ndarray, on: np.ndarray, out: np.ndarray) -> None:
+    """out[:, c] = the smallest of the columns of ``values`` (T, s) whose shape is on frame ``on[c]``."""
+    column = np.full(int(max(on.max(), owner_frames.max())) + 1, -1, dtype=np.int64)
+    column[on] = np.arange(len(on))
+    owner = column[owner_frames]
+    if len(np.unique(owner)) == len(owner):  # one shape per frame (the common case): no reduction
+        out[:, owner] = values
+        return
+    order = np.argsort(owner, kind="stable")
+    sorted_owner = owner[order]
+    starts = np.flatnonzero(np.r_[True, sorted_owner[1:] != sorted_owner[:-1]])
+    out[:, sorted_owner[starts]] = np.minimum.reduceat(values[:, order], starts, axis=1)
 
 
 def pair_distances(frames_a: np.ndarray, a: ShapeSet, frames_b: np.ndarray, b: ShapeSet, pairs: np.ndarray,

@@ -499,11 +499,12 @@ class SnakeRobot:
         about its proximal joint leaves the ground last."""
         links, local = self.link_points
         F = self._straight_frames
-        out = np.empty_like(local)
-        for c, (k, pts) in enumerate(zip(links, local)):
+        chosen = []
+        for k, pts in zip(links, local):
             axial = pts @ (F[k, :3, :3].T @ np.array([1.0, 0.0, 0.0]))
-            far = pts[axial >= axial.max() - STRAIGHT_TOLERANCE]
-            out[c] = far[np.arange(len(pts)) % len(far)]
+            chosen.append(np.unique(pts[axial >= axial.max() - STRAIGHT_TOLERANCE], axis=0))
+        width = max(len(c) for c in chosen)
+        out = np.array([c[np.arange(width) % len(c)] for c in chosen])
         out.setflags(write=False)
         return links, out
 
@@ -565,8 +566,10 @@ class SnakeRobot:
         """The lowest world point (k, 3) of each link's shapes, from the frames (n_links, 4, 4) of one
         configuration (box corner, cylinder rim point, sphere bottom, hull vertex)."""
         links = np.asarray(links, dtype=np.int64)
-        pts, owner = self.lowest_points(np.asarray(frames)[None], links)
+        pts, owner = self.geometry.lowest_points(np.asarray(frames)[None], links, per_shape=1)  # each shape's lowest
         pts = pts[0]
+        if np.array_equal(owner, links):  # one shape per link (the common case)
+            return pts
         out = np.empty((len(links), 3))
         for c, k in enumerate(links):
             mine = pts[owner == k]
