@@ -257,7 +257,7 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
         n_panels = 12 if cols == 4 else 9
         snapshots = body.plot_snapshots(result, n_panels=n_panels, columns=cols,
                                         title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                              "the body at its states (collision boxes; axes in m, equal scales)")
+                                              "the body at its states (collision shapes; axes in m, equal scales)")
         files.append(save(snapshots, out / f"{name}_snapshots.png").name)
     with progress.stage(f"{name}: animation"):
         files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)

@@ -15,9 +15,9 @@ puts a link in the ground or into an obstacle, this module solves one optimisati
 It is solved by SciPy's SLSQP with analytic gradients (the Jacobians of world points of the body, the centre of
 mass and the polygon's active edge) from several starts: the segmented solution, the current configuration, and
 the segmented solutions from base placements that bring the target into the neck's accepted range and from
-other base arcs. Links are capsules in the optimisation (their collision boxes' axes, radius half the section;
-the boxes' corners stick out by at most 41 % of that radius, covered by the clearance); every solution is then
-checked exactly (boxes by separating axes, the support polygon of the boxes' ground footprint).
+other base arcs. Links are capsules in the optimisation (``SnakeRobot.link_capsules``: inside their shapes along the
+body, what sticks out of them (a box's corners) added to the clearance); every solution is then checked exactly
+(the shapes' signed distances, the support polygon of their ground footprint).
 """
 from __future__ import annotations
 

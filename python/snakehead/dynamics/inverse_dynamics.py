@@ -31,7 +31,7 @@ from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .stability import GRAVITY
 
-#: Ramp (m) of the lifted share: a link whose distal face's lowest corner is this high is fully carried by the
+#: Ramp (m) of the lifted share: a link whose distal points' lowest is this high is fully carried by the
 #: joints; on the ground (height 0) not at all; linear in between.
 LIFT_RAMP = 0.005
 

@@ -1,7 +1,7 @@
 """The body sliding over the ground under Coulomb friction, quasi-statically: where a change of shape on the ground
 (a curl, a gait) carries the body.
 
-The model. Each contact i (a box resting on the ground) carries a normal load N_i; where it slips with velocity
+The model. Each contact i (a link resting on the ground) carries a normal load N_i; where it slips with velocity
 v_i the ground pushes it back with a friction force of magnitude mu N_i against v_i. A slow motion has no inertia
 to speak of, so the body moves such that the friction forces balance. For a change of shape that moves contact i
 by d_i in the body's own frame, and a rigid motion of the whole body (translation t, rotation w about the
@@ -23,7 +23,7 @@ sliding workpiece", IEEE J. Robotics and Automation 4(6), 1988). Two uses:
 the planner of a closed loop uses it to know where a curl on the ground will leave the body
 (:mod:`snakehead.motion.locomotion`), and the pose estimate (:mod:`snakehead.sim.estimate`) uses the first.
 Loads are the links' weights (uniform friction, the body flat on the ground); the model ignores inertia and the
-pressure's spread under each box.
+pressure's spread under each link.
 """
 from __future__ import annotations
 

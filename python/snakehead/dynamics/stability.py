@@ -28,7 +28,7 @@ import numpy.typing as npt
 #: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
 GRAVITY = 9.80665
 
-#: A base link counts as lying on the ground when the lowest corner of its collision box is below this
+#: A base link counts as lying on the ground when the lowest point of its collision shapes is below this
 #: height (m). The default robot's flat base links sit at exactly 0.
 CONTACT_TOLERANCE = 1e-3
 
@@ -162,12 +162,14 @@ def support_polygon(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | N
     * ``"endpoints"`` (default, the paper): both endpoints of every base link (link_0 .. link_7 on the default
       robot: the origins of link_0 .. link_7 and of the ``base_end`` marker), projected on the ground.
       This is conservative: the true footprint of the 0.043 m wide modules is larger.
-    * ``"footprint"``: the four bottom corners of every base link's collision box -- the physical contact
-      footprint of the modules; use it for an (almost) straight base, whose endpoints are collinear.
-    * ``"ground"``: the four bottom corners of every link's box that lies on the ground, the neck's and head's
-      included -- the physical support of a robot that still lies (partly) flat, e.g. before the head is lifted.
+    * ``"footprint"``: the lowest points of every base link's collision shapes that touch the ground (a box's
+      bottom corners, a cylinder's bottom line, a sphere's lowest point, a mesh hull's lowest vertices) -- the
+      physical contact footprint of the modules; use it for an (almost) straight base, whose endpoints are
+      collinear.
+    * ``"ground"``: the same for every link that lies on the ground, the neck's and head's included -- the
+      physical support of a robot that still lies (partly) flat, e.g. before the head is lifted.
 
-    Only links lying on the ground count (the lowest corner of their box below ``tolerance`` m). In the paper's
+    Only links lying on the ground count (the lowest point of their shapes below ``tolerance`` m). In the paper's
     model (the first two) only the base supports the body, even when the neck and head touch the ground.
     If the contact points are collinear the "polygon" is the segment between the extreme points (2, 2): it
     has no interior, so :func:`static_margin` is <= 0 for it.

@@ -108,7 +108,7 @@ class Chain:
 
     @property
     def body_hash(self) -> str:
-        """Digest of the links' bodies (masses, centres of mass, inertias, collision boxes), which ``hash``
+        """Digest of the links' bodies (masses, centres of mass, inertias, collision shapes), which ``hash``
         leaves out: together they cover everything the chain holds."""
         return self._model.body_hash
 

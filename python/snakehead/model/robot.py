@@ -2,7 +2,7 @@
 
 This is the one place that knows how the body divides into base, neck and head (paper, Section 2) and what the
 body looks like: where the joints sit along it, which bend in yaw and which in pitch, how long the links are,
-the collision boxes and their corners, the height of the body's axis when the base lies on the ground.
+the collision shapes and their lowest points, the height of the body's axis when the base lies on the ground.
 Everything else asks it; nothing else names a link or holds a dimension of a particular robot.
 
 A robot is a URDF plus three frames (links or fixed marker frames) along one serial chain from the root:
@@ -326,7 +326,7 @@ class SnakeRobot:
 
     @cached_property
     def base_links(self) -> np.ndarray:
-        """Indices (link_names) of the base part's links that carry a body (mass or box): those before base_end."""
+        """Indices (link_names) of the base part's links that carry a body (mass or shapes): those before base_end."""
         return self._bodies(self._part_links(None, self.parts.base_end))
 
     @cached_property
