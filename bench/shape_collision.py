@@ -84,7 +84,7 @@ def main() -> None:
     t_coal, by_coal = best_of(lambda: coal_min_distances(robot, frames[:few], pairs), repeats=1)
     print(f"robot {args.robot}: {args.samples} configurations, {len(S.shapes)} shapes "
           f"({', '.join(sorted({s.kind for s in S.shapes}))}), {len(pairs)} pairs")
-    print(f"| method | µs/sample |\n|---|---|")
+    print("| method | µs/sample |\n|---|---|")
     print(f"| snakehead kernel (FCL), pruned minimum | {1e6 * t_min / args.samples:.1f} |")
     print(f"| snakehead kernel (FCL), every pair | {1e6 * t_all / args.samples:.1f} |")
     print(f"| coal from Python, one call per pair ({few} samples) | {1e6 * t_coal / few:.1f} |")
