@@ -155,3 +155,43 @@ def test_unknown_robot_file_keys_and_bad_tables_are_input_errors(tmp_path: Path)
 
 def test_input_error_is_a_value_error() -> None:
     assert issubclass(snakehead.InputError, ValueError)
+
+
+@pytest.mark.parametrize("damage", ["missing mesh", "unknown package", "empty mesh", "xacro error",
+                                    "continuous without limits"])
+def test_bad_descriptions_on_the_command_line_exit_2_with_one_line(tmp_path: Path, damage: str) -> None:
+    """Each bad description: ``snakehead info`` exits 2 with one line that names the file and the element."""
+    import subprocess
+    import sys
+
+    style = {"missing mesh": "mesh", "unknown package": "sea", "empty mesh": "mesh", "xacro error": "xacro",
+             "continuous without limits": "mesh"}[damage]
+    path = published.write_robot(style, tmp_path / style)
+    folder = tmp_path / style
+    if damage == "missing mesh":
+        victim = sorted(folder.rglob("*.STL"))[0]
+        victim.unlink()
+        expected = [victim.name, "<collision>"]
+    elif damage == "unknown package":
+        _edit(path, '"sea_snake" =', '"other_package" =')
+        expected = ["sea_snake", "[packages]"]
+    elif damage == "empty mesh":
+        victim = sorted(folder.rglob("*.STL"))[0]
+        victim.write_bytes(b"")
+        expected = [victim.name, "<collision>"]
+    elif damage == "xacro error":
+        xacro_file = next(folder.glob("*.xacro"))
+        xacro_file.write_text(xacro_file.read_text().replace("${pi/2}", "${undefined_name/2}", 1))
+        expected = [xacro_file.name, "undefined_name"]
+    else:
+        text = path.read_text()
+        first = text[text.index("[limits]"):].splitlines()[1]
+        path.write_text(text.replace(first + "\n", ""))
+        expected = [first.split("=")[0].strip().strip('"'), "[limits]"]
+    proc = subprocess.run([sys.executable, "-m", "snakehead", "info", "--robot", str(path), "--quick"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("snakehead info: error:"), proc.stderr
+    for word in expected:
+        assert word in lines[0], (word, lines[0])
