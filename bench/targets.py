@@ -58,6 +58,7 @@ def run_set(controller, name: str, targets, sim_left: list, sim_rows: list) -> d
             s = snakehead.simulate(plan)
             sim_rows.append({"set": name, "position_mm": 1000 * s.position_error_m,
                              "direction_deg": s.direction_error_deg, "zmp_inside": s.zmp_inside,
+                             "zmp_margin_mm": 1000 * s.metrics["zmp_min_margin_m"],
                              "slide_mm": 1000 * s.metrics["base_slide_m"]})
         print(f"  {name} {len(rows):3d}: {'ok ' if plan.success else 'NO '} {dt:6.2f} s "
               f"{stage or rows[-1]['cause']}{' (relocated)' if plan.relocation is not None else ''}",
@@ -127,7 +128,8 @@ def main() -> int:
         de = [r["direction_deg"] for r in sim_rows]
         lines += ["", f"MuJoCo, {len(sim_rows)} successful plans: head position error max {max(pe):.2f} mm "
                       f"(median {statistics.median(pe):.2f}), direction max {max(de):.3f} deg (median "
-                      f"{statistics.median(de):.3f}); ZMP inside in {sum(r['zmp_inside'] for r in sim_rows)}; "
+                      f"{statistics.median(de):.3f}); ZMP inside in {sum(r['zmp_inside'] for r in sim_rows)} (least margin "
+                      f"{min(r['zmp_margin_mm'] for r in sim_rows):.2f} mm); "
                       f"base slide max {max(r['slide_mm'] for r in sim_rows):.2f} mm; within 2 mm and 1 deg: "
                       f"{sum(p <= 2 and d <= 1 for p, d in zip(pe, de))}/{len(sim_rows)}."]
     text = "\n".join(lines)
