@@ -293,3 +293,12 @@ def test_a_path_that_turns_back_rests_at_the_turn():
     k = int(np.argmin(np.abs(traj.t - traj.waypoint_times[1])))
     assert np.abs(traj.qd[k]).max() < 1e-9 and np.abs(traj.q[k] - q1).max() < 1e-9
     assert traj.check.within(LIMIT_TOLERANCE), traj.check
+
+
+def test_required_zmp_margin_closed_form():
+    """The ZMP keeps ZMP_MARGIN where the CoM leaves ZMP_DYNAMIC_ROOM more room, else the larger of half the CoM's
+    margin and the CoM's margin less that room (a CoM 8.4 mm inside needs 5 mm, not 4.2: the plan's own check)."""
+    m, room = timing.ZMP_MARGIN, timing.ZMP_DYNAMIC_ROOM
+    static = np.array([0.02, 0.0084, 0.006, 0.004, 0.0])
+    expected = [m, m, max(0.003, 0.006 - room), max(0.002, 0.004 - room), 0.0]
+    np.testing.assert_allclose(timing.required_margins(static, m), expected, atol=1e-15)
