@@ -17,9 +17,10 @@ from snakehead.model import published
 from snakehead.scenes import load_scene
 
 
-def test_a_mesh_obstacle_in_a_scene_file_is_its_box(tmp_path: Path) -> None:
-    trimesh.creation.box(extents=(0.2, 0.3, 0.25)).export(tmp_path / "rock.stl")
-    (tmp_path / "scene.toml").write_text('''
+def scene_with_a_mesh(folder: Path, mesh: str, position: str) -> Path:
+    """A scene file with one target and one mesh obstacle (``position``: its TOML value and any further lines)."""
+    path = folder / "scene.toml"
+    path.write_text(f'''
 [[targets]]
 name = "t"
 position = [0.15, 0.51, 0.40]
@@ -27,11 +28,15 @@ direction = [0.0, 1.0, 0.0]
 
 [[obstacles]]
 kind = "mesh"
-file = "rock.stl"
-position = [0.9, 0.3, 0.125]
-yaw = 0.4
+file = "{mesh}"
+position = {position}
 ''')
-    scene = load_scene(tmp_path / "scene.toml")
+    return path
+
+
+def test_a_mesh_obstacle_in_a_scene_file_is_its_box(tmp_path: Path) -> None:
+    trimesh.creation.box(extents=(0.2, 0.3, 0.25)).export(tmp_path / "rock.stl")
+    scene = load_scene(scene_with_a_mesh(tmp_path, "rock.stl", "[0.9, 0.3, 0.125]\nyaw = 0.4"))
     (rock,) = scene.obstacles
     assert isinstance(rock, MeshObstacle) and len(rock.vertices) == 8
     box = BoxObstacle.from_yaw([0.9, 0.3, 0.125], [0.2, 0.3, 0.25], 0.4)
@@ -46,19 +51,8 @@ yaw = 0.4
 
 
 def test_a_scene_mesh_that_is_missing_is_an_input_error(tmp_path: Path) -> None:
-    (tmp_path / "scene.toml").write_text('''
-[[targets]]
-name = "t"
-position = [0.15, 0.51, 0.40]
-direction = [0.0, 1.0, 0.0]
-
-[[obstacles]]
-kind = "mesh"
-file = "nothing.stl"
-position = [0.9, 0.3, 0.0]
-''')
     with pytest.raises(ValueError, match="nothing.stl"):
-        load_scene(tmp_path / "scene.toml")
+        load_scene(scene_with_a_mesh(tmp_path, "nothing.stl", "[0.9, 0.3, 0.0]"))
 
 
 def test_cylinder_support_polygon_is_the_hull_of_the_bottom_lines(tmp_path: Path) -> None:
