@@ -220,3 +220,20 @@ def test_margins_after_the_lift_on_a_generated_snake(generated):
     np.testing.assert_allclose(way._margins(qs), expected, atol=1e-9)
     footprint = [stability.static_margin(robot, q, way.base, contact="footprint") for q in qs]
     assert np.max(np.array(expected) - footprint) > 0.01  # the case: the footprint model would refuse far more
+
+
+def test_targets_keep_the_lifted_links_off_the_ground():
+    """A target's pose keeps every link after the first one the neck lifts (which pivots on its edge) at least
+    TARGET_GROUND_CLEARANCE above the ground: a head resting on the ground is a contact no plan counts on (in
+    MuJoCo it carried load and moved the head 2.45 mm on a 6-DOF-head snake)."""
+    from snakehead.motion.targets import KINDS, TARGET_GROUND_CLEARANCE
+
+    robot = snakehead.SnakeRobot.default()
+    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
+    pivot = int(robot.joint_frames[robot.lift_joints.start])
+    after = robot.lifted_links[robot.lifted_links > pivot]
+    rng = np.random.default_rng(4)
+    for kind in KINDS:
+        for t in reachable_targets(controller, kind, 5, rng):
+            clear = coll.ground_clearance(robot, t.q, t.base)[0]
+            assert clear[after].min() >= TARGET_GROUND_CLEARANCE and clear[robot.lifted_links].min() >= 0.0

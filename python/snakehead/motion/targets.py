@@ -3,7 +3,8 @@
 A target is *reachable by construction* when it is the head pose of a whole-body configuration that the robot
 can hold: statically stable (the centre of mass inside the support polygon of the links on the ground by
 ``min_margin``, and inside the base's own: a neck or head link resting on the ground does not hold the body up),
-every neck and head link above the ground, no two links touching. The base's own support is that of the links
+every neck and head link above the ground (those after the first link the neck lifts, which pivots on its edge,
+by ``TARGET_GROUND_CLEARANCE``), no two links touching. The base's own support is that of the links
 lying on the ground whatever the pose (``control.whole_body.BodyProblem.ground_links``: the base's, and on a neck
 that begins with yaw joints the links before it lifts), as the whole-body solve checks its solutions
 (``check_solution(problem=)``). Three kinds (``KINDS``):
@@ -32,6 +33,10 @@ if TYPE_CHECKING:
 
 KINDS = ("same", "shape", "place")
 
+#: How far (m) the links after the first one the neck lifts (which pivots on its edge on the ground) keep above the
+#: ground in a target's pose: a head resting on the ground is a contact the plan does not count on.
+TARGET_GROUND_CLEARANCE = 0.002
+
 
 @dataclass(frozen=True)
 class ReachableTarget:
@@ -57,6 +62,8 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
     rng = np.random.default_rng() if rng is None else rng
     lift = np.arange(robot.lift_joints.start, robot.n_joints)
     ground_yaw = np.array([j for j in range(robot.lift_joints.start) if robot.joint_kinds[j] == "yaw"], int)
+    lifted = robot.lifted_links
+    pivot = int(robot.joint_frames[robot.lift_joints.start]) if robot.lift_joints.start < robot.n_joints else -1
     out: list[ReachableTarget] = []
     for _ in range(int(max_draws)):
         if len(out) >= count:
@@ -76,7 +83,8 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
         if min(stability.static_margin(robot, q, base, contact="ground"),
                prob.margin_and_gradient(prob.frames(q, base), base)[0]) <= min_margin:
             continue
-        if coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min() < 0.0:
+        clear = coll.ground_clearance(robot, q, base)[0]
+        if clear[lifted].min() < 0.0 or clear[lifted[lifted > pivot]].min(initial=np.inf) < TARGET_GROUND_CLEARANCE:
             continue
         if coll.self_clearance(robot, q, base)[0] <= 0.0:
             continue
