@@ -224,8 +224,7 @@ def test_margins_after_the_lift_on_a_generated_snake(generated):
 
 def test_targets_keep_the_lifted_links_off_the_ground():
     """A target's pose keeps every link after the first one the neck lifts (which pivots on its edge) at least
-    TARGET_GROUND_CLEARANCE above the ground: a head resting on the ground is a contact no plan counts on (in
-    MuJoCo it carried load and moved the head 2.45 mm on a 6-DOF-head snake)."""
+    TARGET_GROUND_CLEARANCE above the ground: a head resting on the ground is a contact no plan counts on."""
     from snakehead.motion.targets import KINDS, TARGET_GROUND_CLEARANCE
 
     robot = snakehead.SnakeRobot.default()

@@ -34,7 +34,8 @@ if TYPE_CHECKING:
 KINDS = ("same", "shape", "place")
 
 #: How far (m) the links after the first one the neck lifts (which pivots on its edge on the ground) keep above the
-#: ground in a target's pose: a head resting on the ground is a contact the plan does not count on.
+#: ground in a target's pose: a head resting on the ground is a contact the plan does not count on. (The planner's
+#: own solutions may still let a lifted link touch the ground, within GROUND_TOLERANCE: not changed here.)
 TARGET_GROUND_CLEARANCE = 0.002
 
 
