@@ -203,7 +203,7 @@ def test_published_shapes_of_each_style(robot):
         assert geometry == {"mesh"} and {j.get("type") for j in robot.joints()} == {"continuous", "fixed"}
         files = [m.get("filename") for m in mesh_elements(robot, "collision")]
         assert any(f.startswith("package://") for f in files) and any(not f.startswith("package://") for f in files)
-        assert {Path(f).suffix for f in files} == {".STL", ".obj"}
+        assert {Path(f).suffix for f in files} == {".STL", ".obj", ".dae"}
         stl = [resolve(robot, f).read_bytes()[:5] for f in files if f.endswith(".STL")]
         assert b"solid" in stl and any(head != b"solid" for head in stl)  # ASCII and binary STL
     elif style == "one_joint_neck":

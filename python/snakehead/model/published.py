@@ -15,9 +15,9 @@ plans (modules 6-9 cm long, about 0.2 kg each, alternating yaw/pitch, +-90 deg):
   alternation by the joints' axis attribute.
 - ``"rsnake"``: HEBI R8 snake. Modules along y, cylinders of radius 0.05 m centred mid-module (collision origin
   offset and rotated), visual meshes through ``package://`` whose files do not exist.
-- ``"mesh"``: a SolidWorks export. Collision meshes as files (binary and ASCII STL, one OBJ in millimetres),
+- ``"mesh"``: a SolidWorks export. Collision meshes as files (binary and ASCII STL, one OBJ in millimetres, one DAE),
   referenced by ``package://cad_snake/...`` and by paths relative to the URDF; ``continuous`` joints, their limits
-  in the robot file. No DAE: trimesh writes COLLADA only with pycollada, which is not a dependency.
+  in the robot file. The DAE (COLLADA) is read and written by trimesh with pycollada.
 - ``"xacro"``: the ``"reu"`` snake as a xacro module macro with ``$(arg n_modules)``, expanded by the PyPI
   ``xacro`` package (no ROS: no ``$(find ...)``).
 - ``"one_joint_neck"``: the default convention (:func:`snakehead.model.generate.snake_urdf`), 14 joints, a
@@ -541,14 +541,18 @@ def _write_rsnake(spec: StyleSpec, folder: Path) -> Path:
 # --- "mesh": SolidWorks export -----------------------------------------------------------------------------------
 #: The link (0 = base_link) whose mesh is an OBJ in millimetres, as CAD tools often write them.
 MESH_OBJ_LINK = 5
+#: The link of the "mesh" style whose collision mesh is COLLADA (DAE, read and written by trimesh with pycollada).
+MESH_DAE_LINK = 3
 MM = 0.001
 
 
 def _mesh_file(link: int) -> tuple[str, str]:
     """(file name, trimesh file type) of link ``link``'s collision mesh: binary STL on even links, ASCII STL on
-    odd ones, one OBJ."""
+    odd ones, one OBJ, one COLLADA (DAE)."""
     if link == MESH_OBJ_LINK:
         return f"link{link}.obj", "obj"
+    if link == MESH_DAE_LINK:
+        return f"link{link}.dae", "dae"
     name = "base_link" if link == 0 else f"link{link}"
     return f"{name}.STL", "stl" if link % 2 == 0 else "stl_ascii"
 
