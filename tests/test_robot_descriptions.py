@@ -195,3 +195,13 @@ def test_bad_descriptions_on_the_command_line_exit_2_with_one_line(tmp_path: Pat
     assert len(lines) == 1 and lines[0].startswith("snakehead info: error:"), proc.stderr
     for word in expected:
         assert word in lines[0], (word, lines[0])
+
+
+def test_a_continuous_joint_off_the_body_needs_no_limits() -> None:
+    """A camera pan (continuous) on a branch off the body chain: not the planner's, so no [limits] entry."""
+    text = snakehead.default_urdf_path().read_text()
+    branch = ('<link name="camera"/><joint name="camera_pan" type="continuous"><parent link="link_3"/>'
+              '<child link="camera"/><axis xyz="0 0 1"/></joint></robot>')
+    robot = SnakeRobot.from_urdf(text.replace("</robot>", branch), base_end="base_end", neck_end="neck_end",
+                                 head_tip="head_tip")
+    assert robot.n_joints == 16 and "camera_pan" not in robot.joint_names

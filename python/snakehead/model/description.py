@@ -92,11 +92,6 @@ def _xml_root(text: str, where: str) -> ET.Element:
         raise InputError(f"malformed URDF ({where}): {exc}") from None
 
 
-def continuous_joints(text: str, where: str) -> list[str]:
-    """Names of the ``continuous`` joints of a URDF text."""
-    return [j.get("name", "") for j in _xml_root(text, where).iter("joint") if j.get("type") == "continuous"]
-
-
 def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], where: str,
                       needed: list[str] | None = None) -> str:
     """The URDF text with ``continuous`` joints made revolute within ``limits`` (joint -> (lower, upper) rad) and

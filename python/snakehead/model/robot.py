@@ -34,8 +34,7 @@ from .._errors import InputError
 from .._validate import finite_array, joint_vector
 from .chain import Chain, _check_utf8
 from .body_frame import ALIGNED_SUFFIX, HEAD_AXES, STRAIGHT_TOLERANCE, aligned_frames, body_frame
-from .description import (Description, MeshResolver, continuous_joints, convex_hull_vertices, read_description,
-                          with_joint_limits)
+from .description import MeshResolver, convex_hull_vertices, read_description, with_joint_limits
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Mapping
@@ -150,9 +149,11 @@ class SnakeRobot:
         #: Where the robot came from (a robot file's path), for messages and reports.
         self.source = source or description.source
         self._meshes = MeshResolver(description.folder, {k: Path(v) for k, v in (packages or {}).items()})
-        text = _with_limits(description, limits or {})
-        root = _core.urdf_root_link(text) if root is None else _frame_name(root, "root")
+        text = description.text
+        _check_utf8(text, "urdf")
+        root = _core.urdf_root_link(text) if root is None else _frame_name(root, "root")  # the core checks the text
         raw = _body_chain(text, root, names["head_tip"])
+        text, raw = _bounded(text, raw, root, names["head_tip"], limits or {}, description.source)
         parts = _part_slices(raw, root, names)
         body_in_root = body_frame(raw)
         aligned, text = aligned_frames(text, raw, body_in_root, parts, names, head_axis)
@@ -677,9 +678,11 @@ class SnakeRobot:
 # ------------------------------------------------------------------------------------------------
 # construction steps
 # ------------------------------------------------------------------------------------------------
-def _with_limits(description: Description, limits: Mapping[str, tuple[float, float]]) -> str:
-    """The description's URDF text with its continuous joints bounded by ``limits`` (the text unchanged, or the
-    file's path, when it has none and none are given)."""
+def _bounded(text: str, raw: Chain, root: str, head_tip: str, limits: Mapping[str, tuple[float, float]],
+             where: str) -> tuple[str, Chain]:
+    """The description (a path or URDF text) and its body chain with the body's ``continuous`` joints made
+    revolute within ``limits`` (InputError for one without); unchanged when there are none and none are given.
+    Continuous joints off the body (a camera's pan, a wheel) need no limits."""
     checked = {}
     for name, pair in limits.items():
         try:
@@ -689,18 +692,12 @@ def _with_limits(description: Description, limits: Mapping[str, tuple[float, flo
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise InputError(f"limits of {name!r} must be finite with lower < upper, got [{lo}, {hi}]")
         checked[str(name)] = (lo, hi)
-    text = description.text
-    _check_utf8(text, "urdf")
-    _core.urdf_root_link(text)  # the core's checks of the text (size, depth, numbers) before Python parses it
-    if not _is_xml_text(text):
-        if not checked and b"continuous" not in Path(text).read_bytes():
-            return text  # the core reads the file itself
-        text = Path(text).read_text(encoding="utf-8")
-    where = description.source
-    cont = continuous_joints(text, where)
-    if not checked and not cont:
-        return text
-    return with_joint_limits(text, checked, where, needed=cont)
+    needed = [n for n, t in zip(raw.joint_names, raw.joint_types) if t == "continuous"]
+    if not checked and not needed:
+        return text, raw
+    xml = text if _is_xml_text(text) else Path(text).read_text(encoding="utf-8")
+    bounded = with_joint_limits(xml, checked, where, needed=needed)
+    return bounded, _body_chain(bounded, root, head_tip)
 
 
 def _is_xml_text(text: str) -> bool:
