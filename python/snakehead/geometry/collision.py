@@ -94,14 +94,37 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
     return pair_min_distances(frames, robot.geometry, frames, robot.geometry, robot.self_collision_pairs, cutoff)
 
 
+class _ObstacleSets:
+    """The shape sets of obstacle lists already seen (a wall's 32 hulls cost ~5 ms to build; the planner checks the
+    same obstacles many times a plan), keyed by the obstacles' identities and holding them so that no id is reused
+    while its entry lives. Obstacles are immutable. At most ``size`` entries; the oldest go first."""
+
+    def __init__(self, size: int = 32) -> None:
+        self.size = size
+        self._sets: dict[tuple[int, ...], tuple[tuple, ShapeSet, np.ndarray]] = {}
+
+    def get(self, obstacles: Sequence[Any]) -> tuple[ShapeSet, np.ndarray]:
+        key = tuple(id(ob) for ob in obstacles)
+        hit = self._sets.get(key)
+        if hit is None:
+            shapes, owner = [], []
+            for o, ob in enumerate(obstacles):
+                for shape in ob.shapes():
+                    shapes.append(shape)
+                    owner.append(o)
+            hit = (tuple(obstacles), ShapeSet(tuple(shapes), 1), np.array(owner, dtype=np.int64))
+            if len(self._sets) >= self.size:
+                self._sets.pop(next(iter(self._sets)))
+            self._sets[key] = hit
+        return hit[1], hit[2]
+
+
+_OBSTACLE_SETS = _ObstacleSets()
+
+
 def obstacle_shapes(obstacles: Sequence[Any]) -> tuple[ShapeSet, np.ndarray]:
     """The obstacles' convex world shapes as one set (on one identity frame) and the obstacle (S,) of each."""
-    shapes, owner = [], []
-    for o, ob in enumerate(obstacles):
-        for shape in ob.shapes():
-            shapes.append(shape)
-            owner.append(o)
-    return ShapeSet(tuple(shapes), 1), np.array(owner, dtype=np.int64)
+    return _OBSTACLE_SETS.get(list(obstacles))
 
 
 # ------------------------------------------------------------------------------------------------
