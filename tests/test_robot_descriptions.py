@@ -205,3 +205,22 @@ def test_a_continuous_joint_off_the_body_needs_no_limits() -> None:
     robot = SnakeRobot.from_urdf(text.replace("</robot>", branch), base_end="base_end", neck_end="neck_end",
                                  head_tip="head_tip")
     assert robot.n_joints == 16 and "camera_pan" not in robot.joint_names
+
+
+def test_a_root_placed_off_the_body_line(tmp_path: Path) -> None:
+    """A base link whose origin sits off the body's line (a fixed joint 5 cm sideways and 2 cm up to the tail): the
+    line runs from the first joint to the head tip, the body frame's origin is the root's projection on it, and
+    the body is the snake written without the offset, 3 cm along it."""
+    text = snakehead.default_urdf_path().read_text()
+    offset = ('<link name="base_link"/><joint name="base_to_tail" type="fixed"><parent link="base_link"/>'
+              '<child link="link_0"/><origin xyz="0.03 -0.05 -0.02" rpy="0 0 0"/></joint></robot>')
+    shifted = SnakeRobot.from_urdf(text.replace("</robot>", offset), base_end="base_end", neck_end="neck_end",
+                                   head_tip="head_tip")
+    plain = SnakeRobot.default()
+    np.testing.assert_allclose(shifted.body_in_root[:3, :3], np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(shifted.body_in_root[:3, 3], [0.0, -0.05, -0.02], atol=1e-12)  # root's projection
+    q = plain.random_configuration(np.random.default_rng(3))
+    H, H0 = shifted.head_pose(q), plain.head_pose(q)  # the tail 3 cm ahead of the body frame's origin
+    np.testing.assert_allclose(H[:3, :3], H0[:3, :3], atol=1e-12)
+    np.testing.assert_allclose(H[:3, 3], H0[:3, 3] + [0.03, 0.0, 0.0], atol=1e-12)
+    assert shifted.body_axis_height == pytest.approx(plain.body_axis_height, abs=1e-12)

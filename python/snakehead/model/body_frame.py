@@ -30,8 +30,9 @@ HEAD_AXES = {"x": 0, "y": 1, "z": 2, "-x": 0, "-y": 1, "-z": 2}
 
 
 def body_frame(body: Chain) -> np.ndarray:
-    """The body frame (4, 4) in the root frame: x along the straight body's line towards the head, z the
-    joint-axis direction nearest the root frame's z (then x, then y), origin the root's projection on the line.
+    """The body frame (4, 4) in the root frame: x along the straight body's line (from the first joint to the head
+    tip) towards the head, z the joint-axis direction nearest the root frame's z (then x, then y), origin the
+    root's projection on the line.
     InputError when the body is not straight at q = 0 or a joint axis is not across it."""
     if set(body.joint_types) - {"revolute"}:
         raise InputError(f"a snake robot's joints are revolute with limits; this body has "
@@ -39,18 +40,21 @@ def body_frame(body: Chain) -> np.ndarray:
                          "[limits] table)")
     F = body.fk_all(np.zeros(body.n_joints))
     p = F[:, :3, 3]
-    d = p[-1] - p[0]
+    child = np.asarray(body.model.joint_child_links)
+    # the line runs from the first joint (its link's origin) to the head tip; frames before the first joint (a
+    # dummy root, a base link placed elsewhere) may lie off it
+    first = int(child[0]) if len(child) else 0
+    d = p[-1] - p[first]
     if not np.linalg.norm(d) > STRAIGHT_TOLERANCE:
-        raise InputError("the head tip lies on the root at q = 0: the body has no length")
+        raise InputError("the head tip lies on the first joint at q = 0: the body has no length")
     d /= np.linalg.norm(d)
-    s = (p - p[0]) @ d
-    off = np.linalg.norm((p - p[0]) - np.outer(s, d), axis=1)
+    s = (p[first:] - p[first]) @ d
+    off = np.linalg.norm((p[first:] - p[first]) - np.outer(s, d), axis=1)
     if off.max() > STRAIGHT_TOLERANCE or np.any(np.diff(s) < -STRAIGHT_TOLERANCE):
         k = int(np.argmax(off)) if off.max() > STRAIGHT_TOLERANCE else int(np.argmin(np.diff(s))) + 1
-        raise InputError(f"the body does not lie straight at q = 0: frame {body.link_names[k]!r} is "
-                         f"{1000 * off[k]:.2f} mm off the line from the root to the head tip (or out of order); a "
-                         "snake's frames lie on one line, in order, when its joints are at zero")
-    child = np.asarray(body.model.joint_child_links)
+        raise InputError(f"the body does not lie straight at q = 0: frame {body.link_names[first + k]!r} is "
+                         f"{1000 * off[k]:.2f} mm off the line from the first joint to the head tip (or out of "
+                         "order); a snake's frames lie on one line, in order, when its joints are at zero")
     axes = np.einsum("jik,jk->ji", F[child, :3, :3], np.asarray(body.model.joint_axes, float))
     across = axes - np.outer(axes @ d, d)
     up = None
@@ -67,7 +71,7 @@ def body_frame(body: Chain) -> np.ndarray:
         up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0.5 else np.cross(d, np.eye(3)[1])
     T = np.eye(4)
     T[:3, 0], T[:3, 1], T[:3, 2] = d, np.cross(up, d), up
-    T[:3, 3] = p[0] - (p[0] @ d) * d
+    T[:3, 3] = p[first] - ((p[first] - p[0]) @ d) * d  # the root's projection on the line
     return T
 
 
