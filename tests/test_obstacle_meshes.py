@@ -84,3 +84,19 @@ def test_cylinder_support_polygon_is_the_hull_of_the_bottom_lines(tmp_path: Path
     assert len(poly) == len(hull)
     for v in hull:
         assert np.min(np.linalg.norm(poly - v, axis=1)) < 1e-9
+
+
+def test_shapes_and_mesh_obstacles_reject_bad_input(tmp_path: Path) -> None:
+    from snakehead.geometry.shapes import Shape, ShapeSet
+
+    with pytest.raises(ValueError, match="kind"):
+        Shape("cone", 0, np.eye(4), np.ones(3))
+    with pytest.raises(ValueError, match="frame"):
+        ShapeSet((Shape("box", 3, np.eye(4), np.ones(3)),), 2)
+    with pytest.raises(ValueError):
+        ShapeSet((Shape("box", 0, np.eye(4), -np.ones(3)),), 1)  # the core checks sizes
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(tmp_path / "rock.stl")
+    with pytest.raises(ValueError, match="scale"):
+        MeshObstacle.load(tmp_path / "rock.stl", [0, 0, 0], scale=[1, 0, 1])
+    with pytest.raises(ValueError, match="does not exist"):
+        MeshObstacle.load(tmp_path / "none.stl", [0, 0, 0])
