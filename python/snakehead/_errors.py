@@ -1,7 +1,32 @@
-"""The exception for bad input: raised where input enters (files, the CLI, public functions), with one line that
-names the file, field or argument. A ``ValueError``, so code that catches those keeps working."""
+"""snakehead's error taxonomy: whose fault is it?
+
+* :class:`InputError` -- the caller's input is wrong: a file, a field, a command-line option or an argument of a
+  public function. Raised where input enters, with one line that names what was wrong and how. It is a
+  ``ValueError``; :class:`InputTypeError`, for a value of the wrong kind (text where a number is needed), is also a
+  ``TypeError``, so code that catches either keeps working. The command line exits 2 for these, and only for these.
+* :class:`InternalError` -- an invariant of snakehead itself is broken on valid input: a bug. Raised through
+  :func:`invariant`. The command line exits 3 for it, as for any other exception.
+* A plan that is computed but does not succeed (a target out of reach, a relocation out of range) is neither: it is
+  a result whose ``failure`` says why (the command line exits 1).
+"""
 from __future__ import annotations
 
 
 class InputError(ValueError):
     """The caller's input is wrong (the message says which and how); anything else raised on valid input is a bug."""
+
+
+class InputTypeError(InputError, TypeError):
+    """An input of the wrong kind (text, a bool or None where a number is needed): an :class:`InputError` that is
+    also a ``TypeError``."""
+
+
+class InternalError(AssertionError):
+    """A broken invariant of snakehead on valid input: a bug in snakehead, never the caller's fault."""
+
+
+def invariant(condition: object, message: str) -> None:
+    """Raise :class:`InternalError` with ``message`` unless ``condition`` holds. Unlike ``assert`` it is kept
+    under ``python -O``: internal functions state what they rely on with it, not with input errors."""
+    if not condition:
+        raise InternalError(message)
