@@ -6,8 +6,10 @@
   ``TypeError``, so code that catches either keeps working. The command line exits 2 for these, and only for these.
 * :class:`InternalError` -- an invariant of snakehead itself is broken on valid input: a bug. Raised through
   :func:`invariant`. The command line exits 3 for it, as for any other exception.
-* A plan that is computed but does not succeed (a target out of reach, a relocation out of range) is neither: it is
-  a result whose ``failure`` says why (the command line exits 1).
+* :class:`Infeasible` -- valid input for which a computation has no answer: no stable curl on this base, no timing
+  of a path within the robot's limits, no shape of the up curve that fits. Not the caller's fault and not a bug; the
+  planner turns it into a failed result whose ``failure`` says why (the command line exits 1), as it does for a
+  target out of reach or a relocation out of range.
 """
 from __future__ import annotations
 
@@ -19,6 +21,11 @@ class InputError(ValueError):
 class InputTypeError(InputError, TypeError):
     """An input of the wrong kind (text, a bool or None where a number is needed): an :class:`InputError` that is
     also a ``TypeError``."""
+
+
+class Infeasible(Exception):
+    """Valid input for which a computation found no answer (the message says which and why): a failed result, not
+    an error of the caller's and not a bug. Deliberately not a ``ValueError``: code that catches it means it."""
 
 
 class InternalError(AssertionError):

@@ -14,6 +14,7 @@ from typing import Any, IO, Iterator
 import numpy as np
 
 from ._validate import input_file
+from ._errors import InputError
 
 
 
@@ -32,11 +33,14 @@ def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs: Any) -> Iter
     """Open a temporary file beside ``path`` for writing; on success it replaces ``path``, on any error it is
     removed and ``path`` is left as it was. ``mode`` is "w" (text; ``kwargs`` go to ``open``) or "wb"."""
     if mode not in ("w", "wb"):
-        raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+        raise InputError(f"mode must be 'w' or 'wb', got {mode!r}")
     target = Path(path)
     if target.exists() and not target.is_file():  # the rename would replace a device, a FIFO, ...
-        raise OSError(f"{str(target)!r} exists and is not a regular file")
-    fd, tmp = _create_beside(target)
+        raise InputError(f"cannot write {str(target)!r}: it exists and is not a regular file")
+    try:
+        fd, tmp = _create_beside(target)
+    except OSError as exc:
+        raise InputError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
     try:
         with os.fdopen(fd, mode, **kwargs) as f:
             yield f
@@ -44,9 +48,11 @@ def atomic_open(path: str | os.PathLike, mode: str = "w", **kwargs: Any) -> Iter
             os.fsync(f.fileno())
         os.chmod(tmp, _FILE_MODE)
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError):  # a full disk, a folder removed meanwhile: where the output goes is wrong
+            raise InputError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from exc
         raise
 
 
@@ -85,27 +91,27 @@ def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str,
     try:
         archive = zipfile.ZipFile(p)
     except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as exc:
-        raise ValueError(f"{where}: it is not a .npz archive (a zip of .npy arrays): {exc}") from None
+        raise InputError(f"{where}: it is not a .npz archive (a zip of .npy arrays): {exc}") from None
     arrays: dict[str, np.ndarray] = {}
     with archive:
         members = archive.infolist()
         declared = sum(m.file_size for m in members)
         if declared > max_bytes:
-            raise ValueError(f"{where}: it would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
+            raise InputError(f"{where}: it would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
                              "damaged file or a zip bomb)")
         for m in members:
             if m.is_dir() or not m.filename.endswith(".npy"):
-                raise ValueError(f"{where}: it holds {m.filename!r}, which is not a .npy array")
+                raise InputError(f"{where}: it holds {m.filename!r}, which is not a .npy array")
             key = m.filename[:-len(".npy")]
             if key in arrays:
-                raise ValueError(f"{where}: it holds the array {key!r} twice")
+                raise InputError(f"{where}: it holds the array {key!r} twice")
             try:
                 with archive.open(m) as f:
                     arrays[key] = _read_npy(f, m.file_size)
             except ValueError as exc:
-                raise ValueError(f"{where}: its array {key!r} {exc}") from None
+                raise InputError(f"{where}: its array {key!r} {exc}") from None
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, RuntimeError, NotImplementedError) as exc:
-                raise ValueError(f"{where}: its array {key!r} is damaged ({type(exc).__name__}: {exc})") from None
+                raise InputError(f"{where}: its array {key!r} is damaged ({type(exc).__name__}: {exc})") from None
     return arrays
 
 
@@ -116,26 +122,26 @@ def _read_npy(f: IO[bytes], size: int) -> np.ndarray:
     try:
         version = npy.read_magic(f)
     except ValueError as exc:
-        raise ValueError(f"is not a .npy array ({exc})") from None
+        raise InputError(f"is not a .npy array ({exc})") from None
     if version not in ((1, 0), (2, 0)):
-        raise ValueError(f"has an unsupported .npy format version {version}")
+        raise InputError(f"has an unsupported .npy format version {version}")
     try:
         read_header = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
         shape, fortran, dtype = read_header(f)
     except (ValueError, TypeError, SyntaxError, RecursionError, MemoryError) as exc:  # a Python literal, parsed safely
-        raise ValueError(f"has a damaged header ({exc})") from None
+        raise InputError(f"has a damaged header ({exc})") from None
     if dtype.hasobject:
-        raise ValueError("holds Python objects (pickled), which are never read")
+        raise InputError("holds Python objects (pickled), which are never read")
     if any(not isinstance(d, int) or d < 0 for d in shape):
-        raise ValueError(f"has an invalid shape {shape}")
+        raise InputError(f"has an invalid shape {shape}")
     count = math.prod(shape)
     nbytes = count * dtype.itemsize
     if nbytes > size or count > size + 1:  # no more data than the member holds (itemsize 0: no more items)
-        raise ValueError(f"declares {shape} of {dtype} ({nbytes} bytes) but the archive holds {size} bytes for it")
+        raise InputError(f"declares {shape} of {dtype} ({nbytes} bytes) but the archive holds {size} bytes for it")
     data = f.read(nbytes)
     if len(data) != nbytes:
-        raise ValueError(f"is truncated ({len(data)} of {nbytes} bytes)")
+        raise InputError(f"is truncated ({len(data)} of {nbytes} bytes)")
     if f.read(1):  # reading to the member's end also makes zipfile check its CRC
-        raise ValueError(f"holds more bytes than its header declares ({shape} of {dtype})")
+        raise InputError(f"holds more bytes than its header declares ({shape} of {dtype})")
     flat = np.frombuffer(data, dtype=dtype, count=count) if nbytes else np.zeros(count, dtype)
     return flat.reshape(shape, order="F" if fortran else "C").copy()

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 import numpy.typing as npt
+from ._errors import InputError, InputTypeError
 
 ORTHONORMAL_TOLERANCE = 1e-6
 
@@ -45,26 +46,26 @@ def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.
 
     TypeError for text, booleans or None (numpy would read ``"1"`` and True as 1.0, None as NaN)."""
     if _not_a_number(x):
-        raise TypeError(f"{name} must be numbers, got {type(x).__name__} {_shown(x)}")
+        raise InputTypeError(f"{name} must be numbers, got {type(x).__name__} {_shown(x)}")
     try:
         raw = x if isinstance(x, np.ndarray) else np.asarray(x)
     except (TypeError, ValueError, OverflowError) as exc:  # e.g. ragged nested lists
-        raise ValueError(f"{name} must be an array of numbers: {exc}") from None
+        raise InputError(f"{name} must be an array of numbers: {exc}") from None
     if raw.dtype.kind in "USb" or (raw.dtype.kind == "O" and any(_not_a_number(v) for v in raw.flat)):
         what = "booleans" if raw.dtype.kind == "b" else "text" if raw.dtype.kind in "US" else "None or text"
-        raise TypeError(f"{name} must be numbers, got {what}")
+        raise InputTypeError(f"{name} must be numbers, got {what}")
     if raw.dtype.kind in "cmMV":  # numpy would drop the imaginary part (with a warning only), or read dates
-        raise TypeError(f"{name} must be real numbers, got {raw.dtype}")
+        raise InputTypeError(f"{name} must be real numbers, got {raw.dtype}")
     try:
         a = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as exc:  # None, complex, objects, ints beyond a float
-        raise ValueError(f"{name} must be an array of numbers: {exc}") from None
+        raise InputError(f"{name} must be an array of numbers: {exc}") from None
     if shape is not None:
         if a.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, a.shape)):
             want = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
-            raise ValueError(f"{name} has shape {a.shape}; expected {want}")
+            raise InputError(f"{name} has shape {a.shape}; expected {want}")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} contains NaN or inf")
+        raise InputError(f"{name} contains NaN or inf")
     return a
 
 
@@ -80,14 +81,14 @@ def within_limits(q: npt.ArrayLike, lower: npt.ArrayLike, upper: npt.ArrayLike, 
     lo, hi = np.asarray(lower, float), np.asarray(upper, float)
     a = finite_array(q, name)
     if a.ndim not in (1, 2) or a.shape[-1] != lo.shape[-1]:
-        raise ValueError(f"{name} has shape {a.shape}; expected ({lo.shape[-1]},)" +
+        raise InputError(f"{name} has shape {a.shape}; expected ({lo.shape[-1]},)" +
                          ("" if a.ndim == 1 else f" or (T, {lo.shape[-1]})"))
     bad = np.argwhere((a < lo - tolerance) | (a > hi + tolerance))
     if len(bad):
         at = tuple(int(i) for i in bad[0])
         j = at[-1]
         where = f"{name}[{', '.join(map(str, at))}]"
-        raise ValueError(f"{where} = {a[at]:.6g} is outside the joint limits [{lo[j]:.6g}, {hi[j]:.6g}]")
+        raise InputError(f"{where} = {a[at]:.6g} is outside the joint limits [{lo[j]:.6g}, {hi[j]:.6g}]")
     return a
 
 
@@ -95,11 +96,25 @@ def vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     return finite_array(v, name, (3,))
 
 
+#: The largest coordinate (m) of a point in the world (a target, an obstacle, a base): a kilometre. Snakes crawl a
+#: few metres; beyond this, the planner's arithmetic (squared distances, figure extents) would lose all precision.
+MAX_COORDINATE_M = 1000.0
+
+
+def world_position(v: npt.ArrayLike, name: str) -> np.ndarray:
+    """A point (3,) in the world: finite, each coordinate within +-:data:`MAX_COORDINATE_M`."""
+    a = vector3(v, name)
+    if np.abs(a).max() > MAX_COORDINATE_M:
+        raise InputError(f"{name} = {np.array2string(a, precision=4)} m is farther than {MAX_COORDINATE_M:g} m from "
+                         "the world's origin (the most any coordinate may be)")
+    return a
+
+
 def unit_vector3(v: npt.ArrayLike, name: str) -> np.ndarray:
     a = vector3(v, name)
     scale = float(np.abs(a).max())  # divided out first: the norm of a huge finite vector overflows to inf
     if scale * float(np.linalg.norm(a / scale)) < 1e-12 if scale > 0 else True:
-        raise ValueError(f"{name} has zero length; a direction is needed")
+        raise InputError(f"{name} has zero length; a direction is needed")
     a = a / scale
     return a / np.linalg.norm(a)
 
@@ -112,16 +127,16 @@ def position_direction_pairs(positions: npt.ArrayLike, directions: npt.ArrayLike
     single = p.ndim == 1 and d.ndim == 1
     p, d = np.atleast_2d(p), np.atleast_2d(d)
     if p.ndim != 2 or p.shape[1] != 3:
-        raise ValueError(f"positions must have shape (3,) or (K, 3), got {np.shape(positions)}")
+        raise InputError(f"positions must have shape (3,) or (K, 3), got {np.shape(positions)}")
     if d.ndim != 2 or d.shape[1] != 3:
-        raise ValueError(f"directions must have shape (3,) or (K, 3), got {np.shape(directions)}")
+        raise InputError(f"directions must have shape (3,) or (K, 3), got {np.shape(directions)}")
     if len(p) != len(d):
-        raise ValueError(f"{len(p)} positions but {len(d)} directions; give one direction per position")
+        raise InputError(f"{len(p)} positions but {len(d)} directions; give one direction per position")
     scale = np.abs(d).max(axis=1)  # divided out first: the norm of a huge finite vector overflows to inf
     d = d / np.where(scale > 0, scale, 1.0)[:, None]
     norm = np.linalg.norm(d, axis=1)
     if np.any(scale * norm < 1e-12):
-        raise ValueError(f"directions must be non-zero; direction {int(np.argmin(scale * norm))} has zero length")
+        raise InputError(f"directions must be non-zero; direction {int(np.argmin(scale * norm))} has zero length")
     return p, d / norm[:, None], single
 
 
@@ -129,7 +144,7 @@ def pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
     """A 4x4 homogeneous transform with an orthonormal, right-handed rotation."""
     a = finite_array(T, name, (4, 4))
     if not np.allclose(a[3], (0.0, 0.0, 0.0, 1.0), atol=1e-9):
-        raise ValueError(f"{name} last row must be [0, 0, 0, 1], got {a[3].tolist()}")
+        raise InputError(f"{name} last row must be [0, 0, 0, 1], got {a[3].tolist()}")
     rotation_matrix(a[:3, :3], name + " rotation")
     return a
 
@@ -138,7 +153,7 @@ def rotation_matrix(R: npt.ArrayLike, name: str = "rotation") -> np.ndarray:
     a = finite_array(R, name, (3, 3))
     err = np.abs(a.T @ a - np.eye(3)).max()
     if err > ORTHONORMAL_TOLERANCE or np.linalg.det(a) < 0:
-        raise ValueError(f"{name} is not a rotation (orthonormality error {err:.2e}, det {np.linalg.det(a):+.3f})")
+        raise InputError(f"{name} is not a rotation (orthonormality error {err:.2e}, det {np.linalg.det(a):+.3f})")
     return a
 
 
@@ -149,18 +164,18 @@ def real_number(x: Any, name: str) -> float:
     if isinstance(x, np.ndarray) and x.ndim == 0 and x.dtype.kind in "iuf":
         x = x[()]
     if _not_a_number(x) or not isinstance(x, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {type(x).__name__} {_shown(x)}")
+        raise InputTypeError(f"{name} must be a real number, got {type(x).__name__} {_shown(x)}")
     try:
         return float(x)
     except OverflowError:
-        raise ValueError(f"{name} is too large for a float, got {_shown(x)}") from None
+        raise InputError(f"{name} is too large for a float, got {_shown(x)}") from None
 
 
 def finite_float(x: Any, name: str) -> float:
     """``x`` as a finite float (:func:`real_number`); ValueError naming ``name`` for NaN or inf."""
     v = real_number(x, name)
     if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {_shown(x)}")
+        raise InputError(f"{name} must be finite, got {_shown(x)}")
     return v
 
 
@@ -168,9 +183,9 @@ def positive(x: Any, name: str, *, maximum: float | None = None) -> float:
     """``x`` as a positive finite float, at most ``maximum`` when given; ValueError naming ``name`` otherwise."""
     v = finite_float(x, name)
     if v <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {_shown(x)}")
+        raise InputError(f"{name} must be a positive finite number, got {_shown(x)}")
     if maximum is not None and v > maximum:
-        raise ValueError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
+        raise InputError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
     return v
 
 
@@ -178,9 +193,9 @@ def non_negative(x: Any, name: str, *, maximum: float | None = None) -> float:
     """``x`` as a finite float >= 0, at most ``maximum`` when given; ValueError naming ``name`` otherwise."""
     v = finite_float(x, name)
     if v < 0:
-        raise ValueError(f"{name} must be >= 0, got {_shown(x)}")
+        raise InputError(f"{name} must be >= 0, got {_shown(x)}")
     if maximum is not None and v > maximum:
-        raise ValueError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
+        raise InputError(f"{name} must be at most {maximum:g}, got {_shown(x)}")
     return v
 
 
@@ -188,9 +203,9 @@ def duration(x: Any, name: str, *, allow_zero: bool = False, maximum: float = MA
     """A duration in seconds: finite, > 0 (>= 0 with ``allow_zero``) and at most ``maximum`` (one day)."""
     v = finite_float(x, name)
     if v < 0 or (v == 0 and not allow_zero):
-        raise ValueError(f"{name} must be {'>= 0' if allow_zero else '> 0'} s, got {_shown(x)}")
+        raise InputError(f"{name} must be {'>= 0' if allow_zero else '> 0'} s, got {_shown(x)}")
     if v > maximum:
-        raise ValueError(f"{name} must be at most {maximum:g} s, got {_shown(x)}")
+        raise InputError(f"{name} must be at most {maximum:g} s, got {_shown(x)}")
     return v
 
 
@@ -199,12 +214,12 @@ def integer(n: Any, name: str, *, least: int | None = None, most: int | None = N
     if isinstance(n, np.ndarray) and n.ndim == 0 and n.dtype.kind in "iu":
         n = n[()]
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {type(n).__name__} {_shown(n)}")
+        raise InputTypeError(f"{name} must be an integer, got {type(n).__name__} {_shown(n)}")
     v = int(n)
     if (least is not None and v < least) or (most is not None and v > most):
         bounds = (f"between {least} and {most}" if least is not None and most is not None else
                   f">= {least}" if least is not None else f"<= {most}")
-        raise ValueError(f"{name} must be {bounds}, got {_shown(n)}")
+        raise InputError(f"{name} must be {bounds}, got {_shown(n)}")
     return v
 
 
@@ -214,7 +229,7 @@ def sample_count(span: float, step: float, name: str, *, maximum: int = MAX_SAMP
     span, step = finite_float(span, f"{name} ({unit})"), positive(step, f"{name}'s step ({unit})")
     steps = span / step
     if not steps <= maximum - 1:  # also NaN
-        raise ValueError(f"{name}: {span:g} {unit} in steps of {step:g} {unit} is {steps + 1:.3g} samples; at most "
+        raise InputError(f"{name}: {span:g} {unit} in steps of {step:g} {unit} is {steps + 1:.3g} samples; at most "
                          f"{maximum} (shorten it or take longer steps)")
     return int(np.floor(max(steps, 0.0) + 1e-9)) + 1
 
@@ -227,7 +242,7 @@ def sequence(x: Any, name: str) -> tuple:
     """``x`` (a list, tuple or other iterable but text, bytes or a mapping) as a tuple; TypeError otherwise (Python's
     own "'NoneType' object is not iterable" does not say which argument)."""
     if isinstance(x, (str, bytes, Mapping)) or not isinstance(x, Iterable):
-        raise TypeError(f"{name} must be a sequence, got {type(x).__name__} {_shown(x)}")
+        raise InputTypeError(f"{name} must be a sequence, got {type(x).__name__} {_shown(x)}")
     return tuple(x)
 
 
@@ -236,19 +251,19 @@ def file_name_part(name: Any, what: str) -> str:
     separators or control characters, not "." or "..", at most MAX_NAME_BYTES bytes in UTF-8. Anything else could
     write outside the output folder or fail half-way through the outputs."""
     if not isinstance(name, str):
-        raise TypeError(f"{what} must be a str, got {type(name).__name__} {_shown(name)}")
+        raise InputTypeError(f"{what} must be a str, got {type(name).__name__} {_shown(name)}")
     if not name or name in (".", ".."):
-        raise ValueError(f"{what} must be a name, got {name!r}")
+        raise InputError(f"{what} must be a name, got {name!r}")
     bad = sorted({c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127})
     if bad:
-        raise ValueError(f"{what} {_shown(name)} holds {', '.join(map(repr, bad))}: it names files, so it may not hold "
+        raise InputError(f"{what} {_shown(name)} holds {', '.join(map(repr, bad))}: it names files, so it may not hold "
                          "path separators or control characters")
     try:
         size = len(name.encode("utf-8"))
     except UnicodeEncodeError as exc:
-        raise ValueError(f"{what} is not valid text: {exc.reason}") from None
+        raise InputError(f"{what} is not valid text: {exc.reason}") from None
     if size > MAX_NAME_BYTES:
-        raise ValueError(f"{what} is {size} bytes long in UTF-8; at most {MAX_NAME_BYTES} (it names files)")
+        raise InputError(f"{what} is {size} bytes long in UTF-8; at most {MAX_NAME_BYTES} (it names files)")
     return name
 
 
@@ -257,23 +272,23 @@ def input_file(path: Any, what: str, max_bytes: int) -> Path:
     ``max_bytes`` bytes. Checked without opening it: a FIFO would block, /dev/zero would be read forever, a
     directory or a device is not a file. Otherwise ValueError "cannot read {what} {path}: {why}"."""
     if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"{what} must be a path (str or os.PathLike), got {type(path).__name__}")
+        raise InputTypeError(f"{what} must be a path (str or os.PathLike), got {type(path).__name__}")
     text = os.fspath(path)
     if isinstance(text, bytes):
-        raise TypeError(f"{what} must be a str path, got bytes")
+        raise InputTypeError(f"{what} must be a str path, got bytes")
     if "\0" in text:
-        raise ValueError(f"cannot read {what} {text!r}: the path holds a NUL character")
+        raise InputError(f"cannot read {what} {text!r}: the path holds a NUL character")
     try:
         info = os.stat(text)
     except FileNotFoundError:
-        raise ValueError(f"cannot read {what} {text!r}: it does not exist") from None
+        raise InputError(f"cannot read {what} {text!r}: it does not exist") from None
     except (OSError, ValueError) as exc:
-        raise ValueError(f"cannot read {what} {text!r}: {getattr(exc, 'strerror', None) or exc}") from None
+        raise InputError(f"cannot read {what} {text!r}: {getattr(exc, 'strerror', None) or exc}") from None
     if not stat.S_ISREG(info.st_mode):
         kind = ("a directory" if stat.S_ISDIR(info.st_mode) else "a FIFO" if stat.S_ISFIFO(info.st_mode) else
                 "a character device" if stat.S_ISCHR(info.st_mode) else "a block device" if stat.S_ISBLK(info.st_mode)
                 else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a regular file")
-        raise ValueError(f"cannot read {what} {text!r}: it is {kind}, not a regular file")
+        raise InputError(f"cannot read {what} {text!r}: it is {kind}, not a regular file")
     if info.st_size > max_bytes:
-        raise ValueError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
+        raise InputError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
     return Path(text)

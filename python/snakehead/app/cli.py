@@ -10,9 +10,11 @@ The command is snakehead (also python -m snakehead). Subcommands:
 
 Exit status:
   0    success
-  1    a scenario or target was planned but not successfully (the outputs are written all the same)
-  2    bad arguments, bad input files, or outputs that cannot be written (one line on stderr says which)
-  3    an internal error: a bug in snakehead (one line on stderr; please report it with its traceback)
+  1    a scenario or target was planned but not successfully (the outputs are written all the same), or valid
+       input has no answer (snakehead.Infeasible: e.g. a robot whose neck and head cannot rise)
+  2    bad input: arguments, input files, or outputs that cannot be written (snakehead.InputError; one line on
+       stderr says which)
+  3    anything else: a bug in snakehead (one line on stderr; please report it with its traceback)
   130  interrupted (Ctrl-C; but view, which runs until Ctrl-C, then exits with 0)
 Errors are one line on stderr, never a traceback; set SNAKEHEAD_TRACEBACK=1 to see the Python traceback.
 """
@@ -21,6 +23,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import signal
 import sys
 import tempfile
@@ -29,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._errors import Infeasible, InputError
 from .pipeline import FAST, NORMAL, outcome_line
 
 from typing import TYPE_CHECKING, Any, Callable
@@ -37,16 +41,25 @@ if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
 
 
-class UsageError(Exception):
-    """A mistake in the command line or its input files: reported on stderr, exit status 2."""
+class UsageError(InputError):
+    """A mistake in the command line (options that do not go together): reported on stderr, exit status 2."""
 
 
 #: Exit statuses (the module's docstring says when).
 EXIT_OK, EXIT_UNSUCCESSFUL, EXIT_BAD_INPUT, EXIT_INTERNAL_ERROR, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
+#: What argparse must take for a negative number, not an option: its own pattern knows only "-1" and "-.5", so
+#: "-1e5", "-inf" and "-nan" would be read as unknown options ("expected 3 arguments").
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors on one line (argparse prints the whole usage first): exit status 2."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
 
     def error(self, message: str) -> Any:
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
@@ -216,6 +229,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _plan(args: argparse.Namespace) -> int:
+    from .._validate import unit_vector3, world_position
     from ..scenes import Scene, load_scene
     from .pipeline import Progress, run_scenes
 
@@ -224,10 +238,8 @@ def _plan(args: argparse.Namespace) -> int:
     if args.scene is None:
         if args.position is None or args.direction is None:
             raise UsageError("give --position X Y Z and --direction DX DY DZ, or --scene FILE")
-        direction = np.array(args.direction, float)
-        if float(np.linalg.norm(direction)) < 1e-9:
-            raise UsageError(f"--direction must not be zero, got {args.direction}")
-        scene = Scene.from_targets([(np.array(args.position, float), direction)], name="target")
+        scene = Scene.from_targets([(world_position(args.position, "--position"),
+                                     unit_vector3(args.direction, "--direction"))], name="target")
     else:
         scene = load_scene(args.scene)
     if args.robot is None and scene.robot_file is not None:
@@ -436,9 +448,13 @@ def _traceback_wanted() -> bool:
     return os.environ.get("SNAKEHEAD_TRACEBACK", "") not in ("", "0")
 
 
+#: The longest error line printed (a message quoting a whole file or array is cut, its end kept).
+MAX_ERROR_CHARS = 400
+
+
 def _one_line(exc: BaseException) -> str:
-    text = " ".join(line.strip() for line in str(exc).splitlines() if line.strip())
-    return text or type(exc).__name__
+    text = " ".join(line.strip() for line in str(exc).splitlines() if line.strip()) or type(exc).__name__
+    return text if len(text) <= MAX_ERROR_CHARS else text[:MAX_ERROR_CHARS - 60] + " ... " + text[-55:]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -455,11 +471,16 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
         print(f"{command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except (UsageError, ValueError, TypeError, OSError) as exc:  # what the user gave (or where outputs go) is wrong
+    except InputError as exc:  # what the user gave (or where outputs go) is wrong
         if _traceback_wanted():
             raise
         print(f"{command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except Infeasible as exc:  # valid input with no answer (outside a plan, whose failures are in its report)
+        if _traceback_wanted():
+            raise
+        print(f"{command}: not possible: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_UNSUCCESSFUL
     except Exception as exc:  # noqa: BLE001 -- anything else is a bug: one line, the traceback on request
         if _traceback_wanted():
             raise

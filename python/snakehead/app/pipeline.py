@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from . import report as rep
+from .._errors import InputError
 
 
 if TYPE_CHECKING:
@@ -176,7 +177,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
     loop = ClosedLoop(scene, controller=controller)
     if isinstance(start, str):
         if start != PAPER_START:
-            raise ValueError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
+            raise InputError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
         begin = loop.straight_start()
     else:
         begin = start

@@ -30,6 +30,7 @@ import numpy as np
 from .._files import atomic_open, write_text_atomic
 
 from typing import Any
+from .._errors import InputError
 
 #: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
 #: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
@@ -86,7 +87,7 @@ def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict 
     if sim_metrics is not None:
         missing = [k for k in SIM_KEYS if k not in sim_metrics]
         if missing:
-            raise ValueError(f"sim_metrics lacks {missing}")
+            raise InputError(f"sim_metrics lacks {missing}")
     entry = {
         "success": bool(result.success),
         "failure": result.failure,
@@ -157,10 +158,10 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)
     if q.ndim != 2 or q.shape[0] != t.shape[0]:
-        raise ValueError(f"t {t.shape} and q {q.shape} do not match")
+        raise InputError(f"t {t.shape} and q {q.shape} do not match")
     names = joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])]
     if len(names) != q.shape[1]:
-        raise ValueError(f"{len(names)} joint names for {q.shape[1]} joints")
+        raise InputError(f"{len(names)} joint names for {q.shape[1]} joints")
     path = Path(path)
     with atomic_open(path, "w", newline="") as f:  # a failed write leaves no CSV cut mid-row
         w = csv.writer(f)

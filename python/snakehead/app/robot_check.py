@@ -9,6 +9,8 @@ a split of the parts that does (computed, by trying it).
 """
 from __future__ import annotations
 
+from .._errors import Infeasible, InputError
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -89,13 +91,13 @@ def design_problems(robot: SnakeRobot) -> list[str]:
     problems = []
     try:
         q = initial_configuration(robot)
-    except ValueError as exc:
+    except Infeasible as exc:
         problems.append(f"no initial state: {exc}")
         q = None
     if q is not None:
         try:
             ground_curl(robot, q)
-        except ValueError as exc:
+        except Infeasible as exc:
             problems.append(f"no bending state: {exc}")
     return problems
 
@@ -123,7 +125,7 @@ def suggest_split(robot: SnakeRobot) -> tuple[str, SnakeRobot] | None:
             tried.add((base_end, neck_end))
             try:
                 candidate = robot.with_parts(base_end=base_end, neck_end=neck_end)
-            except ValueError:
+            except InputError:
                 continue
             if not design_problems(candidate):
                 change = f'base_end = "{base_end}"'

@@ -21,17 +21,18 @@ from .discretize import joint_intervals
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import Infeasible, InputError
 
 def _check_central_angle(theta: float) -> float:
     th = finite_float(theta, "central_angle")
     if not 0.0 < th <= 2.0 * math.pi:
-        raise ValueError(f"central_angle must be in (0, 2*pi] rad, got {th!r}")
+        raise InputError(f"central_angle must be in (0, 2*pi] rad, got {th!r}")
     return th
 
 
 def _check_turn(turn: int) -> int:
     if turn not in (1, -1):
-        raise ValueError(f"turn must be +1 (left, counter-clockwise from above) or -1 (right), got {turn!r}")
+        raise InputError(f"turn must be +1 (left, counter-clockwise from above) or -1 (right), got {turn!r}")
     return int(turn)
 
 
@@ -142,14 +143,14 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     theta = _check_central_angle(central_angle)
     turn = _check_turn(turn)
     if chords not in CHORD_MODES:
-        raise ValueError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
+        raise InputError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
     robot = as_robot(robot)
     joints = robot.parts.base if joints is None else joints
     idx = np.arange(robot.n_joints)[joints]
     s_joint = robot.joint_arc_lengths
     s = s_joint[idx] - (0.0 if idx[0] == 0 else s_joint[idx[0]])
     if s[-1] > l + 1e-12:
-        raise ValueError(f"the arc ({l:.6g} m) does not reach past the last joint ({s[-1]:.6g} m)")
+        raise InputError(f"the arc ({l:.6g} m) does not reach past the last joint ({s[-1]:.6g} m)")
     kinds = [robot.joint_kinds[i] for i in idx]
     q = np.zeros(len(idx))
     yaw = np.array([k == YAW for k in kinds])
@@ -171,7 +172,7 @@ def exact_chord_radius(chords: npt.ArrayLike, central_angle: float) -> float:
     (rad): sum_j 2 asin(c_j / 2r) = theta. ValueError when no such circle exists (theta too large)."""
     c = finite_array(chords, "chords", (None,))
     if np.any(c <= 0):
-        raise ValueError("chord lengths must be positive")
+        raise InputError("chord lengths must be positive")
     theta = _check_central_angle(central_angle)
 
     def span(r: Any) -> float:
@@ -179,7 +180,7 @@ def exact_chord_radius(chords: npt.ArrayLike, central_angle: float) -> float:
 
     r_min = 0.5 * c.max()
     if span(r_min) < theta:
-        raise ValueError(f"chords {c.round(4).tolist()} cannot span a central angle of {theta:.4f} rad "
+        raise InputError(f"chords {c.round(4).tolist()} cannot span a central angle of {theta:.4f} rad "
                          "with every chord on a minor arc")
     if span(r_min) == theta:
         return r_min
@@ -209,7 +210,7 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
     theta = _check_central_angle(central_angle)
     turn = _check_turn(turn)
     if anchor not in ("tail", "end"):
-        raise ValueError(f"anchor must be 'tail' or 'end', got {anchor!r}")
+        raise InputError(f"anchor must be 'tail' or 'end', got {anchor!r}")
     base = BasePlacement() if base is None else base
     l = robot.base_length
     heading = base.yaw
@@ -223,7 +224,7 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
         r = exact_chord_radius(c, theta)
         heading = base.yaw - turn * math.asin(min(c[0] / (2 * r), 1.0))
     else:
-        raise ValueError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
+        raise InputError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
     arc = PlaneArc(radius=r, central_angle=theta, start=np.array([base.x, base.y]), heading=heading,
                    turn=turn, height=robot.body_axis_height)
     if anchor == "end":
@@ -242,7 +243,7 @@ def arc_segment_area(length: float, central_angle: npt.ArrayLike) -> np.ndarray 
     l = positive(length, "length")
     th = finite_array(central_angle, "central_angle")
     if np.any(th <= 0) or np.any(th > 2 * np.pi):
-        raise ValueError("central_angle must be in (0, 2*pi] rad")
+        raise InputError("central_angle must be in (0, 2*pi] rad")
     r = l / th  # Eq. 1
     S = 0.5 * r ** 2 * (th - np.sin(th))  # Eq. 2
     return float(S) if th.ndim == 0 else S
@@ -303,7 +304,7 @@ def arc_angle_limit(robot: SnakeRobot, *, turn: int = 1, chords: str = "arclengt
     robot = as_robot(robot)
     turn = _check_turn(turn)
     if chords not in CHORD_MODES:
-        raise ValueError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
+        raise InputError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
     l = robot.base_length
     idx = np.arange(robot.n_joints)[robot.parts.base]
     if chords == "arclength":
@@ -392,7 +393,7 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
     turn = _check_turn(turn)
     min_margin = finite_float(min_margin, "min_margin")
     if min_margin < 0:
-        raise ValueError(f"min_margin must be >= 0 m, got {min_margin}")
+        raise InputError(f"min_margin must be >= 0 m, got {min_margin}")
     nb = robot.parts.base.stop
     if q_up is None:
         from .initial import UpCurveShape, _q_up_for  # the default up curve (initial.py builds on this module)
@@ -403,9 +404,9 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
     lo, hi = (0.05, lim) if bounds is None else (
         finite_float(bounds[0], "bounds[0]"), finite_float(bounds[1], "bounds[1]"))
     if not 0 < lo < hi <= lim + 1e-12:
-        raise ValueError(f"bounds must satisfy 0 < lo < hi <= {lim:.6g} (joint limits), got ({lo}, {hi})")
+        raise InputError(f"bounds must satisfy 0 < lo < hi <= {lim:.6g} (joint limits), got ({lo}, {hi})")
     if int(n_grid) < 5:
-        raise ValueError("n_grid must be >= 5")
+        raise InputError("n_grid must be >= 5")
     l = robot.base_length
 
     def q_of(theta: float) -> np.ndarray:
@@ -418,7 +419,7 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
     rows = np.array([(t, *evaluate(t)) for t in thetas])
     feasible = rows[:, 2] >= min_margin
     if not feasible.any():
-        raise ValueError(f"no central angle in [{lo:.4g}, {hi:.4g}] rad keeps the centre of mass inside the "
+        raise Infeasible(f"no central angle in [{lo:.4g}, {hi:.4g}] rad keeps the centre of mass inside the "
                          f"support polygon by {min_margin} m (best margin {rows[:, 2].max():.4g} m)")
     k = int(np.argmax(np.where(feasible, rows[:, 1], -np.inf)))
     a = thetas[max(k - 1, 0)]

@@ -26,6 +26,7 @@ from scipy import integrate, optimize
 from .._validate import finite_array, finite_float, positive
 
 import numpy.typing as npt
+from .._errors import InputError
 
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
 DEFAULT_FD_STEP = 2e-3
@@ -74,15 +75,15 @@ class SpaceCurve:
                  derivatives: Sequence[Callable[[float], np.ndarray]] | None = None,
                  fd_step: float | None = None, rtol: float = DEFAULT_RTOL) -> None:
         if not callable(r):
-            raise ValueError(f"r must be a callable t -> (3,) array, got {type(r).__name__}")
+            raise InputError(f"r must be a callable t -> (3,) array, got {type(r).__name__}")
         self.t0 = finite_float(t0, "t0")
         self.t1 = finite_float(t1, "t1")
         if not self.t1 > self.t0:
-            raise ValueError(f"the parameter interval must have t1 > t0, got [{self.t0}, {self.t1}]")
+            raise InputError(f"the parameter interval must have t1 > t0, got [{self.t0}, {self.t1}]")
         self._r = r
         if derivatives is not None:
             if len(derivatives) != 3 or not all(callable(d) for d in derivatives):
-                raise ValueError("derivatives must be three callables (dr, d2r, d3r), each t -> (3,) array")
+                raise InputError("derivatives must be three callables (dr, d2r, d3r), each t -> (3,) array")
             self._d: tuple[Callable[[float], np.ndarray], ...] | None = tuple(derivatives)
         else:
             self._d = None
@@ -98,7 +99,7 @@ class SpaceCurve:
         try:
             v = f(t)
         except Exception as exc:  # a user's callable failing is an input error
-            raise ValueError(f"{name}({t!r}) failed: {type(exc).__name__}: {exc}") from exc
+            raise InputError(f"{name}({t!r}) failed: {type(exc).__name__}: {exc}") from exc
         return finite_array(v, f"{name}({t:.6g})", (3,))
 
     def point(self, t: float) -> np.ndarray:
@@ -165,7 +166,7 @@ class SpaceCurve:
         cs = np.array(cross_list)
         if speeds.min() <= 1e-9 * max(speeds.max(), 1e-300):
             i = int(np.argmin(speeds))
-            raise ValueError(f"the curve is not regular: r'(t) = 0 near t = {ts[i]:.6g}")
+            raise InputError(f"the curve is not regular: r'(t) = 0 near t = {ts[i]:.6g}")
         norms = np.linalg.norm(cs, axis=1) / speeds ** 3  # kappa
         approx_length = float(speeds.mean()) * (self.t1 - self.t0)
         if norms.max() * approx_length < 1e-8:  # bends by less than 1e-8 rad in all: a straight line
@@ -180,7 +181,7 @@ class SpaceCurve:
         flips = np.flatnonzero(np.einsum("ij,ij->i", B[1:], B[:-1]) < 0.0)
         if len(flips):
             i = np.flatnonzero(ok)[flips[0]]
-            raise ValueError(
+            raise InputError(
                 f"the curvature of the curve vanishes between t = {ts[i]:.6g} and the next sample and its normal "
                 "flips there (an inflection): the Frenet frame of Eqs. 3-4 is undefined; split the curve at that point")
         self._first_curved_t = float(ts[np.flatnonzero(ok)[0]])
@@ -197,7 +198,7 @@ class SpaceCurve:
             sol = integrate.solve_ivp(self._rhs, (self.t0, self.t1), np.zeros(4), method="DOP853",
                                       rtol=self.rtol, atol=self.rtol * 1e-3, dense_output=True)
             if not sol.success:
-                raise ValueError(f"integrating the curve failed: {sol.message}")
+                raise InputError(f"integrating the curve failed: {sol.message}")
             self._sol = sol
         return self._sol
 
@@ -210,7 +211,7 @@ class SpaceCurve:
         """s(t) = int_t0^t |r'| dt (m) at t (scalar or array within [t0, t1])."""
         ta = np.asarray(t, dtype=np.float64)
         if np.any(ta < self.t0 - 1e-12) or np.any(ta > self.t1 + 1e-12):
-            raise ValueError(f"t must lie in [{self.t0}, {self.t1}]")
+            raise InputError(f"t must lie in [{self.t0}, {self.t1}]")
         s = self._solution().sol(np.clip(ta, self.t0, self.t1))[0]
         return float(s) if ta.ndim == 0 else s
 
@@ -219,7 +220,7 @@ class SpaceCurve:
         sa = np.atleast_1d(np.asarray(s, dtype=np.float64))
         L = self.length
         if np.any(~np.isfinite(sa)) or np.any(sa < -1e-12) or np.any(sa > L + 1e-9 * max(L, 1.0)):
-            raise ValueError(f"arc length must lie in [0, {L:.6g}] m")
+            raise InputError(f"arc length must lie in [0, {L:.6g}] m")
         sol = self._solution().sol
         out = np.empty(sa.shape)
         for i, si in enumerate(np.clip(sa, 0.0, L)):
@@ -260,7 +261,7 @@ class SpaceCurve:
         s1a = np.atleast_1d(np.asarray(s1, dtype=np.float64))
         s2a = np.atleast_1d(np.asarray(s2, dtype=np.float64))
         if s1a.shape != s2a.shape:
-            raise ValueError(f"s1 and s2 must have the same shape, got {s1a.shape} and {s2a.shape}")
+            raise InputError(f"s1 and s2 must have the same shape, got {s1a.shape} and {s2a.shape}")
         phi0 = finite_float(phi0, "phi0")
         y1, y2 = self._state_at_s(s1a), self._state_at_s(s2a)
         dc, ds_ = y2[2] - y1[2], y2[3] - y1[3]  # int kappa cos(phi - phi0), int kappa sin(phi - phi0)
@@ -280,7 +281,7 @@ class SpaceCurve:
         R = finite_array(frame0, "frame0", (3, 3))
         F = self.frenet(self.t0)
         if abs(float(R[:, 0] @ F[:, 0]) - 1.0) > 1e-6:
-            raise ValueError("the body frame's x-axis is not the curve's start tangent: "
+            raise InputError("the body frame's x-axis is not the curve's start tangent: "
                              f"x = {R[:, 0].round(6).tolist()}, T(t0) = {F[:, 0].round(6).tolist()}")
         if self._straight:
             return 0.0

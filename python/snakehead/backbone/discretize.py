@@ -49,6 +49,7 @@ from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .curves import SpaceCurve
 
 import numpy.typing as npt
+from .._errors import InputError, InputTypeError
 
 
 def joint_intervals(s_joints: npt.ArrayLike, kinds: Sequence[str], curve_length: float) -> np.ndarray:
@@ -61,13 +62,13 @@ def joint_intervals(s_joints: npt.ArrayLike, kinds: Sequence[str], curve_length:
     s = finite_array(s_joints, "s_joints", (None,))
     L = positive(curve_length, "curve_length")
     if len(kinds) != len(s):
-        raise ValueError(f"kinds has {len(kinds)} entries for {len(s)} joints")
+        raise InputError(f"kinds has {len(kinds)} entries for {len(s)} joints")
     if np.any(np.diff(s) <= 0) or s[0] < -1e-12 or s[-1] > L + 1e-12:
-        raise ValueError(f"joint arc lengths must increase within [0, {L:.6g}] m, got {s.tolist()}")
+        raise InputError(f"joint arc lengths must increase within [0, {L:.6g}] m, got {s.tolist()}")
     out = np.empty((len(s), 2))
     for kind in set(kinds):
         if kind not in (YAW, PITCH):
-            raise ValueError(f"joint kind must be 'yaw' or 'pitch', got {kind!r}")
+            raise InputError(f"joint kind must be 'yaw' or 'pitch', got {kind!r}")
         idx = [i for i, k in enumerate(kinds) if k == kind]
         sk = s[idx]
         mids = 0.5 * (sk[1:] + sk[:-1])
@@ -83,7 +84,7 @@ def discretize(curve: SpaceCurve, s_joints: np.ndarray, kinds: Sequence[str], *,
     it; m). s_joints (m,) arc lengths on the curve (m), kinds (m,) "yaw"/"pitch", phi0 the phase at s = 0.
     Returns (m,) in the curve's sign convention (URDF joint angles: :func:`curve_joint_angles`)."""
     if not isinstance(curve, SpaceCurve):
-        raise TypeError(f"curve must be a SpaceCurve, got {type(curve).__name__}")
+        raise InputTypeError(f"curve must be a SpaceCurve, got {type(curve).__name__}")
     end = curve.length if end is None else min(positive(end, "end"), curve.length)
     iv = joint_intervals(s_joints, kinds, end)
     ty, tp = curve.bending(iv[:, 0], iv[:, 1], phi0=phi0)
@@ -110,25 +111,25 @@ def curve_joint_angles(robot: SnakeRobot, curve: SpaceCurve, joints: slice, *, s
     ValueError if the curve is too short for the joints, or both phi0 and frame0 are given.
     """
     if not isinstance(curve, SpaceCurve):
-        raise TypeError(f"curve must be a SpaceCurve, got {type(curve).__name__}")
+        raise InputTypeError(f"curve must be a SpaceCurve, got {type(curve).__name__}")
     robot = as_robot(robot)
     s_joint, body_kinds = robot.joint_arc_lengths, robot.joint_kinds
     idx = np.arange(robot.n_joints)[joints]
     if len(idx) == 0:
-        raise ValueError("joints selects no joint")
+        raise InputError("joints selects no joint")
     if s_start is None:
         s_start = 0.0 if idx[0] == 0 else float(s_joint[idx[0]])
     s_start = finite_float(s_start, "s_start")
     if phi0 is not None and frame0 is not None:
-        raise ValueError("give phi0 or frame0, not both")
+        raise InputError("give phi0 or frame0, not both")
     if frame0 is not None:
         phi0 = curve.initial_phase(np.asarray(frame0, dtype=np.float64)[:3, :3])
     phi0 = 0.0 if phi0 is None else finite_float(phi0, "phi0")
     s_on = s_joint[idx] - s_start
     if s_on[0] < -1e-12:
-        raise ValueError(f"the curve starts at body arc length {s_start:.6g} m, after the first joint")
+        raise InputError(f"the curve starts at body arc length {s_start:.6g} m, after the first joint")
     if s_on[-1] > curve.length + 1e-12:
-        raise ValueError(f"the curve ({curve.length:.6g} m) is shorter than the body it must cover "
+        raise InputError(f"the curve ({curve.length:.6g} m) is shorter than the body it must cover "
                          f"({s_on[-1]:.6g} m to the last joint)")
     # the part ends where the next joint begins (or at the body's last frame); a longer curve is cut there
     part_end = (s_joint[idx[-1] + 1] if idx[-1] + 1 < robot.n_joints else robot.body_length) - s_start

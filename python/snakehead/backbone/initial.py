@@ -17,6 +17,7 @@ from .curves import SpaceCurve, _planar_bezier_length, cubic_bezier
 from .discretize import curve_joint_angles
 
 from typing import Any
+from .._errors import Infeasible, InputError, InputTypeError
 
 #: The default up curve's end point as shares of the neck and head's length (0.55 m and -0.10 m of 0.738 m on
 #: the default robot), so that the shape scales with any robot.
@@ -65,11 +66,11 @@ class UpCurveShape:
     def __post_init__(self) -> None:
         finite_array([self.height, self.reach, self.tip_angle, self.handle_ratio], "UpCurveShape", (4,))
         if self.height <= 0:
-            raise ValueError(f"height must be > 0 m (the head is raised), got {self.height}")
+            raise InputError(f"height must be > 0 m (the head is raised), got {self.height}")
         if not 0 < self.tip_angle < math.pi:
-            raise ValueError(f"tip_angle must be in (0, pi) rad, got {self.tip_angle}")
+            raise InputError(f"tip_angle must be in (0, pi) rad, got {self.tip_angle}")
         if self.handle_ratio <= 0:
-            raise ValueError(f"handle_ratio must be > 0, got {self.handle_ratio}")
+            raise InputError(f"handle_ratio must be > 0, got {self.handle_ratio}")
 
     @classmethod
     def for_robot(cls, robot: SnakeRobot, *, height_share: float = HEIGHT_SHARE, reach_share: float = REACH_SHARE,
@@ -91,13 +92,13 @@ class UpCurveShape:
 
         chord = float(np.linalg.norm(end))
         if chord >= L:
-            raise ValueError(f"the head tip (reach {self.reach}, height {self.height}) is {chord:.4g} m from P0, "
+            raise Infeasible(f"the head tip (reach {self.reach}, height {self.height}) is {chord:.4g} m from P0, "
                              f"beyond the {L:.4g} m the neck and head can reach")
         a_max = L
         while _planar_bezier_length(pts(a_max)) < L:
             a_max *= 2.0
             if a_max > 1e3 * L:
-                raise ValueError("no handle length gives the curve the body's length")
+                raise Infeasible("no handle length gives the curve the body's length")
         a = optimize.brentq(lambda a: _planar_bezier_length(pts(a)) - L, 0.0, a_max, xtol=1e-14, rtol=1e-14)
         return pts(a)
 
@@ -105,7 +106,7 @@ class UpCurveShape:
 def up_curve(arc: PlaneArc, shape: UpCurveShape, length: float) -> tuple[SpaceCurve, np.ndarray]:
     """The neck-and-head Bezier in the world, joined G1 to ``arc`` at its end P0: (curve, (4, 3) points)."""
     if not isinstance(shape, UpCurveShape):
-        raise TypeError(f"shape must be an UpCurveShape, got {type(shape).__name__}")
+        raise InputTypeError(f"shape must be an UpCurveShape, got {type(shape).__name__}")
     B = shape.plane_control_points(length)
     p0 = arc.point(arc.length)
     T0 = arc.tangent(arc.length)
@@ -183,7 +184,7 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
 
     The base uses Eq. 9 (``"arclength"`` chords) so the robot's last base link leaves along the arc's end
     tangent, which is the Bezier's start tangent; the up curve is discretised by the general method
-    (Eqs. 3-7) with the phase read from the robot's P0 frame. Raises ValueError if a joint leaves its limits.
+    (Eqs. 3-7) with the phase read from the robot's P0 frame. Raises Infeasible if a joint leaves its limits.
     """
     robot = as_robot(robot)
     base = BasePlacement() if base is None else base
@@ -192,7 +193,7 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
         try:
             return initial_backbone(robot, central_angle=central_angle, shape=UpCurveShape.for_robot(robot),
                                     base=base, turn=turn, min_margin=min_margin)
-        except ValueError as first_error:
+        except Infeasible as first_error:
             return _searched_backbone(robot, central_angle, base, turn, min_margin, first_error)
     q_up, _, _, phi0 = _q_up_for(robot, shape, turn)
     optimum = None
@@ -205,7 +206,7 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
     q = np.concatenate([q_base, q_up])
     bad = np.flatnonzero((q < robot.lower - 1e-12) | (q > robot.upper + 1e-12))
     if len(bad):
-        raise ValueError("the backbone needs joints beyond their limits: " + ", ".join(
+        raise Infeasible("the backbone needs joints beyond their limits: " + ", ".join(
             f"joint {i + 1} = {math.degrees(q[i]):.1f} deg" for i in bad))
     arc = base_arc(robot, theta, base, turn=turn, anchor="end")
     curve, P = up_curve(arc, shape, up_length(robot))
@@ -214,7 +215,7 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
 
 
 def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: BasePlacement | None, turn: int,
-                       min_margin: float, first_error: ValueError) -> InitialBackbone:
+                       min_margin: float, first_error: Infeasible) -> InitialBackbone:
     """The backbone of SHAPE_SEARCH's shapes with the largest static margin (see :func:`initial_backbone`)."""
     from ..dynamics import stability
 
@@ -225,13 +226,13 @@ def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: Bas
         try:
             bb = initial_backbone(robot, central_angle=central_angle, shape=shape, base=base, turn=turn,
                                   min_margin=min_margin)
-        except ValueError:
+        except Infeasible:
             continue
         margin = stability.static_margin(robot, bb.q, base)
         if margin > best_margin:
             best, best_margin = bb, margin
     if best is None:
-        raise ValueError(f"no up-curve shape fits this robot ({first_error}): the neck and head cannot rise over its "
+        raise Infeasible(f"no up-curve shape fits this robot ({first_error}): the neck and head cannot rise over its "
                          "base; 'snakehead info --robot FILE' suggests a split of the parts (base_end, neck_end in the "
                          "robot file) that works")
     return best

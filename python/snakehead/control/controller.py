@@ -27,6 +27,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable
+from .._errors import InputError, InputTypeError
 
 if TYPE_CHECKING:
     from ..kinematics.workspace import ReachabilityMap
@@ -81,17 +82,17 @@ class HeadController:
 
         self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):
-            raise ValueError(f"method must be 'rotated' or 'free_roll', got {method!r}")
+            raise InputError(f"method must be 'rotated' or 'free_roll', got {method!r}")
         self.method, self.n_frames = method, integer(n_frames, "n_frames", least=1, most=360)
         timeout = duration(timeout, "timeout")
         if workspace_map is None:
             workspace_map = workspace.map_for(self.robot)
         if not isinstance(workspace_map, workspace.ReachabilityMap):
-            raise TypeError(f"workspace_map must be a ReachabilityMap (snakehead.load_map), got "
+            raise InputTypeError(f"workspace_map must be a ReachabilityMap (snakehead.load_map), got "
                             f"{type(workspace_map).__name__}")
         chain_hash = workspace_map.chain_hash
         if chain_hash != self.robot.head_chain.hash:
-            raise ValueError("the workspace map was made for another head chain (hash "
+            raise InputError("the workspace map was made for another head chain (hash "
                              f"{chain_hash} != {self.robot.head_chain.hash}); compute one for this robot's head")
         self.map = workspace_map
         #: The dexterous workspace's lower index (100 unless the head reaches 100 in too few voxels).
@@ -106,7 +107,7 @@ class HeadController:
         self.Lc = nk.dexterous_distance(self.G0_local)
         self.base = base_pose if base_pose is not None else BasePlacement()
         if not isinstance(self.base, BasePlacement):
-            raise TypeError("base_pose must be a BasePlacement")
+            raise InputTypeError("base_pose must be a BasePlacement")
         self.neck_length = self.robot.lift_length  # the part of the neck that can lift (all of it, usually)
         self.slack = positive(slack, "slack") if slack is not None else self.neck_length / 2
         self.allow_base_move = bool(allow_base_move)
@@ -151,9 +152,9 @@ class HeadController:
                               "q_prev").copy()
         base = self.base if base is None else base
         if not isinstance(base, BasePlacement):
-            raise TypeError(f"base must be a BasePlacement, got {type(base).__name__}")
+            raise InputTypeError(f"base must be a BasePlacement, got {type(base).__name__}")
         if accept is not None and not callable(accept):
-            raise TypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
+            raise InputTypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
         desired = head_ik.frame_from_direction(position, direction)
         P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         check = self._accepted_range(position, P0_frame)

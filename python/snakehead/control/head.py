@@ -19,6 +19,7 @@ from ..kinematics.ik import TracIK
 
 import numpy.typing as npt
 from typing import Any, Callable
+from .._errors import InputTypeError
 
 #: Tolerances (vx vy vz wx wy wz, target frame) that leave the roll about the head's x-axis free.
 FREE_ROLL_BOUNDS = np.array([0.0, 0.0, 0.0, np.inf, 0.0, 0.0])
@@ -102,7 +103,7 @@ def _finish(ik: TracIK, q: np.ndarray | None, target: Any, tried: int, solved: i
 
 def _check_solver(ik: Any) -> None:
     if not isinstance(ik, TracIK):
-        raise TypeError(f"ik must be a snakehead TracIK, got {type(ik).__name__}")
+        raise InputTypeError(f"ik must be a snakehead TracIK, got {type(ik).__name__}")
 
 
 def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarray | None = None,
@@ -121,7 +122,7 @@ def rotated_frames(ik: TracIK, target: Any, n_frames: int = 10, q_init: np.ndarr
     target = pose(target, "target")
     n_frames = integer(n_frames, "n_frames", least=1, most=360)
     if accept is not None and not callable(accept):
-        raise TypeError(f"accept must be a callable accept(q) -> bool or None, got {type(accept).__name__}")
+        raise InputTypeError(f"accept must be a callable accept(q) -> bool or None, got {type(accept).__name__}")
     n = ik.n_joints
     if q_prev is not None:
         q_prev = finite_array(q_prev, "q_prev", (n,))

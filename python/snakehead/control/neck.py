@@ -17,6 +17,7 @@ from ..model.robot import BasePlacement
 
 import numpy.typing as npt
 from typing import Any, Callable
+from .._errors import InputError, InputTypeError
 
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
@@ -42,7 +43,7 @@ def neck_goal(P0: npt.ArrayLike, G0: npt.ArrayLike, Lc: float) -> NeckGoal:
     d = G0 - P0
     dist = float(np.linalg.norm(d))
     if dist < 1e-12:
-        raise ValueError("G0 coincides with P0: the neck direction is undefined")
+        raise InputError("G0 coincides with P0: the neck direction is undefined")
     r_d = d / dist
     return NeckGoal(P0=P0, G0=G0, Lc=Lc, r_d=r_d, P_d=G0 - Lc * r_d)
 
@@ -105,9 +106,9 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
     reached from ``q_init`` is kept unless the grid's is lower by more than ``CONTINUITY_TOLERANCE``.
     """
     if not isinstance(neck, Chain):
-        raise TypeError(f"neck must be a snakehead Chain, got {type(neck).__name__}")
+        raise InputTypeError(f"neck must be a snakehead Chain, got {type(neck).__name__}")
     if not isinstance(goal, NeckGoal):
-        raise TypeError(f"goal must be a NeckGoal (neck_goal()), got {type(goal).__name__}")
+        raise InputTypeError(f"goal must be a NeckGoal (neck_goal()), got {type(goal).__name__}")
     P0_frame = pose(P0_frame, "P0_frame")  # a rigid frame: a scaled or sheared one would distort Eq. 22
     h = positive(h, "h")
     if neck.n_joints == 0:  # nothing to move: the neck end is where the chain puts it
@@ -202,7 +203,7 @@ def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: Bas
     P_hd = vector3(P_hd, "P_hd")
     P0_local = pose(P0_local, "P0_local")
     if not isinstance(base, BasePlacement):
-        raise TypeError(f"base must be a BasePlacement, got {type(base).__name__}")
+        raise InputTypeError(f"base must be a BasePlacement, got {type(base).__name__}")
     Lc, length, slack = positive(Lc, "Lc"), positive(length, "length"), positive(slack, "slack")
     height = finite_float(height, "height")
     want = Lc + length - 0.5 * slack  # |P_hd - P0| in the middle of the accepted band

@@ -34,6 +34,7 @@ from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable, Sequence
+from .._errors import InputError
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -484,7 +485,7 @@ def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.
     min_margin = finite_float(min_margin, "min_margin")
     starts = list(starts)
     if not starts:
-        raise ValueError("the whole-body solve needs at least one start (q, base)")
+        raise InputError("the whole-body solve needs at least one start (q, base)")
     base_first = starts[0][1]
     best, best_key = None, None
     rank = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}

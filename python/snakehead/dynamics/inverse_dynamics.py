@@ -30,6 +30,7 @@ from .. import _core
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .stability import GRAVITY
+from .._errors import InputError
 
 #: Ramp (m) of the lifted share: a link whose distal points' lowest is this high is fully carried by the
 #: joints; on the ground (height 0) not at all; linear in between.
@@ -100,9 +101,9 @@ def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | No
     if a.ndim == 1:
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != n or a.shape[0] < 1:
-        raise ValueError(f"{name} has shape {np.shape(x)}; expected ({n},) or (T, {n})")
+        raise InputError(f"{name} has shape {np.shape(x)}; expected ({n},) or (T, {n})")
     if n_samples is not None and a.shape[0] != n_samples:
-        raise ValueError(f"{name} has {a.shape[0]} samples; q has {n_samples}")
+        raise InputError(f"{name} has {a.shape[0]} samples; q has {n_samples}")
     return a
 
 
@@ -133,7 +134,7 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     robot = as_robot(robot)
     base = as_base(base)
     if gravity not in GRAVITY_MODELS:
-        raise ValueError(f"gravity must be one of {GRAVITY_MODELS}, got {gravity!r}")
+        raise InputError(f"gravity must be one of {GRAVITY_MODELS}, got {gravity!r}")
     single = np.ndim(q) == 1
     qs = _samples(robot, q, "q", None)
     T = qs.shape[0]

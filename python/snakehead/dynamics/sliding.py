@@ -34,6 +34,7 @@ import numpy.typing as npt
 
 from .._validate import finite_array
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from .._errors import InputError
 
 #: A box whose bottom is within this height (m) of the lowest box bottom rests on the ground (flat shapes).
 RESTING_HEIGHT = 0.003
@@ -46,7 +47,7 @@ TRANSLATION_TOLERANCE = 1e-7
 def _loads(weights: npt.ArrayLike, k: int) -> np.ndarray:
     w = finite_array(weights, "weights", (k,))
     if np.any(w < 0) or w.sum() <= 0:
-        raise ValueError("weights (normal loads) must be >= 0 with a positive sum")
+        raise InputError("weights (normal loads) must be >= 0 with a positive sum")
     return w
 
 
@@ -60,7 +61,7 @@ def balance_translation(shifts: npt.ArrayLike, weights: npt.ArrayLike) -> np.nda
     """
     s = finite_array(shifts, "shifts", (None, 2))
     if len(s) == 0:
-        raise ValueError("shifts must hold at least one contact")
+        raise InputError("shifts must hold at least one contact")
     w = _loads(weights, len(s))
     if len(s) == 1:
         return s[0].copy()
@@ -155,7 +156,7 @@ def resting_contacts(robot: SnakeRobot, q: npt.ArrayLike) -> tuple[np.ndarray, n
     links = robot.shaped_links
     if low.max() > low.min() + RESTING_HEIGHT:
         k = int(np.argmax(low))
-        raise ValueError(f"the shape is not flat on the ground: the link {robot.link_names[links[k]]!r} "
+        raise InputError(f"the shape is not flat on the ground: the link {robot.link_names[links[k]]!r} "
                          f"is {1000 * (low[k] - low.min()):.1f} mm above the lowest (keep the pitch joints at 0)")
     return robot.link_centres(F)[0, :, :2], robot.masses[links]
 
@@ -169,7 +170,7 @@ def predict_slide(robot: SnakeRobot, q_path: npt.ArrayLike, start: BasePlacement
     robot = as_robot(robot)
     qs = finite_array(q_path, "q_path", (None, robot.n_joints))
     if len(qs) == 0:
-        raise ValueError("q_path must hold at least one configuration")
+        raise InputError("q_path must hold at least one configuration")
     start = as_base(start)
     x, y, yaw = start.x, start.y, start.yaw
     out = [BasePlacement(x, y, yaw)]

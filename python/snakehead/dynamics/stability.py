@@ -24,6 +24,7 @@ from .._validate import finite_array, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 import numpy.typing as npt
+from .._errors import Infeasible, InputError
 
 #: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
 GRAVITY = 9.80665
@@ -47,12 +48,12 @@ def _joint_matrix(robot: SnakeRobot, q: npt.ArrayLike, name: str = "q") -> tuple
     n = robot.n_joints
     if a.ndim == 1:
         if a.shape != (n,):
-            raise ValueError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
+            raise InputError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
         return a[None, :], True
     if a.ndim != 2 or a.shape[1] != n:
-        raise ValueError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
+        raise InputError(f"{name} has shape {a.shape}; expected ({n},) or (T, {n})")
     if a.shape[0] < 1:
-        raise ValueError(f"{name} has no samples")
+        raise InputError(f"{name} has no samples")
     return a, False
 
 
@@ -63,12 +64,12 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     Returns points (T, N, 2) (world x, y) and active (T, N) bool: which points touch the ground.
     """
     if contact not in CONTACT_MODELS:
-        raise ValueError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
+        raise InputError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
     # the base part's links (the robot's own: those before base_end), or with "ground" every link
     links = np.asarray(robot.base_links, int) if contact != "ground" else np.arange(len(robot.link_names))
     links = links[np.isin(links, robot.shaped_links)]
     if links.size == 0:
-        raise ValueError("the base part has no links with collision shapes; no support polygon")
+        raise InputError("the base part has no links with collision shapes; no support polygon")
     if contact == "endpoints":
         # Eq. 24: p_i are the endpoints of the base links, i.e. the origins of consecutive frames (each
         # link's frame is at its proximal joint; the next frame in chain order is at its distal end). A point
@@ -105,7 +106,7 @@ def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.Ar
     active = np.asarray(active, bool)
     xy = finite_array(xy, "xy", (points.shape[0], 2))
     if active.shape != points.shape[:2]:
-        raise ValueError(f"active has shape {active.shape}; expected {points.shape[:2]}")
+        raise InputError(f"active has shape {active.shape}; expected {points.shape[:2]}")
     return _core.hull_margins(np.ascontiguousarray(points), np.ascontiguousarray(active), np.ascontiguousarray(xy))
 
 
@@ -182,7 +183,7 @@ def support_polygon(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | N
     pts, active = _contact_points_many(robot, frames, contact, tolerance)
     pts = pts[0][active[0]]
     if len(pts) == 0:
-        raise ValueError("no base link touches the ground: there is no support polygon")
+        raise Infeasible("no base link touches the ground: there is no support polygon")
     return _hull_ccw(pts)
 
 
@@ -214,9 +215,9 @@ def is_statically_stable(robot: SnakeRobot, q: np.ndarray, base: BasePlacement |
 def _check_times(t: npt.ArrayLike, name: str = "t") -> np.ndarray:
     t = finite_array(t, name, (None,))
     if t.shape[0] < 2:
-        raise ValueError(f"{name} needs at least two samples, got {t.shape[0]}")
+        raise InputError(f"{name} needs at least two samples, got {t.shape[0]}")
     if np.any(np.diff(t) <= 0):
-        raise ValueError(f"{name} must increase strictly")
+        raise InputError(f"{name} must increase strictly")
     return t
 
 
@@ -224,7 +225,7 @@ def _check_trajectory(robot: SnakeRobot, t: np.ndarray, q: npt.ArrayLike) -> tup
     t = _check_times(t)
     q = finite_array(q, "q", (None, robot.n_joints))
     if q.shape[0] != t.shape[0]:
-        raise ValueError(f"q has {q.shape[0]} samples but t has {t.shape[0]}")
+        raise InputError(f"q has {q.shape[0]} samples but t has {t.shape[0]}")
     return t, q
 
 
@@ -267,7 +268,7 @@ def momenta_from_velocities(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, ba
     qs, single = _joint_matrix(robot, q)
     qds, _ = _joint_matrix(robot, qd, "qd")
     if qds.shape != qs.shape:
-        raise ValueError(f"qd has shape {np.shape(qd)}; expected that of q, {np.shape(q)}")
+        raise InputError(f"qd has shape {np.shape(qd)}; expected that of q, {np.shape(q)}")
     P, L, _ = _momenta(robot, qs, qds, base)
     return (P[0], L[0]) if single else (P, L)
 

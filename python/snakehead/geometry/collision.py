@@ -21,6 +21,7 @@ from .shapes import ShapeSet, pair_distances, pair_min_distances
 
 import numpy.typing as npt
 from typing import Any, Sequence
+from .._errors import InputError, InputTypeError
 
 #: A link whose shapes dip lower than this below the ground (m) is driven into it by the plan; a shape within
 #: this distance of the ground touches it (the base lies at exactly 0).
@@ -34,7 +35,7 @@ def _trajectory(robot: SnakeRobot, qs: npt.ArrayLike) -> np.ndarray:
     if a.ndim == 1:
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != robot.n_joints or a.shape[0] < 1:
-        raise ValueError(f"qs has shape {np.shape(qs)}; expected (T, {robot.n_joints}) or ({robot.n_joints},)")
+        raise InputError(f"qs has shape {np.shape(qs)}; expected (T, {robot.n_joints}) or ({robot.n_joints},)")
     return a
 
 
@@ -183,17 +184,17 @@ def collision_check(robot: SnakeRobot, qs: np.ndarray, obstacles: Sequence[Any],
         obstacles = [obstacles]
     obstacles = list(obstacles)
     if not obstacles:
-        raise ValueError("no obstacles given")
+        raise InputError("no obstacles given")
     for ob in obstacles:
         if not isinstance(ob, OBSTACLE_TYPES):
-            raise TypeError(f"obstacles must be {', '.join(t.__name__ for t in OBSTACLE_TYPES)}, "
+            raise InputTypeError(f"obstacles must be {', '.join(t.__name__ for t in OBSTACLE_TYPES)}, "
                             f"got {type(ob).__name__}")
     try:
         exact_within = float(exact_within)
     except (TypeError, ValueError):
-        raise ValueError(f"exact_within must be a number (m, may be inf), got {exact_within!r}") from None
+        raise InputError(f"exact_within must be a number (m, may be inf), got {exact_within!r}") from None
     if np.isnan(exact_within):
-        raise ValueError("exact_within is NaN")
+        raise InputError("exact_within is NaN")
     scene, owner = obstacle_shapes(obstacles)
     links = robot.shaped_links
     mine = robot.geometry.shapes_of(links)

@@ -16,6 +16,7 @@ from .._validate import finite_array, finite_float, positive, rotation_matrix, u
 from .shapes import Shape
 
 import numpy.typing as npt
+from .._errors import InputError
 
 #: Sides of the polygon inscribed in a wall's hole: the pieces of the wall's solid meet the hole's circle at the
 #: polygon's vertices and stand into it by at most r (1 - cos(pi / 32)) = 0.5 % of its radius.
@@ -40,7 +41,7 @@ class BoxObstacle:
         object.__setattr__(self, "centre", vector3(self.centre, "box centre"))
         size = vector3(self.size, "box size")
         if np.any(size <= 0):
-            raise ValueError(f"box size must be positive, got {size.tolist()}")
+            raise InputError(f"box size must be positive, got {size.tolist()}")
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "rotation", rotation_matrix(self.rotation, "box rotation"))
 
@@ -78,14 +79,14 @@ class WallWithHole:
         object.__setattr__(self, "normal", unit_vector3(self.normal, "wall normal"))
         size = vector3(self.size, "wall size (w, h, thickness)")
         if np.any(size <= 0):
-            raise ValueError(f"wall size must be positive, got {size.tolist()}")
+            raise InputError(f"wall size must be positive, got {size.tolist()}")
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "hole_diameter", positive(self.hole_diameter, "hole_diameter"))
         off = finite_array(self.hole_offset, "hole_offset", (2,))
         object.__setattr__(self, "hole_offset", off)
         r = self.hole_diameter / 2
         if np.any(np.abs(off) + r >= size[:2] / 2):
-            raise ValueError("the hole does not lie inside the wall")
+            raise InputError("the hole does not lie inside the wall")
 
     @classmethod
     def standing(cls, hole_centre: npt.ArrayLike, normal: npt.ArrayLike, size: npt.ArrayLike, hole_diameter: float
@@ -94,11 +95,11 @@ class WallWithHole:
         along the horizontal ``normal``: the paper's wall of Section 4.2 as snakehead places it."""
         normal = unit_vector3(normal, "wall normal")
         if abs(normal[2]) > 1e-9:
-            raise ValueError(f"a standing wall's normal must be horizontal, got {normal.tolist()}")
+            raise InputError(f"a standing wall's normal must be horizontal, got {normal.tolist()}")
         hole_centre = vector3(hole_centre, "hole centre")
         size = vector3(size, "wall size (w, h, thickness)")
         if hole_centre[2] <= 0 or hole_centre[2] >= size[1]:
-            raise ValueError(f"the hole's centre ({hole_centre[2]} m high) must lie within the wall's height "
+            raise InputError(f"the hole's centre ({hole_centre[2]} m high) must lie within the wall's height "
                              f"(0, {size[1]}) m")
         facing = cls(centre=hole_centre, normal=normal, size=size, hole_diameter=hole_diameter)
         wall_centre = np.array([hole_centre[0], hole_centre[1], size[1] / 2])
@@ -193,7 +194,7 @@ class MeshObstacle:
 
         scale_v = vector3(scale, "mesh scale")
         if np.any(scale_v <= 0):
-            raise ValueError(f"{where}: mesh scale must be positive, got {scale_v.tolist()}")
+            raise InputError(f"{where}: mesh scale must be positive, got {scale_v.tolist()}")
         yaw = finite_float(yaw, "mesh yaw")
         c, s = np.cos(yaw), np.sin(yaw)
         pose = _pose(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), vector3(position, "mesh position"))

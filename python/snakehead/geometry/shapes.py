@@ -23,6 +23,7 @@ import numpy as np
 from .. import _core
 
 from typing import Sequence
+from .._errors import InputError
 
 KINDS = ("box", "cylinder", "sphere", "convex")
 
@@ -51,7 +52,7 @@ class Shape:
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
-            raise ValueError(f"shape kind must be one of {KINDS}, got {self.kind!r}")
+            raise InputError(f"shape kind must be one of {KINDS}, got {self.kind!r}")
         origin = np.array(self.origin, float).reshape(4, 4)
         size = np.array(self.size, float).reshape(3)
         origin.setflags(write=False)
@@ -82,7 +83,7 @@ class ShapeSet:
         object.__setattr__(self, "shapes", shapes)
         for s in shapes:
             if not 0 <= s.frame < self.n_frames:
-                raise ValueError(f"shape on frame {s.frame}, outside [0, {self.n_frames})")
+                raise InputError(f"shape on frame {s.frame}, outside [0, {self.n_frames})")
         core = _core.ShapeSet([s.kind for s in shapes], np.array([s.frame for s in shapes], dtype=np.int64).reshape(-1),
                               np.array([s.origin for s in shapes], float).reshape(-1, 4, 4),
                               np.array([s.size for s in shapes], float).reshape(-1, 3),

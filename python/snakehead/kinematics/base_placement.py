@@ -26,6 +26,7 @@ import numpy.typing as npt
 
 from .._validate import joint_vector, position_direction_pairs
 from .map_queries import direction_bits
+from .._errors import InputError
 
 if TYPE_CHECKING:
     from ..model.robot import BasePlacement, SnakeRobot
@@ -64,7 +65,7 @@ def neck_frames(robot: SnakeRobot, base_configuration: npt.ArrayLike | None = No
     from ..model.robot import BasePlacement
 
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ValueError(f"samples must be a positive integer, got {samples!r}")
+        raise InputError(f"samples must be a positive integer, got {samples!r}")
     if base_configuration is None:
         from ..backbone.initial import initial_configuration
 
@@ -92,14 +93,14 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     best voxel per (frame, yaw) when its index is at least ``min_index``; returned: the ``limit`` best."""
     p, d, single = position_direction_pairs(position, direction)
     if not single:
-        raise ValueError("placements take one target: position and direction of shape (3,)")
+        raise InputError("placements take one target: position and direction of shape (3,)")
     for name, v in (("yaw_samples", yaw_samples), ("limit", limit)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise ValueError(f"{name} must be a positive integer, got {v!r}")
+            raise InputError(f"{name} must be a positive integer, got {v!r}")
     frames = np.asarray(frames, dtype=float)
     neck_q = np.asarray(neck_q, dtype=float)
     if frames.ndim != 3 or frames.shape[1:] != (4, 4) or len(frames) != len(neck_q):
-        raise ValueError("frames must be (J, 4, 4), one per row of neck_q")
+        raise InputError("frames must be (J, 4, 4), one per row of neck_q")
     p, d = p[0], d[0]
     m = workspace_map
     bits = direction_bits(m)

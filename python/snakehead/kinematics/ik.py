@@ -24,6 +24,7 @@ from ..model.chain import Chain
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import InputError, InputTypeError
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
 #: Bounds that leave the roll about the target's x-axis free.
@@ -34,11 +35,11 @@ def _bounds(bounds: Any) -> np.ndarray:
     try:
         b = np.asarray(bounds, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"bounds must be 6 numbers: {exc}") from None
+        raise InputError(f"bounds must be 6 numbers: {exc}") from None
     if b.shape != (6,):
-        raise ValueError(f"bounds must have 6 entries (vx vy vz wx wy wz), got shape {b.shape}")
+        raise InputError(f"bounds must have 6 entries (vx vy vz wx wy wz), got shape {b.shape}")
     if np.any(np.isnan(b)) or np.any(b < 0):
-        raise ValueError(f"bounds must be >= 0 (inf leaves an axis free), got {b.tolist()}")
+        raise InputError(f"bounds must be >= 0 (inf leaves an axis free), got {b.tolist()}")
     return b
 
 
@@ -82,7 +83,7 @@ class TracIK:
                    seed: int | None = None, bounds: Any = None) -> "TracIK":
         """A solver for an existing :class:`Chain` (its model is copied into the solver)."""
         if not isinstance(chain, Chain):
-            raise TypeError(f"chain must be a snakehead.Chain, got {type(chain).__name__}")
+            raise InputTypeError(f"chain must be a snakehead.Chain, got {type(chain).__name__}")
         self = cls.__new__(cls)
         self._init(chain, timeout, epsilon, solve_type, seed, bounds)
         return self
@@ -90,7 +91,7 @@ class TracIK:
     def _init(self, chain: Chain, timeout: float, epsilon: float, solve_type: str, seed: int | None, bounds: Any
               ) -> None:
         if not isinstance(solve_type, str) or solve_type not in SOLVE_TYPES:
-            raise ValueError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
+            raise InputError(f"unknown solve_type {solve_type!r}; expected one of {', '.join(SOLVE_TYPES)}")
         self._chain = chain
         self._solver = _core.TracIK(chain.model, duration(timeout, "timeout"), positive(epsilon, "epsilon"),
                                     solve_type, _bounds(np.zeros(6) if bounds is None else bounds), _seed(seed))
@@ -174,7 +175,7 @@ class TracIK:
         b = None if bounds is None else _bounds(bounds)
         t = None if timeout is None else duration(timeout, "timeout")
         if not isinstance(algorithm, str) or algorithm not in ("TRAC-IK", "KDL-RR", "SQP"):
-            raise ValueError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
+            raise InputError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
         return self._solver.ik(T, q, b, t, algorithm)
 
     def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -9,6 +9,7 @@ from .. import _core
 from .._validate import finite_array, joint_vector
 
 import numpy.typing as npt
+from .._errors import InputError, InputTypeError
 
 
 def _check_utf8(text: str, name: str) -> None:
@@ -17,7 +18,7 @@ def _check_utf8(text: str, name: str) -> None:
     try:
         text.encode("utf-8")
     except UnicodeEncodeError as exc:
-        raise ValueError(f"{name} is not valid text: {exc.reason} at position {exc.start}") from None
+        raise InputError(f"{name} is not valid text: {exc.reason} at position {exc.start}") from None
 
 
 class Chain:
@@ -30,7 +31,7 @@ class Chain:
 
     def __init__(self, model: _core.ChainModel, urdf: str | None = None) -> None:
         if not isinstance(model, _core.ChainModel):
-            raise TypeError(f"model must be a snakehead._core.ChainModel (use Chain.from_urdf), got {type(model).__name__}")
+            raise InputTypeError(f"model must be a snakehead._core.ChainModel (use Chain.from_urdf), got {type(model).__name__}")
         self._model = model
         #: The URDF the chain was read from (a path or the XML), when known: lets workers rebuild it.
         self.urdf = urdf
@@ -49,9 +50,9 @@ class Chain:
         if isinstance(urdf, os.PathLike):
             urdf = os.fspath(urdf)
         if not isinstance(urdf, str):
-            raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+            raise InputTypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
         if not isinstance(base, str) or not isinstance(tip, str):
-            raise TypeError("base and tip must be link names (str)")
+            raise InputTypeError("base and tip must be link names (str)")
         for name, text in (("urdf", urdf), ("base", base), ("tip", tip)):
             _check_utf8(text, name)
         return cls(_core.ChainModel.from_urdf(urdf, base, tip), urdf)
@@ -122,7 +123,7 @@ class Chain:
         try:
             return self.link_names.index(name)
         except ValueError:
-            raise ValueError(f"link {name!r} is not on the chain {self.base!r} -> {self.tip!r}") from None
+            raise InputError(f"link {name!r} is not on the chain {self.base!r} -> {self.tip!r}") from None
 
     # --- kinematics --------------------------------------------------------------------------
     def fk(self, q: npt.ArrayLike) -> np.ndarray:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError
+from .._errors import InputError, InputTypeError
 from .._validate import input_file
 
 from typing import Any, Mapping
@@ -50,7 +50,7 @@ def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, obje
     if isinstance(urdf, os.PathLike):
         urdf = os.fspath(urdf)
     if not isinstance(urdf, str):
-        raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+        raise InputTypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
     if _is_xml(urdf):
         if xacro_args:
             raise InputError("xacro_args are given but the description is URDF text, not a .xacro file")

@@ -22,6 +22,7 @@ from xml.sax.saxutils import quoteattr
 from .._validate import finite_float
 
 from typing import Any
+from .._errors import InputError, InputTypeError
 
 GRAVITY = 9.80665
 
@@ -69,29 +70,29 @@ class SnakeSpec:
 
     def __post_init__(self) -> None:
         if isinstance(self.n_joints, bool) or not isinstance(self.n_joints, int) or self.n_joints < 1:
-            raise ValueError(f"n_joints must be a positive integer, got {self.n_joints!r}")
+            raise InputError(f"n_joints must be a positive integer, got {self.n_joints!r}")
         for key in ("module_length", "section", "mass_per_module", "joint_limit_deg", "velocity"):
             if not finite_float(getattr(self, key), key) > 0:
-                raise ValueError(f"{key} must be positive, got {getattr(self, key)!r}")
+                raise InputError(f"{key} must be positive, got {getattr(self, key)!r}")
         for key in ("tail_length", "head_length", "effort"):
             v = getattr(self, key)
             if v is not None and not finite_float(v, key) > 0:
-                raise ValueError(f"{key} must be positive, got {v!r}")
+                raise InputError(f"{key} must be positive, got {v!r}")
         if self.joint_limit_deg > 180:
-            raise ValueError(f"joint_limit_deg must be at most 180, got {self.joint_limit_deg}")
+            raise InputError(f"joint_limit_deg must be at most 180, got {self.joint_limit_deg}")
         if self.first_axis not in ("yaw", "pitch"):
-            raise ValueError(f"first_axis must be 'yaw' or 'pitch', got {self.first_axis!r}")
+            raise InputError(f"first_axis must be 'yaw' or 'pitch', got {self.first_axis!r}")
         names = [self.tip_name]
         for marker, k in dict(self.markers).items():
             if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < self.n_joints:
-                raise ValueError(f"marker {marker!r} must sit at the end of a link 0..{self.n_joints - 1}, got {k!r}")
+                raise InputError(f"marker {marker!r} must sit at the end of a link 0..{self.n_joints - 1}, got {k!r}")
             names.append(marker)
         links = {f"{self.link_prefix}{i}" for i in range(self.n_joints + 1)}
         for n in names:
             if not isinstance(n, str) or not n or n in links:
-                raise ValueError(f"marker name {n!r} must be a non-empty name that no link has")
+                raise InputError(f"marker name {n!r} must be a non-empty name that no link has")
         if len(set(names)) != len(names):
-            raise ValueError("marker names must differ")
+            raise InputError("marker names must differ")
 
     def link_length(self, i: int) -> float:
         """Length of link i (m): the tail link 0, the modules, the head link n_joints."""
@@ -165,9 +166,9 @@ def snake_urdf(spec: SnakeSpec | None = None, **kwargs: Any) -> str:
     if spec is None:
         spec = SnakeSpec(**kwargs)
     elif kwargs:
-        raise TypeError("give a SnakeSpec or keyword arguments, not both")
+        raise InputTypeError("give a SnakeSpec or keyword arguments, not both")
     if not isinstance(spec, SnakeSpec):
-        raise TypeError(f"spec must be a SnakeSpec, got {type(spec).__name__}")
+        raise InputTypeError(f"spec must be a SnakeSpec, got {type(spec).__name__}")
     effort = spec.effort if spec.effort is not None else spec.default_effort()
     limit = math.radians(spec.joint_limit_deg)
     n = spec.n_joints

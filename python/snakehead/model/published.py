@@ -42,6 +42,7 @@ from xml.sax.saxutils import quoteattr
 
 from .._validate import finite_float
 from .generate import SnakeSpec, holding_effort, snake_urdf
+from .._errors import InputError, InputTypeError
 
 STYLES = ("sea", "reu", "rsnake", "mesh", "xacro", "one_joint_neck", "head6")
 
@@ -76,19 +77,19 @@ class StyleSpec:
         for key in ("n_joints", "neck_joints", "head_joints"):
             v = getattr(self, key)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ValueError(f"{key} must be a positive integer, got {v!r}")
+                raise InputError(f"{key} must be a positive integer, got {v!r}")
         if self.base_joints < 1:
-            raise ValueError(f"n_joints ({self.n_joints}) must exceed neck_joints + head_joints "
+            raise InputError(f"n_joints ({self.n_joints}) must exceed neck_joints + head_joints "
                              f"({self.neck_joints} + {self.head_joints}): the base needs a joint")
         for key in ("module_length", "thickness", "mass_per_module", "joint_limit_deg", "velocity"):
             if not finite_float(getattr(self, key), key) > 0:
-                raise ValueError(f"{key} must be positive, got {getattr(self, key)!r}")
+                raise InputError(f"{key} must be positive, got {getattr(self, key)!r}")
         if self.effort is not None and not finite_float(self.effort, "effort") > 0:
-            raise ValueError(f"effort must be positive, got {self.effort!r}")
+            raise InputError(f"effort must be positive, got {self.effort!r}")
         if self.joint_limit_deg > 180:
-            raise ValueError(f"joint_limit_deg must be at most 180, got {self.joint_limit_deg}")
+            raise InputError(f"joint_limit_deg must be at most 180, got {self.joint_limit_deg}")
         if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"name must be a non-empty string, got {self.name!r}")
+            raise InputError(f"name must be a non-empty string, got {self.name!r}")
 
     @property
     def base_joints(self) -> int:
@@ -129,11 +130,11 @@ DEFAULT_SPECS = {
 def style_spec(style: str, **overrides: Any) -> StyleSpec:
     """The numbers ``write_robot(style, ...)`` uses: the style's defaults with ``overrides`` (StyleSpec fields)."""
     if style not in DEFAULT_SPECS:
-        raise ValueError(f"unknown style {style!r} (known: {', '.join(STYLES)})")
+        raise InputError(f"unknown style {style!r} (known: {', '.join(STYLES)})")
     fields = {f.name for f in dataclasses.fields(StyleSpec)}
     unknown = sorted(set(overrides) - fields)
     if unknown:
-        raise TypeError(f"unknown override{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+        raise InputTypeError(f"unknown override{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
                         f"(known: {', '.join(sorted(fields))})")
     return dataclasses.replace(DEFAULT_SPECS[style], **overrides)
 
@@ -237,7 +238,7 @@ def _toml_value(v: Any) -> str:
     if isinstance(v, str):
         return json.dumps(v)  # a JSON string is a valid TOML basic string (same escapes)
     if isinstance(v, bool) or not isinstance(v, (int, float, list, tuple)):
-        raise TypeError(f"cannot write {v!r} to a robot file")
+        raise InputTypeError(f"cannot write {v!r} to a robot file")
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return repr(finite_float(v, "value")) if isinstance(v, float) else str(v)
@@ -638,7 +639,7 @@ def _with_sphere_head(urdf: str, head_link: str, length: float, radius: float) -
     root = ET.fromstring(urdf)
     link = root.find(f"link[@name='{head_link}']")
     if link is None:
-        raise ValueError(f"no link {head_link!r}")
+        raise InputError(f"no link {head_link!r}")
     for old in link.findall("collision"):
         link.remove(old)
     for x in (length / 4, 3 * length / 4):

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
-from .._errors import InputError
+from .._errors import InputError, InputTypeError
 from .._validate import finite_array, joint_vector
 from .chain import Chain, _check_utf8
 from .body_frame import ALIGNED_SUFFIX, HEAD_AXES, STRAIGHT_TOLERANCE, aligned_frames, body_frame
@@ -109,14 +109,14 @@ def _urdf_source(urdf: str | os.PathLike[str]) -> str:
     if isinstance(urdf, os.PathLike):
         urdf = os.fspath(urdf)
     if not isinstance(urdf, str):
-        raise TypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+        raise InputTypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
     _check_utf8(urdf, "urdf")  # before the core sees it (urdf_root_link below)
     return urdf
 
 
 def _frame_name(value: Any, what: str) -> str:
     if not isinstance(value, str) or not value:
-        raise TypeError(f"{what} must be a frame name (a non-empty str), got {value!r}")
+        raise InputTypeError(f"{what} must be a frame name (a non-empty str), got {value!r}")
     _check_utf8(value, what)
     return value
 
@@ -526,7 +526,7 @@ class SnakeRobot:
         links = self.shaped_links if links is None else np.asarray(links)
         frames = np.asarray(frames, float)
         if frames.ndim != 4 or frames.shape[1:] != (len(self.link_names), 4, 4):
-            raise ValueError(f"frames has shape {frames.shape}; expected (T, {len(self.link_names)}, 4, 4)")
+            raise InputError(f"frames has shape {frames.shape}; expected (T, {len(self.link_names)}, 4, 4)")
         return self.geometry.lowest_z(frames, links)
 
     def lowest_points(self, frames: np.ndarray, links: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -743,7 +743,7 @@ def _part_slices(body: Chain, root: str, names: Mapping[str, str]) -> list[slice
 def as_robot(robot: SnakeRobot) -> SnakeRobot:
     """``robot`` itself if it is a SnakeRobot, else TypeError (the check every planning function makes)."""
     if not isinstance(robot, SnakeRobot):
-        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+        raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
     return robot
 
 
@@ -752,5 +752,5 @@ def as_base(base: BasePlacement | None) -> BasePlacement:
     if base is None:
         return BasePlacement()
     if not isinstance(base, BasePlacement):
-        raise TypeError(f"base must be a BasePlacement or None, got {type(base).__name__}")
+        raise InputTypeError(f"base must be a BasePlacement or None, got {type(base).__name__}")
     return base

@@ -33,7 +33,7 @@ from pathlib import Path
 
 from typing import Sequence
 
-from .._errors import InputError
+from .._errors import InputError, InputTypeError
 from .._validate import input_file
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
@@ -68,30 +68,30 @@ def read_toml(path: str | os.PathLike, what: str) -> dict:
         with open(p, "rb") as f:
             raw = f.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise ValueError(f"cannot read {what} {os.fspath(p)!r}: {exc.strerror or exc}") from None
+        raise InputError(f"cannot read {what} {os.fspath(p)!r}: {exc.strerror or exc}") from None
     if len(raw) > MAX_FILE_BYTES:
-        raise ValueError(f"{what} {os.fspath(p)!r} is larger than {MAX_FILE_BYTES} bytes")
+        raise InputError(f"{what} {os.fspath(p)!r} is larger than {MAX_FILE_BYTES} bytes")
     try:
         return tomllib.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"{what} {os.fspath(p)!r} is not valid TOML: {exc}") from None
+        raise InputError(f"{what} {os.fspath(p)!r} is not valid TOML: {exc}") from None
 
 
 def check_keys(data: dict, required: Sequence[str], optional: Sequence[str], where: str) -> None:
     """ValueError for unknown or missing keys of a TOML table."""
     unknown = sorted(set(data) - set(required) - set(optional))
     if unknown:
-        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+        raise InputError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
                          f"(known: {', '.join(list(required) + list(optional))})")
     missing = [k for k in required if k not in data]
     if missing:
-        raise ValueError(f"{where}: missing {', '.join(map(repr, missing))}")
+        raise InputError(f"{where}: missing {', '.join(map(repr, missing))}")
 
 
 def _string(data: dict, key: str, where: str) -> str:
     v = data[key]
     if not isinstance(v, str) or not v:
-        raise ValueError(f"{where}: {key!r} must be a non-empty string, got {v!r}")
+        raise InputError(f"{where}: {key!r} must be a non-empty string, got {v!r}")
     return v
 
 
@@ -103,12 +103,12 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
     folder = Path(path).resolve().parent
     urdf = folder / _string(data, "urdf", where)
     if not urdf.is_file():
-        raise ValueError(f"{where}: its urdf {os.fspath(urdf)!r} does not exist")
+        raise InputError(f"{where}: its urdf {os.fspath(urdf)!r} does not exist")
     map_path = None
     if "map" in data:
         map_path = folder / _string(data, "map", where)
         if not map_path.is_file():
-            raise ValueError(f"{where}: its map {os.fspath(map_path)!r} does not exist")
+            raise InputError(f"{where}: its map {os.fspath(map_path)!r} does not exist")
     return RobotFile(path=Path(path), urdf=os.fspath(urdf), base_end=_string(data, "base_end", where),
                      neck_end=_string(data, "neck_end", where), head_tip=_string(data, "head_tip", where),
                      root=_string(data, "root", where) if "root" in data else None, map=map_path,
@@ -185,7 +185,7 @@ def _toml_string(s: str) -> str:
     """``s`` as a TOML basic string: quotes, backslashes and control characters escaped (a name holding a newline
     or a quote must read back as itself, never end the string early or add a key)."""
     if not isinstance(s, str):
-        raise TypeError(f"expected a str, got {type(s).__name__}")
+        raise InputTypeError(f"expected a str, got {type(s).__name__}")
     out = []
     for c in s:
         if c in '"\\':
@@ -193,7 +193,7 @@ def _toml_string(s: str) -> str:
         elif ord(c) < 32 or ord(c) == 127:
             out.append(f"\\u{ord(c):04x}")
         elif 0xD800 <= ord(c) <= 0xDFFF:
-            raise ValueError(f"{s!r} is not valid text (a lone surrogate)")
+            raise InputError(f"{s!r} is not valid text (a lone surrogate)")
         else:
             out.append(c)
     return '"' + "".join(out) + '"'

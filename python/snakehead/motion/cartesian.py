@@ -15,6 +15,7 @@ from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import InputError
 
 
 @dataclass(frozen=True)
@@ -85,13 +86,13 @@ def _interpolation_parameters(n: int) -> np.ndarray:
     from 0 to 1."""
     if isinstance(n, (int, np.integer)) and not isinstance(n, bool):
         if n < 2:
-            raise ValueError(f"n must be an integer >= 2 (samples including both ends), got {n!r}")
+            raise InputError(f"n must be an integer >= 2 (samples including both ends), got {n!r}")
         return np.linspace(0.0, 1.0, int(n))
     if np.ndim(n) != 1:
-        raise ValueError(f"n must be an integer >= 2 or a 1-D array of interpolation parameters, got {n!r}")
+        raise InputError(f"n must be an integer >= 2 or a 1-D array of interpolation parameters, got {n!r}")
     s = finite_array(n, "interpolation parameters", (None,))
     if len(s) < 2 or s[0] != 0.0 or s[-1] != 1.0 or np.any(np.diff(s) < 0):
-        raise ValueError("interpolation parameters must be non-decreasing from exactly 0 to exactly 1 "
+        raise InputError("interpolation parameters must be non-decreasing from exactly 0 to exactly 1 "
                          "(at least two)")
     return s
 
@@ -129,7 +130,7 @@ def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: np
     s = _interpolation_parameters(n)
     n = len(s)
     if aim not in ("segment", "points"):
-        raise ValueError(f"aim must be 'segment' (Eq. 44) or 'points', got {aim!r}")
+        raise InputError(f"aim must be 'segment' (Eq. 44) or 'points', got {aim!r}")
     q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # base joints: linear (and the fallback)
     joints = _interpolated_joints(robot)
     pts_idx = _joint_point_frames(robot, joints)

@@ -53,6 +53,7 @@ from .interpolation import CONTROL_PERIOD
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import InputError, InputTypeError
 
 #: The fewest joints of a kind per wave (fewer alias the wave: it no longer looks like a wave on the body).
 MIN_JOINTS_PER_WAVE = 3.0
@@ -61,13 +62,13 @@ MIN_JOINTS_PER_WAVE = 3.0
 def _non_negative(value: Any, name: str) -> float:
     v = finite_float(value, name)
     if v < 0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
+        raise InputError(f"{name} must be >= 0, got {value!r}")
     return v
 
 
 def _direction(value: Any) -> int:
     if isinstance(value, bool) or value not in (1, -1):
-        raise ValueError(f"direction must be +1 or -1, got {value!r}")
+        raise InputError(f"direction must be +1 or -1, got {value!r}")
     return int(value)
 
 
@@ -88,7 +89,7 @@ class Wave:
             object.__setattr__(self, key, finite_float(getattr(self, key), key))
         taper = finite_float(self.taper, "taper")
         if not 0.0 <= taper <= 1.0:
-            raise ValueError(f"taper must be within [0, 1], got {self.taper!r}")
+            raise InputError(f"taper must be within [0, 1], got {self.taper!r}")
         object.__setattr__(self, "taper", taper)
 
     def amplitudes(self, s: np.ndarray) -> np.ndarray:
@@ -117,9 +118,9 @@ class Gait:
         object.__setattr__(self, "ramp_s", _non_negative(self.ramp_s, "ramp_s"))
         object.__setattr__(self, "direction", _direction(self.direction))
         if self.motion not in ("translate", "turn", "forward"):
-            raise ValueError(f"motion must be 'translate', 'turn' or 'forward', got {self.motion!r}")
+            raise InputError(f"motion must be 'translate', 'turn' or 'forward', got {self.motion!r}")
         if not isinstance(self.yaw, Wave) or not isinstance(self.pitch, Wave):
-            raise TypeError("yaw and pitch must be Wave objects")
+            raise InputTypeError("yaw and pitch must be Wave objects")
 
     @property
     def period_s(self) -> float:
@@ -139,18 +140,18 @@ class Gait:
             if wave.amplitude == 0.0 and wave.offset == 0.0:
                 continue
             if not mine.any():
-                raise ValueError(f"the {self.name} gait needs {kind} joints; this robot has none")
+                raise InputError(f"the {self.name} gait needs {kind} joints; this robot has none")
             if wave.amplitude > 0 and abs(wave.waves) > 0:
                 per_wave = mine.sum() / abs(wave.waves)
                 if per_wave < MIN_JOINTS_PER_WAVE:
-                    raise ValueError(f"{self.name}: {abs(wave.waves):g} waves per body leave {per_wave:.1f} {kind} "
+                    raise InputError(f"{self.name}: {abs(wave.waves):g} waves per body leave {per_wave:.1f} {kind} "
                                      f"joints per wave on this robot ({mine.sum()} {kind} joints); at least "
                                      f"{MIN_JOINTS_PER_WAVE:g} are needed: use fewer waves")
             reach = np.abs(wave.offset) + np.abs(wave.amplitudes(s[mine]))
             lim = np.minimum(-robot.lower[mine], robot.upper[mine])
             if np.any(reach > lim + 1e-12):
                 j = int(np.flatnonzero(mine)[np.argmax(reach - lim)])
-                raise ValueError(f"{self.name}: joint {robot.joint_names[j]!r} would reach "
+                raise InputError(f"{self.name}: joint {robot.joint_names[j]!r} would reach "
                                  f"{math.degrees(reach.max()):.1f} deg, beyond its limit of "
                                  f"{math.degrees(lim.min()):.1f} deg: lower the amplitude")
 
@@ -159,7 +160,7 @@ class Gait:
         robot = as_robot(robot)
         t = np.atleast_1d(finite_array(t, "t"))
         if t.ndim != 1:
-            raise ValueError(f"t must be a time or a 1-D array of times, got shape {t.shape}")
+            raise InputError(f"t must be a time or a 1-D array of times, got shape {t.shape}")
         self.check(robot)
         cycles = positive(cycles, "cycles")
         running = cycles / self.frequency
@@ -279,8 +280,8 @@ GAITS = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning, "la
 def make_gait(name: str, direction: int = 1, **parameters: Any) -> Gait:
     """The gait called ``name`` (one of :data:`GAITS`) with its commanded ``direction`` and parameters."""
     if not isinstance(name, str) or name not in GAITS:
-        raise ValueError(f"unknown gait {name!r}; the gaits are {', '.join(GAITS)}")
+        raise InputError(f"unknown gait {name!r}; the gaits are {', '.join(GAITS)}")
     try:
         return GAITS[name](direction, **parameters)
     except TypeError as exc:
-        raise TypeError(f"{name}: {exc}") from None
+        raise InputTypeError(f"{name}: {exc}") from None

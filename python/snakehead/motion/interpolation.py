@@ -14,6 +14,7 @@ from scipy.interpolate import BSpline, make_interp_spline
 from .._validate import finite_array, finite_float, joint_vector, positive, sample_count
 
 import numpy.typing as npt
+from .._errors import Infeasible, InputError
 
 #: The joint controller's period (s), Section 4.
 CONTROL_PERIOD = 0.002
@@ -35,12 +36,12 @@ class JointTrajectory:
 def _check_waypoints(times: npt.ArrayLike, waypoints: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     times = finite_array(times, "times", (None,))
     if times.shape[0] < 2:
-        raise ValueError(f"times needs at least two waypoints, got {times.shape[0]}")
+        raise InputError(f"times needs at least two waypoints, got {times.shape[0]}")
     if np.any(np.diff(times) <= 0):
-        raise ValueError("times must increase strictly")
+        raise InputError("times must increase strictly")
     waypoints = finite_array(waypoints, "waypoints", (times.shape[0], None))
     if waypoints.shape[1] < 1:
-        raise ValueError("waypoints have no joints")
+        raise InputError("waypoints have no joints")
     return times, waypoints
 
 
@@ -97,7 +98,7 @@ class MonotoneQuintic:
         if nu == 2:
             return ((-60 * s + 180 * s2 - 120 * s3) * (p0 - p1) / h**2 + (-36 * s + 96 * s2 - 60 * s3) * v0 / h
                     + (-24 * s + 84 * s2 - 60 * s3) * v1 / h)
-        raise ValueError("nu must be 0, 1 or 2")
+        raise InputError("nu must be 0, 1 or 2")
 
 
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:
@@ -105,7 +106,7 @@ def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray
     t0, t1 = finite_float(t0, "t0"), finite_float(t1, "t1")
     dt = positive(dt, "dt")
     if t1 < t0:
-        raise ValueError(f"t1 must be >= t0, got t0 = {t0:g} s and t1 = {t1:g} s")
+        raise InputError(f"t1 must be >= t0, got t0 = {t0:g} s and t1 = {t1:g} s")
     steps = sample_count(t1 - t0, dt, "the trajectory (t1 - t0)") - 1  # at most MAX_SAMPLES: checked before allocating
     t = t0 + dt * np.arange(steps + 1)
     # A gap under a microsecond is round-off, not a sample: stretch the last step to t1 instead of adding a
@@ -135,7 +136,7 @@ def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTR
     elif method == "monotone":
         spline = MonotoneQuintic(times, waypoints)
     else:
-        raise ValueError(f"method must be 'spline' or 'monotone', got {method!r}")
+        raise InputError(f"method must be 'spline' or 'monotone', got {method!r}")
     t = sample_times(times[0], times[-1], dt)
     q, qd, qdd = spline(t), spline(t, 1), spline(t, 2)
     q[0], q[-1] = waypoints[0], waypoints[-1]
@@ -149,7 +150,7 @@ def joint_trajectory(times: np.ndarray, waypoints: np.ndarray, dt: float = CONTR
         over = bad(q, b + (1e-9 if name == "upper" else -1e-9))
         if over.any():
             k, j = np.argwhere(over)[0]
-            raise ValueError(f"the interpolation overshoots the {name} limit of joint {j} "
+            raise Infeasible(f"the interpolation overshoots the {name} limit of joint {j} "
                              f"({q[k, j]:.4f} rad at t = {t[k]:.3f} s; limit {b[j]:.4f} rad)")
     return JointTrajectory(t, q, qd, qdd, spline)
 

@@ -34,6 +34,7 @@ from .._validate import finite_array, positive
 from ..dynamics.sliding import predict_slide
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gaits import Gait, make_gait, virtual_chassis
+from .._errors import InputError
 
 
 # ------------------------------------------------------------------------------------------------
@@ -77,12 +78,12 @@ def flat_shape(robot: SnakeRobot, q: npt.ArrayLike, name: str = "q") -> np.ndarr
     pitch = np.array([k == "pitch" for k in robot.joint_kinds])
     if np.any(np.abs(q[pitch]) > 1e-9):
         j = int(np.flatnonzero(pitch & (np.abs(q) > 1e-9))[0])
-        raise ValueError(f"{name} is not lying flat: pitch joint {robot.joint_names[j]!r} is at {q[j]:.4g} rad "
+        raise InputError(f"{name} is not lying flat: pitch joint {robot.joint_names[j]!r} is at {q[j]:.4g} rad "
                          "(a body lying on the ground has its pitch joints at 0)")
     outside = (q < robot.lower - 1e-9) | (q > robot.upper + 1e-9)
     if outside.any():
         j = int(np.flatnonzero(outside)[0])
-        raise ValueError(f"{name}[{j}] = {q[j]:.4g} rad is outside the limits of {robot.joint_names[j]!r}")
+        raise InputError(f"{name}[{j}] = {q[j]:.4g} rad is outside the limits of {robot.joint_names[j]!r}")
     return q
 
 
@@ -245,7 +246,7 @@ def next_step(robot: SnakeRobot, current: BasePlacement, goal: BasePlacement, ra
     current, goal = as_base(current), as_base(goal)
     frequency = positive(frequency, "frequency")
     if isinstance(max_cycles, bool) or not isinstance(max_cycles, (int, np.integer)) or max_cycles < 1:
-        raise ValueError(f"max_cycles must be a positive integer, got {max_cycles!r}")
+        raise InputError(f"max_cycles must be a positive integer, got {max_cycles!r}")
     offset = chassis_offset(robot)
     here, there = compose(current, offset), compose(goal, offset)
     error = relative(there, BasePlacement(here.x, here.y, here.yaw))  # the middle in the goal's frame

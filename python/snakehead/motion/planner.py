@@ -40,6 +40,7 @@ import os
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Sequence
+from .._errors import Infeasible, InputError, InputTypeError
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -119,6 +120,7 @@ class Plan:
     scene: Scene | None = None
     relocation: "Relocation | None" = None  # the change of base the targets need, before the plan (locomotion)
     timing_failure: str | None = None  # why the path could not be timed within the limits, when it could not
+    out_of_range: str | None = None  # why no relocation was tried: a target beyond MAX_RELOCATION_M of the start
 
     @property
     def min_zmp_margin_m(self) -> float:
@@ -142,7 +144,8 @@ class Plan:
         support polygon, a link in the ground, a link touching an obstacle)."""
         for tg in self.targets:
             if not tg.solved:
-                return f"target {tg.name!r} not solved: {tg.solution.message}"
+                why = self.out_of_range if self.out_of_range is not None else tg.solution.message
+                return f"target {tg.name!r} not solved: {why}"
         if self.timing_failure is not None:
             return self.timing_failure
         if self.min_zmp_margin_m < ZMP_MARGIN:
@@ -392,9 +395,7 @@ class _Waypoints:
                 traj = _concatenate(lift, rest)
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
-        except ValueError as exc:
-            if any(key in str(exc) for key in TIMING_OPTIONS if key in timing):  # a bad option of the caller's
-                raise
+        except Infeasible as exc:  # (the caller's options were checked when plan() began)
             # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
             # slow fixed pace so that the plan can still be looked at, and fail it
             self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
@@ -500,9 +501,25 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
         ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
         if ok.any():
             return qs[chunk[np.argmax(ok)]]
-    raise ValueError("no curl of the neck and head on the ground keeps their mass over the base (the base is too "
+    raise Infeasible("no curl of the neck and head on the ground keeps their mass over the base (the base is too "
                      "short or light for them: 'snakehead info --robot FILE' suggests a split of the parts that works)")
 
+
+
+#: The farthest (m) the planner moves the base by locomotion before a plan (a relocation). A target farther than
+#: this plus the body's length from where the base lies is out of range: the plan fails at once and says so.
+MAX_RELOCATION_M = 10.0
+
+
+def _out_of_range(robot: SnakeRobot, start: BasePlacement, targets: Sequence[Any]) -> str | None:
+    """Why no relocation can reach ``targets`` from ``start`` (None: every one is in range)."""
+    for t in targets:
+        d = float(np.hypot(t.position[0] - start.x, t.position[1] - start.y))
+        if d > MAX_RELOCATION_M + robot.body_length:
+            return (f"out of range: it is {d:.4g} m from the base; a relocation moves the base at most "
+                    f"{MAX_RELOCATION_M:g} m (snakehead.motion.planner.MAX_RELOCATION_M) and the body is "
+                    f"{robot.body_length:.3g} m long")
+    return None
 
 
 @dataclass(frozen=True)
@@ -560,7 +577,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
         ("no curl": the base's shape holds no stable curl of the neck and head; "the start": it is in an obstacle)."""
         try:
             q_bend = bending_state(controller, q_shape)
-        except ValueError:
+        except Infeasible:
             return "no curl", None
         if not clear(q_bend, b):
             return "the start", None
@@ -581,6 +598,9 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
               f"target {first.name!r} is not reached from the start ({why.reason})")
     if not allow_relocation:
         return start, q0.copy(), None, [f"the base is kept (no relocation allowed): {reason}"]
+    far = _out_of_range(robot, start, targets)
+    if far is not None:
+        return start, q0.copy(), None, [f"no relocation: a target is {far}"]
     # a relocated base must hold a stable curl of the neck and head (the bending state the plan lifts them from):
     # the whole-body solve is told so, and looks further than a shape (e.g. a straight base) that holds none
     no_curl = controller.__dict__.setdefault("_shapes_without_curl", set())
@@ -591,7 +611,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
             return False
         try:
             bending_state(controller, q)
-        except ValueError:
+        except Infeasible:
             no_curl.add(key)
             return False
         return True
@@ -603,6 +623,8 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
                            shape_ok=has_curl)
         if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
                                                                    q0[:robot.lift_joints.start])):
+            continue
+        if np.hypot(sol.base.x - start.x, sol.base.y - start.y) > MAX_RELOCATION_M:
             continue
         q_shape = _shape_of(robot, sol.q, q0)
         if failing(sol.base, q_shape)[0] is None:
@@ -625,7 +647,7 @@ def _check_timing(robot: SnakeRobot, timing: dict[str, Any]) -> None:
 
     unknown = [key for key in timing if key not in TIMING_OPTIONS]
     if unknown:
-        raise ValueError(f"timing has no option {unknown[0]!r}; its options are {', '.join(TIMING_OPTIONS)}")
+        raise InputError(f"timing has no option {unknown[0]!r}; its options are {', '.join(TIMING_OPTIONS)}")
     resolve_limits(robot, **timing)
 
 
@@ -638,7 +660,7 @@ def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
     d = b.position - a.position
     length = float(np.linalg.norm(d))
     if length / b.step_m > MAX_LINE_POSES:  # each pose is a whole-body solve
-        raise ValueError(f"target {b.name!r}: the line from {a.name!r} is {length:.4g} m long; at step_m = "
+        raise InputError(f"target {b.name!r}: the line from {a.name!r} is {length:.4g} m long; at step_m = "
                          f"{b.step_m:g} m that is {length / b.step_m:.3g} poses, at most {MAX_LINE_POSES}: take a "
                          "larger step_m")
     n = int(np.ceil(length / b.step_m - 1e-9))
@@ -733,20 +755,20 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
     if timing is not None and not isinstance(timing, dict):
-        raise TypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
+        raise InputTypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
     # checked even when a controller (with its own method and seed) is given: a bad value is a mistake either way
     if not isinstance(method, str) or method not in ("rotated", "free_roll"):
-        raise ValueError(f"method must be 'rotated' or 'free_roll', got {method!r}")
+        raise InputError(f"method must be 'rotated' or 'free_roll', got {method!r}")
     if seed is not None:
         integer(seed, "seed", least=0, most=2**64 - 1)
     if not isinstance(allow_relocation, (bool, np.bool_)):  # "False" or None would pass a truth test
-        raise TypeError(f"allow_relocation must be True or False, got {type(allow_relocation).__name__} "
+        raise InputTypeError(f"allow_relocation must be True or False, got {type(allow_relocation).__name__} "
                         f"{allow_relocation!r}")
     if controller is not None:
         if not isinstance(controller, HeadController):
-            raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
+            raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
         if robot is not None and robot is not controller.robot:
-            raise ValueError("give a robot or a controller (whose robot is used), not both")
+            raise InputError("give a robot or a controller (whose robot is used), not both")
         chosen = base if base is not None else scene.base
         if chosen is not None:
             controller.base = chosen
@@ -754,7 +776,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         if robot is None:
             robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
         elif not isinstance(robot, SnakeRobot):
-            raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+            raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
         controller = HeadController(robot, base_pose=base if base is not None else scene.base, method=method,
                                     seed=seed)
     robot = controller.robot
@@ -852,4 +874,6 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         k = end + 1
     plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing)
     plan.relocation = relocation
+    if allow_relocation and relocation is None:
+        plan.out_of_range = _out_of_range(robot, chosen, scene.reported)
     return plan

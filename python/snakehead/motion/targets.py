@@ -27,6 +27,7 @@ import numpy as np
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement
+from .._errors import Infeasible, InputError
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -55,9 +56,9 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
     """``count`` targets reachable by construction of the given ``kind`` (see the module's docstring) for the
     controller's robot, from its initial configuration and placement."""
     if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+        raise InputError(f"kind must be one of {KINDS}, got {kind!r}")
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0:
-        raise ValueError(f"count must be an integer >= 0, got {count!r}")
+        raise InputError(f"count must be an integer >= 0, got {count!r}")
     robot = controller.robot
     prob = controller.body_problem
     rng = np.random.default_rng() if rng is None else rng
@@ -92,7 +93,7 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
         H = robot.head_pose(q, base)
         out.append(ReachableTarget(H[:3, 3].copy(), H[:3, 0].copy(), q, base, kind))
     if len(out) < count:
-        raise ValueError(f"only {len(out)} of {count} reachable targets in {max_draws} draws")
+        raise Infeasible(f"only {len(out)} of {count} reachable targets in {max_draws} draws")
     return out
 
 

@@ -48,6 +48,7 @@ from ..dynamics import stability
 from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
+from .._errors import Infeasible, InputError, InputTypeError
 
 #: q(s) and its derivatives: f(s (N,), order 0, 1 or 2) -> (N, n).
 PathFunction = Callable[[np.ndarray, int], np.ndarray]
@@ -137,13 +138,13 @@ def _joint_limit(value: npt.ArrayLike | None, n: int, name: str, default: np.nda
         try:
             limit = np.asarray(value, float)
         except (TypeError, ValueError):
-            raise TypeError(f"{name} must be a number or an array of {n} numbers, got {type(value).__name__}") from None
+            raise InputTypeError(f"{name} must be a number or an array of {n} numbers, got {type(value).__name__}") from None
         if limit.ndim == 0:
             limit = np.full(n, float(limit))
         if limit.shape != (n,):
-            raise ValueError(f"{name} must be a number or shape ({n},), got shape {limit.shape}")
+            raise InputError(f"{name} must be a number or shape ({n},), got shape {limit.shape}")
     if np.any(np.isnan(limit)) or np.any(limit <= 0):
-        raise ValueError(f"{name} must be positive (inf for none), got {np.asarray(limit).tolist()}")
+        raise InputError(f"{name} must be positive (inf for none), got {np.asarray(limit).tolist()}")
     return limit
 
 
@@ -155,13 +156,13 @@ def resolve_limits(robot: SnakeRobot, *, velocity_limit: npt.ArrayLike | None = 
     n = robot.n_joints
     vel = _joint_limit(velocity_limit, n, "velocity_limit", VELOCITY_SHARE * robot.velocity_limit)
     if acceleration_limit is None:
-        raise ValueError("acceleration_limit is needed (URDFs give none); e.g. "
+        raise InputError("acceleration_limit is needed (URDFs give none); e.g. "
                          f"{ACCELERATION_LIMIT} rad/s^2, the default")
     acc = _joint_limit(acceleration_limit, n, "acceleration_limit")
     tau = _joint_limit(torque_limit, n, "torque_limit", TORQUE_SHARE * robot.effort)
     margin = finite_float(zmp_margin, "zmp_margin")
     if margin < 0:
-        raise ValueError(f"zmp_margin must be >= 0 m, got {zmp_margin!r}")
+        raise InputError(f"zmp_margin must be >= 0 m, got {zmp_margin!r}")
     mu = positive(friction, "friction")
     return RetimingLimits(vel, acc, tau, margin, mu)
 
@@ -189,7 +190,7 @@ class Support:
         V, count = stability.support_polygons(robot, q, base, contact="ground", frames=frames)
         if np.any(count < 3):
             k = int(np.argmax(count < 3))
-            raise ValueError(f"the links on the ground span no polygon at path point {k} ({count[k]} distinct "
+            raise Infeasible(f"the links on the ground span no polygon at path point {k} ({count[k]} distinct "
                              "contact points): the body cannot stand there")
         h = np.arange(V.shape[1])[None, :]
         start = np.where(h < count[:, None], h, 0)  # padding repeats the first edge
@@ -328,7 +329,7 @@ def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
     robot = as_robot(robot)
     base = as_base(base)
     if not isinstance(limits, RetimingLimits):
-        raise TypeError(f"limits must be RetimingLimits, got {type(limits).__name__}")
+        raise InputTypeError(f"limits must be RetimingLimits, got {type(limits).__name__}")
     q = finite_array(q, "q", (None, robot.n_joints))
     qd = finite_array(qd, "qd", q.shape)
     qdd = finite_array(qdd, "qdd", q.shape)
@@ -422,7 +423,7 @@ class _Timeline:
             elif nu == 2:
                 out[mask] = f(s, 1) * item["u"][i][:, None] + f(s, 2) * (sd ** 2)[:, None]
             else:
-                raise ValueError("nu must be 0, 1 or 2")
+                raise InputError("nu must be 0, 1 or 2")
         return out
 
 
@@ -448,9 +449,9 @@ def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
     if holds.ndim == 0:
         holds = np.full(K - 1, float(holds))
     if holds.shape != (K - 1,):
-        raise ValueError(f"hold_s must be a number or one per segment ({K - 1},), got shape {holds.shape}")
+        raise InputError(f"hold_s must be a number or one per segment ({K - 1},), got shape {holds.shape}")
     if np.any(holds < 0):
-        raise ValueError("hold_s must be >= 0 s")
+        raise InputError("hold_s must be >= 0 s")
     rest = np.zeros(K, bool)
     rest[[0, -1]] = True
     # a cusp: every joint turns back or stops at the waypoint, so the path stands still there (q'(s) = 0 on the
@@ -460,9 +461,9 @@ def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
     rest[1:-1] |= np.all(step[:-1] * step[1:] <= 0.0, axis=1) & ~same[:-1] & ~same[1:]
     for k in stops:
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
-            raise TypeError(f"stops must be waypoint indices (int), got {k!r}")
+            raise InputTypeError(f"stops must be waypoint indices (int), got {k!r}")
         if not -K <= k < K:
-            raise ValueError(f"stop {k} is not a waypoint index (there are {K} waypoints)")
+            raise InputError(f"stop {k} is not a waypoint index (there are {K} waypoints)")
         rest[k] = True
     schedule = []
     start = None
@@ -524,22 +525,22 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     n = robot.n_joints
     W = finite_array(waypoints, "waypoints")
     if W.ndim != 2 or W.shape[1] != n:
-        raise ValueError(f"waypoints has shape {W.shape}; expected (K, {n})")
+        raise InputError(f"waypoints has shape {W.shape}; expected (K, {n})")
     if W.shape[0] < 2:
-        raise ValueError(f"waypoints needs at least two configurations, got {W.shape[0]}")
+        raise InputError(f"waypoints needs at least two configurations, got {W.shape[0]}")
     out = (W < robot.lower - 1e-9) | (W > robot.upper + 1e-9)
     if out.any():
         k, j = np.argwhere(out)[0]
-        raise ValueError(f"waypoint {k} has joint {robot.joint_names[j]} at {W[k, j]:.4f} rad, outside its limits "
+        raise InputError(f"waypoint {k} has joint {robot.joint_names[j]} at {W[k, j]:.4f} rad, outside its limits "
                          f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]")
     limits = resolve_limits(robot, velocity_limit=velocity_limit, acceleration_limit=acceleration_limit,
                             torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
     dt = positive(dt, "dt")
     grid_step = positive(grid_step, "grid_step")
     if not isinstance(check_samples, (bool, np.bool_)):
-        raise TypeError(f"check_samples must be True or False, got {check_samples!r}")
+        raise InputTypeError(f"check_samples must be True or False, got {check_samples!r}")
     if interpolation not in INTERPOLATIONS:
-        raise ValueError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
+        raise InputError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
     schedule, holds = _segments(W, stops, hold_s)
 
     from . import _topp  # toppra imports pyplot: only when a path is retimed
@@ -605,7 +606,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         if interpolation == "spline":
             over = np.maximum(robot.lower - qg, qg - robot.upper).max()
             if over > 1e-9:
-                raise ValueError(f"the spline through waypoints {i0}..{i1} overshoots a joint limit by "
+                raise Infeasible(f"the spline through waypoints {i0}..{i1} overshoots a joint limit by "
                                  f"{np.degrees(over):.2f} deg; use interpolation='monotone'")
         support = Support.of(robot, qg, base, limits.zmp_margin)
         supports[len(grid)] = (qg, support)
@@ -626,7 +627,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
             if sd is None:
                 bad = np.flatnonzero(np.isnan(K).any(axis=1))
                 k = int(bad.max()) if bad.size else 0
-                raise ValueError(f"no motion along the path keeps every limit near waypoint {near(k)} (between "
+                raise Infeasible(f"no motion along the path keeps every limit near waypoint {near(k)} (between "
                                  f"waypoints {i0} and {i1}); loosen the limits or the ZMP margin there")
             if refinement == REFINE_ROUNDS:
                 break
@@ -695,10 +696,10 @@ def _precheck(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, q:
     """Clear errors for paths no timing can follow: holding still there already breaks a limit."""
     if np.any(support.static <= 0):
         k = int(np.argmin(support.static))
-        raise ValueError(f"the centre of mass is {-1000 * support.static[k]:.1f} mm outside the support polygon near "
+        raise Infeasible(f"the centre of mass is {-1000 * support.static[k]:.1f} mm outside the support polygon near "
                          f"waypoint {near(k)}: no motion along this path is stable there")
     hold = np.abs(inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base)) / limits.torque
     if hold.max() > 1.0:
         k, j = (int(i) for i in np.unravel_index(int(np.argmax(hold)), hold.shape))
-        raise ValueError(f"joint {robot.joint_names[j]} needs {hold[k, j] * limits.torque[j]:.2f} N m to hold the body "
+        raise Infeasible(f"joint {robot.joint_names[j]} needs {hold[k, j] * limits.torque[j]:.2f} N m to hold the body "
                          f"still near waypoint {near(k)}; its torque limit is {limits.torque[j]:.2f} N m")

@@ -48,7 +48,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, vector3
+from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, world_position
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, read_toml
@@ -80,7 +80,7 @@ class Target:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
-        object.__setattr__(self, "position", vector3(self.position, f"target {self.name!r} position"))
+        object.__setattr__(self, "position", world_position(self.position, f"target {self.name!r} position"))
         object.__setattr__(self, "direction", unit_vector3(self.direction, f"target {self.name!r} direction"))
         object.__setattr__(self, "hold_s", duration(self.hold_s, f"target {self.name!r} hold_s", allow_zero=True))
         if not isinstance(self.approach, str) or self.approach not in APPROACHES:
