@@ -9,6 +9,18 @@
 
 namespace py = pybind11;
 
+namespace {
+
+// snakehead.InputError (python/snakehead/_errors.py), the one type of bad input on both sides; looked up on first
+// use (the package imports _errors before _core) and kept for the process's life (never released: a static
+// py::object would be destroyed after the interpreter).
+PyObject* input_error_type() {
+  static PyObject* type = py::object(py::module_::import("snakehead._errors").attr("InputError")).release().ptr();
+  return type;
+}
+
+}  // namespace
+
 PYBIND11_MODULE(_core, m) {
   m.doc() =
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
@@ -24,10 +36,11 @@ PYBIND11_MODULE(_core, m) {
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");
 
-  // Every C++ exception reaches Python as ValueError (bad input; also any other failure of the core, with
-  // its message), TypeError (a value pybind11 could not convert), MemoryError, Cancelled, or the Python
-  // exception a callback raised; never RuntimeError, never an abort (tried before register_exception's).
-  // This also covers exceptions raised in worker threads: the core carries them to the calling thread.
+  // Every C++ exception reaches Python as snakehead.InputError (snakehead::InputError: bad input, named in the
+  // message), TypeError (a value pybind11 could not convert), MemoryError, Cancelled, the Python exception a
+  // callback raised, or RuntimeError (any other failure of the core on valid input: a bug, never the caller's
+  // fault); never an abort. This also covers exceptions raised in worker threads: the core carries them to the
+  // calling thread.
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -39,12 +52,14 @@ PYBIND11_MODULE(_core, m) {
       throw;  // pybind11's own value_error, type_error, ...: already the right Python type
     } catch (const snakehead::Cancelled&) {
       throw;  // to the translator register_exception made: snakehead._core.Cancelled
+    } catch (const snakehead::InputError& e) {
+      PyErr_SetString(input_error_type(), e.what());
     } catch (const std::bad_alloc&) {
       PyErr_SetString(PyExc_MemoryError, "out of memory in snakehead's C++ core");
     } catch (const std::exception& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      PyErr_SetString(PyExc_RuntimeError, e.what());
     } catch (...) {
-      PyErr_SetString(PyExc_ValueError, "snakehead's C++ core failed with an exception of unknown type");
+      PyErr_SetString(PyExc_RuntimeError, "snakehead's C++ core failed with an exception of unknown type");
     }
   });
 }

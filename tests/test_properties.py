@@ -3,8 +3,10 @@
 Hypothesis draws hostile inputs -- wrong types and shapes, NaN and inf, huge and tiny numbers, damaged URDFs,
 robot files, scene files and map files, command lines -- and each case runs in a worker process, so that a crash
 (the worker dies) or a hang (no answer within its time) fails the test with the input that caused it instead of
-ending the run. The property, everywhere: a call returns a valid result or raises ValueError/TypeError with a
-message; the command line exits 0, 1 or 2 (2 with one error line), never 3 and never with a traceback.
+ending the run. The property, everywhere: a call returns a valid result or raises snakehead.InputError (or
+snakehead.Infeasible: valid input without an answer) with a message, never another ValueError or TypeError (those
+mean an internal step, not the input's check, refused); the command line exits 0, 1 or 2 (2 with one error line),
+never 3 and never with a traceback.
 
 Examples are bounded and drawn from a fixed seed (``derandomize``), so CI sees the same cases every run; set
 SNAKEHEAD_FUZZ_EXAMPLES=N to draw N random cases per test instead (a longer search, e.g. N = 500).
@@ -31,7 +33,7 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from snakehead import default_urdf_path
+from snakehead import Infeasible, InputError, default_urdf_path
 from snakehead.model.generate import SnakeSpec, snake_urdf
 
 URDF = default_urdf_path()
@@ -66,7 +68,7 @@ def _serve(conn: Any, folder: str) -> None:
             return
         try:
             answer: tuple = ("ok", CALLS[name](*args))
-        except (ValueError, TypeError) as exc:
+        except (InputError, Infeasible) as exc:
             answer = ("error", type(exc).__name__, str(exc))
         except BaseException as exc:  # anything else is a finding: report it with where it came from
             answer = ("unexpected", type(exc).__name__, str(exc), traceback.format_exc(limit=-4))
@@ -143,7 +145,7 @@ def _gist(message: str) -> str:
 
 
 def expect_valid_or_clear_error(name: str, *args: Any, must_fail: bool = False) -> tuple:
-    """Runs case ``name`` in the worker; asserts it returned or raised ValueError/TypeError with a clear message
+    """Runs case ``name`` in the worker; asserts it returned or raised InputError/Infeasible with a clear message
     (never pybind11's "incompatible function arguments", an address, or another exception type). Returns the
     answer."""
     answer = WORKER.call(name, *args)
@@ -314,7 +316,8 @@ HOSTILE_NUMBERS = ["nan", "inf", "-inf", "-1", "0", "-0", "1e300", "1e-300", "1e
 #: text that breaks the syntax or the meaning of a document where it is put
 HOSTILE_TEXT = ['"', "'", "<", ">", "&", "&amp;", "]]>", "<!--", "\x00", "\x7f", "\ud800", "\n", "[", "]", "{", "=",
                 "\\", "\u2603", "<link/>", '<joint name="x" type="revolute"/>', "<a>" * 3000 + "</a>" * 3000,
-                '<!DOCTYPE r [<!ENTITY e "x">]>', "&e;"]
+                '<!DOCTYPE r [<!ENTITY e "x">]>', "&e;", "\nx = " + "[" * 3000 + "]" * 3000 + "\n",
+                "\n[" + "a." * 2000 + "b]\n", "$\\frac{$"]
 
 hostile_scalars = st.one_of(
     st.none(), st.booleans(), st.integers(min_value=-(10**30), max_value=10**30), st.integers(10**300, 10**400),
@@ -389,7 +392,7 @@ def mutated(draw: Any, text: str, fragments: list[str], numbers: list[str]) -> s
     names = sorted(set(re.findall(r'name\s*=\s*"([^"]*)"', text)))
     for _ in range(draw(st.integers(1, 3))):
         n = len(text)
-        kind = draw(st.sampled_from(["number", "delete", "duplicate", "insert", "name", "cut"]))
+        kind = draw(st.sampled_from(["number", "delete", "duplicate", "insert", "name", "cut", "bom"]))
         a = draw(st.integers(0, n))
         b = min(n, a + draw(st.integers(0, 200)))
         if kind == "number" and spots:
@@ -407,6 +410,8 @@ def mutated(draw: Any, text: str, fragments: list[str], numbers: list[str]) -> s
             text = text.replace(f'"{old}"', f'"{new}"', draw(st.integers(1, 3)))
         elif kind == "cut":
             text = text[:a]
+        elif kind == "bom":  # a byte-order mark, as Windows editors write it: valid, and read as if absent
+            text = "\ufeff" + text.removeprefix("\ufeff")
     return text
 
 

@@ -278,17 +278,30 @@ def input_file(path: Any, what: str, max_bytes: int) -> Path:
         raise InputTypeError(f"{what} must be a str path, got bytes")
     if "\0" in text:
         raise InputError(f"cannot read {what} {text!r}: the path holds a NUL character")
+    problem, info = _file_problem(text)
+    if problem is not None:
+        raise InputError(f"cannot read {what} {text!r}: {problem}")
+    if info.st_size > max_bytes:
+        raise InputError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
+    return Path(text)
+
+
+def _file_problem(path: str) -> tuple[str | None, os.stat_result | None]:
+    """Why ``path`` is not a regular file to read (None when it is), and its stat."""
     try:
-        info = os.stat(text)
+        info = os.stat(path)
     except FileNotFoundError:
-        raise InputError(f"cannot read {what} {text!r}: it does not exist") from None
+        return "it does not exist", None
     except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read {what} {text!r}: {getattr(exc, 'strerror', None) or exc}") from None
+        return str(getattr(exc, "strerror", None) or exc), None
     if not stat.S_ISREG(info.st_mode):
         kind = ("a directory" if stat.S_ISDIR(info.st_mode) else "a FIFO" if stat.S_ISFIFO(info.st_mode) else
                 "a character device" if stat.S_ISCHR(info.st_mode) else "a block device" if stat.S_ISBLK(info.st_mode)
                 else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a regular file")
-        raise InputError(f"cannot read {what} {text!r}: it is {kind}, not a regular file")
-    if info.st_size > max_bytes:
-        raise InputError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
-    return Path(text)
+        return f"it is {kind}, not a regular file", info
+    return None, info
+
+
+def file_problem(path: str | os.PathLike) -> str | None:
+    """Why ``path`` is not an existing regular file ("it does not exist", "it is a directory, ..."), or None."""
+    return _file_problem(os.fspath(path))[0]

@@ -142,20 +142,27 @@ class HeadController:
         collision with an obstacle). Only accepted solutions are kept: with free roll, when its solution is
         rejected, the ``n_frames`` rolled frames of the paper's method are solved and filtered.
         """
-        t_start = time.perf_counter()
         position = vector3(position, "position")
         direction = unit_vector3(direction, "direction")
-        if q_prev is None:
-            q = self.q_initial.copy()
-        else:  # joints outside their limits would be returned as they are, with success=True
-            q = within_limits(joint_vector(q_prev, self.robot.n_joints, "q_prev"), self.robot.lower, self.robot.upper,
-                              "q_prev").copy()
-        base = self.base if base is None else base
-        if not isinstance(base, BasePlacement):
+        if q_prev is not None:  # joints outside their limits would be returned as they are, with success=True
+            q_prev = within_limits(joint_vector(q_prev, self.robot.n_joints, "q_prev"), self.robot.lower,
+                                   self.robot.upper, "q_prev")
+        if base is not None and not isinstance(base, BasePlacement):
             raise InputTypeError(f"base must be a BasePlacement, got {type(base).__name__}")
         if accept is not None and not callable(accept):
             raise InputTypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
-        desired = head_ik.frame_from_direction(position, direction)
+        return self.solve_checked(position, direction, q_prev, base, accept, allow_base_move)
+
+    def solve_checked(self, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray | None = None,
+                      base: BasePlacement | None = None, accept: Callable[..., bool] | None = None,
+                      allow_base_move: bool | None = None) -> HeadSolution:
+        """:meth:`solve` of values already checked (a target's, checked where it entered the library; joints the
+        planner computed): ``position`` (3,) finite, ``direction`` (3,) a unit vector, ``q_prev`` within the
+        limits. A value that is not is a bug of the caller's, not bad input."""
+        t_start = time.perf_counter()
+        q = self.q_initial.copy() if q_prev is None else np.array(q_prev, float)
+        base = self.base if base is None else base
+        desired = head_ik.frame_along(position, direction)
         P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         check = self._accepted_range(position, P0_frame)
         solution = self._solve_from(base, q, desired, q_prev is not None, accept)

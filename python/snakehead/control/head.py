@@ -31,9 +31,12 @@ def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: 
 
     When the direction is parallel to ``up``, world x (or y) is used instead, so every direction has a frame.
     """
-    p = vector3(position, "position")
-    x = unit_vector3(direction, "direction")
-    up = unit_vector3(up, "up")
+    return frame_along(vector3(position, "position"), unit_vector3(direction, "direction"), unit_vector3(up, "up"))
+
+
+def frame_along(p: np.ndarray, x: np.ndarray, up: np.ndarray = np.array([0.0, 0.0, 1.0])) -> np.ndarray:
+    """:func:`frame_from_direction` of values already checked: ``p`` (3,) finite, ``x`` and ``up`` (3,) unit
+    vectors (a target's, checked where it entered)."""
     for candidate in (up, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
         z = candidate - (candidate @ x) * x
         if np.linalg.norm(z) > 1e-6:

@@ -534,13 +534,13 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
     chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
     frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
-    from .head import frame_from_direction, roll_about_x
+    from .head import frame_along, roll_about_x
 
     robot = prob.robot
     ik = prob.lifted_ik(seed)
     start = robot.lift_joints.start
     T0 = robot.frame(q_now, robot.lift_frame, base)
-    target = np.linalg.inv(T0) @ frame_from_direction(position, direction)
+    target = np.linalg.inv(T0) @ frame_along(position, direction)
     angles = 2 * np.pi * np.arange(CANDIDATE_ROLLS) / CANDIDATE_ROLLS
     poses = np.stack([roll_about_x(target, a) for a in angles] * CANDIDATE_SEEDS)
     rng = np.random.default_rng(seed)
@@ -560,12 +560,12 @@ def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, po
                    direction: np.ndarray, seed: int) -> np.ndarray | None:
     """The lifted chain's IK from the current joints, the roll about the direction free: the nearest solution."""
     from ..kinematics.ik import FREE_ROLL
-    from .head import frame_from_direction
+    from .head import frame_along
 
     robot = prob.robot
     start = robot.lift_joints.start
     T0 = robot.frame(q_now, robot.lift_frame, base)
-    target = np.linalg.inv(T0) @ frame_from_direction(position, direction)
+    target = np.linalg.inv(T0) @ frame_along(position, direction)
     qk = prob.lifted_ik(seed).ik(target, q_init=np.clip(q_now[start:], robot.lower[start:], robot.upper[start:]),
                                  bounds=FREE_ROLL)
     if qk is None:
@@ -603,11 +603,24 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
 
     The result says which stage solved it, or why the best attempt fails (``REASONS``).
     """
+    return solve_checked_target(controller, vector3(position, "position"), unit_vector3(direction, "direction"),
+                                q_prev=q_prev, base=base, obstacles=obstacles, allow_base_move=allow_base_move,
+                                min_margin=min_margin, time_budget=time_budget, problem=problem, seed=seed, near=near,
+                                shape_ok=shape_ok)
+
+
+def solve_checked_target(controller: HeadController, position: np.ndarray, direction: np.ndarray, *,
+                         q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None,
+                         obstacles: Sequence[Any] = (), allow_base_move: bool = True, min_margin: float = MIN_MARGIN,
+                         time_budget: float = 3.0, problem: BodyProblem | None = None, seed: int = 0,
+                         near: bool = False, shape_ok: Callable[[np.ndarray], bool] | None = None
+                         ) -> WholeBodySolution:
+    """:func:`solve_target` of a target already checked where it entered (a :class:`~snakehead.scenes.Target`'s
+    position (3,) and unit direction (3,)): the planner's entry, which does not check them again."""
     from . import neck as nk
 
     t0 = time.perf_counter()
     robot = controller.robot
-    position, direction = vector3(position, "position"), unit_vector3(direction, "direction")
     base = controller.base if base is None else base
     q_now = controller.q_initial.copy() if q_prev is None else np.asarray(q_prev, float).copy()
     prob = problem if problem is not None else BodyProblem(robot)
@@ -658,7 +671,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
             return found
     # 1. the paper's segmented solve
     if not beyond:
-        seg = controller.solve(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
+        seg = controller.solve_checked(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
                                allow_base_move=False)
         seg_holder[0] = seg
         if found := consider(seg.q, seg.base, STAGES[0], 0):
@@ -707,7 +720,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
         placed = None if controller.neck_length <= 0 else nk.base_move_into_range(
             position, P0_local, base, controller.Lc, controller.neck_length, controller.slack, robot.body_axis_height)
         if placed is not None:
-            s = controller.solve(position, direction, q_prev=q, base=placed, allow_base_move=False)
+            s = controller.solve_checked(position, direction, q_prev=q, base=placed, allow_base_move=False)
             if s.success and (found := moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Sequence
 
 from .._errors import InputError, InputTypeError
-from .._validate import input_file
+from .._validate import file_problem, input_file
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
@@ -72,9 +72,15 @@ def read_toml(path: str | os.PathLike, what: str) -> dict:
     if len(raw) > MAX_FILE_BYTES:
         raise InputError(f"{what} {os.fspath(p)!r} is larger than {MAX_FILE_BYTES} bytes")
     try:
-        return tomllib.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{what} {os.fspath(p)!r} is not UTF-8 text: {exc}") from None
+    try:  # a byte-order mark (Windows editors write one) is not part of the TOML
+        return tomllib.loads(text.removeprefix("\ufeff"))
+    except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{what} {os.fspath(p)!r} is not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib parses nested arrays and tables recursively
+        raise InputError(f"{what} {os.fspath(p)!r} nests arrays or tables too deeply to be read") from None
 
 
 def check_keys(data: dict, required: Sequence[str], optional: Sequence[str], where: str) -> None:
@@ -102,13 +108,13 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
     check_keys(data, REQUIRED_KEYS, OPTIONAL_KEYS, where)
     folder = Path(path).resolve().parent
     urdf = folder / _string(data, "urdf", where)
-    if not urdf.is_file():
-        raise InputError(f"{where}: its urdf {os.fspath(urdf)!r} does not exist")
+    if (problem := file_problem(urdf)) is not None:
+        raise InputError(f"{where}: its urdf {os.fspath(urdf)!r}: {problem}")
     map_path = None
     if "map" in data:
         map_path = folder / _string(data, "map", where)
-        if not map_path.is_file():
-            raise InputError(f"{where}: its map {os.fspath(map_path)!r} does not exist")
+        if (problem := file_problem(map_path)) is not None:
+            raise InputError(f"{where}: its map {os.fspath(map_path)!r}: {problem}")
     return RobotFile(path=Path(path), urdf=os.fspath(urdf), base_end=_string(data, "base_end", where),
                      neck_end=_string(data, "neck_end", where), head_tip=_string(data, "head_tip", where),
                      root=_string(data, "root", where) if "root" in data else None, map=map_path,

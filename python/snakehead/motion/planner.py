@@ -560,7 +560,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: a
     dict that keeps the solves with the base kept (:func:`_solve_kept`) for the plan to reuse."""
-    from ..control.whole_body import solve_target
+    from ..control.whole_body import solve_checked_target
 
     robot = controller.robot
     obstacles = list(obstacles)
@@ -618,7 +618,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
 
     order = ([first] if first not in ("the start", "no curl") else []) + [t for t in targets if t is not first]
     for t in order:
-        sol = solve_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
+        sol = solve_checked_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
                            allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN,
                            shape_ok=has_curl)
         if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
@@ -675,13 +675,13 @@ def _solve_kept(controller: HeadController, position: np.ndarray, direction: np.
     """``control.whole_body.solve_target`` with the base kept, kept in ``solved`` (one plan's: its obstacles are
     fixed) so that choose_base's solves of the chosen base are not repeated by the plan (the solve is
     deterministic: the same inputs give the same solution)."""
-    from ..control.whole_body import solve_target
+    from ..control.whole_body import solve_checked_target
 
     key = (np.asarray(position, float).tobytes(), np.asarray(direction, float).tobytes(),
            np.asarray(q_prev, float).tobytes(), base, near)
     if solved is not None and key in solved:
         return solved[key]
-    sol = solve_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
+    sol = solve_checked_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
                        allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN, near=near)
     if solved is not None:
         solved[key] = sol
