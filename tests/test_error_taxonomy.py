@@ -1,0 +1,169 @@
+"""Whose fault is it? (issue 21): bad input is snakehead.InputError (the CLI's exit 2, and only it); valid input
+without an answer is snakehead.Infeasible (exit 1); anything else on valid input is a bug (exit 3)."""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import snakehead
+from snakehead import Infeasible, InputError, InputTypeError, InternalError
+from snakehead import _core
+from snakehead._errors import invariant
+from snakehead._files import write_text_atomic
+from snakehead.app import cli, pipeline
+from snakehead.model.robot_file import read_toml
+
+
+def _main(argv: list[str], capsys: pytest.CaptureFixture) -> tuple[int, str]:
+    try:
+        code = cli.main(argv)
+    except SystemExit as exc:  # argparse's own errors (exit 2 with one line) end the program
+        code = int(exc.code)
+    return code, capsys.readouterr().err
+
+
+# --- the types ------------------------------------------------------------------------------------------------
+def test_the_types_say_whose_fault_it_is():
+    assert issubclass(InputError, ValueError) and issubclass(InputTypeError, InputError)
+    assert issubclass(InputTypeError, TypeError)
+    assert not issubclass(Infeasible, ValueError)  # caught by name, never by an `except ValueError`
+    assert issubclass(InternalError, AssertionError)
+    invariant(True, "never raised")
+    with pytest.raises(InternalError, match="broken"):
+        invariant(False, "broken")
+
+
+def test_the_core_raises_input_error_for_bad_input():
+    with pytest.raises(InputError, match="malformed URDF"):
+        _core.urdf_root_link("<robot")
+    with pytest.raises(InputError):
+        snakehead.Chain.from_urdf("<robot name='r'><link name='a'/></robot>", "a", "nope")
+
+
+def test_validators_raise_input_errors():
+    from snakehead import _validate
+
+    with pytest.raises(InputTypeError):
+        _validate.finite_array("1", "x")
+    with pytest.raises(InputError, match="NaN"):
+        _validate.vector3([np.nan, 0, 0], "x")
+    with pytest.raises(InputError, match="1000 m"):
+        _validate.world_position([1e308, 0, 0], "p")
+
+
+# --- the command line's exit statuses -------------------------------------------------------------------------
+def test_cli_exit_statuses_follow_the_exception_type(monkeypatch, capsys, tmp_path):
+    """InputError -> 2, Infeasible -> 1, any other exception -> 3 with "this is a bug" (a ValueError too: an
+    internal step's refusal is not the user's mistake)."""
+    def raising(exc: BaseException):
+        def run_scenes(*args, **kwargs):
+            raise exc
+        return run_scenes
+
+    argv = ["plan", "--position", "0.9", "0.3", "0.3", "--direction", "1", "0", "0", "--out", str(tmp_path),
+            "--no-sim"]
+    for exc, code, text in [(InputError("field x is wrong"), 2, "error: field x is wrong"),
+                            (Infeasible("no curl on this base"), 1, "not possible: no curl on this base"),
+                            (ValueError("neck_length must be > 0, got 0.0"), 3, "this is a bug"),
+                            (TypeError("unsupported operand"), 3, "this is a bug"),
+                            (InternalError("an invariant"), 3, "this is a bug")]:
+        monkeypatch.setattr(pipeline, "run_scenes", raising(exc))
+        got, err = _main(argv, capsys)
+        assert got == code, (exc, err)
+        assert text in err.strip().splitlines()[-1], err  # the last line (the progress lines come before it)
+
+
+def test_a_long_error_is_still_one_short_line(monkeypatch, capsys, tmp_path):
+    def run_scenes(*args, **kwargs):
+        raise ValueError("x" * 5000 + "\n" + "y" * 5000)
+
+    monkeypatch.setattr(pipeline, "run_scenes", run_scenes)
+    code, err = _main(["plan", "--position", "0.9", "0.3", "0.3", "--direction", "1", "0", "0", "--out",
+                       str(tmp_path), "--no-sim"], capsys)
+    assert code == 3
+    line = err.strip().splitlines()[-1]
+    assert "this is a bug" in line and len(line) < cli.MAX_ERROR_CHARS + 300
+
+
+@pytest.mark.parametrize("position, message", [
+    (["-inf", "0.5", "0.4"], "must be a finite number"),     # was "expected 3 arguments": -inf read as an option
+    (["1e308", "0.5", "0.4"], "farther than 1000 m"),         # was an internal error drawing the figures
+    (["nan", "0.5", "0.4"], "must be a finite number"),
+])
+def test_cli_positions(position, message, capsys, tmp_path):
+    code, err = _main(["plan", "--position", *position, "--direction", "0", "1", "0", "--out", str(tmp_path),
+                       "--no-sim"], capsys)
+    assert code == 2 and message in err, err
+
+
+def test_negative_numbers_in_any_notation_are_numbers(monkeypatch, capsys, tmp_path):
+    """argparse alone reads "-1e-1" and "-.5e1" as options; they are numbers. A huge direction is normalised
+    without an overflow warning."""
+    seen = []
+
+    def run_scenes(scenes, *args, **kwargs):
+        seen.append(scenes[0])
+        return {"scenarios": {}}
+
+    monkeypatch.setattr(pipeline, "run_scenes", run_scenes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        code, err = _main(["plan", "--position", "-1e-1", "-.5e1", "0.4", "--direction", "1e308", "1e308", "0",
+                           "--out", str(tmp_path), "--no-sim"], capsys)
+    assert code == 0, err
+    target = seen[0].targets[0]
+    np.testing.assert_allclose(target.position, [-0.1, -5.0, 0.4])
+    np.testing.assert_allclose(target.direction, [np.sqrt(0.5), np.sqrt(0.5), 0.0])
+
+
+# --- files ------------------------------------------------------------------------------------------------------
+def test_deeply_nested_toml_is_bad_input(tmp_path, capsys):
+    deep = tmp_path / "deep.toml"
+    deep.write_text("a = " + "[" * 3000 + "]" * 3000 + "\n")
+    with pytest.raises(InputError, match="too deeply"):
+        read_toml(deep, "scene file")
+    for argv in (["plan", "--scene", str(deep), "--out", str(tmp_path / "o")], ["info", "--robot", str(deep)]):
+        code, err = _main(argv, capsys)
+        assert code == 2 and "nests arrays or tables too deeply" in err, err
+
+
+def test_a_byte_order_mark_is_read_as_absent(tmp_path):
+    scene = snakehead.scenes.paper_scene("spheres")
+    source = Path(scene.path).read_text(encoding="utf-8")
+    bom = tmp_path / "bom.toml"
+    bom.write_text("\ufeff" + source, encoding="utf-8")
+    again = snakehead.load_scene(bom)
+    assert [t.name for t in again.targets] == [t.name for t in scene.targets]
+
+
+def test_a_directory_is_not_said_to_be_missing(tmp_path):
+    (tmp_path / "snake.urdf").mkdir()
+    robot = tmp_path / "r.toml"
+    robot.write_text('urdf = "snake.urdf"\nbase_end = "base_end"\nneck_end = "neck_end"\nhead_tip = "head_tip"\n')
+    with pytest.raises(InputError, match="is a directory"):
+        snakehead.SnakeRobot.from_file(robot)
+
+
+def test_an_output_that_cannot_be_written_names_the_file(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(InputError, match="cannot write .*report.json"):
+        write_text_atomic(blocker / "report.json", "{}")
+
+
+# --- far targets ------------------------------------------------------------------------------------------------
+def test_a_target_beyond_the_relocation_range_fails_as_out_of_range():
+    """A target 12 m away is valid input: the plan fails at once, saying why, instead of relocating the base
+    across the world (a target 1e6 m away, once "planned" with a kilometre's relocation, is now bad input)."""
+    from snakehead.motion.planner import MAX_RELOCATION_M
+
+    robot = snakehead.SnakeRobot.default()
+    far = MAX_RELOCATION_M + robot.body_length + 0.5
+    result = snakehead.plan([([far, 0.3, 0.3], [1.0, 0.0, 0.0])], robot=robot)
+    assert not result.success and result.relocation is None
+    assert "out of range" in result.failure and f"{MAX_RELOCATION_M:g} m" in result.failure
+    with pytest.raises(InputError, match="farther than 1000 m"):
+        snakehead.plan([([1e6, 0.3, 0.3], [1.0, 0.0, 0.0])], robot=robot)
