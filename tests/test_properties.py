@@ -207,6 +207,29 @@ def _robot_from_file(toml: str, urdf: str) -> tuple:
     return robot.n_joints, robot.parts.base_end, robot.parts.neck_end, robot.parts.head_tip
 
 
+def _robot_from_xacro(text: str) -> tuple:
+    """The xacro style's robot file with its .xacro text replaced by ``text``."""
+    from snakehead import SnakeRobot
+    from snakehead.model.published import write_robot
+
+    folder = Path(_cache["folder"]) / "case"
+    shutil.rmtree(folder, ignore_errors=True)
+    robot_file = write_robot("xacro", folder)
+    (folder / "reu_snake.urdf.xacro").write_text(text, encoding="utf-8", errors="surrogatepass")
+    robot = SnakeRobot.from_file(robot_file)
+    return robot.n_joints, robot.parts.head_tip
+
+
+def _mesh_obstacle(name: str, data: bytes) -> tuple:
+    """A mesh obstacle from the file ``name`` holding ``data``; what it promises: finite convex pieces."""
+    from snakehead import MeshObstacle
+
+    obstacle = MeshObstacle.load(_in_folder({name: data}) / name, position=[1.0, 0.0, 0.0])
+    vertices = obstacle.world_vertices
+    assert len(vertices) >= 4 and np.all(np.isfinite(vertices))
+    return len(vertices), len(obstacle.shapes())
+
+
 def _load_map(data: bytes) -> tuple:
     from snakehead import load_map
 
@@ -302,6 +325,7 @@ def _cli(argv: list) -> tuple:
 
 
 CALLS = {"robot_from_urdf": _robot_from_urdf, "robot_from_file": _robot_from_file, "load_map": _load_map,
+         "robot_from_xacro": _robot_from_xacro, "mesh_obstacle": _mesh_obstacle,
          "load_scene": _load_scene, "scene_from_dict": _scene_from_dict, "trac_ik": _trac_ik,
          "controller_new": _controller_new, "controller_solve": _controller_solve, "plan": _plan,
          "frames": _frames, "cli": _cli}
@@ -424,6 +448,72 @@ def mutated(draw: Any, text: str, fragments: list[str], numbers: list[str]) -> s
            {k: st.sampled_from([v, "link_0", "head_tip", "", "nope", "\x00", "p0"]) for k, v in SNAKE_FRAMES.items()})))
 def test_robots_from_damaged_urdfs(text, frames):
     expect_valid_or_clear_error("robot_from_urdf", text, frames)
+
+
+def _xacro_text() -> str:
+    from snakehead.model.published import write_robot
+
+    with tempfile.TemporaryDirectory() as folder:
+        write_robot("xacro", folder)
+        return (Path(folder) / "reu_snake.urdf.xacro").read_text(encoding="utf-8")
+
+
+XACRO = _xacro_text()
+
+
+@fuzz(25)
+@given(text=mutated(XACRO, HOSTILE_TEXT + ["${", "${1/0}", "${n_modules * 10**6}", '<xacro:include filename="/dev/zero"/>',
+                                            '<xacro:macro name="m"><xacro:m/></xacro:macro><xacro:m/>'],
+                    HOSTILE_NUMBERS))
+def test_damaged_xacro_files(text):
+    """The xacro style's description damaged: xacro's own errors, recursion, huge or bad expressions, includes of
+    what is not a file: each an InputError naming the file."""
+    expect_valid_or_clear_error("robot_from_xacro", text)
+
+
+def _mesh_bytes() -> dict[str, bytes]:
+    from snakehead.model.published import write_robot
+
+    with tempfile.TemporaryDirectory() as folder:
+        write_robot("mesh", folder)
+        return {p.name: p.read_bytes() for p in sorted((Path(folder) / "meshes").iterdir())}
+
+
+MESHES = _mesh_bytes()
+
+
+@st.composite
+def damaged_meshes(draw: Any) -> tuple[str, bytes]:
+    """A mesh file of each kind (STL, OBJ, DAE) with bytes flipped, cut or repeated, or its text damaged."""
+    name = draw(st.sampled_from(sorted(MESHES)))
+    raw = bytearray(MESHES[name])
+    kind = draw(st.sampled_from(["flip", "cut", "repeat", "empty", "text"]))
+    at = draw(st.integers(0, len(raw) - 1))
+    if kind == "flip":
+        for i in draw(st.lists(st.integers(0, len(raw) - 1), min_size=1, max_size=8)):
+            raw[i] ^= draw(st.integers(1, 255))
+    elif kind == "cut":
+        raw = raw[:at]
+    elif kind == "repeat":
+        raw = raw[:at] + raw[max(at - 64, 0):]
+    elif kind == "empty":
+        raw = bytearray()
+    else:
+        raw = bytearray(raw[:at] + draw(st.sampled_from(HOSTILE_TEXT + HOSTILE_NUMBERS)).encode("utf-8", "surrogatepass")
+                        + raw[at:])
+    return name, bytes(raw)
+
+
+@fuzz(40)
+@given(mesh=damaged_meshes())
+def test_damaged_mesh_files(mesh):
+    expect_valid_or_clear_error("mesh_obstacle", *mesh)
+
+
+def test_the_xacro_and_mesh_properties_can_pass():
+    assert WORKER.call("robot_from_xacro", XACRO)[0] == "ok"
+    for name, data in MESHES.items():
+        assert WORKER.call("mesh_obstacle", name, data)[0] == "ok", name
 
 
 ROBOT_KEYS = ["urdf", "root", "base_end", "neck_end", "head_tip", "map"]

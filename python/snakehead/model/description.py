@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError, InputTypeError
-from .._validate import input_file
+from .._validate import MAX_COORDINATE_M, input_file
 
 from typing import Any, Mapping
 
@@ -210,20 +210,26 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
     scaled. A missing, unreadable, empty or flat mesh is an InputError naming ``where`` and the path."""
     import trimesh
 
-    if not path.is_file():
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} does not exist")
-    if path.stat().st_size > MAX_MESH_BYTES:
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} is larger than {MAX_MESH_BYTES} bytes")
+    input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
     try:
         loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
         vertices = np.asarray(loaded.vertices, dtype=float)
     except Exception as exc:  # trimesh raises many kinds for a bad file
         raise InputError(f"{where}: cannot read mesh file {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None
+    if vertices.ndim != 2 or vertices.shape[1] != 3:  # e.g. an OBJ "v" line with two coordinates
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has vertices of shape {vertices.shape}, not (V, 3)")
     vertices = vertices[np.all(np.isfinite(vertices), axis=1)] * np.asarray(scale, float)
     if len(vertices) < 4 or np.linalg.matrix_rank(vertices - vertices.mean(axis=0), tol=1e-9) < 3:
         raise InputError(f"{where}: mesh file {os.fspath(path)!r} has no volume (empty or flat: "
                          f"{len(vertices)} vertices)")
-    from scipy.spatial import ConvexHull
+    if np.abs(vertices).max() > MAX_COORDINATE_M:
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has a vertex {np.abs(vertices).max():.3g} m from its "
+                         f"origin (at most {MAX_COORDINATE_M:g} m; is the scale right?)")
+    from scipy.spatial import ConvexHull, QhullError
 
-    hull = ConvexHull(vertices)
+    try:
+        hull = ConvexHull(vertices)
+    except QhullError as exc:  # nearly flat, or coordinates whose round-off swamps the shape
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "qhull failed"
+        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has no convex hull ({first})") from None
     return np.ascontiguousarray(vertices[hull.vertices])
