@@ -3,12 +3,33 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._errors import InputError, invariant
 from .._validate import finite_array
 from ..control.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .tracking import SimResult, check_trajectory
 
 from typing import Any
+
+
+#: How far (s) a time may lie outside a simulated span and still be compared (floating-point rounding).
+SPAN_TOLERANCE = 1e-9
+
+
+def in_span(result: SimResult, time: float) -> bool:
+    """Whether ``time`` (s) lies within the simulated span of ``result`` (to SPAN_TOLERANCE)."""
+    return bool(result.t[0] - SPAN_TOLERANCE <= time <= result.t[-1] + SPAN_TOLERANCE)
+
+
+def check_plan_span(plan_t: np.ndarray, times: Any, result: SimResult) -> None:
+    """The invariant of a plan simulated from its own trajectory: every target time of the plan lies within the
+    plan's motion [t[0], t[-1]], and :func:`snakehead.sim.simulate_trajectory` records through the motion's end,
+    so within the simulated span. A failure is a bug in the planner or the simulation (InternalError)."""
+    for time in times:
+        invariant(plan_t[0] - SPAN_TOLERANCE <= time <= plan_t[-1] + SPAN_TOLERANCE,
+                  f"a plan's target time {time!r} s is outside its motion [{plan_t[0]!r}, {plan_t[-1]!r}] s")
+        invariant(in_span(result, time), f"a plan's target time {time!r} s is outside the span simulated from the "
+                  f"plan [{result.t[0]!r}, {result.t[-1]!r}] s")
 
 
 def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement | None, targets: Any) -> list[tuple[float, np.ndarray, np.ndarray]]:
@@ -72,8 +93,8 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
 
     pos_err, dir_err = [], []
     for time, pos, dirn in _targets(robot, planned_t, planned_q, base, targets):
-        if not (result.t[0] - 1e-9 <= time <= result.t[-1] + 1e-9):
-            raise ValueError(f"target time {time} s is outside the simulated span [{result.t[0]}, {result.t[-1]}]")
+        if not in_span(result, time):  # the caller's targets and result do not go together
+            raise InputError(f"target time {time} s is outside the simulated span [{result.t[0]}, {result.t[-1]}]")
         p = np.array([np.interp(time, result.t, result.head_position[:, i]) for i in range(3)])
         x = np.array([np.interp(time, result.t, result.head_direction[:, i]) for i in range(3)])
         x /= np.linalg.norm(x)

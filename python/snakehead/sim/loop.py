@@ -63,7 +63,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
 from ..motion.planner import Plan, as_scene, bending_state, plan
 from ..scenes.scene import Scene
-from .compare import compare
+from .compare import check_plan_span, compare
 from .estimate import BodyPose, pose_error
 from .gaits import GaitRun, GaitSimulator
 from .tracking import SimResult, simulate_trajectory
@@ -339,6 +339,7 @@ class ClosedLoop:
         tip in it (CHECK_ZMP_OUTSIDE, CHECK_BASE_LIFT), else why."""
         robot = self.robot
         checked = simulate_trajectory(robot, p.t, p.q, p.base, obstacles=self.obstacles, **self._ground_options)
+        check_plan_span(p.t, [tg.time_s for tg in p.targets], checked)
         check = compare(robot, p.t, p.q, checked, base=p.base,
                         targets=[(tg.time_s, tg.position, tg.direction) for tg in p.targets] or None)
         if check["zmp_min_margin_m"] < -CHECK_ZMP_OUTSIDE or check["base_lift_m"] > CHECK_BASE_LIFT:
@@ -530,6 +531,7 @@ class ClosedLoop:
             head_t0 = float(state.time)
             head = simulate_trajectory(robot, head_plan.t, head_plan.q, head_plan.base, state=state, settle=0.0,
                                        obstacles=self.obstacles, **self._ground_options)
+            check_plan_span(head_plan.t, [tg.time_s for tg in head_plan.targets], head)
             targets = [(tg.time_s, tg.position, tg.direction) for tg in head_plan.targets] or None
             metrics = compare(robot, head_plan.t, head_plan.q, head, targets=targets, base=head_plan.base)
             phases += head_phases(head_plan, head_t0)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .compare import compare
+from .compare import check_plan_span, compare
 from .tracking import SimResult, simulate_trajectory
 
 from typing import Any
@@ -49,6 +49,7 @@ def simulate(plan: Any, **options: Any) -> PlanSimulation:
         raise TypeError(f"plan must be a snakehead Plan (from snakehead.plan), got {type(plan).__name__}")
     options.setdefault("obstacles", list(plan.obstacles))
     result = simulate_trajectory(plan.robot, plan.t, plan.q, plan.base, **options)
+    check_plan_span(plan.t, [tg.time_s for tg in plan.targets], result)
     targets = [(tg.time_s, tg.position, tg.direction) for tg in plan.targets] or None
     metrics = compare(plan.robot, plan.t, plan.q, result, targets=targets, base=plan.base)
     return PlanSimulation(plan=plan, result=result, metrics=metrics)

@@ -219,6 +219,13 @@ def check_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike) -> t
     return t, q
 
 
+def sample_count_covering(span: float, period: float) -> int:
+    """How many ticks ``period`` apart, the first at 0, it takes for the last to be at or after ``span`` (>= 0):
+    ceil(span / period) + 1, with ``span`` a whole number of periods up to rounding (1e-9 of a period) taking no
+    extra tick."""
+    return int(math.ceil(max(span, 0.0) / period - 1e-9)) + 1
+
+
 #: Modes of gravity compensation in :func:`simulate`.
 GRAVITY_COMPENSATION = ("supported", "bias", "none")
 
@@ -271,7 +278,8 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     were clamped) or "none". ``torque_limit`` N m: scalar or (n,), default the URDF
     effort (:func:`snakehead.sim.gains.default_torque_limits`). Other keywords go to :func:`snakehead.sim.build_spec`.
 
-    Returns a :class:`SimResult` sampled at every control tick from t[0] to t[-1] + hold.
+    Returns a :class:`SimResult` sampled at every control tick from t[0] through the first tick at or after
+    t[-1] + hold (so that any time of the motion, its end included, lies within the recorded span).
     """
     mj = _mujoco()
     robot = as_robot(robot)
@@ -337,7 +345,10 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
         for _ in range(sub - 1):
             mj.mj_step(m, d)
 
-    N = int(math.floor((t[-1] - t[0] + float(hold)) / control_dt + 1e-9)) + 1
+    # Ticks control_dt apart from t[0] through the first one at or after t[-1] + hold: the recorded span covers the
+    # whole motion (and hold) even when its length is not a whole number of periods (a plan's last sample is its
+    # exact end, at most one period after the previous one); past t[-1] the reference holds q[-1] at rest.
+    N = sample_count_covering(t[-1] - t[0] + float(hold), control_dt)
     ts = t[0] + control_dt * np.arange(N)
     q_ref = np.column_stack([np.interp(ts, t, q[:, j]) for j in range(n)])
     qd_ref = np.column_stack([np.interp(ts, t, qdot_plan[:, j]) for j in range(n)])
