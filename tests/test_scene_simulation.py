@@ -239,7 +239,6 @@ def scene_files(draw) -> str:
     return text
 
 
-@pytest.mark.slow
 @settings(max_examples=4, derandomize=True, deadline=None, database=None, print_blob=False,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(text=scene_files())
