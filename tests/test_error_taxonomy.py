@@ -167,3 +167,34 @@ def test_a_target_beyond_the_relocation_range_fails_as_out_of_range():
     assert "out of range" in result.failure and f"{MAX_RELOCATION_M:g} m" in result.failure
     with pytest.raises(InputError, match="farther than 1000 m"):
         snakehead.plan([([1e6, 0.3, 0.3], [1.0, 0.0, 0.0])], robot=robot)
+
+
+# --- validate once: after plan() has checked its input, an InputError inside is a bug -------------------------
+def test_an_input_error_inside_plan_is_an_internal_error(monkeypatch):
+    from snakehead.motion import planner
+
+    robot = snakehead.SnakeRobot.default()
+    with pytest.raises(InputError, match="method"):  # the caller's input, found where it entered
+        snakehead.plan([([0.9, 0.3, 0.3], [1.0, 0.0, 0.0])], robot=robot, method="fast")
+
+    def refusing(*args, **kwargs):  # an internal step that refuses what the planner computed
+        raise InputError("neck_length must be > 0, got 0.0")
+
+    monkeypatch.setattr(planner, "bending_state", refusing)
+    with pytest.raises(InternalError, match="this is a bug") as caught:
+        snakehead.plan([([0.9, 0.3, 0.3], [1.0, 0.0, 0.0])], robot=robot)
+    assert not isinstance(caught.value, InputError)
+
+
+def test_a_too_long_line_approach_is_refused_before_any_work(monkeypatch):
+    from snakehead.motion import planner
+    from snakehead.scenes import Scene, Target
+
+    def never(*args, **kwargs):
+        raise AssertionError("solved a target before the input was checked")
+
+    monkeypatch.setattr(planner, "choose_base", never)
+    scene = Scene(name="line", targets=(Target("a", [0.9, 0.3, 0.3], [1, 0, 0]),
+                                        Target("b", [0.9, -0.3, 0.3], [1, 0, 0], approach="line", step_m=1e-4)))
+    with pytest.raises(InputError, match="take a larger step_m"):
+        snakehead.plan(scene)

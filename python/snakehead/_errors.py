@@ -13,6 +13,12 @@
 """
 from __future__ import annotations
 
+import functools
+from contextvars import ContextVar
+from typing import Any, Callable, TypeVar, cast
+
+F = TypeVar("F", bound=Callable[..., Any])
+
 
 class InputError(ValueError):
     """The caller's input is wrong (the message says which and how); anything else raised on valid input is a bug."""
@@ -37,3 +43,36 @@ def invariant(condition: object, message: str) -> None:
     under ``python -O``: internal functions state what they rely on with it, not with input errors."""
     if not condition:
         raise InternalError(message)
+
+
+# --- entry points: where input is checked once -------------------------------------------------------------------
+_entry_state: ContextVar[list[bool] | None] = ContextVar("snakehead_entry_state", default=None)
+
+
+def entry_point(func: F) -> F:
+    """Mark ``func`` as a public entry point that checks its input once, then calls :func:`inputs_checked`. From
+    that call on, an :class:`InputError` raised inside (an internal step refusing a value the library computed) is
+    a bug: it leaves ``func`` as :class:`InternalError`, never as the caller's fault."""
+
+    @functools.wraps(func)
+    def checked_once(*args: Any, **kwargs: Any) -> Any:
+        state = [False]
+        token = _entry_state.set(state)
+        try:
+            return func(*args, **kwargs)
+        except InputError as exc:
+            if not state[0]:
+                raise
+            raise InternalError(f"{func.__name__}: an internal step refused a value snakehead computed ({exc}); "
+                                "this is a bug") from exc
+        finally:
+            _entry_state.reset(token)
+
+    return cast(F, checked_once)
+
+
+def inputs_checked() -> None:
+    """Say, inside an :func:`entry_point`, that its input is checked: any InputError from here on is a bug."""
+    state = _entry_state.get()
+    if state is not None:
+        state[0] = True

@@ -40,7 +40,7 @@ import os
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Sequence
-from .._errors import Infeasible, InputError, InputTypeError
+from .._errors import Infeasible, InputError, InputTypeError, entry_point, inputs_checked
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -655,14 +655,21 @@ def _check_timing(robot: SnakeRobot, timing: dict[str, Any]) -> None:
 MAX_LINE_POSES = 2000
 
 
+def _check_lines(targets: Sequence[Target]) -> None:
+    """InputError for a target approached along a line (approach = "line") in more than MAX_LINE_POSES steps."""
+    for a, b in zip(targets, targets[1:]):
+        length = float(np.linalg.norm(b.position - a.position))
+        if b.approach == "line" and length / b.step_m > MAX_LINE_POSES:  # each pose is a whole-body solve
+            raise InputError(f"target {b.name!r}: the line from {a.name!r} is {length:.4g} m long; at step_m = "
+                             f"{b.step_m:g} m that is {length / b.step_m:.3g} poses, at most {MAX_LINE_POSES}: take "
+                             "a larger step_m")
+
+
 def _line_poses(a: Target, b: Target) -> list[np.ndarray]:
-    """Positions from target ``a`` to target ``b`` every ``b.step_m`` m (b included, a excluded)."""
+    """Positions from target ``a`` to target ``b`` every ``b.step_m`` m (b included, a excluded; their number was
+    checked by :func:`_check_lines`)."""
     d = b.position - a.position
     length = float(np.linalg.norm(d))
-    if length / b.step_m > MAX_LINE_POSES:  # each pose is a whole-body solve
-        raise InputError(f"target {b.name!r}: the line from {a.name!r} is {length:.4g} m long; at step_m = "
-                         f"{b.step_m:g} m that is {length / b.step_m:.3g} poses, at most {MAX_LINE_POSES}: take a "
-                         "larger step_m")
     n = int(np.ceil(length / b.step_m - 1e-9))
     steps = [min(k * b.step_m, length) for k in range(1, n + 1)]
     if length > 0 and steps and abs(steps[-1] - length) > 1e-12:
@@ -717,6 +724,7 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
 
 
+@entry_point
 def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike, npt.ArrayLike]], *,
          robot: SnakeRobot | None = None, controller: HeadController | None = None,
          obstacles: Sequence[BoxObstacle | WallWithHole | MeshObstacle] = (), base: BasePlacement | None = None,
@@ -790,6 +798,10 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         start_q = joint_vector(start_q, robot.n_joints, "start_q")
         if base_shape is None:
             base_shape = start_q
+    if base_shape is not None:
+        base_shape = joint_vector(base_shape, robot.n_joints, "base_shape")
+    _check_lines(scene.targets)
+    inputs_checked()  # from here on an InputError would be a bug of the planner's (the entry point says so)
     solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape, solved=solved)
