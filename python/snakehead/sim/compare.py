@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._errors import InputError, invariant
+from .._errors import InputError, InputTypeError, invariant
 from .._validate import finite_array
 from ..control.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -42,11 +42,11 @@ def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, ba
             time, pos, dirn = float(tg), None, None
         else:
             if not isinstance(tg, (tuple, list)) or len(tg) != 3:
-                raise ValueError(f"targets[{k}] must be a time or (time, position, direction), got {tg!r}")
+                raise InputError(f"targets[{k}] must be a time or (time, position, direction), got {tg!r}")
             time, pos, dirn = tg
             time = float(finite_array(time, f"targets[{k}] time", ()))
         if not np.isfinite(time):
-            raise ValueError(f"targets[{k}] time is not finite")
+            raise InputError(f"targets[{k}] time is not finite")
         if pos is None or dirn is None:
             qk = np.array([np.interp(time, planned_t, planned_q[:, j]) for j in range(planned_q.shape[1])])
             H = robot.head_pose(qk, base)
@@ -56,7 +56,7 @@ def _targets(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, ba
         dirn = finite_array(dirn, f"targets[{k}] direction", (3,))
         nd = np.linalg.norm(dirn)
         if nd < 1e-12:
-            raise ValueError(f"targets[{k}] direction has zero length")
+            raise InputError(f"targets[{k}] direction has zero length")
         out.append((time, pos, dirn / nd))
     return out
 
@@ -87,7 +87,7 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
 
     robot = as_robot(robot)
     if not isinstance(result, SimResult):
-        raise TypeError(f"result must be a SimResult, got {type(result).__name__}")
+        raise InputTypeError(f"result must be a SimResult, got {type(result).__name__}")
     base = result.base if base is None else as_base(base)
     planned_t, planned_q = check_trajectory(robot, planned_t, planned_q)
 

@@ -41,6 +41,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..motion.gaits import virtual_chassis
 
 import numpy.typing as npt
+from .._errors import InputError
 
 #: A link whose lowest shape point is within this height (m) of the ground touches it.
 CONTACT_HEIGHT = 0.003
@@ -122,7 +123,7 @@ class ShapePoints:
                 local.append(pts)
                 owner.append(np.full(len(pts), c))
         if not local:
-            raise ValueError("the robot has no collision shapes on these links")
+            raise InputError("the robot has no collision shapes on these links")
         self.local = np.concatenate(local)
         self.link = np.concatenate(owner)
         self.starts = np.searchsorted(self.link, np.arange(len(self.links)))
@@ -170,11 +171,11 @@ class BodyPoseEstimator:
         self.imu_index = self.robot.link_index(imu_link)  # ValueError for a frame that is not on the body
         for name, value in (("contact_height", contact_height), ("patch_height", patch_height)):
             if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number of metres, got {value!r}")
+                raise InputError(f"{name} must be a positive number of metres, got {value!r}")
         self.contact_height = float(contact_height)
         self.patch_height = float(patch_height)
         if odometry not in ODOMETRY:
-            raise ValueError(f"odometry must be one of {ODOMETRY}, got {odometry!r}")
+            raise InputError(f"odometry must be one of {ODOMETRY}, got {odometry!r}")
         self.odometry = odometry
         self._points = ShapePoints(self.robot, shaped)
         self._masses = self.robot.masses[shaped]

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from ..model.robot import SnakeRobot, as_robot
+from .._errors import InputError
 
 #: Standard gravity (m/s^2).
 GRAVITY = 9.80665
@@ -71,7 +72,7 @@ def default_gains(robot: SnakeRobot, *, armature: float) -> tuple[np.ndarray, np
     kp = np.maximum(tau / HOLD_DEFLECTION, float(armature) / TIME_CONSTANT**2)
     if np.any(kp <= 0):
         names = [robot.joint_names[j] for j in np.flatnonzero(kp <= 0)]
-        raise ValueError(f"joints {names} carry no mass and have no rotor (armature 0): their gains cannot be derived "
+        raise InputError(f"joints {names} carry no mass and have no rotor (armature 0): their gains cannot be derived "
                          "from a load; give kp and kd")
     return kp, TIME_CONSTANT * kp
 

@@ -36,6 +36,7 @@ from .tracking import SimState, _gains
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import InputError, InputTypeError
 
 
 @dataclass
@@ -135,7 +136,7 @@ class GaitSimulator:
         m.actuator_biasprm[:, 2] = -self.kd
         self.substeps = int(round(control_dt / timestep))
         if self.substeps < 1 or abs(self.substeps * timestep - control_dt) > 1e-9 * control_dt:
-            raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
+            raise InputError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
         self.control_dt = float(control_dt)
         self.data = self._mj.MjData(m)
         self.estimator = BodyPoseEstimator(self.robot, imu_link, odometry=odometry)
@@ -153,7 +154,7 @@ class GaitSimulator:
         q = np.zeros(self.robot.n_joints) if q is None else joint_vector(q, self.robot.n_joints)
         settle_s = finite_float(settle_s, "settle_s")
         if settle_s < 0:
-            raise ValueError(f"settle_s must be >= 0, got {settle_s!r}")
+            raise InputError(f"settle_s must be >= 0, got {settle_s!r}")
         d = self.data
         self.sim.set_state(d, q, base, lift=2e-4)
         for _ in range(int(round(settle_s / self.control_dt))):
@@ -167,7 +168,7 @@ class GaitSimulator:
     def restore(self, state: SimState) -> None:
         """Put the simulation in ``state``."""
         if not isinstance(state, SimState):
-            raise TypeError(f"state must be a SimState (from GaitSimulator.lying or a GaitRun), got "
+            raise InputTypeError(f"state must be a SimState (from GaitSimulator.lying or a GaitRun), got "
                             f"{type(state).__name__}")
         state.load(self.sim, self.data)
         self.time = float(state.time)
@@ -225,10 +226,10 @@ class GaitSimulator:
         ``start_estimate`` (default: the true pose at the start: the robot knows where it starts) and follows the
         joint angles and the IMU from there."""
         if not isinstance(gait, Gait):
-            raise TypeError(f"gait must be a snakehead.motion.gaits.Gait (make_gait), got {type(gait).__name__}")
+            raise InputTypeError(f"gait must be a snakehead.motion.gaits.Gait (make_gait), got {type(gait).__name__}")
         cycles = finite_float(cycles, "cycles")
         if cycles <= 0:
-            raise ValueError(f"cycles must be > 0, got {cycles!r}")
+            raise InputError(f"cycles must be > 0, got {cycles!r}")
         gait.check(self.robot)
         _, q_plan = gait.trajectory(self.robot, cycles, self.control_dt)
         return self._run(state, q_plan, gait.name, rest_s, record_every, start_estimate, gait=gait, cycles=cycles)
@@ -244,15 +245,15 @@ class GaitSimulator:
         q_path = finite_array(q_path, "q_path")
         q_path = finite_array(q_path[None] if q_path.ndim == 1 else q_path, "q_path", (None, n))
         if len(q_path) == 0:
-            raise ValueError("q_path must hold at least one configuration")
+            raise InputError("q_path must hold at least one configuration")
         outside = (q_path < self.robot.lower - 1e-9) | (q_path > self.robot.upper + 1e-9)
         if outside.any():
             k, j = np.argwhere(outside)[0]
-            raise ValueError(f"q_path[{k}, {j}] = {q_path[k, j]:.4g} rad is outside the joint limits of "
+            raise InputError(f"q_path[{k}, {j}] = {q_path[k, j]:.4g} rad is outside the joint limits of "
                              f"{self.robot.joint_names[j]!r}")
         duration_s = finite_float(duration_s, "duration_s")
         if duration_s <= 0:
-            raise ValueError(f"duration_s must be > 0, got {duration_s!r}")
+            raise InputError(f"duration_s must be > 0, got {duration_s!r}")
         self.restore(state)
         q_now = self.joint_angles()
         if np.abs(q_path[0] - q_now).max() > 1e-9:
@@ -274,11 +275,11 @@ class GaitSimulator:
         """Track the reference q_plan (one row per control tick) from ``state``, then rest; record and estimate."""
         rest_s = finite_float(rest_s, "rest_s")
         if rest_s < 0:
-            raise ValueError(f"rest_s must be >= 0, got {rest_s!r}")
+            raise InputError(f"rest_s must be >= 0, got {rest_s!r}")
         if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
-            raise ValueError(f"record_every must be a positive integer, got {record_every!r}")
+            raise InputError(f"record_every must be a positive integer, got {record_every!r}")
         if start_estimate is not None and not isinstance(start_estimate, BodyPose):
-            raise TypeError(f"start_estimate must be a BodyPose, got {type(start_estimate).__name__}")
+            raise InputTypeError(f"start_estimate must be a BodyPose, got {type(start_estimate).__name__}")
         self.restore(state)
         n_rest = int(round(rest_s / self.control_dt))
         q_plan = np.vstack([q_plan, np.repeat(q_plan[-1:], n_rest, axis=0)])

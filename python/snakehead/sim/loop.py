@@ -67,6 +67,7 @@ from .compare import check_plan_span, compare
 from .estimate import BodyPose, pose_error
 from .gaits import GaitRun, GaitSimulator
 from .tracking import SimResult, simulate_trajectory
+from .._errors import InputError, InputTypeError
 
 #: The kinds of phases in a loop's report.
 PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
@@ -96,7 +97,7 @@ class PoseFix:
         for name in ("position_noise_m", "yaw_noise_deg"):
             v = finite_float(getattr(self, name), name)
             if v < 0:
-                raise ValueError(f"{name} must be >= 0, got {v!r}")
+                raise InputError(f"{name} must be >= 0, got {v!r}")
             object.__setattr__(self, name, v)
 
     def measure(self, simulator: GaitSimulator, rng: np.random.Generator) -> BodyPose:
@@ -293,28 +294,28 @@ class ClosedLoop:
                          else SnakeRobot.default())
             controller = HeadController(robot, method=method, seed=seed)
         elif not isinstance(controller, HeadController):
-            raise TypeError(f"controller must be a HeadController, got {type(controller).__name__}")
+            raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
         elif robot is not None and robot is not controller.robot:
-            raise ValueError("give a robot or a controller (whose robot is used), not both")
+            raise InputError("give a robot or a controller (whose robot is used), not both")
         self.controller = controller
         self.robot = controller.robot
         if timing is not None and not isinstance(timing, dict):
-            raise TypeError(f"timing must be a dict of the retiming's options, got {type(timing).__name__}")
+            raise InputTypeError(f"timing must be a dict of the retiming's options, got {type(timing).__name__}")
         self.timing = None if timing is None else dict(timing)
         if fix is not None and not isinstance(fix, PoseFix):
-            raise TypeError(f"fix must be a PoseFix or None, got {type(fix).__name__}")
+            raise InputTypeError(f"fix must be a PoseFix or None, got {type(fix).__name__}")
         if fix is not None and fix.frame is not None:
             self.robot.link_index(fix.frame)  # ValueError for a frame not on the body
         self.fix = fix
         self.frequency = positive(frequency, "frequency")
         self.curl_speed = positive(curl_speed, "curl_speed")
         if not isinstance(tolerance, lc.Tolerance):
-            raise TypeError(f"tolerance must be a snakehead.motion.locomotion.Tolerance, got "
+            raise InputTypeError(f"tolerance must be a snakehead.motion.locomotion.Tolerance, got "
                             f"{type(tolerance).__name__}")
         self.tolerance = tolerance
         for name, value in (("max_gait_runs", max_gait_runs), ("max_corrections", max_corrections)):
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-                raise ValueError(f"{name} must be a non-negative integer, got {value!r}")
+                raise InputError(f"{name} must be a non-negative integer, got {value!r}")
         self.max_gait_runs, self.max_corrections = int(max_gait_runs), int(max_corrections)
         self.dynamics_check = bool(dynamics_check)
         self.obstacles = list(self.scene.obstacles)
@@ -379,10 +380,10 @@ class ClosedLoop:
         q_now = lc.flat_shape(robot, np.zeros(robot.n_joints) if q_start is None else q_start, "q_start")
         q_first = q_now.copy()
         if coll.self_clearance(robot, q_now[None])[0] <= 0.0:
-            raise ValueError("q_start folds the body onto itself (two links overlap)")
+            raise InputError("q_start folds the body onto itself (two links overlap)")
         if self.obstacles and coll.collision_check(robot, q_now[None], self.obstacles, start,
                                                    exact_within=0.005).distance[0] <= 0.0:
-            raise ValueError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
+            raise InputError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
         say = progress or (lambda text: None)
         sim = self.simulator
         rng = np.random.default_rng(None if self.fix is None else self.fix.seed)

@@ -65,6 +65,7 @@ from .gains import default_torque_limits
 
 import numpy.typing as npt
 from typing import Any
+from .._errors import InputError, InputTypeError, InternalError
 
 #: Standard gravity (m/s^2), the same as snakehead.stability.
 GRAVITY = 9.80665
@@ -104,7 +105,7 @@ def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLI
     the circle where a head's corners pass).
     """
     if not (isinstance(hole_slices, (int, np.integer)) and not isinstance(hole_slices, bool) and hole_slices >= 1):
-        raise ValueError(f"hole_slices must be a positive integer, got {hole_slices!r}")
+        raise InputError(f"hole_slices must be a positive integer, got {hole_slices!r}")
     out: list[BoxObstacle] = []
     for ob in obstacles:
         if isinstance(ob, BoxObstacle):
@@ -112,7 +113,7 @@ def obstacle_boxes(obstacles: Sequence[Any], hole_slices: int = DEFAULT_HOLE_SLI
         elif isinstance(ob, WallWithHole):
             out += _wall_boxes(ob, int(hole_slices))
         elif not isinstance(ob, MeshObstacle):
-            raise TypeError(f"obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got {type(ob).__name__}")
+            raise InputTypeError(f"obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got {type(ob).__name__}")
     return out
 
 
@@ -169,7 +170,7 @@ def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np
         lim = np.broadcast_to(finite_array(torque_limit, "torque_limit"), (n,)).astype(float) \
             if np.ndim(torque_limit) == 0 else finite_array(torque_limit, "torque_limit", (n,))
     if np.any(lim <= 0):
-        raise ValueError(f"torque limits must be positive (N m), got {np.asarray(lim).tolist()}")
+        raise InputError(f"torque limits must be positive (N m), got {np.asarray(lim).tolist()}")
     return np.array(lim, float)
 
 
@@ -184,10 +185,10 @@ def _check_names(robot: SnakeRobot) -> None:
     for kind, names in (("frame", robot.link_names), ("joint", robot.body.joint_names)):
         for name in names:
             if not isinstance(name, str) or not name:
-                raise ValueError(f"every {kind} of the robot needs a non-empty name, got {name!r}")
+                raise InputError(f"every {kind} of the robot needs a non-empty name, got {name!r}")
     _check_moving_masses(robot)
     if FREE_JOINT in robot.body.joint_names:
-        raise ValueError(f"a joint of the robot is named {FREE_JOINT!r}, the simulation's name for the free joint "
+        raise InputError(f"a joint of the robot is named {FREE_JOINT!r}, the simulation's name for the free joint "
                          "of the root link; rename it in the URDF")
 
 
@@ -201,7 +202,7 @@ def _check_moving_masses(robot: SnakeRobot) -> None:
     for first, end, joint in zip(child, ends, joints):
         if not any(robot.masses[k] > 0 and np.linalg.eigvalsh(robot.inertias[k]).min() > _MUJOCO_MINVAL
                    for k in range(first, end)):
-            raise ValueError(f"link {robot.link_names[first]!r} is moved by joint {joint} but has no mass and "
+            raise InputError(f"link {robot.link_names[first]!r} is moved by joint {joint} but has no mass and "
                              "inertia in the URDF (nor a link fixed to it): the simulation needs them on every moving "
                              "link (give it an <inertial> with a positive definite inertia)")
 
@@ -230,7 +231,7 @@ def add_shape_geom(spec: Any, body: Any, robot: SnakeRobot, k: int, **options: A
     extra = {}
     if shape.kind == "convex":
         if shape.vertices is None or len(shape.vertices) < 4:
-            raise ValueError(f"the mesh shape {k} ({shape.source}) has fewer than 4 hull vertices")
+            raise InputError(f"the mesh shape {k} ({shape.source}) has fewer than 4 hull vertices")
         mesh = spec.add_mesh(name=f"hull_{k}", uservert=np.asarray(shape.vertices, float).reshape(-1).tolist())
         mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
         extra["meshname"] = mesh.name
@@ -266,10 +267,10 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     joint_damping = non_negative(joint_damping, "joint_damping")
     armature = non_negative(armature, "armature")
     if not isinstance(self_collision, (bool, np.bool_)):
-        raise TypeError(f"self_collision must be True or False, got {self_collision!r}")
+        raise InputTypeError(f"self_collision must be True or False, got {self_collision!r}")
     solref = finite_array(contact_solref, "contact_solref", (2,))
     if solref[0] < 2 * timestep or solref[1] <= 0:
-        raise ValueError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")
+        raise InputError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")
     boxes = obstacle_boxes(obstacles, hole_slices)
     lim = _torque_limits(robot, torque_limit)
     _check_names(robot)
@@ -318,7 +319,7 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
             if i in child_of:
                 j = child_of[i]
                 if robot.body.joint_types[j] not in ("revolute", "continuous"):
-                    raise ValueError(f"joint {jnames[j]!r} is {robot.body.joint_types[j]}; only revolute joints "
+                    raise InputError(f"joint {jnames[j]!r} is {robot.body.joint_types[j]}; only revolute joints "
                                      "are simulated")
                 hinge = body.add_joint(name=jnames[j], type=mj.mjtJoint.mjJNT_HINGE, axis=axes[j],
                                        damping=joint_damping, armature=armature)
@@ -393,8 +394,8 @@ def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
     spec = build_spec(robot, **kwargs)
     try:
         model = spec.compile()
-    except ValueError as exc:
-        raise ValueError(f"MuJoCo could not compile the robot's model: {exc}") from None
+    except ValueError as exc:  # the robot was checked when it was loaded: a model MuJoCo refuses is ours
+        raise InternalError(f"MuJoCo could not compile the model snakehead built of the robot: {exc}") from None
     names = robot.link_names
 
     def ids(kind: str, keys: Any) -> np.ndarray:

@@ -8,6 +8,7 @@ from .compare import check_plan_span, compare
 from .tracking import SimResult, simulate_trajectory
 
 from typing import Any
+from .._errors import InputTypeError, entry_point, inputs_checked
 
 
 @dataclass
@@ -36,6 +37,7 @@ class PlanSimulation:
         return bool(self.metrics["zmp_inside"])
 
 
+@entry_point
 def simulate(plan: Any, **options: Any) -> PlanSimulation:
     """Track ``plan`` (a :class:`~snakehead.motion.planner.Plan`) in MuJoCo with PD control and gravity
     compensation at 2 ms, its obstacles included, and compare with the plan at its targets.
@@ -46,9 +48,10 @@ def simulate(plan: Any, **options: Any) -> PlanSimulation:
     from ..motion.planner import Plan
 
     if not isinstance(plan, Plan):
-        raise TypeError(f"plan must be a snakehead Plan (from snakehead.plan), got {type(plan).__name__}")
+        raise InputTypeError(f"plan must be a snakehead Plan (from snakehead.plan), got {type(plan).__name__}")
     options.setdefault("obstacles", list(plan.obstacles))
-    result = simulate_trajectory(plan.robot, plan.t, plan.q, plan.base, **options)
+    result = simulate_trajectory(plan.robot, plan.t, plan.q, plan.base, **options)  # it checks the options
+    inputs_checked()  # the rest compares the plan with its own simulation: an InputError there is a bug
     check_plan_span(plan.t, [tg.time_s for tg in plan.targets], result)
     targets = [(tg.time_s, tg.position, tg.direction) for tg in plan.targets] or None
     metrics = compare(plan.robot, plan.t, plan.q, result, targets=targets, base=plan.base)

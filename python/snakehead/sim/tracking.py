@@ -17,6 +17,7 @@ from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GR
                    MAX_PHYSICS_STEPS, MAX_TIMESTEP, SimModel, _mujoco, build_model)
 
 import numpy.typing as npt
+from .._errors import InputError, InputTypeError
 
 
 # ------------------------------------------------------------------------------------------------
@@ -120,10 +121,10 @@ class SimState:
     def load(self, sim: SimModel, data: Any) -> None:
         """Put ``data`` (of ``sim``'s model) in this state and compute its kinematics."""
         if self.qpos.shape != data.qpos.shape or self.qvel.shape != data.qvel.shape:
-            raise ValueError(f"the state (qpos {self.qpos.shape}) belongs to another robot's model (qpos "
+            raise InputError(f"the state (qpos {self.qpos.shape}) belongs to another robot's model (qpos "
                              f"{data.qpos.shape})")
         if not (np.all(np.isfinite(self.qpos)) and np.all(np.isfinite(self.qvel))):
-            raise ValueError("the state contains NaN or inf")
+            raise InputError("the state contains NaN or inf")
         data.qpos[:] = self.qpos
         data.qvel[:] = self.qvel
         _mujoco().mj_forward(sim.model, data)
@@ -191,9 +192,9 @@ def _gains(x: npt.ArrayLike, n: int, name: str, allow_zero: bool) -> np.ndarray:
     if a.ndim == 0:
         a = np.full(n, float(a))
     elif a.shape != (n,):
-        raise ValueError(f"{name} must be a number or shape ({n},), got shape {a.shape}")
+        raise InputError(f"{name} must be a number or shape ({n},), got shape {a.shape}")
     if np.any(a < 0) or (not allow_zero and np.any(a <= 0)):
-        raise ValueError(f"{name} must be {'>= 0' if allow_zero else '> 0'}, got {a.tolist()}")
+        raise InputError(f"{name} must be {'>= 0' if allow_zero else '> 0'}, got {a.tolist()}")
     return a
 
 
@@ -202,19 +203,19 @@ def check_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike) -> t
     n = robot.n_joints
     t = finite_array(t, "t")
     if t.ndim != 1 or t.size < 2:
-        raise ValueError(f"t must be a 1-D array of at least 2 times, got shape {t.shape}")
+        raise InputError(f"t must be a 1-D array of at least 2 times, got shape {t.shape}")
     q = finite_array(q, "q")
     if q.ndim != 2 or q.shape[1] != n:
-        raise ValueError(f"q must have shape (T, {n}), got {q.shape}")
+        raise InputError(f"q must have shape (T, {n}), got {q.shape}")
     if q.shape[0] != t.size:
-        raise ValueError(f"t and q have different lengths ({t.size} and {q.shape[0]})")
+        raise InputError(f"t and q have different lengths ({t.size} and {q.shape[0]})")
     if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+        raise InputError("t must be strictly increasing")
     tol = 1e-9
     bad = (q < robot.lower - tol) | (q > robot.upper + tol)
     if bad.any():
         k, j = np.argwhere(bad)[0]
-        raise ValueError(f"q[{k}, {j}] = {q[k, j]:.6g} rad is outside the joint limits "
+        raise InputError(f"q[{k}, {j}] = {q[k, j]:.6g} rad is outside the joint limits "
                          f"[{robot.lower[j]:.6g}, {robot.upper[j]:.6g}]")
     return t, q
 
@@ -231,7 +232,7 @@ GRAVITY_COMPENSATION = ("supported", "bias", "none")
 
 def _compensated_mode(gravity_compensation: str) -> str:
     if gravity_compensation not in GRAVITY_COMPENSATION:
-        raise ValueError(f"gravity_compensation must be one of {GRAVITY_COMPENSATION}, got {gravity_compensation!r}")
+        raise InputError(f"gravity_compensation must be one of {GRAVITY_COMPENSATION}, got {gravity_compensation!r}")
     return gravity_compensation
 
 
@@ -297,7 +298,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     control_dt = duration(control_dt, "control_dt", maximum=MAX_CONTROL_DT)
     sub = int(round(control_dt / timestep))
     if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
-        raise ValueError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
+        raise InputError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
     settle, hold = duration(settle, "settle", allow_zero=True), duration(hold, "hold", allow_zero=True)
     drop = non_negative(drop, "drop", maximum=1.0)
     # What the run will record and step, checked before anything is allocated or stepped.
@@ -318,7 +319,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     elif isinstance(state, SimState):
         state.load(sim, d)
     else:
-        raise TypeError(f"state must be a SimState (from GaitSimulator or a SimResult's end_state), got "
+        raise InputTypeError(f"state must be a SimState (from GaitSimulator or a SimResult's end_state), got "
                         f"{type(state).__name__}")
 
     qdot_plan = np.gradient(q, t, axis=0)
