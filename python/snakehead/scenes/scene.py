@@ -37,6 +37,15 @@ A scene file is TOML::
     position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
 
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
+
+Names (:func:`snakehead._validate.name_text`): a target's name is one line of printable text of at most
+:data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator characters
+(newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``, backticks and
+any script are names like others, shown literally in every figure and report. A scene's name also names its output
+files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name besides
+(:func:`~snakehead._validate.file_name_part`: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,
+at most 100 bytes). A description may also hold newlines and tabs. Anything else is an
+:class:`~snakehead._errors.InputError` naming the field.
 """
 from __future__ import annotations
 
@@ -48,7 +57,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, vector3
+from .._errors import InputError
+from .._validate import (display_text, duration, file_name_part, finite_float, name_text, sequence, unit_vector3,
+                         vector3)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, read_toml
@@ -78,8 +89,7 @@ class Target:
     sphere_diameter: float | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
+        name_text(self.name, "a target's name")
         object.__setattr__(self, "position", vector3(self.position, f"target {self.name!r} position"))
         object.__setattr__(self, "direction", unit_vector3(self.direction, f"target {self.name!r} direction"))
         object.__setattr__(self, "hold_s", duration(self.hold_s, f"target {self.name!r} hold_s", allow_zero=True))
@@ -112,8 +122,7 @@ class Scene:
 
     def __post_init__(self) -> None:
         file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
-        if not isinstance(self.description, str):
-            raise TypeError(f"a scene's description must be a str, got {type(self.description).__name__}")
+        display_text(self.description, "a scene's description")
         targets = sequence(self.targets, f"scene {self.name!r} targets")
         if not targets:
             raise ValueError(f"scene {self.name!r} has no targets")
@@ -147,6 +156,7 @@ class Scene:
     def from_targets(cls, pairs: Sequence, *, name: str = "target", obstacles: Sequence = (),
                      base: BasePlacement | None = None, hold_s: float = 1.0) -> "Scene":
         """A scene of (position, direction) pairs (or :class:`Target` objects), each held ``hold_s`` s."""
+        file_name_part(name, "a scene's name")  # before it names the targets
         targets = []
         items = sequence(pairs, "targets")
         for k, item in enumerate(items):
@@ -197,9 +207,7 @@ def _table(value: Any, where: str) -> dict:
 def _target_from(entry: Any, where: str) -> Target:
     entry = _table(entry, where)
     check_keys(entry, *_TARGET_KEYS, where)
-    name = entry["name"]
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"{where}: name must be a non-empty string, got {name!r}")
+    name = name_text(entry["name"], f"{where}: name")
     kwargs: dict[str, Any] = {}
     for key in ("hold_s", "step_m", "sphere_diameter"):
         if key in entry:
@@ -214,7 +222,7 @@ def _target_from(entry: Any, where: str) -> Target:
         return Target(name, np.asarray(_number_list(entry["position"], "position")),
                       np.asarray(_number_list(entry["direction"], "direction")), **kwargs)
     except ValueError as exc:  # the field's own message, said once where it is
-        raise ValueError(f"{where}: {exc}") from None
+        raise InputError(f"{where}: {exc}") from None
 
 
 def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObstacle | WallWithHole | MeshObstacle:
@@ -239,7 +247,7 @@ def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObs
                                      _number_list(entry["size"], "size"),
                                      _number(entry["hole_diameter"], "hole_diameter"))
     except ValueError as exc:
-        raise ValueError(f"{where}: {exc}") from None
+        raise InputError(f"{where}: {exc}") from None
 
 
 def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = None, where: str = "scene") -> Scene:
@@ -271,8 +279,8 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     try:
         return Scene(name=data.get("name", name), targets=targets, obstacles=obstacles, robot_file=robot_file,
                      base=base, description=data.get("description", ""))
-    except ValueError as exc:
-        raise ValueError(f"{where}: {exc}") from None
+    except ValueError as exc:  # a name or a description refused by Scene: the file's fault
+        raise InputError(f"{where}: {exc}") from None
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
