@@ -39,8 +39,12 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def literal(text: str) -> str:
-    """``text`` (a name from the data: a scene's, a target's) shown as it is: matplotlib reads ``$...$`` as math and
-    fails to draw a figure whose text is not valid math (``$\\frac{$``)."""
+    """``text`` from the data (a scene's, a target's, a phase's or a frame's name; a message) made safe to show in
+    any matplotlib text -- titles, legends, annotations, axis labels -- as it is: matplotlib reads text between two
+    ``$`` as math (mathtext) and fails to draw a figure whose math is not valid (``$\\frac{$``). Every ``$`` is
+    escaped, so no math is parsed and the text is drawn literally (backslashes included). Every figure of
+    :mod:`snakehead.viz` passes names through it; text that is meant as math (``cm$^2$``) is never put in the same
+    string as a name. Titles given by the caller are drawn as given."""
     return str(text).replace("$", r"\$")
 
 

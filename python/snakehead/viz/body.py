@@ -447,7 +447,7 @@ def plot_head_solution(robot: SnakeRobot, solution: HeadSolution) -> Figure:
         ax2.legend(fontsize=7, loc="lower right")
         ax2.grid(alpha=0.3)
     else:
-        ax2.text(0.5, 0.5, "no neck goal: " + solution.message, ha="center", va="center", wrap=True)
+        ax2.text(0.5, 0.5, "no neck goal: " + literal(solution.message), ha="center", va="center", wrap=True)
         ax2.set_axis_off()
     fig.suptitle("HeadController solution (Section 2.4, Fig. 8)")
     return fig

@@ -26,6 +26,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .._files import atomic_open
+from ._common import literal
 from .body import body_faces
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
@@ -70,7 +71,9 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     """The top view: the tail's path over the ground (MuJoCo's) coloured by the kind of phase, and where the loop
     believed it was (dead reckoning, dashed; a fix is a jump of it); the body's footprint at the start, after every
     ground phase and at the end; the targets (crosses, their height written beside them). Phases are numbered
-    along the path and listed in the legend with their times. Axes in m, equal scales."""
+    along the path and listed in the legend with their times. Axes in m, equal scales. Names (the scene's, the
+    targets', the phases') are shown as they are (:func:`~snakehead.viz._common.literal`); ``title`` replaces the
+    title as given (matplotlib's mathtext applies to it)."""
     _check(run)
     from matplotlib.collections import PolyCollection
     from matplotlib.lines import Line2D
@@ -102,7 +105,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
             est = ph.run.root_estimate[:, :2, 3]
             ax.plot(est[:, 0], est[:, 1], "--", color=c, lw=0.9, alpha=0.8, zorder=3)
             body(ph.run.root_truth[-1], ph.run.q[-1], 0.15, zorder=1)
-        legend.append(Line2D([], [], color=c, lw=1.6, label=f"{k} {ph.name} ({ph.t0_s:.1f}-{ph.t1_s:.1f} s)"))
+        legend.append(Line2D([], [], color=c, lw=1.6, label=f"{k} {literal(ph.name)} ({ph.t0_s:.1f}-{ph.t1_s:.1f} s)"))
     if len(t_all):
         body(roots[-1], qs[-1], 0.9, zorder=4)
     for f in run.fixes:  # where the outside fix reset the estimate
@@ -110,7 +113,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         ax.plot(*roots[k, :2, 3], "*", color="k", ms=9, zorder=6)
     for tg in run.scene.targets:
         ax.plot(tg.position[0], tg.position[1], "x", color=TARGET_COLOR, ms=8, mew=2, zorder=6)
-        ax.annotate(f"{tg.name} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7, color=TARGET_COLOR,
+        ax.annotate(f"{literal(tg.name)} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7, color=TARGET_COLOR,
                     xytext=(5, 5), textcoords="offset points", zorder=6)
     legend += [Line2D([], [], color="k", ls="--", lw=0.9, label="estimated (dead reckoning)"),
                Line2D([], [], color="k", marker="*", ls="", label="outside fix"),
@@ -123,7 +126,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     head = run.metrics
     err = (f"; head {1000 * head['position_error_m']:.2f} mm / {head['direction_error_deg']:.2f} deg off"
            if head else f"; {run.failure}" if run.failure else "")
-    ax.set_title(title or f"{run.scene.name}: the tail's path from above, {run.base_travel_m:.2f} m in "
+    ax.set_title(title or f"{literal(run.scene.name)}: the tail's path from above, {run.base_travel_m:.2f} m in "
                           f"{run.total_time_s:.0f} s{err}", fontsize=9)
     ax.legend(handles=legend, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     return fig
@@ -197,7 +200,7 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
     labels = []
     for k in idx:
         ph = next((p for p in run.phases if p.t0_s - 1e-9 <= t[k] <= p.t1_s + 1e-9), run.phases[-1])
-        labels.append(f"{run.scene.name}: t = {t[k]:5.1f} s, {ph.kind}: {ph.name}  (x{speedup:.0f} speed)")
+        labels.append(f"{literal(run.scene.name)}: t = {t[k]:5.1f} s, {ph.kind}: {literal(ph.name)}  (x{speedup:.0f} speed)")
     # the scene's extent: every body position and the targets, the ground up to the highest point
     pts = robot.lowest_points(frames)[0].reshape(-1, 3)
     pts = np.vstack([pts, frames[:, :, :3, 3].reshape(-1, 3)])

@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Sequence
 import numpy as np
 
 from .._files import atomic_open, read_npz, write_text_atomic
+from .._validate import display_text, name_text
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
 
@@ -392,8 +393,10 @@ def load_viewer_scene(path: str | Path) -> ViewerScene:
         raise ValueError(f"{where}: viewer scene without {sorted(missing)}")
     values: dict[str, Any] = {k: contents[k] for k in names}
     _check_scene_arrays(where, values)
-    values["name"] = str(values["name"])
-    values["title"] = str(values["title"])
+    values["name"] = name_text(str(values["name"]), f"{where}: name")
+    values["title"] = display_text(str(values["title"]), f"{where}: title")
+    for k, target in enumerate(values["target_names"].tolist()):
+        name_text(target, f"{where}: target_names[{k}]")
     values["voxel_size"] = float(values["voxel_size"])
     return ViewerScene(**values)
 
@@ -478,7 +481,7 @@ class SceneNodes:
                                 thickness=0.002)
         for i, (p, d, name, dia) in enumerate(zip(data.target_positions, data.target_directions, data.target_names,
                                                   data.target_diameters)):
-            node = f"{root}/targets/{i + 1} {name}"
+            node = f"{root}/targets/{i + 1} {_node_name(name)}"
             if np.isfinite(dia):
                 s.add_icosphere(node + "/sphere", radius=float(dia) / 2, color=TARGET_RGB, opacity=0.6,
                                 position=p, cast_shadow=False)
@@ -556,9 +559,15 @@ def html_page(data: ViewerScene) -> str:
 
 
 def _escape(text: str) -> str:
+    """``text`` as HTML shows it literally (``<script>`` is text, not an element)."""
     import html
 
     return html.escape(text, quote=True)
+
+
+def _node_name(name: str) -> str:
+    """A name as one level of viser's scene tree, whose paths are split at "/": each "/" shown as U+2215."""
+    return str(name).replace("/", "\u2215")
 
 
 def write_html(data: ViewerScene, path: str | Path) -> Path:

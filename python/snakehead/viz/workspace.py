@@ -21,7 +21,7 @@ import numpy.typing as npt
 from matplotlib.figure import Figure
 
 from ..kinematics.workspace import Clusters, ReachabilityMap
-from ._common import new_figure
+from ._common import literal, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -91,7 +91,7 @@ def plot_map(m: ReachabilityMap, ax: Any = None, min_index: float = 0.0, size: f
     sc = ax.scatter(p[:, 0], p[:, 1], p[:, 2], c=d, cmap=cmap, norm=norm, s=s, alpha=alpha, depthshade=False,
                     edgecolors="none")
     _label3d(ax, m)
-    ax.set_title(f"{m.base} \u2192 {m.tip}: {len(p)} voxels")
+    ax.set_title(f"{literal(m.base)} \u2192 {literal(m.tip)}: {len(p)} voxels")  # frame names: data
     if colorbar:
         _colorbar(ax.figure, sc, ax)
     return ax.figure
