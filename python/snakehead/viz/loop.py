@@ -125,7 +125,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     ax.set_ylabel("y (m)")
     head = run.metrics
     err = (f"; head {1000 * head['position_error_m']:.2f} mm / {head['direction_error_deg']:.2f} deg off"
-           if head else f"; {run.failure}" if run.failure else "")
+           if head else f"; {literal(run.failure)}" if run.failure else "")
     ax.set_title(title or f"{literal(run.scene.name)}: the tail's path from above, {run.base_travel_m:.2f} m in "
                           f"{run.total_time_s:.0f} s{err}", fontsize=9)
     ax.legend(handles=legend, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
