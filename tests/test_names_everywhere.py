@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import html
 import json
-import math
 import os
 import re
 import subprocess
@@ -25,7 +24,6 @@ import sys
 import types
 import unicodedata
 import warnings
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -39,8 +37,7 @@ from matplotlib.text import Text
 
 from snakehead import BasePlacement, SnakeRobot
 from snakehead._errors import InputError
-from snakehead._validate import (MAX_NAME_BYTES, MAX_NAME_CHARS, NAME_FORBIDDEN_CATEGORIES, file_name_part,
-                                 name_text)
+from snakehead._validate import MAX_NAME_BYTES, MAX_NAME_CHARS, file_name_part
 from snakehead.app import report as rep
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
@@ -70,7 +67,8 @@ def fuzz(examples: int) -> Any:
 HOSTILE = ["$\\frac{$", "$\\sqrt{$", "$x$", "$$", "\\$", "a\\", "\\", "\\\\|", "<script>alert(1)</script>",
            "<img src=x onerror=alert(1)>", "<!--", "&lt;b&gt;", "a|b", "| x |", "`code`", "``", "**bold**", "_x_",
            "~~s~~", "# heading", "- item", "+ item", "1. one", "3) three", "> quote", "[l](javascript:x)",
-           "![i](x.png)", "---", "=", "   four spaces", "trailing  ", "%s {0} {{}}", "名前 🐍", "Ω ‖ √ ∑", "e\u0301",
+           "![i](x.png)", "---", "=", "   four spaces", "trailing  ", "%s {0} {{}}", "名前 🐍", "Ω ‖ √ ∑",
+           "e\u0301",
            "\u05e9\u05dc\u05d5\u05dd", "x" * MAX_NAME_CHARS, "-" * MAX_NAME_CHARS, "a:b", "NUL", "con.txt", "..", ".",
            "a/b", "a\\b"]
 #: Names that must be refused, with the field named.
@@ -455,6 +453,7 @@ def check_summary(text: str, scene: Scene) -> None:
     assert [tr.find_all("td")[0].get_text() for tr in phases_table.find_all("tr")[1:]] == \
         ["serpenoid forward (head, 1 x 1.00)", target.strip(), f"{target} (hold)".strip()]
     items = [li.get_text() for li in soup.find_all("li")]
+    assert not any("s of motion" in item for item in items)  # a loop without a plan: "- s of motion" was a list
     assert f"note on {target}".strip() in items and f"run note on {target}".strip() in items
     codes = [c.get_text() for c in soup.find_all("code")]
     assert f"{name}_trajectory.csv" in codes and f"{name}.gif" in codes and f"{name}_path.png" in codes

@@ -231,7 +231,8 @@ def summary_markdown(report: dict) -> str:
     m, v = report.get("machine") or {}, report.get("versions") or {}
     if m:
         lines += [f"Run on {md(m.get('cpu'))} ({md(m.get('cores'))} cores), {md(m.get('system'))}; snakehead "
-                  f"{md(v.get('snakehead'))}, Python {md(v.get('python'))}, MuJoCo {md(v.get('mujoco') or 'not installed')}. "
+                  f"{md(v.get('snakehead'))}, Python {md(v.get('python'))}, "
+                  f"MuJoCo {md(v.get('mujoco') or 'not installed')}. "
                   f"Total run time {_fmt(report.get('run_time_s'), 1, 1)} s.", ""]
     for key in ("settings",):
         if report.get(key):
@@ -240,10 +241,12 @@ def summary_markdown(report: dict) -> str:
         paper = sc.get("paper") or {}
         sim = sc.get("sim")
         lines += [f"## {md(name)}: {'success' if sc['success'] else 'NOT successful'}", ""]
-        lines += [f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
-                  f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
-                  f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
-                  f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad.", ""]
+        # escaped as a whole: an unknown duration made it "- s of motion", a list item
+        lines += [md(f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
+                     f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, "
+                     f"planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
+                     f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
+                     f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad."), ""]
         lines += ["| target | planned position error (mm) | planned direction error (deg) | solved |",
                   "|---|---|---|---|"]
         for tg in sc["targets"]:

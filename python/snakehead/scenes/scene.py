@@ -39,8 +39,8 @@ A scene file is TOML::
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
 
 Names (:func:`snakehead._validate.name_text`): a target's name is one line of printable text of at most
-:data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator characters
-(newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``, backticks and
+:data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator
+characters (newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``, backticks and
 any script are names like others, shown literally in every figure and report. A scene's name also names its output
 files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name besides
 (:func:`~snakehead._validate.file_name_part`: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,

@@ -113,8 +113,8 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         ax.plot(*roots[k, :2, 3], "*", color="k", ms=9, zorder=6)
     for tg in run.scene.targets:
         ax.plot(tg.position[0], tg.position[1], "x", color=TARGET_COLOR, ms=8, mew=2, zorder=6)
-        ax.annotate(f"{literal(tg.name)} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7, color=TARGET_COLOR,
-                    xytext=(5, 5), textcoords="offset points", zorder=6)
+        ax.annotate(f"{literal(tg.name)} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7,
+                    color=TARGET_COLOR, xytext=(5, 5), textcoords="offset points", zorder=6)
     legend += [Line2D([], [], color="k", ls="--", lw=0.9, label="estimated (dead reckoning)"),
                Line2D([], [], color="k", marker="*", ls="", label="outside fix"),
                Line2D([], [], color=TARGET_COLOR, marker="x", ls="", label="targets")]
@@ -200,7 +200,8 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
     labels = []
     for k in idx:
         ph = next((p for p in run.phases if p.t0_s - 1e-9 <= t[k] <= p.t1_s + 1e-9), run.phases[-1])
-        labels.append(f"{literal(run.scene.name)}: t = {t[k]:5.1f} s, {ph.kind}: {literal(ph.name)}  (x{speedup:.0f} speed)")
+        labels.append(f"{literal(run.scene.name)}: t = {t[k]:5.1f} s, {ph.kind}: {literal(ph.name)}  "
+                      f"(x{speedup:.0f} speed)")
     # the scene's extent: every body position and the targets, the ground up to the highest point
     pts = robot.lowest_points(frames)[0].reshape(-1, 3)
     pts = np.vstack([pts, frames[:, :, :3, 3].reshape(-1, 3)])
