@@ -365,9 +365,9 @@ def test_every_figure_shows_a_name_literally(robot, motion, name):
     anim = loop_plots.animate_loop(run, max_frames=2, size=(3.0, 2.4), **small)
     assert len(list(anim.images())) == 2
     assert_shown_literally(anim.figure, scene.name)
-    fig = ws.plot_map(make_map(name, name + " tip"))
+    fig = ws.figure_map(make_map(name, name + " tip"))  # the map's frame names, retitled "(a) ..."
     fig.set_dpi(30)
-    assert_shown_literally(fig, f"{name} \u2192 {name} tip")
+    assert_shown_literally(fig, f"(a) {name} \u2192 {name} tip")
 
 
 def test_the_head_solutions_message_is_shown_as_it_is(robot):
