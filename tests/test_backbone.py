@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+
+from snakehead._errors import Infeasible
 from scipy import optimize
 from scipy.spatial import ConvexHull
 
@@ -379,7 +381,7 @@ def test_other_bad_arc_input(robot):
         bb.arc_joint_angles(0.3, 1.0, robot)
     with pytest.raises(ValueError, match="min_margin"):
         bb.optimize_base_arc(robot, min_margin=-0.01)
-    with pytest.raises(ValueError, match="no central angle"):
+    with pytest.raises(Infeasible, match="no central angle"):
         bb.optimize_base_arc(robot, min_margin=1.0)
 
 

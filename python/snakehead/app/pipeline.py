@@ -349,6 +349,7 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     from ..kinematics import workspace
     from ..model.robot import SnakeRobot
 
+    scenes = _distinct_names(scenes)
     settings = settings or Settings()
     progress = progress or Progress()
     out = Path(out)
@@ -389,6 +390,30 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     rep.write_json(report, out / "report.json")
     rep.write_summary(report, out / "summary.md")
     return report
+
+
+def _distinct_names(scenes: Sequence) -> tuple:
+    """InputError unless the scenes' names name distinct files: each scene's outputs are NAME_trajectory.csv,
+    NAME.gif, ... and its report entry is under its name, so two scenes of one name (or of names that differ only in
+    case or Unicode normalisation: one file on macOS and Windows) would overwrite each other's."""
+    from .._errors import InputError, InputTypeError
+    from .._validate import file_name_key, sequence
+    from ..scenes.scene import Scene
+
+    seen: dict[str, str] = {}
+    scenes = sequence(scenes, "scenes")
+    for k, scene in enumerate(scenes):
+        if not isinstance(scene, Scene):
+            raise InputTypeError(f"scenes[{k}] must be a Scene, got {type(scene).__name__}")
+        key = file_name_key(scene.name)
+        if key in seen:
+            same = "the same name" if seen[key] == scene.name else "names that differ only in case or normalisation"
+            raise InputError(f"two scenes have {same} ({seen[key]!r} and {scene.name!r}): their output files "
+                             "(NAME_trajectory.csv, NAME.gif, ...) would overwrite each other; rename one")
+        seen[key] = scene.name
+    if not seen:
+        raise InputError("scenes is empty: give at least one scene")
+    return scenes
 
 
 def _map_label(m: Any) -> str:
