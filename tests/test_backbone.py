@@ -438,9 +438,9 @@ def test_bad_up_curve_shape(kwargs, match):
 
 
 def test_unreachable_or_inflected_up_curve(robot):
-    with pytest.raises(ValueError, match="beyond"):
+    with pytest.raises(Infeasible, match="beyond"):
         bb.initial_configuration(robot, shape=bb.UpCurveShape(height=0.9, reach=0.0))
-    with pytest.raises(ValueError, match="inflection"):  # ends pointing forward: needs an S-bend
+    with pytest.raises(Infeasible, match="inflection"):  # ends pointing forward: needs an S-bend
         bb.initial_configuration(robot, central_angle=2.0,
                                  shape=bb.UpCurveShape(height=0.3, reach=0.5, tip_angle=0.2))
 

@@ -255,7 +255,7 @@ def test_bad_input():
     with pytest.raises(TypeError, match="robot"):
         timing.retime("snake", W)
     # paths no timing can follow, with the reason
-    with pytest.raises(ValueError, match="torque limit"):
+    with pytest.raises(Infeasible, match="torque limit"):
         timing.retime(robot, W, torque_limit=0.5)
     flat = np.zeros(robot.n_joints)
     tipping = flat.copy()
