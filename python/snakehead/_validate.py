@@ -356,7 +356,7 @@ def input_file(path: Any, what: str, max_bytes: int) -> Path:
     if "\0" in text:
         raise InputError(f"cannot read {what} {text!r}: the path holds a NUL character")
     problem, info = _file_problem(text)
-    if problem is not None:
+    if problem is not None or info is None:
         raise InputError(f"cannot read {what} {text!r}: {problem}")
     if info.st_size > max_bytes:
         raise InputError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")
