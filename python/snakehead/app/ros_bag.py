@@ -38,8 +38,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
-from .._errors import invariant
+from .._errors import InternalError, invariant
 from .._files import atomic_open, write_text_atomic
 from ..motion.interpolation import CONTROL_PERIOD
 from . import ros_messages as msgs
@@ -220,14 +221,14 @@ def _tf_messages(stamps: np.ndarray, children: Sequence[str], poses: np.ndarray)
 
 
 # --- markers ------------------------------------------------------------------------------------------------------
-def _marker(ns: str, marker_id: int, kind: int, *, stamp_ns: int = 0, position: Sequence[float] = (0.0, 0.0, 0.0),
-            orientation: Sequence[float] = IDENTITY, scale: Sequence[float] = (1.0, 1.0, 1.0),
+def _marker(ns: str, marker_id: int, kind: int, *, stamp_ns: int = 0, position: npt.ArrayLike = (0.0, 0.0, 0.0),
+            orientation: npt.ArrayLike = IDENTITY, scale: Sequence[float] = (1.0, 1.0, 1.0),
             color: Sequence[float] = (1.0, 1.0, 1.0, 1.0), points: np.ndarray | None = None, text: str = "",
             delete: bool = False) -> dict:
     """A Marker in ``world``: its pose (``position`` m, ``orientation`` quaternion x, y, z, w), sizes in m,
     ``points`` (k, 3) in its pose's frame; ADD, or DELETE with ``delete``."""
-    x, y, z = (float(v) for v in position)
-    qx, qy, qz, qw = (float(v) for v in orientation)
+    x, y, z = np.asarray(position, float).tolist()
+    qx, qy, qz, qw = np.asarray(orientation, float).reshape(4).tolist()
     r, g, b, a = (float(c) for c in color)
     pts = [] if points is None else [{"x": px, "y": py, "z": pz} for px, py, pz in np.asarray(points, float).tolist()]
     return {"header": {"stamp": msgs.stamp(stamp_ns), "frame_id": WORLD_FRAME}, "ns": ns, "id": int(marker_id),
@@ -357,9 +358,11 @@ def _loop_tracks(run: LoopRun) -> tuple[np.ndarray, np.ndarray]:
         qd.append(np.gradient(r.q, r.t, axis=0) if len(r.t) > 1 else np.zeros_like(r.q))
         est.append(r.root_estimate if r.root_estimate is not None else np.full((len(r.t), 4, 4), np.nan))
     if run.head is not None and run.head.root_pose is not None:
-        invariant(run.plan is not None, "head phases simulated without a plan")
+        planned = run.plan
+        if planned is None:
+            raise InternalError("a loop's head phases were simulated without their plan")
         qd.append(run.head.qdot)
-        est.append(np.repeat(robot.root_pose(run.plan.base)[None], len(run.head.t), axis=0))
+        est.append(np.repeat(robot.root_pose(planned.base)[None], len(run.head.t), axis=0))
     if not qd:
         return np.zeros((0, robot.n_joints)), np.zeros((0, 4, 4))
     return np.concatenate(qd), np.concatenate(est)

@@ -1,8 +1,8 @@
 """The ROS 2 messages snakehead writes into its bags (:mod:`snakehead.app.ros_bag`): their definitions, the schema
 text the ROS 2 MCAP profile carries, and their CDR encoding. No ROS installation is needed.
 
-* :data:`DEFINITIONS` -- each message's fields as in ROS 2 Humble's ``.msg`` files (the same in Jazzy for these
-  types; comments and default values left out): ``sensor_msgs/msg/JointState``, ``tf2_msgs/msg/TFMessage``,
+* :data:`DEFINITIONS` -- each message's fields as in ROS 2 Humble's ``.msg`` files (comments and default values
+  left out; Jazzy's are the same but for a constant Marker adds, ARROW_STRIP, which is not on the wire): ``sensor_msgs/msg/JointState``, ``tf2_msgs/msg/TFMessage``,
   ``std_msgs/msg/String``, ``visualization_msgs/msg/MarkerArray`` and what they contain.
 * :func:`schema_text` -- a type's definition followed by those of every type it uses, each after a line of 80 ``=``
   and ``MSG: pkg/Type``: the ``ros2msg`` schema encoding of the MCAP ``ros2`` profile (what ``ros2 bag record``
@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from .._errors import invariant
 
-#: Field definitions per type (ROS 2 Humble; identical in Jazzy). Nested types are named ``pkg/Type`` as .msg files
+#: Field definitions per type (ROS 2 Humble; Jazzy has the same fields). Nested types are named ``pkg/Type`` as .msg files
 #: name them.
 DEFINITIONS: dict[str, str] = {
     "builtin_interfaces/msg/Time": "int32 sec\nuint32 nanosec\n",

@@ -662,8 +662,9 @@ class SnakeRobot:
         T = finite_array(root_pose, "root_pose", (4, 4))
         if self.description_root == self.parts.root:
             return T.copy()
-        above = Chain.from_urdf(self.urdf_text, self.description_root, self.parts.root)
-        return T @ np.linalg.inv(above.fk(np.zeros(above.n_joints)))
+        # the core takes chains with a moving joint: the one to the head tip, read where it passes the root frame
+        whole = Chain.from_urdf(self.urdf_text, self.description_root, self.parts.head_tip)
+        return T @ np.linalg.inv(whole.fk_all(np.zeros(whole.n_joints))[whole.link_index(self.parts.root)])
 
     def frames(self, q: npt.ArrayLike, base: BasePlacement | None = None) -> np.ndarray:
         """World poses of every frame in ``link_names`` at joint vector ``q`` (n,): (n_links, 4, 4)."""
