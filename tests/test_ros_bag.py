@@ -269,6 +269,25 @@ def test_a_robot_whose_body_frame_is_not_its_root_frame(tmp_path):
     check_head_through_the_bag(topics, robot, fake.q, base, range(0, 50, 9))
 
 
+def test_joints_off_the_body_are_held_at_zero(tmp_path):
+    """A movable joint off the body (a camera's pan on the head) is named after the body's, at 0, so that
+    robot_state_publisher places its link; a mimic joint is left to robot_state_publisher."""
+    robot0 = SnakeRobot.default()
+    extra = ("<link name=\"camera\"/><joint name=\"camera_pan\" type=\"continuous\"><parent link=\"link_16\"/>"
+             "<child link=\"camera\"/><axis xyz=\"0 0 1\"/></joint>"
+             "<link name=\"lens\"/><joint name=\"lens_tilt\" type=\"revolute\"><parent link=\"camera\"/>"
+             "<child link=\"lens\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+             "velocity=\"1\"/><mimic joint=\"camera_pan\"/></joint></robot>")
+    robot = SnakeRobot.from_urdf(robot0.urdf_text.replace("</robot>", extra), base_end="base_end",
+                                 neck_end="neck_end", head_tip="head_tip")
+    assert ros_bag.joint_names(robot) == robot.joint_names + ["camera_pan"]
+    fake = synthetic_plan(robot, BasePlacement(), n=5)
+    states = read_bag(ros_bag.write_plan_bag(fake, tmp_path / "camera.mcap"))["/joint_states"]
+    for (_, m), q, qd in zip(states, fake.q, fake.qd):
+        assert list(m.name) == robot.joint_names + ["camera_pan"]
+        assert m.position.tolist() == q.tolist() + [0.0] and m.velocity.tolist() == qd.tolist() + [0.0]
+
+
 def test_markers(plan, written):
     messages = written.topics["/snakehead/markers"]
     static = [(s, m) for s, m in messages if m.markers[0].ns == "targets"]
