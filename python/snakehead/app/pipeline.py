@@ -114,6 +114,7 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
+    files += _ros_outputs(name, out, progress, result)
     drawing = None
     if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates
         drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
@@ -195,6 +196,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
     if run.plan is not None:
         files.append(rep.write_trajectory_csv(run.plan, out / f"{name}_trajectory.csv", controller.robot.joint_names)
                      .name)
+    files += _ros_outputs(name, out, progress, run.plan, run)
     if settings.figures:
         if run.phases:  # a loop that failed before its first phase has no path to draw
             files += _loop_figures(scene, run, out, s, progress)
@@ -223,6 +225,31 @@ def loop_entry(run: LoopRun, files: Sequence[str] = ()) -> dict:
     entry["notes"] = list(entry.get("notes") or []) + list(run.notes) + [LOOP_ASSUMPTION.format(noise=noise)]
     entry["files"] = list(files)
     return rep.jsonable(entry)
+
+
+def _ros_outputs(name: str, out: Path, progress: Progress, plan: Any, run: LoopRun | None = None) -> list[str]:
+    """``NAME.mcap``, the ROS 2 bag of the plan (of the loop's whole run when ``run`` is given and simulated
+    anything), and ``NAME_joint_trajectory.yaml``, the plan for controllers (:mod:`snakehead.app.ros_bag`); the
+    names of those written (none without a plan or a run)."""
+    from . import ros_bag
+
+    written: list[tuple[Path, float]] = []
+    with progress.stage(f"{name}: ROS 2 bag and joint trajectory"):
+        start = time.perf_counter()
+        bag = out / f"{name}.mcap"
+        if run is not None:
+            if run.phases:  # a loop that failed before its first phase simulated nothing
+                written.append((ros_bag.write_loop_bag(run, bag), time.perf_counter() - start))
+        elif plan is not None:
+            written.append((ros_bag.write_plan_bag(plan, bag), time.perf_counter() - start))
+        if plan is not None:
+            start = time.perf_counter()
+            written.append((ros_bag.write_joint_trajectory(plan, out / f"{name}_joint_trajectory.yaml"),
+                            time.perf_counter() - start))
+    if written:
+        progress.say(f"{name}: " + "; ".join(f"{p.name} {p.stat().st_size / 1e6:.1f} MB in {dt:.2f} s"
+                                             for p, dt in written))
+    return [p.name for p, _ in written]
 
 
 def _loop_figures(scene: Scene, run: LoopRun, out: Path, s: dict, progress: Progress) -> list[str]:
