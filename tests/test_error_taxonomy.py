@@ -198,3 +198,18 @@ def test_a_too_long_line_approach_is_refused_before_any_work(monkeypatch):
                                         Target("b", [0.9, -0.3, 0.3], [1, 0, 0], approach="line", step_m=1e-4)))
     with pytest.raises(InputError, match="take a larger step_m"):
         snakehead.plan(scene)
+
+
+def test_the_figure_process_keeps_the_fault_of_its_errors():
+    """Figures are drawn in a forked process beside the simulation: an output it cannot write is still the user's
+    (InputError, exit 2); anything else that goes wrong there is still a bug."""
+    def unwritable(progress):
+        raise InputError("cannot write '/full/figure.png': No space left on device")
+
+    def broken(progress):
+        raise KeyError("a bug")
+
+    with pytest.raises(InputError, match="No space left"):
+        pipeline._Beside(unwritable, pipeline.Progress()).files()
+    with pytest.raises(RuntimeError, match="KeyError"):
+        pipeline._Beside(broken, pipeline.Progress()).files()

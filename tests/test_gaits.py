@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from snakehead import BasePlacement, SnakeRobot
+from snakehead import BasePlacement, InputError, SnakeRobot
 from snakehead.backbone import initial_configuration
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.motion.gaits import GAITS, Gait, Wave, make_gait, virtual_chassis
@@ -173,7 +173,7 @@ def test_bad_estimator_input(robot):
     with pytest.raises(ValueError, match="contact_height"):
         BodyPoseEstimator(robot, contact_height=-1.0)
     est = BodyPoseEstimator(robot)
-    with pytest.raises(RuntimeError, match="reset"):
+    with pytest.raises(InputError, match="reset"):
         est.update(np.zeros(robot.n_joints), np.eye(3))
     with pytest.raises(ValueError, match="not a rotation"):
         est.reset(np.zeros(robot.n_joints), 2 * np.eye(3), (0, 0))

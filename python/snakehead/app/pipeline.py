@@ -346,7 +346,10 @@ class _Beside:
         self.proc.join()
         self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
         if not ok:
-            raise RuntimeError(f"drawing the figures failed: {value}")
+            kind, message = value
+            if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
+                raise InputError(message)
+            raise RuntimeError(f"drawing the figures failed: {message}")
         return value
 
 
@@ -357,7 +360,9 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any)
     try:
         send.send((True, work(progress), progress.stages))
     except BaseException as exc:  # noqa: BLE001 -- reported to the parent, which raises
-        send.send((False, f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}", progress.stages))
+        kind = "InputError" if isinstance(exc, InputError) else type(exc).__name__
+        text = str(exc) if kind == "InputError" else f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"
+        send.send((False, (kind, text), progress.stages))
     finally:
         send.close()
 

@@ -34,7 +34,7 @@ from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable, Sequence
-from .._errors import InputError
+from .._errors import InputError, InternalError
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -280,8 +280,8 @@ class _Objective:
         self.free = np.flatnonzero(prob.free if move_base else prob.free & ~prob.ground_yaw)
         self.n = self.r.n_joints
         self.reg = regularise
-        self._cache_z = None
-        self._cache = None
+        self._cache_z: np.ndarray | None = None
+        self._cache: dict | None = None
         # the capsule pairs that can come near: not two ground links when the base is kept (they do not move
         # relative to each other), and not farther apart at the start than a few links can close in one solve
         F = prob.frames(self.q_template, base0)
@@ -310,7 +310,7 @@ class _Objective:
 
     def columns(self) -> np.ndarray:
         """Indices into the (n + 3) gradient of the variables."""
-        cols = list(self.free)
+        cols = [int(c) for c in self.free]
         if self.move_base:
             cols += [self.n, self.n + 1, self.n + 2]
         return np.array(cols)
@@ -323,7 +323,7 @@ class _Objective:
         return b
 
     def evaluate(self, z: np.ndarray) -> dict:
-        if self._cache_z is not None and np.array_equal(z, self._cache_z):
+        if self._cache is not None and self._cache_z is not None and np.array_equal(z, self._cache_z):
             return self._cache
         prob, r = self.prob, self.r
         cols = self.columns()
@@ -487,7 +487,8 @@ def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.
     if not starts:
         raise InputError("the whole-body solve needs at least one start (q, base)")
     base_first = starts[0][1]
-    best, best_key = None, None
+    best: tuple[np.ndarray, BasePlacement, dict] | None = None
+    best_key: tuple[int, float] | None = None
     rank = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
     tried = 0
     for q0, b0 in starts:
@@ -500,10 +501,12 @@ def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.
         chk = check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin,
                              obstacle_clearance=obstacle_clearance)
         key = (rank[chk["reason"]], chk["static_margin_m"] if chk["reason"] != "out of reach" else -chk["position_error_m"])
-        if best is None or key > best_key:
+        if best is None or best_key is None or key > best_key:
             best, best_key = (q, b, chk), key
         if chk["reason"] is None:
             break
+    if best is None:
+        raise InternalError("the whole-body solve refined no start")
     q, b, chk = best
     same = b == base_first
     stage = None if chk["reason"] else (STAGES[1] if same else STAGES[2])
@@ -642,8 +645,8 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
         return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
                     > OBSTACLE_CLEARANCE)
 
-    best = None
-    seg_holder = [None]
+    best: WholeBodySolution | None = None
+    seg_holder: list[Any] = [None]  # the segmented solution, once stage 1 has run
 
     def consider(q: np.ndarray, b: Any, stage: str, starts: int, chk: dict | None = None) -> Any:
         """Check a configuration (unless its check ``chk`` is given); keep the best attempt; return the solution
@@ -691,7 +694,7 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
         if found := consider(np.clip(q, robot.lower, robot.upper), b, STAGES[1], len(starts)):
             return found
     if not allow_base_move:
-        return best
+        return _attempted(best)
     # 3. the base moved
     rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
 
@@ -724,7 +727,7 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
             if s.success and (found := moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
-        for b in [placed] * (placed is not None) + placements(prob, P0_local, position, direction):
+        for b in ([placed] if placed is not None else []) + placements(prob, P0_local, position, direction):
             if q[:robot.lift_joints.start].tobytes() in rejected_shapes:
                 break
             for qc in lifted_candidates(prob, q, b, position, direction, seed):
@@ -740,6 +743,13 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
         q, b = refine(prob, q0, b0, position, direction, move_base=True, obstacles=obstacles, min_margin=min_margin)
         if found := moved(np.clip(q, robot.lower, robot.upper), b, len(moved_starts)):
             return found
+    return _attempted(best)
+
+
+def _attempted(best: WholeBodySolution | None) -> WholeBodySolution:
+    """The best attempt of :func:`solve_checked_target` (every path through it tries at least one pose)."""
+    if best is None:
+        raise InternalError("the whole-body solve tried no pose")
     return best
 
 

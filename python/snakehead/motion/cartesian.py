@@ -14,7 +14,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
 
 import numpy.typing as npt
-from typing import Any
+from typing import Any, Literal
 from .._errors import InputError
 
 
@@ -81,7 +81,7 @@ def joint_angle_towards(R0: np.ndarray, axis_local: np.ndarray, d_local: np.ndar
     return theta, ok
 
 
-def _interpolation_parameters(n: int) -> np.ndarray:
+def _interpolation_parameters(n: int | npt.ArrayLike) -> np.ndarray:
     """Eq. 41's t_0 .. t_m: n evenly spaced in [0, 1] for an integer n >= 2, or the given non-decreasing values
     from 0 to 1."""
     if isinstance(n, (int, np.integer)) and not isinstance(n, bool):
@@ -186,7 +186,7 @@ def cartesian_trajectory(robot: SnakeRobot, q_start: np.ndarray, q_end: np.ndarr
     s = minimum_jerk(t / duration)
     s[0], s[-1] = 0.0, 1.0
     q = cartesian_interpolation(robot, q_start, q_end, s, base, aim=aim)
-    edge = 2 if len(t) > 2 else 1
+    edge: Literal[1, 2] = 2 if len(t) > 2 else 1
     qd = np.gradient(q, t, axis=0, edge_order=edge)
     qdd = np.gradient(qd, t, axis=0, edge_order=edge)
     qd[[0, -1]] = 0.0

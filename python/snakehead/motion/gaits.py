@@ -52,7 +52,7 @@ from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .interpolation import CONTROL_PERIOD
 
 import numpy.typing as npt
-from typing import Any
+from typing import Any, Callable
 from .._errors import InputError, InputTypeError
 
 #: The fewest joints of a kind per wave (fewer alias the wave: it no longer looks like a wave on the body).
@@ -274,7 +274,7 @@ def lateral_undulation(direction: int = 1, *, amplitude: float = 0.6, waves: flo
 
 
 #: The gaits by name.
-GAITS = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning, "lateral_undulation": lateral_undulation}
+GAITS: dict[str, Callable[..., Gait]] = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning, "lateral_undulation": lateral_undulation}
 
 
 def make_gait(name: str, direction: int = 1, **parameters: Any) -> Gait:

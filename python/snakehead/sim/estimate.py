@@ -41,6 +41,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..motion.gaits import virtual_chassis
 
 import numpy.typing as npt
+from typing import Any
 from .._errors import InputError
 
 #: A link whose lowest shape point is within this height (m) of the ground touches it.
@@ -117,7 +118,7 @@ class ShapePoints:
         self.links = np.asarray(robot.shaped_links if links is None else links, dtype=np.intp).reshape(-1)
         geometry = robot.geometry
         local, owner = [], []
-        for c, link in enumerate(self.links):
+        for c, link in enumerate(int(k) for k in self.links):
             for k in geometry.shapes_of([link]):
                 pts = shape_points(geometry.shapes[int(k)], segments)
                 local.append(pts)
@@ -179,11 +180,11 @@ class BodyPoseEstimator:
         self.odometry = odometry
         self._points = ShapePoints(self.robot, shaped)
         self._masses = self.robot.masses[shaped]
-        self._W = None  # link poses relative to the root origin, world axes, at the last update
-        self._R_root = None
-        self._origin = None  # the root frame's estimated world position
-        self._chassis = None
-        self._contacts = None
+        self._W: np.ndarray | None = None  # link poses relative to the root origin, world axes, at the last update
+        self._R_root: np.ndarray | None = None
+        self._origin: np.ndarray | None = None  # the root frame's estimated world position
+        self._chassis: Any = None
+        self._contacts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._heading_correction = np.eye(3)  # turns the IMU's heading onto the known one (set by reset)
 
     # --- the body in world axes, relative to the root origin --------------------------------------
@@ -225,7 +226,7 @@ class BodyPoseEstimator:
     def pose(self) -> BodyPose:
         """The estimated pose now."""
         if self._W is None:
-            raise RuntimeError("call reset() with the starting pose first")
+            raise InputError("call reset() with the starting pose first")
         root = np.eye(4)
         root[:3, :3] = self._R_root
         root[:3, 3] = self._origin
@@ -258,8 +259,8 @@ class BodyPoseEstimator:
     def update(self, q: np.ndarray, R_imu: npt.ArrayLike) -> None:
         """The body moved to joint angles q (n,) with the IMU at world orientation R_imu (3, 3): move the estimate
         by the contact odometry (see the module; :meth:`pose` reads it)."""
-        if self._W is None:
-            raise RuntimeError("call reset() with the starting pose before update()")
+        if self._W is None or self._contacts is None or self._origin is None:
+            raise InputError("call reset() with the starting pose before update()")
         W, R_root = self._links(q, R_imu)
         points = self._points.world(W)
         links, local, weights = self._contacts

@@ -116,7 +116,7 @@ class GaitSimulator:
     (friction, torque_limit, obstacles, armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
     """
 
-    def __init__(self, robot: SnakeRobot, *, kp: float | None = None, kd: float | None = None,
+    def __init__(self, robot: SnakeRobot, *, kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None,
                  imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
                  control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
                  odometry: str = "friction", **model_options: Any) -> None:

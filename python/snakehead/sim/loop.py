@@ -67,7 +67,7 @@ from .compare import check_plan_span, compare
 from .estimate import BodyPose, pose_error
 from .gaits import GaitRun, GaitSimulator
 from .tracking import SimResult, simulate_trajectory
-from .._errors import InputError, InputTypeError
+from .._errors import InputError, InputTypeError, InternalError
 
 #: The kinds of phases in a loop's report.
 PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
@@ -185,8 +185,12 @@ class LoopRun:
 
     def timeline(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The whole sequence as MuJoCo ran it: t (T,) s, the root frame's world pose (T, 4, 4), the joints (T, n)."""
-        ts, roots, qs = [], [], []
+        ts: list[np.ndarray] = []
+        roots: list[np.ndarray] = []
+        qs: list[np.ndarray] = []
         for run in self.ground_runs:
+            if run.root_truth is None:  # every ground run of a loop records where the body truly was
+                raise InternalError(f"the loop's ground run {run.name!r} has no recorded root pose")
             ts.append(run.t)
             roots.append(run.root_truth)
             qs.append(run.q)

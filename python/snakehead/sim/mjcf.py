@@ -136,7 +136,7 @@ def _wall_boxes(wall: WallWithHole, slices: int) -> list[BoxObstacle]:
         if ub - ua <= 1e-12 or vb - va <= 1e-12:
             continue
         centre = wall.centre + R @ np.array([(ua + ub) / 2, (va + vb) / 2, 0.0])
-        boxes.append(BoxObstacle(centre, (ub - ua, vb - va, thickness), R))
+        boxes.append(BoxObstacle(centre, np.array([ub - ua, vb - va, thickness]), R))
     return boxes
 
 
@@ -149,7 +149,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     tr = np.trace(R)
     if tr > 0:
         s = 2.0 * math.sqrt(tr + 1.0)
-        q = (0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
     else:
         i = int(np.argmax(np.diag(R)))
         j, k = (i + 1) % 3, (i + 2) % 3
@@ -162,7 +162,7 @@ def _quat_array(R: np.ndarray) -> np.ndarray:
     return np.asarray(q, float)
 
 
-def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike) -> np.ndarray:
+def _torque_limits(robot: SnakeRobot, torque_limit: float | npt.ArrayLike | None) -> np.ndarray:
     n = robot.n_joints
     if torque_limit is None:
         lim = default_torque_limits(robot)
