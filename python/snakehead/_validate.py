@@ -285,16 +285,10 @@ def name_text(name: Any, what: str, *, max_chars: int = MAX_NAME_CHARS) -> str:
     marks, surrogates...). Everything else printable is a valid name -- ``$``, ``\\``, ``<script>``, ``|``, backticks,
     any script or emoji -- and every writer shows it literally (escaped for matplotlib, Markdown, HTML). Returned
     unchanged; :class:`InputTypeError` for a non-str, :class:`InputError` naming ``what`` otherwise."""
-    if not isinstance(name, str):
-        raise InputTypeError(f"{what} must be a str, got {type(name).__name__} {_shown(name)}")
+    _text(name, what, "", max_chars, "a name is one line of printable text (no control, format or line-separator "
+          "characters)")
     if not name.strip():
         raise InputError(f"{what} must be a name (visible text), got {name!r}")
-    bad = _forbidden_chars(name)
-    if bad:
-        raise InputError(f"{what} {_shown(name)} holds {', '.join(map(_char, bad))}: a name is one line of printable "
-                         "text (no control, format or line-separator characters)")
-    if len(name) > max_chars:
-        raise InputError(f"{what} is {len(name)} characters long; at most {max_chars}")
     return name
 
 
@@ -302,12 +296,17 @@ def display_text(text: Any, what: str, *, max_chars: int = 10_000) -> str:
     """Free text shown in the outputs (a scene's description, in figure titles and the viewer's page): a str of at
     most ``max_chars`` characters that may hold newlines and tabs but no other character of
     :data:`NAME_FORBIDDEN_CATEGORIES` (escape sequences would reach the terminal, a surrogate fails every writer)."""
+    return _text(text, what, "\n\t", max_chars, "only newlines and tabs of the control characters are kept in text")
+
+
+def _text(text: Any, what: str, allowed: str, max_chars: int, rule: str) -> str:
+    """``text`` if it is a str of at most ``max_chars`` characters without forbidden characters (but ``allowed``);
+    else the error, ending with ``rule``."""
     if not isinstance(text, str):
         raise InputTypeError(f"{what} must be a str, got {type(text).__name__} {_shown(text)}")
-    bad = _forbidden_chars(text, allowed="\n\t")
+    bad = _forbidden_chars(text, allowed=allowed)
     if bad:
-        raise InputError(f"{what} {_shown(text)} holds {', '.join(map(_char, bad))}: only newlines and tabs of the "
-                         "control characters are kept in text")
+        raise InputError(f"{what} {_shown(text)} holds {', '.join(map(_char, bad))}: {rule}")
     if len(text) > max_chars:
         raise InputError(f"{what} is {len(text)} characters long; at most {max_chars}")
     return text
