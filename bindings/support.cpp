@@ -11,7 +11,7 @@ namespace py = pybind11;
 namespace snakehead::bindings {
 
 void bind_support(py::module_& m) {
-  m.def("convex_hull", &convex_hull, py::arg("points"),
+  m.def("convex_hull_2d", &convex_hull, py::arg("points"),
         "Counter-clockwise convex hull indices of (N, 2) points; edge points left out");
   m.def(
       "hull_margins",

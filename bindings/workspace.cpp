@@ -81,8 +81,6 @@ py::dict map_to_dict(const ReachabilityMap& m) {
 }  // namespace
 
 void bind_workspace(py::module_& m) {
-  py::enum_<ApproachAxis>(m, "ApproachAxis").value("X", ApproachAxis::X).value("Z", ApproachAxis::Z);
-
   py::class_<WorkspaceOptions>(m, "WorkspaceOptions", "Parameters of a reachability sweep (workspace.hpp).")
       .def(py::init<>())
       .def_readwrite("voxel_size", &WorkspaceOptions::voxel_size)

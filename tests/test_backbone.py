@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+
+from snakehead._errors import Infeasible
 from scipy import optimize
 from scipy.spatial import ConvexHull
 
@@ -379,7 +381,7 @@ def test_other_bad_arc_input(robot):
         bb.arc_joint_angles(0.3, 1.0, robot)
     with pytest.raises(ValueError, match="min_margin"):
         bb.optimize_base_arc(robot, min_margin=-0.01)
-    with pytest.raises(ValueError, match="no central angle"):
+    with pytest.raises(Infeasible, match="no central angle"):
         bb.optimize_base_arc(robot, min_margin=1.0)
 
 
@@ -436,9 +438,9 @@ def test_bad_up_curve_shape(kwargs, match):
 
 
 def test_unreachable_or_inflected_up_curve(robot):
-    with pytest.raises(ValueError, match="beyond"):
+    with pytest.raises(Infeasible, match="beyond"):
         bb.initial_configuration(robot, shape=bb.UpCurveShape(height=0.9, reach=0.0))
-    with pytest.raises(ValueError, match="inflection"):  # ends pointing forward: needs an S-bend
+    with pytest.raises(Infeasible, match="inflection"):  # ends pointing forward: needs an S-bend
         bb.initial_configuration(robot, central_angle=2.0,
                                  shape=bb.UpCurveShape(height=0.3, reach=0.5, tip_angle=0.2))
 

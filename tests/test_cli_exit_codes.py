@@ -105,7 +105,7 @@ def test_a_traceback_only_when_asked(tmp_path):
     for off in ("", "0"):
         assert "Traceback" not in run(*argv, env={"SNAKEHEAD_TRACEBACK": off}).stderr
     loud = run(*argv, env={"SNAKEHEAD_TRACEBACK": "1"})
-    assert loud.returncode == 1 and "Traceback" in loud.stderr and "ValueError" in loud.stderr
+    assert loud.returncode == 1 and "Traceback" in loud.stderr and "InputError" in loud.stderr
 
 
 # --- 3 ------------------------------------------------------------------------------------------------------

@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from snakehead import InputError
+
 import snakehead
 from snakehead import SnakeRobot, default_urdf_path, sim
 from snakehead._files import atomic_open, write_text_atomic
@@ -236,8 +238,8 @@ def test_a_failed_write_leaves_the_old_file_and_no_partial_one(tmp_path):
     results = dict(line.split(" ", 1) for line in r.stdout.splitlines())
     assert sorted(results) == sorted(OUTPUTS), r.stdout
     for name in OUTPUTS:
-        kind = "ValueError" if name == "map.npz" else "OSError"  # workspace.save: the C++ writer's ValueError
-        assert results[name] == f"{kind} True", (name, results[name])
+        # every writer says which file it could not write: an InputError (the output's place is the user's)
+        assert results[name] == "InputError True", (name, results[name])
         assert (out / name).read_bytes() == b"old\n", name
     assert sorted(p.name for p in out.iterdir()) == sorted(OUTPUTS)  # no temporary file left
 
@@ -271,7 +273,7 @@ def test_atomic_writes_fail_cleanly_wherever_they_fail(tmp_path, monkeypatch, fa
         monkeypatch.setattr(os, "fsync", boom)
     elif failing == "replace":
         monkeypatch.setattr(os, "replace", boom)
-    with pytest.raises(OSError, match="No space left"):
+    with pytest.raises(InputError, match="cannot write .*No space left"):
         if failing == "write":
             with atomic_open(target) as f:
                 f.write("new " * 1000)
@@ -462,17 +464,17 @@ def test_durations_and_sizes_have_limits():
         """, timeout=300)
     assert r.returncode == 0, r.stderr[-3000:]
     lines = r.stdout.splitlines()
-    expected = ["ValueError control_dt must be at most 1 s, got 1e+300",
-                "ValueError the simulated motion (t[-1] - t[0] + hold): 1 s in steps of 1e-300 s is 1e+300 samples",
-                "ValueError hold must be at most 86400 s, got 1e+300",
-                "ValueError the simulated motion (t[-1] - t[0] + hold): 1e+12 s in steps of 0.002 s",
-                "ValueError timing has no option 'dt'; its options are velocity_limit, acceleration_limit, "
+    expected = ["InputError control_dt must be at most 1 s, got 1e+300",
+                "InputError the simulated motion (t[-1] - t[0] + hold): 1 s in steps of 1e-300 s is 1e+300 samples",
+                "InputError hold must be at most 86400 s, got 1e+300",
+                "InputError the simulated motion (t[-1] - t[0] + hold): 1e+12 s in steps of 0.002 s",
+                "InputError timing has no option 'dt'; its options are velocity_limit, acceleration_limit, "
                 "torque_limit, zmp_margin, friction",
-                "ValueError timing has no option 'grid_step'",
-                "ValueError target 'b': the line from 'a' is 0.06002 m long; at step_m = 1e-300 m that is 6e+298 poses",
-                "ValueError target 'a' hold_s must be at most 86400 s",
-                "ValueError the trajectory (t1 - t0): 1e+300 s in steps of 0.002 s is 5e+302 samples; at most 1000000",
-                "ValueError a run of 1e+300 cycles of the rolling gait must be at most 86400 s"]
+                "InputError timing has no option 'grid_step'",
+                "InputError target 'b': the line from 'a' is 0.06002 m long; at step_m = 1e-300 m that is 6e+298 poses",
+                "InputError target 'a' hold_s must be at most 86400 s",
+                "InputError the trajectory (t1 - t0): 1e+300 s in steps of 0.002 s is 5e+302 samples; at most 1000000",
+                "InputError a run of 1e+300 cycles of the rolling gait must be at most 86400 s"]
     assert len(lines) == len(expected), r.stdout
     for line, start in zip(lines, expected):
         assert line.startswith(start), (line, start)

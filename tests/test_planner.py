@@ -3,6 +3,8 @@ kinematic success and every check by independent computations."""
 import numpy as np
 import pytest
 
+from snakehead._errors import Infeasible
+
 import snakehead
 from snakehead import SnakeRobot
 from snakehead.control.controller import HeadController
@@ -107,7 +109,7 @@ def test_bending_state_of_a_base_with_no_stable_curl(controller):
     """A straight base has no support polygon with an interior (its contact points are collinear): no curl is
     stable on it. The bending state says so (it failed on an empty array before, and crashed the planner's choice
     of a base for a random target)."""
-    with pytest.raises(ValueError, match="no curl of the neck and head"):
+    with pytest.raises(Infeasible, match="no curl of the neck and head"):
         planner.bending_state(controller, np.zeros(controller.robot.n_joints))
 
 

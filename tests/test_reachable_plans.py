@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from snakehead._errors import Infeasible
+
 import snakehead
 from shape_reference import box_corners
 from snakehead.control import whole_body as wb
@@ -67,7 +69,7 @@ def test_relocated_base_holds_a_stable_curl(controller):
     prob = controller.body_problem
     plain = wb.solve_target(controller, t.position, t.direction, problem=prob, min_margin=planner.DETOUR_MARGIN)
     assert plain.success and plain.stage == wb.STAGES[2]
-    with pytest.raises(ValueError, match="no curl"):  # the case: the first base found holds no curl
+    with pytest.raises(Infeasible, match="no curl"):  # the case: the first base found holds no curl
         planner.bending_state(controller, plain.q)
 
     plan = snakehead.plan([(t.position, t.direction)], controller=controller)

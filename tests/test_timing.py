@@ -5,6 +5,8 @@ against direct computations; holds, stops and bad input."""
 import numpy as np
 import pytest
 
+from snakehead._errors import Infeasible
+
 import snakehead
 from snakehead.dynamics import stability
 from snakehead.dynamics.inverse_dynamics import inverse_dynamics
@@ -253,12 +255,12 @@ def test_bad_input():
     with pytest.raises(TypeError, match="robot"):
         timing.retime("snake", W)
     # paths no timing can follow, with the reason
-    with pytest.raises(ValueError, match="torque limit"):
+    with pytest.raises(Infeasible, match="torque limit"):
         timing.retime(robot, W, torque_limit=0.5)
     flat = np.zeros(robot.n_joints)
     tipping = flat.copy()
     tipping[robot.lift_joints.start] = -1.2 * robot.joint_signs[robot.lift_joints.start]  # the whole front up
-    with pytest.raises(ValueError, match="outside the support polygon"):
+    with pytest.raises(Infeasible, match="outside the support polygon"):
         timing.retime(robot, np.array([flat, tipping]), torque_limit=100.0)
 
 
@@ -278,7 +280,7 @@ def test_spline_path_and_its_overshoot():
         assert np.abs(traj.spline(traj.waypoint_times) - W).max() < 1e-9
     j = head[-1]  # the head link's joint: the CoM hardly moves
     W[:, j] = [robot.upper[j] - 0.3, robot.upper[j], robot.upper[j] - 0.05, robot.upper[j] - 0.3]
-    with pytest.raises(ValueError, match="overshoots a joint limit"):
+    with pytest.raises(Infeasible, match="overshoots a joint limit"):
         timing.retime(robot, W, interpolation="spline")
     assert timing.retime(robot, W).q[:, j].max() <= robot.upper[j] + 1e-12  # the monotone path never does
 

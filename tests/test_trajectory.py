@@ -2,6 +2,8 @@
 closed forms and brute force, ground clearance, box and wall collisions against brute force; bad input."""
 import numpy as np
 import pytest
+
+from snakehead._errors import Infeasible
 from scipy.optimize import lsq_linear
 from scipy.spatial.transform import Rotation
 
@@ -77,7 +79,7 @@ def test_duration_not_a_multiple_of_dt_ends_exactly():
 
 def test_joint_limits_overshoot_is_reported():
     wps = np.array([[0.0], [1.5], [1.5], [0.0]])
-    with pytest.raises(ValueError, match="overshoots the upper limit"):
+    with pytest.raises(Infeasible, match="overshoots the upper limit"):
         interp.joint_trajectory([0, 1, 1.2, 2.0], wps, lower=[-1.55], upper=[1.55])
 
 

@@ -1,4 +1,353 @@
-# The C++ core (pybind11 extension): its names are typed where the Python package wraps them.
-from typing import Any
-
-def __getattr__(name: str) -> Any: ...
+"""
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics
+"""
+from __future__ import annotations
+import collections.abc
+import numpy
+import numpy.typing
+import typing
+__all__: list[str] = ['Cancelled', 'ChainModel', 'ShapeSet', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'urdf_root_link']
+class ChainModel:
+    """
+    Immutable serial chain between two links of a URDF.
+    """
+    @staticmethod
+    def from_urdf(urdf: str, base: str, tip: str) -> ChainModel:
+        """
+        urdf: an XML document or a file path
+        """
+    def fk(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        ...
+    def fk_all(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> numpy.typing.NDArray[numpy.float64]:
+        ...
+    def fk_all_many(self, qs: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Every link's pose (T, n_links, 4, 4) for configurations qs (T, n), in the chain's base frame or, given origin (the base frame's pose, 4x4), in origin's frame
+        """
+    def jacobian(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    def kdl_fk(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        """
+        Reference FK through KDL's ChainFkSolverPos_recursive.
+        """
+    def kdl_jacobian(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Reference Jacobian through KDL's ChainJntToJacSolver.
+        """
+    @property
+    def base(self) -> str:
+        ...
+    @property
+    def body_hash(self) -> str:
+        """
+        digest of the links' masses, centres of mass, inertias and collision shapes
+        """
+    @property
+    def effort(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def hash(self) -> str:
+        """
+        digest of the kinematics (what maps depend on)
+        """
+    @property
+    def joint_axes(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        (n, 3) unit joint axes, each in the frame of the link the joint moves
+        """
+    @property
+    def joint_child_links(self) -> list[int]:
+        """
+        index into link_names of the link each joint moves (its frame is the joint frame)
+        """
+    @property
+    def joint_names(self) -> list[str]:
+        ...
+    @property
+    def joint_types(self) -> list[str]:
+        ...
+    @property
+    def link_collisions(self) -> list:
+        """
+        per link (link_names order) its <collision> elements as (kind, origin 4x4 in the link frame, size, mesh filename): kind 'box' (size = extents), 'cylinder' (radius, length, 0; axis z), 'sphere' (radius, 0, 0) or 'mesh' (size = scale; filename as written in the URDF)
+        """
+    @property
+    def link_coms(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def link_inertias(self) -> numpy.typing.NDArray[numpy.float64]:
+        ...
+    @property
+    def link_masses(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def link_names(self) -> list[str]:
+        ...
+    @property
+    def lower(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def n_joints(self) -> int:
+        ...
+    @property
+    def reach(self) -> float:
+        ...
+    @property
+    def tip(self) -> str:
+        ...
+    @property
+    def total_mass(self) -> float:
+        """
+        sum of the link masses (kg); may be 0
+        """
+    @property
+    def upper(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def velocity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class TracIK:
+    """
+    TRAC-IK on a chain: KDL-RR and SLSQP raced in a kept thread pool.
+    """
+    def __init__(self, model: ChainModel, timeout: typing.SupportsFloat | typing.SupportsIndex, epsilon: typing.SupportsFloat | typing.SupportsIndex, solve_type: str, bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], seed: typing.SupportsInt | typing.SupportsIndex | None = None) -> None:
+        ...
+    def fk(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        ...
+    def ik(self, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], q_init: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None = None, timeout: typing.SupportsFloat | typing.SupportsIndex | None = None, algorithm: str = 'TRAC-IK') -> tuple[bool, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], float]:
+        """
+        Returns (found, q, seconds); q is q_init when nothing was found.
+        """
+    def ik_many(self, poses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_inits: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], numpy.typing.NDArray[numpy.bool]]:
+        ...
+    @property
+    def bounds(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def epsilon(self) -> float:
+        ...
+    @property
+    def lower(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def n_joints(self) -> int:
+        ...
+    @property
+    def n_workers(self) -> int:
+        ...
+    @property
+    def seed(self) -> int | None:
+        ...
+    @property
+    def solve_type(self) -> str:
+        ...
+    @property
+    def timeout(self) -> float:
+        ...
+    @property
+    def upper(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class WorkspaceOptions:
+    """
+    Parameters of a reachability sweep (workspace.hpp).
+    """
+    any_roll: bool
+    approach_axis: str
+    free_roll: bool
+    hull: str
+    def __init__(self) -> None:
+        ...
+    def validate(self) -> None:
+        ...
+    @property
+    def cloud_samples(self) -> int:
+        ...
+    @cloud_samples.setter
+    def cloud_samples(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def directions(self) -> int:
+        ...
+    @directions.setter
+    def directions(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def epsilon(self) -> float:
+        ...
+    @epsilon.setter
+    def epsilon(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def map_shrink(self) -> float:
+        ...
+    @property
+    def poses_per_voxel(self) -> int:
+        ...
+    @property
+    def rolls(self) -> int:
+        ...
+    @rolls.setter
+    def rolls(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def seed(self) -> int:
+        ...
+    @seed.setter
+    def seed(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def shard_count(self) -> int:
+        ...
+    @shard_count.setter
+    def shard_count(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def shard_index(self) -> int:
+        ...
+    @shard_index.setter
+    def shard_index(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def shrink(self) -> float:
+        ...
+    @shrink.setter
+    def shrink(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def threads(self) -> int:
+        ...
+    @threads.setter
+    def threads(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def timeout(self) -> float:
+        ...
+    @timeout.setter
+    def timeout(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def voxel_size(self) -> float:
+        ...
+    @voxel_size.setter
+    def voxel_size(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+class ShapeSet:
+    """
+    Convex collision shapes attached to frames (immutable; safe to share between threads)
+    """
+    def __getstate__(self) -> tuple:
+        ...
+    def __init__(self, kinds: collections.abc.Sequence[str], frames: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], origins: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], sizes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], vertices: collections.abc.Sequence[typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None]) -> None:
+        """
+        kinds: list of 'box' | 'cylinder' | 'sphere' | 'convex'; frames (S,) int: the frame each is attached to; origins (S, 4, 4): each shape's frame in its frame; sizes (S, 3): box full extents, cylinder (radius, length, 0) along its z, sphere (radius, 0, 0), unused for convex; vertices: per shape a (V, 3) array (convex, in its frame) or None
+        """
+    def __setstate__(self, arg0: tuple) -> None:
+        ...
+    def hull_faces(self, i: typing.SupportsInt | typing.SupportsIndex) -> numpy.typing.NDArray[numpy.int64]:
+        """
+        The hull's triangles (F, 3), indices into hull_vertices, counter-clockwise from outside
+        """
+    def hull_vertices(self, i: typing.SupportsInt | typing.SupportsIndex) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The convex hull's vertices (V, 3) in the shape's frame (convex shapes only)
+        """
+    @property
+    def bounding_radii(self) -> numpy.typing.NDArray[numpy.float64]:
+        ...
+    @property
+    def frames(self) -> numpy.typing.NDArray[numpy.int64]:
+        ...
+    @property
+    def kinds(self) -> list[str]:
+        ...
+    @property
+    def size(self) -> int:
+        ...
+class Cancelled(Exception):
+    pass
+def approach_frame(point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], roll: typing.SupportsFloat | typing.SupportsIndex = 0.0, axis: str = 'x') -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    4x4 frame at point whose x- (or z-) axis is direction, rolled by roll rad about it
+    """
+def boundary(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], shrink: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> dict:
+    """
+    The paper's boundary(P) of (n, 3) points (alpha_shape.hpp): its alpha and size, as a dict
+    """
+def boundary_voxels(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], shrink: typing.SupportsFloat | typing.SupportsIndex, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], voxel: typing.SupportsFloat | typing.SupportsIndex, n: typing.SupportsInt | typing.SupportsIndex) -> numpy.typing.NDArray[numpy.int64]:
+    """
+    Linear ids of the grid voxels whose centre lies inside the boundary of the points
+    """
+def compute_reachability(model: ChainModel, options: WorkspaceOptions, progress: typing.Any = None) -> dict:
+    """
+    Algorithm 1 over options' shard; returns the map's arrays and statistics as a dict
+    """
+def convex_hull(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"]) -> dict:
+    """
+    qhull's hull of (n, 3) points: facet planes normal . x + offset <= 0 inside, volume
+    """
+def convex_hull_2d(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]", "flags.c_contiguous"]) -> list[int]:
+    """
+    Counter-clockwise convex hull indices of (N, 2) points; edge points left out
+    """
+def convex_hulls(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], active: typing.Annotated[numpy.typing.ArrayLike, numpy.bool]) -> tuple[numpy.typing.NDArray[numpy.int32], numpy.typing.NDArray[numpy.int32]]:
+    """
+    Each sample's counter-clockwise convex hull of its active points: vertex indices (T, N), -1 after the count, and the counts (T,)
+    """
+def evaluate_voxels(model: ChainModel, options: WorkspaceOptions, centers: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], stream_ids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], progress: typing.Any = None) -> dict:
+    """
+    Algorithm 1's lines 9-21 for spheres at the given centres; progress(done, total) -> bool
+    """
+def fibonacci_directions(n: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    n unit vectors spread evenly on the sphere (Fibonacci lattice), (n, 3)
+    """
+def hull_margins(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], active: typing.Annotated[numpy.typing.ArrayLike, numpy.bool], xy: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Signed distance (> 0 inside) of each sample's xy to the convex hull of its active points: (T,)
+    """
+def kdl_nr_jl_ik(model: ChainModel, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], q_init: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], timeout: typing.SupportsFloat | typing.SupportsIndex = 0.005, epsilon: typing.SupportsFloat | typing.SupportsIndex = 1e-05) -> tuple[bool, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+    """
+    KDL's ChainIkSolverPos_NR_JL from q_init until converged or timeout: (found, q).
+    """
+def momenta(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    The momenta of Eqs. 25-31 and the CoM: P, L about the frames' origin, c, (T, 3) each
+    """
+def newton_euler(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], share: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    Newton-Euler with the root link still: joint torques (T, n) and the inertial wrench across the first joint (force (T, 3), moment about the frames' origin (T, 3), in their axes; frames in an inertial frame where the root link is still)
+    """
+def pose_error(target: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], current: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    """
+    The IK pose error (vx vy vz wx wy wz) of `current` relative to `target`, in the target frame.
+    """
+def read_urdf_file(path: str) -> str:
+    """
+    The text of a URDF file: ValueError unless a readable regular file of at most 8 MiB
+    """
+def sample_tip_positions(model: ChainModel, samples: typing.SupportsInt | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    ...
+def save_map(path: str, command: str, options: WorkspaceOptions, centers: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], solved: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], voxel_ids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], reached: typing.Annotated[numpy.typing.ArrayLike, numpy.uint8] | None, tried: typing.SupportsInt | typing.SupportsIndex, grid_origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], grid_voxel: typing.SupportsFloat | typing.SupportsIndex, grid_n: typing.SupportsInt | typing.SupportsIndex, hull_voxels: typing.SupportsInt | typing.SupportsIndex, hull_facets: typing.SupportsInt | typing.SupportsIndex, alpha: typing.SupportsFloat | typing.SupportsIndex, reach: typing.SupportsFloat | typing.SupportsIndex, chain_hash: str, base: str, tip: str, ik_calls: typing.SupportsInt | typing.SupportsIndex, cheap_exits: typing.SupportsInt | typing.SupportsIndex, seconds: typing.SupportsFloat | typing.SupportsIndex, threads: typing.SupportsInt | typing.SupportsIndex) -> None:
+    """
+    The one map writer (save_npz, also workspace_gen's): a map's arrays to an .npz that numpy.load reads
+    """
+def shape_lowest_points(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set: ShapeSet, shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], max_points: typing.SupportsInt | typing.SupportsIndex = 16) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Each listed shape's max_points lowest ground-contact candidates in the world, by z ascending (padded with the lowest): (T, k, max_points, 3)
+    """
+def shape_lowest_z(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set: ShapeSet, shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64]) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The lowest world z of each listed shape: frames (T, L, 4, 4), shapes (k,) int -> (T, k)
+    """
+def shape_pair_distances(frames_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_a: ShapeSet, frames_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_b: ShapeSet, pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], cutoff: typing.SupportsFloat | typing.SupportsIndex = ...) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Signed distances (m) of shape pairs (P, 2) (set_a index, set_b index): frames_a (T, La, 4, 4), frames_b (T or 1, Lb, 4, 4) -> (T, P); > 0 apart, < 0 minus the penetration depth; exact where the bounding spheres' lower bound is below cutoff, that bound elsewhere
+    """
+def shape_pair_min_distances(frames_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_a: ShapeSet, frames_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_b: ShapeSet, pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], cutoff: typing.SupportsFloat | typing.SupportsIndex = ...) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The smallest of shape_pair_distances' values at each sample (pruned): (T,), +inf when there is no pair
+    """
+def urdf_root_link(urdf: str) -> str:
+    """
+    The root link of a URDF (an XML document or a file path)
+    """

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 import numpy.typing as npt
+
 from ._errors import InputError, InputTypeError
 
 ORTHONORMAL_TOLERANCE = 1e-6
@@ -234,10 +235,6 @@ def sample_count(span: float, step: float, name: str, *, maximum: int = MAX_SAMP
     return int(np.floor(max(steps, 0.0) + 1e-9)) + 1
 
 
-#: The longest name (UTF-8 bytes) that goes into a file name (a scene's: ``NAME_trajectory.csv``, ``NAME.html``...).
-MAX_NAME_BYTES = 100
-
-
 def sequence(x: Any, name: str) -> tuple:
     """``x`` (a list, tuple or other iterable but text, bytes or a mapping) as a tuple; TypeError otherwise (Python's
     own "'NoneType' object is not iterable" does not say which argument)."""
@@ -246,25 +243,105 @@ def sequence(x: Any, name: str) -> tuple:
     return tuple(x)
 
 
-def file_name_part(name: Any, what: str) -> str:
-    """A name that becomes part of a file name (``out / f"{name}_trajectory.csv"``): a non-empty str without path
-    separators or control characters, not "." or "..", at most MAX_NAME_BYTES bytes in UTF-8. Anything else could
-    write outside the output folder or fail half-way through the outputs."""
+#: The longest name (characters) of a target, a phase or anything else named in the outputs: shown in figure titles,
+#: legends and tables, where a longer one would only be cut off or stretch the figure.
+MAX_NAME_CHARS = 200
+
+#: The longest name (UTF-8 bytes) that goes into a file name (a scene's: ``NAME_trajectory.csv``, ``NAME.html``...).
+MAX_NAME_BYTES = 100
+
+#: Unicode categories that no name may hold: control characters (Cc: newline, tab, NUL, escape, DEL, C1 controls),
+#: format characters (Cf: zero-width spaces and joiners, bidirectional overrides, the soft hyphen), lone surrogates
+#: (Cs: not text at all) and line and paragraph separators (Zl, Zp). A name is one line of visible text.
+NAME_FORBIDDEN_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Zl", "Zp"})
+
+#: What a name that names files may not hold besides: path separators, and what Windows refuses in a file name
+#: (":" would write an NTFS alternate stream), so that an output folder can be copied anywhere.
+FILE_NAME_FORBIDDEN = frozenset('/\\<>:"|?*')
+
+#: Device names that Windows reserves with any suffix (``NUL.html`` is the null device there), compared caseless.
+RESERVED_FILE_NAMES = frozenset({"con", "prn", "aux", "nul", *(f"com{i}" for i in range(1, 10)),
+                                 *(f"lpt{i}" for i in range(1, 10))})
+
+
+def _char(c: str) -> str:
+    """A character as a message shows it: ``U+000A`` and its Unicode name where it has one."""
+    import unicodedata
+
+    kind = {"Cc": "a control character", "Cs": "a lone surrogate"}.get(unicodedata.category(c), "")
+    name = unicodedata.name(c, "") or kind
+    return f"U+{ord(c):04X}" + (f" ({name})" if name else "")
+
+
+def _forbidden_chars(text: str, allowed: str = "") -> list[str]:
+    import unicodedata
+
+    return sorted({c for c in text if c not in allowed and unicodedata.category(c) in NAME_FORBIDDEN_CATEGORIES})
+
+
+def name_text(name: Any, what: str, *, max_chars: int = MAX_NAME_CHARS) -> str:
+    """A name from the user (a target's, a scene's): a str of 1 to ``max_chars`` characters, not only whitespace,
+    without characters of :data:`NAME_FORBIDDEN_CATEGORIES` (newline, tab, NUL, escape, zero-width and bidirectional
+    marks, surrogates...). Everything else printable is a valid name -- ``$``, ``\\``, ``<script>``, ``|``, backticks,
+    any script or emoji -- and every writer shows it literally (escaped for matplotlib, Markdown, HTML). Returned
+    unchanged; :class:`InputTypeError` for a non-str, :class:`InputError` naming ``what`` otherwise."""
     if not isinstance(name, str):
         raise InputTypeError(f"{what} must be a str, got {type(name).__name__} {_shown(name)}")
-    if not name or name in (".", ".."):
-        raise InputError(f"{what} must be a name, got {name!r}")
-    bad = sorted({c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127})
+    if not name.strip():
+        raise InputError(f"{what} must be a name (visible text), got {name!r}")
+    bad = _forbidden_chars(name)
     if bad:
-        raise InputError(f"{what} {_shown(name)} holds {', '.join(map(repr, bad))}: it names files, so it may not hold "
-                         "path separators or control characters")
-    try:
-        size = len(name.encode("utf-8"))
-    except UnicodeEncodeError as exc:
-        raise InputError(f"{what} is not valid text: {exc.reason}") from None
+        raise InputError(f"{what} {_shown(name)} holds {', '.join(map(_char, bad))}: a name is one line of printable "
+                         "text (no control, format or line-separator characters)")
+    if len(name) > max_chars:
+        raise InputError(f"{what} is {len(name)} characters long; at most {max_chars}")
+    return name
+
+
+def display_text(text: Any, what: str, *, max_chars: int = 10_000) -> str:
+    """Free text shown in the outputs (a scene's description, in figure titles and the viewer's page): a str of at
+    most ``max_chars`` characters that may hold newlines and tabs but no other character of
+    :data:`NAME_FORBIDDEN_CATEGORIES` (escape sequences would reach the terminal, a surrogate fails every writer)."""
+    if not isinstance(text, str):
+        raise InputTypeError(f"{what} must be a str, got {type(text).__name__} {_shown(text)}")
+    bad = _forbidden_chars(text, allowed="\n\t")
+    if bad:
+        raise InputError(f"{what} {_shown(text)} holds {', '.join(map(_char, bad))}: only newlines and tabs of the "
+                         "control characters are kept in text")
+    if len(text) > max_chars:
+        raise InputError(f"{what} is {len(text)} characters long; at most {max_chars}")
+    return text
+
+
+def file_name_part(name: Any, what: str) -> str:
+    """A name that becomes part of a file name (``out / f"{name}_trajectory.csv"``): a :func:`name_text` without
+    path separators or the characters Windows refuses in file names (:data:`FILE_NAME_FORBIDDEN`), not "." or "..",
+    not a reserved device name (:data:`RESERVED_FILE_NAMES`, with or without a suffix), at most
+    :data:`MAX_NAME_BYTES` bytes in UTF-8. Anything else could write outside the output folder, fail half-way
+    through the outputs, or make an output folder that cannot be copied to another system."""
+    if isinstance(name, str) and name in (".", ".."):
+        raise InputError(f"{what} must be a name, got {name!r}")
+    if isinstance(name, str) and name:
+        bad = sorted({c for c in name if c in FILE_NAME_FORBIDDEN})
+        if bad:
+            raise InputError(f"{what} {_shown(name)} holds {', '.join(map(repr, bad))}: it names files, so it may "
+                             "not hold path separators or the characters < > : \" | ? *")
+    name_text(name, what, max_chars=MAX_NAME_BYTES)
+    if name.split(".")[0].rstrip(" ").lower() in RESERVED_FILE_NAMES:
+        raise InputError(f"{what} {_shown(name)} is a device name on Windows (NUL.html is not a file there); it "
+                         "names files, so choose another")
+    size = len(name.encode("utf-8"))  # name_text refused surrogates: it encodes
     if size > MAX_NAME_BYTES:
         raise InputError(f"{what} is {size} bytes long in UTF-8; at most {MAX_NAME_BYTES} (it names files)")
     return name
+
+
+def file_name_key(name: str) -> str:
+    """What two names that name files must not share: names equal under Unicode normalisation and case folding
+    ("Hole" and "hole", "é" composed and decomposed) are one file on macOS's and Windows's file systems."""
+    import unicodedata
+
+    return unicodedata.normalize("NFC", unicodedata.normalize("NFD", name).casefold())
 
 
 def input_file(path: Any, what: str, max_bytes: int) -> Path:
@@ -279,7 +356,7 @@ def input_file(path: Any, what: str, max_bytes: int) -> Path:
     if "\0" in text:
         raise InputError(f"cannot read {what} {text!r}: the path holds a NUL character")
     problem, info = _file_problem(text)
-    if problem is not None:
+    if problem is not None or info is None:
         raise InputError(f"cannot read {what} {text!r}: {problem}")
     if info.st_size > max_bytes:
         raise InputError(f"cannot read {what} {text!r}: it is {info.st_size} bytes; at most {max_bytes} are read")

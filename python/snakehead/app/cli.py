@@ -11,11 +11,9 @@ The command is snakehead (also python -m snakehead). Subcommands:
 
 Exit status:
   0    success
-  1    a scenario or target was planned but not successfully (the outputs are written all the same), or valid
-       input has no answer (snakehead.Infeasible: e.g. a robot whose neck and head cannot rise)
-  2    bad input: arguments, input files, or outputs that cannot be written (snakehead.InputError; one line on
-       stderr says which)
-  3    anything else: a bug in snakehead (one line on stderr; please report it with its traceback)
+  1    a scenario or target was planned but not successfully (the outputs are written all the same), or valid input has no answer (snakehead.Infeasible: e.g. a robot whose neck and head cannot rise)
+  2    bad arguments, bad input files, or outputs that cannot be written: snakehead.InputError, and only it (one line on stderr says which)
+  3    an internal error: any other exception, a bug in snakehead (one line on stderr; please report it with its traceback)
   130  interrupted (Ctrl-C; but view, which runs until Ctrl-C, then exits with 0)
 Errors are one line on stderr, never a traceback; set SNAKEHEAD_TRACEBACK=1 to see the Python traceback.
 """

@@ -114,6 +114,7 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
+    files += _ros_outputs(name, out, progress, result)
     drawing = None
     if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates
         drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
@@ -195,6 +196,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
     if run.plan is not None:
         files.append(rep.write_trajectory_csv(run.plan, out / f"{name}_trajectory.csv", controller.robot.joint_names)
                      .name)
+    files += _ros_outputs(name, out, progress, run.plan, run)
     if settings.figures:
         if run.phases:  # a loop that failed before its first phase has no path to draw
             files += _loop_figures(scene, run, out, s, progress)
@@ -223,6 +225,31 @@ def loop_entry(run: LoopRun, files: Sequence[str] = ()) -> dict:
     entry["notes"] = list(entry.get("notes") or []) + list(run.notes) + [LOOP_ASSUMPTION.format(noise=noise)]
     entry["files"] = list(files)
     return rep.jsonable(entry)
+
+
+def _ros_outputs(name: str, out: Path, progress: Progress, plan: Any, run: LoopRun | None = None) -> list[str]:
+    """``NAME.mcap``, the ROS 2 bag of the plan (of the loop's whole run when ``run`` is given and simulated
+    anything), and ``NAME_joint_trajectory.yaml``, the plan for controllers (:mod:`snakehead.app.ros_bag`); the
+    names of those written (none without a plan or a run)."""
+    from . import ros_bag
+
+    written: list[tuple[Path, float]] = []
+    with progress.stage(f"{name}: ROS 2 bag and joint trajectory"):
+        start = time.perf_counter()
+        bag = out / f"{name}.mcap"
+        if run is not None:
+            if run.phases:  # a loop that failed before its first phase simulated nothing
+                written.append((ros_bag.write_loop_bag(run, bag), time.perf_counter() - start))
+        elif plan is not None:
+            written.append((ros_bag.write_plan_bag(plan, bag), time.perf_counter() - start))
+        if plan is not None:
+            start = time.perf_counter()
+            written.append((ros_bag.write_joint_trajectory(plan, out / f"{name}_joint_trajectory.yaml"),
+                            time.perf_counter() - start))
+    if written:
+        progress.say(f"{name}: " + "; ".join(f"{p.name} {p.stat().st_size / 1e6:.1f} MB in {dt:.2f} s"
+                                             for p, dt in written))
+    return [p.name for p, _ in written]
 
 
 def _loop_figures(scene: Scene, run: LoopRun, out: Path, s: dict, progress: Progress) -> list[str]:
@@ -349,6 +376,7 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     from ..kinematics import workspace
     from ..model.robot import SnakeRobot
 
+    scenes = _distinct_names(scenes)
     settings = settings or Settings()
     progress = progress or Progress()
     out = Path(out)
@@ -389,6 +417,30 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     rep.write_json(report, out / "report.json")
     rep.write_summary(report, out / "summary.md")
     return report
+
+
+def _distinct_names(scenes: Sequence) -> tuple:
+    """InputError unless the scenes' names name distinct files: each scene's outputs are NAME_trajectory.csv,
+    NAME.gif, ... and its report entry is under its name, so two scenes of one name (or of names that differ only in
+    case or Unicode normalisation: one file on macOS and Windows) would overwrite each other's."""
+    from .._errors import InputError, InputTypeError
+    from .._validate import file_name_key, sequence
+    from ..scenes.scene import Scene
+
+    seen: dict[str, str] = {}
+    scenes = sequence(scenes, "scenes")
+    for k, scene in enumerate(scenes):
+        if not isinstance(scene, Scene):
+            raise InputTypeError(f"scenes[{k}] must be a Scene, got {type(scene).__name__}")
+        key = file_name_key(scene.name)
+        if key in seen:
+            same = "the same name" if seen[key] == scene.name else "names that differ only in case or normalisation"
+            raise InputError(f"two scenes have {same} ({seen[key]!r} and {scene.name!r}): their output files "
+                             "(NAME_trajectory.csv, NAME.gif, ...) would overwrite each other; rename one")
+        seen[key] = scene.name
+    if not seen:
+        raise InputError("scenes is empty: give at least one scene")
+    return scenes
 
 
 def _map_label(m: Any) -> str:

@@ -171,6 +171,49 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     return path
 
 
+#: What Markdown (CommonMark and GitHub's tables, strikethrough and math) reads as markup within a line: escapes,
+#: code, emphasis, links, raw HTML and entities, table cells, strikethrough, math, headings.
+_MARKDOWN_SPECIAL = frozenset("\\`*_[]<>&|~$#")
+
+
+def markdown_text(text: Any) -> str:
+    r"""``text`` (a name, a message) as Markdown shows it literally, within a line or a table cell: each character
+    that Markdown reads as markup (:data:`_MARKDOWN_SPECIAL`) backslash-escaped (``<script>`` is text, a ``|`` does
+    not split a cell, a ``\`` stays), a leading ``-``, ``+``, ``=`` or ``1.`` kept from starting a list (in a list
+    item), line breaks and other control characters made spaces and lone surrogates U+FFFD (a name has none: they
+    are refused where names enter; a message may). Surrounding whitespace is dropped, as a table cell drops it."""
+    import re
+    import unicodedata
+
+    def one(c: str) -> str:
+        category = unicodedata.category(c)
+        if category in ("Cc", "Zl", "Zp"):
+            return " "
+        if category == "Cs":
+            return "\ufffd"
+        return "\\" + c if c in _MARKDOWN_SPECIAL else c
+
+    out = "".join(map(one, str(text))).strip()
+    numbered = re.match(r"\d{1,9}[.)]", out)
+    if numbered:
+        return out[:numbered.end() - 1] + "\\" + out[numbered.end() - 1:]
+    return "\\" + out if out[:1] in ("-", "+", "=") else out
+
+
+def markdown_code(text: Any) -> str:
+    """``text`` (a file name) as a Markdown code span that shows it literally: fenced by one backtick more than its
+    longest run of backticks, padded with a space where it begins or ends with one (CommonMark's rule); line breaks
+    and other control characters made spaces (a code span cannot hold a line break)."""
+    import re
+    import unicodedata
+
+    t = "".join(" " if unicodedata.category(c) in ("Cc", "Zl", "Zp") else "\ufffd" if unicodedata.category(c) == "Cs"
+                else c for c in str(text))
+    fence = "`" * (max((len(r) for r in re.findall("`+", t)), default=0) + 1)
+    pad = " " if t[:1] == "`" or t[-1:] == "`" or (t[:1] == " " and t[-1:] == " " and t.strip()) else ""
+    return f"{fence}{pad}{t}{pad}{fence}"
+
+
 def _fmt(x: Any, scale: float = 1.0, digits: int = 2) -> str:
     if x is None:
         return "-"
@@ -180,28 +223,35 @@ def _fmt(x: Any, scale: float = 1.0, digits: int = 2) -> str:
 
 
 def summary_markdown(report: dict) -> str:
-    """A readable summary of ``report`` (the dict written to report.json), as Markdown."""
-    lines = [f"# snakehead {report.get('command', '')}", ""]
+    """A readable summary of ``report`` (the dict written to report.json), as Markdown. Every text taken from the
+    report -- scene and target names, phases, notes, stages, settings -- is shown literally (:func:`markdown_text`;
+    file names as code, :func:`markdown_code`): a name is never read as markup, and a table row always has its
+    columns."""
+    md = markdown_text
+    lines = [f"# snakehead {md(report.get('command', ''))}", ""]
     m, v = report.get("machine") or {}, report.get("versions") or {}
     if m:
-        lines += [f"Run on {m.get('cpu')} ({m.get('cores')} cores), {m.get('system')}; snakehead "
-                  f"{v.get('snakehead')}, Python {v.get('python')}, MuJoCo {v.get('mujoco') or 'not installed'}. "
+        lines += [f"Run on {md(m.get('cpu'))} ({md(m.get('cores'))} cores), {md(m.get('system'))}; snakehead "
+                  f"{md(v.get('snakehead'))}, Python {md(v.get('python'))}, "
+                  f"MuJoCo {md(v.get('mujoco') or 'not installed')}. "
                   f"Total run time {_fmt(report.get('run_time_s'), 1, 1)} s.", ""]
     for key in ("settings",):
         if report.get(key):
-            lines += ["Settings: " + ", ".join(f"{k} = {val}" for k, val in report[key].items()), ""]
+            lines += ["Settings: " + ", ".join(f"{md(k)} = {md(val)}" for k, val in report[key].items()), ""]
     for name, sc in report.get("scenarios", {}).items():
         paper = sc.get("paper") or {}
         sim = sc.get("sim")
-        lines += [f"## {name}: {'success' if sc['success'] else 'NOT successful'}", ""]
-        lines += [f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
-                  f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
-                  f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
-                  f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad.", ""]
+        lines += [f"## {md(name)}: {'success' if sc['success'] else 'NOT successful'}", ""]
+        # escaped as a whole: an unknown duration made it "- s of motion", a list item
+        lines += [md(f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
+                     f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, "
+                     f"planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
+                     f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
+                     f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad."), ""]
         lines += ["| target | planned position error (mm) | planned direction error (deg) | solved |",
                   "|---|---|---|---|"]
         for tg in sc["targets"]:
-            lines.append(f"| {tg['name']} | {_fmt(tg['position_error_m'], 1000, 4)} | "
+            lines.append(f"| {md(tg['name'])} | {_fmt(tg['position_error_m'], 1000, 4)} | "
                          f"{_fmt(tg['direction_error_deg'], 1, 4)} | {_fmt(tg.get('solved'))} |")
         lines += ["", "| check | ours (plan) | ours (MuJoCo) | paper |", "|---|---|---|---|"]
         s = sim or {}
@@ -241,20 +291,20 @@ def summary_markdown(report: dict) -> str:
             lines += ["", f"From lying straight (closed loop): {_fmt(sc.get('total_time_s'), 1, 1)} s in all, "
                       f"{sc.get('corrections', 0)} correction(s).", "", "| phase | kind | from (s) | to (s) |",
                       "|---|---|---|---|"]
-            lines += [f"| {ph['name']} | {ph['kind']} | {_fmt(ph['t0_s'], 1, 1)} | {_fmt(ph['t1_s'], 1, 1)} |"
+            lines += [f"| {md(ph['name'])} | {md(ph['kind'])} | {_fmt(ph['t0_s'], 1, 1)} | {_fmt(ph['t1_s'], 1, 1)} |"
                       for ph in sc["phases"]]
         notes = list(sc.get("notes") or [])
         if notes:
-            lines += ["", "Notes:", ""] + [f"- {n}" for n in notes]
+            lines += ["", "Notes:", ""] + [f"- {md(n)}" for n in notes]
         files = sc.get("files") or []
         if files:
-            lines += ["", "Files: " + ", ".join(f"`{f}`" for f in files)]
+            lines += ["", "Files: " + ", ".join(markdown_code(f) for f in files)]
         lines.append("")
     if report.get("notes"):
-        lines += ["## Notes", ""] + [f"- {n}" for n in report["notes"]] + [""]
+        lines += ["## Notes", ""] + [f"- {md(n)}" for n in report["notes"]] + [""]
     if report.get("stages"):
         lines += ["## Where the time went", "", "| stage | s |", "|---|---|"]
-        lines += [f"| {st['stage']} | {st['seconds']:.1f} |" for st in report["stages"]] + [""]
+        lines += [f"| {md(st['stage'])} | {st['seconds']:.1f} |" for st in report["stages"]] + [""]
     return "\n".join(lines)
 
 

@@ -132,9 +132,12 @@ def _q_up_for(robot: SnakeRobot, shape: UpCurveShape, turn: int) -> tuple[np.nda
     q = np.concatenate([q_base, np.zeros(robot.n_joints - nb)])
     F = robot.frames(q)
     R0 = F[robot.body.link_index(robot.parts.base_end), :3, :3]
-    curve, P = up_curve(arc, shape, up_length(robot))
-    phi0 = curve.initial_phase(R0)
-    q_up = curve_joint_angles(robot, curve, slice(nb, robot.n_joints), s_start=robot.base_length, phi0=phi0)
+    try:  # the shape and the robot are valid; a curve they make that Eqs. 3-7 cannot follow has no answer
+        curve, P = up_curve(arc, shape, up_length(robot))
+        phi0 = curve.initial_phase(R0)
+        q_up = curve_joint_angles(robot, curve, slice(nb, robot.n_joints), s_start=robot.base_length, phi0=phi0)
+    except InputError as exc:
+        raise Infeasible(f"the up curve of {shape} cannot be discretised: {exc}") from None
     return q_up, curve, P, phi0
 
 

@@ -27,7 +27,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable
-from .._errors import InputError, InputTypeError
+from .._errors import InputError, InputTypeError, entry_point, inputs_checked
 
 if TYPE_CHECKING:
     from ..kinematics.workspace import ReachabilityMap
@@ -120,6 +120,7 @@ class HeadController:
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 
     # --- the process ---------------------------------------------------------------------------
+    @entry_point
     def solve(self, position: npt.ArrayLike, direction: npt.ArrayLike, q_prev: npt.ArrayLike | None = None,
               base: BasePlacement | None = None, accept: Callable[..., bool] | None = None,
               allow_base_move: bool | None = None) -> HeadSolution:
@@ -151,6 +152,7 @@ class HeadController:
             raise InputTypeError(f"base must be a BasePlacement, got {type(base).__name__}")
         if accept is not None and not callable(accept):
             raise InputTypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
+        inputs_checked()
         return self.solve_checked(position, direction, q_prev, base, accept, allow_base_move)
 
     def solve_checked(self, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray | None = None,

@@ -146,7 +146,7 @@ def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None 
 def hull_indices(pts: npt.ArrayLike) -> list[int]:
     """Indices of the counter-clockwise convex hull vertices of 2-D points (N, 2), collinear points on edges left
     out (the C++ core's monotone chain): one index for coincident points, the two extremes for collinear points."""
-    return list(_core.convex_hull(finite_array(pts, "points", (None, 2))))
+    return list(_core.convex_hull_2d(finite_array(pts, "points", (None, 2))))
 
 
 def _hull_ccw(pts: np.ndarray) -> np.ndarray:

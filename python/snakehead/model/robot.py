@@ -645,6 +645,27 @@ class SnakeRobot:
         """World pose (4, 4) of the root frame when the base lies on the ground at ``base`` (default placement)."""
         return self.body_pose(base) @ np.linalg.inv(self._body_in_root)
 
+    @cached_property
+    def urdf_text(self) -> str:
+        """The URDF (XML) of :attr:`urdf`: the description as the core reads it (a xacro expanded, joint limits
+        and aligned frames added), what ROS tools take as ``robot_description``."""
+        return self.urdf if _is_xml_text(self.urdf) else _core.read_urdf_file(self.urdf)
+
+    @cached_property
+    def description_root(self) -> str:
+        """The URDF's root link: ``parts.root`` or a frame above it (a link-less dummy root)."""
+        return _core.urdf_root_link(self.urdf_text)
+
+    def description_root_pose(self, root_pose: npt.ArrayLike) -> np.ndarray:
+        """World pose (4, 4) of :attr:`description_root` when the root frame (``parts.root``) has the world pose
+        ``root_pose`` (4, 4) (e.g. :meth:`root_pose`); joints between the two, if any, at 0."""
+        T = finite_array(root_pose, "root_pose", (4, 4))
+        if self.description_root == self.parts.root:
+            return T.copy()
+        # the core takes chains with a moving joint: the one to the head tip, read where it passes the root frame
+        whole = Chain.from_urdf(self.urdf_text, self.description_root, self.parts.head_tip)
+        return T @ np.linalg.inv(whole.fk_all(np.zeros(whole.n_joints))[whole.link_index(self.parts.root)])
+
     def frames(self, q: npt.ArrayLike, base: BasePlacement | None = None) -> np.ndarray:
         """World poses of every frame in ``link_names`` at joint vector ``q`` (n,): (n_links, 4, 4)."""
         q = joint_vector(q, self.n_joints)

@@ -47,6 +47,8 @@ if TYPE_CHECKING:
 
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
+#: The contact model plans are checked with (``dynamics.stability.support_polygon``): every link lying on the ground.
+PLAN_CONTACT = "ground"
 DETOUR_MARGIN = 0.01  # m: static margin every planned configuration keeps (twice the ZMP margin: room for the motion)
 DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
@@ -282,7 +284,7 @@ class _Waypoints:
         the smaller of that and the base's own (:meth:`_base_margins`): a motion must not lean on a neck or head
         link that touches the ground at a checked configuration and may leave it in between."""
         com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
-        margin = stability.support_margins(self.robot, qs, com, self.base, contact="ground")
+        margin = stability.support_margins(self.robot, qs, com, self.base, contact=PLAN_CONTACT)
         if self.lift_index is not None:
             margin = np.minimum(margin, self._base_margins(qs, com))
         return margin
@@ -439,7 +441,7 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
     frames = robot.frames_many(traj.q, base)  # once, for every check below
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact=PLAN_CONTACT, frames=frames)
     clearance = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
     distance = None
     if obstacles:

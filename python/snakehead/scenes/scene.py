@@ -37,6 +37,16 @@ A scene file is TOML::
     position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
 
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
+
+Names (:func:`snakehead._validate.name_text`): a target's name is one line of printable text of at most
+:data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator
+characters (newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``, backticks and
+any script are names like others, shown literally in every figure and report. A scene's name also names its output
+files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name besides
+(:func:`~snakehead._validate.file_name_part`: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,
+at most 100 bytes). A description may also hold newlines and tabs. Anything else is an
+:class:`~snakehead._errors.InputError` naming the field.
+
 :func:`save_scene` writes a scene file (:func:`scene_to_toml`: its text) that :func:`load_scene` reads back as the
 same scene.
 """
@@ -50,10 +60,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validate import duration, file_name_part, finite_float, sequence, unit_vector3, world_position
+from .._errors import InputError, InputTypeError
+from .._validate import (display_text, duration, file_name_part, file_problem, finite_float, name_text, sequence, unit_vector3,
+                         world_position)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
-from .._errors import InputError, InputTypeError
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 
 APPROACHES = ("free", "line")
@@ -81,23 +92,22 @@ class Target:
     sphere_diameter: float | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"a target's name must be a non-empty string, got {self.name!r}")
+        name_text(self.name, "a target's name")
         object.__setattr__(self, "position", world_position(self.position, f"target {self.name!r} position"))
         object.__setattr__(self, "direction", unit_vector3(self.direction, f"target {self.name!r} direction"))
         object.__setattr__(self, "hold_s", duration(self.hold_s, f"target {self.name!r} hold_s", allow_zero=True))
         if not isinstance(self.approach, str) or self.approach not in APPROACHES:
-            raise ValueError(f"target {self.name!r}: approach must be one of {APPROACHES}, got {self.approach!r}")
+            raise InputError(f"target {self.name!r}: approach must be one of {APPROACHES}, got {self.approach!r}")
         step = finite_float(self.step_m, f"target {self.name!r} step_m")
         if step <= 0:
-            raise ValueError(f"target {self.name!r}: step_m must be > 0, got {self.step_m!r}")
+            raise InputError(f"target {self.name!r}: step_m must be > 0, got {self.step_m!r}")
         object.__setattr__(self, "step_m", step)
         if not isinstance(self.via, (bool, np.bool_)):
-            raise ValueError(f"target {self.name!r}: via must be true or false, got {self.via!r}")
+            raise InputError(f"target {self.name!r}: via must be true or false, got {self.via!r}")
         if self.sphere_diameter is not None:
             d = finite_float(self.sphere_diameter, f"target {self.name!r} sphere_diameter")
             if d <= 0:
-                raise ValueError(f"target {self.name!r}: sphere_diameter must be > 0, got {self.sphere_diameter!r}")
+                raise InputError(f"target {self.name!r}: sphere_diameter must be > 0, got {self.sphere_diameter!r}")
             object.__setattr__(self, "sphere_diameter", d)
 
 
@@ -115,31 +125,30 @@ class Scene:
 
     def __post_init__(self) -> None:
         file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
-        if not isinstance(self.description, str):
-            raise TypeError(f"a scene's description must be a str, got {type(self.description).__name__}")
+        display_text(self.description, "a scene's description")
         targets = sequence(self.targets, f"scene {self.name!r} targets")
         if not targets:
-            raise ValueError(f"scene {self.name!r} has no targets")
+            raise InputError(f"scene {self.name!r} has no targets")
         for t in targets:
             if not isinstance(t, Target):
-                raise TypeError(f"scene targets must be Target, got {type(t).__name__}")
+                raise InputTypeError(f"scene targets must be Target, got {type(t).__name__}")
         if targets[0].approach == "line":
-            raise ValueError(f"scene {self.name!r}: the first target cannot have approach = 'line' (a line starts at "
+            raise InputError(f"scene {self.name!r}: the first target cannot have approach = 'line' (a line starts at "
                              "the previous target)")
         if all(t.via for t in targets):
-            raise ValueError(f"scene {self.name!r}: every target is a via pose; at least one must be a target")
+            raise InputError(f"scene {self.name!r}: every target is a via pose; at least one must be a target")
         names = [t.name for t in targets]
         if len(set(names)) != len(names):
-            raise ValueError(f"scene {self.name!r}: target names must differ, got {names}")
+            raise InputError(f"scene {self.name!r}: target names must differ, got {names}")
         obstacles = sequence(self.obstacles, f"scene {self.name!r} obstacles")
         for ob in obstacles:
             if not isinstance(ob, OBSTACLE_TYPES):
-                raise TypeError("scene obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got "
+                raise InputTypeError("scene obstacles must be BoxObstacle, WallWithHole or MeshObstacle, got "
                                 f"{type(ob).__name__}")
         object.__setattr__(self, "targets", targets)
         object.__setattr__(self, "obstacles", obstacles)
         if self.base is not None and not isinstance(self.base, BasePlacement):
-            raise TypeError(f"scene base must be a BasePlacement, got {type(self.base).__name__}")
+            raise InputTypeError(f"scene base must be a BasePlacement, got {type(self.base).__name__}")
 
     @property
     def reported(self) -> tuple[Target, ...]:
@@ -150,6 +159,7 @@ class Scene:
     def from_targets(cls, pairs: Sequence, *, name: str = "target", obstacles: Sequence = (),
                      base: BasePlacement | None = None, hold_s: float = 1.0) -> "Scene":
         """A scene of (position, direction) pairs (or :class:`Target` objects), each held ``hold_s`` s."""
+        file_name_part(name, "a scene's name")  # before it names the targets
         targets = []
         items = sequence(pairs, "targets")
         for k, item in enumerate(items):
@@ -159,7 +169,7 @@ class Scene:
             try:
                 position, direction = item
             except (TypeError, ValueError):
-                raise ValueError(f"targets[{k}] must be a (position, direction) pair or a Target, got {item!r}") from None
+                raise InputError(f"targets[{k}] must be a (position, direction) pair or a Target, got {item!r}") from None
             label = name if len(items) == 1 else f"{name} {k + 1}"
             targets.append(Target(label, position, direction, hold_s=hold_s))
         return cls(name=name, targets=tuple(targets), obstacles=sequence(obstacles, "obstacles"), base=base)
@@ -179,30 +189,28 @@ _OBSTACLE_KEYS = {
 def _number_list(value: Any, where: str, n: int = 3) -> list[float]:
     if not isinstance(value, list) or len(value) != n or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        raise ValueError(f"{where} must be a list of {n} numbers, got {value!r}")
+        raise InputError(f"{where} must be a list of {n} numbers, got {value!r}")
     if not all(math.isfinite(v) for v in value):
-        raise ValueError(f"{where} must be finite, got {value!r}")
+        raise InputError(f"{where} must be finite, got {value!r}")
     return [float(v) for v in value]
 
 
 def _number(value: Any, where: str) -> float:
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-        raise ValueError(f"{where} must be a finite number, got {value!r}")
+        raise InputError(f"{where} must be a finite number, got {value!r}")
     return float(value)
 
 
 def _table(value: Any, where: str) -> dict:
     if not isinstance(value, dict):
-        raise ValueError(f"{where} must be a table, got {value!r}")
+        raise InputError(f"{where} must be a table, got {value!r}")
     return value
 
 
 def _target_from(entry: Any, where: str) -> Target:
     entry = _table(entry, where)
     check_keys(entry, *_TARGET_KEYS, where)
-    name = entry["name"]
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"{where}: name must be a non-empty string, got {name!r}")
+    name = name_text(entry["name"], f"{where}: name")
     kwargs: dict[str, Any] = {}
     for key in ("hold_s", "step_m", "sphere_diameter"):
         if key in entry:
@@ -211,25 +219,25 @@ def _target_from(entry: Any, where: str) -> Target:
         kwargs["approach"] = entry["approach"]
     if "via" in entry:
         if not isinstance(entry["via"], bool):
-            raise ValueError(f"{where}: via must be true or false, got {entry['via']!r}")
+            raise InputError(f"{where}: via must be true or false, got {entry['via']!r}")
         kwargs["via"] = entry["via"]
     try:
         return Target(name, np.asarray(_number_list(entry["position"], "position")),
                       np.asarray(_number_list(entry["direction"], "direction")), **kwargs)
     except ValueError as exc:  # the field's own message, said once where it is
-        raise ValueError(f"{where}: {exc}") from None
+        raise InputError(f"{where}: {exc}") from None
 
 
 def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObstacle | WallWithHole | MeshObstacle:
     entry = _table(entry, where)
     kind = entry.get("kind")
     if kind not in _OBSTACLE_KEYS:
-        raise ValueError(f"{where}: kind must be one of {sorted(_OBSTACLE_KEYS)}, got {kind!r}")
+        raise InputError(f"{where}: kind must be one of {sorted(_OBSTACLE_KEYS)}, got {kind!r}")
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
         if kind == "mesh":
             if not isinstance(entry["file"], str) or not entry["file"]:
-                raise ValueError(f"file must be a mesh file's path, got {entry['file']!r}")
+                raise InputError(f"file must be a mesh file's path, got {entry['file']!r}")
             return MeshObstacle.load((folder or Path(".")) / entry["file"], _number_list(entry["position"], "position"),
                                      _number(entry.get("yaw", 0.0), "yaw"),
                                      _number_list(entry.get("scale", [1.0, 1.0, 1.0]), "scale"), where="mesh")
@@ -242,7 +250,7 @@ def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObs
                                      _number_list(entry["size"], "size"),
                                      _number(entry["hole_diameter"], "hole_diameter"))
     except ValueError as exc:
-        raise ValueError(f"{where}: {exc}") from None
+        raise InputError(f"{where}: {exc}") from None
 
 
 def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = None, where: str = "scene") -> Scene:
@@ -250,11 +258,11 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     data = _table(data, where)
     check_keys(data, *_SCENE_KEYS, where)
     if not isinstance(data["targets"], list) or not data["targets"]:
-        raise ValueError(f"{where}: targets must be a non-empty array of tables ([[targets]])")
+        raise InputError(f"{where}: targets must be a non-empty array of tables ([[targets]])")
     targets = tuple(_target_from(e, f"{where}, targets[{k}]") for k, e in enumerate(data["targets"]))
     raw_obstacles = data.get("obstacles", [])
     if not isinstance(raw_obstacles, list):
-        raise ValueError(f"{where}: obstacles must be an array of tables ([[obstacles]])")
+        raise InputError(f"{where}: obstacles must be an array of tables ([[obstacles]])")
     obstacles = tuple(_obstacle_from(e, f"{where}, obstacles[{k}]", folder) for k, e in enumerate(raw_obstacles))
     base = None
     if "base" in data:
@@ -264,18 +272,18 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     robot_file = None
     if "robot" in data:
         if not isinstance(data["robot"], str) or not data["robot"]:
-            raise ValueError(f"{where}: robot must be a robot file's path, got {data['robot']!r}")
+            raise InputError(f"{where}: robot must be a robot file's path, got {data['robot']!r}")
         robot_file = (folder or Path(".")) / data["robot"]
-        if not robot_file.is_file():
-            raise ValueError(f"{where}: its robot file {os.fspath(robot_file)!r} does not exist")
+        if (problem := file_problem(robot_file)) is not None:
+            raise InputError(f"{where}: its robot file {os.fspath(robot_file)!r}: {problem}")
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
-            raise ValueError(f"{where}: {key} must be a string, got {data[key]!r}")
+            raise InputError(f"{where}: {key} must be a string, got {data[key]!r}")
     try:
         return Scene(name=data.get("name", name), targets=targets, obstacles=obstacles, robot_file=robot_file,
                      base=base, description=data.get("description", ""))
-    except ValueError as exc:
-        raise ValueError(f"{where}: {exc}") from None
+    except ValueError as exc:  # a name or a description refused by Scene: the file's fault
+        raise InputError(f"{where}: {exc}") from None
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
@@ -385,7 +393,7 @@ PAPER_SCENES = {"spheres": "spheres.toml", "hole": "hole.toml"}
 def paper_scene(name: str) -> Scene:
     """One of the paper's two scenes: ``"spheres"`` (Section 4.1) or ``"hole"`` (Section 4.2)."""
     if name not in PAPER_SCENES:
-        raise ValueError(f"the paper's scenes are {sorted(PAPER_SCENES)}, got {name!r}")
+        raise InputError(f"the paper's scenes are {sorted(PAPER_SCENES)}, got {name!r}")
     return load_scene(Path(__file__).with_name(PAPER_SCENES[name]))
 
 

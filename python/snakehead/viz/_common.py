@@ -14,6 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .._files import atomic_open
+from .._errors import InputError, InputTypeError
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.axes3d import Axes3D
@@ -39,8 +40,12 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def literal(text: str) -> str:
-    """``text`` (a name from the data: a scene's, a target's) shown as it is: matplotlib reads ``$...$`` as math and
-    fails to draw a figure whose text is not valid math (``$\\frac{$``)."""
+    """``text`` from the data (a scene's, a target's, a phase's or a frame's name; a message) made safe to show in
+    any matplotlib text -- titles, legends, annotations, axis labels -- as it is: matplotlib reads text between two
+    ``$`` as math (mathtext) and fails to draw a figure whose math is not valid (``$\\frac{$``). Every ``$`` is
+    escaped, so no math is parsed and the text is drawn literally (backslashes included). Every figure of
+    :mod:`snakehead.viz` passes names through it; text that is meant as math (``cm$^2$``) is never put in the same
+    string as a name. Titles given by the caller are drawn as given."""
     return str(text).replace("$", r"\$")
 
 
@@ -62,15 +67,15 @@ def save(figure: Figure | BodyAnimation, path: PathLike, *, dpi: float | None = 
     suffix = path.suffix.lower().lstrip(".")
     if isinstance(figure, BodyAnimation):
         if suffix != "gif":
-            raise ValueError(f"an animation is written as .gif, got {path.name!r}")
+            raise InputError(f"an animation is written as .gif, got {path.name!r}")
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_open(path, "wb") as f:
             figure.write_gif(f)
         return path
     if not isinstance(figure, Figure):
-        raise TypeError(f"save() takes a matplotlib Figure or a BodyAnimation, got {type(figure).__name__}")
+        raise InputTypeError(f"save() takes a matplotlib Figure or a BodyAnimation, got {type(figure).__name__}")
     if not suffix:
-        raise ValueError(f"the file name {path.name!r} has no suffix to choose the format by (.png, .pdf, .svg, ...)")
+        raise InputError(f"the file name {path.name!r} has no suffix to choose the format by (.png, .pdf, .svg, ...)")
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_open(path, "wb") as f:
         figure.savefig(f, format=suffix, dpi=DEFAULT_DPI if dpi is None else dpi, bbox_inches="tight")

@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from ._common import literal, new_figure, setup_axes3d
 from .body import Sphere, body_faces, draw_body, draw_scenery, plan_spheres, scene_bounds, view_angles
+from .._errors import InputError
 
 if TYPE_CHECKING:
     from matplotlib.text import Text
@@ -91,9 +92,9 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
     The head tip's path so far is traced. ``spheres``: as :func:`~snakehead.viz.body.plot_snapshots`."""
     fps = float(fps)
     if not (np.isfinite(fps) and fps > 0):
-        raise ValueError(f"fps must be positive, got {fps!r}")
+        raise InputError(f"fps must be positive, got {fps!r}")
     if int(max_frames) != max_frames or max_frames < 2:
-        raise ValueError(f"max_frames must be an integer >= 2, got {max_frames!r}")
+        raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
     spheres = plan_spheres(plan) if spheres is None else list(spheres)
     t = plan.t

@@ -29,6 +29,7 @@ from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..geometry.shapes import shape_mesh
 from ..model.robot import BasePlacement, SnakeRobot
 from ..motion.cartesian import cartesian_interpolation
+from .._errors import InputError
 from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, literal, new_figure,
                       setup_axes3d)
 
@@ -336,7 +337,7 @@ def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np
     target, then the waypoints nearest to evenly spaced times. Holds are left out."""
     states = [s for s in plan.states if not s[0].endswith("(hold)")]
     if not states:
-        raise ValueError("the plan has no states")
+        raise InputError("the plan has no states")
     times = np.array([s[1] for s in states])
     chosen = {0, len(states) - 1}
     for tg in plan.targets:
@@ -447,7 +448,7 @@ def plot_head_solution(robot: SnakeRobot, solution: HeadSolution) -> Figure:
         ax2.legend(fontsize=7, loc="lower right")
         ax2.grid(alpha=0.3)
     else:
-        ax2.text(0.5, 0.5, "no neck goal: " + solution.message, ha="center", va="center", wrap=True)
+        ax2.text(0.5, 0.5, "no neck goal: " + literal(solution.message), ha="center", va="center", wrap=True)
         ax2.set_axis_off()
     fig.suptitle("HeadController solution (Section 2.4, Fig. 8)")
     return fig

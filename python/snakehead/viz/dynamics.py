@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from ..dynamics import stability as st
 from ..model.robot import BasePlacement, SnakeRobot
 from ._common import PLANNED_COLOR, SIMULATED_COLOR, new_figure
+from .._errors import InputError
 
 
 if TYPE_CHECKING:
@@ -45,7 +46,7 @@ def plot_momenta(t: npt.ArrayLike, P: npt.ArrayLike, L: npt.ArrayLike, *, simula
     t = np.asarray(t, float)
     P, L = np.asarray(P, float), np.asarray(L, float)
     if P.shape != (len(t), 3) or L.shape != (len(t), 3):
-        raise ValueError(f"P and L must be (T, 3) arrays matching t ({len(t)} samples), got {P.shape} and {L.shape}")
+        raise InputError(f"P and L must be (T, 3) arrays matching t ({len(t)} samples), got {P.shape} and {L.shape}")
     other = None if simulated is None else _as_momenta(simulated)
     fig = new_figure(figsize=(13, 6))
     axes = fig.subplots(2, 3, sharex=True)

@@ -26,7 +26,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .._files import atomic_open
+from ._common import literal
 from .body import body_faces
+from .._errors import InputError, InputTypeError
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
 KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41"}
@@ -61,16 +63,18 @@ def _check(run: Any) -> None:
     from ..sim.loop import LoopRun
 
     if not isinstance(run, LoopRun):
-        raise TypeError(f"run must be a snakehead.sim.loop.LoopRun (ClosedLoop.run), got {type(run).__name__}")
+        raise InputTypeError(f"run must be a snakehead.sim.loop.LoopRun (ClosedLoop.run), got {type(run).__name__}")
     if not run.phases:
-        raise ValueError("the loop ran no phase: nothing to draw")
+        raise InputError("the loop ran no phase: nothing to draw")
 
 
 def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), title: str | None = None) -> Figure:
     """The top view: the tail's path over the ground (MuJoCo's) coloured by the kind of phase, and where the loop
     believed it was (dead reckoning, dashed; a fix is a jump of it); the body's footprint at the start, after every
     ground phase and at the end; the targets (crosses, their height written beside them). Phases are numbered
-    along the path and listed in the legend with their times. Axes in m, equal scales."""
+    along the path and listed in the legend with their times. Axes in m, equal scales. Names (the scene's, the
+    targets', the phases') are shown as they are (:func:`~snakehead.viz._common.literal`); ``title`` replaces the
+    title as given (matplotlib's mathtext applies to it)."""
     _check(run)
     from matplotlib.collections import PolyCollection
     from matplotlib.lines import Line2D
@@ -102,7 +106,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
             est = ph.run.root_estimate[:, :2, 3]
             ax.plot(est[:, 0], est[:, 1], "--", color=c, lw=0.9, alpha=0.8, zorder=3)
             body(ph.run.root_truth[-1], ph.run.q[-1], 0.15, zorder=1)
-        legend.append(Line2D([], [], color=c, lw=1.6, label=f"{k} {ph.name} ({ph.t0_s:.1f}-{ph.t1_s:.1f} s)"))
+        legend.append(Line2D([], [], color=c, lw=1.6, label=f"{k} {literal(ph.name)} ({ph.t0_s:.1f}-{ph.t1_s:.1f} s)"))
     if len(t_all):
         body(roots[-1], qs[-1], 0.9, zorder=4)
     for f in run.fixes:  # where the outside fix reset the estimate
@@ -110,8 +114,8 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         ax.plot(*roots[k, :2, 3], "*", color="k", ms=9, zorder=6)
     for tg in run.scene.targets:
         ax.plot(tg.position[0], tg.position[1], "x", color=TARGET_COLOR, ms=8, mew=2, zorder=6)
-        ax.annotate(f"{tg.name} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7, color=TARGET_COLOR,
-                    xytext=(5, 5), textcoords="offset points", zorder=6)
+        ax.annotate(f"{literal(tg.name)} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7,
+                    color=TARGET_COLOR, xytext=(5, 5), textcoords="offset points", zorder=6)
     legend += [Line2D([], [], color="k", ls="--", lw=0.9, label="estimated (dead reckoning)"),
                Line2D([], [], color="k", marker="*", ls="", label="outside fix"),
                Line2D([], [], color=TARGET_COLOR, marker="x", ls="", label="targets")]
@@ -122,8 +126,8 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     ax.set_ylabel("y (m)")
     head = run.metrics
     err = (f"; head {1000 * head['position_error_m']:.2f} mm / {head['direction_error_deg']:.2f} deg off"
-           if head else f"; {run.failure}" if run.failure else "")
-    ax.set_title(title or f"{run.scene.name}: the tail's path from above, {run.base_travel_m:.2f} m in "
+           if head else f"; {literal(run.failure)}" if run.failure else "")
+    ax.set_title(title or f"{literal(run.scene.name)}: the tail's path from above, {run.base_travel_m:.2f} m in "
                           f"{run.total_time_s:.0f} s{err}", fontsize=9)
     ax.legend(handles=legend, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     return fig
@@ -169,7 +173,7 @@ class LoopAnimation:
         """Write the GIF to ``path`` (whole or not at all); returns the path."""
         path = Path(path)
         if path.suffix.lower() != ".gif":
-            raise ValueError(f"an animation is written as .gif, got {path.name!r}")
+            raise InputError(f"an animation is written as .gif, got {path.name!r}")
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_open(path, "wb") as f:
             self.write_gif(f)
@@ -186,9 +190,9 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
 
     fps = float(fps)
     if not (np.isfinite(fps) and fps > 0):
-        raise ValueError(f"fps must be positive, got {fps!r}")
+        raise InputError(f"fps must be positive, got {fps!r}")
     if isinstance(max_frames, bool) or int(max_frames) != max_frames or max_frames < 2:
-        raise ValueError(f"max_frames must be an integer >= 2, got {max_frames!r}")
+        raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = run.robot
     t, roots, qs = run.timeline()
     idx = np.unique(np.linspace(0, len(t) - 1, int(min(max_frames, len(t)))).round().astype(int))
@@ -197,7 +201,8 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
     labels = []
     for k in idx:
         ph = next((p for p in run.phases if p.t0_s - 1e-9 <= t[k] <= p.t1_s + 1e-9), run.phases[-1])
-        labels.append(f"{run.scene.name}: t = {t[k]:5.1f} s, {ph.kind}: {ph.name}  (x{speedup:.0f} speed)")
+        labels.append(f"{literal(run.scene.name)}: t = {t[k]:5.1f} s, {ph.kind}: {literal(ph.name)}  "
+                      f"(x{speedup:.0f} speed)")
     # the scene's extent: every body position and the targets, the ground up to the highest point
     pts = robot.lowest_points(frames)[0].reshape(-1, 3)
     pts = np.vstack([pts, frames[:, :, :3, 3].reshape(-1, 3)])

@@ -35,8 +35,10 @@ import numpy as np
 import numpy.typing as npt
 
 from .._files import atomic_open, read_npz, write_text_atomic
+from .._validate import display_text, name_text
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
+from .._errors import InputError
 
 if TYPE_CHECKING:
     import viser
@@ -225,9 +227,9 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     from ..dynamics import stability as st
 
     if not (np.isfinite(frame_step_s) and frame_step_s > 0):
-        raise ValueError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
+        raise InputError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
     if int(max_frames) != max_frames or max_frames < 2:
-        raise ValueError(f"max_frames must be an integer >= 2, got {max_frames!r}")
+        raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
     t = np.asarray(plan.t, float)
     idx = frame_indices(t, frame_step_s, max_frames)
@@ -239,7 +241,7 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
 
     if workspace_map is not None and len(workspace_map):
         if workspace_map.chain_hash != robot.head_chain.hash:
-            raise ValueError(f"the map was made for another head chain ({workspace_map.base} -> {workspace_map.tip});"
+            raise InputError(f"the map was made for another head chain ({workspace_map.base} -> {workspace_map.tip});"
                              f" this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip}")
         voxels = np.asarray(workspace_map.centers, float)
         indices = np.asarray(workspace_map.indices, float)
@@ -385,34 +387,34 @@ def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
     for key, (kind, shape) in _SCENE_ARRAYS.items():
         a = values[key]
         if not (a.dtype.kind == kind or (kind == "f" and a.dtype.kind in "iu") or (kind == "i" and a.dtype.kind == "u")):
-            raise ValueError(f"{where}: {key} holds {a.dtype}, not {dict(f='numbers', i='integers', U='text')[kind]}")
+            raise InputError(f"{where}: {key} holds {a.dtype}, not {dict(f='numbers', i='integers', U='text')[kind]}")
         if a.ndim != len(shape):
-            raise ValueError(f"{where}: {key} has shape {a.shape}, expected {len(shape)} dimensions")
+            raise InputError(f"{where}: {key} has shape {a.shape}, expected {len(shape)} dimensions")
         for d, want in zip(a.shape, shape):
             if isinstance(want, int) and d != want or isinstance(want, str) and sizes.setdefault(want, d) != d:
-                raise ValueError(f"{where}: {key} has shape {a.shape}, which disagrees with the other arrays")
+                raise InputError(f"{where}: {key} has shape {a.shape}, which disagrees with the other arrays")
         if kind == "f" and key not in _SCENE_NAN_ALLOWED and not np.all(np.isfinite(a)):
-            raise ValueError(f"{where}: {key} holds NaN or inf")
+            raise InputError(f"{where}: {key} holds NaN or inf")
     if sizes["F"] < 1 or np.any(np.diff(values["times"]) < 0):
-        raise ValueError(f"{where}: times must be at least one time, in order")
+        raise InputError(f"{where}: times must be at least one time, in order")
     for key, bound in (("polygon_of_frame", "P"), ("wall_triangles", "W")):
         a = values[key]
         if a.size and (a.min() < 0 or a.max() >= sizes[bound]):
-            raise ValueError(f"{where}: {key} points outside its {sizes[bound]} entries")
+            raise InputError(f"{where}: {key} points outside its {sizes[bound]} entries")
     vs, ts = values["mesh_vertex_starts"], values["mesh_triangle_starts"]
     if (sizes["G1"] < 1 or vs[0] != 0 or ts[0] != 0 or vs[-1] != sizes["MV"] or ts[-1] != sizes["MT"]
             or np.any(np.diff(vs) < 0) or np.any(np.diff(ts) < 0)):
-        raise ValueError(f"{where}: mesh_vertex_starts / mesh_triangle_starts must run in order from 0 to the number "
+        raise InputError(f"{where}: mesh_vertex_starts / mesh_triangle_starts must run in order from 0 to the number "
                          "of mesh vertices / triangles")
     mesh = values["shape_mesh"]
     if mesh.size and (mesh.min() < 0 or mesh.max() >= sizes["G1"] - 1):
-        raise ValueError(f"{where}: shape_mesh points outside its {sizes['G1'] - 1} meshes")
+        raise InputError(f"{where}: shape_mesh points outside its {sizes['G1'] - 1} meshes")
     for g in range(sizes["G1"] - 1):
         tri = values["mesh_triangles"][ts[g]:ts[g + 1]]
         if tri.size and (tri.min() < 0 or tri.max() >= vs[g + 1] - vs[g]):
-            raise ValueError(f"{where}: mesh_triangles of mesh {g} point outside its {vs[g + 1] - vs[g]} vertices")
+            raise InputError(f"{where}: mesh_triangles of mesh {g} point outside its {vs[g + 1] - vs[g]} vertices")
     if np.any((values["voxel_indices"] < 0) | (values["voxel_indices"] > 100)) or not values["voxel_size"] >= 0:
-        raise ValueError(f"{where}: voxel_indices must be within [0, 100] and voxel_size >= 0")
+        raise InputError(f"{where}: voxel_indices must be within [0, 100] and voxel_size >= 0")
 
 
 def load_viewer_scene(path: str | Path) -> ViewerScene:
@@ -422,15 +424,17 @@ def load_viewer_scene(path: str | Path) -> ViewerScene:
     contents = read_npz(path, "viewer scene", max_bytes=MAX_SCENE_BYTES)
     version = contents.pop("format", None)
     if version is None or version.shape != () or version.dtype.kind not in "iu" or int(version) != SCENE_FORMAT:
-        raise ValueError(f"{where}: not a viewer scene of format {SCENE_FORMAT} (format {version!r})")
+        raise InputError(f"{where}: not a viewer scene of format {SCENE_FORMAT} (format {version!r})")
     names = {f.name for f in fields(ViewerScene)}
     missing = names - set(contents)
     if missing:
-        raise ValueError(f"{where}: viewer scene without {sorted(missing)}")
+        raise InputError(f"{where}: viewer scene without {sorted(missing)}")
     values: dict[str, Any] = {k: contents[k] for k in names}
     _check_scene_arrays(where, values)
-    values["name"] = str(values["name"])
-    values["title"] = str(values["title"])
+    values["name"] = name_text(str(values["name"]), f"{where}: name")
+    values["title"] = display_text(str(values["title"]), f"{where}: title")
+    for k, target in enumerate(values["target_names"].tolist()):
+        name_text(target, f"{where}: target_names[{k}]")
     values["voxel_size"] = float(values["voxel_size"])
     return ViewerScene(**values)
 
@@ -439,7 +443,7 @@ def scenes_in(directory: str | Path) -> list[Path]:
     """The viewer scenes (``*_viewer.npz``) in the output folder of ``snakehead plan`` or ``demo``, sorted."""
     directory = Path(directory)
     if not directory.is_dir():
-        raise ValueError(f"{directory} is not a directory")
+        raise InputError(f"{directory} is not a directory")
     return sorted(directory.glob("*" + SCENE_SUFFIX))
 
 
@@ -499,7 +503,7 @@ class SceneNodes:
                                 thickness=0.002)
         for i, (p, d, name, dia) in enumerate(zip(data.target_positions, data.target_directions, data.target_names,
                                                   data.target_diameters)):
-            node = f"{root}/targets/{i + 1} {name}"
+            node = f"{root}/targets/{i + 1} {_node_name(name)}"
             if np.isfinite(dia):
                 s.add_icosphere(node + "/sphere", radius=float(dia) / 2, color=TARGET_RGB, opacity=0.6,
                                 position=p, cast_shadow=False)
@@ -641,9 +645,15 @@ def html_page(data: ViewerScene) -> str:
 
 
 def _escape(text: str) -> str:
+    """``text`` as HTML shows it literally (``<script>`` is text, not an element)."""
     import html
 
     return html.escape(text, quote=True)
+
+
+def _node_name(name: str) -> str:
+    """A name as one level of viser's scene tree, whose paths are split at "/": each "/" shown as U+2215."""
+    return str(name).replace("/", "\u2215")
 
 
 def write_html(data: ViewerScene, path: str | Path) -> Path:
@@ -664,7 +674,7 @@ class Viewer:
         import viser
 
         if not scenes:
-            raise ValueError("no viewer scenes to show")
+            raise InputError("no viewer scenes to show")
         self.scenes = {s.name: s for s in scenes}
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
@@ -749,6 +759,6 @@ def serve(directory: str | Path, *, host: str = "127.0.0.1", port: int = 8080) -
     http://HOST:PORT (the next free port if PORT is taken); returns the running :class:`Viewer`."""
     paths = scenes_in(directory)
     if not paths:
-        raise ValueError(f"{directory} holds no viewer scenes (*{SCENE_SUFFIX}); 'snakehead plan' and "
+        raise InputError(f"{directory} holds no viewer scenes (*{SCENE_SUFFIX}); 'snakehead plan' and "
                          "'snakehead demo' write them")
     return Viewer([load_viewer_scene(p) for p in paths], host=host, port=port)

@@ -21,7 +21,8 @@ import numpy.typing as npt
 from matplotlib.figure import Figure
 
 from ..kinematics.workspace import Clusters, ReachabilityMap
-from ._common import new_figure
+from ._common import literal, new_figure
+from .._errors import InputError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -48,9 +49,9 @@ def index_colors(indices: npt.ArrayLike) -> np.ndarray:
 
 def _check(m: Any) -> None:
     if not isinstance(m, ReachabilityMap):
-        raise ValueError(f"expected a ReachabilityMap, got {type(m).__name__}")
+        raise InputError(f"expected a ReachabilityMap, got {type(m).__name__}")
     if len(m) == 0:
-        raise ValueError("the map has no voxels")
+        raise InputError("the map has no voxels")
 
 
 def _axes3d(ax: Any) -> Any:
@@ -58,7 +59,7 @@ def _axes3d(ax: Any) -> Any:
         fig = new_figure(figsize=(6.5, 5.5))
         ax = fig.add_subplot(projection="3d")
     if getattr(ax, "name", "") != "3d":
-        raise ValueError("a 3-D Axes is needed (fig.add_subplot(projection='3d'))")
+        raise InputError("a 3-D Axes is needed (fig.add_subplot(projection='3d'))")
     return ax
 
 
@@ -91,7 +92,7 @@ def plot_map(m: ReachabilityMap, ax: Any = None, min_index: float = 0.0, size: f
     sc = ax.scatter(p[:, 0], p[:, 1], p[:, 2], c=d, cmap=cmap, norm=norm, s=s, alpha=alpha, depthshade=False,
                     edgecolors="none")
     _label3d(ax, m)
-    ax.set_title(f"{m.base} \u2192 {m.tip}: {len(p)} voxels")
+    ax.set_title(f"{literal(m.base)} \u2192 {literal(m.tip)}: {len(p)} voxels")  # frame names: data
     if colorbar:
         _colorbar(ax.figure, sc, ax)
     return ax.figure
@@ -105,13 +106,13 @@ def plot_section(m: ReachabilityMap, ax: Axes | None = None, axis: str = "z", va
     from matplotlib.patches import Rectangle
 
     if axis not in ("x", "y", "z"):
-        raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
+        raise InputError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
     k = "xyz".index(axis)
     u, v = [i for i in range(3) if i != k]
     h = m.voxel_size
     layer = np.floor((float(value) - m.grid_origin[k]) / h)
     if not 0 <= layer < m.grid_shape[k]:
-        raise ValueError(f"{axis} = {value} is outside the grid")
+        raise InputError(f"{axis} = {value} is outside the grid")
     at = m.grid_origin[k] + (layer + 0.5) * h
     keep = np.abs(m.centers[:, k] - at) < h / 2
     if ax is None:

@@ -1,0 +1,438 @@
+"""ROS 2 bags of snakehead's motions, written without ROS, and the motion as a JointTrajectory for controllers.
+
+``snakehead plan`` and ``snakehead demo`` write, per scenario, beside ``NAME.html`` (docs: "Replay a plan in Foxglove
+or RViz"):
+
+* ``NAME.mcap`` (:func:`write_plan_bag`): a ROS 2 bag, one MCAP file in the ``ros2`` profile (``ros2msg`` schemas,
+  CDR messages) that ``ros2 bag play``, RViz and Foxglove read:
+
+  - :data:`JOINT_STATES` (``sensor_msgs/msg/JointState``): every sample of the plan (the control period, 2 ms): the
+    robot's joints in the CSV's order (then any other movable joint of the URDF, held at 0), positions (rad),
+    velocities (rad/s);
+  - :data:`TF` (``tf2_msgs/msg/TFMessage``) every :data:`TF_PERIOD`: ``world`` -> the URDF's root link, placed
+    where the plan puts the base, and ``world`` -> ``target/NAME`` (:func:`frame_name`; x-axis along the target's
+    direction); the links themselves are robot_state_publisher's, from the URDF and the joint states;
+  - :data:`ROBOT_DESCRIPTION` (``std_msgs/msg/String``), once at 0: the URDF (:attr:`SnakeRobot.urdf_text`);
+  - :data:`MARKERS` (``visualization_msgs/msg/MarkerArray``, frame ``world``): the targets and the obstacles every
+    :data:`STATIC_MARKER_PERIOD` (stamped 0), the support polygon and the ZMP on the ground every
+    :data:`MARKER_PERIOD`.
+
+  Time stamps, in the messages' headers and as the bag's log times, are nanoseconds from the start of the motion
+  (its first sample at 0). Every channel offers no recorded QoS (``ros2 bag play`` publishes with its defaults).
+* ``NAME.mcap`` of a closed loop (:func:`write_loop_bag`, ``snakehead plan --start``): the whole sequence as MuJoCo
+  ran it, on the simulation's clock: :data:`JOINT_STATES` the simulated joints, the URDF's root placed where the body
+  truly lay, the body frame's pose (what ``BasePlacement`` places) as :data:`TRUE_BASE_FRAME` and as the loop
+  believed it as :data:`ESTIMATED_BASE_FRAME` on :data:`TF`, the head phases' plan on
+  :data:`PLANNED_JOINT_STATES`, and during the head phases the planned support polygon and ZMP beside the simulated
+  ZMP.
+* ``NAME_joint_trajectory.yaml`` (:func:`write_joint_trajectory`): ``trajectory_msgs/msg/JointTrajectory`` as YAML
+  message fields, a point per sample of the plan.
+"""
+from __future__ import annotations
+
+import os
+import re
+import xml.etree.ElementTree as ET
+from functools import lru_cache
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from .._errors import InternalError, invariant
+from .._files import atomic_open, write_text_atomic
+from ..motion.interpolation import CONTROL_PERIOD
+from . import ros_messages as msgs
+
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
+    from ..motion.planner import Plan
+    from ..sim.loop import LoopRun
+
+#: The fixed frame everything is placed in (world coordinates: z up, the ground at z = 0).
+WORLD_FRAME = "world"
+#: The targets' frames are named this prefix and their names (:func:`frame_name`).
+TARGET_FRAME_PREFIX = "target/"
+#: The closed loop's body frame, as MuJoCo had it and as the loop estimated it.
+TRUE_BASE_FRAME = "base_true"
+ESTIMATED_BASE_FRAME = "base_estimate"
+
+JOINT_STATES = "/joint_states"
+PLANNED_JOINT_STATES = "/snakehead/planned_joint_states"
+TF = "/tf"
+ROBOT_DESCRIPTION = "/robot_description"
+MARKERS = "/snakehead/markers"
+#: The message type of every topic.
+TOPIC_TYPES = {JOINT_STATES: "sensor_msgs/msg/JointState", PLANNED_JOINT_STATES: "sensor_msgs/msg/JointState",
+               TF: "tf2_msgs/msg/TFMessage", ROBOT_DESCRIPTION: "std_msgs/msg/String",
+               MARKERS: "visualization_msgs/msg/MarkerArray"}
+
+#: s: how often /tf is published (20 Hz, robot_state_publisher's default rate); tf2 interpolates between.
+TF_PERIOD = 0.05
+#: s: how often the support polygon and the ZMP are published (10 Hz).
+MARKER_PERIOD = 0.1
+#: s: how often the targets and obstacles are published again (for a viewer that starts late or seeks).
+STATIC_MARKER_PERIOD = 1.0
+
+#: Marker colours (r, g, b, a) and sizes (m).
+TARGET_COLOR = (0.85, 0.15, 0.1, 1.0)
+OBSTACLE_COLOR = (0.55, 0.55, 0.6, 0.6)
+POLYGON_COLOR = (0.1, 0.6, 0.2, 1.0)
+ZMP_COLOR = (0.1, 0.3, 0.9, 1.0)
+SIMULATED_ZMP_COLOR = (0.9, 0.5, 0.0, 1.0)
+ARROW_LENGTH = 0.08
+TARGET_DOT = 0.012
+ZMP_DOT = 0.015
+LINE_WIDTH = 0.004
+TEXT_HEIGHT = 0.03
+GROUND_MARK_Z = 0.001  # m: the polygon and the ZMP are drawn this far above the ground, not in it
+
+_MOVABLE = ("revolute", "continuous", "prismatic")
+
+
+# --- what a bag holds ---------------------------------------------------------------------------------------------
+class _Bag:
+    """The messages of a bag, gathered, then written in time order into one MCAP file: a ``ros2msg`` schema per
+    type, a ``cdr`` channel per topic (``offered_qos_profiles`` empty: rosbag2 reads it as "no recorded QoS")."""
+
+    def __init__(self) -> None:
+        self.records: list[tuple[int, int, str, bytes]] = []  # (stamp ns, order added, topic, CDR)
+
+    def add(self, topic: str, stamp_ns: int, data: bytes) -> None:
+        self.records.append((int(stamp_ns), len(self.records), topic, data))
+
+    def add_message(self, topic: str, stamp_ns: int, message: dict) -> None:
+        self.add(topic, stamp_ns, _encoder(TOPIC_TYPES[topic])(message))
+
+    def add_many(self, topic: str, stamps: np.ndarray, data: Sequence[bytes]) -> None:
+        for s, d in zip(np.asarray(stamps).tolist(), data):
+            self.add(topic, s, d)
+
+    def add_joint_states(self, topic: str, stamps: np.ndarray, names: Sequence[str], q: np.ndarray,
+                         qd: np.ndarray | None) -> None:
+        self.add_many(topic, stamps, msgs.joint_state_cdr(stamps, names, q, qd))
+
+    def write(self, path: str | os.PathLike) -> Path:
+        """Write the bag to ``path`` atomically; returns the path."""
+        from mcap.writer import CompressionType, Writer
+
+        from .. import __version__
+
+        self.records.sort(key=lambda r: (r[0], r[1]))
+        with atomic_open(path, "wb") as f:
+            writer = Writer(f, compression=CompressionType.ZSTD)
+            writer.start(profile="ros2", library=f"snakehead {__version__}")
+            schemas: dict[str, int] = {}
+            channels: dict[str, int] = {}
+            for topic in dict.fromkeys(r[2] for r in self.records):
+                kind = TOPIC_TYPES[topic]
+                if kind not in schemas:
+                    schemas[kind] = writer.register_schema(kind, "ros2msg", msgs.schema_text(kind).encode())
+                channels[topic] = writer.register_channel(topic, "cdr", schemas[kind], {"offered_qos_profiles": ""})
+            sequence = dict.fromkeys(channels, 0)
+            for stamp_ns, _, topic, data in self.records:
+                sequence[topic] += 1
+                writer.add_message(channels[topic], log_time=stamp_ns, data=data, publish_time=stamp_ns,
+                                   sequence=sequence[topic])
+            writer.finish()
+        return Path(path)
+
+
+@lru_cache(maxsize=None)
+def _encoder(type_name: str) -> Callable[[Any], bytes]:
+    return msgs.encoder(type_name)
+
+
+def _stamps(seconds: np.ndarray) -> np.ndarray:
+    """ns (int64) of times in s (>= 0)."""
+    invariant(bool((np.asarray(seconds) >= -1e-9).all()), "a time stamp before the start")
+    return np.maximum(np.round(np.asarray(seconds, float) * 1e9), 0).astype(np.int64)
+
+
+def _every(t: np.ndarray, period: float) -> np.ndarray:
+    """Indices of the samples at (or just after) t[0], t[0] + period, ..., and the last one."""
+    grid = t[0] + period * np.arange(int(np.floor((t[-1] - t[0]) / period + 1e-9)) + 1)
+    return np.unique(np.r_[np.searchsorted(t, grid - 1e-9), len(t) - 1].clip(0, len(t) - 1))
+
+
+# --- joints and frames --------------------------------------------------------------------------------------------
+def joint_names(robot: SnakeRobot) -> list[str]:
+    """The joints :data:`JOINT_STATES` names: the robot's (its body's, the CSV's columns, in order), then every other
+    movable joint of the URDF that mimics none (a camera's pan, a wheel: held at 0), so that robot_state_publisher
+    places every link."""
+    body = list(robot.joint_names)
+    root = ET.fromstring(robot.urdf_text)
+    extra = [j.get("name", "") for j in root.findall("joint")
+             if j.get("type") in _MOVABLE and j.find("mimic") is None and j.get("name") not in body]
+    return body + extra
+
+
+def _joint_rows(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray | None) -> tuple[list[str], np.ndarray,
+                                                                                 np.ndarray | None]:
+    """The names and the position and velocity rows of :data:`JOINT_STATES` (the other joints at 0)."""
+    names = joint_names(robot)
+    pad = len(names) - q.shape[1]
+    if pad:
+        q = np.pad(q, ((0, 0), (0, pad)))
+        qd = None if qd is None else np.pad(qd, ((0, 0), (0, pad)))
+    return names, q, qd
+
+
+def frame_name(name: str) -> str:
+    """A valid tf2 frame id from ``name``: every run of characters other than letters, digits and "_" made one
+    "_" (a target "sphere 1" is the frame ``target/sphere_1``)."""
+    return re.sub(r"[^A-Za-z0-9_]+", "_", str(name)).strip("_") or "unnamed"
+
+
+def target_frames(targets: Sequence[Any]) -> list[tuple[str, np.ndarray]]:
+    """(frame id, world pose (4, 4)) of each target (``name``, ``position``, ``direction``): the x-axis along its
+    direction, z as near world z as can be; names made frame ids and unique (a "_2" for the second of a name)."""
+    from ..control.head import frame_along
+
+    out: list[tuple[str, np.ndarray]] = []
+    for tg in targets:
+        base = TARGET_FRAME_PREFIX + frame_name(tg.name)
+        frame, k = base, 1
+        while frame in (f for f, _ in out):
+            k += 1
+            frame = f"{base}_{k}"
+        d = np.asarray(tg.direction, float)
+        out.append((frame, frame_along(np.asarray(tg.position, float), d / np.linalg.norm(d))))
+    return out
+
+
+def _quaternions(T: np.ndarray) -> np.ndarray:
+    """Unit quaternions (..., 4) as (x, y, z, w) of the rotations of poses T (..., 4, 4)."""
+    from scipy.spatial.transform import Rotation
+
+    T = np.asarray(T, float)
+    return Rotation.from_matrix(T[..., :3, :3].reshape(-1, 3, 3)).as_quat().reshape(T.shape[:-2] + (4,))
+
+
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
+
+def _tf_messages(stamps: np.ndarray, children: Sequence[str], poses: np.ndarray) -> list[bytes]:
+    """TFMessages ``world`` -> each child at each stamp: ``poses`` (T, m, 4, 4) world (or (m, 4, 4): the same at
+    every stamp)."""
+    poses = np.broadcast_to(poses, (len(stamps), len(children), 4, 4))
+    return msgs.tf_message_cdr(stamps, WORLD_FRAME, children, poses[..., :3, 3], _quaternions(poses))
+
+
+# --- markers ------------------------------------------------------------------------------------------------------
+def _marker(ns: str, marker_id: int, kind: int, *, stamp_ns: int = 0, position: npt.ArrayLike = (0.0, 0.0, 0.0),
+            orientation: npt.ArrayLike = IDENTITY, scale: Sequence[float] = (1.0, 1.0, 1.0),
+            color: Sequence[float] = (1.0, 1.0, 1.0, 1.0), points: np.ndarray | None = None, text: str = "",
+            delete: bool = False) -> dict:
+    """A Marker in ``world``: its pose (``position`` m, ``orientation`` quaternion x, y, z, w), sizes in m,
+    ``points`` (k, 3) in its pose's frame; ADD, or DELETE with ``delete``."""
+    x, y, z = np.asarray(position, float).tolist()
+    qx, qy, qz, qw = np.asarray(orientation, float).reshape(4).tolist()
+    r, g, b, a = (float(c) for c in color)
+    pts = [] if points is None else [{"x": px, "y": py, "z": pz} for px, py, pz in np.asarray(points, float).tolist()]
+    return {"header": {"stamp": msgs.stamp(stamp_ns), "frame_id": WORLD_FRAME}, "ns": ns, "id": int(marker_id),
+            "type": kind, "action": 2 if delete else 0,  # DELETE / ADD
+            "pose": {"position": {"x": x, "y": y, "z": z}, "orientation": {"x": qx, "y": qy, "z": qz, "w": qw}},
+            "scale": dict(zip("xyz", (float(v) for v in scale))), "color": {"r": r, "g": g, "b": b, "a": a},
+            "points": pts, "text": text}
+
+
+def target_markers(targets: Sequence[Any], diameters: dict[str, float] | None = None) -> list[dict]:
+    """Per target: an arrow of :data:`ARROW_LENGTH` ending at it along its direction, a sphere (the scene's
+    ``sphere_diameter``, else a dot) and its name above it (namespaces "targets", "target_names")."""
+    frames = target_frames(targets)
+    if not frames:
+        return []
+    quats = _quaternions(np.array([T for _, T in frames]))
+    out = []
+    for k, (tg, (_, T), quat) in enumerate(zip(targets, frames, quats)):
+        p, x = T[:3, 3], T[:3, 0]
+        d = (diameters or {}).get(tg.name) or TARGET_DOT
+        out += [_marker("targets", 2 * k, msgs.ARROW, position=p - ARROW_LENGTH * x, orientation=quat,
+                        scale=(ARROW_LENGTH, 0.006, 0.012), color=TARGET_COLOR),
+                _marker("targets", 2 * k + 1, msgs.SPHERE, position=p, scale=(d, d, d),
+                        color=TARGET_COLOR[:3] + (0.5,)),
+                _marker("target_names", k, msgs.TEXT_VIEW_FACING, position=p + [0.0, 0.0, d / 2 + TEXT_HEIGHT],
+                        scale=(0.0, 0.0, TEXT_HEIGHT), color=(1.0, 1.0, 1.0, 1.0), text=str(tg.name))]
+    return out
+
+
+def obstacle_markers(obstacles: Sequence[Any]) -> list[dict]:
+    """The obstacles' convex shapes (namespace "obstacles"): boxes as cubes, spheres and cylinders as such, convex
+    pieces (a wall's around its hole, a mesh's hull) as one triangle list per obstacle."""
+    from scipy.spatial import ConvexHull
+
+    out: list[dict] = []
+    for obstacle in obstacles:
+        triangles = []
+        for shape in obstacle.shapes():
+            T = shape.origin
+            if shape.kind == "convex":
+                v = shape.vertices @ T[:3, :3].T + T[:3, 3]
+                triangles.append(v[ConvexHull(v).simplices].reshape(-1, 3))
+                continue
+            kind, size = {"box": (msgs.CUBE, shape.size),
+                          "sphere": (msgs.SPHERE, [2 * shape.radius] * 3),
+                          "cylinder": (msgs.CYLINDER, [2 * shape.radius, 2 * shape.radius, shape.size[1]])}[shape.kind]
+            out.append(_marker("obstacles", len(out), kind, position=T[:3, 3], orientation=_quaternions(T),
+                               scale=size, color=OBSTACLE_COLOR))
+        if triangles:
+            out.append(_marker("obstacles", len(out), msgs.TRIANGLE_LIST, points=np.concatenate(triangles),
+                               color=OBSTACLE_COLOR))
+    return out
+
+
+def ground_markers(stamp_ns: int, polygon: np.ndarray, zmp: np.ndarray, *, zmp_ns: str = "zmp",
+                   zmp_color: Sequence[float] = ZMP_COLOR) -> list[dict]:
+    """The support polygon (k, 2) world (x, y) m as a closed line (namespace "support_polygon"; deleted when it has
+    fewer than 2 vertices) and the ZMP (2,) m as a dot (namespace ``zmp_ns``; deleted when not finite), on the
+    ground."""
+    ring = np.c_[np.r_[polygon, polygon[:1]], np.full(len(polygon) + 1, GROUND_MARK_Z)] if len(polygon) else None
+    return [_marker("support_polygon", 0, msgs.LINE_STRIP, stamp_ns=stamp_ns, scale=(LINE_WIDTH, 0, 0),
+                    color=POLYGON_COLOR, points=ring, delete=len(polygon) < 2),
+            _marker(zmp_ns, 0, msgs.SPHERE, stamp_ns=stamp_ns, position=[*np.nan_to_num(zmp[:2]), GROUND_MARK_Z],
+                    scale=(ZMP_DOT,) * 3, color=zmp_color, delete=not bool(np.isfinite(zmp).all()))]
+
+
+def _add_static_markers(bag: _Bag, targets: Sequence[Any], obstacles: Sequence[Any], scene: Any,
+                        t_end_s: float) -> None:
+    """Targets and obstacles every :data:`STATIC_MARKER_PERIOD` from 0 to ``t_end_s`` (one encoding: stamped 0)."""
+    diameters = {t.name: t.sphere_diameter for t in scene.targets} if scene is not None else {}
+    data = _encoder(TOPIC_TYPES[MARKERS])({"markers": target_markers(targets, diameters) + obstacle_markers(obstacles)})
+    for s in _stamps(np.arange(0.0, t_end_s + 1e-9, STATIC_MARKER_PERIOD)).tolist():
+        bag.add(MARKERS, s, data)
+
+
+def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None) -> None:
+    """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``;
+    with ``simulated`` (a SimResult of the plan), its ZMP beside (namespace "zmp_simulated")."""
+    from ..dynamics import stability
+    from ..motion.planner import PLAN_CONTACT
+
+    t = np.asarray(plan.t, float)
+    idx = _every(t, MARKER_PERIOD)
+    vertices, count = stability.support_polygons(plan.robot, plan.q[idx], plan.base, contact=PLAN_CONTACT)
+    stamps = _stamps(t0_s + t[idx] - t[0])
+    sim_zmp = None
+    if simulated is not None:
+        ticks = np.searchsorted(simulated.t, t[idx] - 1e-9).clip(0, len(simulated.t) - 1)
+        sim_zmp = np.asarray(simulated.zmp, float)[ticks]
+    for j, k in enumerate(idx):
+        markers = ground_markers(int(stamps[j]), vertices[j, :count[j]], plan.stability.zmp[k])
+        if sim_zmp is not None:
+            markers += ground_markers(int(stamps[j]), vertices[j, :count[j]], sim_zmp[j], zmp_ns="zmp_simulated",
+                                      zmp_color=SIMULATED_ZMP_COLOR)[1:]
+        bag.add_message(MARKERS, int(stamps[j]), {"markers": markers})
+
+
+# --- the bags -----------------------------------------------------------------------------------------------------
+def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
+    """Write ``plan`` (a :class:`~snakehead.motion.planner.Plan`) as a ROS 2 bag at ``path`` (see the module);
+    returns the path. Every :data:`JOINT_STATES` sample is the plan's (``t``, ``q``, ``qd``)."""
+    robot = plan.robot
+    t = np.asarray(plan.t, float)
+    invariant(len(t) > 0 and plan.q.shape == (len(t), robot.n_joints), "a plan without samples")
+    stamps = _stamps(t - t[0])
+    bag = _Bag()
+    bag.add_joint_states(JOINT_STATES, stamps, *_joint_rows(robot, np.asarray(plan.q), np.asarray(plan.qd)))
+    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.urdf_text}))
+    goals = target_frames(plan.targets)
+    children = [robot.description_root] + [f for f, _ in goals]
+    poses = np.array([robot.description_root_pose(robot.root_pose(plan.base))] + [T for _, T in goals])
+    tf_stamps = stamps[_every(t, TF_PERIOD)]
+    bag.add_many(TF, tf_stamps, _tf_messages(tf_stamps, children, poses))
+    _add_static_markers(bag, plan.targets, plan.obstacles, plan.scene, float(t[-1] - t[0]))
+    _add_plan_markers(bag, plan, 0.0)
+    return bag.write(path)
+
+
+def _loop_tracks(run: LoopRun) -> tuple[np.ndarray, np.ndarray]:
+    """Along :meth:`LoopRun.timeline`: the joint velocities (T, n) rad/s (the head phases' simulated, the ground
+    phases' by finite differences of the recorded joints) and the root frame's estimated world pose (T, 4, 4): the
+    ground phases' dead reckoning (NaN where a run kept none), in the head phases the placement they were planned
+    from."""
+    robot = run.robot
+    qd, est = [], []
+    for r in run.ground_runs:
+        qd.append(np.gradient(r.q, r.t, axis=0) if len(r.t) > 1 else np.zeros_like(r.q))
+        est.append(r.root_estimate if r.root_estimate is not None else np.full((len(r.t), 4, 4), np.nan))
+    if run.head is not None and run.head.root_pose is not None:
+        planned = run.plan
+        if planned is None:
+            raise InternalError("a loop's head phases were simulated without their plan")
+        qd.append(run.head.qdot)
+        est.append(np.repeat(robot.root_pose(planned.base)[None], len(run.head.t), axis=0))
+    if not qd:
+        return np.zeros((0, robot.n_joints)), np.zeros((0, 4, 4))
+    return np.concatenate(qd), np.concatenate(est)
+
+
+def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
+    """Write a closed loop's run (:class:`~snakehead.sim.loop.LoopRun`) as a ROS 2 bag at ``path`` (see the
+    module); returns the path."""
+    robot = run.robot
+    t, roots, q = run.timeline()
+    invariant(len(t) > 0, "a loop that simulated nothing has no bag")
+    qd, estimates = _loop_tracks(run)
+    stamps = _stamps(t)
+    bag = _Bag()
+    bag.add_joint_states(JOINT_STATES, stamps, *_joint_rows(robot, q, qd))
+    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.urdf_text}))
+    targets = run.plan.targets if run.plan is not None else list(run.scene.targets)
+    goals = target_frames(targets)
+    idx = _every(t, TF_PERIOD)
+    body = robot.body_in_root
+    moving = np.stack([roots[idx] @ robot.description_root_pose(np.eye(4)), roots[idx] @ body], axis=1)
+    fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
+    bag.add_many(TF, stamps[idx], _tf_messages(stamps[idx], [robot.description_root, TRUE_BASE_FRAME]
+                                                + [f for f, _ in goals], np.concatenate([moving, fixed], axis=1)))
+    known = idx[np.isfinite(estimates[idx]).all(axis=(1, 2))]
+    bag.add_many(TF, stamps[known], _tf_messages(stamps[known], [ESTIMATED_BASE_FRAME], estimates[known, None] @ body))
+    _add_static_markers(bag, targets, list(run.scene.obstacles), run.scene, float(t[-1]))
+    if run.plan is not None:
+        p = run.plan
+        bag.add_joint_states(PLANNED_JOINT_STATES, _stamps(run.head_t0_s + p.t - p.t[0]),
+                             *_joint_rows(robot, np.asarray(p.q), np.asarray(p.qd)))
+        if run.head is not None:
+            _add_plan_markers(bag, p, run.head_t0_s, run.head)
+    return bag.write(path)
+
+
+# --- the trajectory for controllers -------------------------------------------------------------------------------
+def _yaml_float(x: float) -> str:
+    """``x`` as a YAML float that reads back exactly (Python's shortest repr, with a "." that YAML 1.1 needs)."""
+    text = repr(x)
+    return text.replace("e", ".0e") if "e" in text and "." not in text else text
+
+
+def _yaml_floats(row: np.ndarray) -> str:
+    return ", ".join(map(_yaml_float, row.tolist()))
+
+
+def _yaml_string(text: str) -> str:
+    return "'" + str(text).replace("'", "''") + "'"
+
+
+def write_joint_trajectory(plan: Plan, path: str | os.PathLike) -> Path:
+    """Write ``plan`` as a ``trajectory_msgs/msg/JointTrajectory`` in YAML (the message's fields, as ``ros2 topic
+    echo`` prints them and ``rosidl_runtime_py.set_message_fields`` reads them) at ``path``; returns the path.
+
+    A point per sample of the plan, at the control period (2 ms): ``positions`` (rad), ``velocities`` (rad/s),
+    ``time_from_start`` from the first sample (0); no accelerations or efforts; ``header.stamp`` 0 (a controller
+    starts it on arrival); ``joint_names`` the robot's, in the CSV's order."""
+    t = np.asarray(plan.t, float)
+    q, qd = np.asarray(plan.q, float), np.asarray(plan.qd, float)
+    invariant(len(t) > 0 and bool(np.isfinite(q).all() and np.isfinite(qd).all()), "a plan without finite samples")
+    period = float(np.median(np.diff(t))) if len(t) > 1 else CONTROL_PERIOD
+    title = " ".join(str(plan.name).split())
+    lines = [f"# trajectory_msgs/msg/JointTrajectory: snakehead's plan {title}, {len(t)} points every "
+             f"{1000 * period:g} ms; positions in rad, velocities in rad/s",
+             "header:", "  stamp: {sec: 0, nanosec: 0}", "  frame_id: ''",
+             "joint_names: [" + ", ".join(map(_yaml_string, plan.robot.joint_names)) + "]", "points:"]
+    for s, row, rate in zip(_stamps(t - t[0]).tolist(), q, qd):
+        time = msgs.stamp(s)
+        lines += [f"  - positions: [{_yaml_floats(row)}]", f"    velocities: [{_yaml_floats(rate)}]",
+                  "    accelerations: []", "    effort: []",
+                  f"    time_from_start: {{sec: {time['sec']}, nanosec: {time['nanosec']}}}"]
+    return write_text_atomic(path, "\n".join(lines) + "\n")
