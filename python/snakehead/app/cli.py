@@ -321,10 +321,7 @@ def _view_live(args: argparse.Namespace) -> int:
     from ..scenes import load_scene
     from ..viz.live import LiveViewer
 
-    try:
-        scene = load_scene(args.scene) if args.scene is not None else None
-    except ValueError as exc:  # the scene file's checks raise ValueError naming the file and the entry
-        raise UsageError(str(exc)) from None
+    scene = load_scene(args.scene) if args.scene is not None else None
     live = LiveViewer(scene, robot_file=args.robot, host=args.host, port=args.port)
     try:  # from here on Ctrl-C is how the viewer ends
         what = f"scene {scene.name!r}" if scene is not None else "a target where the head starts"
