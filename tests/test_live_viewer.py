@@ -140,7 +140,12 @@ def test_moving_a_target_replans_and_plays_the_new_motion_on_the_same_nodes(live
     # drawn by moving the nodes there were, none rebuilt
     assert live._nodes is nodes
     assert [h for h, _ in nodes.robot.batches] + [nodes.tip_path, nodes.zmp_path, nodes.polygon] == handles
+    for _ in range(100):  # the paths follow the first frame (PATHS_DELAY_S)
+        if np.allclose(nodes.tip_path.points, live.motion.tip_path, atol=1e-6):
+            break
+        time.sleep(0.05)
     np.testing.assert_allclose(nodes.tip_path.points, live.motion.tip_path, atol=1e-6)
+    np.testing.assert_allclose(nodes.polygon.points, live.motion.polygon, atol=1e-6)
     np.testing.assert_allclose(live._gizmos.handles[0].position, NEAR[1])
     assert f"motion {number} playing" in live._shown.content
 

@@ -52,16 +52,23 @@ if TYPE_CHECKING:
 
 #: s between two steps of the player (30 per second).
 TICK_S = 1.0 / 30.0
+#: s between two moves of the time slider while a motion plays (each is work for the browser's page).
+SLIDER_STEP_S = 0.25
 #: s the last frame of a motion is held before it plays again.
 HOLD_S = 1.0
+#: s after a new motion's first frame when its paths (head tip, ZMP, support polygon) are sent: a browser without a
+#: GPU takes a frame's time to take in new paths, which the first frame would otherwise wait for.
+PATHS_DELAY_S = 0.5
 #: Playback speeds offered, and the one at start.
 SPEEDS = ("1x", "2x", "4x", "8x")
 DEFAULT_SPEED = "4x"
 #: Shares of the body's length: a gizmo's size, and how far beside the last target a new target is put.
-GIZMO_SHARE = 0.12
+GIZMO_SHARE = 0.08
 NEW_TARGET_SHARE = 0.05
 #: s a target added in the viewer (or the one made when no scene is given) is held, as Scene.from_targets does.
 NEW_TARGET_HOLD_S = 1.0
+#: Strength of the hemisphere light that lights the sides the default lights leave dark (no environment map here).
+FILL_LIGHT = 1.5
 #: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
 GROUND_MARGIN_M = 0.2
 
@@ -158,6 +165,7 @@ class LiveViewer:
         self._draw = threading.RLock()  # the motion shown and its nodes
         self._motion: LiveMotion | None = None
         self._t = 0.0
+        self._paths_due: float | None = None  # perf_counter time to draw the motion's paths
         self._check: DynamicsCheck | None = None
         self._checking = False
         self._stop = threading.Event()
@@ -389,6 +397,7 @@ class LiveViewer:
             with self.server.atomic():
                 self._motion, self._t = motion, 0.0
                 self._nodes.start(motion)
+                self._paths_due = time.perf_counter() + PATHS_DELAY_S
                 self._time.max = max(round(motion.duration_s, 1), 0.1)
                 self._time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
                 self._shown.content = _shown_text(record, motion)
@@ -400,19 +409,24 @@ class LiveViewer:
             self._changed.notify_all()
 
     def _run_player(self) -> None:
-        last = time.perf_counter()
+        last = slider_moved = time.perf_counter()
         while not self._stop.wait(TICK_S):
             now = time.perf_counter()
             dt, last = now - last, now
             with self._draw:
                 m = self._motion
+                if m is not None and self._paths_due is not None and now >= self._paths_due:
+                    self._paths_due = None
+                    self._nodes.draw_paths(m)
                 if m is None or not self._playing.value:
                     continue
                 self._t += float(self._speed.value.rstrip("x")) * dt
                 if self._t > m.duration_s + HOLD_S:
                     self._t = 0.0
                 self._nodes.show(m, m.frame_at(self._t))
-                self._time.value = round(min(self._t, m.duration_s), 1)  # type: ignore[misc]
+                if now - slider_moved >= SLIDER_STEP_S:
+                    slider_moved = now
+                    self._time.value = round(min(self._t, m.duration_s), 1)  # type: ignore[misc]
 
     def _seek(self, event: Any) -> None:
         if event.client is None:  # the player moved the slider
@@ -453,7 +467,12 @@ class LiveViewer:
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
         s = self.server.scene
-        vw.light_scene(s)
+        # lit by viser's default lights alone, without shadows or an environment map: each costs a browser that
+        # renders in software (no GPU) much of its frame time, which a new motion waits for (bench/live_latency.py)
+        s.configure_environment_map(hdri=None)
+        s.configure_default_lights(enabled=True, cast_shadow=False)
+        s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
+                               intensity=FILL_LIGHT)
         q0, base = self.controller.q_initial, self.controller.base if self._base is None else self._base
         self._nodes = MotionNodes(s, self.robot, q0, base)
         arrays = vw.obstacle_arrays(self._scene.obstacles)

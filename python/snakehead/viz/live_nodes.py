@@ -172,13 +172,16 @@ class MotionNodes:
         self.frame = -1
 
     def start(self, motion: LiveMotion) -> None:
-        """Show ``motion``'s paths and its first frame."""
-        self.tip_path.points = motion.tip_path.astype(np.float32)
-        self.zmp_path.points = motion.zmp_path.astype(np.float32)
-        self.polygon.points = motion.polygon.astype(np.float32)
+        """Show ``motion``'s first frame (the robot, the ZMP); :meth:`draw_paths` adds its paths."""
         self.zmp.visible = True
         self.frame = -1
         self.show(motion, 0)
+
+    def draw_paths(self, motion: LiveMotion) -> None:
+        """Show ``motion``'s head tip path, ZMP trace and support polygon (in place of the last motion's)."""
+        self.tip_path.points = motion.tip_path.astype(np.float32)
+        self.zmp_path.points = motion.zmp_path.astype(np.float32)
+        self.polygon.points = motion.polygon.astype(np.float32)
 
     def show(self, motion: LiveMotion, k: int) -> None:
         """Move the robot and the ZMP to ``motion``'s frame ``k`` (nothing is sent if it is shown already)."""
