@@ -228,6 +228,34 @@ def test_the_mujoco_check_shows_its_errors_beside_the_plans(live):
     assert "| position error |" in table and "MuJoCo" in table and "| - |" not in table
 
 
+def test_a_snake_unlike_the_default_one(tmp_path):
+    """13 joints from a pitch joint, 10 cm modules, a one-joint neck, parts named by link frames (a coarse map)."""
+    import snakehead
+    from snakehead.kinematics import workspace as ws
+    from snakehead.model.generate import SnakeSpec, snake_urdf
+    from snakehead.model.robot_file import write_robot_file
+
+    spec = SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
+                     link_prefix="seg", joint_prefix="j", tip_name="nose", name="pitchy")
+    (tmp_path / "pitchy.urdf").write_text(snake_urdf(spec))
+    robot_file = write_robot_file(tmp_path / "pitchy.toml", urdf=tmp_path / "pitchy.urdf", base_end="seg6",
+                                  neck_end="seg7", head_tip="nose")
+    robot = snakehead.SnakeRobot.from_file(robot_file)
+    coarse = ws.compute(robot, progress=False, voxel=2 * ws.default_map_options(robot)["voxel"], directions=8,
+                        rolls=1)
+    controller = snakehead.HeadController(robot, coarse, method="free_roll", seed=1)
+    with LiveViewer(controller=controller, robot_file=robot_file, port=0) as viewer:
+        first = viewer.wait_for_plan(TIMEOUT_S)
+        assert first.error is None and first.playing is not None
+        head = robot.head_pose(controller.q_initial, controller.base)  # the one target: where the head starts
+        np.testing.assert_allclose(viewer.targets[0].position, head[:3, 3])
+        assert viewer.motion.positions.shape[1] == len(robot.geometry.shapes)
+        viewer.move_target(0, head[:3, 3] - [0.0, 0.0, 0.03])
+        moved = viewer.wait_for_plan(TIMEOUT_S)
+        assert moved.error is None and moved.playing is not None, moved
+        assert 'robot = "pitchy.toml"' in viewer.save_scene(tmp_path / "scene.toml").read_text()
+
+
 def test_the_command_line_takes_a_folder_or_live(tmp_path, capsys):
     assert main(["view"]) == 2
     assert "give DIR" in capsys.readouterr().err

@@ -154,8 +154,7 @@ class LiveViewer:
         self.controller = _controller(scene, robot, robot_file, controller)
         self.robot = self.controller.robot
         self.frame_step_s = float(frame_step_s)
-        self._base = scene.base if scene is not None else None
-        start = scene if scene is not None else Scene(name="live", targets=(self._initial_target(),))
+        start = scene if scene is not None else Scene(name="scene", targets=(self._initial_target(),))
         self._scene = dataclasses.replace(start, robot_file=Path(robot_file) if robot_file is not None
                                           else start.robot_file)
         self._targets = list(self._scene.targets)
@@ -169,6 +168,7 @@ class LiveViewer:
         self._check: DynamicsCheck | None = None
         self._checking = False
         self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
         self._serve(host, port)
         self._threads = [threading.Thread(target=self._run_worker, name="snakehead-live-planner", daemon=True),
                          threading.Thread(target=self._run_player, name="snakehead-live-player", daemon=True)]
@@ -292,6 +292,8 @@ class LiveViewer:
 
     def close(self) -> None:
         """Stop the threads and the server (a plan running is left to finish in its daemon thread)."""
+        if self._stop.is_set():
+            return
         self._stop.set()
         with self._changed:
             self._changed.notify_all()
@@ -466,15 +468,23 @@ class LiveViewer:
 
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        try:
+            self._draw_scene()
+            self._panel()
+        except BaseException:
+            self.server.stop()
+            raise
+
+    def _draw_scene(self) -> None:
         s = self.server.scene
-        # lit by viser's default lights alone, without shadows or an environment map: each costs a browser that
-        # renders in software (no GPU) much of its frame time, which a new motion waits for (bench/live_latency.py)
+        # lit by viser's default lights and a fill light, without shadows or an environment map: each costs a browser
+        # that renders in software (no GPU) much of its frame time, which a new motion waits for
+        # (bench/live_latency.py)
         s.configure_environment_map(hdri=None)
         s.configure_default_lights(enabled=True, cast_shadow=False)
         s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
                                intensity=FILL_LIGHT)
-        q0, base = self.controller.q_initial, self.controller.base if self._base is None else self._base
-        self._nodes = MotionNodes(s, self.robot, q0, base)
+        self._nodes = MotionNodes(s, self.robot, self.controller.q_initial, self.controller.base)
         arrays = vw.obstacle_arrays(self._scene.obstacles)
         vw.add_obstacles(s, f"{ROOT}/obstacles", **arrays)
         self._gizmos = TargetGizmos(s, GIZMO_SHARE * self.robot.body_length, self._released)
@@ -485,7 +495,6 @@ class LiveViewer:
         lo, hi = np.vstack(shown).min(axis=0), np.vstack(shown).max(axis=0)
         vw.add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
         vw.camera_to(self.server.initial_camera, *vw.camera_for(lo - 0.05, hi + 0.05))
-        self._panel()
 
     def _panel(self) -> None:
         gui = self.server.gui
