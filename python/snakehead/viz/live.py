@@ -375,8 +375,6 @@ class LiveViewer:
                 return
             motion = live_motion(record.number, result, self._nodes.origins, self.frame_step_s)
             record.drawn = time.time()
-            if self._superseded(record):
-                return
         except Exception as exc:  # noqa: BLE001 -- the viewer shows it and keeps serving; the traceback to stderr
             traceback.print_exc(file=sys.stderr)
             record.error = f"{type(exc).__name__}: {exc}"
@@ -394,8 +392,11 @@ class LiveViewer:
             return record.superseded
 
     def _start(self, record: Replan, motion: LiveMotion) -> None:
-        """Show ``motion`` from its first frame, with its status, in one message window sent at once."""
+        """Show ``motion`` from its first frame, with its status, in one message window sent at once (unless a
+        newer request came meanwhile)."""
         with self._draw:
+            if self._superseded(record):
+                return
             with self.server.atomic():
                 self._motion, self._t = motion, 0.0
                 self._nodes.start(motion)
