@@ -6,7 +6,8 @@ The command is snakehead (also python -m snakehead). Subcommands:
   demo        the paper's two scenarios of Section 4 end to end, with figures, animations and a report
   plan        head targets (--position/--direction, or --scene FILE) with the same outputs
   workspace   compute a reachability map of a robot's head (Algorithm 1) into a .npz file
-  view        the interactive 3-D viewer of the output of plan or demo, served to a web browser
+  view        the interactive 3-D viewer of the output of plan or demo, served to a web browser; --live plans
+              as you drag the head's targets
 
 Exit status:
   0    success
@@ -291,6 +292,16 @@ def _workspace(args: argparse.Namespace) -> int:
 def _view(args: argparse.Namespace) -> int:
     from ..viz import viewer
 
+    if args.live:
+        if args.dir is not None:
+            raise UsageError(f"--live plans as you drag the targets and shows no folder: drop {args.dir!r} (--scene "
+                             "FILE starts from a scene's targets and obstacles)")
+        return _view_live(args)
+    if args.dir is None:
+        raise UsageError("give DIR (the --out folder of 'snakehead plan' or 'demo'), or --live")
+    for option in ("robot", "scene"):
+        if getattr(args, option) is not None:
+            raise UsageError(f"--{option} goes with --live (DIR's scenes hold their robot and targets)")
     directory = Path(args.dir)
     if not directory.is_dir():
         raise UsageError(f"{args.dir!r} is not a directory (give the --out folder of 'snakehead plan' or 'demo')")
@@ -304,6 +315,24 @@ def _view(args: argparse.Namespace) -> int:
         return 0
     finally:
         shown.close()
+
+
+def _view_live(args: argparse.Namespace) -> int:
+    from ..scenes import load_scene
+    from ..viz.live import LiveViewer
+
+    scene = load_scene(args.scene) if args.scene is not None else None
+    live = LiveViewer(scene, robot_file=args.robot, host=args.host, port=args.port)
+    try:  # from here on Ctrl-C is how the viewer ends
+        what = f"scene {scene.name!r}" if scene is not None else "a target where the head starts"
+        print(f"snakehead view --live: http://{args.host}:{live.port} plans {what} again whenever a target's gizmo is "
+              "let go; Ctrl-C stops", flush=True)
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        live.close()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -427,13 +456,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_workspace)
 
-    p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo (a web page)",
+    p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo, or (--live) of "
+                                    "plans made as you drag targets (a web page)",
                        description="Serve the scenes that 'snakehead plan' or 'snakehead demo' wrote into DIR "
                                    "(NAME_viewer.npz) at http://HOST:PORT until Ctrl-C: the robot moving along its "
                                    "motion with play/pause and a time slider, the targets, the obstacles, the "
                                    "support polygon and the ZMP's trace, and the head's reachability map (toggled "
-                                   "on in the panel). Without a server, open DIR/NAME.html: the same scene.")
-    p.add_argument("dir", metavar="DIR", help="the --out folder of snakehead plan or demo")
+                                   "on in the panel). Without a server, open DIR/NAME.html: the same scene. With "
+                                   "--live (no DIR): the robot in its initial state and the targets as gizmos to "
+                                   "drag, turn, add and remove; the plan is made again and played whenever one is "
+                                   "let go, its failure shown with its reason; buttons check the motion in MuJoCo "
+                                   "and save the targets and obstacles as a scene file.")
+    p.add_argument("dir", metavar="DIR", nargs="?", default=None,
+                   help="the --out folder of snakehead plan or demo (not with --live)")
+    p.add_argument("--live", action="store_true",
+                   help="plan as you drag the targets (default: one where the head starts; --scene for a scene's)")
+    _add_robot_option(p)
+    p.add_argument("--scene", default=None, metavar="SCENE.toml",
+                   help="with --live: start from a scene file's targets, obstacles and base (its robot file unless "
+                        "--robot is given)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for every interface)")
     p.add_argument("--port", type=_port, default=8080, metavar="N",

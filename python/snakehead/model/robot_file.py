@@ -166,28 +166,29 @@ def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_e
     """Write a robot file; ``urdf`` and ``map`` are written relative to the file's folder when they lie under it."""
     out = Path(path)
     folder = out.resolve().parent
-
-    def rel(where: str | os.PathLike[str]) -> str:
-        p = Path(where).resolve()
-        try:
-            return p.relative_to(folder).as_posix()
-        except ValueError:
-            return os.path.relpath(p, folder).replace(os.sep, "/")
-
-    lines = [f"urdf = {_toml_string(rel(urdf))}"]
+    lines = [f"urdf = {toml_string(path_from(folder, urdf))}"]
     if root is not None:
-        lines.append(f"root = {_toml_string(root)}")
-    lines += [f"base_end = {_toml_string(base_end)}", f"neck_end = {_toml_string(neck_end)}",
-              f"head_tip = {_toml_string(head_tip)}"]
+        lines.append(f"root = {toml_string(root)}")
+    lines += [f"base_end = {toml_string(base_end)}", f"neck_end = {toml_string(neck_end)}",
+              f"head_tip = {toml_string(head_tip)}"]
     if map is not None:
-        lines.append(f"map = {_toml_string(rel(map))}")
+        lines.append(f"map = {toml_string(path_from(folder, map))}")
     from .._files import write_text_atomic
 
     write_text_atomic(out, "\n".join(lines) + "\n")
     return out
 
 
-def _toml_string(s: str) -> str:
+def path_from(folder: Path, where: str | os.PathLike[str]) -> str:
+    """``where`` as a file written in ``folder`` names it: relative to ``folder`` (with "/"), "../" where needed."""
+    p = Path(where).resolve()
+    try:
+        return p.relative_to(folder).as_posix()
+    except ValueError:
+        return os.path.relpath(p, folder).replace(os.sep, "/")
+
+
+def toml_string(s: str) -> str:
     """``s`` as a TOML basic string: quotes, backslashes and control characters escaped (a name holding a newline
     or a quote must read back as itself, never end the string early or add a key)."""
     if not isinstance(s, str):

@@ -1,5 +1,8 @@
-"""Scenes: head targets and obstacles as data (TOML scene files); the paper's two scenarios ship as scene files
-(``spheres.toml``, ``hole.toml``; :func:`paper_scene`)."""
-from .scene import APPROACHES, PAPER_SCENES, Scene, Target, load_scene, paper_scene, scene_from_dict
+"""Scenes: head targets and obstacles as data (TOML scene files, read by :func:`load_scene` and written by
+:func:`save_scene`); the paper's two scenarios ship as scene files (``spheres.toml``, ``hole.toml``;
+:func:`paper_scene`)."""
+from .scene import (APPROACHES, PAPER_SCENES, Scene, Target, load_scene, paper_scene, save_scene, scene_from_dict,
+                    scene_to_toml)
 
-__all__ = ["Scene", "Target", "load_scene", "scene_from_dict", "paper_scene", "PAPER_SCENES", "APPROACHES"]
+__all__ = ["Scene", "Target", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
+           "PAPER_SCENES", "APPROACHES"]

@@ -46,6 +46,9 @@ files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name
 (:func:`~snakehead._validate.file_name_part`: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,
 at most 100 bytes). A description may also hold newlines and tabs. Anything else is an
 :class:`~snakehead._errors.InputError` naming the field.
+
+:func:`save_scene` writes a scene file (:func:`scene_to_toml`: its text) that :func:`load_scene` reads back as the
+same scene.
 """
 from __future__ import annotations
 
@@ -62,7 +65,7 @@ from .._validate import (display_text, duration, file_name_part, file_problem, f
                          world_position)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
-from ..model.robot_file import check_keys, read_toml
+from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 
 APPROACHES = ("free", "line")
 #: Default spacing (m) of the poses solved along a straight-line approach.
@@ -292,6 +295,97 @@ def load_scene(path: str | os.PathLike) -> Scene:
                  base=scene.base, description=scene.description, path=p)
 
 
+# --- writing ----------------------------------------------------------------------------------------------
+def save_scene(scene: Scene, path: str | os.PathLike) -> Path:
+    """Write ``scene`` as a scene file at ``path`` (atomically) that :func:`load_scene` reads back as the same
+    scene: its robot file and mesh files named relative to the file's folder. Returns the path. InputError for an
+    obstacle a scene file cannot hold (see :func:`scene_to_toml`) or a path that cannot be written."""
+    from .._files import write_text_atomic
+
+    if not isinstance(scene, Scene):
+        raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
+    out = Path(path)
+    return write_text_atomic(out, scene_to_toml(scene, out.resolve().parent))
+
+
+def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
+    """The scene file (TOML text) of ``scene``, its paths relative to ``folder`` (where the file goes). Numbers are
+    written to their last digit, so that they read back exactly. InputError for what a scene file cannot say: a box
+    not upright (turned other than about z), a wall not standing on the ground (as ``WallWithHole.standing`` makes
+    it), a mesh obstacle tilted."""
+    if not isinstance(scene, Scene):
+        raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
+    where = Path(folder).resolve()
+    lines = [f"name = {toml_string(scene.name)}"]
+    if scene.description:
+        lines.append(f"description = {toml_string(scene.description)}")
+    if scene.robot_file is not None:
+        lines.append(f"robot = {toml_string(path_from(where, scene.robot_file))}")
+    if scene.base is not None:
+        b = scene.base
+        lines.append(f"base = {{ x = {_toml_float(b.x)}, y = {_toml_float(b.y)}, yaw = {_toml_float(b.yaw)} }}")
+    for t in scene.targets:
+        lines += ["", "[[targets]]"] + [f"{k} = {v}" for k, v in _target_entry(t).items()]
+    for k, ob in enumerate(scene.obstacles):
+        entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]")
+        lines += ["", "[[obstacles]]"] + [f"{key} = {v}" for key, v in entry.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _toml_float(x: float) -> str:
+    return repr(float(x))  # the shortest text that reads back as the same float; valid TOML (1e-05, 2.0)
+
+
+def _toml_floats(v: Any) -> str:
+    return "[" + ", ".join(_toml_float(x) for x in np.asarray(v, float).ravel()) + "]"
+
+
+def _target_entry(t: Target) -> dict[str, str]:
+    """A target's keys as TOML values: those that differ from their defaults only."""
+    entry = {"name": toml_string(t.name), "position": _toml_floats(t.position), "direction": _toml_floats(t.direction)}
+    if t.hold_s:
+        entry["hold_s"] = _toml_float(t.hold_s)
+    if t.approach != "free":
+        entry["approach"] = toml_string(t.approach)
+    if t.step_m != DEFAULT_LINE_STEP:
+        entry["step_m"] = _toml_float(t.step_m)
+    if t.via:
+        entry["via"] = "true"
+    if t.sphere_diameter is not None:
+        entry["sphere_diameter"] = _toml_float(t.sphere_diameter)
+    return entry
+
+
+def _yaw_of(R: np.ndarray, where: str, what: str) -> float:
+    """The yaw (rad) of a rotation about the world z-axis; InputError for any other rotation."""
+    yaw = math.atan2(R[1, 0], R[0, 0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    if not np.allclose(R, [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], atol=1e-9):
+        raise InputError(f"{where}: {what} is turned other than about the world z-axis, which a scene file cannot "
+                         "say (its yaw is the only rotation)")
+    return yaw
+
+
+def _obstacle_entry(ob: Any, folder: Path, where: str) -> dict[str, str]:
+    """An obstacle's keys as TOML values (the entry :func:`_obstacle_from` reads)."""
+    if isinstance(ob, BoxObstacle):
+        return {"kind": '"box"', "centre": _toml_floats(ob.centre), "size": _toml_floats(ob.size),
+                "yaw": _toml_float(_yaw_of(ob.rotation, where, "the box"))}
+    if isinstance(ob, WallWithHole):
+        standing = WallWithHole.standing(ob.centre, ob.normal, ob.size, ob.hole_diameter) \
+            if abs(ob.normal[2]) <= 1e-9 and 0 < ob.centre[2] < ob.size[1] else None
+        if standing is None or not np.allclose(standing.hole_offset, ob.hole_offset, atol=1e-9):
+            raise InputError(f"{where}: the wall does not stand on the ground with its hole on its vertical centre "
+                             "line (WallWithHole.standing), the only wall a scene file can say")
+        return {"kind": '"wall_with_hole"', "hole_centre": _toml_floats(ob.centre), "normal": _toml_floats(ob.normal),
+                "size": _toml_floats(ob.size), "hole_diameter": _toml_float(ob.hole_diameter)}
+    if isinstance(ob, MeshObstacle):
+        return {"kind": '"mesh"', "file": toml_string(path_from(folder, ob.path)),
+                "position": _toml_floats(ob.pose[:3, 3]),
+                "yaw": _toml_float(_yaw_of(ob.pose[:3, :3], where, "the mesh")), "scale": _toml_floats(ob.scale)}
+    raise InputTypeError(f"{where}: not an obstacle: {type(ob).__name__}")
+
+
 #: The paper's scenes shipped with the package (Section 4): name -> file.
 PAPER_SCENES = {"spheres": "spheres.toml", "hole": "hole.toml"}
 
@@ -303,4 +397,5 @@ def paper_scene(name: str) -> Scene:
     return load_scene(Path(__file__).with_name(PAPER_SCENES[name]))
 
 
-__all__ = ["Target", "Scene", "load_scene", "scene_from_dict", "paper_scene", "PAPER_SCENES", "APPROACHES"]
+__all__ = ["Target", "Scene", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
+           "PAPER_SCENES", "APPROACHES"]

@@ -9,7 +9,9 @@ to a file, atomically. By topic:
 * :mod:`.workspace` -- reachability maps: Figs. 4-7;
 * :mod:`.dynamics` -- momenta (Figs. 18-19) and the ZMP in the support polygon (Fig. 20);
 * :mod:`.animation` -- a plan's motion as a GIF (:func:`~.animation.animate`);
-* :mod:`.viewer` -- the interactive 3-D viewer (viser): a standalone HTML page per plan and ``snakehead view``.
+* :mod:`.viewer` -- the interactive 3-D viewer (viser): a standalone HTML page per plan and ``snakehead view``;
+* :mod:`.live` -- the live viewer (``snakehead view --live``): drag the head's targets, the plan follows
+  (:mod:`.live_nodes`: what it draws).
 
 >>> from snakehead.viz import save, body
 >>> save(body.plot_snapshots(plan), "snapshots.png")                    # doctest: +SKIP

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from .._files import atomic_open, read_npz, write_text_atomic
 from .._validate import display_text, name_text
@@ -59,6 +60,10 @@ TARGET_RGB = (192, 57, 43)
 WALL_RGB = (161, 136, 127)
 OBSTACLE_RGB = (141, 110, 99)
 TIP_PATH_RGB = (90, 90, 90)
+#: m: a target's arrow runs along its direction from this far behind the target to this far short of it.
+TARGET_ARROW_M = (0.09, 0.01)
+#: m: a target's label is this high above it.
+TARGET_LABEL_HEIGHT_M = 0.04
 #: Vertical field of view of the initial camera (deg); the browser test projects with it.
 CAMERA_FOV_DEG = 45.0
 #: (elevation, azimuth) in degrees of the initial camera about the scene's centre, as matplotlib's view_init.
@@ -141,13 +146,17 @@ class ViewerScene:
 
     def camera(self) -> tuple[np.ndarray, np.ndarray]:
         """(position, look-at point) of the initial camera: the whole scene in view from :data:`CAMERA_VIEW_DEG`."""
-        lo, hi = self.bounds()
-        centre = 0.5 * (lo + hi)
-        radius = 0.5 * float(np.linalg.norm(hi - lo))
-        elev, azim = np.radians(CAMERA_VIEW_DEG)
-        towards_eye = np.array([np.cos(elev) * np.cos(azim), np.cos(elev) * np.sin(azim), np.sin(elev)])
-        distance = 1.05 * radius / np.sin(np.radians(CAMERA_FOV_DEG) / 2)
-        return centre + distance * towards_eye, centre
+        return camera_for(*self.bounds())
+
+
+def camera_for(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(position, look-at point) of a camera that sees the box [lo, hi] (3,) m whole from :data:`CAMERA_VIEW_DEG`."""
+    centre = 0.5 * (lo + hi)
+    radius = 0.5 * float(np.linalg.norm(hi - lo))
+    elev, azim = np.radians(CAMERA_VIEW_DEG)
+    towards_eye = np.array([np.cos(elev) * np.cos(azim), np.cos(elev) * np.sin(azim), np.sin(elev)])
+    distance = 1.05 * radius / np.sin(np.radians(CAMERA_FOV_DEG) / 2)
+    return centre + distance * towards_eye, centre
 
 
 def _wxyz(R: np.ndarray) -> np.ndarray:
@@ -223,15 +232,11 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
         raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
     t = np.asarray(plan.t, float)
-    n = int(min(max_frames, len(t), np.floor((t[-1] - t[0]) / frame_step_s) + 1))
-    idx = np.unique(np.r_[np.searchsorted(t, np.linspace(t[0], t[-1], max(n, 2))), len(t) - 1].clip(0, len(t) - 1))
+    idx = frame_indices(t, frame_step_s, max_frames)
     q = plan.q[idx]
     frames = robot.frames_many(q, plan.base)
     meshes = robot_meshes(robot)
-    origins = meshes.pop("origins")
-    links = robot.geometry.shape_frames
-    B = frames[:, links] @ origins  # (F, K, 4, 4) the shapes' frames
-    colors = part_colors(robot)
+    shape_positions, shape_wxyz = shape_poses(robot, frames, meshes.pop("origins"))
     map_frame = frames[:, robot.link_index(robot.parts.neck_end)]
 
     if workspace_map is not None and len(workspace_map):
@@ -268,27 +273,9 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     spheres = plan_spheres(plan) if spheres is None else list(spheres)
     diameters = {tuple(np.round(np.asarray(c, float), 9)): d for c, d in spheres}
     targets = list(plan.targets)
-    boxes = [o for o in plan.obstacles if isinstance(o, BoxObstacle)]
-    walls = [o for o in plan.obstacles if isinstance(o, WallWithHole)]
-    quads = [wall_faces(w) for w in walls]
-    wall_vertices = np.concatenate([qd.reshape(-1, 3) for qd in quads]) if quads else np.zeros((0, 3))
-    tris = []
-    offset = 0
-    for qd in quads:
-        base_idx = offset + 4 * np.arange(len(qd))[:, None]
-        tris.append(np.concatenate([base_idx + [0, 1, 2], base_idx + [0, 2, 3]]))
-        offset += 4 * len(qd)
-    for mesh in (o for o in plan.obstacles if isinstance(o, MeshObstacle)):  # drawn with the walls: triangles
-        from scipy.spatial import ConvexHull
-
-        v = mesh.world_vertices
-        wall_vertices = np.concatenate([wall_vertices, v])
-        tris.append(ConvexHull(v).simplices + offset)
-        offset += len(v)
     return ViewerScene(
-        name=plan.name, title=title or plan.name, times=t[idx],
-        shape_positions=B[..., :3, 3], shape_wxyz=_wxyz(B[..., :3, :3]),
-        shape_colors=np.array([_rgb(colors[i]) for i in links], np.uint8).reshape(-1, 3), **meshes,
+        name=plan.name, title=title or plan.name, times=t[idx], shape_positions=shape_positions,
+        shape_wxyz=shape_wxyz, shape_colors=shape_colors(robot), **meshes,
         head_tip=frames[:, robot.link_index(robot.parts.head_tip), :3, 3],
         map_frame_positions=map_frame[:, :3, 3], map_frame_wxyz=_wxyz(map_frame[:, :3, :3]),
         voxel_centers=voxels, voxel_indices=indices, voxel_size=voxel_size,
@@ -297,13 +284,63 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
         target_directions=np.array([tg.direction for tg in targets]).reshape(-1, 3),
         target_names=np.array([tg.name for tg in targets], dtype=str),
         target_diameters=np.array([diameters.get(tuple(np.round(tg.position, 9)), np.nan) for tg in targets], float),
+        **obstacle_arrays(plan.obstacles),
+    )
+
+
+def frame_indices(t: np.ndarray, frame_step_s: float = FRAME_STEP_S, max_frames: int = 2000) -> np.ndarray:
+    """Indices into the sample times ``t`` (T,) s of the viewer's frames: one every ``frame_step_s`` s of motion, at
+    most ``max_frames``, the first and the last sample included."""
+    n = int(min(max_frames, len(t), np.floor((t[-1] - t[0]) / frame_step_s) + 1))
+    return np.unique(np.r_[np.searchsorted(t, np.linspace(t[0], t[-1], max(n, 2))), len(t) - 1].clip(0, len(t) - 1))
+
+
+def shape_poses(robot: Any, frames: np.ndarray, origins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (F, K, 3) and quaternions (F, K, 4) of the robot's K collision shapes, given its link frames
+    (F, L, 4, 4) (``robot.frames_many``) and the shapes' frames in their links ``origins`` (K, 4, 4)
+    (:func:`robot_meshes`)."""
+    B = frames[:, robot.geometry.shape_frames] @ origins
+    return B[..., :3, 3], _wxyz(B[..., :3, :3])
+
+
+def shape_colors(robot: Any) -> np.ndarray:
+    """(K, 3) RGB 0-255 of the robot's collision shapes: the colours of their links' parts."""
+    colors = part_colors(robot)
+    return np.array([_rgb(colors[i]) for i in robot.geometry.shape_frames], np.uint8).reshape(-1, 3)
+
+
+#: The :class:`ViewerScene` fields that hold the obstacles (:func:`obstacle_arrays`, :func:`add_obstacles`).
+OBSTACLE_FIELDS = ("obstacle_centres", "obstacle_sizes", "obstacle_wxyz", "wall_vertices", "wall_triangles",
+                   "hole_rims")
+
+
+def obstacle_arrays(obstacles: Sequence[Any]) -> dict[str, np.ndarray]:
+    """The obstacles as the :class:`ViewerScene` draws them (:data:`OBSTACLE_FIELDS`): boxes by centre, size and
+    rotation; walls and mesh obstacles' hulls as triangles; the holes' rims."""
+    boxes = [o for o in obstacles if isinstance(o, BoxObstacle)]
+    walls = [o for o in obstacles if isinstance(o, WallWithHole)]
+    quads = [wall_faces(w) for w in walls]
+    wall_vertices = np.concatenate([qd.reshape(-1, 3) for qd in quads]) if quads else np.zeros((0, 3))
+    tris = []
+    offset = 0
+    for qd in quads:
+        base_idx = offset + 4 * np.arange(len(qd))[:, None]
+        tris.append(np.concatenate([base_idx + [0, 1, 2], base_idx + [0, 2, 3]]))
+        offset += 4 * len(qd)
+    for mesh in (o for o in obstacles if isinstance(o, MeshObstacle)):  # drawn with the walls: triangles
+        from scipy.spatial import ConvexHull
+
+        v = mesh.world_vertices
+        wall_vertices = np.concatenate([wall_vertices, v])
+        tris.append(ConvexHull(v).simplices + offset)
+        offset += len(v)
+    return dict(
         obstacle_centres=np.array([b.centre for b in boxes]).reshape(-1, 3),
         obstacle_sizes=np.array([b.size for b in boxes]).reshape(-1, 3),
         obstacle_wxyz=_wxyz(np.array([b.rotation for b in boxes]).reshape(-1, 3, 3)),
         wall_vertices=wall_vertices,
         wall_triangles=np.concatenate(tris).astype(np.int32) if tris else np.zeros((0, 3), np.int32),
-        hole_rims=np.array([hole_rim(w) for w in walls]).reshape(-1, 65, 3),
-    )
+        hole_rims=np.array([hole_rim(w) for w in walls]).reshape(-1, 65, 3))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -423,30 +460,14 @@ class SceneNodes:
         self.root = root
         self.frame = -1
         s = scene_api
-        # lit by an environment map at 0.4 of its strength: at full strength the parts' colours wash out to white
-        s.configure_environment_map(hdri="warehouse", environment_intensity=0.4)
+        light_scene(s)
         # one parent node per layer, so that a layer shows or hides as one (viser's visibility is inherited)
         self.groups = {layer: s.add_frame(f"{root}/{layer}", show_axes=False)
                        for layer in ("ZMP and support polygon", "targets", "obstacles", "head tip path")}
-        lo, hi = data.bounds(margin=0.2)
-        size = float(max(hi[0] - lo[0], hi[1] - lo[1]))
-        centre = 0.5 * (lo + hi)
-        self.ground = s.add_grid(f"{root}/ground", width=size, height=size, plane="xy", cell_size=0.1,
-                                 section_size=0.5, position=(centre[0], centre[1], 0.0))
-        # the robot: one batch of instances per mesh (every box one unit cube scaled, ...), moved together per frame
-        self.robot = s.add_frame(f"{root}/robot", show_axes=False)
-        self.robot_meshes = []
-        vs, ts = data.mesh_vertex_starts, data.mesh_triangle_starts
-        for g in range(len(vs) - 1):
-            which = np.flatnonzero(data.shape_mesh == g)
-            if not which.size:
-                continue
-            handle = s.add_batched_meshes_simple(
-                f"{root}/robot/mesh {g}", data.mesh_vertices[vs[g]:vs[g + 1]].astype(np.float32),
-                data.mesh_triangles[ts[g]:ts[g + 1]].astype(np.uint32), batched_wxyzs=data.shape_wxyz[0, which],
-                batched_positions=data.shape_positions[0, which], batched_scales=data.shape_scales[which],
-                batched_colors=data.shape_colors[which], lod="off", flat_shading=True)
-            self.robot_meshes.append((handle, which))
+        self.ground = add_ground(s, f"{root}/ground", *data.bounds(margin=0.2))
+        self.robot_nodes = RobotNodes(s, f"{root}/robot", {k: getattr(data, k) for k in MESH_FIELDS},
+                                      data.shape_colors, data.shape_positions[0], data.shape_wxyz[0])
+        self.robot = self.robot_nodes.frame
         self.map_frame = s.add_frame(f"{root}/head base frame", show_axes=True, axes_length=0.05, axes_radius=0.002,
                                      position=data.map_frame_positions[0], wxyz=data.map_frame_wxyz[0])
         self.voxels = None
@@ -486,19 +507,8 @@ class SceneNodes:
             if np.isfinite(dia):
                 s.add_icosphere(node + "/sphere", radius=float(dia) / 2, color=TARGET_RGB, opacity=0.6,
                                 position=p, cast_shadow=False)
-            s.add_arrows(node + "/direction", np.array([[p - 0.09 * d, p - 0.01 * d]]), TARGET_RGB,
-                         shaft_radius=0.003, head_radius=0.008, head_length=0.02)
-            s.add_label(node + "/label", str(name), position=p + np.array([0.0, 0.0, 0.04]))
-        for i, (c, size, q) in enumerate(zip(data.obstacle_centres, data.obstacle_sizes, data.obstacle_wxyz)):
-            s.add_box(f"{root}/obstacles/box {i + 1}", color=OBSTACLE_RGB, dimensions=tuple(size), position=c, wxyz=q,
-                      opacity=0.6)
-        if len(data.wall_triangles):
-            s.add_mesh_simple(f"{root}/obstacles/wall", data.wall_vertices.astype(np.float32),
-                              data.wall_triangles.astype(np.uint32), color=WALL_RGB, opacity=0.45, side="double",
-                              cast_shadow=False)
-            for i, rim in enumerate(data.hole_rims):
-                s.add_line_segments(f"{root}/obstacles/hole {i + 1}", np.stack([rim[:-1], rim[1:]], axis=1),
-                                    (0, 0, 0), thickness=0.002)
+            add_target_marker(s, node, str(name), p, d)
+        add_obstacles(s, f"{root}/obstacles", **{k: getattr(data, k) for k in OBSTACLE_FIELDS})
         self.show_frame(0)
 
     def show_frame(self, k: int) -> None:
@@ -509,9 +519,7 @@ class SceneNodes:
             return
         before = self.frame
         self.frame = k
-        for handle, which in self.robot_meshes:
-            handle.batched_positions = d.shape_positions[k, which]
-            handle.batched_wxyzs = d.shape_wxyz[k, which]
+        self.robot_nodes.move(d.shape_positions[k], d.shape_wxyz[k])
         self.map_frame.position = d.map_frame_positions[k]
         self.map_frame.wxyz = d.map_frame_wxyz[k]
         self.zmp.position = (d.zmp[k, 0], d.zmp[k, 1], 0.0)
@@ -521,12 +529,89 @@ class SceneNodes:
                 node.visible = bool(d.polygon_of_frame[k] == i)
 
 
-def _camera_to(target: Any, data: ViewerScene) -> None:
-    position, look_at = data.camera()
+#: The :class:`ViewerScene` fields that say how the robot's shapes are drawn (:func:`robot_meshes`).
+MESH_FIELDS = ("shape_mesh", "shape_scales", "mesh_vertices", "mesh_triangles", "mesh_vertex_starts",
+               "mesh_triangle_starts")
+
+
+class RobotNodes:
+    """The robot's collision shapes in a viser scene under the frame ``name``: one batch of instances per mesh
+    (every box one unit cube scaled, ...), all moved at once by :meth:`move`. ``meshes``: the :data:`MESH_FIELDS`
+    of :func:`robot_meshes`; ``colors`` (K, 3) RGB 0-255; ``positions`` (K, 3) and ``wxyz`` (K, 4): the first pose."""
+
+    def __init__(self, scene_api: viser.SceneApi, name: str, meshes: dict[str, np.ndarray], colors: np.ndarray,
+                 positions: np.ndarray, wxyz: np.ndarray) -> None:
+        self.frame = scene_api.add_frame(name, show_axes=False)
+        self.batches = []
+        vs, ts = meshes["mesh_vertex_starts"], meshes["mesh_triangle_starts"]
+        for g in range(len(vs) - 1):
+            which = np.flatnonzero(meshes["shape_mesh"] == g)
+            if not which.size:
+                continue
+            handle = scene_api.add_batched_meshes_simple(
+                f"{name}/mesh {g}", meshes["mesh_vertices"][vs[g]:vs[g + 1]].astype(np.float32),
+                meshes["mesh_triangles"][ts[g]:ts[g + 1]].astype(np.uint32), batched_wxyzs=wxyz[which],
+                batched_positions=positions[which], batched_scales=meshes["shape_scales"][which],
+                batched_colors=colors[which], lod="off", flat_shading=True)
+            self.batches.append((handle, which))
+
+    def move(self, positions: np.ndarray, wxyz: np.ndarray) -> None:
+        """Put the K shapes at ``positions`` (K, 3) m with orientations ``wxyz`` (K, 4)."""
+        for handle, which in self.batches:
+            handle.batched_positions = positions[which]
+            handle.batched_wxyzs = wxyz[which]
+
+
+def light_scene(scene_api: viser.SceneApi) -> None:
+    """The viewer's lighting: an environment map at 0.4 of its strength (at full strength the parts' colours wash
+    out to white)."""
+    scene_api.configure_environment_map(hdri="warehouse", environment_intensity=0.4)
+
+
+def add_ground(scene_api: viser.SceneApi, name: str, lo: np.ndarray, hi: np.ndarray) -> Any:
+    """A ground grid (z = 0) under the box [lo, hi] (3,) m: 0.1 m cells, 0.5 m sections."""
+    size = float(max(hi[0] - lo[0], hi[1] - lo[1]))
+    centre = 0.5 * (lo + hi)
+    return scene_api.add_grid(name, width=size, height=size, plane="xy", cell_size=0.1, section_size=0.5,
+                              position=(centre[0], centre[1], 0.0))
+
+
+def add_obstacles(scene_api: viser.SceneApi, root: str, *, obstacle_centres: np.ndarray, obstacle_sizes: np.ndarray,
+                  obstacle_wxyz: np.ndarray, wall_vertices: np.ndarray, wall_triangles: np.ndarray,
+                  hole_rims: np.ndarray) -> None:
+    """The obstacles (:func:`obstacle_arrays`) under ``root``: boxes, walls and mesh hulls, the holes' rims."""
+    s = scene_api
+    for i, (c, size, q) in enumerate(zip(obstacle_centres, obstacle_sizes, obstacle_wxyz)):
+        s.add_box(f"{root}/box {i + 1}", color=OBSTACLE_RGB, dimensions=tuple(size), position=c, wxyz=q, opacity=0.6)
+    if len(wall_triangles):
+        s.add_mesh_simple(f"{root}/wall", wall_vertices.astype(np.float32), wall_triangles.astype(np.uint32),
+                          color=WALL_RGB, opacity=0.45, side="double", cast_shadow=False)
+        for i, rim in enumerate(hole_rims):
+            s.add_line_segments(f"{root}/hole {i + 1}", np.stack([rim[:-1], rim[1:]], axis=1), (0, 0, 0),
+                                thickness=0.002)
+
+
+def add_target_marker(scene_api: viser.SceneApi, node: str, name: str, position: npt.ArrayLike,
+                      direction: npt.ArrayLike) -> None:
+    """A target's arrow (along ``direction``, its tip short of ``position``) and its label, under ``node``."""
+    p, d = np.asarray(position, float), np.asarray(direction, float)
+    back, front = TARGET_ARROW_M
+    scene_api.add_arrows(node + "/direction", np.array([[p - back * d, p - front * d]]), TARGET_RGB,
+                         shaft_radius=0.003, head_radius=0.008, head_length=0.02)
+    scene_api.add_label(node + "/label", name, position=p + np.array([0.0, 0.0, TARGET_LABEL_HEIGHT_M]))
+
+
+def camera_to(target: Any, position: np.ndarray, look_at: np.ndarray) -> None:
+    """Point a viser camera (``server.initial_camera``, a client's ``camera``) from ``position`` at ``look_at``,
+    z up, with the viewer's field of view."""
     target.fov = np.radians(CAMERA_FOV_DEG)
     target.up = (0.0, 0.0, 1.0)
     target.position = position
     target.look_at = look_at
+
+
+def _camera_to(target: Any, data: ViewerScene) -> None:
+    camera_to(target, *data.camera())
 
 
 @contextlib.contextmanager

@@ -1,0 +1,596 @@
+"""The live viewer (``snakehead view --live``): drag the head's targets in a web browser and the plan follows.
+
+What it shows (viser; drawn with :mod:`.viewer`'s pieces): the robot's collision shapes, first in its initial state,
+then playing the plan of the current targets; each target as a gizmo (drag its arrows or planes to move it, its
+rings to turn it: its x-axis, the red arrow, is the head's direction) with its name; the scene's obstacles; the
+current plan's support polygon at its start, the ZMP's trace and the ZMP now, and the head tip's path. The panel:
+the plan's state (planning, its errors, or why it failed), play/pause, time and speed; adding and removing targets;
+the MuJoCo check of the current plan (its errors beside the plan's); saving the targets and obstacles as a scene
+file (TOML, :func:`snakehead.scenes.save_scene`).
+
+How: one :class:`~snakehead.control.HeadController` (one robot, its map and its TRAC-IK threads) plans every
+target set in one worker thread. Each change (a gizmo released, a target added or removed) is a request; a request
+made while a plan runs supersedes it: that plan finishes (a plan cannot be stopped) and is dropped, and the newest
+target set is planned next, so that only the latest target set's motion is drawn, never two at once. A new motion
+starts at once by moving the nodes the viewer already has (the robot's shapes, fixed-size paths): nothing is
+rebuilt (:mod:`.live_nodes`: the nodes, and a plan as frames). A player thread steps it along. Each request keeps
+a :class:`Replan` record of when it was released, planned and shown.
+
+The Python API (what tests and benchmarks drive, without a mouse): :class:`LiveViewer` with ``move_target``,
+``add_target``, ``remove_target``, ``wait_for_plan``, ``check_dynamics``, ``wait_for_check``, ``save_scene``,
+``latest`` and ``records``.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import io
+import os
+import sys
+import threading
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+import numpy.typing as npt
+
+from .._errors import InputError, InputTypeError
+from .._validate import unit_vector3, world_position
+from ..scenes.scene import Scene, Target
+from . import viewer as vw
+from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, live_motion, x_axis
+
+if TYPE_CHECKING:
+
+    from ..control.controller import HeadController
+    from ..model.robot import SnakeRobot
+    from ..motion.planner import Plan
+    from ..sim.plan import PlanSimulation
+
+#: s between two steps of the player (30 per second).
+TICK_S = 1.0 / 30.0
+#: s between two moves of the time slider while a motion plays (each is work for the browser's page).
+SLIDER_STEP_S = 0.25
+#: s the last frame of a motion is held before it plays again.
+HOLD_S = 1.0
+#: s after a new motion's first frame when its paths (head tip, ZMP, support polygon) are sent: a browser without a
+#: GPU takes a frame's time to take in new paths, which the first frame would otherwise wait for.
+PATHS_DELAY_S = 0.5
+#: Playback speeds offered, and the one at start.
+SPEEDS = ("1x", "2x", "4x", "8x")
+DEFAULT_SPEED = "4x"
+#: Shares of the body's length: a gizmo's size, and how far beside the last target a new target is put.
+GIZMO_SHARE = 0.08
+NEW_TARGET_SHARE = 0.05
+#: s a target added in the viewer (or the one made when no scene is given) is held, as Scene.from_targets does.
+NEW_TARGET_HOLD_S = 1.0
+#: Strength of the hemisphere light that lights the sides the default lights leave dark (no environment map here).
+FILL_LIGHT = 1.5
+#: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
+GROUND_MARGIN_M = 0.2
+
+
+@dataclass
+class Replan:
+    """One request (a target moved, added or removed) and what became of it. Times are epoch seconds
+    (``time.time()``; a browser's ``Date.now() / 1000`` on the same machine compares with them): ``released``
+    (the request), ``plan_started`` and ``planned`` (around ``snakehead.plan``), ``drawn`` (its motion's frames
+    computed) and ``playing`` (its first frame sent to the browsers). ``superseded``: a newer request came while it
+    was planned, so it was never shown. ``failure``: the plan's, if it failed; ``error``: what went wrong if
+    planning raised (then nothing plays)."""
+
+    number: int
+    what: str
+    released: float
+    plan_started: float | None = None
+    planned: float | None = None
+    drawn: float | None = None
+    playing: float | None = None
+    superseded: bool = False
+    failure: str | None = None
+    error: str | None = None
+
+    @property
+    def settled(self) -> bool:
+        """Done with: playing, dropped for a newer request, or failed with an error."""
+        return self.playing is not None or self.superseded or self.error is not None
+
+    @property
+    def planning_s(self) -> float:
+        """s spent in ``snakehead.plan``."""
+        return _span(self.plan_started, self.planned)
+
+    @property
+    def latency_s(self) -> float:
+        """s from the request to its motion playing (NaN if it never played)."""
+        return _span(self.released, self.playing)
+
+    @property
+    def overhead_s(self) -> float:
+        """The viewer's share of :attr:`latency_s`: everything but planning (waiting for the worker, drawing,
+        sending)."""
+        return self.latency_s - self.planning_s
+
+
+def _span(start: float | None, end: float | None) -> float:
+    return float("nan") if start is None or end is None else end - start
+
+
+
+# ----------------------------------------------------------------------------------------------
+# the viewer
+# ----------------------------------------------------------------------------------------------
+@dataclass
+class DynamicsCheck:
+    """The MuJoCo check of motion ``number``: its :class:`~snakehead.sim.plan.PlanSimulation`, or ``error``."""
+
+    number: int
+    simulation: PlanSimulation | None = None
+    error: str | None = None
+    seconds: float = float("nan")
+
+
+class LiveViewer:
+    """A viser server where the user drags the head's targets and the plan follows (``snakehead view --live``).
+
+    scene: the targets, obstacles, base and robot file to start from (default: one target where the robot's head
+    is in its initial state, no obstacles). robot: the robot (default: ``robot_file``'s, else the scene's robot
+    file's, else the shipped one); robot_file: the robot file the saved scene names (default: the scene's).
+    controller: the :class:`~snakehead.control.HeadController` that plans every request (default: one for the
+    robot with seed 1, as ``snakehead plan``). Served at http://HOST:PORT (the next free port if PORT is taken);
+    :meth:`close` stops it. The first plan (of the scene's targets) is requested at once.
+    """
+
+    def __init__(self, scene: Scene | None = None, *, robot: SnakeRobot | None = None,
+                 robot_file: str | os.PathLike | None = None, controller: HeadController | None = None,
+                 host: str = "127.0.0.1", port: int = 8080, frame_step_s: float = vw.FRAME_STEP_S) -> None:
+        if scene is not None and not isinstance(scene, Scene):
+            raise InputTypeError(f"scene must be a Scene (snakehead.load_scene), got {type(scene).__name__}")
+        if not (np.isfinite(frame_step_s) and frame_step_s > 0):
+            raise InputError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
+        self.controller = _controller(scene, robot, robot_file, controller)
+        self.robot = self.controller.robot
+        self.frame_step_s = float(frame_step_s)
+        start = scene if scene is not None else Scene(name="scene", targets=(self._initial_target(),))
+        self._scene = dataclasses.replace(start, robot_file=Path(robot_file) if robot_file is not None
+                                          else start.robot_file)
+        self._targets = list(self._scene.targets)
+        self._records: list[Replan] = []
+        self._pending: tuple[Replan, Scene] | None = None
+        self._changed = threading.Condition()  # targets, requests, records, checks
+        self._draw = threading.RLock()  # the motion shown and its nodes
+        self._motion: LiveMotion | None = None
+        self._t = 0.0
+        self._paths_due: float | None = None  # perf_counter time to draw the motion's paths
+        self._check: DynamicsCheck | None = None
+        self._checking = False
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        self._serve(host, port)
+        self._threads = [threading.Thread(target=self._run_worker, name="snakehead-live-planner", daemon=True),
+                         threading.Thread(target=self._run_player, name="snakehead-live-player", daemon=True)]
+        for thread in self._threads:
+            thread.start()
+        with self._changed:
+            self._request("the scene's targets" if scene is not None else "the start")
+
+    # --- the public API -------------------------------------------------------------------------------------------
+    @property
+    def port(self) -> int:
+        return int(self.server.get_port())
+
+    @property
+    def targets(self) -> list[Target]:
+        with self._changed:
+            return list(self._targets)
+
+    @property
+    def records(self) -> list[Replan]:
+        """Every request so far, oldest first (see :class:`Replan`)."""
+        with self._changed:
+            return list(self._records)
+
+    @property
+    def latest(self) -> Plan | None:
+        """The plan whose motion is shown (None before the first)."""
+        with self._draw:
+            return None if self._motion is None else self._motion.plan
+
+    @property
+    def motion(self) -> LiveMotion | None:
+        """The motion shown (None before the first)."""
+        with self._draw:
+            return self._motion
+
+    def scene(self) -> Scene:
+        """The current targets with the scene's obstacles, base and robot file."""
+        with self._changed:
+            return dataclasses.replace(self._scene, targets=tuple(self._targets))
+
+    def move_target(self, index: int, position: npt.ArrayLike, direction: npt.ArrayLike | None = None) -> int:
+        """Move target ``index`` (0-based, in visiting order) to ``position`` (3,) m, pointing along ``direction``
+        (3,) (default: as before), as releasing its gizmo does; returns the number of the replan requested."""
+        with self._changed:
+            k = self._index(index)
+            old = self._targets[k]
+            moved = dataclasses.replace(old, position=world_position(position, "position"),
+                                        direction=old.direction if direction is None
+                                        else unit_vector3(direction, "direction"))
+            number = self._change(self._targets[:k] + [moved] + self._targets[k + 1:], f"moved {old.name!r}")
+            self._gizmos.place(k, moved)
+            return number
+
+    def add_target(self, position: npt.ArrayLike | None = None, direction: npt.ArrayLike | None = None,
+                   name: str | None = None) -> int:
+        """Add a target after the last one, at ``position`` (default: beside the last one) pointing along
+        ``direction`` (default: as the last one), held 1 s; returns the number of the replan requested."""
+        with self._changed:
+            last = self._targets[-1]
+            side = np.cross([0.0, 0.0, 1.0], last.direction)
+            side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-6 else np.array([1.0, 0.0, 0.0])
+            p = (last.position + NEW_TARGET_SHARE * self.robot.body_length * side if position is None
+                 else world_position(position, "position"))
+            d = last.direction if direction is None else unit_vector3(direction, "direction")
+            label = name if name is not None else self._free_name()
+            try:
+                target = Target(label, p, d, hold_s=NEW_TARGET_HOLD_S)
+            except ValueError as exc:
+                raise InputError(str(exc)) from None
+            number = self._change([*self._targets, target], f"added {label!r}")
+            self._gizmos.add(target)
+            return number
+
+    def remove_target(self, index: int) -> int:
+        """Remove target ``index`` (0-based); returns the number of the replan requested. InputError for the only
+        target (a plan needs one) or a change the scene refuses (a line approach left first)."""
+        with self._changed:
+            k = self._index(index)
+            if len(self._targets) == 1:
+                raise InputError("the only target cannot be removed: a plan needs one")
+            name = self._targets[k].name
+            number = self._change(self._targets[:k] + self._targets[k + 1:], f"removed {name!r}")
+            self._gizmos.remove(k)
+            return number
+
+    def wait_for_plan(self, timeout: float | None = None) -> Replan:
+        """Wait until the latest request is settled (its motion playing, or planning it raised); its record.
+        TimeoutError after ``timeout`` s."""
+        with self._changed:
+            if not self._changed.wait_for(lambda: self._records[-1].settled, timeout):
+                raise TimeoutError(f"request {self._records[-1].number} not shown within {timeout} s")
+            return self._records[-1]
+
+    def check_dynamics(self) -> int:
+        """Check the motion shown in MuJoCo (``snakehead.simulate``) in the background; its number. Its errors show
+        beside the plan's; :meth:`wait_for_check` waits for them."""
+        motion = self.motion
+        if motion is None:
+            raise InputError("no motion to check yet: the first plan is still running")
+        with self._changed:
+            if self._checking:
+                raise InputError("a MuJoCo check is running already")
+            self._checking = True
+        threading.Thread(target=self._run_check, args=(motion,), name="snakehead-live-mujoco", daemon=True).start()
+        return motion.number
+
+    def wait_for_check(self, timeout: float | None = None) -> DynamicsCheck:
+        """Wait for the MuJoCo check started last (TimeoutError after ``timeout`` s); its result."""
+        with self._changed:
+            if not self._changed.wait_for(lambda: not self._checking and self._check is not None, timeout):
+                raise TimeoutError(f"the MuJoCo check did not end within {timeout} s")
+            assert self._check is not None
+            return self._check
+
+    def save_scene(self, path: str | os.PathLike) -> Path:
+        """Write the current targets and the scene's obstacles as a scene file (TOML) at ``path``; the path."""
+        from ..scenes.scene import save_scene
+
+        return save_scene(self.scene(), path)
+
+    def close(self) -> None:
+        """Stop the threads and the server (a plan running is left to finish in its daemon thread)."""
+        if self._stop.is_set():
+            return
+        self._stop.set()
+        with self._changed:
+            self._changed.notify_all()
+        for thread in self._threads:
+            thread.join(timeout=2.0)
+        self.server.stop()
+
+    def __enter__(self) -> "LiveViewer":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- targets --------------------------------------------------------------------------------------------------
+    def _initial_target(self) -> Target:
+        """The head's pose in the robot's initial state, as the one target when no scene is given."""
+        head = self.robot.head_pose(self.controller.q_initial, self.controller.base)
+        return Target("target 1", head[:3, 3], head[:3, 0], hold_s=NEW_TARGET_HOLD_S)
+
+    def _index(self, index: int) -> int:
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            raise InputTypeError(f"a target's index must be an integer, got {type(index).__name__}")
+        if not 0 <= index < len(self._targets):
+            raise InputError(f"no target {index}: there are {len(self._targets)} (0 to {len(self._targets) - 1})")
+        return int(index)
+
+    def _free_name(self) -> str:
+        names = {t.name for t in self._targets}
+        return next(f"target {k}" for k in range(1, len(names) + 2) if f"target {k}" not in names)
+
+    def _change(self, targets: list[Target], what: str) -> int:
+        """Take ``targets`` (checked as a scene) and request their plan; the request's number. Holds _changed."""
+        try:
+            dataclasses.replace(self._scene, targets=tuple(targets))
+        except ValueError as exc:  # the scene's own checks (a line approach first, names alike...): the user's
+            raise InputError(str(exc)) from None
+        self._targets = targets
+        self._chosen.options = tuple(t.name for t in targets)
+        return self._request(what)
+
+    def _request(self, what: str) -> int:
+        """Plan the current targets next (superseding a request not started yet). Holds _changed."""
+        record = Replan(number=len(self._records), what=what, released=time.time())
+        self._records.append(record)
+        if self._pending is not None:
+            self._pending[0].superseded = True
+        self._pending = (record, dataclasses.replace(self._scene, targets=tuple(self._targets)))
+        self._changed.notify_all()
+        return record.number
+
+    def _released(self, handle: Any) -> None:
+        """A gizmo let go (viser's thread): its pose is the target's."""
+        with self._changed:
+            k = self._gizmos.index(handle)
+        if k >= 0:
+            self._reported(self._say, lambda: self.move_target(k, handle.position, x_axis(handle.wxyz)))
+
+    # --- planning and playing -------------------------------------------------------------------------------------
+    def _run_worker(self) -> None:
+        while True:
+            with self._changed:
+                self._changed.wait_for(lambda: self._pending is not None or self._stop.is_set())
+                if self._stop.is_set():
+                    return
+                assert self._pending is not None
+                (record, scene), self._pending = self._pending, None
+            self._replan(record, scene)
+
+    def _replan(self, record: Replan, scene: Scene) -> None:
+        from ..motion.planner import plan
+
+        self._say(f"Planning request {record.number} ({record.what}) ...")
+        record.plan_started = time.time()
+        try:
+            result = plan(scene, controller=self.controller)
+            record.planned = time.time()
+            record.failure = result.failure
+            if self._superseded(record):
+                return
+            motion = live_motion(record.number, result, self._nodes.origins, self.frame_step_s)
+            record.drawn = time.time()
+        except Exception as exc:  # noqa: BLE001 -- the viewer shows it and keeps serving; the traceback to stderr
+            traceback.print_exc(file=sys.stderr)
+            record.error = f"{type(exc).__name__}: {exc}"
+            self._say(f"**Request {record.number} ({record.what}) raised** {record.error}")
+            with self._changed:
+                self._changed.notify_all()
+            return
+        self._start(record, motion)
+
+    def _superseded(self, record: Replan) -> bool:
+        with self._changed:
+            if self._pending is not None:
+                record.superseded = True
+                self._changed.notify_all()
+            return record.superseded
+
+    def _start(self, record: Replan, motion: LiveMotion) -> None:
+        """Show ``motion`` from its first frame, with its status, in one message window sent at once (unless a
+        newer request came meanwhile)."""
+        with self._draw:
+            if self._superseded(record):
+                return
+            with self.server.atomic():
+                self._motion, self._t = motion, 0.0
+                self._nodes.start(motion)
+                self._paths_due = time.perf_counter() + PATHS_DELAY_S
+                self._time.max = max(round(motion.duration_s, 1), 0.1)
+                self._time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
+                self._shown.content = _shown_text(record, motion)
+                self._errors.content = _errors_text(motion, self._check)
+                self._status.content = "Ready: drag a target's gizmo, or add one."
+            self.server.flush()
+            record.playing = time.time()
+        with self._changed:
+            self._changed.notify_all()
+
+    def _run_player(self) -> None:
+        last = slider_moved = time.perf_counter()
+        while not self._stop.wait(TICK_S):
+            now = time.perf_counter()
+            dt, last = now - last, now
+            with self._draw:
+                m = self._motion
+                if m is not None and self._paths_due is not None and now >= self._paths_due:
+                    self._paths_due = None
+                    self._nodes.draw_paths(m)
+                if m is None or not self._playing.value:
+                    continue
+                self._t += float(self._speed.value.rstrip("x")) * dt
+                if self._t > m.duration_s + HOLD_S:
+                    self._t = 0.0
+                self._nodes.show(m, m.frame_at(self._t))
+                if now - slider_moved >= SLIDER_STEP_S:
+                    slider_moved = now
+                    self._time.value = round(min(self._t, m.duration_s), 1)  # type: ignore[misc]
+
+    def _seek(self, event: Any) -> None:
+        if event.client is None:  # the player moved the slider
+            return
+        with self._draw:
+            if self._motion is not None:
+                self._t = float(self._time.value)
+                self._nodes.show(self._motion, self._motion.frame_at(self._t))
+
+    def _run_check(self, motion: LiveMotion) -> None:
+        import importlib.util
+
+        self._errors.content = _errors_text(motion, None) + "\n\nMuJoCo: simulating ..."
+        started = time.perf_counter()
+        check = DynamicsCheck(motion.number)
+        try:
+            if importlib.util.find_spec("mujoco") is None:
+                raise InputError("MuJoCo is not installed (pip install snakehead[sim])")
+            from ..sim.plan import simulate
+
+            check.simulation = simulate(motion.plan)
+        except Exception as exc:  # noqa: BLE001 -- shown in the panel; the viewer keeps serving
+            if not isinstance(exc, InputError):
+                traceback.print_exc(file=sys.stderr)
+            check.error = f"{type(exc).__name__}: {exc}"
+        check.seconds = time.perf_counter() - started
+        with self._changed:
+            self._check, self._checking = check, False
+            self._changed.notify_all()
+        shown = self.motion
+        if shown is not None:
+            self._errors.content = _errors_text(shown, check)
+
+    # --- the server and its panel ---------------------------------------------------------------------------------
+    def _serve(self, host: str, port: int) -> None:
+        import viser
+
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        try:
+            self._draw_scene()
+            self._panel()
+        except BaseException:
+            self.server.stop()
+            raise
+
+    def _draw_scene(self) -> None:
+        s = self.server.scene
+        # lit by viser's default lights and a fill light, without shadows or an environment map: each costs a browser
+        # that renders in software (no GPU) much of its frame time, which a new motion waits for
+        # (bench/live_latency.py)
+        s.configure_environment_map(hdri=None)
+        s.configure_default_lights(enabled=True, cast_shadow=False)
+        s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
+                               intensity=FILL_LIGHT)
+        self._nodes = MotionNodes(s, self.robot, self.controller.q_initial, self.controller.base)
+        arrays = vw.obstacle_arrays(self._scene.obstacles)
+        vw.add_obstacles(s, f"{ROOT}/obstacles", **arrays)
+        self._gizmos = TargetGizmos(s, GIZMO_SHARE * self.robot.body_length, self._released)
+        for target in self._targets:
+            self._gizmos.add(target)
+        shown = [self._nodes.start_positions, np.array([t.position for t in self._targets]),
+                 arrays["obstacle_centres"], arrays["wall_vertices"], np.zeros((1, 3))]
+        lo, hi = np.vstack(shown).min(axis=0), np.vstack(shown).max(axis=0)
+        vw.add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
+        vw.camera_to(self.server.initial_camera, *vw.camera_for(lo - 0.05, hi + 0.05))
+
+    def _panel(self) -> None:
+        gui = self.server.gui
+        gui.configure_theme(control_width="medium")
+        self._status = gui.add_markdown("Planning the first motion ...")
+        self._shown = gui.add_markdown("")
+        self._errors = gui.add_markdown("")
+        with gui.add_folder("Motion"):
+            self._playing = gui.add_checkbox("play", initial_value=True)
+            self._time = gui.add_slider("time (s)", min=0.0, max=1.0, step=0.1, initial_value=0.0)
+            self._speed = gui.add_dropdown("speed", SPEEDS, initial_value=DEFAULT_SPEED)
+        with gui.add_folder("Targets"):
+            self._chosen = gui.add_dropdown("target", tuple(t.name for t in self._targets))
+            add, remove = gui.add_button("add target"), gui.add_button("remove target")
+        with gui.add_folder("MuJoCo"):
+            check = gui.add_button("check the motion in MuJoCo")
+        with gui.add_folder("Scene file"):
+            self._file = gui.add_text("file", initial_value=f"{self._scene.name}_live.toml")
+            save = gui.add_button("save scene")
+            self._saved = gui.add_markdown("")
+        self._time.on_update(self._seek)
+        add.on_click(lambda _: self._reported(self._say, self.add_target))
+        remove.on_click(lambda _: self._reported(self._say, lambda: self.remove_target(self._chosen_index())))
+        check.on_click(lambda _: self._reported(self._say, self.check_dynamics))
+        save.on_click(lambda _: self._reported(lambda text: setattr(self._saved, "content", text), self._save))
+
+    def _chosen_index(self) -> int:
+        names = [t.name for t in self.targets]
+        return names.index(self._chosen.value) if self._chosen.value in names else -1
+
+    def _save(self) -> None:
+        path = self.save_scene(self._file.value)
+        self._saved.content = f"Saved to `{path.resolve()}`"
+
+    def _say(self, text: str) -> None:
+        self._status.content = text
+
+    @staticmethod
+    def _reported(say: Callable[[str], None], action: Callable[[], Any]) -> None:
+        """Run a panel's or a gizmo's action; a mistake of the user's (InputError) is said in the panel."""
+        try:
+            action()
+        except InputError as exc:
+            say(f"**Not done:** {exc}")
+
+
+def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str | os.PathLike | None,
+                controller: HeadController | None) -> HeadController:
+    """The controller the viewer plans with (see :class:`LiveViewer`)."""
+    from ..control.controller import HeadController
+    from ..model.robot import SnakeRobot
+
+    if controller is not None:
+        if not isinstance(controller, HeadController):
+            raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
+        return controller
+    if robot is None:
+        file = robot_file if robot_file is not None else scene.robot_file if scene is not None else None
+        robot = SnakeRobot.from_file(file) if file is not None else SnakeRobot.default()
+    elif not isinstance(robot, SnakeRobot):
+        raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+    return HeadController(robot, base_pose=scene.base if scene is not None else None, seed=1)
+
+
+def _shown_text(record: Replan, motion: LiveMotion) -> str:
+    """The panel's line on the motion shown (the browser test reads "motion N playing" in it)."""
+    plan = motion.plan
+    text = (f"**Plan {record.number}** ({record.what}): planned in {record.planning_s:.2f} s; motion "
+            f"{record.number} playing ({motion.duration_s:.1f} s).")
+    if plan.relocation is not None:
+        r = plan.relocation.base
+        text += f" The base lies elsewhere first (x {r.x:.3f} m, y {r.y:.3f} m, yaw {r.yaw:.2f} rad)."
+    if record.failure is not None:
+        text += f"\n\n**Failed:** {record.failure}"
+    return text
+
+
+def _errors_text(motion: LiveMotion, check: DynamicsCheck | None) -> str:
+    """The plan's errors, and beside them MuJoCo's when the last check was of this motion."""
+    plan = motion.plan
+    pos = max((tg.position_error_m for tg in plan.targets), default=float("nan"))
+    ang = max((tg.direction_error_deg for tg in plan.targets), default=float("nan"))
+    rows = [("position error", f"{1000 * pos:.2f} mm"), ("direction error", f"{ang:.2f}°"),
+            ("ZMP", f"{1000 * plan.min_zmp_margin_m:.1f} mm inside at least")]
+    sim = None if check is None or check.number != motion.number else check
+    if sim is not None and sim.simulation is not None:
+        m = sim.simulation
+        cells = [f"{1000 * m.position_error_m:.2f} mm", f"{m.direction_error_deg:.2f}°",
+                 "inside" if m.zmp_inside else "**leaves the polygon**"]
+    else:
+        cells = ["-"] * 3
+    lines = ["| | planned | MuJoCo |", "|---|---|---|"]
+    lines += [f"| {name} | {value} | {cell} |" for (name, value), cell in zip(rows, cells)]
+    if sim is not None and sim.error is not None:
+        lines.append(f"\nMuJoCo: {sim.error}")
+    elif check is not None and sim is None:
+        lines.append(f"\n(the last MuJoCo check was of motion {check.number})")
+    return "\n".join(lines)

@@ -1,0 +1,192 @@
+"""What the live viewer (:mod:`.live`) draws, and a plan as frames to play.
+
+* :class:`LiveMotion` / :func:`live_motion`: a plan's frames (the robot's shapes every ``frame_step_s`` of motion,
+  the ZMP), its head tip's path and ZMP's trace, its support polygon at the start;
+* :class:`MotionNodes`: the viser nodes that play it -- the robot (:class:`.viewer.RobotNodes`), the ZMP, and
+  paths of a fixed number of segments, so that a new plan moves the points of nodes that exist and rebuilds none;
+* :class:`TargetGizmos`: the targets as transform gizmos (the x-axis the head's direction) with their arrows and
+  names (:func:`.viewer.add_target_marker`), and the release of a gizmo as a callback.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+import numpy.typing as npt
+
+from ..scenes.scene import Target
+from . import viewer as vw
+
+if TYPE_CHECKING:
+    import viser
+
+    from ..model.robot import BasePlacement, SnakeRobot
+    from ..motion.planner import Plan
+
+#: Segments of the head tip's path and of the ZMP's trace: fixed, so that a new plan moves their points only.
+PATH_SEGMENTS = 200
+#: Edges of the support polygon's node (a polygon of fewer repeats its last vertex; one of more is resampled).
+POLYGON_EDGES = 64
+#: Where the live viewer's nodes are in viser's scene tree.
+ROOT = "/live"
+
+@dataclass
+class LiveMotion:
+    """A plan as the live viewer plays it: frames every ``frame_step_s`` of motion (``times`` (F,) s from 0), the
+    robot's K shapes at each (``positions`` (F, K, 3), ``wxyz`` (F, K, 4)), the ZMP at each (``zmp`` (F, 2)); the
+    head tip's path and the ZMP's trace as :data:`PATH_SEGMENTS` segments (S, 2, 3), the support polygon at the
+    start as :data:`POLYGON_EDGES` edges (E, 2, 3)."""
+
+    number: int
+    plan: Plan
+    times: np.ndarray
+    positions: np.ndarray
+    wxyz: np.ndarray
+    zmp: np.ndarray
+    tip_path: np.ndarray
+    zmp_path: np.ndarray
+    polygon: np.ndarray
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.times[-1])
+
+    def frame_at(self, t: float) -> int:
+        """The frame shown at ``t`` s into the motion."""
+        return int(np.clip(np.searchsorted(self.times, t + 1e-9, side="right") - 1, 0, len(self.times) - 1))
+
+
+def live_motion(number: int, plan: Plan, origins: np.ndarray, frame_step_s: float = vw.FRAME_STEP_S) -> LiveMotion:
+    """The frames of ``plan`` the live viewer plays (``origins``: the shapes' frames in their links,
+    :func:`.viewer.robot_meshes`)."""
+    from ..dynamics.stability import support_polygon
+
+    robot, t = plan.robot, np.asarray(plan.t, float)
+    idx = vw.frame_indices(t, frame_step_s)
+    frames = robot.frames_many(plan.q[idx], plan.base)
+    positions, wxyz = vw.shape_poses(robot, frames, origins)
+    path = np.linspace(0, len(t) - 1, PATH_SEGMENTS + 1).round().astype(int)
+    tip = robot.frames_many(plan.q[path], plan.base)[:, robot.link_index(robot.parts.head_tip), :3, 3]
+    zmp = np.asarray(plan.stability.zmp, float)
+    polygon = support_polygon(robot, plan.q[0], plan.base, contact="ground")
+    return LiveMotion(number=number, plan=plan, times=t[idx] - t[0], positions=positions, wxyz=wxyz, zmp=zmp[idx],
+                      tip_path=_segments(tip), zmp_path=_segments(_on_ground(zmp[path], 0.0015)),
+                      polygon=_closed_edges(polygon, POLYGON_EDGES))
+
+
+def _on_ground(xy: np.ndarray, height: float) -> np.ndarray:
+    return np.column_stack([xy, np.full(len(xy), height)])
+
+
+def _segments(points: np.ndarray) -> np.ndarray:
+    """(N - 1, 2, 3) segments joining consecutive points (N, 3)."""
+    return np.stack([points[:-1], points[1:]], axis=1)
+
+
+def _closed_edges(polygon: np.ndarray, n: int) -> np.ndarray:
+    """The edges of a closed ground polygon (k, 2) as exactly ``n`` segments (n, 2, 3) just above the ground: its
+    last vertex repeated when it has fewer, its vertices resampled when it has more."""
+    p = np.asarray(polygon, float).reshape(-1, 2)
+    if len(p) == 0:
+        p = np.zeros((1, 2))
+    k = np.arange(n + 1)
+    ring = np.vstack([p, p[:1]])
+    picked = ring[np.minimum(k, len(p))] if len(p) <= n else ring[np.round(k * len(p) / n).astype(int)]
+    return _segments(_on_ground(picked, 0.001))
+
+
+# ----------------------------------------------------------------------------------------------
+# targets and gizmos
+# ----------------------------------------------------------------------------------------------
+def frame_along(direction: npt.ArrayLike) -> np.ndarray:
+    """A quaternion (w, x, y, z) whose frame's x-axis is ``direction`` (3,), its y-axis level when it can be."""
+    x = np.asarray(direction, float) / np.linalg.norm(direction)
+    up = np.array([0.0, 0.0, 1.0]) if abs(x[2]) < 0.99 else np.array([1.0, 0.0, 0.0])
+    y = np.cross(up, x)
+    y /= np.linalg.norm(y)
+    return vw._wxyz(np.column_stack([x, y, np.cross(x, y)])[None])[0]
+
+
+def x_axis(wxyz: npt.ArrayLike) -> np.ndarray:
+    """The x-axis (3,) of the frame turned by the quaternion ``wxyz`` (normalised first)."""
+    w, x, y, z = np.asarray(wxyz, float) / np.linalg.norm(wxyz)
+    return np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)])
+
+
+class TargetGizmos:
+    """The targets in the scene: one transform gizmo each (its x-axis the target's direction) carrying an arrow and
+    the target's name. ``on_release(name)`` is called (on viser's thread) when the user lets go of a gizmo."""
+
+    def __init__(self, scene_api: viser.SceneApi, size: float, on_release: Callable[[Any], None]) -> None:
+        self.scene, self.size, self.on_release = scene_api, size, on_release
+        self.handles: list[Any] = []
+        self._made = 0
+
+    def add(self, target: Target) -> None:
+        self._made += 1
+        node = f"{ROOT}/targets/{self._made}"
+        handle = self.scene.add_transform_controls(node, scale=self.size, position=target.position,
+                                                   wxyz=frame_along(target.direction), depth_test=False)
+        vw.add_target_marker(self.scene, node, target.name, np.zeros(3), np.array([1.0, 0.0, 0.0]))
+        handle.on_update(self._released)
+        self.handles.append(handle)
+
+    def remove(self, index: int) -> None:
+        self.handles.pop(index).remove()
+
+    def place(self, index: int, target: Target) -> None:
+        handle = self.handles[index]
+        handle.position = target.position
+        handle.wxyz = frame_along(target.direction)
+
+    def index(self, handle: Any) -> int:
+        names = [h.name for h in self.handles]
+        return names.index(handle.name) if handle.name in names else -1
+
+    def _released(self, event: Any) -> None:
+        if event.phase == "end":
+            self.on_release(event.target)
+
+
+# ----------------------------------------------------------------------------------------------
+# the motion's nodes
+# ----------------------------------------------------------------------------------------------
+class MotionNodes:
+    """What moves with the plan: the robot (its shapes, :class:`.viewer.RobotNodes`), the ZMP now, and per plan the
+    head tip's path, the ZMP's trace and the support polygon (segment nodes of fixed size, their points moved)."""
+
+    def __init__(self, scene_api: viser.SceneApi, robot: SnakeRobot, q: np.ndarray, base: BasePlacement) -> None:
+        meshes = vw.robot_meshes(robot)
+        self.origins = meshes.pop("origins")
+        positions, wxyz = vw.shape_poses(robot, robot.frames(q, base)[None], self.origins)
+        self.start_positions = positions[0]
+        s = scene_api
+        self.robot = vw.RobotNodes(s, f"{ROOT}/robot", meshes, vw.shape_colors(robot), positions[0], wxyz[0])
+        nothing = np.zeros((PATH_SEGMENTS, 2, 3))
+        self.tip_path = s.add_line_segments(f"{ROOT}/head tip path", nothing, vw.TIP_PATH_RGB, thickness=0.002)
+        self.zmp_path = s.add_line_segments(f"{ROOT}/ZMP path", nothing, vw.ZMP_RGB, thickness=0.002)
+        self.polygon = s.add_line_segments(f"{ROOT}/support polygon", np.zeros((POLYGON_EDGES, 2, 3)),
+                                           vw.POLYGON_RGB, thickness=0.004)
+        self.zmp = s.add_icosphere(f"{ROOT}/ZMP", radius=0.008, color=vw.ZMP_RGB, cast_shadow=False, visible=False)
+        self.frame = -1
+
+    def start(self, motion: LiveMotion) -> None:
+        """Show ``motion``'s first frame (the robot, the ZMP); :meth:`draw_paths` adds its paths."""
+        self.zmp.visible = True
+        self.frame = -1
+        self.show(motion, 0)
+
+    def draw_paths(self, motion: LiveMotion) -> None:
+        """Show ``motion``'s head tip path, ZMP trace and support polygon (in place of the last motion's)."""
+        self.tip_path.points = motion.tip_path.astype(np.float32)
+        self.zmp_path.points = motion.zmp_path.astype(np.float32)
+        self.polygon.points = motion.polygon.astype(np.float32)
+
+    def show(self, motion: LiveMotion, k: int) -> None:
+        """Move the robot and the ZMP to ``motion``'s frame ``k`` (nothing is sent if it is shown already)."""
+        if k == self.frame:
+            return
+        self.frame = k
+        self.robot.move(motion.positions[k], motion.wxyz[k])
+        self.zmp.position = (float(motion.zmp[k, 0]), float(motion.zmp[k, 1]), 0.0)
