@@ -437,13 +437,20 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
     traj = plan.sample(notes, timing or {})
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
-    frames = robot.frames_many(traj.q, base)  # once, for every check below
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", frames=frames)
-    clearance = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
+    # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
+    # every check takes what it needs from them in one pass
+    clearance = np.empty(len(traj.t))
+
+    def lowest(rows: slice, frames: np.ndarray) -> None:
+        clearance[rows] = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
+
+    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", with_frames=lowest)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
-        distance = coll.collision_check(robot, traj.q, list(obstacles), base, exact_within=0.005).distance
+        distance = np.concatenate([
+            coll.collision_check(robot, traj.q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
+                                 exact_within=0.005).distance for k in range(0, len(traj.q), stability.SAMPLE_CHUNK)])
     states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
