@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import integer, joint_vector
+from .._errors import InputError, InputTypeError
+from .._validate import MAX_SAMPLES, integer, joint_vector
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -39,7 +40,7 @@ from .cartesian import tracking_interpolation
 import os
 
 import numpy.typing as npt
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -65,6 +66,43 @@ BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the 
 #: How far choose_base tries stepping the base back from the targets, as shares of the body's length
 #: (0.05, 0.1, 0.15, 0.2 m on the default robot, 1.384 m long).
 BASE_STEP_SHARES = tuple(k * 0.05 / 1.384 for k in (1, 2, 3, 4))
+
+
+#: s: the longest motion a plan may have: MAX_SAMPLES samples at the 2 ms control period (2000 s). Checked before
+#: anything is solved (the targets' holds alone), after each target is solved (the holds and the least time the
+#: joints' velocity limits allow for the moves so far) and while the path is timed (``motion.timing.retime``),
+#: before anything is sampled: a scene that needs more raises ``snakehead.InputError`` (split it into scenes).
+MAX_MOTION_S = (MAX_SAMPLES - 1) * interp.CONTROL_PERIOD
+#: The most poses a plan solves: its targets and the poses along its straight-line approaches (each a whole-body
+#: solve, ~0.1-0.5 s on the default robot), counted before any is solved.
+MAX_POSES = 5000
+
+
+@dataclass(frozen=True)
+class PlanProgress:
+    """What :func:`plan` tells its ``progress`` callback, one record per call.
+
+    kind: "target" once a target of the scene has been solved and the move to it planned (in the scene's order,
+    via poses included): ``index`` 1..``count`` (the scene's targets), ``name``, ``solved``, ``seconds`` (its solve
+    and move), ``message`` (why it was not solved; "" when it was). "stage" when a stage over the whole plan begins:
+    ``name`` "base" (every target solved from the start, to choose the base), "timing" (the time-optimal retiming of
+    the whole path, often the longest stage), "checks" (the ZMP, the ground and the obstacles at every 2 ms sample);
+    ``message`` says what it does. ``elapsed_s``: seconds since :func:`plan` was called.
+    """
+
+    kind: str
+    name: str
+    index: int = 0
+    count: int = 0
+    solved: bool = True
+    seconds: float = 0.0
+    elapsed_s: float = 0.0
+    message: str = ""
+
+
+#: The signature of ``plan(progress=...)``: called with a :class:`PlanProgress`; its return value is ignored and an
+#: exception it raises stops the plan (it propagates to the caller of :func:`plan`).
+ProgressCallback = Callable[[PlanProgress], None]
 
 
 @dataclass
@@ -216,9 +254,21 @@ class _Waypoints:
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: dict | None = None  # timed lifts, kept by the controller
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
+        self._least = (0, 0.0)  # (waypoints counted, s): least_duration's sum so far
+
+    def least_duration(self, velocity: np.ndarray) -> float:
+        """s: the least the motion through the waypoints so far can last: each step at the joints' velocity limits
+        (rad/s, (n,)) and the holds (the retiming keeps the limits: the timed motion lasts at least this long)."""
+        done, total = self._least
+        if len(self.qs) > done + 1:
+            steps = np.abs(np.diff(np.array(self.qs[max(done - 1, 0):]), axis=0)) / velocity
+            total += float(steps.max(axis=1).sum())
+            self._least = (len(self.qs), total)
+        return total + float(sum(self.holds.values()))
 
     def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs = [label], [np.asarray(q, float)]
+        self._least = (0, 0.0)
 
     def _append(self, label: str, q: np.ndarray) -> None:
         if np.abs(q - self.qs[-1]).max() <= 1e-12:  # the same configuration: nothing to move
@@ -389,9 +439,12 @@ class _Waypoints:
                     self.lift_cache[key] = lift
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
                               **timing)
+                _check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
                 traj = _concatenate(lift, rest)
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
+        except InputError:  # the motion is too long (retime stops as soon as it is): no slower fallback either
+            raise
         except ValueError as exc:
             if any(key in str(exc) for key in TIMING_OPTIONS if key in timing):  # a bad option of the caller's
                 raise
@@ -400,11 +453,19 @@ class _Waypoints:
             self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
             times = np.concatenate([[0.0], np.cumsum(np.maximum(
                 np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1) / FALLBACK_SPEED, hold_s) + 1e-3)])
+            _check_motion_length(float(times[-1]), f"at the slow pace of a path that cannot be timed ({exc})")
             self.times = [float(x) for x in times]
             return interp.joint_trajectory(times, np.array(self.qs), method="monotone")
         self.times = [float(x) for x in traj.waypoint_times]
         notes += list(traj.notes)
         return traj
+
+
+def _check_motion_length(duration_s: float, how: str = "") -> None:
+    """InputError when a motion of ``duration_s`` is longer than :data:`MAX_MOTION_S` (before it is sampled)."""
+    if duration_s > MAX_MOTION_S:
+        raise InputError(f"the timed motion lasts {duration_s:.1f} s{' ' + how if how else ''}; at most "
+                         f"{MAX_MOTION_S:g} s ({MAX_SAMPLES} samples at {interp.CONTROL_PERIOD:g} s)")
 
 
 def _concatenate(a: Any, b: Any) -> Any:
@@ -431,10 +492,15 @@ def _concatenate(a: Any, b: Any) -> Any:
 
 
 def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
-            notes: Sequence[str] = (), scene: Scene | None = None, timing: dict[str, Any] | None = None) -> Plan:
+            notes: Sequence[str] = (), scene: Scene | None = None, timing: dict[str, Any] | None = None,
+            stage: Callable[[str, str], None] | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
+    stage = stage or (lambda what, message: None)
+    stage("timing", f"timing the motion through {len(plan.qs)} waypoints (TOPP-RA under the robot's limits)")
     traj = plan.sample(notes, timing or {})
+    stage("checks", f"checking the {len(traj.t)} samples of {float(traj.t[-1] - traj.t[0]):.1f} s of motion (ZMP, "
+                    "ground" + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
     # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
@@ -707,7 +773,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
          obstacles: Sequence[BoxObstacle | WallWithHole | MeshObstacle] = (), base: BasePlacement | None = None,
          method: str = "rotated", seed: int | None = 1, allow_relocation: bool = True,
          timing: dict[str, Any] | None = None, base_shape: npt.ArrayLike | None = None,
-         start_q: npt.ArrayLike | None = None) -> Plan:
+         start_q: npt.ArrayLike | None = None, progress: ProgressCallback | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -733,12 +799,29 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         it lies (measured) in a bending state on the ground, so that the plan starts where the robot is (a closed
         loop, ``snakehead.sim.loop``). Its base shape is ``base_shape``'s default. Used when the base stays (no
         relocation); a note says so otherwise.
+    progress : called as ``progress(record)`` with a :class:`PlanProgress` after each target is solved (in the
+        scene's order) and when each stage over the whole plan begins (choosing the base, the timing, the checks);
+        an exception it raises stops the plan.
+
+    Bounds, checked before anything is solved (``snakehead.InputError`` naming the scene): at most
+    ``scenes.MAX_TARGETS`` (1000) targets; the targets' holds at most :data:`MAX_MOTION_S` (2000 s: MAX_SAMPLES
+    samples at 2 ms) together; at most :data:`MAX_POSES` poses solved in all (the targets and the poses along their
+    line approaches). The motion's length is checked again after each target is solved (the holds and the least
+    time the joints' velocity limits allow for the moves so far) and while the path is timed, before it is sampled.
+
+    Memory grows with the motion's 2 ms samples, not with the targets: the plan keeps t, q, qd and the checks'
+    results, ~370 bytes per sample on the 16-joint default robot (its frames, 2.5 kB a sample, are made a chunk at a
+    time: ``dynamics.stability.SAMPLE_CHUNK``); the peak while the path is timed and checked is ~1.5 kB per sample
+    above the controller's ~150 MB (bench/many_targets.py: 100 targets, 556 s of motion, 278,000 samples, ~540 MiB).
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
     """
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
+    if progress is not None and not callable(progress):
+        raise InputTypeError(f"progress must be a function of a PlanProgress (or None), got {type(progress).__name__}")
+    lines = _check_size(scene)  # before anything is solved
     if timing is not None and not isinstance(timing, dict):
         raise TypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
     # checked even when a controller (with its own method and seed) is given: a bad value is a mistake either way
@@ -775,7 +858,33 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         start_q = joint_vector(start_q, robot.n_joints, "start_q")
         if base_shape is None:
             base_shape = start_q
+    scene_targets = scene.targets
+    count = len(scene_targets)
+    from .timing import resolve_limits
+
+    velocity = resolve_limits(robot, **(timing or {})).velocity  # for the least duration of the moves so far
+
+    def stage(what: str, message: str) -> None:
+        if progress is not None:
+            progress(PlanProgress("stage", what, count=count, elapsed_s=time.perf_counter() - t_start,
+                                  message=message))
+
+    def done(k: int, sol: Any, seconds: float) -> None:
+        """Target k (0-based) is solved and the move to it planned: tell progress; InputError once the motion so
+        far cannot fit in MAX_MOTION_S."""
+        tg = scene_targets[k]
+        if progress is not None:
+            progress(PlanProgress("target", tg.name, k + 1, count, bool(sol.success), seconds,
+                                  time.perf_counter() - t_start, "" if sol.success else str(sol.message)))
+        least = way.least_duration(velocity)
+        if least > MAX_MOTION_S:
+            raise InputError(f"scene {scene.name!r}: the motion to its target {k + 1} of {count} ({tg.name!r}) lasts "
+                             f"at least {least:.0f} s (the moves at the joints' velocity limits and the holds); a plan "
+                             f"lasts at most {MAX_MOTION_S:g} s (MAX_MOTION_S): split the scene into scenes planned "
+                             "one after the other")
+
     solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
+    stage("base", f"solving the {len(scene.reported)} targets from the start to choose the base")
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape, solved=solved)
     notes += base_notes
@@ -809,7 +918,6 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         q = way.qs[-1]
     results: list[TargetResult] = []
     k = 0
-    scene_targets = scene.targets
     while k < len(scene_targets):
         # a run: this target and the following ones approached along a line from it
         end = k
@@ -817,6 +925,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             end += 1
         if end == k:
             tg = scene_targets[k]
+            clock = time.perf_counter()
             sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes, solved=solved)
             way.move(tg.name, sol.q)
             q = sol.q
@@ -824,6 +933,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                 results.append(TargetResult(tg.name, tg.position, tg.direction, way.stop(), sol))
             if tg.hold_s > 0:
                 way.hold(tg.hold_s)
+            done(k, sol, time.perf_counter() - clock)
             k += 1
             continue
         # poses along the lines, solved backwards from the deepest (the most constrained, e.g. only the head link in
@@ -831,20 +941,26 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
         poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
             (scene_targets[k].name, scene_targets[k].position, scene_targets[k].direction, scene_targets[k])]
+        owner = [k]  # the scene target each pose leads to
         for j in range(k + 1, end + 1):
-            line = _line_poses(scene_targets[j - 1], scene_targets[j])
+            line = lines[j]
             for m, p in enumerate(line):
                 last = m == len(line) - 1
                 label = scene_targets[j].name if last else f"{scene_targets[j].name} ({m + 1}/{len(line)})"
                 poses.append((label, p, scene_targets[j].direction, scene_targets[j] if last else None))
+                owner.append(j)
+        seconds = dict.fromkeys(range(k, end + 1), 0.0)  # each target's share of the run's solves and moves
         sols: list = [None] * len(poses)
         q_back = q
         for m in range(len(poses) - 1, -1, -1):
+            clock = time.perf_counter()
             label, p, d, _ = poses[m]
             sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
             if sols[m].success:
                 q_back = sols[m].q
+            seconds[owner[m]] += time.perf_counter() - clock
         for m, (label, p, d, line_target) in enumerate(poses):
+            clock = time.perf_counter()
             if m == 0:
                 way.move(label, sols[m].q)
             else:
@@ -855,8 +971,37 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                                                 way.stop(), sols[m]))
                 if line_target.hold_s > 0:
                     way.hold(line_target.hold_s)
+            seconds[owner[m]] += time.perf_counter() - clock
+            if line_target is not None:
+                done(owner[m], sols[m], seconds[owner[m]])
         q = sols[-1].q
         k = end + 1
-    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing)
+    try:
+        plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing,
+                       stage=stage)
+    except InputError as exc:  # the timed motion is too long
+        raise InputError(f"scene {scene.name!r}: {exc}: split the scene into scenes planned one after the other"
+                         ) from None
     plan.relocation = relocation
     return plan
+
+
+def _check_size(scene: Scene) -> dict[int, list[np.ndarray]]:
+    """InputError (naming the scene) for a scene too large to plan, before anything is solved (see :func:`plan`);
+    the poses along its line approaches (target index -> positions), which are counted here."""
+    from ..scenes.scene import check_target_count
+
+    targets = scene.targets
+    check_target_count(len(targets), f"scene {scene.name!r}")
+    hold = float(sum(t.hold_s for t in targets))
+    if hold > MAX_MOTION_S:
+        raise InputError(f"scene {scene.name!r}: its targets' hold_s add up to {hold:g} s; a plan's motion lasts at "
+                         f"most {MAX_MOTION_S:g} s (MAX_MOTION_S: {MAX_SAMPLES} samples at "
+                         f"{interp.CONTROL_PERIOD:g} s): split the scene into scenes planned one after the other")
+    lines = {j: _line_poses(targets[j - 1], targets[j]) for j in range(1, len(targets)) if targets[j].approach == "line"}
+    poses = len(targets) + sum(len(line) - 1 for line in lines.values())
+    if poses > MAX_POSES:
+        raise InputError(f"scene {scene.name!r}: its {len(targets)} targets and the poses along their line approaches "
+                         f"are {poses} whole-body solves; at most {MAX_POSES} (MAX_POSES): take a larger step_m or "
+                         "split the scene")
+    return lines

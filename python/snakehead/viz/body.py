@@ -333,13 +333,18 @@ def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
 # ----------------------------------------------------------------------------------------------
 def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np.ndarray]]:
     """Up to ``n_panels`` of the plan's states (label, time s, q (n,)) in time order: the first and last, every
-    target, then the waypoints nearest to evenly spaced times. Holds are left out."""
+    target (evenly spread ones when more than ``n_panels - 2``: the figure's size does not grow with the targets),
+    then the waypoints nearest to evenly spaced times. Holds are left out."""
     states = [s for s in plan.states if not s[0].endswith("(hold)")]
     if not states:
         raise ValueError("the plan has no states")
     times = np.array([s[1] for s in states])
     chosen = {0, len(states) - 1}
-    for tg in plan.targets:
+    targets = list(plan.targets)
+    if len(targets) > max(n_panels - 2, 1):
+        targets = [targets[int(k)] for k in np.unique(np.round(np.linspace(0, len(targets) - 1,
+                                                                           max(n_panels - 2, 1))))]
+    for tg in targets:
         chosen.add(int(np.argmin(np.abs(times - tg.time_s))))
     for want in np.linspace(times[0], times[-1], max(n_panels, 2)):
         if len(chosen) >= n_panels:
@@ -349,7 +354,7 @@ def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np
             if int(k) not in chosen:
                 chosen.add(int(k))
                 break
-    return [states[k] for k in sorted(chosen)][:max(n_panels, len(plan.targets) + 2)]
+    return [states[k] for k in sorted(chosen)][:max(n_panels, len(targets) + 2)]
 
 
 def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_panels: int = 12, columns: int = 4,
