@@ -23,7 +23,7 @@ the ground's friction); the motion rests at every target.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -440,6 +440,10 @@ class _Waypoints:
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
                               **timing)
                 _check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
+                # the whole motion is sampled again from the pieces' splines: the rest's samples (~400 B each) are
+                # dropped first, so that they and the whole motion's are never held at once
+                rest = replace(rest, t=rest.t[-1:].copy(), q=rest.q[-1:].copy(), qd=rest.qd[-1:].copy(),
+                               qdd=rest.qdd[-1:].copy())
                 traj = _concatenate(lift, rest)
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
@@ -471,7 +475,7 @@ def _check_motion_length(duration_s: float, how: str = "") -> None:
 def _concatenate(a: Any, b: Any) -> Any:
     """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
     first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
-    first."""
+    first. Of the second's samples only the last is used (its end: when and where)."""
     from .timing import RetimedTrajectory
 
     offset = float(a.t[-1])
@@ -499,26 +503,28 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
     stage = stage or (lambda what, message: None)
     stage("timing", f"timing the motion through {len(plan.qs)} waypoints (TOPP-RA under the robot's limits)")
     traj = plan.sample(notes, timing or {})
-    stage("checks", f"checking the {len(traj.t)} samples of {float(traj.t[-1] - traj.t[0]):.1f} s of motion (ZMP, "
-                    "ground" + (", obstacles)" if obstacles else ")"))
+    t, q, qd = traj.t, traj.q, traj.qd
+    del traj  # its accelerations (unused) are freed before the checks
+    stage("checks", f"checking the {len(t)} samples of {float(t[-1] - t[0]):.1f} s of motion (ZMP, ground"
+                    + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
     # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
     # every check takes what it needs from them in one pass
-    clearance = np.empty(len(traj.t))
+    clearance = np.empty(len(t))
 
     def lowest(rows: slice, frames: np.ndarray) -> None:
         clearance[rows] = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
 
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact="ground", with_frames=lowest)
+    dyn = stability.dynamic_stability(robot, t, q, base, qd, contact="ground", with_frames=lowest)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
         distance = np.concatenate([
-            coll.collision_check(robot, traj.q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
-                                 exact_within=0.005).distance for k in range(0, len(traj.q), stability.SAMPLE_CHUNK)])
-    states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
-    return Plan(name=name, robot=robot, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
+            coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
+                                 exact_within=0.005).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+    states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
+    return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
                 planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene,
                 timing_failure=plan.timing_failure)
