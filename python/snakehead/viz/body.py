@@ -295,11 +295,10 @@ def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: b
             faces = box_faces(ob) if isinstance(ob, BoxObstacle) else mesh_obstacle_faces(ob)
             ax.add_collection3d(Poly3DCollection(faces, facecolor=OBSTACLE_COLOR, edgecolor="k", linewidths=0.3,
                                                  alpha=0.45), autolim=False)  # faces of several sizes: no autoscale
-    if arrows:
-        for tg in plan.targets:
-            d = 0.08 * np.asarray(tg.direction, float)
-            p = np.asarray(tg.position, float) - d  # the arrow ends at the target
-            ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.0, arrow_length_ratio=0.3)
+    if arrows and len(plan.targets):  # one collection of arrows: one per target made the figure grow per target
+        d = 0.08 * np.array([tg.direction for tg in plan.targets], float)
+        p = np.array([tg.position for tg in plan.targets], float) - d  # each arrow ends at its target
+        ax.quiver(p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2], color="k", lw=1.0, arrow_length_ratio=0.3)
 
 
 def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
