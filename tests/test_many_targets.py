@@ -197,6 +197,19 @@ def test_a_timed_motion_too_long_is_refused_before_it_is_sampled(three, controll
         snakehead.plan(three, controller=controller)
 
 
+def test_a_path_that_cannot_be_timed_still_fits_the_longest_motion(three, controller, monkeypatch):
+    """A path the retiming cannot time is sampled at a slow pace to be looked at, and the plan fails on its timing;
+    that pace quickens when it would make the motion longer than MAX_MOTION_S (it was an error, then)."""
+    def untimeable(*args, **kwargs):
+        raise ValueError("no motion along the path keeps every limit near waypoint 3")
+
+    monkeypatch.setattr(timing, "retime", untimeable)
+    monkeypatch.setattr(planner, "MAX_MOTION_S", 30.0)
+    result = snakehead.plan(three, controller=controller)
+    assert not result.success and "cannot be timed" in result.failure
+    assert result.duration_s <= 30.0
+
+
 # ------------------------------------------------------------------------------------------------
 # memory: the checks by chunks, the snapshots bounded
 # ------------------------------------------------------------------------------------------------

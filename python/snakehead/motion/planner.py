@@ -52,7 +52,8 @@ DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straigh
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
-FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails)
+FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails; faster when
+#                        the motion would be longer than MAX_MOTION_S)
 DENSIFY = 3  # configurations checked between consecutive waypoints of a move, at least
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
@@ -455,9 +456,13 @@ class _Waypoints:
             # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
             # slow fixed pace so that the plan can still be looked at, and fail it
             self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
-            times = np.concatenate([[0.0], np.cumsum(np.maximum(
-                np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1) / FALLBACK_SPEED, hold_s) + 1e-3)])
-            _check_motion_length(float(times[-1]), f"at the slow pace of a path that cannot be timed ({exc})")
+            move = np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1)
+            # faster than FALLBACK_SPEED when that pace would make the motion longer than a plan may be (the plan
+            # fails on its timing either way; its motion must still fit in MAX_SAMPLES samples)
+            budget = 0.95 * MAX_MOTION_S - float(hold_s.sum()) - 1e-3 * len(move)
+            speed = max(FALLBACK_SPEED, float(move.sum()) / budget) if budget > 0 else FALLBACK_SPEED
+            times = np.concatenate([[0.0], np.cumsum(np.maximum(move / speed, hold_s) + 1e-3)])
+            _check_motion_length(float(times[-1]), "with its holds")
             self.times = [float(x) for x in times]
             return interp.joint_trajectory(times, np.array(self.qs), method="monotone")
         self.times = [float(x) for x in traj.waypoint_times]
