@@ -821,9 +821,11 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     time the joints' velocity limits allow for the moves so far) and while the path is timed, before it is sampled.
 
     Memory grows with the motion's 2 ms samples, not with the targets: the plan keeps t, q, qd and the checks'
-    results, ~370 bytes per sample on the 16-joint default robot (its frames, 2.5 kB a sample, are made a chunk at a
-    time: ``dynamics.stability.SAMPLE_CHUNK``); the peak while the path is timed and checked is ~1.5 kB per sample
-    above the controller's ~150 MB (bench/many_targets.py: 100 targets, 556 s of motion, 278,000 samples, ~540 MiB).
+    results, ~370 bytes per sample on the 16-joint default robot (8 + 2 x 128 for t, q, qd; ~105 for the ZMP, its
+    margin, the momenta, the CoM and the ground clearance); the world frames of the samples (2.5 kB each) are made
+    and dropped a chunk at a time (``dynamics.stability.SAMPLE_CHUNK``). Measured peak of ``snakehead plan --no-sim``
+    (bench/many_targets.py, figures included): ~300 MiB + ~0.75 kB per sample, e.g. 100 targets, 556 s of motion,
+    277,699 samples: 498 MiB; at MAX_SAMPLES (2000 s) about 1 GiB.
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
