@@ -897,7 +897,8 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                              "one after the other")
 
     solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
-    stage("base", f"solving the {len(scene.reported)} targets from the start to choose the base")
+    reported = len(scene.reported)
+    stage("base", f"solving the {reported} target{'' if reported == 1 else 's'} from the start to choose the base")
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape, solved=solved)
     notes += base_notes
