@@ -34,6 +34,11 @@ class Infeasible(Exception):
     an error of the caller's and not a bug. Deliberately not a ``ValueError``: code that catches it means it."""
 
 
+class MotionTooLong(Infeasible):
+    """A motion that would last longer than a plan may (``snakehead._validate.MAX_SAMPLES`` samples at the control
+    period): valid targets whose moves turn out too long. No slower timing is tried for it."""
+
+
 class InternalError(AssertionError):
     """A broken invariant of snakehead on valid input: a bug in snakehead, never the caller's fault."""
 

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from ..control.controller import HeadController
     from ..kinematics.workspace import ReachabilityMap
     from ..model.robot import BasePlacement, SnakeRobot
+    from ..motion.planner import PlanProgress
     from ..scenes.scene import Scene
     from ..sim.loop import LoopRun
 
@@ -98,6 +99,16 @@ def outcome_line(success: bool, failure: str | None, relocation: dict | None) ->
             f"({relocation['reason']}; --no-relocation forbids it)")
 
 
+def plan_progress_line(record: PlanProgress) -> str:
+    """One line for a ``plan(progress=...)`` record: "target 3/100 'name': solved in 0.21 s" (or why it was not
+    solved), or the stage that begins."""
+    if record.kind == "target":
+        what = (f"solved in {record.seconds:.2f} s" if record.solved else
+                f"NOT solved in {record.seconds:.2f} s: {record.message}")
+        return f"target {record.index}/{record.count} {record.name!r}: {what}"
+    return f"{record.message} ..."
+
+
 def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
               solution_figure: bool = False) -> dict:
     """One scene through the pipeline; its report entry (``report.scenario_entry``) with the files written."""
@@ -108,7 +119,8 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
     name = scene.name
     label = scene.description or name
     with progress.stage(f"{name}: planning {label}"):
-        result = plan(scene, controller=controller, allow_relocation=settings.relocation)
+        result = plan(scene, controller=controller, allow_relocation=settings.relocation,
+                      progress=lambda record: progress.say(f"{name}: {plan_progress_line(record)}"))
     progress.say(f"{name}: {outcome_line(result.success, result.failure, _relocation_dict(result))}, "
                  f"{result.duration_s:.1f} s of motion, {len(result.t)} samples; targets: "
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"

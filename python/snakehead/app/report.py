@@ -166,8 +166,8 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     with atomic_open(path, "w", newline="") as f:  # a failed write leaves no CSV cut mid-row
         w = csv.writer(f)
         w.writerow(["time_s"] + [f"{n}_rad" for n in names])
-        for row in np.column_stack([t, q]):
-            w.writerow([f"{row[0]:.6f}"] + [f"{v:.7f}" for v in row[1:]])
+        for when, row in zip(t, q):  # row by row: no copy of the whole trajectory
+            w.writerow([f"{when:.6f}"] + [f"{v:.7f}" for v in row])
     return path
 
 

@@ -16,6 +16,7 @@ body along +x).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -35,6 +36,10 @@ CONTACT_TOLERANCE = 1e-3
 
 #: Contact models of :func:`support_polygon`.
 CONTACT_MODELS = ("endpoints", "footprint", "ground")
+
+#: Samples of a trajectory whose world frames :func:`dynamic_stability` holds at once (~10 MB on the default robot's
+#: 20 frames): the memory of a check grows with the trajectory's samples by what it returns only.
+SAMPLE_CHUNK = 4096
 
 
 # ------------------------------------------------------------------------------------------------
@@ -348,20 +353,48 @@ class DynamicStability:
 
 def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
                       qd: npt.ArrayLike | None = None, *, contact: str = "endpoints",
-                      tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None) -> DynamicStability:
+                      tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None,
+                      with_frames: Callable[[slice, np.ndarray], None] | None = None) -> DynamicStability:
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
     The support polygon (see :func:`support_polygon` for ``contact`` and ``tolerance``) is rebuilt for every
     distinct contact configuration along the trajectory (the base joints may move, e.g. into the initial arc;
     with ``contact="ground"`` the neck and head may lie down or lift off).
+
+    ``frames``: the world frames of ``q`` (T, n_links, 4, 4), when the caller has them; else they are computed
+    :data:`SAMPLE_CHUNK` samples at a time and never held for the whole trajectory (they take n_links x 128 bytes
+    per sample, 2.5 kB on the default robot: more than everything else together). ``with_frames(rows, frames)``:
+    called with each chunk of samples (a slice of the trajectory) and its frames, so that a caller computes what
+    else it needs from them (e.g. the ground clearance) in the same pass.
     """
     robot = as_robot(robot)
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
-    p, P, L, com, q = _zmp(robot, t, q, base, qd, frames)
+    t, q = _check_trajectory(robot, t, q)
+    qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
+    if frames is not None and np.shape(frames) != (q.shape[0], len(robot.link_names), 4, 4):
+        frames = None
+    n = len(t)
+    P, L, com = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    chunks = []  # (rows, the distinct contact polygons in them and which each sample has)
+    for start in range(0, n, SAMPLE_CHUNK):
+        rows = slice(start, min(n, start + SAMPLE_CHUNK))
+        f = robot.frames_many(q[rows], base) if frames is None else frames[rows]
+        P[rows], L[rows], com[rows] = _momenta(robot, q[rows], qd[rows], base, f)
+        chunks.append((rows, _polygons_along(robot, q[rows], base, contact, tolerance, f)))
+        if with_frames is not None:
+            with_frames(rows, f)
+        del f
+    edge = 2 if n > 2 else 1
+    Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
+    Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
+    p = _zmp_from(com, Pdot, Ldot, robot.total_mass)
+    del Pdot, Ldot
     flying = ~np.all(np.isfinite(p), axis=1)
-    margin = support_margins(robot, q, np.where(flying[:, None], 0.0, p), base, contact=contact, tolerance=tolerance,
-                             frames=frames)
+    xy = np.where(flying[:, None], 0.0, p)
+    margin = np.empty(n)
+    for rows, (pts, active, inv) in chunks:
+        margin[rows] = polygon_margin_many(pts[inv], active[inv], xy[rows])
     margin[flying] = -np.inf  # no ZMP: the body would leave the ground
     inside = margin > 0.0
     k = int(np.argmin(margin))

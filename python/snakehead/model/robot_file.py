@@ -61,16 +61,17 @@ class RobotFile:
     limits: dict | None = None
 
 
-def read_toml(path: str | os.PathLike, what: str) -> dict:
-    """A small TOML file as a dict; ValueError naming the file for a missing, oversized or malformed one."""
-    p = input_file(path, what, MAX_FILE_BYTES)
+def read_toml(path: str | os.PathLike, what: str, max_bytes: int = MAX_FILE_BYTES) -> dict:
+    """A small TOML file (at most ``max_bytes``) as a dict; ValueError naming the file for a missing, oversized or
+    malformed one."""
+    p = input_file(path, what, max_bytes)
     try:
         with open(p, "rb") as f:
-            raw = f.read(MAX_FILE_BYTES + 1)
+            raw = f.read(max_bytes + 1)
     except OSError as exc:
         raise InputError(f"cannot read {what} {os.fspath(p)!r}: {exc.strerror or exc}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise InputError(f"{what} {os.fspath(p)!r} is larger than {MAX_FILE_BYTES} bytes")
+    if len(raw) > max_bytes:
+        raise InputError(f"{what} {os.fspath(p)!r} is larger than {max_bytes} bytes")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -23,11 +23,12 @@ the ground's friction); the motion rests at every target.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import integer, joint_vector
+from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
+from .._validate import MAX_SAMPLES, integer, joint_vector
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
@@ -39,8 +40,7 @@ from .cartesian import tracking_interpolation
 import os
 
 import numpy.typing as npt
-from typing import TYPE_CHECKING, Any, Sequence
-from .._errors import Infeasible, InputError, InputTypeError, entry_point, inputs_checked
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -54,7 +54,8 @@ DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straigh
 DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
 DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
 JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
-FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails)
+FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails; faster when
+#                        the motion would be longer than MAX_MOTION_S)
 DENSIFY = 3  # configurations checked between consecutive waypoints of a move, at least
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
@@ -68,6 +69,43 @@ BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the 
 #: How far choose_base tries stepping the base back from the targets, as shares of the body's length
 #: (0.05, 0.1, 0.15, 0.2 m on the default robot, 1.384 m long).
 BASE_STEP_SHARES = tuple(k * 0.05 / 1.384 for k in (1, 2, 3, 4))
+
+
+#: s: the longest motion a plan may have: MAX_SAMPLES samples at the 2 ms control period (2000 s). Checked before
+#: anything is solved (the targets' holds alone), after each target is solved (the holds and the least time the
+#: joints' velocity limits allow for the moves so far) and while the path is timed (``motion.timing.retime``),
+#: before anything is sampled: a scene that needs more raises ``snakehead.InputError`` (split it into scenes).
+MAX_MOTION_S = (MAX_SAMPLES - 1) * interp.CONTROL_PERIOD
+#: The most poses a plan solves: its targets and the poses along its straight-line approaches (each a whole-body
+#: solve, ~0.1-0.5 s on the default robot), counted before any is solved.
+MAX_POSES = 5000
+
+
+@dataclass(frozen=True)
+class PlanProgress:
+    """What :func:`plan` tells its ``progress`` callback, one record per call.
+
+    kind: "target" once a target of the scene has been solved and the move to it planned (in the scene's order,
+    via poses included): ``index`` 1..``count`` (the scene's targets), ``name``, ``solved``, ``seconds`` (its solve
+    and move), ``message`` (why it was not solved; "" when it was). "stage" when a stage over the whole plan begins:
+    ``name`` "base" (every target solved from the start, to choose the base), "timing" (the time-optimal retiming of
+    the whole path, often the longest stage), "checks" (the ZMP, the ground and the obstacles at every 2 ms sample);
+    ``message`` says what it does. ``elapsed_s``: seconds since :func:`plan` was called.
+    """
+
+    kind: str
+    name: str
+    index: int = 0
+    count: int = 0
+    solved: bool = True
+    seconds: float = 0.0
+    elapsed_s: float = 0.0
+    message: str = ""
+
+
+#: The signature of ``plan(progress=...)``: called with a :class:`PlanProgress`; its return value is ignored and an
+#: exception it raises stops the plan (it propagates to the caller of :func:`plan`).
+ProgressCallback = Callable[[PlanProgress], None]
 
 
 @dataclass
@@ -221,9 +259,21 @@ class _Waypoints:
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: dict | None = None  # timed lifts, kept by the controller
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
+        self._least = (0, 0.0)  # (waypoints counted, s): least_duration's sum so far
+
+    def least_duration(self, velocity: np.ndarray) -> float:
+        """s: the least the motion through the waypoints so far can last: each step at the joints' velocity limits
+        (rad/s, (n,)) and the holds (the retiming keeps the limits: the timed motion lasts at least this long)."""
+        done, total = self._least
+        if len(self.qs) > done + 1:
+            steps = np.abs(np.diff(np.array(self.qs[max(done - 1, 0):]), axis=0)) / velocity
+            total += float(steps.max(axis=1).sum())
+            self._least = (len(self.qs), total)
+        return total + float(sum(self.holds.values()))
 
     def start(self, label: str, q: npt.ArrayLike) -> None:
         self.labels, self.qs = [label], [np.asarray(q, float)]
+        self._least = (0, 0.0)
 
     def _append(self, label: str, q: np.ndarray) -> None:
         if np.abs(q - self.qs[-1]).max() <= 1e-12:  # the same configuration: nothing to move
@@ -394,15 +444,27 @@ class _Waypoints:
                     self.lift_cache[key] = lift
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
                               **timing)
+                _check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
+                # the whole motion is sampled again from the pieces' splines: the rest's samples (~400 B each) are
+                # dropped first, so that they and the whole motion's are never held at once
+                rest = replace(rest, t=rest.t[-1:].copy(), q=rest.q[-1:].copy(), qd=rest.qd[-1:].copy(),
+                               qdd=rest.qdd[-1:].copy())
                 traj = _concatenate(lift, rest)
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
+        except MotionTooLong:  # no slower fallback either: the motion is already too long
+            raise
         except Infeasible as exc:  # (the caller's options were checked when plan() began)
             # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
             # slow fixed pace so that the plan can still be looked at, and fail it
             self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
-            times = np.concatenate([[0.0], np.cumsum(np.maximum(
-                np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1) / FALLBACK_SPEED, hold_s) + 1e-3)])
+            move = np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1)
+            # faster than FALLBACK_SPEED when that pace would make the motion longer than a plan may be (the plan
+            # fails on its timing either way; its motion must still fit in MAX_SAMPLES samples)
+            budget = 0.95 * MAX_MOTION_S - float(hold_s.sum()) - 1e-3 * len(move)
+            speed = max(FALLBACK_SPEED, float(move.sum()) / budget) if budget > 0 else FALLBACK_SPEED
+            times = np.concatenate([[0.0], np.cumsum(np.maximum(move / speed, hold_s) + 1e-3)])
+            _check_motion_length(float(times[-1]), "with its holds")
             self.times = [float(x) for x in times]
             return interp.joint_trajectory(times, np.array(self.qs), method="monotone")
         self.times = [float(x) for x in traj.waypoint_times]
@@ -410,10 +472,17 @@ class _Waypoints:
         return traj
 
 
+def _check_motion_length(duration_s: float, how: str = "") -> None:
+    """MotionTooLong when a motion of ``duration_s`` is longer than :data:`MAX_MOTION_S` (before it is sampled)."""
+    if duration_s > MAX_MOTION_S:
+        raise MotionTooLong(f"the timed motion lasts {duration_s:.1f} s{' ' + how if how else ''}; at most "
+                         f"{MAX_MOTION_S:g} s ({MAX_SAMPLES} samples at {interp.CONTROL_PERIOD:g} s)")
+
+
 def _concatenate(a: Any, b: Any) -> Any:
     """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
     first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
-    first."""
+    first. Of the second's samples only the last is used (its end: when and where)."""
     from .timing import RetimedTrajectory
 
     offset = float(a.t[-1])
@@ -434,21 +503,35 @@ def _concatenate(a: Any, b: Any) -> Any:
 
 
 def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
-            notes: Sequence[str] = (), scene: Scene | None = None, timing: dict[str, Any] | None = None) -> Plan:
+            notes: Sequence[str] = (), scene: Scene | None = None, timing: dict[str, Any] | None = None,
+            stage: Callable[[str, str], None] | None = None) -> Plan:
     robot, base = plan.robot, plan.base
     notes = list(notes)
+    stage = stage or (lambda what, message: None)
+    stage("timing", f"timing the motion through {len(plan.qs)} waypoints (TOPP-RA under the robot's limits)")
     traj = plan.sample(notes, timing or {})
+    t, q, qd = traj.t, traj.q, traj.qd
+    del traj  # its accelerations (unused) are freed before the checks
+    stage("checks", f"checking the {len(t)} samples of {float(t[-1] - t[0]):.1f} s of motion (ZMP, ground"
+                    + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
-    frames = robot.frames_many(traj.q, base)  # once, for every check below
-    dyn = stability.dynamic_stability(robot, traj.t, traj.q, base, traj.qd, contact=PLAN_CONTACT, frames=frames)
-    clearance = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
+    # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
+    # every check takes what it needs from them in one pass
+    clearance = np.empty(len(t))
+
+    def lowest(rows: slice, frames: np.ndarray) -> None:
+        clearance[rows] = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
+
+    dyn = stability.dynamic_stability(robot, t, q, base, qd, contact=PLAN_CONTACT, with_frames=lowest)
     distance = None
     if obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
-        distance = coll.collision_check(robot, traj.q, list(obstacles), base, exact_within=0.005).distance
-    states = [(lab, float(t), q) for lab, t, q in zip(plan.labels, plan.times, plan.qs)]
-    return Plan(name=name, robot=robot, base=base, t=traj.t, q=traj.q, qd=traj.qd, states=states, targets=targets,
+        distance = np.concatenate([
+            coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
+                                 exact_within=0.005).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+    states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
+    return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
                 planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene,
                 timing_failure=plan.timing_failure)
@@ -732,7 +815,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
          obstacles: Sequence[BoxObstacle | WallWithHole | MeshObstacle] = (), base: BasePlacement | None = None,
          method: str = "rotated", seed: int | None = 1, allow_relocation: bool = True,
          timing: dict[str, Any] | None = None, base_shape: npt.ArrayLike | None = None,
-         start_q: npt.ArrayLike | None = None) -> Plan:
+         start_q: npt.ArrayLike | None = None, progress: ProgressCallback | None = None) -> Plan:
     """Plan the head through ``targets`` and check the motion (the control process of Section 3.3).
 
     Parameters
@@ -758,12 +841,31 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         it lies (measured) in a bending state on the ground, so that the plan starts where the robot is (a closed
         loop, ``snakehead.sim.loop``). Its base shape is ``base_shape``'s default. Used when the base stays (no
         relocation); a note says so otherwise.
+    progress : called as ``progress(record)`` with a :class:`PlanProgress` after each target is solved (in the
+        scene's order) and when each stage over the whole plan begins (choosing the base, the timing, the checks);
+        an exception it raises stops the plan.
+
+    Bounds, checked before anything is solved (``snakehead.InputError`` naming the scene): at most
+    ``scenes.MAX_TARGETS`` (1000) targets; the targets' holds at most :data:`MAX_MOTION_S` (2000 s: MAX_SAMPLES
+    samples at 2 ms) together; at most :data:`MAX_POSES` poses solved in all (the targets and the poses along their
+    line approaches). The motion's length is checked again after each target is solved (the holds and the least
+    time the joints' velocity limits allow for the moves so far) and while the path is timed, before it is sampled.
+
+    Memory grows with the motion's 2 ms samples, not with the targets: the plan keeps t, q, qd and the checks'
+    results, ~370 bytes per sample on the 16-joint default robot (8 + 2 x 128 for t, q, qd; ~105 for the ZMP, its
+    margin, the momenta, the CoM and the ground clearance); the world frames of the samples (2.5 kB each) are made
+    and dropped a chunk at a time (``dynamics.stability.SAMPLE_CHUNK``). Measured peak of ``snakehead plan --no-sim``
+    (bench/many_targets.py, figures included): ~300 MiB + ~0.75 kB per sample, e.g. 100 targets, 556 s of motion,
+    277,699 samples: 498 MiB; at MAX_SAMPLES (2000 s) about 1 GiB.
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
     """
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
+    if progress is not None and not callable(progress):
+        raise InputTypeError(f"progress must be a function of a PlanProgress (or None), got {type(progress).__name__}")
+    lines = _check_size(scene)  # before anything is solved
     if timing is not None and not isinstance(timing, dict):
         raise InputTypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
     # checked even when a controller (with its own method and seed) is given: a bad value is a mistake either way
@@ -802,9 +904,35 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             base_shape = start_q
     if base_shape is not None:
         base_shape = joint_vector(base_shape, robot.n_joints, "base_shape")
-    _check_lines(scene.targets)
     inputs_checked()  # from here on an InputError would be a bug of the planner's (the entry point says so)
+    scene_targets = scene.targets
+    count = len(scene_targets)
+    from .timing import resolve_limits
+
+    velocity = resolve_limits(robot, **(timing or {})).velocity  # for the least duration of the moves so far
+
+    def stage(what: str, message: str) -> None:
+        if progress is not None:
+            progress(PlanProgress("stage", what, count=count, elapsed_s=time.perf_counter() - t_start,
+                                  message=message))
+
+    def done(k: int, sol: Any, seconds: float) -> None:
+        """Target k (0-based) is solved and the move to it planned: tell progress; MotionTooLong once the motion
+        so far cannot fit in MAX_MOTION_S (the scene's input was valid: its moves only turn out too long)."""
+        tg = scene_targets[k]
+        if progress is not None:
+            progress(PlanProgress("target", tg.name, k + 1, count, bool(sol.success), seconds,
+                                  time.perf_counter() - t_start, "" if sol.success else str(sol.message)))
+        least = way.least_duration(velocity)
+        if least > MAX_MOTION_S:
+            raise MotionTooLong(f"scene {scene.name!r}: the motion to its target {k + 1} of {count} ({tg.name!r}) lasts "
+                             f"at least {least:.0f} s (the moves at the joints' velocity limits and the holds); a plan "
+                             f"lasts at most {MAX_MOTION_S:g} s (MAX_MOTION_S): split the scene into scenes planned "
+                             "one after the other")
+
     solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
+    reported = len(scene.reported)
+    stage("base", f"solving the {reported} target{'' if reported == 1 else 's'} from the start to choose the base")
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape, solved=solved)
     notes += base_notes
@@ -838,7 +966,6 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         q = way.qs[-1]
     results: list[TargetResult] = []
     k = 0
-    scene_targets = scene.targets
     while k < len(scene_targets):
         # a run: this target and the following ones approached along a line from it
         end = k
@@ -846,6 +973,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             end += 1
         if end == k:
             tg = scene_targets[k]
+            clock = time.perf_counter()
             sol = _solve(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes, solved=solved)
             way.move(tg.name, sol.q)
             q = sol.q
@@ -853,6 +981,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                 results.append(TargetResult(tg.name, tg.position, tg.direction, way.stop(), sol))
             if tg.hold_s > 0:
                 way.hold(tg.hold_s)
+            done(k, sol, time.perf_counter() - clock)
             k += 1
             continue
         # poses along the lines, solved backwards from the deepest (the most constrained, e.g. only the head link in
@@ -860,20 +989,26 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
         poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
             (scene_targets[k].name, scene_targets[k].position, scene_targets[k].direction, scene_targets[k])]
+        owner = [k]  # the scene target each pose leads to
         for j in range(k + 1, end + 1):
-            line = _line_poses(scene_targets[j - 1], scene_targets[j])
+            line = lines[j]
             for m, p in enumerate(line):
                 last = m == len(line) - 1
                 label = scene_targets[j].name if last else f"{scene_targets[j].name} ({m + 1}/{len(line)})"
                 poses.append((label, p, scene_targets[j].direction, scene_targets[j] if last else None))
+                owner.append(j)
+        seconds = dict.fromkeys(range(k, end + 1), 0.0)  # each target's share of the run's solves and moves
         sols: list = [None] * len(poses)
         q_back = q
         for m in range(len(poses) - 1, -1, -1):
+            clock = time.perf_counter()
             label, p, d, _ = poses[m]
             sols[m] = _solve(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
             if sols[m].success:
                 q_back = sols[m].q
+            seconds[owner[m]] += time.perf_counter() - clock
         for m, (label, p, d, line_target) in enumerate(poses):
+            clock = time.perf_counter()
             if m == 0:
                 way.move(label, sols[m].q)
             else:
@@ -884,10 +1019,40 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
                                                 way.stop(), sols[m]))
                 if line_target.hold_s > 0:
                     way.hold(line_target.hold_s)
+            seconds[owner[m]] += time.perf_counter() - clock
+            if line_target is not None:
+                done(owner[m], sols[m], seconds[owner[m]])
         q = sols[-1].q
         k = end + 1
-    plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing)
+    try:
+        plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing,
+                       stage=stage)
+    except MotionTooLong as exc:
+        raise MotionTooLong(f"scene {scene.name!r}: {exc}: split the scene into scenes planned one after the other"
+                            ) from None
     plan.relocation = relocation
     if allow_relocation and relocation is None:
         plan.out_of_range = _out_of_range(robot, chosen, scene.reported)
     return plan
+
+
+def _check_size(scene: Scene) -> dict[int, list[np.ndarray]]:
+    """InputError (naming the scene) for a scene too large to plan, before anything is solved (see :func:`plan`);
+    the poses along its line approaches (target index -> positions), which are counted here."""
+    from ..scenes.scene import check_target_count
+
+    targets = scene.targets
+    check_target_count(len(targets), f"scene {scene.name!r}")
+    _check_lines(targets)  # before the poses along the lines are made
+    hold = float(sum(t.hold_s for t in targets))
+    if hold > MAX_MOTION_S:
+        raise InputError(f"scene {scene.name!r}: its targets' hold_s add up to {hold:g} s; a plan's motion lasts at "
+                         f"most {MAX_MOTION_S:g} s (MAX_MOTION_S: {MAX_SAMPLES} samples at "
+                         f"{interp.CONTROL_PERIOD:g} s): split the scene into scenes planned one after the other")
+    lines = {j: _line_poses(targets[j - 1], targets[j]) for j in range(1, len(targets)) if targets[j].approach == "line"}
+    poses = len(targets) + sum(len(line) - 1 for line in lines.values())
+    if poses > MAX_POSES:
+        raise InputError(f"scene {scene.name!r}: its {len(targets)} targets and the poses along their line approaches "
+                         f"are {poses} whole-body solves; at most {MAX_POSES} (MAX_POSES): take a larger step_m or "
+                         "split the scene")
+    return lines

@@ -43,12 +43,12 @@ import numpy as np
 import numpy.typing as npt
 from scipy.interpolate import CubicSpline
 
-from .._validate import finite_array, finite_float, positive, sample_count
+from .._validate import MAX_SAMPLES, finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
 from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
-from .._errors import Infeasible, InputError, InputTypeError
+from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong
 
 #: q(s) and its derivatives: f(s (N,), order 0, 1 or 2) -> (N, n).
 PathFunction = Callable[[np.ndarray, int], np.ndarray]
@@ -513,7 +513,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
 
     Returns a :class:`RetimedTrajectory` (a JointTrajectory with ``duration``, ``waypoint_times``, ``check``).
     Raises ValueError when no motion along the path keeps the limits (the CoM outside the support polygon, the
-    torque to hold still beyond the limit, ...), saying where.
+    torque to hold still beyond the limit, ...), saying where; ``snakehead.InputError`` as soon as the motion timed
+    so far is longer than MAX_SAMPLES samples at ``dt`` (2000 s at 2 ms).
     """
     clock = time.perf_counter()
     robot = as_robot(robot)
@@ -592,6 +593,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
             k = item[1]
             timeline.add_pause(W[k + 1], float(holds[k]))
             times[k + 1] = timeline.end
+            _check_length(timeline.end, dt)
             continue
         _, i0, i1 = item
         pts = W[i0:i1 + 1]
@@ -643,12 +645,21 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         assert sd is not None  # the loop raised otherwise
         t_grid = timeline.add_piece(f, grid, sd)
         times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
+        _check_length(timeline.end, dt)
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
     q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
     q[0], q[-1] = W[0], W[-1]
     check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
     return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
                              notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
+
+
+def _check_length(end: float, dt: float) -> None:
+    """MotionTooLong as soon as the motion timed so far (``end`` s) is longer than MAX_SAMPLES samples at ``dt`` take:
+    before the rest of the path is solved or anything is sampled."""
+    if end > (MAX_SAMPLES - 1) * dt:
+        raise MotionTooLong(f"the timed motion lasts more than {end:.1f} s; at most {(MAX_SAMPLES - 1) * dt:g} s "
+                         f"({MAX_SAMPLES} samples at {dt:g} s)")
 
 
 def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:

@@ -49,6 +49,10 @@ at most 100 bytes). A description may also hold newlines and tabs. Anything else
 
 :func:`save_scene` writes a scene file (:func:`scene_to_toml`: its text) that :func:`load_scene` reads back as the
 same scene.
+
+Sizes are bounded: a scene holds at most :data:`MAX_TARGETS` targets (via poses included) and a scene file is at
+most :data:`MAX_SCENE_FILE_BYTES` bytes, refused before anything is planned (``snakehead.InputError``); a plan also
+bounds the motion's length (``snakehead.motion.planner.MAX_MOTION_S``).
 """
 from __future__ import annotations
 
@@ -68,8 +72,24 @@ from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 
 APPROACHES = ("free", "line")
+
+#: The most targets (entries of ``[[targets]]``, via poses included) a scene may hold. Each is a whole-body solve
+#: and a rest-to-rest move: ~0.4-0.8 s of planning and ~5 s of motion each on the default robot (bench/RESULTS.md,
+#: "Many targets"), so 1000 take minutes to plan; and a plan's motion is at most MAX_SAMPLES 2 ms samples (2000 s,
+#: ``motion.planner.MAX_MOTION_S``), 2 s per target at 1000 targets, about the shortest a move with a hold takes.
+#: A longer task is several scenes, planned one after the other.
+MAX_TARGETS = 1000
+#: The largest scene file (bytes): MAX_TARGETS targets written out in full (~200 bytes each), comments and obstacles.
+MAX_SCENE_FILE_BYTES = 1 << 20
 #: Default spacing (m) of the poses solved along a straight-line approach.
 DEFAULT_LINE_STEP = 0.01
+
+
+def check_target_count(count: int, where: str) -> None:
+    """InputError unless ``count`` targets are at most :data:`MAX_TARGETS` (``where``: the scene or the file)."""
+    if count > MAX_TARGETS:
+        raise InputError(f"{where} has {count} targets; at most {MAX_TARGETS} (MAX_TARGETS): split it into scenes "
+                         "planned one after the other")
 
 
 @dataclass(frozen=True)
@@ -129,6 +149,7 @@ class Scene:
         targets = sequence(self.targets, f"scene {self.name!r} targets")
         if not targets:
             raise InputError(f"scene {self.name!r} has no targets")
+        check_target_count(len(targets), f"scene {self.name!r}")
         for t in targets:
             if not isinstance(t, Target):
                 raise InputTypeError(f"scene targets must be Target, got {type(t).__name__}")
@@ -162,6 +183,7 @@ class Scene:
         file_name_part(name, "a scene's name")  # before it names the targets
         targets = []
         items = sequence(pairs, "targets")
+        check_target_count(len(items), "targets")  # before a Target is made of each
         for k, item in enumerate(items):
             if isinstance(item, Target):
                 targets.append(item)
@@ -259,6 +281,7 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     check_keys(data, *_SCENE_KEYS, where)
     if not isinstance(data["targets"], list) or not data["targets"]:
         raise InputError(f"{where}: targets must be a non-empty array of tables ([[targets]])")
+    check_target_count(len(data["targets"]), where)  # before a Target is made of each
     targets = tuple(_target_from(e, f"{where}, targets[{k}]") for k, e in enumerate(data["targets"]))
     raw_obstacles = data.get("obstacles", [])
     if not isinstance(raw_obstacles, list):
@@ -288,7 +311,7 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
 
 def load_scene(path: str | os.PathLike) -> Scene:
     """Read a scene file (see the module's docstring). ValueError names the file, the entry and the problem."""
-    data = read_toml(path, "scene file")
+    data = read_toml(path, "scene file", MAX_SCENE_FILE_BYTES)
     p = Path(path)
     scene = scene_from_dict(data, name=p.stem, folder=p.resolve().parent, where=f"scene file {os.fspath(p)!r}")
     return Scene(name=scene.name, targets=scene.targets, obstacles=scene.obstacles, robot_file=scene.robot_file,
@@ -398,4 +421,4 @@ def paper_scene(name: str) -> Scene:
 
 
 __all__ = ["Target", "Scene", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
-           "PAPER_SCENES", "APPROACHES"]
+           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "MAX_SCENE_FILE_BYTES"]

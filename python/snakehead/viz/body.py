@@ -296,11 +296,10 @@ def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: b
             faces = box_faces(ob) if isinstance(ob, BoxObstacle) else mesh_obstacle_faces(ob)
             ax.add_collection3d(Poly3DCollection(faces, facecolor=OBSTACLE_COLOR, edgecolor="k", linewidths=0.3,
                                                  alpha=0.45), autolim=False)  # faces of several sizes: no autoscale
-    if arrows:
-        for tg in plan.targets:
-            d = 0.08 * np.asarray(tg.direction, float)
-            p = np.asarray(tg.position, float) - d  # the arrow ends at the target
-            ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.0, arrow_length_ratio=0.3)
+    if arrows and len(plan.targets):  # one collection of arrows: one per target made the figure grow per target
+        d = 0.08 * np.array([tg.direction for tg in plan.targets], float)
+        p = np.array([tg.position for tg in plan.targets], float) - d  # each arrow ends at its target
+        ax.quiver(p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2], color="k", lw=1.0, arrow_length_ratio=0.3)
 
 
 def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
@@ -334,13 +333,18 @@ def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
 # ----------------------------------------------------------------------------------------------
 def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np.ndarray]]:
     """Up to ``n_panels`` of the plan's states (label, time s, q (n,)) in time order: the first and last, every
-    target, then the waypoints nearest to evenly spaced times. Holds are left out."""
+    target (evenly spread ones when more than ``n_panels - 2``: the figure's size does not grow with the targets),
+    then the waypoints nearest to evenly spaced times. Holds are left out."""
     states = [s for s in plan.states if not s[0].endswith("(hold)")]
     if not states:
         raise InputError("the plan has no states")
     times = np.array([s[1] for s in states])
     chosen = {0, len(states) - 1}
-    for tg in plan.targets:
+    targets = list(plan.targets)
+    if len(targets) > max(n_panels - 2, 1):
+        targets = [targets[int(k)] for k in np.unique(np.round(np.linspace(0, len(targets) - 1,
+                                                                           max(n_panels - 2, 1))))]
+    for tg in targets:
         chosen.add(int(np.argmin(np.abs(times - tg.time_s))))
     for want in np.linspace(times[0], times[-1], max(n_panels, 2)):
         if len(chosen) >= n_panels:
@@ -350,7 +354,7 @@ def snapshot_states(plan: Plan, n_panels: int = 12) -> list[tuple[str, float, np
             if int(k) not in chosen:
                 chosen.add(int(k))
                 break
-    return [states[k] for k in sorted(chosen)][:max(n_panels, len(plan.targets) + 2)]
+    return [states[k] for k in sorted(chosen)][:max(n_panels, len(targets) + 2)]
 
 
 def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_panels: int = 12, columns: int = 4,
