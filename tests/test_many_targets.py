@@ -204,7 +204,7 @@ def test_a_path_that_cannot_be_timed_still_fits_the_longest_motion(three, contro
     """A path the retiming cannot time is sampled at a slow pace to be looked at, and the plan fails on its timing;
     that pace quickens when it would make the motion longer than MAX_MOTION_S (it was an error, then)."""
     def untimeable(*args, **kwargs):
-        raise ValueError("no motion along the path keeps every limit near waypoint 3")
+        raise Infeasible("no motion along the path keeps every limit near waypoint 3")
 
     monkeypatch.setattr(timing, "retime", untimeable)
     monkeypatch.setattr(planner, "MAX_MOTION_S", 30.0)
