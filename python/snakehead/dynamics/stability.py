@@ -16,7 +16,7 @@ body along +x).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Literal
 
 import numpy as np
 
@@ -87,7 +87,7 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
         active[:, np.searchsorted(idx, links + 1)] |= on_ground
         return pts, active
     if contact == "ground":  # only the links that touch in some sample can give a contact point
-        keep = (robot.lowest_z(frames, links) <= tolerance).any(axis=0)
+        keep: np.ndarray = np.asarray((robot.lowest_z(frames, links) <= tolerance).any(axis=0))
         keep[0] |= not keep.any()  # (one link, none of its points active: no polygon, but the shapes stay)
         links = links[keep]
     # footprint / ground: each shape's lowest candidate points (box corners, cylinder rims, sphere bottoms, hull
@@ -226,7 +226,7 @@ def _check_times(t: npt.ArrayLike, name: str = "t") -> np.ndarray:
     return t
 
 
-def _check_trajectory(robot: SnakeRobot, t: np.ndarray, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def _check_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     t = _check_times(t)
     q = finite_array(q, "q", (None, robot.n_joints))
     if q.shape[0] != t.shape[0]:
@@ -241,8 +241,13 @@ def joint_velocities(t: np.ndarray, q: npt.ArrayLike) -> np.ndarray:
     one-sided differences at the ends (first order with only two samples).
     """
     t = _check_times(t)
-    q = finite_array(q, "q", (t.shape[0], None))
-    return np.gradient(q, t, axis=0, edge_order=2 if len(t) > 2 else 1)
+    return _time_derivative(t, finite_array(q, "q", (t.shape[0], None)))
+
+
+def _time_derivative(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """d/dt of samples x (T, ...) at times t (T,) by ``np.gradient`` along the samples (see joint_velocities)."""
+    edge: Literal[1, 2] = 2 if len(t) > 2 else 1
+    return np.asarray(np.gradient(x, t, axis=0, edge_order=edge))
 
 
 def _momenta(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray, base: BasePlacement, frames: np.ndarray | None = None
@@ -311,9 +316,8 @@ def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, q
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     P, L, com = _momenta(robot, q, qd, base, frames)
-    edge = 2 if len(t) > 2 else 1
-    Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
-    Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
+    Pdot = _time_derivative(t, P)  # Eq. 33's dP/dt
+    Ldot = _time_derivative(t, L)  # Eq. 34's dL/dt
     return _zmp_from(com, Pdot, Ldot, robot.total_mass), P, L, com, q
 
 
@@ -385,9 +389,8 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
         if with_frames is not None:
             with_frames(rows, f)
         del f
-    edge = 2 if n > 2 else 1
-    Pdot = np.gradient(P, t, axis=0, edge_order=edge)  # Eq. 33's dP/dt
-    Ldot = np.gradient(L, t, axis=0, edge_order=edge)  # Eq. 34's dL/dt
+    Pdot = _time_derivative(t, P)  # Eq. 33's dP/dt
+    Ldot = _time_derivative(t, L)  # Eq. 34's dL/dt
     p = _zmp_from(com, Pdot, Ldot, robot.total_mass)
     del Pdot, Ldot
     flying = ~np.all(np.isfinite(p), axis=1)
