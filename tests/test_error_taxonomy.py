@@ -213,3 +213,31 @@ def test_the_figure_process_keeps_the_fault_of_its_errors():
         pipeline._Beside(unwritable, pipeline.Progress()).files()
     with pytest.raises(RuntimeError, match="KeyError"):
         pipeline._Beside(broken, pipeline.Progress()).files()
+
+
+def test_a_figure_process_that_dies_is_replaced_by_drawing_here():
+    """The forked figure process of a process with threads can crash (a SIGSEGV was seen once under load): the
+    figures are then drawn in the main process, and the user is told, instead of the run ending as a bug."""
+    import os
+    import signal
+
+    parent = os.getpid()
+
+    def crashes_when_forked(progress):
+        if os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return ["drawn here.png"]
+
+    progress = pipeline.Progress()
+    said = []
+    progress.say = said.append
+    assert pipeline._Beside(crashes_when_forked, progress).files() == ["drawn here.png"]
+    assert any("died (exit code -11)" in line for line in said), said
+
+
+def test_an_obstacle_kind_of_the_wrong_type_is_bad_input():
+    from snakehead.scenes.scene import scene_from_dict
+
+    with pytest.raises(InputError, match="kind must be one of"):
+        scene_from_dict({"name": "s", "targets": [{"name": "a", "position": [0.9, 0.3, 0.3], "direction": [1, 0, 0]}],
+                         "obstacles": [{"kind": ["box"], "centre": [1, 1, 0.1], "size": [0.1, 0.1, 0.1]}]})

@@ -126,11 +126,11 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
-    files += _ros_outputs(name, out, progress, result)
     drawing = None
-    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates
+    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates (forked first: see _Beside)
         drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
                           progress, parallel=settings.parallel)
+    files += _ros_outputs(name, out, progress, result)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -337,6 +337,7 @@ class _Beside:
         import multiprocessing
 
         self.progress = progress
+        self.work = work
         self.proc = None
         if not (parallel and sys.platform.startswith("linux")):
             self._files = work(progress)
@@ -352,9 +353,11 @@ class _Beside:
             return self._files
         try:
             ok, value, stages = self.recv.recv()
-        except EOFError:
+        except EOFError:  # the forked child died (a fork of a process with threads can crash): draw here instead
             self.proc.join()
-            raise RuntimeError(f"the process drawing the figures died (exit code {self.proc.exitcode})") from None
+            self.progress.say(f"the process drawing the figures died (exit code {self.proc.exitcode}); drawing them "
+                              "in this process instead")
+            return self.work(self.progress)
         self.proc.join()
         self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
         if not ok:

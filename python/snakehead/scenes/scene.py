@@ -253,7 +253,7 @@ def _target_from(entry: Any, where: str) -> Target:
 def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObstacle | WallWithHole | MeshObstacle:
     entry = _table(entry, where)
     kind = entry.get("kind")
-    if kind not in _OBSTACLE_KEYS:
+    if not isinstance(kind, str) or kind not in _OBSTACLE_KEYS:  # (a list or a table is not hashable)
         raise InputError(f"{where}: kind must be one of {sorted(_OBSTACLE_KEYS)}, got {kind!r}")
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
