@@ -13,6 +13,7 @@ from typing import Any, IO, Iterator
 
 import numpy as np
 
+from ._errors import InputError
 from ._validate import input_file
 
 
@@ -77,35 +78,36 @@ def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str,
     archive's members, as its directory declares them, must be ``.npy`` arrays of at most ``max_bytes`` bytes in
     all, checked before anything is unpacked (a zip bomb of a few MB can declare gigabytes); each array's header
     must agree with its member's size before its memory is allocated; arrays of Python objects (pickles) are
-    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is a ValueError "cannot read
-    {what} {path}: ..." naming, where it applies, the array: never EOFError, zipfile.BadZipFile or zlib.error.
+    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is an InputError (a ValueError)
+    "cannot read {what} {path}: ..." naming, where it applies, the array: never EOFError, zipfile.BadZipFile or
+    zlib.error.
     """
     p = input_file(path, what, max_bytes)
     where = f"cannot read {what} {os.fspath(p)!r}"
     try:
         archive = zipfile.ZipFile(p)
     except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError) as exc:
-        raise ValueError(f"{where}: it is not a .npz archive (a zip of .npy arrays): {exc}") from None
+        raise InputError(f"{where}: it is not a .npz archive (a zip of .npy arrays): {exc}") from None
     arrays: dict[str, np.ndarray] = {}
     with archive:
         members = archive.infolist()
         declared = sum(m.file_size for m in members)
         if declared > max_bytes:
-            raise ValueError(f"{where}: it would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
+            raise InputError(f"{where}: it would unpack to {declared} bytes, more than the {max_bytes} allowed (a "
                              "damaged file or a zip bomb)")
         for m in members:
             if m.is_dir() or not m.filename.endswith(".npy"):
-                raise ValueError(f"{where}: it holds {m.filename!r}, which is not a .npy array")
+                raise InputError(f"{where}: it holds {m.filename!r}, which is not a .npy array")
             key = m.filename[:-len(".npy")]
             if key in arrays:
-                raise ValueError(f"{where}: it holds the array {key!r} twice")
+                raise InputError(f"{where}: it holds the array {key!r} twice")
             try:
                 with archive.open(m) as f:
                     arrays[key] = _read_npy(f, m.file_size)
             except ValueError as exc:
-                raise ValueError(f"{where}: its array {key!r} {exc}") from None
+                raise InputError(f"{where}: its array {key!r} {exc}") from None
             except (zipfile.BadZipFile, zlib.error, OSError, EOFError, RuntimeError, NotImplementedError) as exc:
-                raise ValueError(f"{where}: its array {key!r} is damaged ({type(exc).__name__}: {exc})") from None
+                raise InputError(f"{where}: its array {key!r} is damaged ({type(exc).__name__}: {exc})") from None
     return arrays
 
 

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import InputError
 from .._validate import joint_vector, position_direction_pairs
 from .map_queries import direction_bits
 
@@ -64,7 +65,7 @@ def neck_frames(robot: SnakeRobot, base_configuration: npt.ArrayLike | None = No
     from ..model.robot import BasePlacement
 
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ValueError(f"samples must be a positive integer, got {samples!r}")
+        raise InputError(f"samples must be a positive integer, got {samples!r}")
     if base_configuration is None:
         from ..backbone.initial import initial_configuration
 
@@ -90,18 +91,20 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     k, and the map voxels whose sphere point in direction k lies within half a voxel of the height plane of the
     target; the target position seen from B0 is that point moved onto the plane, which fixes x, y. Kept: the
     best voxel per (frame, yaw) when its index is at least ``min_index``; returned: the ``limit`` best."""
+    from .workspace import require_map
+
+    m = require_map(workspace_map, needs=("poses",), what="workspace_map")  # whole, with per-direction results
     p, d, single = position_direction_pairs(position, direction)
     if not single:
-        raise ValueError("placements take one target: position and direction of shape (3,)")
+        raise InputError("placements take one target: position and direction of shape (3,)")
     for name, v in (("yaw_samples", yaw_samples), ("limit", limit)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise ValueError(f"{name} must be a positive integer, got {v!r}")
+            raise InputError(f"{name} must be a positive integer, got {v!r}")
     frames = np.asarray(frames, dtype=float)
     neck_q = np.asarray(neck_q, dtype=float)
     if frames.ndim != 3 or frames.shape[1:] != (4, 4) or len(frames) != len(neck_q):
-        raise ValueError("frames must be (J, 4, 4), one per row of neck_q")
+        raise InputError("frames must be (J, 4, 4), one per row of neck_q")
     p, d = p[0], d[0]
-    m = workspace_map
     bits = direction_bits(m)
     index = np.where(m.indices >= float(min_index) - 1e-9, m.indices, -1.0)
     dirs = m.sphere_directions
@@ -156,6 +159,9 @@ def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position:
     The base keeps the base joints of ``base_configuration`` (default: the initial configuration); the neck
     joints take ``neck_samples`` values each; yaws are sampled every 360 / ``yaw_samples`` degrees. See the
     module's doc. The result says, for each placement, the neck joints and the target as seen from B0."""
+    from .workspace import require_map
+
+    require_map(workspace_map, robot, needs=("poses",), what="workspace_map")  # also: a map of this robot's head
     frames, neck_q = neck_frames(robot, base_configuration, neck_samples)
     return placements_from_frames(workspace_map, frames, neck_q, position, direction, yaw_samples=yaw_samples,
                                   min_index=min_index, limit=limit)

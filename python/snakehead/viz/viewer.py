@@ -220,6 +220,10 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     if int(max_frames) != max_frames or max_frames < 2:
         raise ValueError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
+    if workspace_map is not None:  # a whole map (a shard shows part of it) of this robot's head
+        from ..kinematics.workspace import require_map
+
+        require_map(workspace_map, robot, what="workspace_map")
     t = np.asarray(plan.t, float)
     n = int(min(max_frames, len(t), np.floor((t[-1] - t[0]) / frame_step_s) + 1))
     idx = np.unique(np.r_[np.searchsorted(t, np.linspace(t[0], t[-1], max(n, 2))), len(t) - 1].clip(0, len(t) - 1))
@@ -233,9 +237,6 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     map_frame = frames[:, robot.link_index(robot.parts.neck_end)]
 
     if workspace_map is not None and len(workspace_map):
-        if workspace_map.chain_hash != robot.head_chain.hash:
-            raise ValueError(f"the map was made for another head chain ({workspace_map.base} -> {workspace_map.tip});"
-                             f" this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip}")
         voxels = np.asarray(workspace_map.centers, float)
         indices = np.asarray(workspace_map.indices, float)
         voxel_size = float(workspace_map.voxel_size)
