@@ -288,7 +288,8 @@ def test_compute_map_with_an_executor_bounds_the_shards(robot):
 
 def test_the_limits_are_the_cores():
     """The Python limits are the C++ core's: its own check takes each and refuses one more."""
-    for field, most, extra in (("directions", ws.MAX_DIRECTIONS, {"rolls": 1}), ("rolls", ws.MAX_ROLLS, {"directions": 1}),
+    for field, most, extra in (("directions", ws.MAX_DIRECTIONS, {"rolls": 1}),
+                               ("rolls", ws.MAX_ROLLS, {"directions": 1}),
                                ("cloud_samples", ws.MAX_CLOUD_SAMPLES, {}), ("threads", ws.MAX_THREADS, {})):
         o = _core.WorkspaceOptions()
         for k, v in extra.items():

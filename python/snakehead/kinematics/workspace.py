@@ -143,12 +143,12 @@ class ReachabilityMap:
 
     # --- what the map is, and whether it is what a caller needs ------------------------------------------
     def require_whole_for(self, chain: Chain | SnakeRobot | None = None, *, needs: Iterable[str] = (),
-                          what: str | None = None, shard_ok: bool = False) -> ReachabilityMap:
+                          what: str | None = None) -> ReachabilityMap:
         """The one check of a map where it is accepted: returns the map, or raises :class:`InputError` (one line
         naming the map and what to do) when it is
 
-        * a shard of a map (``shard_ok=False``, for everyone but the code that merges shards): its G0, dexterous band
-          and queries would be those of a part of the map;
+        * a shard of a map: its G0, dexterous band and queries would be those of a part of the map (shards load, and
+          :func:`merge` takes them as they are: the one place that does);
         * a map of another chain than ``chain`` (a :class:`Chain`, or a SnakeRobot's head chain), by the chains'
           kinematics hash;
         * lacking what the caller ``needs``: ``"voxels"`` (at least one), ``"G0"`` (the dexterous centre:
@@ -161,7 +161,7 @@ class ReachabilityMap:
         unknown = [n for n in needs if n not in ("voxels", "G0", "poses")]
         if unknown:
             raise InputError(f"needs may hold 'voxels', 'G0' and 'poses', got {unknown[0]!r}")
-        if not shard_ok and tuple(self.shard) != (0, 1):
+        if tuple(self.shard) != (0, 1):
             i, n = self.shard
             raise InputError(f"{name} is shard {i}/{n} of a map, not a whole map ({len(self)} of its "
                              f"{self.hull_voxels} voxels): {_MERGE_HINT}")
@@ -480,8 +480,8 @@ def parse_shard(shard: Any) -> tuple[int, int]:
     bad = InputError(f"shard must be 'i/N' or (i, N) with integers 0 <= i < N <= {MAX_SHARDS}, got {shard!r}")
     if isinstance(shard, str):
         parts = shard.split("/")
-        if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
-            raise bad
+        if len(parts) != 2 or not all(p.strip().isdecimal() and len(p) <= 20 for p in parts):
+            raise bad  # (more than 20 digits is beyond any limit, and int() refuses thousands)
         i, n = (int(p) for p in parts)
     else:
         try:
@@ -761,7 +761,7 @@ _KINDS = {"text": "U", "int": "iu", "bool": "b", "float": "fiu"}
 
 def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -> None:
     """Check the arrays of a map file (as :func:`snakehead._files.read_npz` returns them) before a map is made of
-    them: ValueError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
+    them: InputError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
     outside [0, 100] or not 100 * solved / tried, solved counts outside [0, tried], NaN or non-positive sizes,
     voxel ids duplicated, out of order or outside the grid, voxel centres that are not their voxels' centres,
     per-direction results of the wrong shape, and parameters beyond the sweep's limits. Either format (1 or 2)."""
@@ -859,9 +859,10 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
     """Read a map written by ``save`` or ``workspace_gen`` (numpy alone reads the file; this only checks it).
 
     A map file of the first format loads too: its voxels were those of the convex hull, and it lacks the
-    per-direction results (``m.lacks == ("reached",)``; queries then say so). ValueError for a missing, foreign,
+    per-direction results (``m.lacks == ("reached",)``; queries then say so). InputError for a missing, foreign,
     damaged or inconsistent file (:func:`snakehead._files.read_npz`, :func:`validate_map_arrays`), naming what is
-    wrong."""
+    wrong. A shard loads too, for :func:`merge`; everything that uses a map refuses it
+    (:meth:`ReachabilityMap.require_whole_for`)."""
     from .._files import read_npz
 
     z = read_npz(path, "the map", max_bytes=MAX_MAP_BYTES)  # a regular file; sizes checked before unpacking
