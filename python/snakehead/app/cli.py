@@ -101,17 +101,6 @@ def _bounded_int(least: int, most: int) -> Callable[[str], int]:
     return parse
 
 
-def _bounded_float(most: float) -> Callable[[str], float]:
-    """An argument type: a number in (0, most]."""
-    def parse(text: str) -> float:
-        x = _positive_float(text)
-        if x > most:
-            raise argparse.ArgumentTypeError(f"must be at most {most:g}, got {text!r}")
-        return x
-
-    return parse
-
-
 def _shard(text: str) -> str:
     """An argument type: i/N with 0 <= i < N <= the most shards a map has (kinematics.workspace.MAX_SHARDS)."""
     from .._errors import InputError
@@ -470,7 +459,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"frames about the approach axis per point, 1 to {ws.MAX_ROLLS}, and directions x rolls at "
                         f"most {ws.MAX_FRAMES_PER_VOXEL} (default 4)")
     p.add_argument("--free-roll", action="store_true", help="one IK call per point with the roll left free")
-    p.add_argument("--timeout", type=_bounded_float(ws.MAX_TIMEOUT_S), default=3e-4, metavar="S",
+    p.add_argument("--timeout", type=_positive_float, default=3e-4, metavar="S",
                    help=f"TRAC-IK budget per call (s, over 0 and at most {ws.MAX_TIMEOUT_S:g}; default 0.0003)")
     p.add_argument("--seed", type=_bounded_int(0, ws.MAX_SEED), default=1, metavar="N",
                    help="random seed, 0 to 2^64 - 1 (default 1)")

@@ -172,7 +172,7 @@ class ReachabilityMap:
             if self.chain_hash != head.hash:
                 mine = (f"{chain.parts.neck_end} -> {chain.parts.head_tip}" if isinstance(chain, SnakeRobot) else
                         f"{head.base} -> {head.tip}")
-                raise InputError(f"{name} was made for another chain ({self.base} -> {self.tip}, hash "
+                raise InputError(f"{name} was made for another head chain ({self.base} -> {self.tip}, hash "
                                  f"{self.chain_hash}); this robot's head is {mine} (hash {head.hash}): compute its map "
                                  "(snakehead workspace --robot ROBOT.toml --out MAP.npz)")
         if needs and len(self) == 0:
@@ -441,8 +441,10 @@ def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_rol
     voxel, timeout, epsilon = _real("voxel", voxel), _real("timeout", timeout), _real("epsilon", epsilon)
     if not (math.isfinite(voxel) and voxel > 0):
         raise InputError(f"voxel size must be a positive number of metres, got {voxel!r}")
-    if not (math.isfinite(timeout) and 0 < timeout <= MAX_TIMEOUT_S):
-        raise InputError(f"timeout must be within (0, {MAX_TIMEOUT_S:g}] s (one day), got {timeout!r}")
+    if not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"timeout must be a positive finite number of seconds, got {timeout!r}")
+    if timeout > MAX_TIMEOUT_S:
+        raise InputError(f"timeout must be at most {MAX_TIMEOUT_S:g} s (one day), got {timeout:g}")
     if not (math.isfinite(epsilon) and epsilon > 0):
         raise InputError(f"epsilon must be a positive number, got {epsilon!r}")
     if not isinstance(approach_axis, str) or approach_axis not in ("x", "z"):
