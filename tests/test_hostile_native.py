@@ -127,11 +127,12 @@ def test_sizes_beyond_their_limits_name_the_field():
     assert r.returncode == 0, r.stderr[-2000:]
     lines = r.stdout.splitlines()
     assert len(lines) == 5, r.stdout
-    assert lines[0].startswith("ValueError directions must be between 1 and 4096"), lines[0]
-    assert lines[1].startswith("ValueError voxel size 1e-09 m is too small") and "at most 256" in lines[1], lines[1]
-    assert lines[2].startswith("ValueError cloud_samples must be between 100 and 10000000"), lines[2]
-    assert lines[3].startswith("ValueError threads must be between 0 and 256"), lines[3]
-    assert lines[4].startswith("ValueError directions must be between 1 and 4096"), lines[4]
+    # InputErrors (ValueErrors) naming the argument, raised in Python before the core is called
+    assert lines[0].startswith("InputError directions must be between 1 and 4096"), lines[0]
+    assert lines[1].startswith("InputError voxel size 1e-09 m is too small") and "at most 256" in lines[1], lines[1]
+    assert lines[2].startswith("InputError cloud_samples must be between 100 and 10000000"), lines[2]
+    assert lines[3].startswith("InputError threads must be between 0 and 256"), lines[3]
+    assert lines[4].startswith("InputError n (directions) must be between 1 and 4096"), lines[4]
 
 
 # --- robot descriptions ---------------------------------------------------------------------------------

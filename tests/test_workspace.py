@@ -310,7 +310,7 @@ def test_bad_chain_and_output(robot, small, tmp_path):
         ws.compute("neck_end", progress=False, **SMALL)
     # One joint: the tip moves on an arc, whose points span no volume (no hull).
     with pytest.raises(ValueError, match="no volume"):
-        ws.compute(Chain.from_urdf(robot.urdf, "link_15", "head_tip"), progress=False, **SMALL)
+        ws.compute(Chain.from_urdf(robot.urdf, "link_15", "head_tip"), progress=False, **{**SMALL, "voxel": 0.05})
     with pytest.raises(ValueError, match="cannot write"):
         small.save(tmp_path / "no-such-dir" / "map.npz")
     with pytest.raises(ValueError, match=".npz"):

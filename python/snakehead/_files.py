@@ -13,8 +13,8 @@ from typing import Any, IO, Iterator
 
 import numpy as np
 
-from ._validate import input_file
 from ._errors import InputError
+from ._validate import input_file
 
 
 
@@ -83,8 +83,9 @@ def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str,
     archive's members, as its directory declares them, must be ``.npy`` arrays of at most ``max_bytes`` bytes in
     all, checked before anything is unpacked (a zip bomb of a few MB can declare gigabytes); each array's header
     must agree with its member's size before its memory is allocated; arrays of Python objects (pickles) are
-    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is a ValueError "cannot read
-    {what} {path}: ..." naming, where it applies, the array: never EOFError, zipfile.BadZipFile or zlib.error.
+    refused. Every failure -- an empty, truncated or corrupted file, a foreign one -- is an InputError (a ValueError)
+    "cannot read {what} {path}: ..." naming, where it applies, the array: never EOFError, zipfile.BadZipFile or
+    zlib.error.
     """
     p = input_file(path, what, max_bytes)
     where = f"cannot read {what} {os.fspath(p)!r}"

@@ -102,6 +102,29 @@ def _seed(text: str) -> int:
     return _int(text, 0)
 
 
+def _bounded_int(least: int, most: int) -> Callable[[str], int]:
+    """An argument type: an integer within [least, most] (a number beyond is refused here, before any work)."""
+    def parse(text: str) -> int:
+        n = _int(text, least)
+        if n > most:
+            raise argparse.ArgumentTypeError(f"must be at most {most}, got {text!r}")
+        return n
+
+    return parse
+
+
+def _shard(text: str) -> str:
+    """An argument type: i/N with 0 <= i < N <= the most shards a map has (kinematics.workspace.MAX_SHARDS)."""
+    from .._errors import InputError
+    from ..kinematics.workspace import parse_shard
+
+    try:
+        parse_shard(text)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def _port(text: str) -> int:
     n = _int(text, 0)
     if n > 65535:
@@ -135,17 +158,13 @@ def _robot(args: argparse.Namespace) -> SnakeRobot:
 
 
 def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
-    """The map given with --map (checked against the robot's head), else None (the pipeline finds one)."""
+    """The map given with --map, else None (the pipeline finds one): InputError unless a whole map (not a shard) of
+    the robot's head with the voxels its dexterous centre G0 needs (the controller's check, made before any work)."""
     from ..kinematics import workspace
 
     if args.map is None:
         return None
-    m = workspace.load(args.map)
-    if m.chain_hash != robot.head_chain.hash:
-        raise UsageError(f"--map {args.map!r} was made for another head chain ({m.base} -> {m.tip}, hash "
-                         f"{m.chain_hash}); this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip} "
-                         f"(hash {robot.head_chain.hash})")
-    return m
+    return workspace.load(args.map).require_whole_for(robot, needs=("G0",), what=f"--map {args.map!r}")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -259,30 +278,57 @@ def _plan(args: argparse.Namespace) -> int:
 # workspace
 # ----------------------------------------------------------------------------------------------
 def _workspace(args: argparse.Namespace) -> int:
+    from .._errors import InputError
     from ..kinematics import workspace
 
     out = Path(args.out)
     if out.suffix != ".npz":
-        raise UsageError(f"--out must end in .npz, got {args.out!r}")
+        raise InputError(f"--out must end in .npz, got {args.out!r}")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
-        raise UsageError(f"the directory of --out {args.out!r} does not exist")
+        raise InputError(f"the directory of --out {args.out!r} does not exist")
     if not os.access(parent, os.W_OK):
-        raise UsageError(f"cannot write to the directory of --out {args.out!r}")
+        raise InputError(f"cannot write to the directory of --out {args.out!r}")
+    if args.merge:
+        return _merge_shards(args, out)
     robot = _robot(args)
     chain = robot.head_chain
     defaults = workspace.default_map_options(chain)
     voxel = args.voxel if args.voxel is not None else defaults["voxel"]
+    options = dict(voxel=voxel, directions=args.directions, rolls=args.rolls, free_roll=args.free_roll,
+                   timeout=args.timeout, seed=args.seed, threads=args.threads, shard=args.shard)
+    workspace.check_options(chain, **options)  # bad values (the voxel against the head's reach) before any output
     t0 = time.perf_counter()
     print(f"snakehead workspace: head chain {chain.base} -> {chain.tip} ({chain.n_joints} joints), voxel {voxel} m, "
           f"{args.directions} directions x {'free roll' if args.free_roll else f'{args.rolls} rolls'}",
           file=sys.stderr, flush=True)
-    m = workspace.compute(chain, voxel=voxel, directions=args.directions, rolls=args.rolls,
-                          free_roll=args.free_roll, timeout=args.timeout, seed=args.seed, threads=args.threads,
-                          shard=args.shard, progress=not args.quiet)
+    m = workspace.compute(chain, progress=not args.quiet, **options)
+    if args.shard is None and len(m) == 0:  # nothing written: a map without voxels is refused wherever it goes
+        raise InputError(f"--voxel {voxel} m: no voxel of the grid lies inside the head's workspace; give a smaller "
+                         "--voxel")
     workspace.save(m, out)
     print(f"snakehead workspace: {len(m)} voxels in {time.perf_counter() - t0:.1f} s; wrote {out.resolve()}")
     if m.shard == (0, 1) and len(m):
+        print(m.summary())
+    return 0
+
+
+def _merge_shards(args: argparse.Namespace, out: Path) -> int:
+    """workspace --merge: the shards' files merged into --out (the one place shards are read as they are)."""
+    from .._errors import InputError
+    from ..kinematics import workspace
+
+    given = [name for name, value in (("--shard", args.shard), ("--voxel", args.voxel)) if value is not None]
+    if given:
+        raise InputError(f"--merge merges computed shards: {' and '.join(given)} cannot be given with it")
+    shards = [workspace.load(path) for path in args.merge]
+    m = workspace.merge(shards)
+    if args.robot is not None:  # the shards must be of this robot's head
+        m.require_whole_for(_robot(args), what=f"the merged map of {len(shards)} shards")
+    m.command = f"snakehead workspace --merge ({len(shards)} shards)"
+    workspace.save(m, out)
+    print(f"snakehead workspace: merged {len(shards)} shards into {len(m)} voxels; wrote {out.resolve()}")
+    if len(m):
         print(m.summary())
     return 0
 
@@ -440,19 +486,30 @@ def build_parser() -> argparse.ArgumentParser:
                                    "executable installed with the package (workspace_gen --help).")
     p.add_argument("--out", required=True, metavar="MAP.npz", help="output file (.npz)")
     _add_robot_option(p)
+    from ..kinematics import workspace as ws
+
     p.add_argument("--voxel", type=_positive_float, default=None, metavar="M",
-                   help="voxel edge (m; default: a twelfth of the head's reach rounded to 5 mm, 0.05 on the default "
-                        "robot)")
-    p.add_argument("--directions", type=_positive_int, default=20, metavar="N",
-                   help="points per voxel sphere (default 20)")
-    p.add_argument("--rolls", type=_positive_int, default=4, metavar="R",
-                   help="frames about the approach axis per point (default 4)")
+                   help="voxel edge (m; default: a twelfth of the head's reach rounded to 5 mm, 0.045 on the default "
+                        f"robot); the grid, of side 2 x the head's reach, must hold {ws.MIN_VOXELS_PER_AXIS} to "
+                        f"{ws.MAX_VOXELS_PER_AXIS} voxels per axis (so a voxel under 2/3 of the reach)")
+    p.add_argument("--directions", type=_bounded_int(1, ws.MAX_DIRECTIONS), default=20, metavar="N",
+                   help=f"points per voxel sphere, 1 to {ws.MAX_DIRECTIONS} (default 20)")
+    p.add_argument("--rolls", type=_bounded_int(1, ws.MAX_ROLLS), default=4, metavar="R",
+                   help=f"frames about the approach axis per point, 1 to {ws.MAX_ROLLS}, and directions x rolls at "
+                        f"most {ws.MAX_FRAMES_PER_VOXEL} (default 4)")
     p.add_argument("--free-roll", action="store_true", help="one IK call per point with the roll left free")
     p.add_argument("--timeout", type=_positive_float, default=3e-4, metavar="S",
-                   help="TRAC-IK budget per call (s, default 0.0003)")
-    p.add_argument("--seed", type=_seed, default=1, metavar="N", help="random seed (default 1)")
-    p.add_argument("--threads", type=_positive_int, default=None, metavar="N", help="worker threads (default all)")
-    p.add_argument("--shard", default=None, metavar="i/N", help="compute only shard i of N (merge them afterwards)")
+                   help=f"TRAC-IK budget per call (s, over 0 and at most {ws.MAX_TIMEOUT_S:g}; default 0.0003)")
+    p.add_argument("--seed", type=_bounded_int(0, ws.MAX_SEED), default=1, metavar="N",
+                   help="random seed, 0 to 2^64 - 1 (default 1)")
+    p.add_argument("--threads", type=_bounded_int(1, ws.MAX_THREADS), default=None, metavar="N",
+                   help=f"worker threads, 1 to {ws.MAX_THREADS} (default all cores)")
+    p.add_argument("--shard", type=_shard, default=None, metavar="i/N",
+                   help=f"compute only shard i of N (0 <= i < N <= {ws.MAX_SHARDS}); merge the N files afterwards "
+                        "with --merge")
+    p.add_argument("--merge", nargs="+", default=None, metavar="SHARD.npz",
+                   help="instead of computing, merge the files of the shards 0/N ... N-1/N of one map into --out (a "
+                        "shard alone is refused wherever a map is taken)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_workspace)
 

@@ -144,8 +144,10 @@ def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
     if robot.map_path is None:
         return "none (plan computes one and caches it)", None
     m = workspace.load(robot.map_path)
-    if m.chain_hash != robot.head_chain.hash:
-        return f"{robot.map_path}", "the map was made for another head chain: compute one (snakehead workspace)"
+    try:  # the planner's check: a whole map of this head with voxels enough for G0
+        m.require_whole_for(robot, needs=("G0",), what="the map")
+    except InputError as exc:
+        return f"{robot.map_path}", str(exc)
     roll = "free roll" if m.params.get("free_roll") else f"{m.params.get('rolls')} rolls"
     line = f"{robot.map_path}: {len(m)} voxels, {m.params.get('directions')} directions x {roll}, " \
            f"best index {m.indices.max():.1f}"

@@ -87,14 +87,8 @@ class HeadController:
         timeout = duration(timeout, "timeout")
         if workspace_map is None:
             workspace_map = workspace.map_for(self.robot)
-        if not isinstance(workspace_map, workspace.ReachabilityMap):
-            raise InputTypeError(f"workspace_map must be a ReachabilityMap (snakehead.load_map), got "
-                            f"{type(workspace_map).__name__}")
-        chain_hash = workspace_map.chain_hash
-        if chain_hash != self.robot.head_chain.hash:
-            raise InputError("the workspace map was made for another head chain (hash "
-                             f"{chain_hash} != {self.robot.head_chain.hash}); compute one for this robot's head")
-        self.map = workspace_map
+        # a whole map of this robot's head, with enough voxels for G0 (a shard's G0 is elsewhere)
+        self.map = workspace.require_map(workspace_map, self.robot, needs=("G0",), what="workspace_map")
         #: The dexterous workspace's lower index (100 unless the head reaches 100 in too few voxels).
         self.dexterous_threshold = float(self.map.dexterous_threshold())
         self.dexterous_note = ("G0 is the centre of the voxels of index 100 (the paper's dexterous workspace)"

@@ -24,9 +24,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import InputError
 from .._validate import joint_vector, position_direction_pairs
 from .map_queries import direction_bits
-from .._errors import InputError
 
 if TYPE_CHECKING:
     from ..model.robot import BasePlacement, SnakeRobot
@@ -91,6 +91,9 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     k, and the map voxels whose sphere point in direction k lies within half a voxel of the height plane of the
     target; the target position seen from B0 is that point moved onto the plane, which fixes x, y. Kept: the
     best voxel per (frame, yaw) when its index is at least ``min_index``; returned: the ``limit`` best."""
+    from .workspace import require_map
+
+    m = require_map(workspace_map, needs=("poses",), what="workspace_map")  # whole, with per-direction results
     p, d, single = position_direction_pairs(position, direction)
     if not single:
         raise InputError("placements take one target: position and direction of shape (3,)")
@@ -102,7 +105,6 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     if frames.ndim != 3 or frames.shape[1:] != (4, 4) or len(frames) != len(neck_q):
         raise InputError("frames must be (J, 4, 4), one per row of neck_q")
     p, d = p[0], d[0]
-    m = workspace_map
     bits = direction_bits(m)
     index = np.where(m.indices >= float(min_index) - 1e-9, m.indices, -1.0)
     dirs = m.sphere_directions
@@ -157,6 +159,9 @@ def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position:
     The base keeps the base joints of ``base_configuration`` (default: the initial configuration); the neck
     joints take ``neck_samples`` values each; yaws are sampled every 360 / ``yaw_samples`` degrees. See the
     module's doc. The result says, for each placement, the neck joints and the target as seen from B0."""
+    from .workspace import require_map
+
+    require_map(workspace_map, robot, needs=("poses",), what="workspace_map")  # also: a map of this robot's head
     frames, neck_q = neck_frames(robot, base_configuration, neck_samples)
     return placements_from_frames(workspace_map, frames, neck_q, position, direction, yaw_samples=yaw_samples,
                                   min_index=min_index, limit=limit)

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import InputError
 from .._validate import finite_float, position_direction_pairs as _poses
 
 if TYPE_CHECKING:
@@ -33,9 +34,18 @@ if TYPE_CHECKING:
 BLENDED_DIRECTIONS = 3
 
 
+def _usable(m: ReachabilityMap) -> ReachabilityMap:
+    """The map if pose queries can be asked of it: a whole map (a shard would answer False for its other shards'
+    voxels) with per-direction results along the head's x-axis; InputError otherwise (the one check of maps)."""
+    from .workspace import require_map
+
+    return require_map(m, needs=("poses",))
+
+
 def direction_bits(m: ReachabilityMap) -> np.ndarray:
     """(M, N) bool: direction k of voxel v was reached with some roll (its units OR-ed over the rolls when
     every roll counted on its own). Cached on the map."""
+    _usable(m)
     if "direction_bits" not in m._cache:
         units = m.reached_units()
         n = int(m.params["directions"])
@@ -111,6 +121,7 @@ def reachable(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.Arra
     """Whether each pose is reachable by the map (see the module's doc). positions, directions: (3,) or (K, 3);
     a bool for one pose, else (K,) bools. ``interpolate``: :func:`reachability` >= 1/2 (default), else the
     nearest sample."""
+    _usable(m)
     p, d, single = _poses(positions, directions)
     if interpolate:
         out = _reachability(m, p, d) >= 0.5
@@ -129,6 +140,7 @@ def reachability(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.A
     """A score in [0, 1] per pose: the map's reached/not-reached samples around it, blended trilinearly over the
     8 voxels whose sphere points surround the position, and over the BLENDED_DIRECTIONS nearest directions
     (weights falling linearly with the angle to zero at the next direction's). Voxels outside the map count 0."""
+    _usable(m)
     p, d, single = _poses(positions, directions)
     s = _reachability(m, p, d)
     return float(s[0]) if single else s
@@ -213,13 +225,14 @@ def inverse(m: ReachabilityMap, position: npt.ArrayLike, direction: npt.ArrayLik
     T's rotation taking d_k to ``direction``, turned about ``direction`` by ``rolls`` evenly spaced angles.
     ``min_index``: only voxels of at least this index; ``limit``: the best ``limit`` (voxel, direction) pairs
     (None: all) before the turns. Ties in the index keep the map's order."""
+    _usable(m)
     p, d, single = _poses(position, direction)
     if not single:
-        raise ValueError("inverse takes one target: position and direction of shape (3,)")
+        raise InputError("inverse takes one target: position and direction of shape (3,)")
     if isinstance(rolls, bool) or not isinstance(rolls, (int, np.integer)) or rolls < 1:
-        raise ValueError(f"rolls must be a positive integer, got {rolls!r}")
+        raise InputError(f"rolls must be a positive integer, got {rolls!r}")
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 1):
-        raise ValueError(f"limit must be a positive integer or None, got {limit!r}")
+        raise InputError(f"limit must be a positive integer or None, got {limit!r}")
     t = finite_float(min_index, "min_index")
     p, d = p[0], d[0]
     bits = direction_bits(m)

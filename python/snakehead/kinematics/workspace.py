@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 import numpy as np
 
 from .. import _core
+from .._errors import InputError, InputTypeError
 from ..model.chain import Chain
 
 if TYPE_CHECKING:
@@ -48,6 +49,32 @@ TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
 #: How many voxels the dexterous band must hold at least, as a share of the map's voxels (see
 #: :meth:`ReachabilityMap.dexterous_threshold`): the paper's dexterous workspace holds 3.69 % of its map's voxels.
 DEXTEROUS_MIN_SHARE = 0.01
+
+# The limits of a sweep's options, checked in Python before any work (an InputError naming the option, never a
+# number handed to the bindings' 32- or 64-bit fields). Most are the C++ core's (include/snakehead/limits.hpp).
+#: Points per voxel sphere (``directions``), and frames about the approach axis per point (``rolls``).
+MAX_DIRECTIONS, MAX_ROLLS = 4096, 360
+#: Frames per voxel: directions x rolls (unless free roll).
+MAX_FRAMES_PER_VOXEL = 4096
+#: Voxels per axis of the grid (whose side is 2 x the chain's reach): at most 256 (256^3 = 16.8 million voxels), at
+#: least 4, so a voxel is under a third of the grid's side (2/3 of the reach; a larger one gives a map of a few
+#: voxels of index 0 and no dexterous workspace).
+MAX_VOXELS_PER_AXIS, MIN_VOXELS_PER_AXIS = 256, 4
+#: Random configurations sampled for the hull (``cloud_samples``).
+MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES = 100, 10_000_000
+#: Worker threads (0 or None: all cores).
+MAX_THREADS = 256
+#: The seed is an unsigned 64-bit integer.
+MAX_SEED = 2**64 - 1
+#: Shards of one map: a shard is a set of tiles of 4 x 4 lines of voxels, and the largest grid has (256 / 4)^2 tiles
+#: (more shards than the grid's tiles are empty).
+MAX_SHARDS = 4096
+#: TRAC-IK's budget per call (s): a day at most.
+MAX_TIMEOUT_S = 86400.0
+#: Voxels the dexterous centre G0 needs at least: its k-means++ makes three clusters (Section 2.3).
+G0_MIN_VOXELS = 3
+_MERGE_HINT = ("merge the shards (snakehead workspace --merge SHARD.npz ... --out MAP.npz, or "
+               "snakehead.kinematics.workspace.merge) and use the merged map")
 
 # Parameters that define a map (two maps, or shards, with the same values are parts of one computation).
 _PARAMS = ("voxel_size", "directions", "rolls", "any_roll", "free_roll", "approach_axis", "timeout", "epsilon",
@@ -114,13 +141,64 @@ class ReachabilityMap:
     def __len__(self) -> int:
         return len(self.voxel_ids)
 
+    # --- what the map is, and whether it is what a caller needs ------------------------------------------
+    def require_whole_for(self, chain: Chain | SnakeRobot | None = None, *, needs: Iterable[str] = (),
+                          what: str | None = None) -> ReachabilityMap:
+        """The one check of a map where it is accepted: returns the map, or raises :class:`InputError` (one line
+        naming the map and what to do) when it is
+
+        * a shard of a map: its G0, dexterous band and queries would be those of a part of the map (shards load, and
+          :func:`merge` takes them as they are: the one place that does);
+        * a map of another chain than ``chain`` (a :class:`Chain`, or a SnakeRobot's head chain), by the chains'
+          kinematics hash;
+        * lacking what the caller ``needs``: ``"voxels"`` (at least one), ``"G0"`` (the dexterous centre:
+          :data:`G0_MIN_VOXELS` voxels for its k-means++ clusters), ``"poses"`` (pose queries, inverse reachability,
+          base placements: per-direction results, of directions of the head's pointing axis x, in some voxel).
+
+        ``what``: how the caller names the map (e.g. ``"--map 'm.npz'"``; default: its file, when it has one)."""
+        name = what or (f"map {os.fspath(self.path)!r}" if self.path is not None else "the map")
+        needs = tuple(needs)
+        unknown = [n for n in needs if n not in ("voxels", "G0", "poses")]
+        if unknown:
+            raise InputError(f"needs may hold 'voxels', 'G0' and 'poses', got {unknown[0]!r}")
+        if tuple(self.shard) != (0, 1):
+            i, n = self.shard
+            raise InputError(f"{name} is shard {i}/{n} of a map, not a whole map ({len(self)} of its "
+                             f"{self.hull_voxels} voxels): {_MERGE_HINT}")
+        if chain is not None:
+            from ..model.robot import SnakeRobot
+
+            head = _resolve_chain(chain)
+            if self.chain_hash != head.hash:
+                mine = (f"{chain.parts.neck_end} -> {chain.parts.head_tip}" if isinstance(chain, SnakeRobot) else
+                        f"{head.base} -> {head.tip}")
+                raise InputError(f"{name} was made for another head chain ({self.base} -> {self.tip}, hash "
+                                 f"{self.chain_hash}); this robot's head is {mine} (hash {head.hash}): compute its map "
+                                 "(snakehead workspace --robot ROBOT.toml --out MAP.npz)")
+        if needs and len(self) == 0:
+            raise InputError(f"{name} holds no voxels (no voxel of its grid lies inside the chain's workspace): "
+                             "compute it again with a smaller voxel")
+        if "G0" in needs and len(self) < G0_MIN_VOXELS:
+            raise InputError(f"{name} holds {len(self)} voxels; the dexterous centre G0 needs at least "
+                             f"{G0_MIN_VOXELS} (its k-means++ clusters): compute it again with a smaller voxel")
+        if "poses" in needs:
+            if self.reached is None:
+                raise InputError(f"{name} holds no per-direction results (a map file of the first format), which "
+                                 "pose queries need: compute it again (snakehead workspace)")
+            axis = self.params.get("approach_axis", "x")
+            if axis != "x":
+                raise InputError(f"{name} was swept with the approach axis {axis!r}, not the head's pointing axis x, "
+                                 "which pose queries take the directions along: compute it again with "
+                                 "approach_axis='x'")
+        return self
+
     def histogram(self, bins: Sequence[float] = TABLE2_BINS) -> tuple[np.ndarray, np.ndarray]:
         """Voxel counts and percentages per bin, Table 2's bins by default; the last bin is closed ([80, 100])."""
         from .._validate import finite_array
 
         edges = finite_array(bins, "bins", (None,))  # NaN edges passed the test below and gave negative counts
         if len(edges) < 2 or np.any(np.diff(edges) <= 0):
-            raise ValueError(f"bins must be an increasing sequence of at least two edges, got {edges.tolist()}")
+            raise InputError(f"bins must be an increasing sequence of at least two edges, got {edges.tolist()}")
         counts, _ = np.histogram(self.indices, bins=edges)  # numpy's last bin is closed
         pct = 100.0 * counts / max(len(self), 1)
         return counts, pct
@@ -134,9 +212,9 @@ class ReachabilityMap:
 
     def reached_units(self) -> np.ndarray:
         """(M, tried) bool: which units of each voxel were reached (directions, or (direction, roll) frames
-        when every roll counted on its own). ValueError for a map file without them."""
+        when every roll counted on its own). InputError for a map file without them."""
         if self.reached is None:
-            raise ValueError("this map holds no per-direction results (a map file of the first format); "
+            raise InputError("this map holds no per-direction results (a map file of the first format); "
                              "recompute it (workspace_gen or compute) to query poses")
         return np.unpackbits(self.reached, axis=1, count=self.tried, bitorder="little").astype(bool)
 
@@ -160,10 +238,12 @@ class ReachabilityMap:
         return inverse(self, position, direction, **options)
 
     def index_at(self, points: npt.ArrayLike) -> np.ndarray:
-        """Index of the voxel containing each point (0 outside the map's voxels), (k,) for (k, 3) points."""
+        """Index of the voxel containing each point (0 outside the map's voxels), (k,) for (k, 3) points. A shard
+        is refused: the points of its other shards' voxels would read 0."""
+        self.require_whole_for()
         p = np.atleast_2d(np.asarray(points, dtype=float))
         if p.shape[-1] != 3 or not np.all(np.isfinite(p)):
-            raise ValueError("points must be finite, shape (3,) or (k, 3)")
+            raise InputError("points must be finite, shape (3,) or (k, 3)")
         n = self.grid_shape[0]
         ijk = np.floor((p - self.grid_origin) / self.voxel_size).astype(np.int64)
         inside = np.all((ijk >= 0) & (ijk < n), axis=1)
@@ -184,11 +264,10 @@ class ReachabilityMap:
         3, the paper's clusters, or 1 % of the map's voxels if more). A head that reaches no voxel at 100 (most
         6-DOF heads) thus still gets a dexterous workspace and a centre G0, in its most reachable band.
         """
-        if len(self) == 0:
-            raise ValueError("the map has no voxels: it has no dexterous workspace")
+        self.require_whole_for(needs=("voxels",))  # a shard's band and G0 are not the map's
         need = max(3, int(np.ceil(DEXTEROUS_MIN_SHARE * len(self)))) if min_voxels is None else int(min_voxels)
         if need < 1:
-            raise ValueError(f"min_voxels must be >= 1, got {min_voxels!r}")
+            raise InputError(f"min_voxels must be >= 1, got {min_voxels!r}")
         need = min(need, len(self))
         levels = np.sort(self.indices)[::-1]  # descending
         return float(min(100.0, levels[need - 1]))
@@ -196,7 +275,7 @@ class ReachabilityMap:
     def quality_problem(self) -> str | None:
         """Why the map's dexterous band says little (None when it is fine): a best band of index 0 (the head reaches
         none of its directions from enough voxels; G0 is then the middle of every reached voxel), with what to do."""
-        if len(self) == 0 or self.dexterous_threshold() > 0:
+        if len(self) == 0 or self.shard != (0, 1) or self.dexterous_threshold() > 0:
             return None
         hint = ("" if self.params.get("free_roll") else "; a head of fewer than 6 joints cannot turn about its own "
                 "axis to the rolls tried: compute the map with free roll (snakehead workspace --free-roll)")
@@ -210,6 +289,10 @@ class ReachabilityMap:
                  "Table 2 bands [0,20) [20,40) [40,60) [60,80) [80,100]: " + " ".join(f"{p:.2f} %" for p in pct)]
         if len(self) == 0:
             lines.append("no voxels")
+            return "\n".join(lines)
+        if self.shard != (0, 1):
+            lines.append(f"shard {self.shard[0]}/{self.shard[1]}: the dexterous workspace and G0 are those of the "
+                         f"whole map ({_MERGE_HINT})")
             return "\n".join(lines)
         t = self.dexterous_threshold()
         lines.append(f"max index {self.indices.max():.1f}; dexterous workspace: "
@@ -229,7 +312,7 @@ class ReachabilityMap:
         best band, :meth:`dexterous_threshold`), (m, 3)."""
         t = self.dexterous_threshold() if threshold is None else float(threshold)
         if not 0.0 <= t <= 100.0:
-            raise ValueError(f"threshold must be within [0, 100], got {threshold}")
+            raise InputError(f"threshold must be within [0, 100], got {threshold}")
         return self.centers[self.indices >= t - 1e-9]
 
     def clusters(self, k: int = 3, threshold: float | None = None, rule: str = "largest",
@@ -248,14 +331,15 @@ class ReachabilityMap:
         """
         from sklearn.cluster import KMeans
 
+        self.require_whole_for()  # the clusters of a shard's voxels are not the map's (G0 moved by 37 cm)
         if not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"k must be a positive integer, got {k!r}")
+            raise InputError(f"k must be a positive integer, got {k!r}")
         if rule not in ("largest", "index"):
-            raise ValueError(f"rule must be 'largest' or 'index', got {rule!r}")
+            raise InputError(f"rule must be 'largest' or 'index', got {rule!r}")
         threshold = self.dexterous_threshold() if threshold is None else float(threshold)
         pts = self.dexterous(threshold)
         if len(pts) < k:
-            raise ValueError(f"{len(pts)} voxels have an index >= {threshold}; {k} clusters need at least {k}")
+            raise InputError(f"{len(pts)} voxels have an index >= {threshold}; {k} clusters need at least {k}")
         km = KMeans(n_clusters=int(k), init="k-means++", n_init=10, random_state=random_state).fit(pts)
         sizes = np.bincount(km.labels_, minlength=k)
         # Order clusters by decreasing size (then by centroid coordinates) so that labels are stable.
@@ -302,6 +386,18 @@ class ReachabilityMap:
                 f"mean index {self.indices.mean() if len(self) else 0:.1f}{lacks})")
 
 
+def require_map(m: Any, chain: Chain | SnakeRobot | None = None, *, needs: Iterable[str] = (),
+                what: str = "the map") -> ReachabilityMap:
+    """``m`` where a map is accepted: InputTypeError unless a :class:`ReachabilityMap`, then
+    :meth:`ReachabilityMap.require_whole_for` (a whole map of ``chain``'s head holding what the caller ``needs``).
+    ``what`` names the argument; the map's file is added when it has one."""
+    if not isinstance(m, ReachabilityMap):
+        raise InputTypeError(f"{what} must be a ReachabilityMap (snakehead.load_map or compute_map), got "
+                             f"{type(m).__name__}")
+    return m.require_whole_for(chain, needs=needs,
+                               what=f"{what} (map {os.fspath(m.path)!r})" if m.path is not None else what)
+
+
 def _param_equal(a: Any, b: Any) -> bool:
     if isinstance(a, float) or isinstance(b, float):
         return float(a) == float(b)
@@ -309,59 +405,134 @@ def _param_equal(a: Any, b: Any) -> bool:
 
 
 # --- computing -------------------------------------------------------------------------------------------
+def _count(name: str, value: Any, least: int, most: int, hint: str = "") -> int:
+    """``value`` as an int within [least, most]: InputTypeError unless an integer (not a bool), InputError beyond."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputTypeError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
+    if not least <= int(value) <= most:
+        raise InputError(f"{name} must be between {least} and {most}{hint}, got {value}")
+    return int(value)
+
+
+def _real(name: str, value: Any) -> float:
+    """``value`` as a float: InputTypeError unless a number (not a bool); its range is the caller's to check."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputTypeError(f"{name} must be a number, got {type(value).__name__} {value!r}")
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond a float
+        raise InputError(f"{name} must be a finite number, got {value}") from None
+
+
 def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_roll: bool, approach_axis: str,
              timeout: float, epsilon: float, cloud_samples: int, seed: int | None, threads: int | None, shard: Any,
              hull: str = "boundary", shrink: float = 0.5) -> _core.WorkspaceOptions:
+    """The core's options, every value checked against the limits above first (InputError naming it)."""
     o = _core.WorkspaceOptions()
-    for name, value in (("directions", directions), ("rolls", rolls), ("cloud_samples", cloud_samples),
-                        ("seed", seed)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise ValueError(f"{name} must be an integer, got {value!r}")
-    if isinstance(seed, (int, np.integer)) and seed < 0:
-        raise ValueError(f"seed must be >= 0, got {seed}")
-    for name, value in (("voxel", voxel), ("timeout", timeout), ("epsilon", epsilon)):
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise ValueError(f"{name} must be a number, got {value!r}")
-    if not isinstance(approach_axis, str):
-        raise ValueError(f"approach_axis must be 'x' or 'z', got {approach_axis!r}")
-    if hull not in ("boundary", "convex"):
-        raise ValueError(f"hull must be 'boundary' (the paper's boundary(P)) or 'convex', got {hull!r}")
-    if isinstance(shrink, bool) or not isinstance(shrink, (int, float, np.integer, np.floating)):
-        raise ValueError(f"shrink must be a number in [0, 1], got {shrink!r}")
-    o.voxel_size = float(voxel)
-    o.directions = int(directions)
-    o.rolls = int(rolls)
+    directions = _count("directions", directions, 1, MAX_DIRECTIONS)
+    rolls = _count("rolls", rolls, 0 if free_roll else 1, MAX_ROLLS, "" if free_roll else " (or use free roll)")
+    if not free_roll and directions * rolls > MAX_FRAMES_PER_VOXEL:
+        raise InputError(f"directions x rolls (frames per voxel) must be at most {MAX_FRAMES_PER_VOXEL}, got "
+                         f"{directions} x {rolls} = {directions * rolls}")
+    cloud_samples = _count("cloud_samples", cloud_samples, MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES,
+                           " (the hull needs a cloud)")
+    seed = _count("seed", seed, 0, MAX_SEED)
+    threads = 0 if threads is None else _count("threads", threads, 0, MAX_THREADS, " (0 = all cores)")
+    voxel, timeout, epsilon = _real("voxel", voxel), _real("timeout", timeout), _real("epsilon", epsilon)
+    if not (math.isfinite(voxel) and voxel > 0):
+        raise InputError(f"voxel size must be a positive number of metres, got {voxel!r}")
+    if not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"timeout must be a positive finite number of seconds, got {timeout!r}")
+    if timeout > MAX_TIMEOUT_S:
+        raise InputError(f"timeout must be at most {MAX_TIMEOUT_S:g} s (one day), got {timeout:g}")
+    if not (math.isfinite(epsilon) and epsilon > 0):
+        raise InputError(f"epsilon must be a positive number, got {epsilon!r}")
+    if not isinstance(approach_axis, str) or approach_axis not in ("x", "z"):
+        raise InputError(f"approach_axis must be 'x' or 'z', got {approach_axis!r}")
+    if not isinstance(hull, str) or hull not in ("boundary", "convex"):
+        raise InputError(f"hull must be 'boundary' (the paper's boundary(P)) or 'convex', got {hull!r}")
+    shrink = _real("shrink", shrink)
+    if not 0.0 <= shrink <= 1.0:  # NaN too
+        raise InputError(f"shrink (the boundary's shrink factor) must be within [0, 1], got {shrink!r}")
+    o.voxel_size = voxel
+    o.directions = directions
+    o.rolls = rolls
     o.any_roll = bool(any_roll)
     o.free_roll = bool(free_roll)
-    o.approach_axis = approach_axis  # ValueError unless 'x' or 'z'
-    o.timeout = float(timeout)
-    o.epsilon = float(epsilon)
-    o.cloud_samples = int(cloud_samples)
+    o.approach_axis = approach_axis
+    o.timeout = timeout
+    o.epsilon = epsilon
+    o.cloud_samples = cloud_samples
     o.hull = hull
-    o.shrink = float(shrink)
-    o.seed = int(seed)
-    o.threads = 0 if threads is None else int(threads)
-    o.shard_index, o.shard_count = _parse_shard(shard)
-    o.validate()  # ValueError naming the first bad field
+    o.shrink = shrink
+    o.seed = seed
+    o.threads = threads
+    o.shard_index, o.shard_count = parse_shard(shard)
+    try:
+        o.validate()  # the core's own check (the same limits): a ValueError naming the first bad field
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
     return o
 
 
-def _parse_shard(shard: Any) -> tuple[int, int]:
+def parse_shard(shard: Any) -> tuple[int, int]:
+    """``shard`` ('i/N' or (i, N)) as (i, N) with 0 <= i < N <= MAX_SHARDS; InputError otherwise."""
     if shard is None:
         return 0, 1
+    bad = InputError(f"shard must be 'i/N' or (i, N) with integers 0 <= i < N <= {MAX_SHARDS}, got {shard!r}")
     if isinstance(shard, str):
-        try:
-            i, n = (int(x) for x in shard.split("/"))
-        except ValueError:
-            raise ValueError(f"shard must be 'i/N' or (i, N), got {shard!r}") from None
+        parts = shard.split("/")
+        if len(parts) != 2 or not all(p.strip().isdecimal() and len(p) <= 20 for p in parts):
+            raise bad  # (more than 20 digits is beyond any limit, and int() refuses thousands)
+        i, n = (int(p) for p in parts)
     else:
         try:
-            i, n = (int(x) for x in shard)
-        except (TypeError, ValueError):
-            raise ValueError(f"shard must be 'i/N' or (i, N), got {shard!r}") from None
-    if n < 1 or not 0 <= i < n:
-        raise ValueError(f"shard must satisfy 0 <= i < N, got {i}/{n}")
+            parts = list(shard)
+        except TypeError:
+            raise bad from None
+        if len(parts) != 2 or any(isinstance(x, bool) or not isinstance(x, (int, np.integer)) for x in parts):
+            raise bad
+        i, n = (int(x) for x in parts)
+    if not 0 <= i < n <= MAX_SHARDS:
+        raise InputError(f"shard must be i/N with 0 <= i < N <= {MAX_SHARDS} (a shard is at least one tile of the "
+                         f"grid), got {i}/{n}")
     return i, n
+
+
+def check_options(chain_or_robot: Chain | SnakeRobot, **options: Any) -> _core.WorkspaceOptions:
+    """The checks :func:`compute` makes of its options before any work (``voxel``, ``directions``, ``rolls``,
+    ``any_roll``, ``free_roll``, ``approach_axis``, ``timeout``, ``epsilon``, ``cloud_samples``, ``seed``, ``threads``,
+    ``shard``, ``hull``, ``shrink``; compute's defaults for those not given), against the limits above and the chain's
+    reach: InputError naming the first bad one. Returns the core's options."""
+    import inspect
+
+    chain = _resolve_chain(chain_or_robot)
+    names = ("voxel", "directions", "rolls", "any_roll", "free_roll", "approach_axis", "timeout", "epsilon",
+             "cloud_samples", "seed", "threads", "shard", "hull", "shrink")
+    defaults = {k: v.default for k, v in inspect.signature(compute).parameters.items() if k in names}
+    unknown = sorted(set(options) - set(defaults))
+    if unknown:
+        raise InputError(f"unknown option {unknown[0]!r} (the options are {', '.join(defaults)})")
+    o = _options(**{**defaults, **options})
+    _check_grid(chain, o.voxel_size)
+    return o
+
+
+def _check_grid(chain: Chain, voxel: float) -> None:
+    """InputError unless the grid of side 2 x reach holds MIN_VOXELS_PER_AXIS to MAX_VOXELS_PER_AXIS voxels of edge
+    ``voxel`` per axis (the core's count of them), so that a voxel is neither too small to allocate nor so large
+    that the map has a few voxels of index 0."""
+    side = 2.0 * chain.reach
+    ratio = side / voxel
+    cells = math.ceil(ratio - 1e-9) if math.isfinite(ratio) else math.inf
+    if cells > MAX_VOXELS_PER_AXIS:
+        raise InputError(f"voxel size {voxel:g} m is too small for the grid of side {side:.4g} m (2 x the chain's "
+                         f"reach): {cells:.3g} voxels per axis, at most {MAX_VOXELS_PER_AXIS} (voxel size >= "
+                         f"{side / MAX_VOXELS_PER_AXIS:.4g} m)")
+    if cells < MIN_VOXELS_PER_AXIS:
+        raise InputError(f"voxel size {voxel:g} m is too large for the grid of side {side:.4g} m (2 x the chain's "
+                         f"reach): {max(cells, 1)} voxel{'s' if cells > 1 else ''} per axis, at least "
+                         f"{MIN_VOXELS_PER_AXIS} (voxel size < {side / (MIN_VOXELS_PER_AXIS - 1):.4g} m)")
 
 
 def _resolve_chain(chain_or_robot: Chain | SnakeRobot) -> Chain:
@@ -373,7 +544,8 @@ def _resolve_chain(chain_or_robot: Chain | SnakeRobot) -> Chain:
         return chain_or_robot
     if isinstance(chain_or_robot, _core.ChainModel):
         return Chain(chain_or_robot)
-    raise ValueError(f"expected a Chain or a SnakeRobot (whose head chain is mapped), got {type(chain_or_robot).__name__}")
+    raise InputTypeError(f"expected a Chain or a SnakeRobot (whose head chain is mapped), got "
+                         f"{type(chain_or_robot).__name__}")
 
 
 def _from_result(d: dict, o: _core.WorkspaceOptions, command: str) -> ReachabilityMap:
@@ -440,21 +612,19 @@ def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directio
     kwargs = dict(voxel=voxel, directions=directions, rolls=rolls, any_roll=any_roll, free_roll=free_roll,
                   approach_axis=approach_axis, timeout=timeout, epsilon=epsilon, cloud_samples=cloud_samples,
                   seed=seed, threads=threads, hull=hull, shrink=shrink)
-    options = _options(shard=shard, **kwargs)  # validates everything before any work
+    options = check_options(chain, shard=shard, **kwargs)  # everything, before any work
     if executor is None:
         if shards is not None:
-            raise ValueError("shards= needs an executor; use shard=(i, N) to compute one shard here")
+            raise InputError("shards= needs an executor; use shard=(i, N) to compute one shard here")
         return _compute_local(chain, options, progress)
     if shard is not None:
-        raise ValueError("give either shard= (one shard here) or executor= (all shards there), not both")
+        raise InputError("give either shard= (one shard here) or executor= (all shards there), not both")
     if not isinstance(executor, Executor):
-        raise ValueError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
+        raise InputTypeError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
+    n = min(_default_shards(executor), MAX_SHARDS) if shards is None else _count("shards", shards, 1, MAX_SHARDS)
     text = _urdf_text(chain_or_robot, urdf)
     if Chain.from_urdf(text, chain.base, chain.tip).hash != chain.hash:
-        raise ValueError("the URDF given does not describe this chain (different kinematics hash)")
-    n = _default_shards(executor) if shards is None else shards
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"shards must be a positive integer, got {shards!r}")
+        raise InputError("the URDF given does not describe this chain (different kinematics hash)")
     if threads is None:
         kwargs["threads"] = 1  # each shard is one task; the executor provides the parallelism
     futures = [executor.submit(_compute_shard, text, chain.base, chain.tip, kwargs, i, int(n)) for i in range(int(n))]
@@ -483,11 +653,11 @@ def _default_shards(executor: Any) -> int:
 def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str]) -> str:
     source = urdf if urdf is not None else getattr(chain_or_robot, "urdf", None)
     if source is None:
-        raise ValueError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
+        raise InputError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
                          "pass a SnakeRobot or a Chain made by Chain.from_urdf, or urdf= (a path or the XML)")
     source = os.fspath(source) if isinstance(source, os.PathLike) else source
     if not isinstance(source, str):
-        raise ValueError("urdf must be a path or an XML string")
+        raise InputTypeError("urdf must be a path or an XML string")
     if source.lstrip().startswith("<"):
         return source
     return _core.read_urdf_file(source)  # ValueError unless a regular file of bounded size, as Chain.from_urdf
@@ -533,7 +703,7 @@ def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxe
     chain = _resolve_chain(chain_or_robot)
     c = np.ascontiguousarray(np.atleast_2d(np.asarray(centers, dtype=float)))
     if c.ndim != 2 or c.shape[1] != 3 or not np.all(np.isfinite(c)):
-        raise ValueError("centers must be finite, shape (k, 3)")
+        raise InputError("centers must be finite, shape (k, 3)")
     o = _options(voxel, directions, rolls, any_roll, free_roll, approach_axis, timeout, epsilon, 100, seed, threads,
                  None)
     d = _core.evaluate_voxels(chain.model, o, c, list(range(len(c))))
@@ -552,10 +722,10 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
     (ik_calls, cheap_exits, seconds, threads; -1 or NaN when not known).
     """
     if not isinstance(m, ReachabilityMap):
-        raise ValueError(f"expected a ReachabilityMap, got {type(m).__name__}")
+        raise InputTypeError(f"expected a ReachabilityMap, got {type(m).__name__}")
     path = os.fspath(path)
     if not path.endswith(".npz"):
-        raise ValueError(f"a map file ends in .npz, got {path!r}")
+        raise InputError(f"a map file ends in .npz, got {path!r}")
     p = m.params
     o = _options(p["voxel_size"], p["directions"], max(int(p["rolls"]), 1), p["any_roll"], p["free_roll"],
                  p["approach_axis"], p["timeout"], p["epsilon"], p["cloud_samples"], p["seed"], None, m.shard,
@@ -575,8 +745,6 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
 #: The largest map file read (bytes, as its archive declares them unpacked). A full grid of 256^3 voxels -- the C++
 #: sweep's limit -- holds at most 16.8 million voxels of about 50 bytes each: 840 MB.
 MAX_MAP_BYTES = 1 << 30
-#: The C++ sweep's limits (include/snakehead/limits.hpp): voxels per grid axis, points per sphere, rolls.
-_MAX_VOXELS_PER_AXIS, _MAX_DIRECTIONS, _MAX_ROLLS = 256, 4096, 360
 
 # What each key of a map file holds: "text", "int", "bool" or "float" scalars; arrays by (kind, shape) with "M"
 # the voxel count. Keys of the second format (reached, sphere_directions, hull, shrink, alpha) are optional.
@@ -595,15 +763,15 @@ _KINDS = {"text": "U", "int": "iu", "bool": "b", "float": "fiu"}
 
 def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -> None:
     """Check the arrays of a map file (as :func:`snakehead._files.read_npz` returns them) before a map is made of
-    them: ValueError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
+    them: InputError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
     outside [0, 100] or not 100 * solved / tried, solved counts outside [0, tried], NaN or non-positive sizes,
     voxel ids duplicated, out of order or outside the grid, voxel centres that are not their voxels' centres,
     per-direction results of the wrong shape, and parameters beyond the sweep's limits. Either format (1 or 2)."""
-    def fail(field: str, what: str) -> ValueError:
-        return ValueError(f"{where}: {field} {what}")
+    def fail(field: str, what: str) -> InputError:
+        return InputError(f"{where}: {field} {what}")
 
     if "format" not in arrays or arrays["format"].dtype.kind != "U" or str(arrays["format"][()]) not in FORMATS:
-        raise ValueError(f"{where} is not a snakehead reachability map (its format is not one of "
+        raise InputError(f"{where} is not a snakehead reachability map (its format is not one of "
                          f"{', '.join(FORMATS)})")
     scalars = dict(_MAP_SCALARS)
     for key, kind in _MAP_OPTIONAL_SCALARS.items():
@@ -641,14 +809,14 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
     if "shrink" in value and not 0.0 <= float(value["shrink"]) <= 1.0:  # NaN too
         raise fail("shrink", f"must be within [0, 1], got {value['shrink']}")
     directions, rolls, tried = int(value["directions"]), int(value["rolls"]), int(value["tried"])
-    if not 1 <= directions <= _MAX_DIRECTIONS or not 0 <= rolls <= _MAX_ROLLS:
-        raise fail("directions/rolls", f"must be within [1, {_MAX_DIRECTIONS}] / [0, {_MAX_ROLLS}], got {directions} "
+    if not 1 <= directions <= MAX_DIRECTIONS or not 0 <= rolls <= MAX_ROLLS:
+        raise fail("directions/rolls", f"must be within [1, {MAX_DIRECTIONS}] / [0, {MAX_ROLLS}], got {directions} "
                                        f"/ {rolls}")
     if tried not in (directions, directions * max(rolls, 1)):
         raise fail("tried", f"must be the directions ({directions}) or directions x rolls, got {tried}")
     n = arrays["grid_shape"]
-    if not (n[0] == n[1] == n[2] and 1 <= int(n[0]) <= _MAX_VOXELS_PER_AXIS):
-        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {_MAX_VOXELS_PER_AXIS}, got {n.tolist()}")
+    if not (n[0] == n[1] == n[2] and 1 <= int(n[0]) <= MAX_VOXELS_PER_AXIS):
+        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {MAX_VOXELS_PER_AXIS}, got {n.tolist()}")
     n = int(n[0])
     voxel = float(value["voxel_size"])
     if not math.isclose(float(value["grid_size"]), n * voxel, rel_tol=1e-9):
@@ -693,9 +861,10 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
     """Read a map written by ``save`` or ``workspace_gen`` (numpy alone reads the file; this only checks it).
 
     A map file of the first format loads too: its voxels were those of the convex hull, and it lacks the
-    per-direction results (``m.lacks == ("reached",)``; queries then say so). ValueError for a missing, foreign,
+    per-direction results (``m.lacks == ("reached",)``; queries then say so). InputError for a missing, foreign,
     damaged or inconsistent file (:func:`snakehead._files.read_npz`, :func:`validate_map_arrays`), naming what is
-    wrong."""
+    wrong. A shard loads too, for :func:`merge`; everything that uses a map refuses it
+    (:meth:`ReachabilityMap.require_whole_for`)."""
     from .._files import read_npz
 
     z = read_npz(path, "the map", max_bytes=MAX_MAP_BYTES)  # a regular file; sizes checked before unpacking
@@ -717,6 +886,10 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
             if not (v == -1 or (isinstance(v, float) and math.isnan(v))):  # -1 / NaN: not known
                 stats[k] = v
     reached = np.array(z["reached"], dtype=np.uint8) if "reached" in z else None
+    if reached is None and str(z["format"][()]) != FORMATS[0] and len(z["voxel_ids"]) == 0:
+        # the writer leaves the per-direction results out when there are none (an empty shard): nothing is lacking,
+        # and the shard merges with the others without losing theirs
+        reached = np.zeros((0, (scalar("tried", int) + 7) // 8), np.uint8)
     m = ReachabilityMap(
         centers=np.array(z["centers"], dtype=float).reshape(-1, 3),
         solved=np.array(z["solved"], dtype=np.int32),
@@ -741,31 +914,36 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
 
 
 def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
-    """The exact union of the shards 0..N-1 of one map (any order). ValueError when they do not fit together."""
+    """The exact union of the shards 0..N-1 of one map (any order): the one place shards are taken as they are
+    (elsewhere :meth:`ReachabilityMap.require_whole_for` refuses them). InputError when they do not fit together."""
     parts = list(shards)
     if not parts:
-        raise ValueError("merge needs at least one shard")
+        raise InputError("merge needs at least one shard")
     for p in parts:
         if not isinstance(p, ReachabilityMap):
-            raise ValueError(f"merge takes ReachabilityMaps, got {type(p).__name__}")
+            raise InputTypeError(f"merge takes ReachabilityMaps, got {type(p).__name__}")
     first = parts[0]
     n = first.shard[1]
     if len(parts) != n:
-        raise ValueError(f"the map was split into {n} shards; got {len(parts)}")
+        missing = sorted(set(range(n)) - {p.shard[0] for p in parts})
+        raise InputError(f"the map was split into {n} shards; got {len(parts)}"
+                         + (f" (missing shard{'s' if len(missing) > 1 else ''} "
+                            f"{', '.join(f'{i}/{n}' for i in missing[:5])}{' ...' if len(missing) > 5 else ''})"
+                            if missing else ""))
     seen = set()
     for p in parts:
         if (p.chain_hash != first.chain_hash or p.shard[1] != n or p.tried != first.tried
                 or p.grid_shape != first.grid_shape or p.hull_voxels != first.hull_voxels
                 or not all(_param_equal(p.params[k], first.params[k]) for k in _PARAMS)):
-            raise ValueError("shards of different maps (chain, parameters or grid differ) cannot be merged")
+            raise InputError("shards of different maps (chain, parameters or grid differ) cannot be merged")
         if p.shard[0] in seen:
-            raise ValueError(f"shard {p.shard[0]}/{n} given twice")
+            raise InputError(f"shard {p.shard[0]}/{n} given twice")
         seen.add(p.shard[0])
     ids = np.concatenate([p.voxel_ids for p in parts])
     if len(np.unique(ids)) != len(ids):
-        raise ValueError("a voxel appears in two shards")
+        raise InputError("a voxel appears in two shards")
     if len(ids) != first.hull_voxels:
-        raise ValueError(f"the shards hold {len(ids)} voxels; the map has {first.hull_voxels}")
+        raise InputError(f"the shards hold {len(ids)} voxels; the map has {first.hull_voxels}")
     order = np.argsort(ids, kind="stable")
     stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in ("ik_calls", "cheap_exits", "seconds")}
     stats.update({k: first.stats[k] for k in ("hull_facets", "reach", "alpha") if k in first.stats})
@@ -809,14 +987,14 @@ def map_for(robot: SnakeRobot, *, progress: bool = True, cache: bool = True, **o
     from ..model.robot import SnakeRobot
 
     if not isinstance(robot, SnakeRobot):
-        raise TypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+        raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+    if "shard" in options or "executor" in options:
+        raise InputError("map_for gives a robot's whole map: compute shards with compute(shard=...) or "
+                         "compute(executor=...)")
     chain = robot.head_chain
     if robot.map_path is not None and not options:
-        m = load(robot.map_path)
-        if m.chain_hash != chain.hash:
-            raise ValueError(f"the map {os.fspath(robot.map_path)!r} of the robot file was made for another head chain "
-                             f"(hash {m.chain_hash} != {chain.hash}); recompute it")
-        return m
+        m = load(robot.map_path)  # what the map is: whole, and this head's; what it must hold is the caller's check
+        return m.require_whole_for(robot, what=f"the robot file's map {os.fspath(robot.map_path)!r}")
     opts = {**default_map_options(chain), **options}
     key = ",".join(f"{k}={opts[k]!r}" for k in sorted(opts))
     import hashlib
@@ -825,11 +1003,9 @@ def map_for(robot: SnakeRobot, *, progress: bool = True, cache: bool = True, **o
     path = cache_dir() / f"map-{chain.base}-{chain.tip}-{digest}.npz"
     if cache and path.is_file():
         try:
-            m = load(path)
-            if m.chain_hash == chain.hash:
-                return m
-        except ValueError:
-            pass  # a damaged cache entry is recomputed
+            return load(path).require_whole_for(robot)
+        except InputError:
+            pass  # a damaged cache entry (or a file that is not this head's whole map) is recomputed
     m = compute(chain, progress=progress, **opts)
     if cache:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -840,9 +1016,7 @@ def map_for(robot: SnakeRobot, *, progress: bool = True, cache: bool = True, **o
 
 def fibonacci_directions(n: int) -> np.ndarray:
     """n unit vectors spread evenly over the sphere (the sweep's Fibonacci lattice), (n, 3)."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-        raise ValueError(f"n must be an integer, got {n!r}")
-    return _core.fibonacci_directions(int(n))
+    return _core.fibonacci_directions(_count("n (directions)", n, 1, MAX_DIRECTIONS))
 
 
 def approach_frame(point: npt.ArrayLike, direction: npt.ArrayLike, roll: float = 0.0, axis: str = "x") -> np.ndarray:
@@ -852,5 +1026,5 @@ def approach_frame(point: npt.ArrayLike, direction: npt.ArrayLike, roll: float =
     p = finite_array(point, "point", (3,))
     d = finite_array(direction, "direction", (3,))
     if not math.isfinite(float(roll)):
-        raise ValueError("roll must be finite")
+        raise InputError("roll must be finite")
     return _core.approach_frame(p, d, float(roll), axis)

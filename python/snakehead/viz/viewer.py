@@ -231,6 +231,10 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     if int(max_frames) != max_frames or max_frames < 2:
         raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
+    if workspace_map is not None:  # a whole map (a shard shows part of it) of this robot's head
+        from ..kinematics.workspace import require_map
+
+        require_map(workspace_map, robot, what="workspace_map")
     t = np.asarray(plan.t, float)
     idx = frame_indices(t, frame_step_s, max_frames)
     q = plan.q[idx]
@@ -240,9 +244,6 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     map_frame = frames[:, robot.link_index(robot.parts.neck_end)]
 
     if workspace_map is not None and len(workspace_map):
-        if workspace_map.chain_hash != robot.head_chain.hash:
-            raise InputError(f"the map was made for another head chain ({workspace_map.base} -> {workspace_map.tip});"
-                             f" this robot's head is {robot.parts.neck_end} -> {robot.parts.head_tip}")
         voxels = np.asarray(workspace_map.centers, float)
         indices = np.asarray(workspace_map.indices, float)
         voxel_size = float(workspace_map.voxel_size)
