@@ -374,7 +374,7 @@ class ReachabilityMap:
             and np.array_equal(self.voxel_ids, other.voxel_ids)
             and np.array_equal(self.solved, other.solved)
             and (self.reached is None) == (other.reached is None)
-            and (self.reached is None or np.array_equal(self.reached, other.reached))
+            and (self.reached is None or (other.reached is not None and np.array_equal(self.reached, other.reached)))
             and np.allclose(self.centers, other.centers, rtol=0, atol=1e-12)
         )
 
@@ -650,7 +650,7 @@ def _default_shards(executor: Any) -> int:
     return 4 * int(workers) if isinstance(workers, int) and workers > 0 else 8
 
 
-def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str]) -> str:
+def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike | None) -> str:
     source = urdf if urdf is not None else getattr(chain_or_robot, "urdf", None)
     if source is None:
         raise InputError("compute(..., executor=...) rebuilds the chain in the workers from its URDF: "
@@ -660,7 +660,7 @@ def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike[str])
         raise InputTypeError("urdf must be a path or an XML string")
     if source.lstrip().startswith("<"):
         return source
-    return _core.read_urdf_file(source)  # ValueError unless a regular file of bounded size, as Chain.from_urdf
+    return _core.read_urdf_file(source)  # InputError unless a regular file of bounded size, as Chain.from_urdf
 
 
 def _bar(progress: bool, total: int, unit: str) -> Any:
@@ -733,8 +733,8 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
     n = int(m.grid_shape[0])
     stats = m.stats
     _core.save_map(
-        path, m.command, o, np.ascontiguousarray(m.centers, dtype=float), m.solved.astype(np.int32),
-        m.voxel_ids.astype(np.int64), None if m.reached is None else np.ascontiguousarray(m.reached, dtype=np.uint8),
+        path, m.command, o, np.ascontiguousarray(m.centers, dtype=float), m.solved.astype(np.int32).tolist(),
+        m.voxel_ids.astype(np.int64).tolist(), None if m.reached is None else np.ascontiguousarray(m.reached, dtype=np.uint8),
         int(m.tried), np.asarray(m.grid_origin, dtype=float), float(m.grid_size) / n, n, int(m.hull_voxels),
         int(stats.get("hull_facets", -1)), float(stats.get("alpha", math.inf if o.hull == "convex" else math.nan)),
         float(stats.get("reach", math.nan)), m.chain_hash, m.base, m.tip, int(stats.get("ik_calls", -1)),
@@ -814,10 +814,10 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
                                        f"/ {rolls}")
     if tried not in (directions, directions * max(rolls, 1)):
         raise fail("tried", f"must be the directions ({directions}) or directions x rolls, got {tried}")
-    n = arrays["grid_shape"]
-    if not (n[0] == n[1] == n[2] and 1 <= int(n[0]) <= MAX_VOXELS_PER_AXIS):
-        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {MAX_VOXELS_PER_AXIS}, got {n.tolist()}")
-    n = int(n[0])
+    grid_shape = arrays["grid_shape"]
+    if not (grid_shape[0] == grid_shape[1] == grid_shape[2] and 1 <= int(grid_shape[0]) <= MAX_VOXELS_PER_AXIS):
+        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {MAX_VOXELS_PER_AXIS}, got {grid_shape.tolist()}")
+    n = int(grid_shape[0])
     voxel = float(value["voxel_size"])
     if not math.isclose(float(value["grid_size"]), n * voxel, rel_tol=1e-9):
         raise fail("grid_size", f"must be grid_shape x voxel_size ({n} x {voxel}), got {value['grid_size']}")
