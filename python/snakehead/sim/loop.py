@@ -67,7 +67,7 @@ from .compare import check_plan_span, compare
 from .estimate import BodyPose, pose_error
 from .gaits import GaitRun, GaitSimulator
 from .tracking import SimResult, simulate_trajectory
-from .._errors import InputError, InputTypeError, InternalError
+from .._errors import InputError, InputTypeError, InternalError, entry_point, inputs_checked
 
 #: The kinds of phases in a loop's report.
 PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
@@ -372,6 +372,7 @@ class ClosedLoop:
         return None
 
     # --- running ---------------------------------------------------------------------------------------
+    @entry_point
     def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *, believed_start: BasePlacement | None = None,
             progress: Callable[[str], None] | None = None) -> LoopRun:
         """Run the loop from the body lying at ``start`` (the body frame's placement) with joints ``q_start``
@@ -388,6 +389,7 @@ class ClosedLoop:
         if self.obstacles and coll.collision_check(robot, q_now[None], self.obstacles, start,
                                                    exact_within=0.005).distance[0] <= 0.0:
             raise InputError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
+        inputs_checked()  # the loop plans and simulates from here: an InputError inside would be a bug
         say = progress or (lambda text: None)
         sim = self.simulator
         rng = np.random.default_rng(None if self.fix is None else self.fix.seed)
