@@ -115,7 +115,6 @@ def _bounded_int(least: int, most: int) -> Callable[[str], int]:
 
 def _shard(text: str) -> str:
     """An argument type: i/N with 0 <= i < N <= the most shards a map has (kinematics.workspace.MAX_SHARDS)."""
-    from .._errors import InputError
     from ..kinematics.workspace import parse_shard
 
     try:
@@ -278,7 +277,6 @@ def _plan(args: argparse.Namespace) -> int:
 # workspace
 # ----------------------------------------------------------------------------------------------
 def _workspace(args: argparse.Namespace) -> int:
-    from .._errors import InputError
     from ..kinematics import workspace
 
     out = Path(args.out)
@@ -315,7 +313,6 @@ def _workspace(args: argparse.Namespace) -> int:
 
 def _merge_shards(args: argparse.Namespace, out: Path) -> int:
     """workspace --merge: the shards' files merged into --out (the one place shards are read as they are)."""
-    from .._errors import InputError
     from ..kinematics import workspace
 
     given = [name for name, value in (("--shard", args.shard), ("--voxel", args.voxel)) if value is not None]
