@@ -328,6 +328,11 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
         return [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
 
 
+#: s: the longest the forked figure process may take before it is taken for hung (the paper's scenes take ~10 s,
+#: 1000 targets ~60 s on a loaded 2-core machine); the figures are then drawn in the main process.
+FIGURE_PROCESS_TIMEOUT_S = 900.0
+
+
 class _Beside:
     """Runs ``work(progress)`` (-> list of file names) beside the caller: in a forked child process on Linux, so
     that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
@@ -352,12 +357,20 @@ class _Beside:
         if self.proc is None:
             return self._files
         try:
-            ok, value, stages = self.recv.recv()
+            answer: tuple[bool, Any, list[dict]] | None = (
+                self.recv.recv() if self.recv.poll(FIGURE_PROCESS_TIMEOUT_S) else None)
         except EOFError:  # the forked child died (a fork of a process with threads can crash): draw here instead
             self.proc.join()
             self.progress.say(f"the process drawing the figures died (exit code {self.proc.exitcode}); drawing them "
                               "in this process instead")
             return self.work(self.progress)
+        if answer is None:  # hung (a lock another thread held at the fork): stop it and draw here
+            self.proc.kill()
+            self.proc.join()
+            self.progress.say(f"the process drawing the figures gave no answer in {FIGURE_PROCESS_TIMEOUT_S:g} s; "
+                              "drawing them in this process instead")
+            return self.work(self.progress)
+        ok, value, stages = answer
         self.proc.join()
         self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
         if not ok:
@@ -365,7 +378,7 @@ class _Beside:
             if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
                 raise InputError(message)
             raise RuntimeError(f"drawing the figures failed: {message}")
-        return value
+        return list(value)
 
 
 def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
