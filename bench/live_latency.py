@@ -32,20 +32,6 @@ import numpy as np
 #: Poses the default robot's head reaches from its resting base (m, world; the head along +y): one per drag, in turn.
 POSES = ((0.10, 0.55, 0.32), (0.05, 0.50, 0.32), (0.08, 0.52, 0.30), (0.12, 0.50, 0.34), (0.04, 0.54, 0.30))
 FORWARD = (0.0, 1.0, 0.0)
-#: JavaScript: when each "motion N playing" first appears in the page's panel, and the second frame after it.
-WATCH = """
-window.__motions = {};
-const seen = () => {
-  const m = document.body.textContent.match(/motion (\\d+) playing/);
-  if (m && !(m[1] in window.__motions)) {
-    const entry = {text: Date.now()};
-    window.__motions[m[1]] = entry;
-    requestAnimationFrame(() => requestAnimationFrame(() => { entry.painted = Date.now(); }));
-  }
-};
-new MutationObserver(seen).observe(document.body, {subtree: true, childList: true, characterData: true});
-seen();
-"""
 
 
 def browser():
@@ -124,7 +110,7 @@ def main() -> int:
                         help="one run: the planner as it is, or plans made beforehand")
     args = parser.parse_args()
     from snakehead.scenes import Scene, Target
-    from snakehead.viz.live import LiveViewer
+    from snakehead.viz.live import MOTION_WATCH_JS, LiveViewer
 
     scene = Scene(name="bench", targets=(Target("target", POSES[0], FORWARD, hold_s=1.0),))
     live = LiveViewer(scene, robot_file=args.robot, port=0)
@@ -133,7 +119,7 @@ def main() -> int:
         live.wait_for_plan(300)
         driver.get(f"http://127.0.0.1:{live.port}")
         time.sleep(20)  # the page loads, the scene arrives and fades in (slow in SwiftShader)
-        driver.execute_script(WATCH)
+        driver.execute_script(MOTION_WATCH_JS)
         print(f"python {platform.python_version()}, {platform.machine()}; headless Chromium (SwiftShader) 1000x720")
         if args.only in (None, "planner"):
             print(table("planner as it is", drags(live, driver, args.drags)), flush=True)

@@ -20,8 +20,8 @@ import pytest
 from snakehead import BasePlacement, BoxObstacle, InputError, MeshObstacle, WallWithHole
 from snakehead.app.cli import main
 from snakehead.scenes import Scene, Target, load_scene, paper_scene, save_scene, scene_to_toml
-from snakehead.viz.live import LiveViewer
-from snakehead.viz.live_nodes import frame_along, x_axis
+from snakehead.viz.live import MOTION_WATCH_JS, LiveViewer
+from snakehead.viz.live_nodes import wxyz_along, x_axis
 
 #: Targets the default robot reaches with short plans (m, world), and one far above it that fails at once.
 NEAR = ((0.10, 0.55, 0.32), (0.05, 0.50, 0.32), (0.08, 0.52, 0.30))
@@ -165,7 +165,7 @@ def test_releasing_a_gizmo_moves_its_target_to_its_pose(live):
     handle = live._gizmos.handles[0]
     direction = np.array([0.2, 1.0, 0.1]) / np.linalg.norm([0.2, 1.0, 0.1])
     handle._impl.position = np.array(NEAR[1])  # what viser does with a pose the browser sends
-    handle._impl.wxyz = frame_along(direction)
+    handle._impl.wxyz = wxyz_along(direction)
     before = len(live.records)
     live._gizmos._released(SimpleNamespace(phase="update", target=handle))  # dragging: nothing yet
     assert len(live.records) == before
@@ -174,7 +174,7 @@ def test_releasing_a_gizmo_moves_its_target_to_its_pose(live):
     assert record.number == before and record.what == "moved 'target'"
     np.testing.assert_allclose(live.targets[0].position, NEAR[1])
     np.testing.assert_allclose(live.targets[0].direction, direction, atol=1e-12)
-    np.testing.assert_allclose(x_axis(frame_along(direction)), direction, atol=1e-12)
+    np.testing.assert_allclose(x_axis(wxyz_along(direction)), direction, atol=1e-12)
 
 
 def test_targets_are_added_and_removed(live):
@@ -270,21 +270,6 @@ def test_the_command_line_takes_a_folder_or_live(tmp_path, capsys):
 # ----------------------------------------------------------------------------------------------
 # a real browser
 # ----------------------------------------------------------------------------------------------
-#: JavaScript run in the page: the time (Date.now(), ms) each "motion N playing" first appears in the panel, and
-#: the time of the next frame the page paints after it.
-_WATCH_MOTIONS = """
-window.__motions = {};
-const seen = () => {
-  const m = document.body.textContent.match(/motion (\\d+) playing/);
-  if (m && !(m[1] in window.__motions)) {
-    const entry = {text: Date.now()};
-    window.__motions[m[1]] = entry;
-    requestAnimationFrame(() => requestAnimationFrame(() => { entry.painted = Date.now(); }));
-  }
-};
-new MutationObserver(seen).observe(document.body, {subtree: true, childList: true, characterData: true});
-seen();
-"""
 
 
 def wait_in_page(driver, number: int, timeout: float = 60.0) -> dict:
@@ -318,7 +303,7 @@ def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
             if blue > 300:
                 break
         assert blue > 300
-        driver.execute_script(_WATCH_MOTIONS)
+        driver.execute_script(MOTION_WATCH_JS)
         latencies = []
         for position in (NEAR[1], NEAR[0]):
             number = live.move_target(0, position, FORWARD)

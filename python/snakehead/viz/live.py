@@ -594,3 +594,20 @@ def _errors_text(motion: LiveMotion, check: DynamicsCheck | None) -> str:
     elif check is not None and sim is None:
         lines.append(f"\n(the last MuJoCo check was of motion {check.number})")
     return "\n".join(lines)
+
+
+#: JavaScript for measuring the viewer in a browser (tests/test_live_viewer.py, bench/live_latency.py): the time
+#: (Date.now(), ms) each "motion N playing" first appears in the panel, and the second frame painted after it.
+MOTION_WATCH_JS = """
+window.__motions = {};
+const seen = () => {
+  const m = document.body.textContent.match(/motion (\\d+) playing/);
+  if (m && !(m[1] in window.__motions)) {
+    const entry = {text: Date.now()};
+    window.__motions[m[1]] = entry;
+    requestAnimationFrame(() => requestAnimationFrame(() => { entry.painted = Date.now(); }));
+  }
+};
+new MutationObserver(seen).observe(document.body, {subtree: true, childList: true, characterData: true});
+seen();
+"""

@@ -99,13 +99,13 @@ def _closed_edges(polygon: np.ndarray, n: int) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # targets and gizmos
 # ----------------------------------------------------------------------------------------------
-def frame_along(direction: npt.ArrayLike) -> np.ndarray:
-    """A quaternion (w, x, y, z) whose frame's x-axis is ``direction`` (3,), its y-axis level when it can be."""
+def wxyz_along(direction: npt.ArrayLike) -> np.ndarray:
+    """A quaternion (w, x, y, z) of the head's frame for ``direction`` (3,): x along it, z as near the world's up as
+    can be (:func:`snakehead.control.head.frame_along`, the frame the planner aims the head at)."""
+    from ..control.head import frame_along
+
     x = np.asarray(direction, float) / np.linalg.norm(direction)
-    up = np.array([0.0, 0.0, 1.0]) if abs(x[2]) < 0.99 else np.array([1.0, 0.0, 0.0])
-    y = np.cross(up, x)
-    y /= np.linalg.norm(y)
-    return vw._wxyz(np.column_stack([x, y, np.cross(x, y)])[None])[0]
+    return vw._wxyz(frame_along(np.zeros(3), x)[:3, :3][None])[0]
 
 
 def x_axis(wxyz: npt.ArrayLike) -> np.ndarray:
@@ -127,7 +127,7 @@ class TargetGizmos:
         self._made += 1
         node = f"{ROOT}/targets/{self._made}"
         handle = self.scene.add_transform_controls(node, scale=self.size, position=target.position,
-                                                   wxyz=frame_along(target.direction), depth_test=False)
+                                                   wxyz=wxyz_along(target.direction), depth_test=False)
         vw.add_target_marker(self.scene, node, target.name, np.zeros(3), np.array([1.0, 0.0, 0.0]))
         handle.on_update(self._released)
         self.handles.append(handle)
@@ -138,7 +138,7 @@ class TargetGizmos:
     def place(self, index: int, target: Target) -> None:
         handle = self.handles[index]
         handle.position = target.position
-        handle.wxyz = frame_along(target.direction)
+        handle.wxyz = wxyz_along(target.direction)
 
     def index(self, handle: Any) -> int:
         names = [h.name for h in self.handles]
