@@ -14,7 +14,7 @@ The C++ core (``snakehead._core``) does kinematics, TRAC-IK and the workspace sw
 
 Start with ``SnakeRobot.default()``.
 """
-from ._errors import Infeasible, InputError, InputTypeError, InternalError
+from ._errors import Infeasible, InputError, InputTypeError, InternalError, MotionTooLong
 from .control.controller import HeadController, HeadSolution
 from .geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .kinematics.ik import TracIK
@@ -27,7 +27,7 @@ from .motion.planner import Plan, PlanProgress, TargetResult, plan
 from .scenes.scene import Scene, Target, load_scene
 from .sim.plan import PlanSimulation, simulate
 
-__all__ = ["Infeasible", "InputError", "InputTypeError", "InternalError", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
+__all__ = ["Infeasible", "InputError", "InputTypeError", "InternalError", "MotionTooLong", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
            "ReachabilityMap", "compute_map", "load_map", "plan", "Plan", "PlanProgress", "TargetResult", "simulate",
            "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "MeshObstacle", "WallWithHole", "default_robot_file",
            "default_urdf_path"]
