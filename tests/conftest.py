@@ -23,6 +23,19 @@ def pitch_first():
     return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
 
 
+#: A coarse, quick reachability map of the default robot's head (a few seconds): the options the map tests share.
+SMALL_MAP = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
+
+
+@pytest.fixture(scope="session")
+def small_map():
+    """The default robot's head map with SMALL_MAP's options, computed once per session."""
+    from snakehead import SnakeRobot
+    from snakehead.kinematics import workspace
+
+    return workspace.compute(SnakeRobot.default(), progress=False, **SMALL_MAP)
+
+
 @pytest.fixture(scope="session")
 def mixed_urdf() -> str:
     """A chain with revolute, continuous, prismatic and fixed joints (tests/data/mixed_chain.urdf)."""

@@ -22,10 +22,10 @@ from snakehead.kinematics import base_placement as bp
 from snakehead.kinematics import map_queries as mq
 from snakehead.kinematics import workspace as ws
 from snakehead.model.robot_file import write_robot_file
-from conftest import head6_robot
+from conftest import SMALL_MAP, head6_robot
 
 # Small maps of the default robot's 7-DOF head: about half a second each.
-SMALL = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
+SMALL = SMALL_MAP
 DATA = Path(__file__).resolve().parent / "data"
 POSE = ([0.2, 0.0, 0.1], [1.0, 0.0, 0.0])  # a pose in the head's base frame
 
@@ -36,8 +36,8 @@ def robot():
 
 
 @pytest.fixture(scope="module")
-def whole(robot):
-    return ws.compute(robot, progress=False, **SMALL)
+def whole(small_map):
+    return small_map
 
 
 @pytest.fixture(scope="module")

@@ -89,6 +89,15 @@ def refused(name: str) -> bool:
             or any(unicodedata.category(c) in ("Cc", "Cf", "Cs", "Zl", "Zp") for c in name))
 
 
+def scene_unless_refused(name: str) -> Scene | None:
+    """:func:`make_scene` of ``name``, or None once the boundary is seen to refuse a name the rule refuses."""
+    if refused(name):
+        with pytest.raises(InputError):
+            make_scene(name)
+        return None
+    return make_scene(name)
+
+
 def as_scene_name(name: str) -> str:
     """``name`` where it can name files, else a stand-in (the figures then show the name as a target's)."""
     try:
@@ -342,11 +351,9 @@ def test_every_figure_shows_a_name_literally(robot, motion, name):
     from snakehead.viz import loop as loop_plots
     from snakehead.viz import workspace as ws
 
-    if refused(name):
-        with pytest.raises(InputError):
-            make_scene(name)
+    scene = scene_unless_refused(name)
+    if scene is None:
         return
-    scene = make_scene(name)
     plan = make_plan(robot, motion, scene)
     small = dict(dpi=30)
     fig = body.plot_snapshots(plan, n_panels=3, columns=3)
@@ -465,11 +472,9 @@ def check_summary(text: str, scene: Scene) -> None:
 @example(name="a|b\\")
 @example(name="`x` | $y$")
 def test_summary_shows_names_literally(robot, motion, name):
-    if refused(name):
-        with pytest.raises(InputError):
-            make_scene(name)
+    scene = scene_unless_refused(name)
+    if scene is None:
         return
-    scene = make_scene(name)
     report = make_report(robot, motion, scene)
     text = rep.summary_markdown(rep.jsonable(report))
     check_summary(text, scene)
@@ -499,11 +504,9 @@ def test_the_viewer_shows_names_as_text(robot, motion, plain_page, name, tmp_pat
     the viewer's scene file keeps the names; a "/" in a target's name stays in its node of the scene tree."""
     from snakehead.viz import viewer
 
-    if refused(name):
-        with pytest.raises(InputError):
-            make_scene(name)
+    scene = scene_unless_refused(name)
+    if scene is None:
         return
-    scene = make_scene(name)
     plan = make_plan(robot, motion, scene)
     data = viewer.viewer_scene(plan, title=name)
     page = viewer.html_page(data)

@@ -13,9 +13,9 @@ import pytest
 
 from snakehead import Chain, SnakeRobot, default_robot_file
 from snakehead.kinematics import workspace as ws
-from conftest import head6_robot
+from conftest import SMALL_MAP, head6_robot
 
-SMALL = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
+SMALL = SMALL_MAP
 
 
 @pytest.fixture(scope="module")
@@ -24,8 +24,8 @@ def robot():
 
 
 @pytest.fixture(scope="module")
-def small(robot):
-    return ws.compute(robot, progress=False, **SMALL)
+def small(small_map):
+    return small_map
 
 
 DATA = Path(__file__).resolve().parent / "data"
