@@ -262,3 +262,21 @@ def test_viewer_refuses_a_map_of_another_head(plan):
     m = load_map(SnakeRobot.default().map_path)
     with pytest.raises(ValueError, match="another head chain"):
         viewer.viewer_scene(plan, workspace_map=m)
+
+
+@pytest.mark.parametrize("contact", ["ground", "endpoints"])
+def test_distinct_support_polygons_are_the_samples_own_without_repeats(plan, contact):
+    """The batch (one support_polygons call, deduplicated by rounded vertices) against the polygons computed sample
+    by sample with support_polygon and compared by np.allclose: the same polygons, in the same order."""
+    robot, q, base = plan.robot, plan.q, plan.base
+    got = dynamics.distinct_support_polygons(robot, q, base, contact, samples=100)
+    step = max(1, len(q) // 100)
+    expected: list[np.ndarray] = []
+    for k in range(0, len(q), step):
+        poly = stability.support_polygon(robot, q[k], base, contact=contact)
+        if not any(p.shape == poly.shape and np.allclose(p, poly, atol=1e-6) for p in expected):
+            expected.append(poly)
+    assert len(expected) > 1 if contact == "ground" else len(expected) >= 1  # the neck lifts off the ground
+    assert len(got) == len(expected)
+    for a, b in zip(got, expected):
+        np.testing.assert_allclose(a, b, atol=1e-9)
