@@ -96,6 +96,49 @@ def test_momenta_of_a_state_three_ways(robot):
     np.testing.assert_allclose(P, robot.total_mass * (c[0] - c[1]) / (2 * h), atol=1e-7)
 
 
+def test_gravity_torques_of_any_weights_equal_the_cross_products(robot):
+    """tau_j = -a_j . sum_i W_ji (c_i - p_j) x (m_i g), term by term with np.cross, for random weights W."""
+    rng = np.random.default_rng(14)
+    s = sim.build_model(robot)
+    d = mujoco.MjData(s.model)
+    s.set_state(d, robot.body.random_configuration(rng), BasePlacement(0.3, 0.2, 1.1))
+    W = rng.uniform(0.0, 1.0, (robot.n_joints, len(robot.link_names)))
+    jid = s.model.dof_jntid[s.dof_adr]
+    expected = np.zeros(robot.n_joints)
+    for j in range(robot.n_joints):
+        for i, b in enumerate(s.body_ids):
+            mg = s.model.body_mass[b] * np.array([0.0, 0.0, -sim.mjcf.GRAVITY])
+            expected[j] -= W[j, i] * d.xaxis[jid[j]] @ np.cross(d.xipos[b] - d.xanchor[jid[j]], mg)
+    np.testing.assert_allclose(tracking.gravity_torques(s, d, W), expected, atol=1e-12)
+
+
+def test_ground_contacts_are_mujocos_contacts_on_the_robot(robot):
+    """Contact by contact against mj_contactForce rotated by the contact frame; at rest on the floor the forces carry
+    the robot's weight."""
+    s = sim.build_model(robot)
+    d = mujoco.MjData(s.model)
+    s.set_state(d, np.zeros(robot.n_joints), BasePlacement(0.1, 0.0, 0.5), lift=0.0)
+    for _ in range(600):  # settle
+        mujoco.mj_step(s.model, d)
+    weight = s.model.body_subtreemass[s.root_body] * sim.mjcf.GRAVITY
+    assert tracking.ground_contacts(s, d)[1][:, 2].sum() == pytest.approx(weight, rel=0.02)
+    d.qvel[:2] = [0.4, -0.2]  # sliding: the friction forces are not small
+    mujoco.mj_forward(s.model, d)
+    points, forces = tracking.ground_contacts(s, d)
+    f6 = np.zeros(6)
+    expected = []
+    for i in range(d.ncon):
+        c = d.contact[i]
+        if s.floor_geom in (c.geom1, c.geom2):
+            mujoco.mj_contactForce(s.model, d, i, f6)
+            f = np.asarray(c.frame).reshape(3, 3).T @ f6[:3]
+            expected.append((np.array(c.pos), f if c.geom1 == s.floor_geom else -f))  # on the robot
+    assert len(expected) == len(points) > 3
+    np.testing.assert_allclose(points, [p for p, _ in expected], atol=0)
+    np.testing.assert_allclose(forces, [f for _, f in expected], atol=1e-12)
+    assert np.abs(forces[:, :2]).sum() > 0.1 * weight
+
+
 def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(robot):
     rng = np.random.default_rng(4)
     s = sim.build_model(robot)

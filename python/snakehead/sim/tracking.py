@@ -35,8 +35,13 @@ def momenta_of_state(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     b = sim.root_body
     P = sim.model.body_subtreemass[b] * data.subtree_linvel[b]
     c = data.subtree_com[b]
-    L = data.subtree_angmom[b] + np.cross(c, P)
+    L = data.subtree_angmom[b] + _cross3(c, P)
     return P.copy(), L.copy()
+
+
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (np.cross costs ~20 us a call; this runs at every control tick)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -64,24 +69,38 @@ def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def ground_contacts(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     """Contact points (k, 3) m and forces on the robot (k, 3) N, world frame, of every robot-floor contact."""
-    mj = _mujoco()
-    pts, frc = [], []
-    f6 = np.zeros(6)
-    for i in range(data.ncon):
-        c = data.contact[i]
-        g1, g2 = int(c.geom1), int(c.geom2)
-        if sim.floor_geom not in (g1, g2):
-            continue
-        mj.mj_contactForce(sim.model, data, i, f6)
-        frame = np.asarray(c.frame).reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
-        f = frame.T @ f6[:3]  # force of geom1 on geom2, world
-        if g1 != sim.floor_geom:
-            f = -f
-        pts.append(np.array(c.pos))
-        frc.append(f)
-    if not pts:
+    if data.ncon == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))
-    return np.array(pts), np.array(frc)
+    contacts = data.contact  # the contact list's fields as arrays (ncon, ...): one read, not one per contact
+    g1, g2 = contacts.geom1, contacts.geom2
+    rows = np.flatnonzero((g1 == sim.floor_geom) | (g2 == sim.floor_geom))
+    if rows.size == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    frame = contacts.frame[rows].reshape(-1, 3, 3)  # rows: normal (geom1 -> geom2), tangents
+    f = np.einsum("kij,ki->kj", frame, _contact_forces(sim, data, rows))  # force of geom1 on geom2, world
+    f[g1[rows] != sim.floor_geom] *= -1.0  # on the robot
+    return contacts.pos[rows].copy(), f
+
+
+def _contact_forces(sim: SimModel, data: Any, rows: np.ndarray) -> np.ndarray:
+    """(k, 3) normal and two tangential forces of contacts ``rows`` in their contact frames, as mj_contactForce
+    gives them. For the pyramidal friction cone of 3-D contacts (the models :func:`build_model` makes) they are
+    decoded from the constraint forces at once: normal = the sum of the pyramid's 4 edge forces, tangent i =
+    (edge 2i - edge 2i+1) mu_i; contacts without a constraint row (excluded) carry none. Else contact by contact."""
+    mj = _mujoco()
+    contacts = data.contact
+    if sim.model.opt.cone == mj.mjtCone.mjCONE_PYRAMIDAL and np.all(contacts.dim[rows] == 3):
+        adr = contacts.efc_address[rows]
+        edges = np.where(adr[:, None] >= 0, data.efc_force[np.maximum(adr, 0)[:, None] + np.arange(4)], 0.0)
+        mu = contacts.friction[rows, :2]
+        return np.column_stack([edges.sum(axis=1), (edges[:, 0] - edges[:, 1]) * mu[:, 0],
+                                (edges[:, 2] - edges[:, 3]) * mu[:, 1]])
+    local = np.empty((rows.size, 3))
+    f6 = np.zeros(6)
+    for k, i in enumerate(rows):
+        mj.mj_contactForce(sim.model, data, int(i), f6)
+        local[k] = f6[:3]
+    return local
 
 
 def center_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray:
@@ -248,10 +267,11 @@ def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray
     a = data.xaxis[jid]  # (n, 3)
     p = data.xanchor[jid]  # (n, 3)
     c = data.xipos[sim.body_ids]  # (L, 3)
-    mg = m.body_mass[sim.body_ids][:, None] * np.array([0.0, 0.0, -GRAVITY])  # (L, 3)
-    r = c[None, :, :] - p[:, None, :]  # (n, L, 3)
-    torque = np.cross(r, mg[None, :, :])  # (n, L, 3)
-    return -np.einsum("nl,nlk,nk->n", weights, torque, a)
+    # with g = (0, 0, -G): a . (r x m g) = m G (a_y r_x - a_x r_y), r = c - p, so the sum over links needs only
+    # the weighted masses' totals and first moments (one matrix product, no (n, L, 3) cross products)
+    wm = weights * m.body_mass[sim.body_ids][None, :]  # (n, L)
+    moment = wm @ c[:, :2] - wm.sum(axis=1)[:, None] * p[:, :2]  # (n, 2): sum_i W m (c_i - p_j), x and y
+    return GRAVITY * (a[:, 0] * moment[:, 1] - a[:, 1] * moment[:, 0])
 
 
 def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
