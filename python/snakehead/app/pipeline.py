@@ -112,6 +112,30 @@ def plan_progress_line(record: PlanProgress) -> str:
 def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
               solution_figure: bool = False) -> dict:
     """One scene through the pipeline; its report entry (``report.scenario_entry``) with the files written."""
+    return start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure).finish()
+
+
+@dataclass
+class PendingScene:
+    """A scene whose last figures are still being drawn beside the caller (:func:`start_scene`): :meth:`finish`
+    waits for them and returns the scene's report entry with every file written."""
+
+    entry: dict
+    files: list[str]
+    drawing: list[_Beside]
+
+    def finish(self) -> dict:
+        for beside in self.drawing:
+            self.files += beside.files()
+        self.drawing = []
+        self.entry["files"] = list(self.files)
+        return self.entry
+
+
+def start_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
+                solution_figure: bool = False) -> PendingScene:
+    """:func:`run_scene` up to its last figures (the momenta and the ZMP, drawn beside the caller once MuJoCo is
+    done), so that the next scene is planned while they are drawn."""
     from ..motion.planner import plan
 
     s = FAST if settings.fast else NORMAL
@@ -157,12 +181,13 @@ def run_scene(scene: Scene, controller: HeadController, out: Path, settings: Set
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
+    pending = []
     if drawing is not None:
-        files += _dynamics_figures(scene, result, sim_result, out, progress)
-        files += drawing.files()
+        pending = [drawing, _Beside(lambda p: _dynamics_figures(scene, result, sim_result, out, p), progress,
+                                    parallel=settings.parallel)]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
-    return entry
+    return PendingScene(entry, files, pending)
 
 
 #: ``start`` of :func:`run_scenes` for the paper's "current state": lying straight where the curl into the bending
@@ -372,7 +397,7 @@ class _Beside:
             return self.work(self.progress)
         ok, value, stages = answer
         self.proc.join()
-        self.progress.stages += [{**st, "stage": st["stage"] + " [beside the simulation]"} for st in stages]
+        self.progress.stages += [{**st, "stage": st["stage"] + " [in a second process]"} for st in stages]
         if not ok:
             kind, message = value
             if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
@@ -431,12 +456,18 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     if on_controller is not None:
         on_controller(controller)
     entries = {}
+    drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
     for scene in scenes:
         if start is not None:
             entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
                                                  solution_figure=solution_figure)
             continue
-        entries[scene.name] = run_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+        if drawing is not None:
+            drawing.finish()
+        entries[scene.name], drawing = pending.entry, pending
+    if drawing is not None:
+        drawing.finish()
     robot = controller.robot
     report = {"command": command, "scenarios": entries,
               "settings": {**settings.as_dict(), "map": _map_label(controller.map)},
