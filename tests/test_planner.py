@@ -155,7 +155,7 @@ def test_lift_kept_per_base_shape_gives_the_plan_a_fresh_controller_gives(contro
     target = [(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])]
     snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
                    controller=controller)  # the default placement: fills the caches
-    assert controller.__dict__.get("_lift_paths") and controller.__dict__.get("_timed_lifts")
+    assert len(controller.plan_cache.lift_paths) and len(controller.plan_cache.timed_lifts)
     reused = snakehead.plan(target, controller=controller, base=moved, allow_relocation=False)
     fresh = snakehead.plan(target, controller=HeadController(robot, method="free_roll", seed=0), base=moved,
                            allow_relocation=False)

@@ -15,6 +15,7 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..margins import DETOUR_MARGIN, OBSTACLE_CLEARANCE
 from ..model.robot import BasePlacement, SnakeRobot
+from .plan_cache import shape_key
 from .start_state import bending_state
 from .target_solves import solve_kept
 
@@ -116,16 +117,16 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
         return start, q0.copy(), None, [f"no relocation: a target is {far}"]
     # a relocated base must hold a stable curl of the neck and head (the bending state the plan lifts them from):
     # the whole-body solve is told so, and looks further than a shape (e.g. a straight base) that holds none
-    no_curl = controller.__dict__.setdefault("_shapes_without_curl", set())
+    no_curl = controller.plan_cache.shapes_without_curl
 
     def has_curl(q: np.ndarray) -> bool:
-        key = np.round(q[:robot.lift_joints.start], 12).tobytes()
+        key = shape_key(q, robot.lift_joints.start, 12)
         if key in no_curl:
             return False
         try:
             bending_state(controller, q)
         except Infeasible:
-            no_curl.add(key)
+            no_curl.put(key, True)
             return False
         return True
 

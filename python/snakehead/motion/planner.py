@@ -20,8 +20,8 @@ the ground's friction); the motion rests at every target.
 
 The planner's parts, by concern: what a plan returns (:mod:`.plan_result`), the bounds checked before anything is
 solved (:mod:`.plan_bounds`), the start state (:mod:`.start_state`), the base's choice and relocation
-(:mod:`.base_choice`), the targets' solves (:mod:`.target_solves`), the path and its checks and the path and
-its checks (:mod:`.waypoints`).
+(:mod:`.base_choice`), the targets' solves (:mod:`.target_solves`), the path and its checks (:mod:`.waypoints`),
+and what a controller keeps from one plan for the next (:mod:`.plan_cache`).
 """
 from __future__ import annotations
 
@@ -46,7 +46,7 @@ from .plan_bounds import check_size, check_timing
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
 from .start_state import LIFT_STEPS, bending_state
 from .target_solves import solve_noted
-from .waypoints import KEPT_LIFTS, PLAN_CONTACT, Waypoints
+from .waypoints import PLAN_CONTACT, Waypoints
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -211,7 +211,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
         # the lift's path, like its timing, is the same for every plan from a base of this shape wherever it lies
         # (obstacles apart: with them it is checked again)
-        lifts = controller.__dict__.setdefault("_lift_paths", {})
+        lifts = controller.plan_cache.lift_paths
         key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
         kept = lifts.get(key) if not obstacles else None  # (one lookup: another thread may clear the dict)
         if kept is not None:
@@ -220,11 +220,9 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
             first = len(way.qs) - 1
             method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
             if not obstacles:
-                if len(lifts) > KEPT_LIFTS:
-                    lifts.clear()
-                lifts[key] = (np.array(way.qs[first:]), method)
+                lifts.put(key, (np.array(way.qs[first:]), method))
         way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
-        way.lift_cache = controller.__dict__.setdefault("_timed_lifts", {})
+        way.lift_cache = controller.plan_cache.timed_lifts
     else:
         q = way.qs[-1]
     results: list[TargetResult] = []

@@ -12,6 +12,7 @@ from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import SnakeRobot
+from .plan_cache import shape_key
 
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
@@ -31,11 +32,12 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     give the shape on the ground (default: the controller's initial configuration)."""
     robot = controller.robot
     shape = controller.q_initial if q_shape is None else np.asarray(q_shape, float)
-    key = shape[:robot.lift_joints.start].tobytes()
-    cache = controller.__dict__.setdefault("_bending_states", {})
-    if key not in cache:
-        cache[key] = ground_curl(robot, shape)
-    return cache[key].copy()
+    kept = controller.plan_cache.bending_states
+    key = shape_key(shape, robot.lift_joints.start)
+    q = kept.get(key)
+    if q is None:
+        q = kept.put(key, ground_curl(robot, shape))
+    return q.copy()
 
 
 def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from . import interpolation as interp
 from . import plan_bounds
 from .cartesian import tracking_interpolation
 from .plan_bounds import check_motion_length
+from .plan_cache import KeptMap
 
 #: The contact model plans are checked with (``dynamics.stability.support_polygon``): every link lying on the ground.
 PLAN_CONTACT = "ground"
@@ -31,7 +32,6 @@ DENSIFY = 3  # configurations checked between consecutive waypoints of a move, a
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
 DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
-KEPT_LIFTS = 16  # lifts (checked paths, timed motions) a controller keeps, one per base shape
 
 
 def _subdivide(qs: np.ndarray, step: float, least: int = 1) -> np.ndarray:
@@ -84,7 +84,7 @@ class Waypoints:
         self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
         self.timing_failure: str | None = None  # why the path could not be timed, when it could not
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
-        self.lift_cache: dict | None = None  # timed lifts, kept by the controller
+        self.lift_cache: KeptMap[tuple[bytes, str], Any] | None = None  # timed lifts: controller.plan_cache's
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
         self._least = (0, 0.0)  # (waypoints counted, s): least_duration's sum so far
 
@@ -264,11 +264,8 @@ class Waypoints:
                 key = (np.round(Q[:k + 1], 9).tobytes(), repr(sorted(timing.items())))  # round-off apart
                 lift = self.lift_cache.get(key)
                 if lift is None:
-                    lift = retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
-                                  stops=[i for i in stops if i <= k], **timing)
-                    if len(self.lift_cache) > KEPT_LIFTS:
-                        self.lift_cache.clear()
-                    self.lift_cache[key] = lift
+                    lift = self.lift_cache.put(key, retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
+                                                           stops=[i for i in stops if i <= k], **timing))
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
                               **timing)
                 check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
@@ -324,4 +321,4 @@ def concatenate_motions(a: Any, b: Any) -> Any:
 
 __all__ = ["Waypoints", "split_steps", "check_points", "densify", "concatenate_motions", "PLAN_CONTACT",
            "DETOUR_TRIALS", "DETOUR_SPREAD", "DETOUR_SEED", "JOINT_STEP_CHECK", "FALLBACK_SPEED", "DENSIFY", "MOVE_CHECK_STEP",
-           "MAX_WAYPOINT_STEP", "DETOUR_BATCH", "KEPT_LIFTS"]
+           "MAX_WAYPOINT_STEP", "DETOUR_BATCH"]
