@@ -158,7 +158,7 @@ def test_an_output_that_cannot_be_written_names_the_file(tmp_path):
 def test_a_target_beyond_the_relocation_range_fails_as_out_of_range():
     """A target 12 m away is valid input: the plan fails at once, saying why, instead of relocating the base
     across the world (a target 1e6 m away, once "planned" with a kilometre's relocation, is now bad input)."""
-    from snakehead.motion.planner import MAX_RELOCATION_M
+    from snakehead.motion.base_choice import MAX_RELOCATION_M
 
     robot = snakehead.SnakeRobot.default()
     far = MAX_RELOCATION_M + robot.body_length + 0.5

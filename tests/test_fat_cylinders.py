@@ -16,7 +16,7 @@ import snakehead
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
 from snakehead.model import published
-from snakehead.motion import planner as pl
+from snakehead.motion import start_state, waypoints
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -44,11 +44,11 @@ def test_lift_keeps_the_ground_links_and_the_body_clear(fat_rsnake):
 
 def test_detour_moves_only_the_lifting_joints(fat_rsnake):
     robot, controller, _ = fat_rsnake
-    way = pl._Waypoints(robot, snakehead.BasePlacement())
-    qa = pl.bending_state(controller)
+    way = waypoints.Waypoints(robot, snakehead.BasePlacement())
+    qa = start_state.bending_state(controller)
     qb = qa.copy()
     qb[robot.lift_joints.start:] = controller.q_initial[robot.lift_joints.start:]
-    way._feasible = lambda qs: np.zeros(len(qs), bool)  # nothing passes: every detour is tried
+    way.feasible = lambda qs: np.zeros(len(qs), bool)  # nothing passes: every detour is tried
     path, method = way._joint_path(qa, qb, 8)
     assert "detour" in method
     assert np.abs(path[:, :robot.lift_joints.start] - qa[:robot.lift_joints.start]).max() < 1e-12

@@ -16,7 +16,7 @@ from snakehead.control import whole_body
 from snakehead.control.controller import HeadController
 from snakehead.dynamics import stability
 from snakehead.model.robot import SnakeRobot
-from snakehead.motion import planner, timing
+from snakehead.motion import plan_bounds, timing
 from snakehead.motion.targets import reachable_targets
 from snakehead.scenes import MAX_TARGETS, Scene, Target, load_scene, scene_from_dict
 
@@ -160,7 +160,7 @@ def test_a_scene_of_max_targets_loads(tmp_path):
 
 def test_too_long_holds_are_refused_at_once(no_solving, controller):
     p, d = np.array([0.0, 0.5, 0.3]), np.array([0.0, 1.0, 0.0])
-    half = planner.MAX_MOTION_S / 2 + 1
+    half = plan_bounds.MAX_MOTION_S / 2 + 1
     scene = Scene(name="long", targets=(Target("a", p, d, hold_s=half), Target("b", p, d, hold_s=half)))
     with pytest.raises(InputError, match=r"scene 'long': its targets' hold_s add up to 2002 s; a plan's motion "
                                          r"lasts at most 2000 s"):
@@ -169,12 +169,12 @@ def test_too_long_holds_are_refused_at_once(no_solving, controller):
 
 def test_too_many_line_poses_are_refused_at_once(no_solving, controller):
     d = np.array([0.0, 1.0, 0.0])
-    step = 1.0 / planner.MAX_LINE_POSES  # each line the most poses one line may take
-    lines = planner.MAX_POSES // planner.MAX_LINE_POSES + 1
+    step = 1.0 / plan_bounds.MAX_LINE_POSES  # each line the most poses one line may take
+    lines = plan_bounds.MAX_POSES // plan_bounds.MAX_LINE_POSES + 1
     targets = [Target("t0", [0.0, 0.0, 0.3], d)]
     targets += [Target(f"t{k}", [0.0, float(k % 2), 0.3], d, approach="line", step_m=step) for k in range(1, lines + 1)]
     with pytest.raises(InputError, match=rf"scene 'lines': its {lines + 1} targets and the poses along their line "
-                                         rf"approaches are \d+ whole-body solves; at most {planner.MAX_POSES}"):
+                                         rf"approaches are \d+ whole-body solves; at most {plan_bounds.MAX_POSES}"):
         snakehead.plan(Scene(name="lines", targets=tuple(targets)), controller=controller)
 
 
@@ -183,7 +183,7 @@ def test_a_motion_too_long_stops_as_soon_as_the_targets_show_it(three, controlle
     at the first target that takes it beyond MAX_MOTION_S, without solving the others. The scene was valid input:
     its moves only turn out too long (MotionTooLong, an Infeasible: the command line's exit 1)."""
     assert issubclass(MotionTooLong, Infeasible) and not issubclass(MotionTooLong, InputError)
-    monkeypatch.setattr(planner, "MAX_MOTION_S", 0.05)
+    monkeypatch.setattr(plan_bounds, "MAX_MOTION_S", 0.05)
     still = Scene(name="three", targets=tuple(replace(t, hold_s=0.0) for t in three.targets))
     records: list = []
     with pytest.raises(MotionTooLong, match=r"scene 'three': the motion to its target 1 of 3 \('t1'\) lasts at least"):
@@ -207,7 +207,7 @@ def test_a_path_that_cannot_be_timed_still_fits_the_longest_motion(three, contro
         raise Infeasible("no motion along the path keeps every limit near waypoint 3")
 
     monkeypatch.setattr(timing, "retime", untimeable)
-    monkeypatch.setattr(planner, "MAX_MOTION_S", 30.0)
+    monkeypatch.setattr(plan_bounds, "MAX_MOTION_S", 30.0)
     result = snakehead.plan(three, controller=controller)
     assert not result.success and "cannot be timed" in result.failure
     assert result.duration_s <= 30.0
@@ -258,7 +258,7 @@ def test_the_plan_keeps_its_checks(planned):
 
 
 def test_snapshots_stay_one_page_with_many_targets(planned):
-    from snakehead.motion.planner import TargetResult
+    from snakehead.motion.plan_result import TargetResult
     from snakehead.viz import body
 
     result = planned[0]

@@ -43,7 +43,7 @@ from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion.planner import Plan, TargetResult
+from snakehead.motion.plan_result import Plan, TargetResult
 from snakehead.scenes.scene import Scene, Target, load_scene, scene_from_dict
 
 _EXAMPLES = int(os.environ.get("SNAKEHEAD_FUZZ_EXAMPLES", "0"))

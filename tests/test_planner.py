@@ -10,7 +10,8 @@ from snakehead import SnakeRobot
 from snakehead.control.controller import HeadController
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
-from snakehead.motion import planner
+from snakehead.margins import DETOUR_MARGIN
+from snakehead.motion import start_state
 from snakehead.scenes import paper_scene
 
 HOLE = paper_scene("hole")
@@ -45,11 +46,11 @@ def check(result, robot):
         assert np.degrees(np.arccos(np.clip(T[:3, 0] @ tg.direction, -1, 1))) <= 0.05
         # a target's state keeps the static margin the moves to and from it keep (else no path leaves it stably)
         margin = stability.static_margin(robot, result.q[k], result.base, contact="ground")
-        assert margin >= planner.DETOUR_MARGIN - 1e-6, (tg.name, margin)
+        assert margin >= DETOUR_MARGIN - 1e-6, (tg.name, margin)
         # ... and keeps it on the base alone: a pose that stands only because a lifted link rests on the ground
         # cannot be reached from the air
         base_margin = stability.static_margin(robot, result.q[k], result.base, contact="footprint")
-        assert base_margin >= planner.DETOUR_MARGIN - 1e-6, (tg.name, base_margin)
+        assert base_margin >= DETOUR_MARGIN - 1e-6, (tg.name, base_margin)
     assert result.stability.inside.all(), f"ZMP outside at t = {result.t[result.stability.argmin]:.3f} s"
     below = coll.below_ground(robot, result.q, result.base)
     assert not below.any()
@@ -64,7 +65,7 @@ def test_spheres(spheres, controller):
     # the paper's phases: the bending state (on the ground), lifting the head, then the targets
     labels = [lab for lab, _, _ in spheres.states]
     assert labels[0] == "bending state" and "initial state (head lifted)" in labels
-    np.testing.assert_array_equal(spheres.states[0][2], planner.bending_state(controller))
+    np.testing.assert_array_equal(spheres.states[0][2], start_state.bending_state(controller))
     names = [t.name for t in spheres.targets]
     assert names == ["sphere 1", "sphere 2"]
 
@@ -110,19 +111,19 @@ def test_bending_state_of_a_base_with_no_stable_curl(controller):
     stable on it. The bending state says so (it failed on an empty array before, and crashed the planner's choice
     of a base for a random target)."""
     with pytest.raises(Infeasible, match="no curl of the neck and head"):
-        planner.bending_state(controller, np.zeros(controller.robot.n_joints))
+        start_state.bending_state(controller, np.zeros(controller.robot.n_joints))
 
 
 def test_bending_state(controller):
     robot = controller.robot
-    q = planner.bending_state(controller)
+    q = start_state.bending_state(controller)
     np.testing.assert_array_equal(q[robot.parts.base], controller.q_initial[robot.parts.base])
     pitch = np.abs(np.asarray(robot.body.model.joint_axes)[:, 1]) > 0.5
     np.testing.assert_array_equal(q[pitch], 0.0)  # everything lies flat on the ground
     clearance = coll.ground_clearance(robot, q)[0]
     boxed = np.isfinite(clearance)
     np.testing.assert_allclose(clearance[boxed], 0.0, atol=1e-12)
-    assert coll.self_clearance(robot, q)[0] > planner.BENDING_CLEARANCE
+    assert coll.self_clearance(robot, q)[0] > start_state.BENDING_CLEARANCE
     # once lifted, only the base supports: the curl keeps the whole body's CoM over the base's polygon
     from snakehead.dynamics import stability
 
@@ -132,7 +133,7 @@ def test_bending_state(controller):
 def test_self_clearance_detects_overlap(controller):
     robot = controller.robot
     assert coll.self_clearance(robot, np.zeros(16))[0] == pytest.approx(0.0865)  # straight: a module apart
-    q = planner.bending_state(controller)
+    q = start_state.bending_state(controller)
     yaw_up = [8, 10, 12, 14]
     q[yaw_up] = np.radians([90, 90, 0, 0])  # curls the head across the base: link_14 lies on link_4
     assert coll.self_clearance(robot, q)[0] < 0
@@ -154,7 +155,7 @@ def test_lift_kept_per_base_shape_gives_the_plan_a_fresh_controller_gives(contro
     target = [(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])]
     snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
                    controller=controller)  # the default placement: fills the caches
-    assert controller.__dict__.get("_lift_paths") and controller.__dict__.get("_timed_lifts")
+    assert len(controller.plan_cache.lift_paths) and len(controller.plan_cache.timed_lifts)
     reused = snakehead.plan(target, controller=controller, base=moved, allow_relocation=False)
     fresh = snakehead.plan(target, controller=HeadController(robot, method="free_roll", seed=0), base=moved,
                            allow_relocation=False)

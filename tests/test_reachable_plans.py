@@ -2,7 +2,7 @@
 planned and its motion checked by independent computations (FK, support polygons, ground and self clearance at
 every 2 ms sample); and the pieces of the planner that fixed them: a relocated base holds a stable curl of the
 neck and head (``choose_base``), long steps of a move are split and every move is checked densely, and after the
-lift a move's static margin is the base's own (``planner._Waypoints``)."""
+lift a move's static margin is the base's own (``waypoints.Waypoints``)."""
 from __future__ import annotations
 
 import numpy as np
@@ -15,7 +15,8 @@ from shape_reference import box_corners
 from snakehead.control import whole_body as wb
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
-from snakehead.motion import planner
+from snakehead import margins
+from snakehead.motion import start_state, waypoints
 from snakehead.motion.targets import reachable_targets
 
 
@@ -40,7 +41,7 @@ def verify_plan(plan, position, direction):
     # the ZMP from finite differences of the samples (not the plan's own velocities) inside by the plan's margin,
     # up to the difference between the two derivatives
     dyn = stability.dynamic_stability(robot, plan.t, plan.q, base, contact="ground")
-    assert dyn.min_margin >= planner.ZMP_MARGIN - 1e-3, dyn.min_margin
+    assert dyn.min_margin >= margins.ZMP_MARGIN - 1e-3, dyn.min_margin
     assert coll.ground_clearance(robot, plan.q, base)[:, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
     assert coll.self_clearance(robot, plan.q[::2], base).min() > 0.0
     # the base lies still on the ground throughout
@@ -56,7 +57,7 @@ def test_long_step_of_a_tracked_move_is_no_longer_trusted(controller):
     plan = snakehead.plan([(t.position, t.direction)], controller=controller)
     verify_plan(plan, t.position, t.direction)
     Q = np.array([q for _, _, q in plan.states])
-    assert np.abs(np.diff(Q, axis=0)).max() <= planner.MAX_WAYPOINT_STEP + 1e-9
+    assert np.abs(np.diff(Q, axis=0)).max() <= waypoints.MAX_WAYPOINT_STEP + 1e-9
 
 
 def test_relocated_base_holds_a_stable_curl(controller):
@@ -67,10 +68,10 @@ def test_relocated_base_holds_a_stable_curl(controller):
     robot = controller.robot
     t = reachable_targets(controller, "shape", 100, np.random.default_rng(1))[44]
     prob = controller.body_problem
-    plain = wb.solve_target(controller, t.position, t.direction, problem=prob, min_margin=planner.DETOUR_MARGIN)
+    plain = wb.solve_target(controller, t.position, t.direction, problem=prob, min_margin=margins.DETOUR_MARGIN)
     assert plain.success and plain.stage == wb.STAGES[2]
     with pytest.raises(Infeasible, match="no curl"):  # the case: the first base found holds no curl
-        planner.bending_state(controller, plain.q)
+        start_state.bending_state(controller, plain.q)
 
     plan = snakehead.plan([(t.position, t.direction)], controller=controller)
     verify_plan(plan, t.position, t.direction)
@@ -98,40 +99,40 @@ def test_shape_ok_is_obeyed(controller):
         return ok
 
     sol = wb.solve_target(controller, t.position, t.direction, problem=controller.body_problem,
-                          min_margin=planner.DETOUR_MARGIN, shape_ok=bent)
+                          min_margin=margins.DETOUR_MARGIN, shape_ok=bent)
     assert sol.success and sol.stage == wb.STAGES[2] and np.abs(sol.q[yaw]).min() > 0.1
     assert refused  # a straight shape was found first and refused
     H = robot.head_pose(sol.q, sol.base)
     assert np.linalg.norm(H[:3, 3] - t.position) <= 1e-4
     assert np.degrees(np.arccos(np.clip(H[:3, 0] @ t.direction, -1.0, 1.0))) <= 0.05
     assert min(stability.static_margin(robot, sol.q, sol.base, contact=c) for c in ("ground", "footprint")) \
-        >= planner.DETOUR_MARGIN - 1e-9
+        >= margins.DETOUR_MARGIN - 1e-9
     assert coll.ground_clearance(robot, sol.q, sol.base)[0, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
     assert coll.self_clearance(robot, sol.q[None], sol.base)[0] > 0.0
 
 
 def test_split_steps_and_checked_configurations():
     qs = np.array([[0.0, 0.0], [0.3, -0.1], [1.3, 0.9], [1.3, 0.9]])
-    split = planner._split_steps(qs, most=0.5)
+    split = waypoints.split_steps(qs, most=0.5)
     # the same straight segments: 1 + 2 + 1 steps, none longer than 0.5 rad, the waypoints kept
     assert len(split) == 1 + 1 + 2 + 1
     assert np.abs(np.diff(split, axis=0)).max() <= 0.5 + 1e-12
     for q in qs:
         assert np.min(np.abs(split - q).max(axis=1)) < 1e-12
     np.testing.assert_allclose(split[2], [0.8, 0.4])
-    checked = planner._checked(qs, step=0.05)
+    checked = waypoints.check_points(qs, step=0.05)
     assert np.abs(np.diff(checked, axis=0)).max() <= 0.05 + 1e-12
-    assert len(checked) == 1 + 6 + 20 + planner.DENSIFY + 1
+    assert len(checked) == 1 + 6 + 20 + waypoints.DENSIFY + 1
 
 
 def test_after_the_lift_a_move_stands_on_the_base(controller):
-    """Once the head is up, ``_Waypoints._feasible`` takes the smaller of the ground contact's margin and the
+    """Once the head is up, ``Waypoints.feasible`` takes the smaller of the ground contact's margin and the
     base's own: a configuration that keeps DETOUR_MARGIN only because a neck or head link rests on the ground is
     refused after the lift (and accepted before it). Independent: stability.static_margin with both models."""
     robot = controller.robot
     rng = np.random.default_rng(4)
     lifted = np.arange(robot.lift_joints.start, robot.n_joints)
-    way = planner._Waypoints(robot, controller.base)
+    way = waypoints.Waypoints(robot, controller.base)
     found = 0
     for _ in range(400):
         q = controller.q_initial.copy()
@@ -139,15 +140,15 @@ def test_after_the_lift_a_move_stands_on_the_base(controller):
         q = np.clip(q, robot.lower, robot.upper)
         ground = stability.static_margin(robot, q, controller.base, contact="ground")
         footprint = stability.static_margin(robot, q, controller.base, contact="footprint")
-        if not (ground >= planner.DETOUR_MARGIN > footprint):
+        if not (ground >= margins.DETOUR_MARGIN > footprint):
             continue
         if (coll.ground_clearance(robot, q, controller.base)[0, robot.lifted_links].min() < -coll.GROUND_TOLERANCE
                 or coll.self_clearance(robot, q[None], controller.base)[0] <= 0):
             continue
         way.lift_index = None
-        assert way._feasible(q[None])[0]
+        assert way.feasible(q[None])[0]
         way.lift_index = 15
-        assert not way._feasible(q[None])[0]
+        assert not way.feasible(q[None])[0]
         found += 1
     assert found > 0  # the case the check is for was drawn
 
@@ -195,22 +196,22 @@ def test_targets_stand_on_the_links_that_stay_on_the_ground(generated):
 def test_generated_snake_plans_other_shapes(generated):
     """A generated snake (13 joints, pitch first) plans targets that need another base shape: relocated, every
     check recomputed, and after the lift every planned waypoint stands on the links that stay on the ground by
-    DETOUR_MARGIN (scipy's hull), as ``_Waypoints._feasible`` asks."""
+    DETOUR_MARGIN (scipy's hull), as ``Waypoints.feasible`` asks."""
     for t in reachable_targets(generated, "shape", 3, np.random.default_rng(0)):
         plan = snakehead.plan([(t.position, t.direction)], controller=generated)
         verify_plan(plan, t.position, t.direction)
         lifted = [q for label, _, q in plan.states if not label.startswith(("bending", "initial"))]
         assert lifted
-        assert min(base_only_margin(plan.robot, q, plan.base) for q in lifted) >= planner.DETOUR_MARGIN - 1e-9
+        assert min(base_only_margin(plan.robot, q, plan.base) for q in lifted) >= margins.DETOUR_MARGIN - 1e-9
 
 
 def test_margins_after_the_lift_on_a_generated_snake(generated):
-    """``_Waypoints._margins`` after the lift: the smaller of the ground contact's margin and that over the links
+    """``Waypoints._margins`` after the lift: the smaller of the ground contact's margin and that over the links
     that stay on the ground (here the base's last link is a real link, not a marker: the 'footprint' model leaves
     it out, the planner must not). Independent: stability.static_margin and scipy's hull."""
     robot = generated.robot
     rng = np.random.default_rng(2)
-    way = planner._Waypoints(robot, snakehead.BasePlacement(0.2, -0.1, 0.7))
+    way = waypoints.Waypoints(robot, snakehead.BasePlacement(0.2, -0.1, 0.7))
     way.lift_index = 1
     lifted = np.arange(robot.lift_joints.start, robot.n_joints)
     qs = np.tile(generated.q_initial, (30, 1))

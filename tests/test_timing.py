@@ -13,7 +13,7 @@ from snakehead.dynamics.inverse_dynamics import inverse_dynamics
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion import planner, timing
+from snakehead.motion import start_state, timing
 from snakehead.motion.interpolation import MonotoneQuintic
 
 pytest.importorskip("toppra")
@@ -38,7 +38,7 @@ def feasible(robot, qs, margin=0.02):
 def stable_lift(robot, controller, n=16, trials=64, seed=3):
     """Waypoints lifting the head from the bending state to the initial state: the straight joint path when it is
     feasible, else the shortest of seeded two-piece paths through a midpoint with the neck and head perturbed."""
-    qa, qb = planner.bending_state(controller), controller.q_initial
+    qa, qb = start_state.bending_state(controller), controller.q_initial
     s = np.linspace(0.0, 1.0, n)[:, None]
     straight = qa + s * (qb - qa)
     if feasible(robot, straight).all():

@@ -23,7 +23,8 @@ from .kinematics.workspace import compute as compute_map
 from .kinematics.workspace import load as load_map
 from .model.chain import Chain
 from .model.robot import BasePlacement, RobotParts, SnakeRobot, default_robot_file, default_urdf_path
-from .motion.planner import Plan, PlanProgress, TargetResult, plan
+from .motion.plan_result import Plan, PlanProgress, TargetResult
+from .motion.planner import plan
 from .scenes.scene import Scene, Target, load_scene
 from .sim.plan import PlanSimulation, simulate
 

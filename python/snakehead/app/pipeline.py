@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..control.controller import HeadController
     from ..kinematics.workspace import ReachabilityMap
     from ..model.robot import BasePlacement, SnakeRobot
-    from ..motion.planner import PlanProgress
+    from ..motion.plan_result import PlanProgress
     from ..scenes.scene import Scene
     from ..sim.loop import LoopRun
 

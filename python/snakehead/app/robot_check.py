@@ -86,7 +86,7 @@ def describe_parts(robot: SnakeRobot) -> list[PartReport]:
 def design_problems(robot: SnakeRobot) -> list[str]:
     """What keeps the planner from starting on this robot (empty when nothing does)."""
     from ..backbone.initial import initial_configuration
-    from ..motion.planner import ground_curl
+    from ..motion.start_state import ground_curl
 
     problems = []
     try:

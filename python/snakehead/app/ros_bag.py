@@ -47,7 +47,7 @@ from . import ros_messages as msgs
 
 if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
     from ..sim.loop import LoopRun
 
 #: The fixed frame everything is placed in (world coordinates: z up, the ground at z = 0).
@@ -308,7 +308,7 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
     """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``;
     with ``simulated`` (a SimResult of the plan), its ZMP beside (namespace "zmp_simulated")."""
     from ..dynamics import stability
-    from ..motion.planner import PLAN_CONTACT
+    from ..motion.waypoints import PLAN_CONTACT
 
     t = np.asarray(plan.t, float)
     idx = _every(t, MARKER_PERIOD)
@@ -328,7 +328,7 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
 
 # --- the bags -----------------------------------------------------------------------------------------------------
 def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
-    """Write ``plan`` (a :class:`~snakehead.motion.planner.Plan`) as a ROS 2 bag at ``path`` (see the module);
+    """Write ``plan`` (a :class:`~snakehead.motion.plan_result.Plan`) as a ROS 2 bag at ``path`` (see the module);
     returns the path. Every :data:`JOINT_STATES` sample is the plan's (``t``, ``q``, ``qd``)."""
     robot = plan.robot
     t = np.asarray(plan.t, float)

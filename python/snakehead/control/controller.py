@@ -79,6 +79,7 @@ class HeadController:
         from .. import backbone  # late: heavier imports, only needed here
 
         from ..kinematics import workspace
+        from ..motion.plan_cache import PlanCache
 
         self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):
@@ -110,6 +111,8 @@ class HeadController:
         self.q_initial = within_limits(joint_vector(base_configuration, self.robot.n_joints, "base_configuration"),
                                        self.robot.lower, self.robot.upper, "base_configuration")
         self._polygons: dict = {}  # (base placement, base joints) -> support polygon
+        #: What this controller keeps from one plan for the next (the start states and lifts of its base shapes).
+        self.plan_cache = PlanCache()
         self.ik = TracIK.from_chain(self.robot.head_chain, timeout=timeout,
                                     epsilon=positive(epsilon, "epsilon"), seed=seed)
 

@@ -1,7 +1,7 @@
 """The dynamics check in MuJoCo (an optional extra: ``pip install snakehead[sim]``): the robot's model, PD control
 with gravity compensation at the 2 ms control period, and the comparison with the plan (paper Section 4).
 
-* :func:`simulate` -- a :class:`~snakehead.motion.planner.Plan` end to end (``snakehead.simulate``);
+* :func:`simulate` -- a :class:`~snakehead.motion.plan_result.Plan` end to end (``snakehead.simulate``);
 * :func:`simulate_trajectory` -- any joint trajectory; :func:`compare` -- a simulation against its plan;
 * :func:`build_model` / :func:`build_spec` -- the MuJoCo model (built with MjSpec) of a robot and the scene's obstacles;
   :mod:`.gains` -- the servos' gains and torque limits, derived from each joint's load;

@@ -61,7 +61,9 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
-from ..motion.planner import Plan, as_scene, bending_state, plan
+from ..motion.plan_result import Plan
+from ..motion.planner import as_scene, plan
+from ..motion.start_state import bending_state
 from ..scenes.scene import Scene
 from .compare import check_plan_span, compare
 from .estimate import BodyPose, pose_error

@@ -1,4 +1,4 @@
-"""Simulate a :class:`~snakehead.motion.planner.Plan` in MuJoCo and compare it with the plan: the dynamics check of
+"""Simulate a :class:`~snakehead.motion.plan_result.Plan` in MuJoCo and compare it with the plan: the dynamics check of
 the paper's Section 4, in one call."""
 from __future__ import annotations
 
@@ -39,13 +39,13 @@ class PlanSimulation:
 
 @entry_point
 def simulate(plan: Any, **options: Any) -> PlanSimulation:
-    """Track ``plan`` (a :class:`~snakehead.motion.planner.Plan`) in MuJoCo with PD control and gravity
+    """Track ``plan`` (a :class:`~snakehead.motion.plan_result.Plan`) in MuJoCo with PD control and gravity
     compensation at 2 ms, its obstacles included, and compare with the plan at its targets.
 
     ``options`` go to :func:`snakehead.sim.simulate_trajectory` (gains, torque limits, friction, hole_slices...).
     Needs MuJoCo (``pip install snakehead[sim]``).
     """
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
 
     if not isinstance(plan, Plan):
         raise InputTypeError(f"plan must be a snakehead Plan (from snakehead.plan), got {type(plan).__name__}")

@@ -43,7 +43,7 @@ if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
     from ..control.controller import HeadSolution
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
 
 #: A sphere drawn at a target: (centre (3,) m, diameter m).
 Sphere = tuple[npt.ArrayLike, float]

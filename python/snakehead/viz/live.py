@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 
     from ..control.controller import HeadController
     from ..model.robot import SnakeRobot
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
     from ..sim.plan import PlanSimulation
 
 #: s between two steps of the player (30 per second).

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     import viser
 
     from ..model.robot import BasePlacement, SnakeRobot
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
 
 #: Segments of the head tip's path and of the ZMP's trace: fixed, so that a new plan moves their points only.
 PATH_SEGMENTS = 200

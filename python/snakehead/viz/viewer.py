@@ -9,7 +9,7 @@ paper's 20-step bar, Figs. 4-5), attached to the head's base frame and hidden un
 
 Three ways to it:
 
-* :func:`viewer_scene` turns a :class:`~snakehead.motion.planner.Plan` into a :class:`ViewerScene` (plain arrays),
+* :func:`viewer_scene` turns a :class:`~snakehead.motion.plan_result.Plan` into a :class:`ViewerScene` (plain arrays),
   which :func:`save_viewer_scene` writes as ``NAME_viewer.npz`` (``numpy.load`` reads it) and
   :func:`load_viewer_scene` reads back -- ``snakehead plan`` and ``snakehead demo`` write one per scenario;
 * :func:`write_html`: a single HTML file that opens from disk in a browser, with no server and no network (viser's
@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     import viser
 
     from ..kinematics.workspace import ReachabilityMap
-    from ..motion.planner import Plan
+    from ..motion.plan_result import Plan
 
 #: What :func:`save_viewer_scene` appends to a scenario's name.
 SCENE_SUFFIX = "_viewer.npz"

@@ -1,0 +1,18 @@
+"""The margins every plan keeps, each defined once: how far the ZMP stays inside the support polygon, the static
+margin of every planned configuration, and how far a solved configuration stays from the obstacles.
+
+The planner (:mod:`snakehead.motion.planner`), the whole-body solve (:mod:`snakehead.control.whole_body`) and the
+retiming (:mod:`snakehead.motion.timing`) read them from here.
+"""
+from __future__ import annotations
+
+#: m: the least distance of the ZMP inside the support polygon a successful plan keeps (Eqs. 36-40), and the
+#: margin the time-optimal retiming keeps it by.
+ZMP_MARGIN = 0.005
+#: m: the static margin every planned configuration keeps (the CoM inside the support polygon): twice the ZMP
+#: margin, room for the motion's dynamic terms between the configurations.
+DETOUR_MARGIN = 2 * ZMP_MARGIN
+#: m: the least distance a solved configuration keeps from every obstacle.
+OBSTACLE_CLEARANCE = 0.002
+
+__all__ = ["ZMP_MARGIN", "DETOUR_MARGIN", "OBSTACLE_CLEARANCE"]

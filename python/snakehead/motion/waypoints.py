@@ -1,0 +1,324 @@
+"""The path a plan is built of: waypoints joined by checked whole-body moves (Section 3.2), with stable detours
+where the straight path is not safe, pauses and stops, then timed by the time-optimal retiming and sampled at the
+2 ms control period (:class:`Waypoints`)."""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from .._errors import Infeasible, MotionTooLong
+from ..dynamics import stability
+from ..geometry import collision as coll
+from ..margins import DETOUR_MARGIN
+from ..model.robot import BasePlacement, SnakeRobot
+from . import interpolation as interp
+from . import plan_bounds
+from .cartesian import tracking_interpolation
+from .plan_bounds import check_motion_length
+from .plan_cache import KeptMap
+
+#: The contact model plans are checked with (``dynamics.stability.support_polygon``): every link lying on the ground.
+PLAN_CONTACT = "ground"
+DETOUR_TRIALS = 256  # candidate detour waypoints tried for a move whose straight path is unstable
+DETOUR_SPREAD = 0.4  # rad: spread of the neck and head joints of a detour waypoint around the midpoint
+DETOUR_SEED = 20211  # fixed: the same inputs give the same plan
+JOINT_STEP_CHECK = 0.02  # rad: a joint-space step is checked at least this densely
+FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time (the plan then fails; faster when
+#                        the motion would be longer than MAX_MOTION_S)
+DENSIFY = 3  # configurations checked between consecutive waypoints of a move, at least
+MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
+MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
+DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
+
+
+def _subdivide(qs: np.ndarray, step: float, least: int = 1) -> np.ndarray:
+    """The waypoints qs (K, n) with each straight segment between two cut into equal pieces, as many as keep every
+    joint's change within ``step`` rad and at least ``least``."""
+    qs = np.asarray(qs, float)
+    out = [qs[:1]]
+    for a, b in zip(qs[:-1], qs[1:]):
+        pieces = max(least, int(np.ceil(np.abs(b - a).max() / step - 1e-9)))
+        out.append(a + (np.arange(1, pieces + 1) / pieces)[:, None] * (b - a))
+    return np.concatenate(out)
+
+
+def split_steps(qs: np.ndarray, most: float = MAX_WAYPOINT_STEP) -> np.ndarray:
+    """The path of waypoints qs (K, n) with every step whose largest joint change exceeds ``most`` rad split into
+    equal joint-space steps (the same straight segments, more waypoints)."""
+    return _subdivide(qs, most)
+
+
+def check_points(qs: np.ndarray, step: float = MOVE_CHECK_STEP) -> np.ndarray:
+    """The configurations a path of waypoints qs (K, n) is checked at: every waypoint and, along the straight
+    segment between two, as many evenly spaced ones as keep each joint's change below ``step`` rad (at least
+    DENSIFY)."""
+    return _subdivide(qs, step, DENSIFY + 1)
+
+
+def densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
+    """The waypoints (..., K, n) with ``between`` evenly spaced configurations inserted between consecutive ones
+    (what the motion passes through between the waypoints, to within the interpolation's curvature)."""
+    qs = np.asarray(qs, float)
+    s = np.arange(between + 1) / (between + 1)
+    a, b = qs[..., :-1, :], qs[..., 1:, :]
+    fine = a[..., None, :] + s[:, None] * (b - a)[..., None, :]  # (..., K-1, between+1, n)
+    fine = fine.reshape(qs.shape[:-2] + (-1, qs.shape[-1]))
+    return np.concatenate([fine, qs[..., -1:, :]], axis=-2)
+
+
+class Waypoints:
+    """Accumulates the path's waypoints (label, q), the pauses and the stops, then times the whole path
+    (``motion.timing.retime``: TOPP-RA under the robot's limits and the ZMP) and samples it at the control period."""
+
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, obstacles: Sequence[Any] = ()) -> None:
+        self.robot, self.base = robot, base
+        self.obstacles = list(obstacles)
+        self.labels: list[str] = []
+        self.qs: list[np.ndarray] = []
+        self.times: list[float] = []  # filled in by sample()
+        self.holds: dict[int, float] = {}  # segment index -> pause (s)
+        self.stops: list[int] = []  # waypoints where the motion comes to rest
+        self.methods: list[tuple[str, str]] = []  # (segment, interpolation used)
+        self.timing_failure: str | None = None  # why the path could not be timed, when it could not
+        self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
+        self.lift_cache: KeptMap[tuple[bytes, str], Any] | None = None  # timed lifts: controller.plan_cache's
+        self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
+        self._least = (0, 0.0)  # (waypoints counted, s): least_duration's sum so far
+
+    def least_duration(self, velocity: np.ndarray) -> float:
+        """s: the least the motion through the waypoints so far can last: each step at the joints' velocity limits
+        (rad/s, (n,)) and the holds (the retiming keeps the limits: the timed motion lasts at least this long)."""
+        done, total = self._least
+        if len(self.qs) > done + 1:
+            steps = np.abs(np.diff(np.array(self.qs[max(done - 1, 0):]), axis=0)) / velocity
+            total += float(steps.max(axis=1).sum())
+            self._least = (len(self.qs), total)
+        return total + float(sum(self.holds.values()))
+
+    def start(self, label: str, q: npt.ArrayLike) -> None:
+        self.labels, self.qs = [label], [np.asarray(q, float)]
+        self._least = (0, 0.0)
+
+    def _append(self, label: str, q: np.ndarray) -> None:
+        if np.abs(q - self.qs[-1]).max() <= 1e-12:  # the same configuration: nothing to move
+            self.labels[-1] = label
+            return
+        self.qs.append(q)
+        self.labels.append(label)
+
+    def stop(self) -> int:
+        """The motion comes to rest at the last waypoint (a target); its index."""
+        self.stops.append(len(self.qs) - 1)
+        return len(self.qs) - 1
+
+    def move_joint(self, label: str, q: npt.ArrayLike) -> None:
+        """A short joint-space step to q (e.g. the next pose along a line); a whole-body move (:meth:`move`) when
+        the straight step is not safe throughout."""
+        q = np.asarray(q, float)
+        step = np.abs(q - self.qs[-1]).max()
+        n = max(3, int(np.ceil(step / JOINT_STEP_CHECK)) + 1)
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        if not self.feasible(self.qs[-1] + s * (q - self.qs[-1])).all():
+            self.move(label, q)
+            return
+        self._append(label, q)
+
+    def move(self, label: str, q: npt.ArrayLike, n: int = 12) -> str:
+        """A whole-body move from the last state to q (Section 3.2); returns the method used.
+
+        First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
+        ``motion.cartesian.tracking_interpolation``), kept when every configuration is safe (above the ground, clear
+        of itself and the obstacles, statically stable with DETOUR_MARGIN); else the straight joint-space path;
+        else a joint-space path through a safe detour waypoint (see ``_joint_path``). Steps longer than
+        MAX_WAYPOINT_STEP are split (:func:`split_steps`) and every path is checked at least every
+        MOVE_CHECK_STEP (:func:`check_points`): the timed motion passes near the straight segments between the
+        waypoints only when they are short (a fit that cannot follow the points to q ends in one long jump).
+        """
+        q = np.asarray(q, float)
+        if np.abs(q - self.qs[-1]).max() <= 1e-12:
+            self._append(label, q)
+            return "none"
+        path = split_steps(tracking_interpolation(self.robot, self.qs[-1], q, n, self.base).q)
+        if self.feasible(check_points(path)).all():
+            qs, method = path, "cartesian (Eq. 41, tracked)"
+        else:
+            qs, method = self._joint_path(self.qs[-1], q, n)
+        self.append_path(label, qs, method)
+        return method
+
+    def append_path(self, label: str, qs: np.ndarray, method: str) -> None:
+        """The configurations qs[1:] of a checked path from the last state (qs[0]), made by ``method``."""
+        for k in range(1, len(qs)):
+            self._append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})", qs[k])
+        self.methods.append((label, method))
+
+    def _margins(self, qs: np.ndarray) -> np.ndarray:
+        """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
+        link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
+        the smaller of that and the base's own (:meth:`_base_margins`): a motion must not lean on a neck or head
+        link that touches the ground at a checked configuration and may leave it in between."""
+        com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
+        margin = stability.support_margins(self.robot, qs, com, self.base, contact=PLAN_CONTACT)
+        if self.lift_index is not None:
+            margin = np.minimum(margin, self._base_margins(qs, com))
+        return margin
+
+    def _base_margins(self, qs: np.ndarray, com_xy: np.ndarray) -> np.ndarray:
+        """Static margins (m) of configurations qs (m, n) with CoM projections com_xy (m, 2) over the support of the
+        links that lie on the ground whatever the pose (``control.whole_body.BodyProblem.ground_links``: the base's
+        and the neck's before it lifts, flat: their boxes' bottom corners), as ``check_solution`` takes it."""
+        from ..control.whole_body import BodyProblem
+
+        if self._problem is None:
+            self._problem = BodyProblem(self.robot)
+        prob, start = self._problem, self.robot.lift_joints.start
+        shapes, which = np.unique(np.round(qs[:, :start], 12), axis=0, return_inverse=True)
+        polygons = []
+        for shape in shapes:  # those links move with the joints before the lift only
+            q = np.zeros(self.robot.n_joints)
+            q[:start] = shape
+            polygons.append(prob.contact_points(prob.frames(q, self.base))[0][:, :2])
+        pts = np.stack(polygons)[np.asarray(which).reshape(-1)]
+        return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com_xy)
+
+    def feasible(self, qs: np.ndarray) -> np.ndarray:
+        """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links
+        overlapping, and clear of the obstacles (the cheap checks first: the others only where those pass)."""
+        clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
+        ok = clearance >= -coll.GROUND_TOLERANCE
+        if ok.any():
+            rows = np.flatnonzero(ok)
+            ok[rows] = self._margins(qs[rows]) >= DETOUR_MARGIN
+        if ok.any():
+            rows = np.flatnonzero(ok)
+            ok[rows] = coll.self_clearance(self.robot, qs[rows], self.base) > 0.0
+        if self.obstacles and ok.any():
+            rows = np.flatnonzero(ok)
+            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
+            ok[rows] = d > 0.0
+        return ok
+
+    def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
+        """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
+
+        The straight path when it does; else the shortest of DETOUR_TRIALS two-piece paths through a waypoint
+        drawn around the midpoint (the joints from the neck's first lifting joint on perturbed, seeded: plans are
+        reproducible; the joints before it keep their straight path, since their links lie on the ground and a
+        detour would sweep them across it, the ground's friction pushing the base) whose every
+        configuration passes (tried shortest first, DETOUR_BATCH at a time, each screened at DENSIFY
+        configurations per step and then checked as densely as a move); else the one with the largest worst
+        margin (the scenario's checks report it).
+        """
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        straight = split_steps(qa + s * (qb - qa))
+        if self.feasible(check_points(straight)).all():
+            return straight, "joint space"
+        movable = np.arange(self.robot.lift_joints.start, self.robot.parts.head.stop)
+        rng = np.random.default_rng(DETOUR_SEED)
+        W = np.tile(0.5 * (qa + qb), (DETOUR_TRIALS, 1))
+        W[:, movable] += rng.normal(0.0, DETOUR_SPREAD, (DETOUR_TRIALS, len(movable)))
+        W = np.clip(W, self.robot.lower, self.robot.upper)
+        paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
+        length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
+        order = np.argsort(length, kind="stable")
+        for batch in np.array_split(order, max(1, len(order) // DETOUR_BATCH)):
+            flat = densify(paths[batch]).reshape(-1, qa.size)
+            ok = self.feasible(flat).reshape(len(batch), -1).all(axis=1)
+            for k in batch[ok]:
+                path = split_steps(paths[k])
+                if self.feasible(check_points(path)).all():
+                    return path, "joint space via a stable detour"
+        flat = densify(paths).reshape(-1, qa.size)
+        worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
+        return split_steps(paths[int(np.argmax(worst))]), "joint space (no stable detour found)"
+
+    def hold(self, seconds: float) -> None:
+        """A pause of ``seconds`` at the last waypoint (which becomes a stop)."""
+        if self.stops[-1:] != [len(self.qs) - 1]:
+            self.stop()
+        self.holds[len(self.qs) - 1] = float(seconds)
+        self.qs.append(self.qs[-1].copy())
+        self.labels.append(self.labels[-1] + " (hold)")
+
+    def sample(self, notes: list, timing: dict[str, Any]) -> interp.JointTrajectory:
+        """The fastest motion through the waypoints (``motion.timing.retime``, options ``timing``) at 2 ms; fills in
+        ``times`` (when each waypoint is reached)."""
+        from .timing import retime
+
+        # the plan checks its 2 ms samples itself (_finish: the ZMP by the paper's momenta, the ground, obstacles);
+        # the retiming keeps the joint limits between its gridpoints by refining them
+        timing = dict(timing, check_samples=False)
+        hold_s = np.zeros(len(self.qs) - 1)
+        for k, seconds in self.holds.items():
+            hold_s[k] = seconds
+        Q = np.array(self.qs)
+        stops = sorted(set(self.stops))
+        try:
+            k = self.lift_index if self.lift_index is not None else -1
+            if 0 < k < len(Q) - 1 and self.lift_cache is not None:
+                # the lift from the bending state is the same for every target from a base of this shape, wherever
+                # it lies (retime does not depend on the placement): time it once
+                key = (np.round(Q[:k + 1], 9).tobytes(), repr(sorted(timing.items())))  # round-off apart
+                lift = self.lift_cache.get(key)
+                if lift is None:
+                    lift = self.lift_cache.put(key, retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
+                                                           stops=[i for i in stops if i <= k], **timing))
+                rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
+                              **timing)
+                check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
+                # the whole motion is sampled again from the pieces' splines: the rest's samples (~400 B each) are
+                # dropped first, so that they and the whole motion's are never held at once
+                rest = replace(rest, t=rest.t[-1:].copy(), q=rest.q[-1:].copy(), qd=rest.qd[-1:].copy(),
+                               qdd=rest.qdd[-1:].copy())
+                traj = concatenate_motions(lift, rest)
+            else:
+                traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
+        except MotionTooLong:  # no slower fallback either: the motion is already too long
+            raise
+        except Infeasible as exc:  # (the caller's options were checked when plan() began)
+            # no motion along this path keeps the limits (e.g. it passes a state that cannot be held): time it at a
+            # slow fixed pace so that the plan can still be looked at, and fail it
+            self.timing_failure = f"the path cannot be timed within the robot's limits: {exc}"
+            move = np.abs(np.diff(np.array(self.qs), axis=0)).max(axis=1)
+            # faster than FALLBACK_SPEED when that pace would make the motion longer than a plan may be (the plan
+            # fails on its timing either way; its motion must still fit in MAX_SAMPLES samples)
+            budget = 0.95 * plan_bounds.MAX_MOTION_S - float(hold_s.sum()) - 1e-3 * len(move)
+            speed = max(FALLBACK_SPEED, float(move.sum()) / budget) if budget > 0 else FALLBACK_SPEED
+            times = np.concatenate([[0.0], np.cumsum(np.maximum(move / speed, hold_s) + 1e-3)])
+            check_motion_length(float(times[-1]), "with its holds")
+            self.times = [float(x) for x in times]
+            return interp.joint_trajectory(times, np.array(self.qs), method="monotone")
+        self.times = [float(x) for x in traj.waypoint_times]
+        notes += list(traj.notes)
+        return traj
+
+
+def concatenate_motions(a: Any, b: Any) -> Any:
+    """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
+    first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
+    first. Of the second's samples only the last is used (its end: when and where)."""
+    from .timing import RetimedTrajectory
+
+    offset = float(a.t[-1])
+    dt = float(a.t[1] - a.t[0]) if len(a.t) > 1 else interp.CONTROL_PERIOD
+    t = interp.sample_times(0.0, offset + float(b.t[-1]), dt)
+    first = t <= offset
+    arrays = []
+    for nu in (0, 1, 2):
+        x = np.empty((len(t), a.q.shape[1]))
+        x[first] = a.spline(t[first], nu)
+        x[~first] = b.spline(t[~first] - offset, nu)
+        arrays.append(x)
+    arrays[0][-1] = b.q[-1]
+    return RetimedTrajectory(t, arrays[0], arrays[1], arrays[2], None,
+                             waypoint_times=np.concatenate([a.waypoint_times, b.waypoint_times[1:] + offset]),
+                             limits=b.limits, check=None, notes=tuple(a.notes) + tuple(b.notes),
+                             solve_time_s=b.solve_time_s)
+
+
+__all__ = ["Waypoints", "split_steps", "check_points", "densify", "concatenate_motions", "PLAN_CONTACT",
+           "DETOUR_TRIALS", "DETOUR_SPREAD", "DETOUR_SEED", "JOINT_STEP_CHECK", "FALLBACK_SPEED", "DENSIFY", "MOVE_CHECK_STEP",
+           "MAX_WAYPOINT_STEP", "DETOUR_BATCH"]
