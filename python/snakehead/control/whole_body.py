@@ -30,6 +30,7 @@ from scipy import optimize
 from .._validate import finite_float, unit_vector3, vector3
 from ..dynamics import stability
 from ..geometry import collision as coll
+from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
@@ -45,7 +46,6 @@ MIN_MARGIN = 0.005
 SELF_CLEARANCE = 0.002
 #: A ground link's shape points within this height (m) of its lowest point touch the ground (its support).
 CONTACT_BAND = 1e-3
-OBSTACLE_CLEARANCE = 0.002
 #: Tolerances of a solution: head position (m) and direction (rad).
 POSITION_TOLERANCE = 1e-4
 DIRECTION_TOLERANCE = np.radians(0.05)
@@ -418,6 +418,16 @@ def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[n
     return d0, g
 
 
+def clear_of_obstacles(robot: SnakeRobot, q: np.ndarray, obstacles: Sequence[Any], base: BasePlacement,
+                       clearance: float = OBSTACLE_CLEARANCE) -> bool:
+    """Whether configuration q (n,) at ``base`` keeps more than ``clearance`` m from every obstacle (True without
+    obstacles)."""
+    if not obstacles:
+        return True
+    return bool(coll.collision_check(robot, q[None], list(obstacles), base,
+                                     exact_within=EXACT_DISTANCE_WITHIN).distance[0] > clearance)
+
+
 def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
                    obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
                    obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None) -> dict:
@@ -642,8 +652,7 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
                                  seconds=time.perf_counter() - t0)
 
     def accept(q: np.ndarray, b: Any) -> Any:
-        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
-                    > OBSTACLE_CLEARANCE)
+        return clear_of_obstacles(robot, q, obstacles, b)
 
     best: WholeBodySolution | None = None
     seg_holder: list[Any] = [None]  # the segmented solution, once stage 1 has run

@@ -35,9 +35,10 @@ import numpy.typing as npt
 from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
 from .._validate import integer, joint_vector
 from ..control.controller import HeadController
+from ..control.whole_body import clear_of_obstacles
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..margins import OBSTACLE_CLEARANCE
+from ..margins import EXACT_DISTANCE_WITHIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import plan_bounds
@@ -207,8 +208,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
     # state there; else the lift goes straight to the first target
     q = shape_of(robot, q_shape, controller.q_initial)
-    if way.feasible(q[None])[0] and (not obstacles or coll.collision_check(
-            robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
+    if way.feasible(q[None])[0] and clear_of_obstacles(robot, q, obstacles, chosen):
         # the lift's path, like its timing, is the same for every plan from a base of this shape wherever it lies
         # (obstacles apart: with them it is checked again)
         lifts = controller.plan_cache.lift_paths
@@ -325,7 +325,7 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
         distance = np.concatenate([
             coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
-                                 exact_within=0.005).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+                                 exact_within=EXACT_DISTANCE_WITHIN).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
