@@ -14,5 +14,8 @@ ZMP_MARGIN = 0.005
 DETOUR_MARGIN = 2 * ZMP_MARGIN
 #: m: the least distance a solved configuration keeps from every obstacle.
 OBSTACLE_CLEARANCE = 0.002
+#: m: obstacle distances up to this are computed exactly by the checks (``collision_check(exact_within=...)``);
+#: beyond it a lower bound is enough for their verdict.
+EXACT_DISTANCE_WITHIN = 0.005
 
-__all__ = ["ZMP_MARGIN", "DETOUR_MARGIN", "OBSTACLE_CLEARANCE"]
+__all__ = ["ZMP_MARGIN", "DETOUR_MARGIN", "OBSTACLE_CLEARANCE", "EXACT_DISTANCE_WITHIN"]

@@ -30,6 +30,7 @@ from scipy import optimize
 from .._validate import finite_float, unit_vector3, vector3
 from ..dynamics import stability
 from ..geometry import collision as coll
+from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
@@ -45,7 +46,6 @@ MIN_MARGIN = 0.005
 SELF_CLEARANCE = 0.002
 #: A ground link's shape points within this height (m) of its lowest point touch the ground (its support).
 CONTACT_BAND = 1e-3
-OBSTACLE_CLEARANCE = 0.002
 #: Tolerances of a solution: head position (m) and direction (rad).
 POSITION_TOLERANCE = 1e-4
 DIRECTION_TOLERANCE = np.radians(0.05)
@@ -418,6 +418,16 @@ def _distance_and_gradient(ob: Any, pts: np.ndarray, h: float = 1e-6) -> tuple[n
     return d0, g
 
 
+def clear_of_obstacles(robot: SnakeRobot, q: np.ndarray, obstacles: Sequence[Any], base: BasePlacement,
+                       clearance: float = OBSTACLE_CLEARANCE) -> bool:
+    """Whether configuration q (n,) at ``base`` keeps more than ``clearance`` m from every obstacle (True without
+    obstacles)."""
+    if not obstacles:
+        return True
+    return bool(coll.collision_check(robot, q[None], list(obstacles), base,
+                                     exact_within=EXACT_DISTANCE_WITHIN).distance[0] > clearance)
+
+
 def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray,
                    obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN, self_clearance: float = 0.0,
                    obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None) -> dict:
@@ -620,130 +630,178 @@ def solve_checked_target(controller: HeadController, position: np.ndarray, direc
                          ) -> WholeBodySolution:
     """:func:`solve_target` of a target already checked where it entered (a :class:`~snakehead.scenes.Target`'s
     position (3,) and unit direction (3,)): the planner's entry, which does not check them again."""
-    from . import neck as nk
+    search = _TargetSearch(controller, position, direction, q_prev, base, obstacles, min_margin, time_budget,
+                           problem, seed, shape_ok)
+    found = search.base_kept(near and q_prev is not None)
+    if found is None and allow_base_move:
+        found = search.base_moved()
+    return found if found is not None else _attempted(search.best)
 
-    t0 = time.perf_counter()
-    robot = controller.robot
-    base = controller.base if base is None else base
-    q_now = controller.q_initial.copy() if q_prev is None else np.asarray(q_prev, float).copy()
-    prob = problem if problem is not None else BodyProblem(robot)
-    obstacles = list(obstacles)
 
-    def check(q: np.ndarray, b: Any) -> Any:
-        return check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin, problem=prob)
+class _TargetSearch:
+    """One whole-body solve of :func:`solve_checked_target`: the target, the body as it is, the limits, and the best
+    attempt so far (:meth:`consider`); its stages are :meth:`base_kept` (the near continuation, stages 1 and 2)
+    and :meth:`base_moved` (stage 3), each returning the first solution that passes every check, else None."""
 
-    def solution(q: np.ndarray, b: Any, chk: Any, stage: str, starts: int) -> Any:
-        return WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
-                                 position_error_m=chk["position_error_m"],
-                                 direction_error_deg=chk["direction_error_deg"],
-                                 static_margin_m=chk["static_margin_m"], ground_clearance_m=chk["ground_clearance_m"],
-                                 self_clearance_m=chk["self_clearance_m"],
-                                 obstacle_clearance_m=chk["obstacle_clearance_m"], starts=starts,
-                                 seconds=time.perf_counter() - t0)
+    def __init__(self, controller: HeadController, position: np.ndarray, direction: np.ndarray,
+                 q_prev: npt.ArrayLike | None, base: BasePlacement | None, obstacles: Sequence[Any],
+                 min_margin: float, time_budget: float, problem: BodyProblem | None, seed: int,
+                 shape_ok: Callable[[np.ndarray], bool] | None) -> None:
+        self.t0 = time.perf_counter()
+        self.controller, self.robot = controller, controller.robot
+        self.position, self.direction = position, direction
+        self.base = controller.base if base is None else base
+        self.q_now = controller.q_initial.copy() if q_prev is None else np.asarray(q_prev, float).copy()
+        self.prob = problem if problem is not None else BodyProblem(self.robot)
+        self.obstacles = list(obstacles)
+        self.min_margin, self.time_budget, self.seed, self.shape_ok = min_margin, time_budget, seed, shape_ok
+        self.best: WholeBodySolution | None = None
+        self.segmented: Any = None  # the segmented solution, once stage 1 has run
+        self.rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
 
-    def accept(q: np.ndarray, b: Any) -> Any:
-        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
-                    > OBSTACLE_CLEARANCE)
+    def out_of_time(self) -> bool:
+        return time.perf_counter() - self.t0 > self.time_budget
 
-    best: WholeBodySolution | None = None
-    seg_holder: list[Any] = [None]  # the segmented solution, once stage 1 has run
+    def check(self, q: np.ndarray, b: BasePlacement) -> dict:
+        return check_solution(self.robot, q, b, self.position, self.direction, self.obstacles,
+                              min_margin=self.min_margin, problem=self.prob)
 
-    def consider(q: np.ndarray, b: Any, stage: str, starts: int, chk: dict | None = None) -> Any:
+    def consider(self, q: np.ndarray, b: BasePlacement, stage: str, starts: int,
+                 chk: dict | None = None) -> WholeBodySolution | None:
         """Check a configuration (unless its check ``chk`` is given); keep the best attempt; return the solution
         when it passes."""
-        nonlocal best
-        chk = check(q, b) if chk is None else chk
-        sol = solution(q, b, chk, stage, starts)
-        sol.segmented = seg_holder[0]
-        sol.desired_frame = None if seg_holder[0] is None else seg_holder[0].desired_frame
-        if best is None or _rank(sol) > _rank(best):
-            best = sol
+        chk = self.check(q, b) if chk is None else chk
+        sol = WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
+                                position_error_m=chk["position_error_m"],
+                                direction_error_deg=chk["direction_error_deg"],
+                                static_margin_m=chk["static_margin_m"], ground_clearance_m=chk["ground_clearance_m"],
+                                self_clearance_m=chk["self_clearance_m"],
+                                obstacle_clearance_m=chk["obstacle_clearance_m"], starts=starts,
+                                seconds=time.perf_counter() - self.t0)
+        sol.segmented = self.segmented
+        sol.desired_frame = None if self.segmented is None else self.segmented.desired_frame
+        if self.best is None or _rank(sol) > _rank(self.best):
+            self.best = sol
         return sol if sol.success else None
 
-    # with the base kept, the frame the neck lifts from stays where it is, and no point of the lifted chain gets
-    # farther from it than the chain's reach: beyond that (by more than the position tolerance) stages 1 and 2
-    # cannot succeed, and their IK would spend its whole time budget finding so
-    lift_origin = robot.frame(q_now, robot.lift_frame, base)[:3, 3]
-    beyond = np.linalg.norm(position - lift_origin) > robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach \
-        + POSITION_TOLERANCE
-    if beyond:
-        consider(q_now, base, STAGES[1], 0)  # the attempt to report: out of reach
-    if near and q_prev is not None and not beyond:
-        q = _continue_from(prob, q_now, base, position, direction, seed)
-        if q is not None and (found := consider(q, base, STAGES[1], 1)):
-            return found
-    # 1. the paper's segmented solve
-    if not beyond:
-        seg = controller.solve_checked(position, direction, q_prev=q_now, base=base, accept=accept if obstacles else None,
-                               allow_base_move=False)
-        seg_holder[0] = seg
-        if found := consider(seg.q, seg.base, STAGES[0], 0):
-            return found
-    # 2. the base kept
-    for k, q in enumerate(lifted_candidates(prob, q_now, base, position, direction, seed) if not beyond else []):
-        if found := consider(q, base, STAGES[1], k + 1):
-            return found
-    # refine only what reached the head but failed stability or clearance: from there a local optimisation can
-    # move the body; a target out of reach from this base is the placement's problem (stage 3)
-    starts = [best.q] if best is not None and best.reason != "out of reach" else []
-    for q0 in starts:
-        if time.perf_counter() - t0 > time_budget:
-            break
-        q, b = refine(prob, q0, base, position, direction, move_base=False, obstacles=obstacles,
-                      min_margin=min_margin)
-        if found := consider(np.clip(q, robot.lower, robot.upper), b, STAGES[1], len(starts)):
-            return found
-    if not allow_base_move:
-        return _attempted(best)
-    # 3. the base moved
-    rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
+    def beyond_reach(self) -> bool:
+        """With the base kept, the frame the neck lifts from stays where it is, and no point of the lifted chain
+        gets farther from it than the chain's reach: whether the target is beyond that (by more than the position
+        tolerance), where stages 1 and 2 cannot succeed and their IK would spend its whole time budget finding so."""
+        robot = self.robot
+        lift_origin = robot.frame(self.q_now, robot.lift_frame, self.base)[:3, 3]
+        reach = robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach
+        return bool(np.linalg.norm(self.position - lift_origin) > reach + POSITION_TOLERANCE)
 
-    def shape_passes(q: np.ndarray) -> bool:
-        key = q[:robot.lift_joints.start].tobytes()
-        if key in rejected_shapes:
+    def base_kept(self, near: bool) -> WholeBodySolution | None:
+        """The base as it is: with ``near``, the lifted chain's IK continued from the current joints
+        (:func:`_continue_from`); 1. the paper's segmented solve; 2. the lifted chain's IK candidates, then the
+        whole-body optimisation from the best attempt when it reached the head."""
+        if self.beyond_reach():
+            self.consider(self.q_now, self.base, STAGES[1], 0)  # the attempt to report: out of reach
+        else:
+            if near:
+                q = _continue_from(self.prob, self.q_now, self.base, self.position, self.direction, self.seed)
+                if q is not None and (found := self.consider(q, self.base, STAGES[1], 1)):
+                    return found
+            if found := self.segmented_solve():
+                return found
+            candidates = lifted_candidates(self.prob, self.q_now, self.base, self.position, self.direction, self.seed)
+            for k, q in enumerate(candidates):
+                if found := self.consider(q, self.base, STAGES[1], k + 1):
+                    return found
+        return self.refine_kept()
+
+    def segmented_solve(self) -> WholeBodySolution | None:
+        """Stage 1: the paper's segmented solve (:meth:`HeadController.solve_checked`) from the base as it is,
+        clear of the obstacles."""
+        accept = (lambda q, b: clear_of_obstacles(self.robot, q, self.obstacles, b)) if self.obstacles else None
+        seg = self.controller.solve_checked(self.position, self.direction, q_prev=self.q_now, base=self.base,
+                                            accept=accept, allow_base_move=False)
+        self.segmented = seg
+        return self.consider(seg.q, seg.base, STAGES[0], 0)
+
+    def refine_kept(self) -> WholeBodySolution | None:
+        """The whole-body optimisation over the lifted joints from the best attempt, only when it reached the head
+        and failed stability or clearance (a local optimisation can move the body from there; a target out of
+        reach from this base is the placement's problem: stage 3)."""
+        starts = [self.best.q] if self.best is not None and self.best.reason != "out of reach" else []
+        for q0 in starts:
+            if self.out_of_time():
+                break
+            q, b = refine(self.prob, q0, self.base, self.position, self.direction, move_base=False,
+                          obstacles=self.obstacles, min_margin=self.min_margin)
+            if found := self.consider(np.clip(q, self.robot.lower, self.robot.upper), b, STAGES[1], len(starts)):
+                return found
+        return None
+
+    def shape_passes(self, q: np.ndarray) -> bool:
+        """Whether the flat shape of q (its joints before the lift) passes ``shape_ok`` (remembered when not)."""
+        key = q[:self.robot.lift_joints.start].tobytes()
+        if key in self.rejected_shapes:
             return False
-        if shape_ok is not None and not shape_ok(q):
-            rejected_shapes.add(key)
+        if self.shape_ok is not None and not self.shape_ok(q):
+            self.rejected_shapes.add(key)
             return False
         return True
 
-    def moved(q: np.ndarray, b: Any, starts: int) -> Any:
-        """consider() for a moved base, whose shape must pass ``shape_ok`` too (asked only of a configuration that
-        passes every other check; one whose shape fails is not kept as the best attempt either)."""
-        chk = check(q, b)
-        if shape_ok is not None and chk["reason"] is None and not shape_passes(q):
+    def moved(self, q: np.ndarray, b: BasePlacement, starts: int) -> WholeBodySolution | None:
+        """:meth:`consider` for a moved base, whose shape must pass ``shape_ok`` too (asked only of a configuration
+        that passes every other check; one whose shape fails is not kept as the best attempt either)."""
+        chk = self.check(q, b)
+        if self.shape_ok is not None and chk["reason"] is None and not self.shape_passes(q):
             return None
-        return consider(q, b, STAGES[2], starts, chk)
+        return self.consider(q, b, STAGES[2], starts, chk)
 
-    moved_starts = []
-    for qb in [q_now[robot.parts.base]] + _base_shapes(controller):
-        q = q_now.copy()
+    def base_moved(self) -> WholeBodySolution | None:
+        """Stage 3: for the base's shape and other flat shapes (:func:`_base_shapes`), placements that bring the
+        target into reach (:meth:`from_shape`), then the whole-body optimisation over the base's yaw joints, its
+        placement and the lifted joints from the segmented solutions found there."""
+        moved_starts: list[tuple[np.ndarray, BasePlacement]] = []
+        for qb in [self.q_now[self.robot.parts.base]] + _base_shapes(self.controller):
+            if found := self.from_shape(qb, moved_starts):
+                return found
+            if self.out_of_time():
+                break
+        for q0, b0 in moved_starts:
+            if self.out_of_time():
+                break
+            q, b = refine(self.prob, q0, b0, self.position, self.direction, move_base=True, obstacles=self.obstacles,
+                          min_margin=self.min_margin)
+            if found := self.moved(np.clip(q, self.robot.lower, self.robot.upper), b, len(moved_starts)):
+                return found
+        return None
+
+    def from_shape(self, qb: np.ndarray, moved_starts: list[tuple[np.ndarray, BasePlacement]]
+                   ) -> WholeBodySolution | None:
+        """The base with base joints qb: the placement that brings the target into the neck's accepted range
+        (Section 3.3 (3)) and its segmented solution (added to ``moved_starts``), then the lifted chain's IK
+        candidates there and at the other candidate placements (:func:`placements`), while the shape passes and
+        time is left."""
+        from . import neck as nk
+
+        robot, controller, base = self.robot, self.controller, self.base
+        q = self.q_now.copy()
         q[robot.parts.base] = qb
         P0_local = np.linalg.inv(robot.body_pose(base)) @ robot.frame(q, robot.lift_frame, base)
         placed = None if controller.neck_length <= 0 else nk.base_move_into_range(
-            position, P0_local, base, controller.Lc, controller.neck_length, controller.slack, robot.body_axis_height)
+            self.position, P0_local, base, controller.Lc, controller.neck_length, controller.slack,
+            robot.body_axis_height)
         if placed is not None:
-            s = controller.solve_checked(position, direction, q_prev=q, base=placed, allow_base_move=False)
-            if s.success and (found := moved(s.q, placed, 0)):
+            s = controller.solve_checked(self.position, self.direction, q_prev=q, base=placed, allow_base_move=False)
+            if s.success and (found := self.moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
-        for b in ([placed] if placed is not None else []) + placements(prob, P0_local, position, direction):
-            if q[:robot.lift_joints.start].tobytes() in rejected_shapes:
+        for b in ([placed] if placed is not None else []) + placements(self.prob, P0_local, self.position,
+                                                                      self.direction):
+            if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes:
                 break
-            for qc in lifted_candidates(prob, q, b, position, direction, seed):
-                if found := moved(qc, b, 0):
+            for qc in lifted_candidates(self.prob, q, b, self.position, self.direction, self.seed):
+                if found := self.moved(qc, b, 0):
                     return found
-            if time.perf_counter() - t0 > time_budget:
+            if self.out_of_time():
                 break
-        if time.perf_counter() - t0 > time_budget:
-            break
-    for q0, b0 in moved_starts:
-        if time.perf_counter() - t0 > time_budget:
-            break
-        q, b = refine(prob, q0, b0, position, direction, move_base=True, obstacles=obstacles, min_margin=min_margin)
-        if found := moved(np.clip(q, robot.lower, robot.upper), b, len(moved_starts)):
-            return found
-    return _attempted(best)
+        return None
 
 
 def _attempted(best: WholeBodySolution | None) -> WholeBodySolution:

@@ -29,7 +29,7 @@ import numpy.typing as npt
 from .. import _core
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-from .stability import GRAVITY
+from ..model.physics import GRAVITY
 from .._errors import InputError
 
 #: Ramp (m) of the lifted share: a link whose distal points' lowest is this high is fully carried by the

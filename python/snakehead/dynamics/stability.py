@@ -22,13 +22,11 @@ import numpy as np
 
 from .. import _core
 from .._validate import finite_array, joint_vector
+from ..model.physics import GRAVITY  # g in Eq. 38 is (0, 0, -GRAVITY)
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 import numpy.typing as npt
 from .._errors import Infeasible, InputError
-
-#: Standard gravity (m/s^2); g in Eq. 38 is (0, 0, -GRAVITY).
-GRAVITY = 9.80665
 
 #: A base link counts as lying on the ground when the lowest point of its collision shapes is below this
 #: height (m). The default robot's flat base links sit at exactly 0.

@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 from xml.sax.saxutils import quoteattr
 
 from .._validate import finite_float
+from .physics import GRAVITY
 
 from typing import Any
 from .._errors import InputError, InputTypeError
 
-GRAVITY = 9.80665
 
 
 def holding_effort(mass_per_metre: float, body_length: float) -> float:

@@ -12,8 +12,7 @@ import numpy.typing as npt
 from .._errors import Infeasible
 from .._validate import joint_vector
 from ..control.controller import HeadController
-from ..geometry import collision as coll
-from ..margins import DETOUR_MARGIN, OBSTACLE_CLEARANCE
+from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import shape_key
 from .start_state import bending_state
@@ -74,17 +73,11 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: a
     dict that keeps the solves with the base kept (:func:`solve_kept`) for the plan to reuse."""
-    from ..control.whole_body import solve_checked_target
+    from ..control.whole_body import clear_of_obstacles, solve_checked_target
 
     robot = controller.robot
     obstacles = list(obstacles)
     targets = list(targets)
-
-    def clear(q: np.ndarray, b: Any) -> bool:
-        if not obstacles:
-            return True
-        return bool(coll.collision_check(robot, q[None], obstacles, b, exact_within=0.005).distance[0]
-                    > OBSTACLE_CLEARANCE)
 
     def failing(b: Any, q_shape: Any) -> Any:
         """The first target not solved from this base (None: all are), or why the start state is not usable
@@ -93,7 +86,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
             q_bend = bending_state(controller, q_shape)
         except Infeasible:
             return "no curl", None
-        if not clear(q_bend, b):
+        if not clear_of_obstacles(robot, q_bend, obstacles, b):
             return "the start", None
         for t in targets:
             sol = solve_kept(controller, t.position, t.direction, q_shape, b, obstacles, solved)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
@@ -35,9 +36,10 @@ import numpy.typing as npt
 from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
 from .._validate import integer, joint_vector
 from ..control.controller import HeadController
+from ..control.whole_body import clear_of_obstacles
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..margins import OBSTACLE_CLEARANCE
+from ..margins import EXACT_DISTANCE_WITHIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import plan_bounds
@@ -129,73 +131,20 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if progress is not None and not callable(progress):
         raise InputTypeError(f"progress must be a function of a PlanProgress (or None), got {type(progress).__name__}")
     lines = check_size(scene)  # before anything is solved
-    if timing is not None and not isinstance(timing, dict):
-        raise InputTypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
-    # checked even when a controller (with its own method and seed) is given: a bad value is a mistake either way
-    if not isinstance(method, str) or method not in ("rotated", "free_roll"):
-        raise InputError(f"method must be 'rotated' or 'free_roll', got {method!r}")
-    if seed is not None:
-        integer(seed, "seed", least=0, most=2**64 - 1)
-    if not isinstance(allow_relocation, (bool, np.bool_)):  # "False" or None would pass a truth test
-        raise InputTypeError(f"allow_relocation must be True or False, got {type(allow_relocation).__name__} "
-                        f"{allow_relocation!r}")
-    if controller is not None:
-        if not isinstance(controller, HeadController):
-            raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
-        if robot is not None and robot is not controller.robot:
-            raise InputError("give a robot or a controller (whose robot is used), not both")
-        chosen = base if base is not None else scene.base
-        if chosen is not None:
-            controller.base = chosen
-    else:
-        if robot is None:
-            robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
-        elif not isinstance(robot, SnakeRobot):
-            raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
-        controller = HeadController(robot, base_pose=base if base is not None else scene.base, method=method,
-                                    seed=seed)
+    _check_options(timing, method, seed, allow_relocation)
+    controller = _controller_for(scene, robot, controller, base, method, seed)
     robot = controller.robot
     if timing:  # checked before anything is planned: a bad option is the caller's, found at once
         check_timing(robot, timing)
-    obstacles = list(scene.obstacles)
-    notes: list[str] = []
-    if controller.dexterous_threshold < 100.0:
-        notes.append(controller.dexterous_note)
-    if start_q is not None:
-        start_q = joint_vector(start_q, robot.n_joints, "start_q")
-        if base_shape is None:
-            base_shape = start_q
-    if base_shape is not None:
-        base_shape = joint_vector(base_shape, robot.n_joints, "base_shape")
+    start_q, base_shape = _start_shapes(robot, start_q, base_shape)
     inputs_checked()  # from here on an InputError would be a bug of the planner's (the entry point says so)
-    scene_targets = scene.targets
-    count = len(scene_targets)
-    from .timing import resolve_limits
-
-    velocity = resolve_limits(robot, **(timing or {})).velocity  # for the least duration of the moves so far
-
-    def stage(what: str, message: str) -> None:
-        if progress is not None:
-            progress(PlanProgress("stage", what, count=count, elapsed_s=time.perf_counter() - t_start,
-                                  message=message))
-
-    def done(k: int, sol: Any, seconds: float) -> None:
-        """Target k (0-based) is solved and the move to it planned: tell progress; MotionTooLong once the motion
-        so far cannot fit in MAX_MOTION_S (the scene's input was valid: its moves only turn out too long)."""
-        tg = scene_targets[k]
-        if progress is not None:
-            progress(PlanProgress("target", tg.name, k + 1, count, bool(sol.success), seconds,
-                                  time.perf_counter() - t_start, "" if sol.success else str(sol.message)))
-        least = way.least_duration(velocity)
-        if least > plan_bounds.MAX_MOTION_S:
-            raise MotionTooLong(f"scene {scene.name!r}: the motion to its target {k + 1} of {count} ({tg.name!r}) lasts "
-                             f"at least {least:.0f} s (the moves at the joints' velocity limits and the holds); a plan "
-                                f"lasts at most {plan_bounds.MAX_MOTION_S:g} s (MAX_MOTION_S): split the scene into "
-                                "scenes planned one after the other")
-
+    obstacles = list(scene.obstacles)
+    notes: list[str] = [controller.dexterous_note] if controller.dexterous_threshold < 100.0 else []
+    report = _Progress(progress, scene, t_start, robot, timing)
     solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
     reported = len(scene.reported)
-    stage("base", f"solving the {reported} target{'' if reported == 1 else 's'} from the start to choose the base")
+    report.stage("base", f"solving the {reported} target{'' if reported == 1 else 's'} from the start to choose the "
+                         "base")
     chosen, q_shape, relocation, base_notes = choose_base(controller, scene.reported, obstacles, allow_relocation,
                                                           base_shape, solved=solved)
     notes += base_notes
@@ -204,91 +153,12 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
         notes.append("start_q is not used: the plan starts at the relocated base, in its bending state")
         start_q = None
     way.start("bending state", bending_state(controller, q_shape) if start_q is None else start_q)
-    # the initial state of Section 3.3 (1) (the head lifted on its Bezier) with the base's shape, when it is a safe
-    # state there; else the lift goes straight to the first target
-    q = shape_of(robot, q_shape, controller.q_initial)
-    if way.feasible(q[None])[0] and (not obstacles or coll.collision_check(
-            robot, q[None], obstacles, chosen, exact_within=0.005).distance[0] > OBSTACLE_CLEARANCE):
-        # the lift's path, like its timing, is the same for every plan from a base of this shape wherever it lies
-        # (obstacles apart: with them it is checked again)
-        lifts = controller.plan_cache.lift_paths
-        key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
-        kept = lifts.get(key) if not obstacles else None  # (one lookup: another thread may clear the dict)
-        if kept is not None:
-            way.append_path("initial state (head lifted)", *kept)
-        else:
-            first = len(way.qs) - 1
-            method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
-            if not obstacles:
-                lifts.put(key, (np.array(way.qs[first:]), method))
-        way.lift_index = way.stop()  # the lift comes to rest in the initial state (Fig. 17c-d)
-        way.lift_cache = controller.plan_cache.timed_lifts
-    else:
-        q = way.qs[-1]
-    results: list[TargetResult] = []
-    k = 0
-    while k < len(scene_targets):
-        # a run: this target and the following ones approached along a line from it
-        end = k
-        while end + 1 < len(scene_targets) and scene_targets[end + 1].approach == "line":
-            end += 1
-        if end == k:
-            tg = scene_targets[k]
-            clock = time.perf_counter()
-            sol = solve_noted(controller, tg.position, tg.direction, q, chosen, obstacles, tg.name, notes,
-                              solved=solved)
-            way.move(tg.name, sol.q)
-            q = sol.q
-            if not tg.via:  # time_s holds the waypoint's index until the path is timed (_finish)
-                results.append(TargetResult(tg.name, tg.position, tg.direction, way.stop(), sol))
-            if tg.hold_s > 0:
-                way.hold(tg.hold_s)
-            done(k, sol, time.perf_counter() - clock)
-            k += 1
-            continue
-        # poses along the lines, solved backwards from the deepest (the most constrained, e.g. only the head link in
-        # a hole) out to the run's first target, each from the previous joints: a branch of solutions that clears
-        # an obstacle deep in it also clears it further out, while one chosen from the outside may run into it
-        poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
-            (scene_targets[k].name, scene_targets[k].position, scene_targets[k].direction, scene_targets[k])]
-        owner = [k]  # the scene target each pose leads to
-        for j in range(k + 1, end + 1):
-            line = lines[j]
-            for m, p in enumerate(line):
-                last = m == len(line) - 1
-                label = scene_targets[j].name if last else f"{scene_targets[j].name} ({m + 1}/{len(line)})"
-                poses.append((label, p, scene_targets[j].direction, scene_targets[j] if last else None))
-                owner.append(j)
-        seconds = dict.fromkeys(range(k, end + 1), 0.0)  # each target's share of the run's solves and moves
-        sols: list = [None] * len(poses)
-        q_back = q
-        for m in range(len(poses) - 1, -1, -1):
-            clock = time.perf_counter()
-            label, p, d, _ = poses[m]
-            sols[m] = solve_noted(controller, p, d, q_back, chosen, obstacles, label, notes, near=m < len(poses) - 1)
-            if sols[m].success:
-                q_back = sols[m].q
-            seconds[owner[m]] += time.perf_counter() - clock
-        for m, (label, p, d, line_target) in enumerate(poses):
-            clock = time.perf_counter()
-            if m == 0:
-                way.move(label, sols[m].q)
-            else:
-                way.move_joint(label, sols[m].q)
-            if line_target is not None:
-                if not line_target.via:
-                    results.append(TargetResult(line_target.name, line_target.position, line_target.direction,
-                                                way.stop(), sols[m]))
-                if line_target.hold_s > 0:
-                    way.hold(line_target.hold_s)
-            seconds[owner[m]] += time.perf_counter() - clock
-            if line_target is not None:
-                done(owner[m], sols[m], seconds[owner[m]])
-        q = sols[-1].q
-        k = end + 1
+    q = _lift(way, controller, q_shape)
+    run = _Run(controller, scene, lines, chosen, obstacles, way, notes, solved, report)
+    run.reach_targets(q)
     try:
-        plan = _finish(scene.name, way, results, t_start, obstacles=obstacles, notes=notes, scene=scene, timing=timing,
-                       stage=stage)
+        plan = _finish(scene.name, way, run.results, t_start, obstacles=obstacles, notes=notes, scene=scene,
+                       timing=timing, stage=report.stage)
     except MotionTooLong as exc:
         raise MotionTooLong(f"scene {scene.name!r}: {exc}: split the scene into scenes planned one after the other"
                             ) from None
@@ -296,6 +166,211 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if allow_relocation and relocation is None:
         plan.out_of_range = out_of_range(robot, chosen, scene.reported)
     return plan
+
+
+def _check_options(timing: Any, method: Any, seed: Any, allow_relocation: Any) -> None:
+    """InputError/InputTypeError for a bad ``timing`` (not a dict), ``method``, ``seed`` or ``allow_relocation`` of
+    :func:`plan` (checked even when a controller, with its own method and seed, is given: a bad value is a mistake
+    either way)."""
+    if timing is not None and not isinstance(timing, dict):
+        raise InputTypeError(f"timing must be a dict of retime's options, got {type(timing).__name__}")
+    if not isinstance(method, str) or method not in ("rotated", "free_roll"):
+        raise InputError(f"method must be 'rotated' or 'free_roll', got {method!r}")
+    if seed is not None:
+        integer(seed, "seed", least=0, most=2**64 - 1)
+    if not isinstance(allow_relocation, (bool, np.bool_)):  # "False" or None would pass a truth test
+        raise InputTypeError(f"allow_relocation must be True or False, got {type(allow_relocation).__name__} "
+                             f"{allow_relocation!r}")
+
+
+def _controller_for(scene: Scene, robot: Any, controller: Any, base: BasePlacement | None, method: str,
+                    seed: int | None) -> HeadController:
+    """The controller :func:`plan` solves with: the one given (placed at ``base``, else at the scene's base, when
+    either is given), else a new one for ``robot`` (default: the scene's robot file, else the default robot)."""
+    if controller is not None:
+        if not isinstance(controller, HeadController):
+            raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
+        if robot is not None and robot is not controller.robot:
+            raise InputError("give a robot or a controller (whose robot is used), not both")
+        chosen = base if base is not None else scene.base
+        if chosen is not None:
+            controller.base = chosen
+        return controller
+    if robot is None:
+        robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
+    elif not isinstance(robot, SnakeRobot):
+        raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
+    return HeadController(robot, base_pose=base if base is not None else scene.base, method=method, seed=seed)
+
+
+def _start_shapes(robot: SnakeRobot, start_q: npt.ArrayLike | None, base_shape: npt.ArrayLike | None
+                  ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """:func:`plan`'s ``start_q`` and ``base_shape`` checked (joint vectors of the robot); the base's shape is the
+    start's when only ``start_q`` is given."""
+    start = joint_vector(start_q, robot.n_joints, "start_q") if start_q is not None else None
+    if start is not None and base_shape is None:
+        base_shape = start
+    shape = joint_vector(base_shape, robot.n_joints, "base_shape") if base_shape is not None else None
+    return start, shape
+
+
+class _Progress:
+    """What :func:`plan` tells its ``progress`` callback (stages and targets), and the check of the motion's length
+    after each target (the moves so far at the joints' velocity limits ``timing`` allows, and the holds)."""
+
+    def __init__(self, progress: ProgressCallback | None, scene: Scene, t_start: float, robot: SnakeRobot,
+                 timing: dict[str, Any] | None) -> None:
+        from .timing import resolve_limits
+
+        self.progress, self.scene, self.t_start = progress, scene, t_start
+        self.count = len(scene.targets)
+        self.velocity = resolve_limits(robot, **(timing or {})).velocity  # for the least duration of the moves
+
+    def stage(self, what: str, message: str) -> None:
+        """A stage over the whole plan begins (see :class:`PlanProgress`)."""
+        if self.progress is not None:
+            self.progress(PlanProgress("stage", what, count=self.count,
+                                       elapsed_s=time.perf_counter() - self.t_start, message=message))
+
+    def target(self, k: int, sol: Any, seconds: float, way: Waypoints) -> None:
+        """Target k (0-based) is solved and the move to it planned: tell progress; MotionTooLong once the motion
+        so far cannot fit in MAX_MOTION_S (the scene's input was valid: its moves only turn out too long)."""
+        tg, count = self.scene.targets[k], self.count
+        if self.progress is not None:
+            self.progress(PlanProgress("target", tg.name, k + 1, count, bool(sol.success), seconds,
+                                       time.perf_counter() - self.t_start,
+                                       "" if sol.success else str(sol.message)))
+        least = way.least_duration(self.velocity)
+        if least > plan_bounds.MAX_MOTION_S:
+            raise MotionTooLong(f"scene {self.scene.name!r}: the motion to its target {k + 1} of {count} "
+                                f"({tg.name!r}) lasts at least {least:.0f} s (the moves at the joints' velocity "
+                                f"limits and the holds); a plan lasts at most {plan_bounds.MAX_MOTION_S:g} s "
+                                "(MAX_MOTION_S): split the scene into scenes planned one after the other")
+
+
+def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np.ndarray:
+    """The lift from the start state (``way``'s last waypoint) to the initial state of Section 3.3 (1) (the head
+    lifted on its Bezier, with the base's shape ``q_shape``), when that is a safe state at the base (it is then a
+    stop: the lift comes to rest there, Fig. 17c-d); its configuration, or the start's when it is not safe (the
+    first move then goes straight to the first target). The lift's path and timing are the same for every plan from
+    a base of this shape wherever it lies: they are kept in ``controller.plan_cache`` (the path only without
+    obstacles: with them it is checked again)."""
+    robot, obstacles = controller.robot, way.obstacles
+    q = shape_of(robot, q_shape, controller.q_initial)
+    if not (way.feasible(q[None])[0] and clear_of_obstacles(robot, q, obstacles, way.base)):
+        return way.qs[-1]
+    lifts = controller.plan_cache.lift_paths
+    key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
+    kept = lifts.get(key) if not obstacles else None
+    if kept is not None:
+        way.append_path("initial state (head lifted)", *kept)
+    else:
+        first = len(way.qs) - 1
+        method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        if not obstacles:
+            lifts.put(key, (np.array(way.qs[first:]), method))
+    way.lift_index = way.stop()
+    way.lift_cache = controller.plan_cache.timed_lifts
+    return q
+
+
+@dataclass
+class _Run:
+    """The targets of one plan being reached in the scene's order, from the chosen base: each solved (with the base
+    kept, :func:`~snakehead.motion.target_solves.solve_noted`) and moved to on ``way``; ``results`` the reported
+    targets (their ``time_s`` the waypoint's index until the path is timed, :func:`_finish`)."""
+
+    controller: HeadController
+    scene: Scene
+    lines: dict[int, list[np.ndarray]]  # the poses along each line approach (check_size)
+    base: BasePlacement
+    obstacles: list[Any]
+    way: Waypoints
+    notes: list[str]
+    solved: dict  # the solves with the base kept, shared with choose_base
+    report: _Progress
+    results: list[TargetResult] = field(default_factory=list)
+
+    def reach_targets(self, q: np.ndarray) -> np.ndarray:
+        """Every target from configuration q, a run at a time (a target and the following ones approached along a
+        line from it); the last configuration."""
+        targets = self.scene.targets
+        k = 0
+        while k < len(targets):
+            end = k
+            while end + 1 < len(targets) and targets[end + 1].approach == "line":
+                end += 1
+            q = self.reach_target(k, q) if end == k else self.reach_line_run(k, end, q)
+            k = end + 1
+        return q
+
+    def arrive(self, target: Target, sol: Any) -> None:
+        """The motion rests at the last waypoint, ``target`` reached by ``sol``: reported (unless a via target),
+        then held."""
+        if not target.via:  # time_s holds the waypoint's index until the path is timed (_finish)
+            self.results.append(TargetResult(target.name, target.position, target.direction, self.way.stop(), sol))
+        if target.hold_s > 0:
+            self.way.hold(target.hold_s)
+
+    def reach_target(self, k: int, q: np.ndarray) -> np.ndarray:
+        """Target k solved from q and reached by a whole-body move; the configuration it is solved at."""
+        tg = self.scene.targets[k]
+        clock = time.perf_counter()
+        sol = solve_noted(self.controller, tg.position, tg.direction, q, self.base, self.obstacles, tg.name,
+                          self.notes, solved=self.solved)
+        self.way.move(tg.name, sol.q)
+        self.arrive(tg, sol)
+        self.report.target(k, sol, time.perf_counter() - clock, self.way)
+        return sol.q
+
+    def line_run_poses(self, k: int, end: int) -> tuple[list[tuple[str, np.ndarray, np.ndarray, Target | None]],
+                                                         list[int]]:
+        """The poses of the run of targets k..end (k's, then those along each line up to and including its
+        target): (label, position, direction, the scene's target when the pose is one), and the index of the
+        target each leads to."""
+        targets = self.scene.targets
+        poses: list[tuple[str, np.ndarray, np.ndarray, Target | None]] = [
+            (targets[k].name, targets[k].position, targets[k].direction, targets[k])]
+        owner = [k]
+        for j in range(k + 1, end + 1):
+            line = self.lines[j]
+            for m, p in enumerate(line):
+                last = m == len(line) - 1
+                label = targets[j].name if last else f"{targets[j].name} ({m + 1}/{len(line)})"
+                poses.append((label, p, targets[j].direction, targets[j] if last else None))
+                owner.append(j)
+        return poses, owner
+
+    def reach_line_run(self, k: int, end: int, q: np.ndarray) -> np.ndarray:
+        """Targets k..end, each after k approached along a line from the one before: the poses along the lines
+        solved backwards from the deepest (the most constrained, e.g. only the head link in a hole) out to target
+        k, each from the previous joints (a branch of solutions that clears an obstacle deep in it also clears it
+        further out, while one chosen from the outside may run into it); then a whole-body move to the first and
+        joint-space steps along the rest. The last pose's configuration."""
+        poses, owner = self.line_run_poses(k, end)
+        seconds = dict.fromkeys(range(k, end + 1), 0.0)  # each target's share of the run's solves and moves
+        sols: list = [None] * len(poses)
+        q_back = q
+        for m in range(len(poses) - 1, -1, -1):
+            clock = time.perf_counter()
+            label, p, d, _ = poses[m]
+            sols[m] = solve_noted(self.controller, p, d, q_back, self.base, self.obstacles, label, self.notes,
+                                  near=m < len(poses) - 1)
+            if sols[m].success:
+                q_back = sols[m].q
+            seconds[owner[m]] += time.perf_counter() - clock
+        for m, (label, _, _, line_target) in enumerate(poses):
+            clock = time.perf_counter()
+            if m == 0:
+                self.way.move(label, sols[m].q)
+            else:
+                self.way.move_joint(label, sols[m].q)
+            if line_target is not None:
+                self.arrive(line_target, sols[m])
+            seconds[owner[m]] += time.perf_counter() - clock
+            if line_target is not None:
+                self.report.target(owner[m], sols[m], seconds[owner[m]], self.way)
+        return sols[-1].q
 
 
 def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles: Sequence[Any] = (),
@@ -325,7 +400,7 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
         # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
         distance = np.concatenate([
             coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
-                                 exact_within=0.005).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+                                 exact_within=EXACT_DISTANCE_WITHIN).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,

@@ -12,7 +12,7 @@ import numpy.typing as npt
 from .._errors import Infeasible, MotionTooLong
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..margins import DETOUR_MARGIN
+from ..margins import DETOUR_MARGIN, EXACT_DISTANCE_WITHIN
 from ..model.robot import BasePlacement, SnakeRobot
 from . import interpolation as interp
 from . import plan_bounds
@@ -197,7 +197,8 @@ class Waypoints:
             ok[rows] = coll.self_clearance(self.robot, qs[rows], self.base) > 0.0
         if self.obstacles and ok.any():
             rows = np.flatnonzero(ok)
-            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
+            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base,
+                                    exact_within=EXACT_DISTANCE_WITHIN).distance
             ok[rows] = d > 0.0
         return ok
 

@@ -33,11 +33,10 @@ import math
 
 import numpy as np
 
+from ..model.physics import GRAVITY
 from ..model.robot import SnakeRobot, as_robot
 from .._errors import InputError
 
-#: Standard gravity (m/s^2).
-GRAVITY = 9.80665
 #: How far a joint may give under its whole load (rad).
 HOLD_DEFLECTION = math.radians(1.0)
 #: The time constant kd / kp of every joint's loop (s).

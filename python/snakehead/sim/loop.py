@@ -59,6 +59,7 @@ import numpy.typing as npt
 from .._validate import finite_float, positive
 from ..control.controller import HeadController
 from ..geometry import collision as coll
+from ..margins import EXACT_DISTANCE_WITHIN
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..motion import locomotion as lc
 from ..motion.plan_result import Plan
@@ -389,7 +390,7 @@ class ClosedLoop:
         if coll.self_clearance(robot, q_now[None])[0] <= 0.0:
             raise InputError("q_start folds the body onto itself (two links overlap)")
         if self.obstacles and coll.collision_check(robot, q_now[None], self.obstacles, start,
-                                                   exact_within=0.005).distance[0] <= 0.0:
+                                                   exact_within=EXACT_DISTANCE_WITHIN).distance[0] <= 0.0:
             raise InputError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
         inputs_checked()  # the loop plans and simulates from here: an InputError inside would be a bug
         say = progress or (lambda text: None)

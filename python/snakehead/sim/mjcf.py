@@ -60,6 +60,7 @@ import numpy as np
 
 from .._validate import duration, finite_array, non_negative, positive
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
+from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from .gains import default_torque_limits
 
@@ -67,8 +68,6 @@ import numpy.typing as npt
 from typing import Any
 from .._errors import InputError, InputTypeError, InternalError
 
-#: Standard gravity (m/s^2), the same as snakehead.stability.
-GRAVITY = 9.80665
 
 #: Physics timestep (s) and control period (s) used by default.
 DEFAULT_TIMESTEP = 0.001
@@ -243,7 +242,7 @@ def add_shape_geom(spec: Any, body: Any, robot: SnakeRobot, k: int, **options: A
 _MUJOCO_MINVAL = 1e-15
 
 
-def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = 0.8,
+def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = GROUND_FRICTION,
                joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                contact_solref: tuple = (0.005, 1.0)) -> Any:

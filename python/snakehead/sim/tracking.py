@@ -11,9 +11,10 @@ import numpy as np
 
 from .._validate import duration, finite_array, non_negative, sample_count
 from ..dynamics.inverse_dynamics import LIFT_RAMP, carried_weights  # noqa: F401  (the one rule; re-exported)
+from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gains import default_gains
-from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, GRAVITY, MAX_CONTROL_DT,
+from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, MAX_CONTROL_DT,
                    MAX_PHYSICS_STEPS, MAX_TIMESTEP, SimModel, _mujoco, build_model)
 
 import numpy.typing as npt
@@ -278,7 +279,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                         kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None, *,
                         control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
                         settle: float = 0.3, hold: float = 0.0, gravity_compensation: str = "supported",
-                        torque_limit: npt.ArrayLike | None = None, friction: float = 0.8,
+                        torque_limit: npt.ArrayLike | None = None, friction: float = GROUND_FRICTION,
                         joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (),
                         hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                         drop: float = 2e-4, state: SimState | None = None) -> SimResult:

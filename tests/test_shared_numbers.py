@@ -1,0 +1,58 @@
+"""Every shared number is defined once: gravity and the ground's friction (``model.physics``), the plans' margins
+(``snakehead.margins``); the modules that use them import them (the same object, not an equal copy)."""
+import ast
+import importlib
+import inspect
+from pathlib import Path
+
+
+import snakehead
+from snakehead import margins
+from snakehead.model import physics
+
+PACKAGE = Path(snakehead.__file__).parent
+
+
+def definitions(name):
+    """The modules (paths relative to the package) that assign ``name`` at module level."""
+    out = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in tree.body:
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
+                node, ast.AnnAssign) else []
+            if any(isinstance(t, ast.Name) and t.id == name for t in targets):
+                out.append(str(path.relative_to(PACKAGE)))
+    return out
+
+
+def test_gravity_and_the_margins_are_defined_once():
+    assert definitions("GRAVITY") == ["model/physics.py"]
+    assert definitions("GROUND_FRICTION") == ["model/physics.py"]
+    assert definitions("DETOUR_MARGIN") == ["margins.py"]
+    assert definitions("OBSTACLE_CLEARANCE") == ["margins.py"]
+    assert definitions("EXACT_DISTANCE_WITHIN") == ["margins.py"]
+    # motion/timing.py still defines its own ZMP_MARGIN and SIM_FRICTION (its rewrite imports them): equal meanwhile
+    assert set(definitions("ZMP_MARGIN")) <= {"margins.py", "motion/timing.py"}
+
+
+def test_the_users_read_the_one_definition():
+    from snakehead.control import whole_body
+    from snakehead.motion import timing
+    from snakehead.sim import mjcf, tracking
+
+    for name in ("dynamics.stability", "dynamics.inverse_dynamics", "model.generate", "sim.gains", "sim.mjcf",
+                 "sim.tracking"):  # (by module: dynamics.inverse_dynamics is also a function's name)
+        assert importlib.import_module(f"snakehead.{name}").GRAVITY is physics.GRAVITY, name
+    assert whole_body.OBSTACLE_CLEARANCE is margins.OBSTACLE_CLEARANCE
+    assert timing.ZMP_MARGIN == margins.ZMP_MARGIN and timing.SIM_FRICTION == physics.GROUND_FRICTION
+    # the simulation's ground is the one the retiming's friction is a share of
+    assert inspect.signature(mjcf.build_spec).parameters["friction"].default == physics.GROUND_FRICTION
+    assert inspect.signature(tracking.simulate_trajectory).parameters["friction"].default == physics.GROUND_FRICTION
+
+
+def test_the_values_are_the_documented_ones():
+    """Standard gravity (CGPM 1901) and the margins the plans were measured with (bench/RESULTS.md)."""
+    assert physics.GRAVITY == 9.80665 and physics.GROUND_FRICTION == 0.8
+    assert margins.ZMP_MARGIN == 0.005 and margins.DETOUR_MARGIN == 0.01 == 2 * margins.ZMP_MARGIN
+    assert margins.OBSTACLE_CLEARANCE == 0.002 and margins.EXACT_DISTANCE_WITHIN == 0.005
