@@ -32,6 +32,7 @@ from .._validate import MAX_SAMPLES, integer, joint_vector
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
+from ..geometry import path_check
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import interpolation as interp
@@ -315,7 +316,7 @@ class _Waypoints:
             self._append(label, q)
             return "none"
         path = _split_steps(tracking_interpolation(self.robot, self.qs[-1], q, n, self.base).q)
-        if self._feasible(_checked(path)).all():
+        if self._path_feasible(path):
             qs, method = path, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
@@ -359,20 +360,13 @@ class _Waypoints:
 
     def _feasible(self, qs: np.ndarray) -> np.ndarray:
         """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links
-        overlapping, and clear of the obstacles (the cheap checks first: the others only where those pass)."""
-        clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
-        ok = clearance >= -coll.GROUND_TOLERANCE
-        if ok.any():
-            rows = np.flatnonzero(ok)
-            ok[rows] = self._margins(qs[rows]) >= DETOUR_MARGIN
-        if ok.any():
-            rows = np.flatnonzero(ok)
-            ok[rows] = coll.self_clearance(self.robot, qs[rows], self.base) > 0.0
-        if self.obstacles and ok.any():
-            rows = np.flatnonzero(ok)
-            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base, exact_within=0.005).distance
-            ok[rows] = d > 0.0
-        return ok
+        overlapping, and clear of the obstacles (``geometry.path_check.feasible``: the clearances in one C++ call)."""
+        return path_check.feasible(self, qs, DETOUR_MARGIN)
+
+    def _path_feasible(self, path: np.ndarray) -> bool:
+        """A path of waypoints whose clearances are proven along its straight segments and whose static margin
+        keeps DETOUR_MARGIN at its :func:`_checked` configurations (``geometry.path_check.path_feasible``)."""
+        return path_check.path_feasible(self, path, _checked(path), DETOUR_MARGIN)
 
     def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
         """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
@@ -387,7 +381,7 @@ class _Waypoints:
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = _split_steps(qa + s * (qb - qa))
-        if self._feasible(_checked(straight)).all():
+        if self._path_feasible(straight):
             return straight, "joint space"
         movable = np.arange(self.robot.lift_joints.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -402,7 +396,7 @@ class _Waypoints:
             ok = self._feasible(flat).reshape(len(batch), -1).all(axis=1)
             for k in batch[ok]:
                 path = _split_steps(paths[k])
-                if self._feasible(_checked(path)).all():
+                if self._path_feasible(path):
                     return path, "joint space via a stable detour"
         flat = _densify(paths).reshape(-1, qa.size)
         worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
@@ -516,20 +510,8 @@ def _finish(name: str, plan: _Waypoints, targets: Any, t_start: float, obstacles
                     + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
-    # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
-    # every check takes what it needs from them in one pass
-    clearance = np.empty(len(t))
-
-    def lowest(rows: slice, frames: np.ndarray) -> None:
-        clearance[rows] = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
-
-    dyn = stability.dynamic_stability(robot, t, q, base, qd, contact=PLAN_CONTACT, with_frames=lowest)
-    distance = None
-    if obstacles:
-        # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
-        distance = np.concatenate([
-            coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
-                                 exact_within=0.005).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+    # the ZMP, the ground and the obstacles at every sample, in C++ (geometry.path_check.finish_checks)
+    dyn, clearance, distance = path_check.finish_checks(robot, base, t, q, qd, obstacles, PLAN_CONTACT)
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
