@@ -2,6 +2,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <functional>
+#include <optional>
 #include <string>
 
 #include "bindings.hpp"
@@ -48,7 +50,8 @@ void bind_path_check(py::module_& m) {
       "Ground, self and obstacle clearances of a chain's configurations, per sample and proven along straight "
       "joint segments (path_check.hpp); immutable, safe to share between threads")
       .def(py::init([](const ChainModel& model, const ShapeSet& shapes, const Eigen::Matrix4d& origin,
-                       const Indices& ground_shapes, const Indices& self_pairs, const ShapeSet* obstacles,
+                       const Indices& ground_shapes, const Indices& self_pairs,
+                       std::optional<std::reference_wrapper<const ShapeSet>> obstacles,
                        const Indices& obstacle_pairs, double ground_floor, double obstacle_cutoff) {
              PathCheckSpec spec;
              spec.ground_shapes = list_of("ground_shapes", ground_shapes);
@@ -56,7 +59,8 @@ void bind_path_check(py::module_& m) {
              spec.obstacle_pairs = pairs_of("obstacle_pairs", obstacle_pairs);
              spec.ground_floor = ground_floor;
              spec.obstacle_cutoff = obstacle_cutoff;
-             return std::make_shared<PathChecker>(model, shapes, origin, std::move(spec), obstacles);
+             return std::make_shared<PathChecker>(model, shapes, origin, std::move(spec),
+                                                 obstacles ? &obstacles->get() : nullptr);
            }),
            py::arg("model"), py::arg("shapes"), py::arg("origin"), py::arg("ground_shapes"), py::arg("self_pairs"),
            py::arg("obstacles"), py::arg("obstacle_pairs"), py::arg("ground_floor"), py::arg("obstacle_cutoff"),

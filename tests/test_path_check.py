@@ -10,7 +10,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import snakehead
 from snakehead.dynamics import stability
 from snakehead.geometry import BoxObstacle, collision as coll, path_check
 from snakehead.geometry.shapes import shape_points
