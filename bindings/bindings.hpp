@@ -10,4 +10,5 @@ void bind_workspace(pybind11::module_& m);
 void bind_support(pybind11::module_& m);
 void bind_shape_set(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
+void bind_path_check(pybind11::module_& m);
 }  // namespace snakehead::bindings

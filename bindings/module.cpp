@@ -25,13 +25,14 @@ PYBIND11_MODULE(_core, m) {
   m.doc() =
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
       "convex-shape distances (FCL), "
-      "inverse dynamics";
+      "inverse dynamics, path checks";
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
   snakehead::bindings::bind_support(m);
   snakehead::bindings::bind_shape_set(m);
   snakehead::bindings::bind_dynamics(m);
+  snakehead::bindings::bind_path_check(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");

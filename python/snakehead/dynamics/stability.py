@@ -374,6 +374,65 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
+    if frames is None and with_frames is None and contact in CORE_CONTACT_MODELS:
+        return _stability_in_core(robot, t, q, base, qd, contact, tolerance)[0]
+    return _dynamic_stability_python(robot, t, q, base, qd, contact, tolerance, frames, with_frames)
+
+
+#: The contact models whose dynamic stability runs in the C++ core in one call (``_core.zmp_check``); "endpoints"
+#: runs in Python.
+CORE_CONTACT_MODELS = ("ground", "footprint")
+
+
+def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike,
+                                     base: BasePlacement | None = None, qd: npt.ArrayLike | None = None, *,
+                                     contact: str = "ground", tolerance: float = CONTACT_TOLERANCE
+                                     ) -> tuple[DynamicStability, np.ndarray]:
+    """:func:`dynamic_stability` (contact "ground" or "footprint") and, from the same frames in the same C++ pass,
+    the lowest point of the neck and head links above the ground at each sample (T,) m (as
+    ``geometry.collision.ground_clearance`` over ``robot.lifted_links``)."""
+    robot = as_robot(robot)
+    base = as_base(base)
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    t, q = _check_trajectory(robot, t, q)
+    qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
+    if contact not in CORE_CONTACT_MODELS:
+        raise InputError(f"contact must be one of {CORE_CONTACT_MODELS}, got {contact!r}")
+    return _stability_in_core(robot, t, q, base, qd, contact, tolerance)
+
+
+def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
+                       contact: str, tolerance: float) -> tuple[DynamicStability, np.ndarray]:
+    """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
+    differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
+    and the neck and head's lowest point per sample."""
+    from ..geometry.path_check import checker
+
+    g = robot.geometry
+    if contact == "ground":
+        links, key_joints = robot.shaped_links, []
+    else:
+        links = np.asarray(robot.base_links, int)
+        links = links[np.isin(links, robot.shaped_links)]
+        key_joints = list(range(robot.n_joints))[robot.parts.base]
+    if len(links) == 0:
+        raise InputError("the base part has no links with collision shapes; no support polygon")
+    out = _core.zmp_check(checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
+                          g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
+                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK)
+    margin = out["margin"]
+    inside = margin > 0.0
+    k = int(np.argmin(margin))
+    dyn = DynamicStability(out["zmp"], margin, inside, float(margin[k]), k, bool(inside.all()), out["P"], out["L"],
+                           out["com"])
+    return dyn, out["clearance"]
+
+
+def _dynamic_stability_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
+                              contact: str, tolerance: float, frames: np.ndarray | None,
+                              with_frames: Callable[[slice, np.ndarray], None] | None) -> DynamicStability:
+    """:func:`dynamic_stability` in Python over the core's frames, momenta and hulls, :data:`SAMPLE_CHUNK` samples at
+    a time (the reference of the C++ path, and the path for contact "endpoints", given frames or ``with_frames``)."""
     if frames is not None and np.shape(frames) != (q.shape[0], len(robot.link_names), 4, 4):
         frames = None
     n = len(t)

@@ -37,9 +37,7 @@ from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, in
 from .._validate import integer, joint_vector
 from ..control.controller import HeadController
 from ..control.whole_body import clear_of_obstacles
-from ..dynamics import stability
-from ..geometry import collision as coll
-from ..margins import EXACT_DISTANCE_WITHIN
+from ..geometry import path_check
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import plan_bounds
@@ -387,20 +385,8 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
                     + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
-    # the world frames of the samples (2.5 kB each on the default robot) are made and dropped a chunk at a time:
-    # every check takes what it needs from them in one pass
-    clearance = np.empty(len(t))
-
-    def lowest(rows: slice, frames: np.ndarray) -> None:
-        clearance[rows] = robot.lowest_z(frames, robot.lifted_links).min(axis=1)
-
-    dyn = stability.dynamic_stability(robot, t, q, base, qd, contact=PLAN_CONTACT, with_frames=lowest)
-    distance = None
-    if obstacles:
-        # exact distances only near the obstacles: the verdict needs the sign, the note the least clearance
-        distance = np.concatenate([
-            coll.collision_check(robot, q[k:k + stability.SAMPLE_CHUNK], list(obstacles), base,
-                                 exact_within=EXACT_DISTANCE_WITHIN).distance for k in range(0, len(q), stability.SAMPLE_CHUNK)])
+    # the ZMP, the ground and the obstacles at every sample, in C++ (geometry.path_check.finish_checks)
+    dyn, clearance, distance = path_check.finish_checks(robot, base, t, q, qd, obstacles, PLAN_CONTACT)
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,

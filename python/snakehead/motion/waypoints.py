@@ -11,8 +11,8 @@ import numpy.typing as npt
 
 from .._errors import Infeasible, MotionTooLong
 from ..dynamics import stability
-from ..geometry import collision as coll
-from ..margins import DETOUR_MARGIN, EXACT_DISTANCE_WITHIN
+from ..geometry import path_check
+from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from . import interpolation as interp
 from . import plan_bounds
@@ -142,7 +142,7 @@ class Waypoints:
             self._append(label, q)
             return "none"
         path = split_steps(tracking_interpolation(self.robot, self.qs[-1], q, n, self.base).q)
-        if self.feasible(check_points(path)).all():
+        if self.path_feasible(path):
             qs, method = path, "cartesian (Eq. 41, tracked)"
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
@@ -186,21 +186,13 @@ class Waypoints:
 
     def feasible(self, qs: np.ndarray) -> np.ndarray:
         """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links
-        overlapping, and clear of the obstacles (the cheap checks first: the others only where those pass)."""
-        clearance = coll.ground_clearance(self.robot, qs, self.base)[:, self.robot.lifted_links].min(axis=1)
-        ok = clearance >= -coll.GROUND_TOLERANCE
-        if ok.any():
-            rows = np.flatnonzero(ok)
-            ok[rows] = self._margins(qs[rows]) >= DETOUR_MARGIN
-        if ok.any():
-            rows = np.flatnonzero(ok)
-            ok[rows] = coll.self_clearance(self.robot, qs[rows], self.base) > 0.0
-        if self.obstacles and ok.any():
-            rows = np.flatnonzero(ok)
-            d = coll.collision_check(self.robot, qs[rows], self.obstacles, self.base,
-                                    exact_within=EXACT_DISTANCE_WITHIN).distance
-            ok[rows] = d > 0.0
-        return ok
+        overlapping, and clear of the obstacles (``geometry.path_check.feasible``: the clearances in one C++ call)."""
+        return path_check.feasible(self, qs, DETOUR_MARGIN)
+
+    def path_feasible(self, path: np.ndarray) -> bool:
+        """A path of waypoints whose clearances are proven along its straight segments and whose static margin
+        keeps DETOUR_MARGIN at its :func:`check_points` configurations (``geometry.path_check.path_feasible``)."""
+        return path_check.path_feasible(self, path, check_points(path), DETOUR_MARGIN)
 
     def _joint_path(self, qa: np.ndarray, qb: np.ndarray, n: int) -> tuple[np.ndarray, str]:
         """A joint-space path qa -> qb of about n configurations that stays stable and above the ground.
@@ -215,7 +207,7 @@ class Waypoints:
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = split_steps(qa + s * (qb - qa))
-        if self.feasible(check_points(straight)).all():
+        if self.path_feasible(straight):
             return straight, "joint space"
         movable = np.arange(self.robot.lift_joints.start, self.robot.parts.head.stop)
         rng = np.random.default_rng(DETOUR_SEED)
@@ -230,7 +222,7 @@ class Waypoints:
             ok = self.feasible(flat).reshape(len(batch), -1).all(axis=1)
             for k in batch[ok]:
                 path = split_steps(paths[k])
-                if self.feasible(check_points(path)).all():
+                if self.path_feasible(path):
                     return path, "joint space via a stable detour"
         flat = densify(paths).reshape(-1, qa.size)
         worst = self._margins(flat).reshape(len(W), -1).min(axis=1)

@@ -1,0 +1,177 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+#include "snakehead/path_check.hpp"
+
+namespace py = pybind11;
+
+namespace snakehead::bindings {
+
+namespace {
+
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Indices = py::array_t<long, py::array::c_style>;
+
+std::vector<std::array<long, 2>> pairs_of(const char* what, const Indices& pairs) {
+  if (pairs.ndim() != 2 || pairs.shape(1) != 2) throw InputError(std::string(what) + " must have shape (P, 2)");
+  std::vector<std::array<long, 2>> out;
+  for (py::ssize_t p = 0; p < pairs.shape(0); ++p) out.push_back({pairs.at(p, 0), pairs.at(p, 1)});
+  return out;
+}
+
+std::vector<long> list_of(const char* what, const Indices& list) {
+  if (list.ndim() != 1) throw InputError(std::string(what) + " must have shape (k,)");
+  return {list.data(), list.data() + list.shape(0)};
+}
+
+long samples_of(const char* what, const Doubles& q, long n) {
+  if (q.ndim() != 2 || q.shape(1) != n)
+    throw InputError(std::string(what) + " must have shape (T, " + std::to_string(n) + ")");
+  return static_cast<long>(q.shape(0));
+}
+
+py::array_t<double> array_of(const std::vector<double>& v, std::vector<py::ssize_t> shape) {
+  py::array_t<double> out(shape);
+  std::copy(v.begin(), v.end(), out.mutable_data());
+  return out;
+}
+
+}  // namespace
+
+void bind_path_check(py::module_& m) {
+  py::class_<PathChecker, std::shared_ptr<PathChecker>>(
+      m, "PathChecker",
+      "Ground, self and obstacle clearances of a chain's configurations, per sample and proven along straight "
+      "joint segments (path_check.hpp); immutable, safe to share between threads")
+      .def(py::init([](const ChainModel& model, const ShapeSet& shapes, const Eigen::Matrix4d& origin,
+                       const Indices& ground_shapes, const Indices& self_pairs,
+                       std::optional<std::reference_wrapper<const ShapeSet>> obstacles,
+                       const Indices& obstacle_pairs, double ground_floor, double obstacle_cutoff) {
+             PathCheckSpec spec;
+             spec.ground_shapes = list_of("ground_shapes", ground_shapes);
+             spec.self_pairs = pairs_of("self_pairs", self_pairs);
+             spec.obstacle_pairs = pairs_of("obstacle_pairs", obstacle_pairs);
+             spec.ground_floor = ground_floor;
+             spec.obstacle_cutoff = obstacle_cutoff;
+             return std::make_shared<PathChecker>(model, shapes, origin, std::move(spec),
+                                                 obstacles ? &obstacles->get() : nullptr);
+           }),
+           py::arg("model"), py::arg("shapes"), py::arg("origin"), py::arg("ground_shapes"), py::arg("self_pairs"),
+           py::arg("obstacles"), py::arg("obstacle_pairs"), py::arg("ground_floor"), py::arg("obstacle_cutoff"),
+           py::keep_alive<1, 2>(), py::keep_alive<1, 3>(), py::keep_alive<1, 7>(),
+           "model: the chain; shapes: its links' shapes; origin: the chain base's world pose (4, 4); ground_shapes "
+           "(k,): shapes whose lowest point must stay >= ground_floor (m); self_pairs (P, 2): shape pairs that must "
+           "stay apart; obstacles: a ShapeSet on one world frame (or None) and obstacle_pairs (Q, 2) (robot shape, "
+           "obstacle shape); obstacle_cutoff (m): per-sample obstacle distances are exact below it")
+      .def(
+          "sample",
+          [](const PathChecker& c, const Doubles& qs) {
+            const long T = samples_of("qs", qs, c.n_joints());
+            SampleClearances s;
+            {
+              py::gil_scoped_release release;
+              s = c.sample(qs.data(), T);
+            }
+            const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(T)};
+            return py::make_tuple(array_of(s.ground, shape), array_of(s.self, shape), array_of(s.obstacle, shape));
+          },
+          py::arg("qs"),
+          "Each configuration's (T, n) smallest ground clearance, self clearance and obstacle distance (m): three "
+          "(T,) arrays, +inf where nothing is checked")
+      .def(
+          "motion_bounds",
+          [](const PathChecker& c, const Eigen::VectorXd& qa, const Eigen::VectorXd& qb) {
+            if (qa.size() != c.n_joints() || qb.size() != c.n_joints())
+              throw InputError("motion_bounds: qa and qb must have n_joints entries");
+            std::vector<double> B, Z;
+            {
+              py::gil_scoped_release release;
+              c.motion_bounds(qa, qb, B, Z);
+            }
+            const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(B.size())};
+            return py::make_tuple(array_of(B, shape), array_of(Z, shape));
+          },
+          py::arg("qa"), py::arg("qb"),
+          "Per robot shape: how far any of its points moves (m) and how far its lowest z changes (m) along the "
+          "straight joint segment qa -> qb (proven bounds: path_check.hpp)")
+      .def(
+          "check_path",
+          [](const PathChecker& c, const Doubles& waypoints, double first_step, double floor_step,
+             bool stop_at_violation) {
+            const long K = samples_of("waypoints", waypoints, c.n_joints());
+            PathOptions o;
+            o.first_step = first_step;
+            o.floor_step = floor_step;
+            o.stop_at_violation = stop_at_violation;
+            PathVerdict v;
+            {
+              py::gil_scoped_release release;
+              v = c.check_path(waypoints.data(), K, o);
+            }
+            py::array_t<bool> segments(static_cast<py::ssize_t>(v.segment_clear.size()));
+            for (std::size_t i = 0; i < v.segment_clear.size(); ++i) segments.mutable_at(i) = v.segment_clear[i] != 0;
+            py::dict d;
+            d["clear"] = v.clear() && v.violations == 0;
+            d["segments"] = segments;
+            d["samples"] = v.samples;
+            d["proven"] = v.proven;
+            d["unproven"] = v.unproven;
+            d["violations"] = v.violations;
+            d["ground"] = v.ground;
+            d["self"] = v.self;
+            d["obstacle"] = v.obstacle;
+            return d;
+          },
+          py::arg("waypoints"), py::arg("first_step") = 0.05, py::arg("floor_step") = 1e-3,
+          py::arg("stop_at_violation") = true,
+          "Proves the straight joint segments between waypoints (K, n) clear: a dict with clear, segments (K-1,) "
+          "bool, samples evaluated, intervals proven / unproven (at the floor), violations (samples below a floor) "
+          "and the smallest ground, self, obstacle values evaluated");
+
+  m.def(
+      "zmp_check",
+      [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
+         long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
+         double tolerance, long chunk) {
+        const long n = c.n_joints();
+        const long T = samples_of("q", q, n);
+        if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
+        if (samples_of("qd", qd, n) != T) throw InputError("qd must have the shape of q");
+        ZmpCheckSpec spec;
+        spec.contact_shapes = list_of("contact_shapes", contact_shapes);
+        spec.points_per_shape = points_per_shape;
+        spec.clearance_shapes = list_of("clearance_shapes", clearance_shapes);
+        spec.ground_key = ground_key;
+        spec.key_joints = std::move(key_joints);
+        spec.tolerance = tolerance;
+        spec.chunk = chunk;
+        ZmpCheck z;
+        {
+          py::gil_scoped_release release;
+          const RigidBodyChain chain = chain_dynamics(c.model());
+          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T);
+        }
+        const auto N = static_cast<py::ssize_t>(T);
+        py::dict d;
+        d["zmp"] = array_of(z.zmp, {N, 2});
+        d["margin"] = array_of(z.margin, {N});
+        d["P"] = array_of(z.linear, {N, 3});
+        d["L"] = array_of(z.angular, {N, 3});
+        d["com"] = array_of(z.com, {N, 3});
+        d["clearance"] = array_of(z.clearance, {N});
+        return d;
+      },
+      py::arg("checker"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("contact_shapes"),
+      py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
+      py::arg("tolerance"), py::arg("chunk"),
+      "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin "
+      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes");
+}
+
+}  // namespace snakehead::bindings

@@ -1,0 +1,535 @@
+#include "snakehead/path_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "snakehead/kinematics.hpp"
+#include "snakehead/support.hpp"
+
+namespace snakehead {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using Row4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+
+using ItemKind = PathChecker::ItemKind;
+
+// Intervals are not split deeper than this many times (a floor_step of 0 would otherwise recurse without end).
+constexpr int kMaxDepth = 40;
+
+void check_index(const char* what, long index, const ShapeSet& set) {
+  if (index < 0 || index >= set.size())
+    throw InputError(std::string("PathChecker: ") + what + " shape index " + std::to_string(index) +
+                     " is outside the set of " + std::to_string(set.size()) + " shapes");
+}
+
+}  // namespace
+
+bool PathVerdict::clear() const {
+  return std::all_of(segment_clear.begin(), segment_clear.end(), [](unsigned char c) { return c != 0; });
+}
+
+PathChecker::PathChecker(const ChainModel& model, const ShapeSet& shapes, const Eigen::Matrix4d& origin,
+                         PathCheckSpec spec, const ShapeSet* obstacles)
+    : model_(model), shapes_(shapes), obstacles_(obstacles), spec_(std::move(spec)) {
+  if (!origin.allFinite()) throw InputError("PathChecker: origin must be finite");
+  origin_.matrix() = origin;
+  if (std::isnan(spec_.ground_floor) || std::isnan(spec_.obstacle_cutoff))
+    throw InputError("PathChecker: ground_floor and obstacle_cutoff must not be NaN");
+  const auto& segs = model_.segments();
+  const int n = model_.n_joints();
+  for (const auto& s : segs)
+    if (s.prismatic) throw InputError("PathChecker: prismatic joints are not supported (the motion bound needs revolute joints)");
+  if (shapes_.max_frame() >= static_cast<int>(model_.links().size()))
+    throw InputError("PathChecker: a shape is attached to a frame the chain does not have");
+  if (obstacles_ != nullptr && obstacles_->max_frame() > 0)
+    throw InputError("PathChecker: obstacle shapes must all be on frame 0 (the world)");
+  // arm[m]: |o_{m+1} - o_m|, constant for revolute joints (o_{m+1} in joint m's frame is (post_m pre_{m+1})'s origin)
+  std::vector<double> arm(static_cast<std::size_t>(std::max(n - 1, 0)));
+  for (int m = 0; m + 1 < n; ++m) arm[m] = (segs[m].post * segs[m + 1].pre).translation().norm();
+  const auto& links = model_.links();
+  joint_of_shape_.resize(static_cast<std::size_t>(shapes_.size()));
+  reach_.assign(static_cast<std::size_t>(shapes_.size()), std::vector<double>(static_cast<std::size_t>(n), kInf));
+  for (int s = 0; s < shapes_.size(); ++s) {
+    const LinkInfo& link = links[static_cast<std::size_t>(shapes_.shape(s).frame)];
+    const int k = link.segment;
+    joint_of_shape_[s] = k;
+    if (k < 0) continue;
+    // the bounding sphere's centre in joint k's frame (its distance from o_k is constant)
+    const Eigen::Vector3d c = segs[k].post * link.offset * shapes_.shape(s).origin * shapes_.geometry(s).sphere_centre;
+    double along = c.norm();
+    for (int i = k; i >= 0; --i) {
+      reach_[s][i] = along;
+      if (i > 0) along += arm[i - 1];
+    }
+  }
+  for (long s : spec_.ground_shapes) {
+    check_index("ground", s, shapes_);
+    items_.push_back({ItemKind::Ground, s, -1});
+  }
+  for (const auto& p : spec_.self_pairs) {
+    check_index("self pair", p[0], shapes_);
+    check_index("self pair", p[1], shapes_);
+    // the earlier shape first: the pair's bound counts the joints between them
+    const bool swap = joint_of_shape_[p[0]] > joint_of_shape_[p[1]];
+    items_.push_back({ItemKind::Self, swap ? p[1] : p[0], swap ? p[0] : p[1]});
+  }
+  for (const auto& p : spec_.obstacle_pairs) {
+    if (obstacles_ == nullptr) throw InputError("PathChecker: obstacle pairs given without obstacles");
+    check_index("obstacle pair", p[0], shapes_);
+    check_index("obstacle pair", p[1], *obstacles_);
+    items_.push_back({ItemKind::Obstacle, p[0], p[1]});
+  }
+}
+
+void PathChecker::world_frames(const Eigen::VectorXd& q, double* out) const {
+  Frames f;
+  world_frames(q, out, f);
+}
+
+void PathChecker::world_frames(const Eigen::VectorXd& q, double* out, Frames& f) const {
+  link_frames(model_, q, f);
+  for (std::size_t k = 0; k < f.size(); ++k)
+    Eigen::Map<Row4>(out + 16 * k) = origin_.matrix() * f[k].matrix();  // as ChainModel.fk_all_many(qs, origin)
+}
+
+void PathChecker::joints_at(const Eigen::VectorXd& q, Joints& out, std::vector<double>& frames) const {
+  model_.check_configuration(q);
+  frames.resize(static_cast<std::size_t>(16 * links()));
+  world_frames(q, frames.data());
+  const auto& segs = model_.segments();
+  out.axis.resize(segs.size());
+  out.origin.resize(segs.size());
+  Eigen::Isometry3d frame = origin_;
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    const Eigen::Isometry3d joint = frame * segs[i].pre;  // the rotation about the axis keeps both
+    out.axis[i] = joint.linear() * segs[i].axis;
+    out.origin[i] = joint.translation();
+    frame = joint * Eigen::AngleAxisd(q[static_cast<Eigen::Index>(i)], segs[i].axis) * segs[i].post;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Per-sample minima.
+
+SampleClearances PathChecker::sample(const double* qs, long T) const {
+  if (T < 0) throw InputError("PathChecker.sample: negative sample count");
+  const long n = model_.n_joints(), L = links();
+  SampleClearances out;
+  out.ground.assign(static_cast<std::size_t>(T), kInf);
+  out.self.assign(static_cast<std::size_t>(T), kInf);
+  out.obstacle.assign(static_cast<std::size_t>(T), kInf);
+  std::vector<long> self_pairs, obstacle_pairs;
+  for (const auto& p : spec_.self_pairs) self_pairs.insert(self_pairs.end(), {p[0], p[1]});
+  for (const auto& p : spec_.obstacle_pairs) obstacle_pairs.insert(obstacle_pairs.end(), {p[0], p[1]});
+  const long G = static_cast<long>(spec_.ground_shapes.size());
+  constexpr long kBlock = 256;  // samples whose frames are held at once
+  std::vector<double> frames(static_cast<std::size_t>(16 * L * kBlock)), low(static_cast<std::size_t>(G * kBlock));
+  const Eigen::Matrix4d world = Eigen::Matrix4d::Identity();
+  Frames work;
+  for (long t0 = 0; t0 < T; t0 += kBlock) {
+    const long B = std::min(kBlock, T - t0);
+    for (long t = 0; t < B; ++t) {
+      const Eigen::Map<const Eigen::VectorXd> q(qs + (t0 + t) * n, n);
+      model_.check_configuration(q);
+      world_frames(q, frames.data() + 16 * L * t, work);
+    }
+    if (G > 0) {
+      lowest_z(frames.data(), B, L, shapes_, spec_.ground_shapes.data(), G, low.data());
+      for (long t = 0; t < B; ++t)
+        out.ground[t0 + t] = *std::min_element(low.begin() + t * G, low.begin() + (t + 1) * G);
+    }
+    if (!self_pairs.empty())
+      pair_min_distances(frames.data(), B, L, shapes_, frames.data(), B, L, shapes_, self_pairs.data(),
+                         static_cast<long>(self_pairs.size() / 2), kInf, out.self.data() + t0);
+    if (!obstacle_pairs.empty())
+      pair_min_distances(frames.data(), B, L, shapes_, world.data(), 1, 1, *obstacles_, obstacle_pairs.data(),
+                         static_cast<long>(obstacle_pairs.size() / 2), spec_.obstacle_cutoff,
+                         out.obstacle.data() + t0);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The motion bound (see the header).
+
+namespace {
+
+// Distance of point p to the line through o along unit a.
+double axis_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& o, const Eigen::Vector3d& a) {
+  return a.cross(p - o).norm();
+}
+
+// A configuration evaluated lazily: its frames and joints at once, each item's lower bound (cheap) or exact value
+// when first asked.
+class Sample {
+ public:
+  Sample() = default;
+  Eigen::VectorXd q;
+  std::vector<double> frames;
+  std::vector<Eigen::Vector3d> centre;    // world bounding-sphere centre per robot shape
+  std::vector<double> lower;              // per item: a lower bound of its value (exact once exact[i])
+  std::vector<unsigned char> exact;
+  std::vector<Eigen::Vector3d> axis, origin;  // world joint axes and origins
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------------
+// The proof over a path.
+
+class PathProof {
+ public:
+  PathProof(const PathChecker& c, const PathOptions& o) : c_(c), o_(o) {}
+
+  PathVerdict run(const double* waypoints, long K) {
+    const long n = c_.model_.n_joints();
+    if (K < 1) throw InputError("check_path: at least one waypoint is needed");
+    if (!(o_.first_step > 0.0) || !(o_.floor_step >= 0.0) || !std::isfinite(o_.first_step))
+      throw InputError("check_path: first_step must be finite and > 0, floor_step >= 0");
+    v_.segment_clear.assign(static_cast<std::size_t>(K - 1), 0);
+    Sample prev = evaluate(Eigen::Map<const Eigen::VectorXd>(waypoints, n));
+    if (K == 1) single(prev);
+    for (long w = 0; w + 1 < K && !stopped_; ++w) {
+      Sample next = evaluate(Eigen::Map<const Eigen::VectorXd>(waypoints + (w + 1) * n, n));
+      v_.segment_clear[w] = segment(prev, next) ? 1 : 0;
+      prev = std::move(next);
+    }
+    return v_;
+  }
+
+  enum class Status { Clear, Split, Violated };
+
+  Sample evaluate(const Eigen::VectorXd& q) {
+    Sample s;
+    s.q = q;
+    PathChecker::Joints j;
+    c_.joints_at(q, j, s.frames);
+    s.axis = std::move(j.axis);
+    s.origin = std::move(j.origin);
+    ++v_.samples;
+    const int S = c_.shapes_.size();
+    s.centre.resize(static_cast<std::size_t>(S));
+    for (int i = 0; i < S; ++i) s.centre[i] = pose(s, i) * c_.shapes_.geometry(i).sphere_centre;
+    s.lower.resize(c_.items_.size());
+    s.exact.assign(c_.items_.size(), 0);
+    for (std::size_t i = 0; i < c_.items_.size(); ++i) s.lower[i] = cheap(s, c_.items_[i], s.exact[i]);
+    return s;
+  }
+
+ private:
+  Eigen::Isometry3d pose(const Sample& s, long shape) const {
+    Eigen::Isometry3d frame;
+    frame.matrix() = Eigen::Map<const Row4>(s.frames.data() + 16 * c_.shapes_.shape(static_cast<int>(shape)).frame);
+    return frame * c_.shapes_.shape(static_cast<int>(shape)).origin;
+  }
+
+  // The item's lower bound from the bounding spheres (exact for the ground: it is a closed form).
+  double cheap(const Sample& s, const PathChecker::Item& it, unsigned char& exact) {
+    if (it.kind == ItemKind::Ground) {
+      double z = 0.0;
+      lowest_z(s.frames.data(), 1, c_.links(), c_.shapes_, &it.a, 1, &z);
+      exact = 1;
+      note(it, z);
+      return z;
+    }
+    const ShapeGeometry& ga = c_.shapes_.geometry(static_cast<int>(it.a));
+    if (it.kind == ItemKind::Self) {
+      const ShapeGeometry& gb = c_.shapes_.geometry(static_cast<int>(it.b));
+      return (s.centre[it.a] - s.centre[it.b]).norm() - ga.sphere_radius - gb.sphere_radius;
+    }
+    const ShapeGeometry& gb = c_.obstacles_->geometry(static_cast<int>(it.b));
+    const Eigen::Vector3d cb = c_.obstacles_->shape(static_cast<int>(it.b)).origin * gb.sphere_centre;
+    return (s.centre[it.a] - cb).norm() - ga.sphere_radius - gb.sphere_radius;
+  }
+
+  double exact(Sample& s, std::size_t i) {
+    if (s.exact[i]) return s.lower[i];
+    const PathChecker::Item& it = c_.items_[i];
+    const Eigen::Isometry3d pa = pose(s, it.a);
+    double d;
+    if (it.kind == ItemKind::Self)
+      d = shape_signed_distance(c_.shapes_, static_cast<int>(it.a), pa, c_.shapes_, static_cast<int>(it.b), pose(s, it.b));
+    else
+      d = shape_signed_distance(c_.shapes_, static_cast<int>(it.a), pa, *c_.obstacles_, static_cast<int>(it.b),
+                                c_.obstacles_->shape(static_cast<int>(it.b)).origin);
+    s.exact[i] = 1;
+    s.lower[i] = d;
+    note(it, d);
+    return d;
+  }
+
+  void note(const PathChecker::Item& it, double d) {
+    double& m = it.kind == ItemKind::Ground ? v_.ground : it.kind == ItemKind::Self ? v_.self : v_.obstacle;
+    m = std::min(m, d);
+  }
+
+  bool passes(const PathChecker::Item& it, double value) const {
+    return it.kind == ItemKind::Ground ? value >= c_.spec_.ground_floor : value > 0.0;
+  }
+
+  // A single configuration: clear when every item passes exactly.
+  void single(Sample& s) {
+    for (std::size_t i = 0; i < c_.items_.size(); ++i)
+      if (!passes(c_.items_[i], s.lower[i]) && !passes(c_.items_[i], exact(s, i))) ++v_.violations;
+  }
+
+  Status interval(Sample& a, Sample& b) {
+    bounds(a, b, B_, Z_);
+    bool split = false;
+    for (std::size_t i = 0; i < c_.items_.size(); ++i) {
+      const PathChecker::Item& it = c_.items_[i];
+      const double bound = it.kind == ItemKind::Ground ? Z_[it.a] : it.kind == ItemKind::Obstacle ? B_[it.a] : pair_[i];
+      if (passes(it, 0.5 * (a.lower[i] + b.lower[i] - bound))) continue;
+      const double ea = exact(a, i), eb = exact(b, i);
+      if (!passes(it, ea) || !passes(it, eb)) return Status::Violated;
+      if (!passes(it, 0.5 * (ea + eb - bound))) split = true;
+    }
+    return split ? Status::Split : Status::Clear;
+  }
+
+ public:
+  // The motion bounds of the straight segment a -> b (see the header): B_S and Z_S per robot shape, and each self
+  // pair's bound (pair_), the sum over the joints between the pair's links only.
+  void bounds(const Sample& a, const Sample& b, std::vector<double>& B, std::vector<double>& Z) {
+    const int S = c_.shapes_.size(), n = c_.model_.n_joints();
+    B.assign(static_cast<std::size_t>(S), 0.0);
+    Z.assign(static_cast<std::size_t>(S), 0.0);
+    const Eigen::VectorXd dq = (b.q - a.q).cwiseAbs();
+    turned_.assign(static_cast<std::size_t>(n) + 1, 0.0);  // turned_[j]: sum_{i < j} |dq_i|
+    for (int j = 0; j < n; ++j) turned_[j + 1] = turned_[j] + dq[j];
+    radius_.assign(static_cast<std::size_t>(S * n), 0.0);  // r_{j,S} + rho
+    for (int s = 0; s < S; ++s) {
+      const double rho = c_.shapes_.geometry(s).sphere_radius;
+      double relative = 0.0;  // sum_{j < i <= k} |dq_i| reach(i, S), built from the last joint back
+      for (int j = c_.joint_of_shape_[s]; j >= 0; --j) {
+        const double d = std::min(axis_distance(a.centre[s], a.origin[j], a.axis[j]),
+                                  axis_distance(b.centre[s], b.origin[j], b.axis[j]));
+        const double r = std::min(d + relative, c_.reach_[s][j]) + rho;
+        const double tilt = std::min(1.0, std::min(a.axis[j].head<2>().norm(), b.axis[j].head<2>().norm()) + turned_[j]);
+        radius_[static_cast<std::size_t>(s * n + j)] = r;
+        B[s] += dq[j] * r;
+        Z[s] += dq[j] * tilt * r;
+        relative += dq[j] * c_.reach_[s][j];
+      }
+    }
+    pair_.assign(c_.items_.size(), 0.0);
+    for (std::size_t i = 0; i < c_.items_.size(); ++i) {
+      const PathChecker::Item& it = c_.items_[i];
+      if (it.kind != ItemKind::Self) continue;
+      // in the earlier link's frame only the joints after it move the later shape, each about the same axis
+      // distance (frame-invariant) but with the relative term counting the joints after j only: r_{j,S2} holds
+      double sum = 0.0;
+      for (int j = c_.joint_of_shape_[it.b]; j > c_.joint_of_shape_[it.a]; --j)
+        sum += dq[j] * radius_[static_cast<std::size_t>(it.b * n + j)];
+      pair_[i] = sum;
+    }
+  }
+
+ private:
+  // Proves [a, b]; splits it (down to the floor) where the bound is too loose.
+  bool prove(Sample& a, Sample& b, int depth) {
+    const Status s = interval(a, b);
+    if (s == Status::Clear) {
+      ++v_.proven;
+      return true;
+    }
+    if (s == Status::Violated) {
+      ++v_.violations;
+      stopped_ = o_.stop_at_violation;
+      return false;
+    }
+    if ((b.q - a.q).cwiseAbs().maxCoeff() <= o_.floor_step || depth >= kMaxDepth) {
+      ++v_.unproven;
+      return false;
+    }
+    Sample mid = evaluate(0.5 * (a.q + b.q));
+    const bool left = prove(a, mid, depth + 1);
+    if (stopped_) return false;
+    const bool right = prove(mid, b, depth + 1);
+    return left && right;
+  }
+
+  // The segment a -> b, first sampled at most first_step apart.
+  bool segment(Sample& a, Sample& b) {
+    const double step = (b.q - a.q).cwiseAbs().maxCoeff();
+    const long pieces = std::max(1L, static_cast<long>(std::ceil(step / o_.first_step - 1e-9)));
+    bool clear = true;
+    Sample left = a;
+    for (long p = 1; p <= pieces && !stopped_; ++p) {
+      Sample right = p == pieces ? b : evaluate(a.q + (static_cast<double>(p) / pieces) * (b.q - a.q));
+      clear = prove(left, right, 0) && clear;
+      if (p == pieces) b = right;  // keeps the exact values computed at b for the next segment
+      left = std::move(right);
+    }
+    return clear && !stopped_;
+  }
+
+  const PathChecker& c_;
+  const PathOptions& o_;
+  PathVerdict v_;
+  bool stopped_ = false;
+  std::vector<double> B_, Z_, pair_, turned_, radius_;
+};
+
+PathVerdict PathChecker::check_path(const double* waypoints, long K, const PathOptions& options) const {
+  return PathProof(*this, options).run(waypoints, K);
+}
+
+void PathChecker::motion_bounds(const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, std::vector<double>& B,
+                                std::vector<double>& Z) const {
+  const PathOptions options;
+  PathProof proof(*this, options);
+  proof.bounds(proof.evaluate(qa), proof.evaluate(qb), B, Z);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The ZMP check.
+
+void time_derivative(const double* t, const double* x, long T, long m, double* out) {
+  if (T < 2) throw InputError("time_derivative: at least two samples are needed");
+  if (T == 2) {
+    for (long c = 0; c < m; ++c) out[c] = out[m + c] = (x[m + c] - x[c]) / (t[1] - t[0]);
+    return;
+  }
+  for (long k = 1; k + 1 < T; ++k) {  // numpy.gradient's second-order differences on uneven steps
+    const double h1 = t[k] - t[k - 1], h2 = t[k + 1] - t[k];
+    const double a = -h2 / (h1 * (h1 + h2)), b = (h2 - h1) / (h1 * h2), c = h1 / (h2 * (h1 + h2));
+    for (long j = 0; j < m; ++j) out[k * m + j] = a * x[(k - 1) * m + j] + b * x[k * m + j] + c * x[(k + 1) * m + j];
+  }
+  {
+    const double h1 = t[1] - t[0], h2 = t[2] - t[1];
+    const double a = -(2.0 * h1 + h2) / (h1 * (h1 + h2)), b = (h1 + h2) / (h1 * h2), c = -h1 / (h2 * (h1 + h2));
+    for (long j = 0; j < m; ++j) out[j] = a * x[j] + b * x[m + j] + c * x[2 * m + j];
+  }
+  {
+    const double h1 = t[T - 2] - t[T - 3], h2 = t[T - 1] - t[T - 2];
+    const double a = h2 / (h1 * (h1 + h2)), b = -(h2 + h1) / (h1 * h2), c = (2.0 * h2 + h1) / (h2 * (h1 + h2));
+    for (long j = 0; j < m; ++j)
+      out[(T - 1) * m + j] = a * x[(T - 3) * m + j] + b * x[(T - 2) * m + j] + c * x[(T - 1) * m + j];
+  }
+}
+
+namespace {
+
+// The contact configuration a sample belongs to (see ZmpCheckSpec): the rounded key joints (np.round(q, 12)) and,
+// for contact "ground", the last link touching the ground; `low` holds the contact shapes' lowest z.
+void contact_key(const ZmpCheckSpec& spec, const std::vector<int>& child, const ShapeSet& shapes, const double* low,
+                 const double* q, std::vector<double>& key) {
+  key.clear();
+  const auto rounded = [](double v) { return std::nearbyint(v * 1e12) / 1e12; };
+  if (!spec.ground_key) {
+    for (int j : spec.key_joints) key.push_back(rounded(q[j]));
+    return;
+  }
+  int last = -1;
+  for (std::size_t i = 0; i < spec.contact_shapes.size(); ++i)
+    if (low[i] <= spec.tolerance) last = std::max(last, shapes.shape(static_cast<int>(spec.contact_shapes[i])).frame);
+  for (std::size_t j = 0; j < child.size(); ++j) key.push_back(child[j] <= last ? rounded(q[j]) : 0.0);
+  key.push_back(last);
+}
+
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
+
+// A run's support polygon: the convex hull (counter-clockwise vertices) of its touching contact points.
+Points support_hull(const ZmpCheckSpec& spec, const ShapeSet& shapes, const double* frames, long L) {
+  const long k = static_cast<long>(spec.contact_shapes.size()), M = spec.points_per_shape;
+  std::vector<double> pts(static_cast<std::size_t>(3 * k * M));
+  lowest_points(frames, 1, L, shapes, spec.contact_shapes.data(), k, M, pts.data());
+  Points touching(k * M, 2);
+  long m = 0;
+  for (long p = 0; p < k * M; ++p)
+    if (pts[3 * p + 2] <= spec.tolerance) touching.row(m++) << pts[3 * p], pts[3 * p + 1];
+  const std::vector<int> hull = convex_hull(touching.topRows(m));
+  Points out(static_cast<Eigen::Index>(hull.size()), 2);
+  for (std::size_t v = 0; v < hull.size(); ++v) out.row(static_cast<Eigen::Index>(v)) = touching.row(hull[v]);
+  return out;
+}
+
+}  // namespace
+
+ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, const ZmpCheckSpec& spec,
+                   const double* t, const double* q, const double* qd, long T) {
+  const ChainModel& model = checker.model();
+  const ShapeSet& shapes = checker.shapes();
+  const long n = model.n_joints(), L = checker.links();
+  if (T < 2) throw InputError("zmp_check: at least two samples are needed");
+  for (long k = 1; k < T; ++k)
+    if (!(t[k] > t[k - 1])) throw InputError("zmp_check: t must increase strictly");
+  if (spec.chunk < 1 || spec.points_per_shape < 1) throw InputError("zmp_check: chunk and points_per_shape must be >= 1");
+  for (long s : spec.contact_shapes) check_index("contact", s, shapes);
+  for (long s : spec.clearance_shapes) check_index("clearance", s, shapes);
+  for (int j : spec.key_joints)
+    if (j < 0 || j >= n) throw InputError("zmp_check: key joint " + std::to_string(j) + " is outside the chain");
+  ZmpCheck out;
+  out.linear.resize(static_cast<std::size_t>(3 * T));
+  out.angular.resize(static_cast<std::size_t>(3 * T));
+  out.com.resize(static_cast<std::size_t>(3 * T));
+  out.clearance.assign(static_cast<std::size_t>(T), kInf);
+  std::vector<Points> polygons;  // each run's support polygon
+  std::vector<long> run(static_cast<std::size_t>(T));
+  std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
+  // one lowest_z call per sample for the contact shapes and the clearance shapes after them
+  std::vector<long> lowest_of(spec.contact_shapes);
+  lowest_of.insert(lowest_of.end(), spec.clearance_shapes.begin(), spec.clearance_shapes.end());
+  const long K = static_cast<long>(spec.contact_shapes.size()), C = static_cast<long>(spec.clearance_shapes.size());
+  std::vector<double> low(static_cast<std::size_t>(K + C));
+  const std::vector<int> child = chain.joint_child;
+  Frames work;
+  for (long k = 0; k < T; ++k) {
+    const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
+    model.check_configuration(qk);
+    checker.world_frames(qk, frames.data(), work);
+    momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
+    lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), K + C, low.data());
+    if (C > 0) out.clearance[k] = *std::min_element(low.begin() + K, low.end());
+    contact_key(spec, child, shapes, low.data(), q + k * n, key);
+    if (k % spec.chunk == 0 || key != previous) {
+      polygons.push_back(support_hull(spec, shapes, frames.data(), L));
+      previous = key;
+    }
+    run[k] = static_cast<long>(polygons.size()) - 1;
+  }
+  std::vector<double> Pdot(static_cast<std::size_t>(3 * T)), Ldot(static_cast<std::size_t>(3 * T));
+  time_derivative(t, out.linear.data(), T, 3, Pdot.data());    // Eq. 33's dP/dt
+  time_derivative(t, out.angular.data(), T, 3, Ldot.data());   // Eq. 34's dL/dt
+  double M = 0.0;
+  for (double m : chain.mass) M += m;
+  constexpr double kGravity = 9.80665;  // snakehead.dynamics.stability.GRAVITY
+  out.zmp.resize(static_cast<std::size_t>(2 * T));
+  out.margin.resize(static_cast<std::size_t>(T));
+  for (long k = 0; k < T; ++k) {
+    const double den = M * kGravity + Pdot[3 * k + 2];
+    const double* c = &out.com[3 * k];
+    if (!(den > 0.0)) {  // the ground cannot pull: no ZMP, the body would leave the ground
+      out.zmp[2 * k] = out.zmp[2 * k + 1] = std::numeric_limits<double>::quiet_NaN();
+      out.margin[k] = -kInf;
+      continue;
+    }
+    const Eigen::Vector2d p((M * kGravity * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
+                            (M * kGravity * c[1] + Ldot[3 * k]) / den);      // Eq. 40
+    out.zmp[2 * k] = p.x();
+    out.zmp[2 * k + 1] = p.y();
+    out.margin[k] = hull_margin(polygons[static_cast<std::size_t>(run[k])], p);  // the hull's hull: itself
+  }
+  return out;
+}
+
+RigidBodyChain chain_dynamics(const ChainModel& model) {
+  RigidBodyChain chain;
+  for (const auto& s : model.segments()) {
+    chain.joint_child.push_back(model.link_index(s.link));
+    chain.axis.push_back(s.axis);
+  }
+  for (const auto& link : model.links()) {
+    chain.mass.push_back(link.mass);
+    chain.com.push_back(link.com);
+    chain.inertia.push_back(link.inertia);
+  }
+  return chain;
+}
+
+}  // namespace snakehead

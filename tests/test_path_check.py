@@ -1,0 +1,171 @@
+"""The path checks in C++ batches (geometry.path_check, _core.PathChecker, _core.zmp_check) against brute force and
+the Python reference: per-sample minima equal the collision module's, the motion bound is never exceeded (100x finer
+sampling), a proven-clear path is clear at every fine sample, and the ZMP check equals the Python dynamic_stability."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from snakehead.dynamics import stability
+from snakehead.geometry import BoxObstacle, collision as coll, path_check
+from snakehead.margins import EXACT_DISTANCE_WITHIN
+from snakehead.geometry.shapes import shape_points
+from snakehead.model.published import write_robot
+from snakehead.model.robot import BasePlacement, SnakeRobot
+
+FINE = 100  # brute force: points per interval
+
+
+@pytest.fixture(scope="module")
+def robots(tmp_path_factory: pytest.TempPathFactory) -> dict[str, SnakeRobot]:
+    """The default robot and published-style snakes: cylinders along x (reu), modules along z (sea), meshes."""
+    folder = Path(tmp_path_factory.mktemp("published"))
+    out = {"default": SnakeRobot.default()}
+    for style in ("reu", "sea", "mesh"):
+        out[style] = SnakeRobot.from_file(write_robot(style, folder / style))
+    return out
+
+
+def _near_start(robot: SnakeRobot, rng: np.random.Generator, spread: float) -> np.ndarray:
+    """A configuration near the straight body, the neck and head lifted a little (close to the ground)."""
+    q = rng.normal(0.0, spread, robot.n_joints)
+    return np.clip(q, robot.lower, robot.upper)
+
+
+def _world_points(robot: SnakeRobot, frames: np.ndarray) -> list[np.ndarray]:
+    """Per shape, its points (T, P, 3) in the world (convex hulls of shapes: the extreme points of each)."""
+    out = []
+    for s in robot.geometry.shapes:
+        P = shape_points(s, 32)
+        F = frames[:, s.frame]
+        out.append(np.einsum("tij,pj->tpi", F[:, :3, :3], P) + F[:, None, :3, 3])
+    return out
+
+
+def test_sample_minima_equal_the_collision_module(robots: dict[str, SnakeRobot]) -> None:
+    rng = np.random.default_rng(5)
+    for name, robot in robots.items():
+        base = BasePlacement(0.1, -0.2, 0.3)
+        qs = np.array([_near_start(robot, rng, 0.4) for _ in range(40)])
+        box = BoxObstacle(centre=(0.5, 0.0, 0.1), size=(0.1, 0.3, 0.2))
+        ground, self_, obstacle = path_check.sample_clearances(robot, qs, base, [box])
+        ref = coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min(axis=1)
+        np.testing.assert_array_equal(ground, ref, err_msg=name)
+        np.testing.assert_allclose(self_, coll.self_clearance(robot, qs, base), atol=1e-12, err_msg=name)
+        d = coll.collision_check(robot, qs, [box], base, exact_within=EXACT_DISTANCE_WITHIN).distance
+        near = d < EXACT_DISTANCE_WITHIN  # exact there; both report lower bounds above it
+        np.testing.assert_allclose(obstacle[near], d[near], atol=1e-12, err_msg=name)
+        assert (obstacle[~near] >= EXACT_DISTANCE_WITHIN).all()
+        assert near.any() and (d <= 0).any(), f"{name}: the obstacle must be met by some samples"
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 2**32 - 1), which=st.sampled_from(["default", "reu", "sea", "mesh"]),
+       spread=st.sampled_from([0.02, 0.1, 0.4]))
+def test_motion_bound_is_never_exceeded(robots: dict[str, SnakeRobot], seed: int, which: str, spread: float) -> None:
+    """Every point of every shape moves at most B_S and its lowest z changes at most Z_S along the segment, and the
+    true minimum of a clearance over the interval is at least the ends' minus the bound."""
+    robot = robots[which]
+    rng = np.random.default_rng(seed)
+    base = BasePlacement(*rng.uniform(-1, 1, 3))
+    qa = _near_start(robot, rng, 0.5)
+    qb = np.clip(qa + rng.normal(0.0, spread, robot.n_joints), robot.lower, robot.upper)
+    B, Z = path_check.checker(robot, base).motion_bounds(qa, qb)
+    s = np.linspace(0.0, 1.0, FINE + 1)[:, None]
+    frames = robot.frames_many(qa + s * (qb - qa), base)
+    for i, W in enumerate(_world_points(robot, frames)):
+        moved = np.linalg.norm(W - W[:1], axis=2).max()
+        low = W[..., 2].min(axis=1)
+        assert moved <= B[i] + 1e-12
+        assert np.abs(low - low[0]).max() <= Z[i] + 1e-12
+        assert low.min() >= 0.5 * (low[0] + low[-1] - Z[i]) - 1e-12  # the cones' meeting point
+
+
+@pytest.mark.parametrize("which", ["default", "reu", "sea", "mesh"])
+def test_a_proven_clear_path_is_clear_at_every_fine_sample(robots: dict[str, SnakeRobot], which: str) -> None:
+    robot = robots[which]
+    base = BasePlacement()
+    box = BoxObstacle(centre=(robot.body_length * 0.6, 0.25, 0.1), size=(0.1, 0.1, 0.2))
+    proven = 0
+    for seed in range(8):
+        rng = np.random.default_rng(seed)
+        W = np.array([_near_start(robot, rng, 0.15) for _ in range(3)])
+        W[:, robot.lift_joints.start] = -np.abs(W[:, robot.lift_joints.start])  # the neck's first pitch, one way
+        for obstacles in ([], [box]):
+            report = path_check.check_path(robot, W, base, obstacles, stop_at_violation=False)
+            for k in np.flatnonzero(report.segments):
+                proven += 1
+                s = np.linspace(0.0, 1.0, FINE + 1)[:, None]
+                qs = W[k] + s * (W[k + 1] - W[k])
+                assert coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min() >= -coll.GROUND_TOLERANCE
+                assert coll.self_clearance(robot, qs, base).min() > 0.0
+                if obstacles:
+                    assert coll.collision_check(robot, qs, obstacles, base, exact_within=np.inf).distance.min() > 0.0
+    assert proven > 0, "no segment proven: the test would check nothing"
+
+
+def test_check_path_finds_a_violation_between_clear_waypoints() -> None:
+    """Two waypoints clear of a thin wall, the straight path between them through it: not proven, a violation."""
+    robot = SnakeRobot.default()
+    H = robot.head_pose(np.zeros(robot.n_joints))
+    wall = BoxObstacle(centre=(H[0, 3] - 0.1, 0.0, 0.02), size=(0.01, 0.02, 0.04))
+    qa, qb = np.zeros(robot.n_joints), np.zeros(robot.n_joints)
+    yaw = [j for j in range(robot.lift_joints.start, robot.n_joints) if robot.joint_kinds[j] == "yaw"][0]
+    qa[yaw], qb[yaw] = 0.6, -0.6
+    ends = path_check.sample_clearances(robot, np.array([qa, qb]), None, [wall])[2]
+    assert (ends > 0).all()
+    report = path_check.check_path(robot, np.array([qa, qb]), None, [wall])
+    assert not report.clear and report.violations >= 1 and report.obstacle <= 0.0
+
+
+def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) -> None:
+    """The C++ dynamic stability (contact "ground" and "footprint") equals the Python path to 1e-9: the same
+    contact runs (chunks of a few samples, to cross their boundaries), ZMP and margins."""
+    for name in ("default", "reu"):
+        robot = robots[name]
+        q0 = np.zeros(robot.n_joints)  # flat and straight: every link on the ground
+        q1 = q0.copy()
+        pitch = robot.lift_joints.start
+        q1[pitch] = 0.5  # the neck rises (the sign that lifts the head, below)
+        q1[pitch] = -q1[pitch] if robot.head_pose(q1)[2, 3] < robot.head_pose(-q1)[2, 3] else q1[pitch]
+        t = np.linspace(0.0, 2.0, 401)
+        s = (3 * (t / 2) ** 2 - 2 * (t / 2) ** 3)[:, None]  # rest to rest: the head lifts off the ground
+        q, qd = q0 + s * (q1 - q0), (6 * (t / 2) * (1 - t / 2) / 2)[:, None] * (q1 - q0)
+        base = BasePlacement(0.2, 0.1, 0.4)
+        for contact in ("ground", "footprint"):
+            old = stability.SAMPLE_CHUNK
+            stability.SAMPLE_CHUNK = 37
+            try:
+                core, clearance = stability.dynamic_stability_with_clearance(robot, t, q, base, qd, contact=contact)
+                ref = stability._dynamic_stability_python(robot, t, q, base, qd, contact, stability.CONTACT_TOLERANCE,
+                                                          None, None)
+            finally:
+                stability.SAMPLE_CHUNK = old
+            np.testing.assert_allclose(core.margin, ref.margin, atol=1e-9, rtol=0, err_msg=f"{name} {contact}")
+            np.testing.assert_allclose(core.zmp, ref.zmp, atol=1e-9, rtol=0)
+            np.testing.assert_allclose(core.P, ref.P, atol=1e-9, rtol=0)
+            np.testing.assert_allclose(core.L, ref.L, atol=1e-9, rtol=0)
+            np.testing.assert_allclose(core.com, ref.com, atol=1e-12, rtol=0)
+            assert core.argmin == ref.argmin and core.stable == ref.stable
+            lowest = robot.lowest_z(robot.frames_many(q, base), robot.lifted_links).min(axis=1)
+            np.testing.assert_array_equal(clearance, lowest)
+        runs = stability._polygons_along(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+        assert runs > 2, "the motion must change its contacts (the head lifts)"
+
+
+def test_checker_refuses_bad_input() -> None:
+    robot = SnakeRobot.default()
+    from snakehead import InputError, _core
+
+    with pytest.raises(InputError, match="ground"):
+        _core.PathChecker(robot.body.model, robot.geometry.core, np.eye(4), np.array([10**6]),
+                          np.zeros((0, 2), np.int64), None, np.zeros((0, 2), np.int64), -1e-3, np.inf)
+    c = path_check.checker(robot)
+    with pytest.raises(InputError, match="first_step"):
+        c.check_path(np.zeros((2, robot.n_joints)), 0.0, 1e-3, True)
+    with pytest.raises(InputError, match="waypoints"):
+        c.check_path(np.zeros((2, 3)), 0.5, 1e-3, True)
