@@ -386,11 +386,12 @@ CORE_CONTACT_MODELS = ("ground", "footprint")
 
 def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike,
                                      base: BasePlacement | None = None, qd: npt.ArrayLike | None = None, *,
-                                     contact: str = "ground", tolerance: float = CONTACT_TOLERANCE
-                                     ) -> tuple[DynamicStability, np.ndarray]:
+                                     contact: str = "ground", tolerance: float = CONTACT_TOLERANCE,
+                                     made: _core.PathChecker | None = None) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` (contact "ground" or "footprint") and, from the same frames in the same C++ pass,
     the lowest point of the neck and head links above the ground at each sample (T,) m (as
-    ``geometry.collision.ground_clearance`` over ``robot.lifted_links``)."""
+    ``geometry.collision.ground_clearance`` over ``robot.lifted_links``). ``made``: the
+    ``geometry.path_check.checker`` of the robot at ``base``, when the caller keeps one."""
     robot = as_robot(robot)
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
@@ -398,11 +399,12 @@ def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     if contact not in CORE_CONTACT_MODELS:
         raise InputError(f"contact must be one of {CORE_CONTACT_MODELS}, got {contact!r}")
-    return _stability_in_core(robot, t, q, base, qd, contact, tolerance)
+    return _stability_in_core(robot, t, q, base, qd, contact, tolerance, made)
 
 
 def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
-                       contact: str, tolerance: float) -> tuple[DynamicStability, np.ndarray]:
+                       contact: str, tolerance: float, made: _core.PathChecker | None = None
+                       ) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
     differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
     and the neck and head's lowest point per sample."""
@@ -417,7 +419,7 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
         key_joints = list(range(robot.n_joints))[robot.parts.base]
     if len(links) == 0:
         raise InputError("the base part has no links with collision shapes; no support polygon")
-    out = _core.zmp_check(checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
+    out = _core.zmp_check(made if made is not None else checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
                           g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
                           contact == "ground", key_joints, tolerance, SAMPLE_CHUNK)
     margin = out["margin"]

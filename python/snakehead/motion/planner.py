@@ -386,7 +386,8 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
     # the ZMP, the ground and the obstacles at every sample, in C++ (geometry.path_check.finish_checks)
-    dyn, clearance, distance = path_check.finish_checks(robot, base, t, q, qd, obstacles, PLAN_CONTACT)
+    dyn, clearance, distance = path_check.finish_checks(robot, base, t, q, qd, obstacles, PLAN_CONTACT,
+                                                          made=plan.checker)
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,

@@ -9,6 +9,7 @@ from typing import Any, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from .. import _core
 from .._errors import Infeasible, MotionTooLong
 from ..dynamics import stability
 from ..geometry import path_check
@@ -76,6 +77,7 @@ class Waypoints:
     def __init__(self, robot: SnakeRobot, base: BasePlacement, obstacles: Sequence[Any] = ()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
+        self._checker: _core.PathChecker | None = None  # built when first needed (checker)
         self.labels: list[str] = []
         self.qs: list[np.ndarray] = []
         self.times: list[float] = []  # filled in by sample()
@@ -183,6 +185,14 @@ class Waypoints:
             polygons.append(prob.contact_points(prob.frames(q, self.base))[0][:, :2])
         pts = np.stack(polygons)[np.asarray(which).reshape(-1)]
         return stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com_xy)
+
+    @property
+    def checker(self) -> _core.PathChecker:
+        """The C++ path checker of the robot at this plan's base among its obstacles (``geometry.path_check``),
+        built once per plan."""
+        if self._checker is None:
+            self._checker = path_check.checker(self.robot, self.base, self.obstacles)
+        return self._checker
 
     def feasible(self, qs: np.ndarray) -> np.ndarray:
         """(m,) bool: above the ground, statically stable with DETOUR_MARGIN to spare, no two non-neighbouring links
