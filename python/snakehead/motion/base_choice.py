@@ -73,31 +73,13 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: a
     dict that keeps the solves with the base kept (:func:`solve_kept`) for the plan to reuse."""
-    from ..control.whole_body import clear_of_obstacles, solve_checked_target
-
     robot = controller.robot
     obstacles = list(obstacles)
     targets = list(targets)
-
-    def failing(b: Any, q_shape: Any) -> Any:
-        """The first target not solved from this base (None: all are), or why the start state is not usable
-        ("no curl": the base's shape holds no stable curl of the neck and head; "the start": it is in an obstacle)."""
-        try:
-            q_bend = bending_state(controller, q_shape)
-        except Infeasible:
-            return "no curl", None
-        if not clear_of_obstacles(robot, q_bend, obstacles, b):
-            return "the start", None
-        for t in targets:
-            sol = solve_kept(controller, t.position, t.direction, q_shape, b, obstacles, solved)
-            if not sol.success:
-                return t, sol
-        return None, None
-
     start, q0 = controller.base, controller.q_initial
     if base_shape is not None:
         q0 = shape_of(robot, joint_vector(base_shape, robot.n_joints, "base_shape"), q0)
-    first, why = failing(start, q0)
+    first, why = _first_failure(controller, start, q0, targets, obstacles, solved)
     if first is None:
         return start, q0.copy(), None, []
     reason = ("the start state touches an obstacle" if first == "the start" else
@@ -108,40 +90,75 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     far = out_of_range(robot, start, targets)
     if far is not None:
         return start, q0.copy(), None, [f"no relocation: a target is {far}"]
-    # a relocated base must hold a stable curl of the neck and head (the bending state the plan lifts them from):
-    # the whole-body solve is told so, and looks further than a shape (e.g. a straight base) that holds none
-    no_curl = controller.plan_cache.shapes_without_curl
-
-    def has_curl(q: np.ndarray) -> bool:
-        key = shape_key(q, robot.lift_joints.start, 12)
-        if key in no_curl:
-            return False
-        try:
-            bending_state(controller, q)
-        except Infeasible:
-            no_curl.put(key, True)
-            return False
-        return True
-
     order = ([first] if first not in ("the start", "no curl") else []) + [t for t in targets if t is not first]
     for t in order:
-        sol = solve_checked_target(controller, t.position, t.direction, q_prev=q0, base=start, obstacles=obstacles,
-                           allow_base_move=True, problem=controller.body_problem, min_margin=DETOUR_MARGIN,
-                           shape_ok=has_curl)
-        if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
-                                                                   q0[:robot.lift_joints.start])):
-            continue
-        if np.hypot(sol.base.x - start.x, sol.base.y - start.y) > MAX_RELOCATION_M:
-            continue
-        q_shape = shape_of(robot, sol.q, q0)
-        if failing(sol.base, q_shape)[0] is None:
+        found = _relocated_for(controller, t, q0, targets, obstacles, solved)
+        if found is not None:
+            base, q_shape = found
             changed = not np.allclose(q_shape[:robot.lift_joints.start], q0[:robot.lift_joints.start])
-            reloc = Relocation(start, sol.base, changed, reason)
-            return sol.base, q_shape, reloc, [f"the base is relocated to {sol.base}"
-                                              + (" with another flat shape" if changed else "")
-                                              + f" (by locomotion, before the plan): {reason}"]
+            return base, q_shape, Relocation(start, base, changed, reason), [
+                f"the base is relocated to {base}" + (" with another flat shape" if changed else "")
+                + f" (by locomotion, before the plan): {reason}"]
     return start, q0.copy(), None, [f"no single base reaches every target: {reason}"]
 
 
+def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.ndarray, targets: Sequence[Any],
+                   obstacles: Sequence[Any], solved: dict | None) -> tuple[Any, Any]:
+    """The first of ``targets`` not solved (with the base kept, :func:`solve_kept`) from the base at ``base`` with
+    the flat shape of ``q_shape``, and its solution; (None, None) when all are; ("no curl", None) when the base's
+    shape holds no stable curl of the neck and head, ("the start", None) when the start state is in an obstacle."""
+    from ..control.whole_body import clear_of_obstacles
 
-__all__ = ["MAX_RELOCATION_M", "Relocation", "choose_base", "out_of_range", "shape_of"]
+    try:
+        q_bend = bending_state(controller, q_shape)
+    except Infeasible:
+        return "no curl", None
+    if not clear_of_obstacles(controller.robot, q_bend, obstacles, base):
+        return "the start", None
+    for t in targets:
+        sol = solve_kept(controller, t.position, t.direction, q_shape, base, obstacles, solved)
+        if not sol.success:
+            return t, sol
+    return None, None
+
+
+def has_curl(controller: HeadController, q: np.ndarray) -> bool:
+    """Whether the flat shape of q (its joints before the lift) holds a stable curl of the neck and head (a
+    bending state); the shapes that hold none are kept in ``controller.plan_cache.shapes_without_curl``."""
+    no_curl = controller.plan_cache.shapes_without_curl
+    key = shape_key(q, controller.robot.lift_joints.start, 12)
+    if key in no_curl:
+        return False
+    try:
+        bending_state(controller, q)
+    except Infeasible:
+        no_curl.put(key, True)
+        return False
+    return True
+
+
+def _relocated_for(controller: HeadController, target: Any, q0: np.ndarray, targets: Sequence[Any],
+                   obstacles: Sequence[Any], solved: dict | None) -> tuple[BasePlacement, np.ndarray] | None:
+    """The base (placement, a configuration with its flat shape) that the whole-body solve with the base moved
+    finds for ``target`` from the controller's base and the shape of ``q0``, when it is another base, at most
+    MAX_RELOCATION_M away, whose shape holds a stable curl of the neck and head (the bending state the plan lifts
+    them from: the solve is told so, and looks further than a shape, e.g. a straight base, that holds none) and
+    from which every target is solved; else None."""
+    from ..control.whole_body import solve_checked_target
+
+    robot, start = controller.robot, controller.base
+    sol = solve_checked_target(controller, target.position, target.direction, q_prev=q0, base=start,
+                               obstacles=obstacles, allow_base_move=True, problem=controller.body_problem,
+                               min_margin=DETOUR_MARGIN, shape_ok=lambda q: has_curl(controller, q))
+    if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
+                                                               q0[:robot.lift_joints.start])):
+        return None
+    if np.hypot(sol.base.x - start.x, sol.base.y - start.y) > MAX_RELOCATION_M:
+        return None
+    q_shape = shape_of(robot, sol.q, q0)
+    if _first_failure(controller, sol.base, q_shape, targets, obstacles, solved)[0] is not None:
+        return None
+    return sol.base, q_shape
+
+
+__all__ = ["MAX_RELOCATION_M", "Relocation", "choose_base", "out_of_range", "shape_of", "has_curl"]
