@@ -355,7 +355,7 @@ def _reach(args: argparse.Namespace) -> int:
     return 0
 
 
-def _reach_executor(args: argparse.Namespace) -> tuple[object | None, object | None]:
+def _reach_executor(args: argparse.Namespace) -> tuple[Any, Any]:
     """The executor of --workers N (a pool of N processes) or --scheduler ADDRESS (a Dask cluster), and how to
     close it; (None, None) for one process."""
     if args.scheduler is not None:

@@ -40,7 +40,8 @@ class RobotRecipe:
 
     @classmethod
     def of(cls, robot: SnakeRobot) -> RobotRecipe:
-        args = {k: (os.fspath(v) if isinstance(v, os.PathLike) else v) for k, v in robot._arguments.items()}
+        args: dict[str, Any] = {k: (os.fspath(v) if isinstance(v, os.PathLike) else v)
+                                for k, v in robot._arguments.items()}
         for k in ("packages", "limits", "xacro_args"):  # mappings: as sorted pairs, so that the recipe hashes
             if args.get(k) is not None:
                 args[k] = tuple(sorted((str(n), os.fspath(v) if isinstance(v, os.PathLike) else v)
@@ -180,7 +181,7 @@ def plan_one(recipe: RobotRecipe | None, scene: Scene, options: dict, keep_robot
         result: Plan | PlanError = plan(scene, controller=controller, **options)
     except (Infeasible, MotionTooLong, InputError) as exc:
         return PlanError(scene.name, type(exc).__name__, str(exc), time.perf_counter() - t0)
-    if not keep_robot:
+    if not keep_robot and isinstance(result, Plan):
         result.robot = None  # type: ignore[assignment]  # (its C++ chains do not pickle; the caller's is put back)
     return result
 
@@ -211,6 +212,7 @@ def plan_many(target_sets: Sequence[Any], *, executor: Any = None, progress: Pro
     pool = None if executor is None else as_executor(executor)
     robot = plan_options.get("robot")
     recipe = RobotRecipe.of(robot) if robot is not None else None
+    sent = {k: v for k, v in plan_options.items() if k != "robot"}  # the recipe stands for the robot
     robots: dict = {}  # the robots put back in plans that come back without theirs, by robot file
     t0 = time.perf_counter()
     finished = [0]
@@ -227,10 +229,10 @@ def plan_many(target_sets: Sequence[Any], *, executor: Any = None, progress: Pro
     if pool is None:  # here: the plans keep their robot
         results = []
         for i, scene in enumerate(scenes):
-            results.append(plan_one(recipe, scene, plan_options, keep_robot=True))
+            results.append(plan_one(recipe, scene, sent, keep_robot=True))
             done(i, results[-1])
         return results
-    return run_tasks(pool, plan_one, [(recipe, scene, plan_options) for scene in scenes], done)
+    return run_tasks(pool, plan_one, [(recipe, scene, sent) for scene in scenes], done)
 
 
 def _robot_of(scene: Scene, robots: dict) -> SnakeRobot:
