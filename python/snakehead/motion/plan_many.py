@@ -22,6 +22,8 @@ from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene
 from .planner import Plan, PlanProgress, ProgressCallback, TIMING_OPTIONS, as_scene, plan
 
+__all__ = ["plan_many", "plan_one", "PlanError", "RobotRecipe", "WorkerControllers", "WORKERS", "KEPT_CONTROLLERS"]
+
 if TYPE_CHECKING:
     from ..control.controller import HeadController
 

@@ -40,6 +40,8 @@ from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Target
 from .plan_many import WORKERS, RobotRecipe, plan_many
 
+__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK", "SOLVE_BUDGET_S"]
+
 if TYPE_CHECKING:
     from ..control.controller import HeadController
 
