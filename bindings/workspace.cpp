@@ -188,8 +188,20 @@ void bind_workspace(py::module_& m) {
            std::optional<py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>> reached, int tried,
            const Eigen::Vector3d& grid_origin, double grid_voxel, int grid_n, std::int64_t hull_voxels, int hull_facets,
            double alpha, double reach, const std::string& chain_hash, const std::string& base, const std::string& tip,
-           std::int64_t ik_calls, std::int64_t cheap_exits, double seconds, int threads) {
+           std::int64_t ik_calls, std::int64_t cheap_exits, double seconds, int threads, const std::string& kind,
+           std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> base_joints,
+           std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> base_placements) {
           ReachabilityMap map;
+          map.kind = kind;
+          if (base_joints) {
+            if (base_joints->ndim() != 3) throw InputError("base_joints must be (voxels, tried, k)");
+            map.base_joint_count = static_cast<int>(base_joints->shape(2));
+            map.base_joints.assign(base_joints->data(), base_joints->data() + base_joints->size());
+          }
+          if (base_placements) {
+            if (base_placements->ndim() != 3) throw InputError("base_placements must be (voxels, tried, 3)");
+            map.base_placements.assign(base_placements->data(), base_placements->data() + base_placements->size());
+          }
           map.options = o;
           map.centres = centres;
           map.solved = std::move(solved);
@@ -217,7 +229,8 @@ void bind_workspace(py::module_& m) {
         py::arg("voxel_ids"), py::arg("reached"), py::arg("tried"), py::arg("grid_origin"), py::arg("grid_voxel"),
         py::arg("grid_n"), py::arg("hull_voxels"), py::arg("hull_facets"), py::arg("alpha"), py::arg("reach"),
         py::arg("chain_hash"), py::arg("base"), py::arg("tip"), py::arg("ik_calls"), py::arg("cheap_exits"),
-        py::arg("seconds"), py::arg("threads"),
+        py::arg("seconds"), py::arg("threads"), py::arg("kind") = std::string(kMapKindHead),
+        py::arg("base_joints") = py::none(), py::arg("base_placements") = py::none(),
         "The one map writer (save_npz, also workspace_gen's): a map's arrays to an .npz that numpy.load reads");
   m.def("evaluate_voxels",
         [](const ChainModel& model, const WorkspaceOptions& o, const Eigen::Ref<const RowMat3>& centres,

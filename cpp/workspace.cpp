@@ -869,6 +869,8 @@ ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards) {
   out.voxel_ids.clear();
   out.solved.clear();
   out.reached.clear();
+  out.base_joints.clear();  // (shards of whole-body maps are not merged here)
+  out.base_placements.clear();
   const int bytes = reached_bytes_per_voxel(first.tried);
   out.centres.resize(static_cast<Eigen::Index>(voxels.size()), 3);
   Eigen::Index row = 0;
@@ -893,6 +895,14 @@ void save_npz(const ReachabilityMap& map, const std::string& path, const std::st
     throw InputError("a map's per-direction results need " + std::to_string(bytes) + " bytes per voxel");
   if (!std::is_sorted(map.voxel_ids.begin(), map.voxel_ids.end()))
     throw InputError("a map's voxel ids must be ascending");
+  if (map.kind != kMapKindHead && map.kind != kMapKindWholeBody)
+    throw InputError("a map's kind is 'head' or 'whole-body', got '" + map.kind + "'");
+  const std::int64_t poses = m * map.tried;
+  if (!map.base_joints.empty() &&
+      (map.base_joint_count < 1 || static_cast<std::int64_t>(map.base_joints.size()) != poses * map.base_joint_count))
+    throw InputError("a map's base joints need base_joint_count (>= 1) values per voxel and pose");
+  if (!map.base_placements.empty() && static_cast<std::int64_t>(map.base_placements.size()) != poses * 3)
+    throw InputError("a map's base placements need 3 values (x, y, yaw) per voxel and pose");
   NpzWriter w;
   w.add_string("format", kMapFormat);
   std::vector<double> centres(map.centres.data(), map.centres.data() + map.centres.size());
@@ -902,6 +912,9 @@ void save_npz(const ReachabilityMap& map, const std::string& path, const std::st
   w.add_i32("solved", map.solved, {m});
   w.add_i64("voxel_ids", map.voxel_ids, {m});
   if (!map.reached.empty()) w.add_u8("reached", map.reached, {m, bytes});
+  w.add_string("map_kind", map.kind);
+  if (!map.base_joints.empty()) w.add_f64("base_joints", map.base_joints, {m, map.tried, map.base_joint_count});
+  if (!map.base_placements.empty()) w.add_f64("base_placements", map.base_placements, {m, map.tried, 3});
   w.add_scalar("tried", static_cast<std::int64_t>(map.tried));
   const WorkspaceOptions& o = map.options;
   // The directions of every voxel's sphere, so that a reader needs numpy alone.

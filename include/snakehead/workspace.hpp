@@ -184,6 +184,14 @@ struct ReachabilityMap {
   std::vector<std::int32_t> solved;                                   // poses solved per voxel
   std::vector<std::uint8_t> reached;  // which poses: see reached_bytes_per_voxel (may be empty: unknown)
   int tried = 0;                                                      // poses per voxel
+  // What the map answers: kMapKindHead (the head chain's reach, Algorithm 1) or kMapKindWholeBody (the whole
+  // body's stable reach, snakehead reach). A whole-body map may say with which base each pose is reached: per voxel
+  // and pose, the base's flat-shape joints (base_joint_count of them) and its placement (x m, y m, yaw rad), NaN
+  // where the pose is not reached; both empty when unknown.
+  std::string kind = "head";
+  int base_joint_count = 0;
+  std::vector<double> base_joints;      // voxels x tried x base_joint_count
+  std::vector<double> base_placements;  // voxels x tried x 3
   std::int64_t hull_voxels = 0;  // in-hull voxels of the whole map (all shards)
   int hull_facets = 0;           // of the convex hull, or triangles of the boundary's surface
   double alpha = 0.0;            // m, the boundary's alpha radius (infinity for the convex hull)
@@ -237,5 +245,7 @@ ReachabilityMap merge_shards(const std::vector<ReachabilityMap>& shards);
 // Throws InputError when the map is inconsistent or the file cannot be written.
 void save_npz(const ReachabilityMap& map, const std::string& path, const std::string& command);
 inline constexpr const char* kMapFormat = "snakehead-reachability-2";
+inline constexpr const char* kMapKindHead = "head";
+inline constexpr const char* kMapKindWholeBody = "whole-body";
 
 }  // namespace snakehead

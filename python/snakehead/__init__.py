@@ -23,13 +23,14 @@ from .kinematics.workspace import compute as compute_map
 from .kinematics.workspace import load as load_map
 from .model.chain import Chain
 from .model.robot import BasePlacement, RobotParts, SnakeRobot, default_robot_file, default_urdf_path
+from .motion.plan_many import PlanError, plan_many
 from .motion.plan_result import Plan, PlanProgress, TargetResult
 from .motion.planner import plan
 from .scenes.scene import Scene, Target, load_scene
 from .sim.plan import PlanSimulation, simulate
 
 __all__ = ["Infeasible", "InputError", "InputTypeError", "InternalError", "MotionTooLong", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
-           "ReachabilityMap", "compute_map", "load_map", "plan", "Plan", "PlanProgress", "TargetResult", "simulate",
+           "ReachabilityMap", "compute_map", "load_map", "plan", "plan_many", "PlanError", "Plan", "PlanProgress", "TargetResult", "simulate",
            "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "MeshObstacle", "WallWithHole", "default_robot_file",
            "default_urdf_path"]
 __version__ = "0.2.0"

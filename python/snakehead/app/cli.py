@@ -6,6 +6,7 @@ The command is snakehead (also python -m snakehead). Subcommands:
   demo        the paper's two scenarios of Section 4 end to end, with figures, animations and a report
   plan        head targets (--position/--direction, or --scene FILE) with the same outputs
   workspace   compute a reachability map of a robot's head (Algorithm 1) into a .npz file
+  reach       compute the whole body's stable reachability map (where a stable pose puts the head) into a .npz file
   view        the interactive 3-D viewer of the output of plan or demo, served to a web browser; --live plans
               as you drag the head's targets
 
@@ -311,6 +312,72 @@ def _workspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def _reach(args: argparse.Namespace) -> int:
+    from ..motion import reach
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {args.out!r} is not a directory")
+    parent = out if out.is_dir() else (out.parent if str(out.parent) else Path("."))
+    if not parent.is_dir() or not os.access(parent, os.W_OK):
+        raise InputError(f"cannot write into --out {args.out!r} (its parent directory must exist and be writable)")
+    robot = _robot(args)
+    voxel, directions = reach.check_options(robot, args.voxel, args.directions)  # before any work or output
+    out.mkdir(exist_ok=True)
+    executor, closing = _reach_executor(args)
+    t0 = time.perf_counter()
+    last = [0.0]
+
+    def progress(stage: str, done: int, total: int) -> None:
+        now = time.perf_counter() - t0
+        if not args.quiet and (done == total or now - last[0] >= 5.0):
+            last[0] = now
+            print(f"snakehead reach: {stage}: {done}/{total} tasks, {now:.0f} s", file=sys.stderr, flush=True)
+
+    try:
+        print(f"snakehead reach: {robot.source or 'the robot'}, voxel {voxel:g} m, {directions} directions, "
+              f"{'1 process' if executor is None else (args.scheduler or f'{args.workers} workers')}",
+              file=sys.stderr, flush=True)
+        m = reach.compute_reach(robot, voxel=voxel, directions=directions, executor=executor, seed=args.seed,
+                                progress=progress)
+        m.command = "snakehead reach " + " ".join(sys.argv[2:]) if sys.argv[1:2] == ["reach"] else m.command
+        path = out / "reach.npz"
+        m.save(path)  # (the one map writer writes a temporary file and renames it)
+        reached = m.reached_units()
+        print(f"snakehead reach: {len(m)} voxels x {m.tried} directions, {int(reached.sum())} poses reached "
+              f"({100 * reached.mean():.1f} %) in {time.perf_counter() - t0:.1f} s; wrote {path.resolve()}")
+        if args.check:
+            c = reach.check_reach(m, robot, args.check, seed=args.seed, executor=executor)
+            print(f"snakehead reach --check: {c.summary()}")
+    finally:
+        if closing is not None:
+            closing()
+    return 0
+
+
+def _reach_executor(args: argparse.Namespace) -> tuple[Any, Any]:
+    """The executor of --workers N (a pool of N processes) or --scheduler ADDRESS (a Dask cluster), and how to
+    close it; (None, None) for one process."""
+    if args.scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise InputError("--scheduler needs Dask (pip install 'snakehead[dist]')") from None
+        try:
+            client = Client(args.scheduler, timeout="20s")
+        except OSError as exc:
+            raise InputError(f"--scheduler {args.scheduler!r}: cannot connect ({exc})") from None
+        return client, client.close
+    if args.workers and args.workers > 1:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        # spawned workers: a forked child of a process whose C++ threads hold locks can hang
+        pool = ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn"))
+        return pool, pool.shutdown
+    return None, None
+
+
 def _merge_shards(args: argparse.Namespace, out: Path) -> int:
     """workspace --merge: the shards' files merged into --out (the one place shards are read as they are)."""
     from ..kinematics import workspace
@@ -509,6 +576,33 @@ def build_parser() -> argparse.ArgumentParser:
                         "shard alone is refused wherever a map is taken)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_workspace)
+
+    from ..motion import reach as rc
+
+    p = sub.add_parser("reach", help="compute the whole body's stable reachability map",
+                       description="For voxels around the robot (a cube of side 2 x the body's length, from the "
+                                   "ground up to the highest the head gets) and directions per voxel, whether the "
+                                   "planner's whole-body solve finds a stable, collision-free pose that puts the "
+                                   "head there (with the base as it lies, or moved), and with which base shape and "
+                                   "placement: a map of kind 'whole-body' written to DIR/reach.npz "
+                                   "(snakehead.load_map(path).reachable(positions, directions) answers from it).")
+    _add_robot_option(p)
+    p.add_argument("--voxel", type=_positive_float, default=0.1, metavar="M",
+                   help=f"voxel edge (m, default 0.1; at least {rc.MIN_VOXEL_M:g})")
+    p.add_argument("--directions", type=_bounded_int(1, rc.MAX_DIRECTIONS), default=12, metavar="N",
+                   help=f"directions per voxel, 1 to {rc.MAX_DIRECTIONS} (default 12)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_bounded_int(1, 256), default=None, metavar="N",
+                       help="a pool of N worker processes on this machine (default: this process)")
+    where.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="a Dask scheduler (tcp://host:port) whose workers do the work")
+    p.add_argument("--check", type=_bounded_int(0, 100_000), default=0, metavar="K",
+                   help="then plan K sampled poses (half reached, half not) in full and report the agreement")
+    p.add_argument("--seed", type=_bounded_int(0, 2**32 - 1), default=1, metavar="N",
+                   help="the head IK's seed, and the check's sample (default 1)")
+    p.add_argument("--out", default="reach", metavar="DIR", help="output directory (default ./reach)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=_reach)
 
     p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo, or (--live) of "
                                     "plans made as you drag targets (a web page)",

@@ -34,18 +34,20 @@ if TYPE_CHECKING:
 BLENDED_DIRECTIONS = 3
 
 
-def _usable(m: ReachabilityMap) -> ReachabilityMap:
+def _usable(m: ReachabilityMap, any_kind: bool = False) -> ReachabilityMap:
     """The map if pose queries can be asked of it: a whole map (a shard would answer False for its other shards'
-    voxels) with per-direction results along the head's x-axis; InputError otherwise (the one check of maps)."""
-    from .workspace import require_map
+    voxels) with per-direction results along the head's x-axis, a head map unless ``any_kind`` (whether a pose is
+    reachable is asked of a whole-body map too); InputError otherwise (the one check of maps)."""
+    from .workspace import KIND_HEAD, ReachabilityMap, require_map
 
-    return require_map(m, needs=("poses",))
+    kind = m.kind if any_kind and isinstance(m, ReachabilityMap) else KIND_HEAD
+    return require_map(m, needs=("poses",), kind=kind)
 
 
 def direction_bits(m: ReachabilityMap) -> np.ndarray:
     """(M, N) bool: direction k of voxel v was reached with some roll (its units OR-ed over the rolls when
     every roll counted on its own). Cached on the map."""
-    _usable(m)
+    _usable(m, any_kind=True)
     if "direction_bits" not in m._cache:
         units = m.reached_units()
         n = int(m.params["directions"])
@@ -121,7 +123,7 @@ def reachable(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.Arra
     """Whether each pose is reachable by the map (see the module's doc). positions, directions: (3,) or (K, 3);
     a bool for one pose, else (K,) bools. ``interpolate``: :func:`reachability` >= 1/2 (default), else the
     nearest sample."""
-    _usable(m)
+    _usable(m, any_kind=True)
     p, d, single = _poses(positions, directions)
     if interpolate:
         out = _reachability(m, p, d) >= 0.5
@@ -140,7 +142,7 @@ def reachability(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.A
     """A score in [0, 1] per pose: the map's reached/not-reached samples around it, blended trilinearly over the
     8 voxels whose sphere points surround the position, and over the BLENDED_DIRECTIONS nearest directions
     (weights falling linearly with the angle to zero at the next direction's). Voxels outside the map count 0."""
-    _usable(m)
+    _usable(m, any_kind=True)
     p, d, single = _poses(positions, directions)
     s = _reachability(m, p, d)
     return float(s[0]) if single else s

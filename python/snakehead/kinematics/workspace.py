@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
@@ -33,6 +32,7 @@ import numpy as np
 
 from .. import _core
 from .._errors import InputError, InputTypeError
+from .._executors import as_executor, run_tasks, worker_count
 from ..model.chain import Chain
 
 if TYPE_CHECKING:
@@ -44,6 +44,13 @@ import numpy.typing as npt
 FORMAT = "snakehead-reachability-2"
 #: Formats :func:`load` reads: the first lacks the per-direction results and the hull's kind (always convex).
 FORMATS = ("snakehead-reachability-1", FORMAT)
+#: What a map answers (its ``kind``): the head chain's reach (Algorithm 1: ``snakehead workspace``, in the head's base
+#: frame) or the whole body's stable reach (``snakehead reach``, ``motion.reach``: poses a stable, collision-free
+#: whole-body pose reaches, in the world frame of a base starting at ``BasePlacement()``).
+KIND_HEAD, KIND_WHOLE_BODY = "head", "whole-body"
+MAP_KINDS = (KIND_HEAD, KIND_WHOLE_BODY)
+_KIND_HINTS = {KIND_HEAD: "a head map (snakehead workspace)",
+               KIND_WHOLE_BODY: "a whole-body stable reachability map (snakehead reach)"}
 #: Table 2's bins of the reachability index: [0,20) [20,40) [40,60) [60,80) [80,100].
 TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
 #: How many voxels the dexterous band must hold at least, as a share of the map's voxels (see
@@ -126,6 +133,12 @@ class ReachabilityMap:
     # (numpy.unpackbits(..., bitorder="little")); None for a map file that predates them.
     reached: np.ndarray | None = None
     lacks: tuple = ()  # what an older map file does not hold (e.g. "reached"), said by load
+    kind: str = KIND_HEAD  # one of MAP_KINDS: what the map answers
+    # a whole-body map's witnesses, per voxel and unit (NaN where not reached; None when not known): the base's
+    # flat-shape joints (M, tried, k) (rad, the joints before the neck lifts) and its placement (M, tried, 3)
+    # (x m, y m, yaw rad) with which the pose is reached
+    base_joints: np.ndarray | None = None
+    base_placements: np.ndarray | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # --- the index --------------------------------------------------------------------------------
@@ -143,7 +156,7 @@ class ReachabilityMap:
 
     # --- what the map is, and whether it is what a caller needs ------------------------------------------
     def require_whole_for(self, chain: Chain | SnakeRobot | None = None, *, needs: Iterable[str] = (),
-                          what: str | None = None) -> ReachabilityMap:
+                          what: str | None = None, kind: str = KIND_HEAD) -> ReachabilityMap:
         """The one check of a map where it is accepted: returns the map, or raises :class:`InputError` (one line
         naming the map and what to do) when it is
 
@@ -155,8 +168,17 @@ class ReachabilityMap:
           :data:`G0_MIN_VOXELS` voxels for its k-means++ clusters), ``"poses"`` (pose queries, inverse reachability,
           base placements: per-direction results, of directions of the head's pointing axis x, in some voxel).
 
+        * of another ``kind`` (:data:`MAP_KINDS`) than the caller takes: a head map where the whole body's stable
+          reach is asked for, or the reverse (for a whole-body map, ``chain`` is the robot, checked by its body
+          chain's hash).
+
         ``what``: how the caller names the map (e.g. ``"--map 'm.npz'"``; default: its file, when it has one)."""
         name = what or (f"map {os.fspath(self.path)!r}" if self.path is not None else "the map")
+        if kind not in MAP_KINDS:
+            raise InputError(f"kind must be one of {', '.join(map(repr, MAP_KINDS))}, got {kind!r}")
+        if self.kind != kind:
+            raise InputError(f"{name} is {_KIND_HINTS.get(self.kind, repr(self.kind))}, not "
+                             f"{_KIND_HINTS[kind]}: give {_KIND_HINTS[kind]}")
         needs = tuple(needs)
         unknown = [n for n in needs if n not in ("voxels", "G0", "poses")]
         if unknown:
@@ -165,7 +187,9 @@ class ReachabilityMap:
             i, n = self.shard
             raise InputError(f"{name} is shard {i}/{n} of a map, not a whole map ({len(self)} of its "
                              f"{self.hull_voxels} voxels): {_MERGE_HINT}")
-        if chain is not None:
+        if chain is not None and kind == KIND_WHOLE_BODY:
+            _require_body(self, chain, name)
+        elif chain is not None:
             from ..model.robot import SnakeRobot
 
             head = _resolve_chain(chain)
@@ -368,6 +392,7 @@ class ReachabilityMap:
         """Same chain, parameters, grid and per-voxel results (statistics and command aside)."""
         return (
             self.chain_hash == other.chain_hash
+            and self.kind == other.kind
             and all(_param_equal(self.params[p], other.params[p]) for p in _PARAMS)
             and self.tried == other.tried
             and self.grid_shape == other.grid_shape
@@ -381,20 +406,32 @@ class ReachabilityMap:
     def __repr__(self) -> str:
         s = "" if self.shard == (0, 1) else f", shard {self.shard[0]}/{self.shard[1]}"
         lacks = f", lacks {', '.join(self.lacks)}" if self.lacks else ""
+        lacks += "" if self.kind == KIND_HEAD else f", {self.kind}"
         return (f"ReachabilityMap({self.base!r} -> {self.tip!r}, {len(self)} voxels of {self.voxel_size} m "
                 f"inside the {self.params.get('hull', 'convex')} hull, {self.params['directions']} directions{s}, "
                 f"mean index {self.indices.mean() if len(self) else 0:.1f}{lacks})")
 
 
+def _require_body(m: ReachabilityMap, robot: Any, name: str) -> None:
+    """InputError unless the whole-body map ``m`` was made for ``robot``'s body (by its body chain's hash)."""
+    from ..model.robot import SnakeRobot
+
+    if not isinstance(robot, SnakeRobot):
+        raise InputTypeError(f"a whole-body map is checked against a SnakeRobot, got {type(robot).__name__}")
+    if m.chain_hash != robot.body.hash:
+        raise InputError(f"{name} was made for another robot (body chain hash {m.chain_hash}; this robot's is "
+                         f"{robot.body.hash}): compute its map (snakehead reach --robot ROBOT.toml)")
+
+
 def require_map(m: Any, chain: Chain | SnakeRobot | None = None, *, needs: Iterable[str] = (),
-                what: str = "the map") -> ReachabilityMap:
+                what: str = "the map", kind: str = KIND_HEAD) -> ReachabilityMap:
     """``m`` where a map is accepted: InputTypeError unless a :class:`ReachabilityMap`, then
     :meth:`ReachabilityMap.require_whole_for` (a whole map of ``chain``'s head holding what the caller ``needs``).
     ``what`` names the argument; the map's file is added when it has one."""
     if not isinstance(m, ReachabilityMap):
         raise InputTypeError(f"{what} must be a ReachabilityMap (snakehead.load_map or compute_map), got "
                              f"{type(m).__name__}")
-    return m.require_whole_for(chain, needs=needs,
+    return m.require_whole_for(chain, needs=needs, kind=kind,
                                what=f"{what} (map {os.fspath(m.path)!r})" if m.path is not None else what)
 
 
@@ -585,7 +622,7 @@ def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, cou
 def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
             any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
             epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, hull: str = "boundary",
-            shrink: float = 0.5, threads: int | None = None, shard: Any = None, executor: Executor | None = None,
+            shrink: float = 0.5, threads: int | None = None, shard: Any = None, executor: Any = None,
             shards: int | None = None,
             urdf: str | os.PathLike | None = None, progress: bool = True) -> ReachabilityMap:
     """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
@@ -601,7 +638,8 @@ def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directio
     the machine's load); seed: the map is a function of it; threads: worker threads (None: all cores; the
     map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th tile of voxels.
 
-    executor: any ``concurrent.futures.Executor`` (a process pool, Dask's ``client.get_executor()``...):
+    executor: any ``concurrent.futures.Executor`` (a process pool, Dask's ``client.get_executor()``...) or a Dask
+    ``distributed.Client`` (``snakehead._executors``, the one way work is spread):
     the map is split into ``shards`` shards (default 4 per worker thread the executor reports, else 8),
     each computed in a worker with ``threads`` threads (default 1) and merged; the result equals the
     one-process map. Workers rebuild the chain from the URDF: a SnakeRobot carries it; for a Chain pass
@@ -619,35 +657,29 @@ def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directio
         return _compute_local(chain, options, progress)
     if shard is not None:
         raise InputError("give either shard= (one shard here) or executor= (all shards there), not both")
-    if not isinstance(executor, Executor):
-        raise InputTypeError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
+    executor = as_executor(executor)
     n = min(_default_shards(executor), MAX_SHARDS) if shards is None else _count("shards", shards, 1, MAX_SHARDS)
     text = _urdf_text(chain_or_robot, urdf)
     if Chain.from_urdf(text, chain.base, chain.tip).hash != chain.hash:
         raise InputError("the URDF given does not describe this chain (different kinematics hash)")
     if threads is None:
         kwargs["threads"] = 1  # each shard is one task; the executor provides the parallelism
-    futures = [executor.submit(_compute_shard, text, chain.base, chain.tip, kwargs, i, int(n)) for i in range(int(n))]
-    parts = []
     bar = _bar(progress, int(n), "shards")
     try:
-        for f in as_completed(futures):
-            parts.append(f.result())
-            if bar is not None:
-                bar.update(1)
+        parts = run_tasks(executor, _compute_shard, [(text, chain.base, chain.tip, kwargs, i, int(n))
+                                                     for i in range(int(n))],
+                          None if bar is None else lambda i, part: bar.update(1))
     finally:
         if bar is not None:
             bar.close()
-        for f in futures:
-            f.cancel()
     merged = merge(parts)
     merged.command = f"snakehead.workspace.compute(executor={type(executor).__name__}, shards={n})"
     return merged
 
 
 def _default_shards(executor: Any) -> int:
-    workers = getattr(executor, "_max_workers", None)
-    return 4 * int(workers) if isinstance(workers, int) and workers > 0 else 8
+    workers = worker_count(executor)
+    return 4 * workers if workers else 8
 
 
 def _urdf_text(chain_or_robot: Chain | SnakeRobot, urdf: str | os.PathLike | None) -> str:
@@ -719,7 +751,9 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
     hull_voxels, hull_facets, hull ('boundary' or 'convex'), shrink (0 for the convex hull), alpha (m; inf for the
     convex hull), reach, the parameters (voxel_size, directions, rolls, any_roll, free_roll, approach_axis,
     timeout, epsilon, cloud_samples, seed), shard (2,), chain_hash, base, tip, command, and the run's statistics
-    (ik_calls, cheap_exits, seconds, threads; -1 or NaN when not known).
+    (ik_calls, cheap_exits, seconds, threads; -1 or NaN when not known), map_kind (:data:`MAP_KINDS`; a file
+    without it is a head map) and, for a whole-body map, base_joints (M, tried, k) and base_placements (M, tried, 3)
+    (NaN where not reached; absent when not known).
     """
     if not isinstance(m, ReachabilityMap):
         raise InputTypeError(f"expected a ReachabilityMap, got {type(m).__name__}")
@@ -738,8 +772,13 @@ def save(m: ReachabilityMap, path: str | os.PathLike) -> None:
         int(m.tried), np.asarray(m.grid_origin, dtype=float), float(m.grid_size) / n, n, int(m.hull_voxels),
         int(stats.get("hull_facets", -1)), float(stats.get("alpha", math.inf if o.hull == "convex" else math.nan)),
         float(stats.get("reach", math.nan)), m.chain_hash, m.base, m.tip, int(stats.get("ik_calls", -1)),
-        int(stats.get("cheap_exits", -1)), float(stats.get("seconds", math.nan)), int(stats.get("threads", -1)))
+        int(stats.get("cheap_exits", -1)), float(stats.get("seconds", math.nan)), int(stats.get("threads", -1)),
+        m.kind, _witness(m.base_joints), _witness(m.base_placements))
     m.path = Path(path)
+
+
+def _witness(a: np.ndarray | None) -> np.ndarray | None:
+    return None if a is None else np.ascontiguousarray(a, dtype=float)
 
 
 #: The largest map file read (bytes, as its archive declares them unpacked). A full grid of 256^3 voxels -- the C++
@@ -754,7 +793,7 @@ _MAP_SCALARS = {
     "any_roll": "bool", "free_roll": "bool", "grid_size": "float", "voxel_size": "float", "timeout": "float",
     "epsilon": "float",
 }
-_MAP_OPTIONAL_SCALARS = {"hull": "text", "shrink": "float", "alpha": "float", "reach": "float", "seconds": "float",
+_MAP_OPTIONAL_SCALARS = {"map_kind": "text", "hull": "text", "shrink": "float", "alpha": "float", "reach": "float", "seconds": "float",
                          "ik_calls": "int", "cheap_exits": "int", "threads": "int", "hull_facets": "int"}
 _MAP_ARRAYS = {"centers": ("f", ("M", 3)), "indices": ("f", ("M",)), "solved": ("i", ("M",)),
                "voxel_ids": ("i", ("M",)), "grid_origin": ("f", (3,)), "grid_shape": ("i", (3,)), "shard": ("i", (2,))}
@@ -804,6 +843,8 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
             raise fail(key, "holds NaN or inf")
     if str(value["approach_axis"]) not in ("x", "z"):
         raise fail("approach_axis", f"must be 'x' or 'z', got {str(value['approach_axis'])!r}")
+    if "map_kind" in value and str(value["map_kind"]) not in MAP_KINDS:
+        raise fail("map_kind", f"must be one of {', '.join(MAP_KINDS)}, got {str(value['map_kind'])!r}")
     if "hull" in value and str(value["hull"]) not in ("convex", "boundary"):
         raise fail("hull", f"must be 'convex' or 'boundary', got {str(value['hull'])!r}")
     if "shrink" in value and not 0.0 <= float(value["shrink"]) <= 1.0:  # NaN too
@@ -851,6 +892,16 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
         bits = np.unpackbits(r, axis=1, count=tried, bitorder="little") if M else np.zeros((0, tried), np.uint8)
         if not np.array_equal(bits.sum(axis=1), solved):
             raise fail("reached", "(the per-direction results) disagree with the solved counts")
+    for key, width in (("base_joints", None), ("base_placements", 3)):
+        if key in arrays:
+            a = arrays[key]
+            if (a.dtype.kind != "f" or a.ndim != 3 or a.shape[:2] != (M, tried) or a.shape[2] < 1
+                    or (width is not None and a.shape[2] != width)):
+                raise fail(key, f"must be numbers of shape ({M}, {tried}, {width or 'k'}), got {a.dtype} {a.shape}")
+            if M and not np.array_equal(np.isfinite(a).all(axis=2), np.unpackbits(
+                    arrays["reached"], axis=1, count=tried, bitorder="little").astype(bool)
+                    if "reached" in arrays else np.isfinite(a).all(axis=2)):
+                raise fail(key, "must be finite exactly where a pose is reached (NaN elsewhere)")
     if "sphere_directions" in arrays:
         d = arrays["sphere_directions"]
         if d.dtype.kind != "f" or d.shape != (directions, 3) or not np.all(np.isfinite(d)):
@@ -909,6 +960,9 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
         path=Path(path),
         reached=reached,
         lacks=() if reached is not None else ("reached",),
+        kind=scalar("map_kind", str) if "map_kind" in z else KIND_HEAD,
+        base_joints=np.array(z["base_joints"], dtype=float) if "base_joints" in z else None,
+        base_placements=np.array(z["base_placements"], dtype=float) if "base_placements" in z else None,
     )
     return m
 
@@ -923,6 +977,8 @@ def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
         if not isinstance(p, ReachabilityMap):
             raise InputTypeError(f"merge takes ReachabilityMaps, got {type(p).__name__}")
     first = parts[0]
+    if any(p.kind != KIND_HEAD for p in parts):
+        raise InputError("merge takes the shards of a head map; a whole-body map is computed whole (snakehead reach)")
     n = first.shard[1]
     if len(parts) != n:
         missing = sorted(set(range(n)) - {p.shard[0] for p in parts})

@@ -1,0 +1,61 @@
+"""The whole body's stable reachability map (snakehead reach) of the default robot: its time on one process and on
+a local Dask cluster of 1, 2 and 4 workers (one thread each), and the agreement of full plans with it.
+
+    python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100]
+
+Prints a Markdown table. More workers than cores shows the overhead, not a speed-up (say how many cores there are).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+import snakehead as sh
+from snakehead.motion import reach
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--voxel", type=float, default=0.1)
+    ap.add_argument("--directions", type=int, default=12)
+    ap.add_argument("--workers", type=int, nargs="*", default=[1, 2, 4])
+    ap.add_argument("--check", type=int, default=100)
+    ap.add_argument("--no-serial", action="store_true", help="skip the one-process run")
+    args = ap.parse_args()
+    robot = sh.SnakeRobot.default()
+    grid = reach.reach_grid(robot, args.voxel, args.directions)
+    print(f"default robot, voxel {args.voxel} m, {args.directions} directions: {len(grid.ids)} voxels, at most "
+          f"{reach.estimated_solves(robot, grid)} whole-body solves; {os.cpu_count()} cores; load "
+          f"{os.getloadavg()[0]:.1f}\n")
+    rows, maps = [], []
+    if not args.no_serial:
+        t = time.perf_counter()
+        maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions))
+        rows.append(("1 process", time.perf_counter() - t))
+    from distributed import Client, LocalCluster
+
+    for w in args.workers:
+        with LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+                Client(cluster) as client:
+            t = time.perf_counter()
+            maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, executor=client))
+            rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''}", time.perf_counter() - t))
+    print("| run | time (s) | poses reached |")
+    print("|---|---:|---:|")
+    for (name, seconds), m in zip(rows, maps):
+        print(f"| {name} | {seconds:.1f} | {100 * m.reached_units().mean():.1f} % |")
+    same = [np.array_equal(maps[0].reached, m.reached) for m in maps[1:]]
+    print(f"\nmaps equal to the first: {same}")
+    if args.check and maps:
+        t = time.perf_counter()
+        c = reach.check_reach(maps[0], robot, args.check, seed=0)
+        print(f"\nspot check ({time.perf_counter() - t:.0f} s): {c.summary()}")
+        for f in c.failures[:10]:
+            print(f"  - {f[:160]}")
+
+
+if __name__ == "__main__":
+    main()
