@@ -19,16 +19,28 @@ MatrixView matrix(const Array& a, py::ssize_t cols, const char* what) {
   if (a.ndim() != 2 || (cols >= 0 && a.shape(1) != cols)) throw InputError(std::string(what) + " has the wrong shape");
   return MatrixView(a.data(), a.shape(0), a.shape(1));
 }
+
+const char* status_name(ToppRaStatus status) {
+  switch (status) {
+    case ToppRaStatus::kFeasible:
+      return "feasible";
+    case ToppRaStatus::kUncontrollable:
+      return "uncontrollable";
+    case ToppRaStatus::kStartOutside:
+      return "start_outside";
+    case ToppRaStatus::kForwardFailed:
+      return "forward_failed";
+  }
+  return "unknown";
+}
 }  // namespace
 
 void bind_topp_ra(py::module_& m) {
-  py::enum_<ToppRaStatus>(m, "ToppRaStatus", "How a TOPP-RA solve ended (ToppRaResult.status)")
-      .value("feasible", ToppRaStatus::kFeasible)
-      .value("uncontrollable", ToppRaStatus::kUncontrollable, "the backward pass found an empty controllable set")
-      .value("start_outside", ToppRaStatus::kStartOutside, "x_start is not in K_0")
-      .value("forward_failed", ToppRaStatus::kForwardFailed, "round-off: the forward pass found no u");
   py::class_<ToppRaResult>(m, "ToppRaResult", "The result of topp_ra")
-      .def_readonly("status", &ToppRaResult::status)
+      .def_property_readonly(
+          "status", [](const ToppRaResult& r) { return status_name(r.status); },
+          "'feasible', 'uncontrollable' (the backward pass found an empty controllable set), 'start_outside' "
+          "(x_start is not in K_0) or 'forward_failed' (round-off: the forward pass found no u)")
       .def_readonly("failed_at", &ToppRaResult::failed_at, "the gridpoint where it failed; -1 when feasible")
       .def_property_readonly(
           "x", [](const ToppRaResult& r) { return py::array_t<double>(r.x.size(), r.x.data()); },

@@ -85,5 +85,5 @@ def solve(grid: np.ndarray, rows: Canonical) -> Solution:
     u_bounds = np.tile([-np.inf, np.inf], (N, 1))
     x_bounds = np.column_stack([np.zeros(N + 1), rows.x_max])
     result = _core.topp_ra(grid, A, B, C, u_bounds, x_bounds, 0.0, 0.0)
-    sd = np.sqrt(result.x) if result.status == _core.ToppRaStatus.feasible else None
+    sd = np.sqrt(result.x) if result.status == "feasible" else None
     return Solution(sd, result.K, int(result.failed_at))

@@ -2,9 +2,10 @@
 
 :func:`retime` takes waypoints (K, n) -- the states of a plan, or the dense configurations of a Cartesian move --
 joins them by a smooth path q(s) through every one of them that never leaves the range of two neighbouring
-waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018, with the
-``toppra`` package's ``seidel`` solver) that keeps, at every gridpoint (and, the grid refined where needed, between
-them: at every sample):
+waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018: the
+constraints of every gridpoint in numpy, :mod:`._topp`; the passes and each gridpoint's 2-D LP in the C++ core,
+``snakehead._core.topp_ra``, as the ``toppra`` package's ``seidel`` solver does them) that keeps, at every gridpoint
+(and, the grid refined where needed, between them: at every sample):
 
 * each joint's velocity within ``velocity_limit`` (default :data:`VELOCITY_SHARE` of the URDF's);
 * each joint's acceleration within ``acceleration_limit`` (URDFs have none: default :data:`ACCELERATION_LIMIT`);
