@@ -72,7 +72,7 @@ void bind_topp_ra(py::module_& m) {
         const auto rows = matrix(rows_array, 3, "rows (m, 3): a, b, c of a u + b x <= c");
         if (!rows.allFinite() || lo.hasNaN() || hi.hasNaN()) throw InputError("rows, lo and hi must not be NaN");
         std::vector<HalfPlane> h(rows.rows());
-        for (Eigen::Index k = 0; k < rows.rows(); ++k) h[k] = {rows(k, 0), rows(k, 1), rows(k, 2)};
+        for (Eigen::Index k = 0; k < rows.rows(); ++k) h[k] = normalized({rows(k, 0), rows(k, 1), rows(k, 2)});
         const Lp2dSolution s = solve_lp2d(v_u, v_x, h.data(), static_cast<int>(h.size()), lo.data(), hi.data());
         return py::make_tuple(s.feasible, s.u, s.x);
       },

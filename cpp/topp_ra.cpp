@@ -20,7 +20,6 @@ namespace {
 constexpr double kTiny = 1e-10;        // a row is kept when broken by less; |coefficient| below: zero
 constexpr double kSmall = 1e-8;        // a row parallel to the line of the optimum is broken by more: infeasible
 constexpr double kVarLimit = 1e8;      // |u|, |x| at most this (unbounded sides are taken at it)
-constexpr double kLineLimit = 1e10;    // the 1-D LP's own bounds along a line (the box always binds first)
 constexpr double kTieWeight = 1e-9;    // weight of u in the objective of K's LPs: among equal x, the least |u| side
 constexpr double kStartTolerance = 1e-5;  // x_start may lie this far outside K_0
 constexpr double kStepShrink = 1e-8;      // the forward pass lowers each x_{i+1} by this (or by kStepShrinkShare)
@@ -33,25 +32,29 @@ constexpr std::uint32_t kOrderSeed = 0x70bbau;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The best point on the line h (a u + b x = c) under the rows order[0..k) and the box: a 1-D LP in the line's
-// parameter t, p(t) = p0 + t d. False when infeasible (an empty interval, or a parallel row broken).
+// parameter t, p(t) = p0 + t d with d a unit vector. False when infeasible (an empty interval, or a parallel row
+// broken). (toppra's seidel solver takes d = (-b, a) unnormalised and bounds t by +-1e10: on the line of a row with
+// small coefficients, e.g. 1e-7 u - 2e-5 x <= 8, that bound cuts off the box, and an LP that has a solution is
+// reported infeasible. Here t is a length, and the box bounds it.)
 bool optimum_on_line(const double v[2], const HalfPlane& h, const HalfPlane* rows, const int* order, int k,
                      const double lo[2], const double hi[2], double p[2], int* active) {
   const double nn = h.a * h.a + h.b * h.b;
   if (!(nn > 0.0)) return false;  // 0 u + 0 x <= c with c < 0: no point keeps it
   const double p0[2] = {h.a * h.c / nn, h.b * h.c / nn};  // the line's point nearest the origin
-  const double d[2] = {-h.b, h.a};
-  double t_lo = -kLineLimit, t_hi = kLineLimit;
+  const double norm = std::sqrt(nn);
+  const double d[2] = {-h.b / norm, h.a / norm};
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double t_lo = -kInf, t_hi = kInf;
   int id_lo = 0, id_hi = 0;
-  bool set_lo = false, set_hi = false;
   auto clip = [&](double a, double b, double c, int id) {
     const double slope = a * d[0] + b * d[1];
     const double room = c - (a * p0[0] + b * p0[1]);
     if (slope > kTiny) {
       const double t = room / slope;
-      if (t < t_hi) t_hi = t, id_hi = id, set_hi = true;
+      if (t < t_hi) t_hi = t, id_hi = id;
     } else if (slope < -kTiny) {
       const double t = room / slope;
-      if (t > t_lo) t_lo = t, id_lo = id, set_lo = true;
+      if (t > t_lo) t_lo = t, id_lo = id;
     } else if (room < -kSmall) {
       return false;  // parallel to the line and broken all along it
     }
@@ -66,8 +69,8 @@ bool optimum_on_line(const double v[2], const HalfPlane& h, const HalfPlane* row
     return false;
   if (t_lo > t_hi) return false;
   const bool up = v[0] * d[0] + v[1] * d[1] > kTiny;  // else (also when the objective is level along the line) down
-  if (!(up ? set_hi : set_lo)) return false;           // unbounded along the line: cannot happen with a finite box
   const double t = up ? t_hi : t_lo;
+  if (!std::isfinite(t)) return false;  // unbounded along the line: cannot happen with a finite box (|d| = 1)
   p[0] = p0[0] + t * d[0];
   p[1] = p0[1] + t * d[1];
   *active = up ? id_hi : id_lo;
@@ -78,9 +81,9 @@ bool optimum_on_line(const double v[2], const HalfPlane& h, const HalfPlane* row
 void fill_stage(std::vector<HalfPlane>& rows, double delta, double K_lo, double K_hi,
                 const Eigen::Ref<const RowMatrixXd>& A, const Eigen::Ref<const RowMatrixXd>& B,
                 const Eigen::Ref<const RowMatrixXd>& C, Eigen::Index i) {
-  rows[0] = {2.0 * delta, 1.0, K_hi};
-  rows[1] = {-2.0 * delta, -1.0, -K_lo};
-  for (Eigen::Index k = 0; k < A.cols(); ++k) rows[2 + k] = {A(i, k), B(i, k), C(i, k)};
+  rows[0] = normalized({2.0 * delta, 1.0, K_hi});
+  rows[1] = normalized({-2.0 * delta, -1.0, -K_lo});
+  for (Eigen::Index k = 0; k < A.cols(); ++k) rows[2 + k] = normalized({A(i, k), B(i, k), C(i, k)});
 }
 
 // The box of stage i's LP: its own bounds, sides at most kVarLimit, and x >= 0 (x = s'^2).
@@ -143,6 +146,11 @@ void validate(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<co
 }
 
 }  // namespace
+
+HalfPlane normalized(const HalfPlane& h) {
+  const double norm = std::hypot(h.a, h.b);
+  return norm > 0.0 ? HalfPlane{h.a / norm, h.b / norm, h.c / norm} : h;
+}
 
 Lp2dSolution solve_lp2d(double v_u, double v_x, const HalfPlane* rows, int m, const double lo[2], const double hi[2],
                         const int* order) {

@@ -13,7 +13,8 @@
 // that keeps x_{i+1} in K_{i+1} (a 1-D LP, x_i fixed). Both passes keep toppra's safeguards against round-off
 // (the same constants; see cpp/topp_ra.cpp).
 //
-// Each 2-D LP is solved exactly by Seidel's randomized incremental algorithm: the rows are added one at a time in
+// Each 2-D LP (its rows normalised to unit normals, so that the tolerances are lengths whatever the rows' scale)
+// is solved exactly by Seidel's randomized incremental algorithm: the rows are added one at a time in
 // a random order (one permutation per call, from a fixed seed: the results are reproducible), and whenever the
 // optimum so far breaks the new row, the optimum moves onto that row's line, a 1-D LP over the rows before it and
 // the bounds; expected O(m) per LP. As toppra's seidel solver does, the rows active at the previous optimum of the
@@ -49,11 +50,15 @@ struct Lp2dSolution {
   int active[2] = {kULow, kXLow};
 };
 
+// The half-plane with a unit normal (a, b) (the same set; a row 0 u + 0 x <= c as it is).
+HalfPlane normalized(const HalfPlane& h);
+
 // maximise v_u u + v_x x subject to rows[k] (k < m) and lo <= (u, x) <= hi (finite; lo > hi: infeasible).
-// order: the order in which the rows are added (a permutation of 0..m-1; nullptr: 0, 1, ..., m-1). The rows and
-// the box are checked with toppra's tolerances: a row counts as kept within 1e-10, two rows as parallel within
-// 1e-10 (then infeasible only when broken by more than 1e-8). Where the optimum is not unique, the result is one
-// of the optimal vertices (which one depends on the order).
+// order: the order in which the rows are added (a permutation of 0..m-1; nullptr: 0, 1, ..., m-1). The rows should
+// have unit normals (normalized()): the tolerances are toppra's, as lengths in the (u, x) plane then: a row counts
+// as kept when broken by less than 1e-10, two rows as parallel when the sine of their angle is below 1e-10 (then
+// infeasible only when one is broken by more than 1e-8 all along the other). Where the optimum is not unique, the
+// result is one of the optimal vertices (which one depends on the order).
 Lp2dSolution solve_lp2d(double v_u, double v_x, const HalfPlane* rows, int m, const double lo[2], const double hi[2],
                         const int* order = nullptr);
 

@@ -54,18 +54,27 @@ BruteForce brute_force(double vu, double vx, const std::vector<HalfPlane>& rows,
 TEST(Lp2d, MatchesBruteForceOnRandomLps) {
   std::mt19937 rng(7);
   std::normal_distribution<double> normal(0.0, 1.0);
-  std::uniform_real_distribution<double> side(0.5, 5.0);
+  std::uniform_real_distribution<double> side(0.5, 5.0), exponent(-6.0, 2.0);
   int feasible = 0, infeasible = 0;
   for (int trial = 0; trial < 4000; ++trial) {
     const int m = trial % 25;
     std::vector<HalfPlane> rows(m);
     for (HalfPlane& h : rows) h = {normal(rng), normal(rng), normal(rng) + (trial % 2 ? 2.0 : 0.0)};
-    const double lo[2] = {-side(rng), -side(rng)}, hi[2] = {side(rng), side(rng)};
+    // rows of very different scales, some nearly parallel to the u axis (as TOPP-RA's are: u spans +-1e8); a
+    // wide box in u
+    for (HalfPlane& h : rows) {
+      const double scale = trial % 4 == 3 ? std::pow(10.0, exponent(rng)) : 1.0;
+      h = {h.a * scale * (trial % 8 == 7 ? 1e-4 : 1.0), h.b * scale, h.c * scale};
+    }
+    std::vector<HalfPlane> unit(m);
+    std::transform(rows.begin(), rows.end(), unit.begin(), snakehead::normalized);
+    const double u_side = trial % 8 == 7 ? 1e6 : 1.0;
+    const double lo[2] = {-u_side * side(rng), -side(rng)}, hi[2] = {u_side * side(rng), side(rng)};
     const double vu = normal(rng), vx = normal(rng);
     std::vector<int> order(m);
     for (int k = 0; k < m; ++k) order[k] = m - 1 - k;  // any order gives the optimum
-    const Lp2dSolution s = snakehead::solve_lp2d(vu, vx, rows.data(), m, lo, hi, trial % 3 ? nullptr : order.data());
-    const BruteForce b = brute_force(vu, vx, rows, lo, hi);
+    const Lp2dSolution s = snakehead::solve_lp2d(vu, vx, unit.data(), m, lo, hi, trial % 3 ? nullptr : order.data());
+    const BruteForce b = brute_force(vu, vx, unit, lo, hi);
     ASSERT_EQ(s.feasible, b.feasible) << "trial " << trial;
     if (!s.feasible) {
       ++infeasible;
@@ -93,6 +102,22 @@ TEST(Lp2d, EmptyBoxAndBrokenZeroRowAreInfeasible) {
   EXPECT_TRUE(s.feasible);
   EXPECT_EQ(s.u, 1.0);
   EXPECT_EQ(s.x, 1.0);
+}
+
+// A row with small coefficients whose line passes far from the origin, met first at the box's corner u = 1e8 (the
+// u bounds are +-1e8 in TOPP-RA): the optimum walks ~4e7 along its line back into the box. (toppra's bound of
+// +-1e10 on the unnormalised line parameter, ~2e5 in length here, made this LP infeasible: a planner's lift failed.)
+TEST(Lp2d, RowWithSmallCoefficientsFarAlongItsLine) {
+  const double delta = 0.018;
+  const HalfPlane rows[3] = {snakehead::normalized({1.81e-7, -1.73e-5, 7.96}),
+                             snakehead::normalized({2 * delta, 1, 0}), snakehead::normalized({-2 * delta, -1, 0})};
+  const double lo[2] = {-1e8, 0}, hi[2] = {1e8, 114};
+  const Lp2dSolution s = snakehead::solve_lp2d(1e-9, -1, rows, 3, lo, hi);  // min x (toppra's objective for K_lo)
+  ASSERT_TRUE(s.feasible);
+  EXPECT_NEAR(s.x, 0.0, 1e-9);
+  EXPECT_NEAR(s.u, 0.0, 1e-6);
+  const int first_row_first[3] = {0, 1, 2};
+  EXPECT_TRUE(snakehead::solve_lp2d(-1e-9, 1, rows, 3, lo, hi, first_row_first).feasible);  // max x
 }
 
 // A straight path of length L (q(s) = s, one joint) with |q'| <= v and |q''| <= a: u in [-a, a] (rows u <= a,

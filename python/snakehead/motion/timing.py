@@ -632,6 +632,7 @@ class _Piece:
         """Solve; cut the stages that break a limit between their gridpoints; again, up to REFINE_ROUNDS times
         (the constraints computed once per gridpoint)."""
         first_size = len(points.s)
+        kept: set[tuple[float, ...]] = set()  # stages (s_i, s_i+1, x_i, x_i+1) probed within the limits
         for refinement in range(REFINE_ROUNDS + 1):
             solution = _solve_grid(self.robot, points, self.limits)
             if solution.sd is None:
@@ -640,7 +641,14 @@ class _Piece:
                                  f"{self.i1}); loosen the limits or the ZMP margin there")
             if refinement == REFINE_ROUNDS:
                 break
-            split = _stages_over(self.robot, self.base, self.limits, self.f, points.s, solution.sd, points.support)
+            # a stage that is the same as one probed within the limits in an earlier round (same ends, same
+            # speeds: the profile there did not change) is within them again: only the others are probed
+            x = solution.sd ** 2
+            stages = list(zip(points.s[:-1].tolist(), points.s[1:].tolist(), x[:-1].tolist(), x[1:].tolist()))
+            todo = np.array([stage not in kept for stage in stages])
+            split = _stages_over(self.robot, self.base, self.limits, self.f, points.s, solution.sd, points.support,
+                                 only=todo)
+            kept.update(stage for stage, probed, over in zip(stages, todo, split) if probed and not over)
             if not split.any():
                 break
             refined = _refined(points.s, split)
@@ -755,16 +763,18 @@ def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:
 
 
 def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f: PathFunction, grid: np.ndarray,
-                 sd: np.ndarray, support: Support) -> np.ndarray:
+                 sd: np.ndarray, support: Support, only: np.ndarray | None = None) -> np.ndarray:
     """(N-1,) bool: the stages of a solution that break a limit between their gridpoints (TOPP-RA keeps the limits
     at the gridpoints only). Probed at PROBES points inside each stage, with its constant path acceleration; the
-    ZMP against the support polygon of the nearer gridpoint."""
+    ZMP against the support polygon of the nearer gridpoint. ``only``: (N-1,) bool, the stages to probe (the others
+    are reported within the limits)."""
     x = sd ** 2
     ds = np.diff(grid)
     u = (x[1:] - x[:-1]) / (2 * ds)
     frac = (np.arange(PROBES) + 0.5) / PROBES
-    stage = np.repeat(np.arange(len(ds)), PROBES)
-    fr = np.tile(frac, len(ds))
+    probed = np.arange(len(ds)) if only is None else np.flatnonzero(only)
+    stage = np.repeat(probed, PROBES)
+    fr = np.tile(frac, len(probed))
     s = grid[stage] + fr * ds[stage]
     xs = np.maximum(x[stage] + 2 * u[stage] * (s - grid[stage]), 0.0)
     dq, ddq = f(s, 1), f(s, 2)
