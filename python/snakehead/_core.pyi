@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, time-optimal path parameterization (TOPP-RA)
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA)
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'ShapeSet', 'ToppRaResult', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -263,6 +263,26 @@ class ShapeSet:
     @property
     def size(self) -> int:
         ...
+class PathChecker:
+    """
+    Ground, self and obstacle clearances of a chain's configurations, per sample and proven along straight joint segments (path_check.hpp); immutable, safe to share between threads
+    """
+    def __init__(self, model: ChainModel, shapes: ShapeSet, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], ground_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], self_pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], obstacles: ShapeSet | None, obstacle_pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_floor: typing.SupportsFloat | typing.SupportsIndex, obstacle_cutoff: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        model: the chain; shapes: its links' shapes; origin: the chain base's world pose (4, 4); ground_shapes (k,): shapes whose lowest point must stay >= ground_floor (m); self_pairs (P, 2): shape pairs that must stay apart; obstacles: a ShapeSet on one world frame (or None) and obstacle_pairs (Q, 2) (robot shape, obstacle shape); obstacle_cutoff (m): per-sample obstacle distances are exact below it
+        """
+    def check_path(self, waypoints: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], first_step: typing.SupportsFloat | typing.SupportsIndex = 0.05, floor_step: typing.SupportsFloat | typing.SupportsIndex = 0.001, stop_at_violation: bool = True) -> dict:
+        """
+        Proves the straight joint segments between waypoints (K, n) clear: a dict with clear, segments (K-1,) bool, samples evaluated, intervals proven / unproven (at the floor), violations (samples below a floor) and the smallest ground, self, obstacle values evaluated
+        """
+    def motion_bounds(self, qa: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qb: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+        """
+        Per robot shape: how far any of its points moves (m) and how far its lowest z changes (m) along the straight joint segment qa -> qb (proven bounds: path_check.hpp)
+        """
+    def sample(self, qs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+        """
+        Each configuration's (T, n) smallest ground clearance, self clearance and obstacle distance (m): three (T,) arrays, +inf where nothing is checked
+        """
 class ToppRaResult:
     """
     The result of topp_ra
@@ -392,4 +412,8 @@ def topp_ra(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], A: ty
 def urdf_root_link(urdf: str) -> str:
     """
     The root link of a URDF (an XML document or a file path)
+    """
+def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex) -> dict:
+    """
+    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes
     """
