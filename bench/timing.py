@@ -96,7 +96,8 @@ class SolveClock:
 
 def solver_rows(name: str, sc: dict, repeats: int) -> list[str]:
     """toppra (the code the core replaced: tests/topp_reference.py) and the core's TOPP-RA on the scenario's path
-    and on its whole plan, in this run: per grid solve (median), all solves, the retime, the motion, the plan."""
+    and on its whole plan, in this run: per grid solve (median), all solves, the retime (without the check of every
+    sample, as the planner calls it), the motion, the plan (the fastest of the repeats, at most 3)."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from topp_reference import toppra_solve_grid, toppra_solver
 
@@ -109,14 +110,16 @@ def solver_rows(name: str, sc: dict, repeats: int) -> list[str]:
             clock_ = SolveClock(solve)
             with toppra_solver(clock_):
                 start = time.perf_counter()
-                traj = timing.retime(plan.robot, sc["q"], plan.base, hold_s=holds, stops=stops)
+                traj = timing.retime(plan.robot, sc["q"], plan.base, hold_s=holds, stops=stops, check_samples=False)
                 total = time.perf_counter() - start
             if not best or total < best["total"]:
                 best = dict(total=total, clock=clock_, duration=traj.duration)
-        with toppra_solver(solve) if solver == "toppra" else contextlib.nullcontext():
-            start = time.perf_counter()
-            full = snakehead.plan(paper_scene(name))
-            plan_s = time.perf_counter() - start
+        plan_s = np.inf
+        for _ in range(min(repeats, 3)):
+            with toppra_solver(solve) if solver == "toppra" else contextlib.nullcontext():
+                start = time.perf_counter()
+                full = snakehead.plan(paper_scene(name))
+                plan_s = min(plan_s, time.perf_counter() - start)
         c = best["clock"]
         rows.append(f"| {name} | {solver} | {len(c.times)} | {int(np.median(c.points))} | "
                     f"{1000 * statistics.median(c.times):.1f} | {1000 * sum(c.times):.0f} | {1000 * best['total']:.0f} | "
@@ -159,7 +162,8 @@ def main() -> None:
               f"{PAPER[name]['direction_deg']} deg", flush=True)
 
     if args.solvers:
-        print("\n### TOPP-RA: toppra (seidel) against the core, the scenario's states retimed at the default limits\n")
+        print("\n### TOPP-RA: toppra (seidel) against the core, the scenario's states retimed at the default limits "
+              f"(fastest of {args.repeats}; retime without the sample check)\n")
         print("| scenario | solver | grid solves | gridpoints (median) | per solve (ms, median) | all solves (ms) | "
               "retime (ms) | motion (s) | whole plan (s) | plan's motion (s) |")
         print("|---|---|---|---|---|---|---|---|---|---|")

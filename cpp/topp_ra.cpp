@@ -77,13 +77,28 @@ bool optimum_on_line(const double v[2], const HalfPlane& h, const HalfPlane* row
   return true;
 }
 
+// The stage rows with unit normals (a, b), all at once (rows 0 u + 0 x <= c as they are).
+struct UnitRows {
+  RowMatrixXd a, b, c;
+  UnitRows(const Eigen::Ref<const RowMatrixXd>& A, const Eigen::Ref<const RowMatrixXd>& B,
+           const Eigen::Ref<const RowMatrixXd>& C) {
+    Eigen::ArrayXXd norm = (A.array().square() + B.array().square()).sqrt();
+    if (!norm.allFinite())  // the squares overflowed (|a| or |b| > 1e154)
+      for (Eigen::Index i = 0; i < norm.rows(); ++i)
+        for (Eigen::Index k = 0; k < norm.cols(); ++k) norm(i, k) = std::hypot(A(i, k), B(i, k));
+    const Eigen::ArrayXXd scale = (norm > 0.0).select(norm.inverse(), 1.0);
+    a = (A.array() * scale).matrix();
+    b = (B.array() * scale).matrix();
+    c = (C.array() * scale).matrix();
+  }
+};
+
 // Stage i's LP: the two rows that keep x + 2 delta u in [K_lo, K_hi] (rows 0 and 1), then its m rows.
-void fill_stage(std::vector<HalfPlane>& rows, double delta, double K_lo, double K_hi,
-                const Eigen::Ref<const RowMatrixXd>& A, const Eigen::Ref<const RowMatrixXd>& B,
-                const Eigen::Ref<const RowMatrixXd>& C, Eigen::Index i) {
+void fill_stage(std::vector<HalfPlane>& rows, double delta, double K_lo, double K_hi, const UnitRows& stage,
+                Eigen::Index i) {
   rows[0] = normalized({2.0 * delta, 1.0, K_hi});
   rows[1] = normalized({-2.0 * delta, -1.0, -K_lo});
-  for (Eigen::Index k = 0; k < A.cols(); ++k) rows[2 + k] = normalized({A(i, k), B(i, k), C(i, k)});
+  for (Eigen::Index k = 0; k < stage.a.cols(); ++k) rows[2 + k] = {stage.a(i, k), stage.b(i, k), stage.c(i, k)};
 }
 
 // The box of stage i's LP: its own bounds, sides at most kVarLimit, and x >= 0 (x = s'^2).
@@ -148,7 +163,8 @@ void validate(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<co
 }  // namespace
 
 HalfPlane normalized(const HalfPlane& h) {
-  const double norm = std::hypot(h.a, h.b);
+  double norm = std::sqrt(h.a * h.a + h.b * h.b);  // (std::hypot is several times slower: one per row and stage)
+  if (!std::isfinite(norm)) norm = std::hypot(h.a, h.b);  // the squares overflowed
   return norm > 0.0 ? HalfPlane{h.a / norm, h.b / norm, h.c / norm} : h;
 }
 
@@ -197,6 +213,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
                      const Eigen::Ref<const RowMatrixX2d>& u_bounds, const Eigen::Ref<const RowMatrixX2d>& x_bounds,
                      double x_start, double x_end) {
   validate(grid, A, B, C, u_bounds, x_bounds, x_start, x_end);
+  const UnitRows stage(A, B, C);
   const int N = static_cast<int>(grid.size() - 1);
   const int rows_count = static_cast<int>(A.cols()) + 2;
   ToppRaResult res;
@@ -220,7 +237,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
   res.K(N, 0) = res.K(N, 1) = x_end;
   int warm_max[2] = {-1, -1}, warm_min[2] = {-1, -1};
   for (int i = N - 1; i >= 0; --i) {
-    fill_stage(rows, grid(i + 1) - grid(i), res.K(i + 1, 0), res.K(i + 1, 1), A, B, C, i);
+    fill_stage(rows, grid(i + 1) - grid(i), res.K(i + 1, 0), res.K(i + 1, 1), stage, i);
     stage_box(u_bounds, x_bounds, i, lo, hi);
     warm_order(shuffled, warm_max, order);
     const Lp2dSolution top = solve_lp2d(-kTieWeight, 1.0, rows.data(), rows_count, lo, hi, order.data());
@@ -248,7 +265,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
   int tries = 0;
   for (int i = 0; i < N;) {
     const double delta = grid(i + 1) - grid(i);
-    fill_stage(rows, delta, res.K(i + 1, 0), res.K(i + 1, 1), A, B, C, i);
+    fill_stage(rows, delta, res.K(i + 1, 0), res.K(i + 1, 1), stage, i);
     stage_box(u_bounds, x_bounds, i, lo, hi);
     double u = 0.0;
     ++res.lp_count;
