@@ -288,3 +288,33 @@ def test_many_threads_same_result() -> None:
     for r in results:
         assert r.status == "feasible"
         assert np.array_equal(r.x, one.x) and np.array_equal(r.K, one.K)
+
+
+def test_refinement_probing_only_changed_stages_gives_the_same_grid(monkeypatch: pytest.MonkeyPatch) -> None:
+    """_Piece._refine probes again only the stages whose ends or speeds changed since a round found them within the
+    limits: the same grid and profile as probing every stage every round."""
+    robot = snakehead.SnakeRobot.default()
+    W = random_waypoints(robot, np.random.default_rng(2))
+    limits = timing.resolve_limits(robot, acceleration_limit=4.0)
+    probed: list[tuple[int, int]] = []  # per round: stages probed, stages
+    original = timing._stages_over
+
+    def spy(*args: object, only: np.ndarray | None = None) -> np.ndarray:
+        assert only is not None
+        probed.append((int(only.sum()), len(only)))
+        return original(*args, only=only)  # type: ignore[arg-type]
+
+    def every_stage(*args: object, only: np.ndarray | None = None) -> np.ndarray:
+        return original(*args)  # type: ignore[arg-type]
+
+    def timed() -> tuple[np.ndarray, np.ndarray]:
+        return timing._Piece(robot, snakehead.BasePlacement(), limits, W, 0, 2, "monotone").time(timing.GRID_STEP, [])
+
+    monkeypatch.setattr(timing, "_stages_over", spy)
+    grid, sd = timed()
+    assert len(probed) >= 2, "the path needs no refinement: no test"
+    monkeypatch.setattr(timing, "_stages_over", every_stage)
+    grid_all, sd_all = timed()
+    assert np.array_equal(grid, grid_all) and np.array_equal(sd, sd_all)
+    assert probed[0][0] == probed[0][1]  # the first round probes every stage
+    assert all(todo < stages for todo, stages in probed[1:]), probed  # later ones only those that changed
