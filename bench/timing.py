@@ -9,13 +9,20 @@ run time, the simulated head errors against the paper's, momentum errors, ZMP, b
     python3 bench/timing.py                       # the sweep below, both scenarios, MuJoCo for each
     python3 bench/timing.py --accelerations 1 --velocity-shares 0.5 --no-sim
     python3 bench/timing.py --accelerations 4 --velocity-shares 1 --zmp-margins 0.005 0.01 0.015 --interpolations
+    python3 bench/timing.py --solvers --no-sim --accelerations 2 --velocity-shares 0.5 --interpolations
+                                                  # + toppra against the core's TOPP-RA, side by side (needs toppra)
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import platform
+import statistics
+import sys
 import time
+from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
 
@@ -73,6 +80,53 @@ def run(name: str, sc: dict, *, simulate: bool, **limits) -> dict:
     return row
 
 
+class SolveClock:
+    """Wraps a grid solver (timing._solve_grid's signature): the run time and gridpoints of each call."""
+
+    def __init__(self, solve: Callable) -> None:
+        self.solve, self.times, self.points = solve, [], []
+
+    def __call__(self, robot: Any, points: Any, limits: Any) -> Any:
+        clock = time.perf_counter()
+        out = self.solve(robot, points, limits)
+        self.times.append(time.perf_counter() - clock)
+        self.points.append(len(points.s))
+        return out
+
+
+def solver_rows(name: str, sc: dict, repeats: int) -> list[str]:
+    """toppra (the code the core replaced: tests/topp_reference.py) and the core's TOPP-RA on the scenario's path
+    and on its whole plan, in this run: per grid solve (median), all solves, the retime (without the check of every
+    sample, as the planner calls it), the motion, the plan (the fastest of the repeats, at most 3)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from topp_reference import toppra_solve_grid, toppra_solver
+
+    plan = sc["plan"]
+    holds, stops = np.diff(sc["times"]), [k for k, _, _ in sc["targets"]]
+    rows = []
+    for solver, solve in (("toppra", toppra_solve_grid), ("core", timing._solve_grid)):
+        best: dict = {}
+        for _ in range(repeats):  # the fastest of the repeats (the machine is shared)
+            clock_ = SolveClock(solve)
+            with toppra_solver(clock_):
+                start = time.perf_counter()
+                traj = timing.retime(plan.robot, sc["q"], plan.base, hold_s=holds, stops=stops, check_samples=False)
+                total = time.perf_counter() - start
+            if not best or total < best["total"]:
+                best = dict(total=total, clock=clock_, duration=traj.duration)
+        plan_s = np.inf
+        for _ in range(min(repeats, 3)):
+            with toppra_solver(solve) if solver == "toppra" else contextlib.nullcontext():
+                start = time.perf_counter()
+                full = snakehead.plan(paper_scene(name))
+                plan_s = min(plan_s, time.perf_counter() - start)
+        c = best["clock"]
+        rows.append(f"| {name} | {solver} | {len(c.times)} | {int(np.median(c.points))} | "
+                    f"{1000 * statistics.median(c.times):.1f} | {1000 * sum(c.times):.0f} | {1000 * best['total']:.0f} | "
+                    f"{best['duration']:.3f} | {plan_s:.2f} | {full.duration_s:.2f} |")
+    return rows
+
+
 def binds(check) -> str:
     shares = sorted(check.binding.items(), key=lambda kv: -kv[1])
     return ", ".join(f"{k} {100 * v:.0f} %" for k, v in shares if v >= 0.01) or "-"
@@ -88,6 +142,9 @@ def main() -> None:
     ap.add_argument("--zmp-margins", nargs="+", type=float, default=[timing.ZMP_MARGIN], help="m, swept")
     ap.add_argument("--friction", type=float, default=timing.FRICTION)
     ap.add_argument("--no-sim", action="store_true", help="skip MuJoCo")
+    ap.add_argument("--solvers", action="store_true",
+                    help="also compare toppra and the core's TOPP-RA side by side (needs toppra: the test extra)")
+    ap.add_argument("--repeats", type=int, default=3, help="retimes per solver in --solvers (the fastest counts)")
     ap.add_argument("--interpolations", nargs="*", default=["monotone", "spline"],
                     help="paths compared at the default limits")
     args = ap.parse_args()
@@ -103,6 +160,16 @@ def main() -> None:
                      f"{fixed.direction_error_deg:.3f} deg, ZMP inside {fixed.zmp_inside}")
         print(line + f"; the paper's {PAPER[name]['duration']:.0f} s, {PAPER[name]['position_mm']} mm / "
               f"{PAPER[name]['direction_deg']} deg", flush=True)
+
+    if args.solvers:
+        print("\n### TOPP-RA: toppra (seidel) against the core, the scenario's states retimed at the default limits "
+              f"(fastest of {args.repeats}; retime without the sample check)\n")
+        print("| scenario | solver | grid solves | gridpoints (median) | per solve (ms, median) | all solves (ms) | "
+              "retime (ms) | motion (s) | whole plan (s) | plan's motion (s) |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for name, sc in scenarios.items():
+            for row in solver_rows(name, sc, args.repeats):
+                print(row, flush=True)
 
     print(f"\n### Limits swept (monotone path; torque {timing.TORQUE_SHARE} x URDF effort; friction {args.friction})\n")
     head = ("| scenario | acc (rad/s^2) | vel (x URDF) | ZMP margin (mm) | duration (s) | retime (s) | binds | planned ZMP (mm) |"

@@ -11,4 +11,5 @@ void bind_support(pybind11::module_& m);
 void bind_shape_set(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
 void bind_path_check(pybind11::module_& m);
+void bind_topp_ra(pybind11::module_& m);
 }  // namespace snakehead::bindings

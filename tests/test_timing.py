@@ -16,8 +16,6 @@ from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.motion import start_state, timing
 from snakehead.motion.interpolation import MonotoneQuintic
 
-pytest.importorskip("toppra")
-
 GENERATED = SnakeSpec(n_joints=14, module_length=0.08, section=0.045, mass_per_module=0.22, first_axis="yaw",
                       markers={"p0": 7, "b0": 9}, tip_name="tip", name="gen14")
 #: The fixed speed the planner used before retiming (rad/s of the fastest joint) and its shortest move (s).

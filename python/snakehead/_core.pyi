@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA)
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -283,6 +283,40 @@ class PathChecker:
         """
         Each configuration's (T, n) smallest ground clearance, self clearance and obstacle distance (m): three (T,) arrays, +inf where nothing is checked
         """
+class ToppRaResult:
+    """
+    The result of topp_ra
+    """
+    @property
+    def K(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        """
+        (N+1, 2) controllable sets of x (NaN at failed_at and before when uncontrollable)
+        """
+    @property
+    def failed_at(self) -> int:
+        """
+        the gridpoint where it failed; -1 when feasible
+        """
+    @property
+    def lp_count(self) -> int:
+        """
+        LPs solved
+        """
+    @property
+    def status(self) -> str:
+        """
+        'feasible', 'uncontrollable' (the backward pass found an empty controllable set), 'start_outside' (x_start is not in K_0) or 'forward_failed' (round-off: the forward pass found no u)
+        """
+    @property
+    def u(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        (N,) path accelerations of the stages, (x_{i+1} - x_i) / (2 delta_i)
+        """
+    @property
+    def x(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        (N+1,) squared path speeds (NaN where the forward pass did not reach)
+        """
 class Cancelled(Exception):
     pass
 def approach_frame(point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], roll: typing.SupportsFloat | typing.SupportsIndex = 0.0, axis: str = 'x') -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
@@ -366,6 +400,14 @@ def shape_pair_distances(frames_a: typing.Annotated[numpy.typing.ArrayLike, nump
 def shape_pair_min_distances(frames_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_a: ShapeSet, frames_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set_b: ShapeSet, pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], cutoff: typing.SupportsFloat | typing.SupportsIndex = ...) -> numpy.typing.NDArray[numpy.float64]:
     """
     The smallest of shape_pair_distances' values at each sample (pruned): (T,), +inf when there is no pair
+    """
+def solve_lp2d(v_u: typing.SupportsFloat | typing.SupportsIndex, v_x: typing.SupportsFloat | typing.SupportsIndex, rows: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], lo: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[2, 1]"], hi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[2, 1]"]) -> tuple[bool, float, float]:
+    """
+    max v_u u + v_x x subject to rows (m, 3) a u + b x <= c and lo <= (u, x) <= hi: (feasible, u, x)
+    """
+def topp_ra(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], C: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], u_bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_start: typing.SupportsFloat | typing.SupportsIndex = 0.0, x_end: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> ToppRaResult:
+    """
+    TOPP-RA over grid (N+1,) with stage rows A u + B x <= C (N, m each), u_bounds (N, 2), x_bounds (N+1, 2): the controllable sets and the greedy forward pass from x_start to x_end (include/snakehead/topp_ra.hpp)
     """
 def urdf_root_link(urdf: str) -> str:
     """

@@ -1,113 +1,89 @@
-"""The TOPP-RA side of :mod:`snakehead.motion.timing`: the path and constraint types toppra asks for.
+"""The TOPP-RA side of :mod:`snakehead.motion.timing`: the path's constraints at the gridpoints in TOPP-RA's
+canonical form, their discretization, and the solve in the C++ core (``snakehead._core.topp_ra``,
+``include/snakehead/topp_ra.hpp``).
 
-Kept apart so that toppra (which imports matplotlib's pyplot) is imported only when a path is retimed.
-Each constraint computes its coefficients at all gridpoints at once from a function of the path's points
-(q, dq/ds, d2q/ds2), and uses toppra's *interpolation* discretization: the constraint of gridpoint i+1 is also
-imposed on the state that stage i reaches there (x_i + 2 delta_i u_i, with u_i), so that the constant path
-acceleration of a stage keeps the limits at both of its ends.
+Along a path q(s) with u = s'' and x = s'^2 (Pham and Pham 2018), each constraint at a gridpoint is a row
+``P u + Q x <= R``: the joint accelerations q' u + q'' x, the torques tau_a u + tau_b x + tau_hold, the stability
+rows F (w_a u + w_b x) <= g; the joint velocities q' s' bound x alone. All are computed for every gridpoint at
+once. The discretization is toppra's *interpolation* one: stage i keeps the rows of gridpoint i at (u, x) and those
+of gridpoint i+1 at the state it reaches there, (u, x + 2 delta_i u), so that a stage's constant path acceleration
+keeps the limits at both of its ends.
 """
 from __future__ import annotations
 
-import logging
-from typing import Any, Callable
+from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
-import toppra.algorithm as algo
-from toppra.constraint import (DiscretizationType, JointAccelerationConstraint, JointVelocityConstraint,
-                               LinearConstraint)
-from toppra.constraint.linear_constraint import canlinear_colloc_to_interpolate
-from toppra.interpolator import AbstractGeometricPath
 
-#: q(s) and its derivatives: f(s (N,), order 0, 1 or 2) -> (N, n).
-PathFunction = Callable[[np.ndarray, int], np.ndarray]
-#: (q, dq/ds, d2q/ds2) at N points -> a, b, c (N, m), F, g of a linear constraint (see PointwiseLinearConstraint).
-ParamsFunction = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]
-
-# toppra logs every infeasible path as a warning; the caller turns it into a ValueError that says where
-logging.getLogger("toppra").setLevel(logging.ERROR)
+from .. import _core
 
 
-class GeometricPath(AbstractGeometricPath):
-    """A joint path q(s), s in [0, length], from a callable ``f(s (N,), order) -> (N, n)`` (order 0, 1, 2)."""
+@dataclass(frozen=True)
+class PathLimits:
+    """The limits TOPP-RA is given, per joint (n,): velocity (rad/s), acceleration (rad/s^2), torque (N m); inf
+    for none. x_cap: the cap on x = s'^2 where the joint velocities leave it unbounded (a path that stands still)."""
 
-    def __init__(self, f: PathFunction, length: float, dof: int) -> None:
-        self._f, self._length, self._dof = f, float(length), int(dof)
-
-    def __call__(self, path_positions: npt.ArrayLike, order: int = 0) -> np.ndarray:
-        s = np.asarray(path_positions, float)
-        out = self._f(np.atleast_1d(s), order)
-        return out[0] if s.ndim == 0 else out
-
-    @property
-    def dof(self) -> int:
-        return self._dof
-
-    @property
-    def path_interval(self) -> np.ndarray:
-        return np.array([0.0, self._length])
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    torque: np.ndarray
+    x_cap: float
 
 
-class PointwiseLinearConstraint(LinearConstraint):
-    """A toppra LinearConstraint ``a u + b x + c = v, F v <= g`` whose parameters come from ``params(q, dq, ddq)``
-    evaluated at every gridpoint at once (q, dq = dq/ds, ddq = d2q/ds2, each (N, n)).
+@dataclass(frozen=True)
+class Canonical:
+    """The constraints at N+1 gridpoints: rows P u + Q x <= R (N+1, m) and x <= x_max (N+1,)."""
 
-    ``params`` returns a, b, c (N, m) and F (N, k, m), g (N, k), or F (k, m), g (k,) when ``identical``.
-    """
-
-    def __init__(self, params: ParamsFunction, dof: int, identical: bool, name: str) -> None:
-        super().__init__()
-        self._params, self.dof, self.identical, self.name = params, int(dof), bool(identical), name
-        self.set_discretization_type(DiscretizationType.Interpolation)
-        self._format_string = f"    {name}\n"
-
-    def compute_constraint_params(self, path: GeometricPath, gridpoints: np.ndarray, *args: Any, **kwargs: Any
-                                  ) -> tuple:
-        grid = np.asarray(gridpoints, float)
-        a, b, c, F, g = self._params(path(grid, 0), path(grid, 1), path(grid, 2))
-        return canlinear_colloc_to_interpolate(a, b, c, F, g, None, None, grid, identical=self.identical)
+    P: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    x_max: np.ndarray
 
 
-def box_constraint(limit: np.ndarray, coefficients: ParamsFunction, dof: int, name: str) -> PointwiseLinearConstraint:
-    """|a u + b x + c| <= limit, joint by joint, with (a, b, c) = coefficients(q, dq, ddq) (e.g. joint torques)."""
-    n = len(limit)
-    F = np.vstack([np.eye(n), -np.eye(n)])
-    g = np.concatenate([limit, limit])
+@dataclass(frozen=True)
+class Solution:
+    """A solve: sd (N+1,) the path speeds s' at the gridpoints (None when no timing keeps the constraints); K
+    (N+1, 2) the controllable sets of x = s'^2 (NaN at ``failed_at`` and before it when the backward pass found
+    none); failed_at: the gridpoint where it failed (-1 when feasible)."""
 
-    def params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
-        a, b, c = coefficients(q, dq, ddq)
-        return a, b, c, F, g
-
-    return PointwiseLinearConstraint(params, dof, identical=True, name=name)
+    sd: np.ndarray | None
+    K: np.ndarray
+    failed_at: int
 
 
-class CappedVelocityConstraint(JointVelocityConstraint):
-    """toppra's joint velocity constraint, with the squared path velocity also capped at ``x_cap``: where the path
-    stands still (q'(s) = 0, at a cusp of the path where every joint turns back or stops) the joint limits leave
-    the path velocity unbounded, and toppra's solver turns the unbounded set into NaN."""
-
-    def __init__(self, limit: np.ndarray, x_cap: float) -> None:
-        super().__init__(np.column_stack([-limit, limit]))
-        self.x_cap = float(x_cap)
-
-    def compute_constraint_params(self, path: GeometricPath, gridpoints: np.ndarray) -> tuple:
-        params = list(super().compute_constraint_params(path, gridpoints))
-        params[6] = np.column_stack([params[6][:, 0], np.minimum(params[6][:, 1], self.x_cap)])
-        return tuple(params)
-
-
-def velocity_constraint(limit: np.ndarray, x_cap: float) -> CappedVelocityConstraint:
-    return CappedVelocityConstraint(limit, x_cap)
-
-
-def acceleration_constraint(limit: np.ndarray) -> JointAccelerationConstraint:
-    return JointAccelerationConstraint(np.column_stack([-limit, limit]),
-                                       discretization_scheme=DiscretizationType.Interpolation)
+def canonical(limits: PathLimits, dq: np.ndarray, ddq: np.ndarray, tau_a: np.ndarray, tau_b: np.ndarray,
+              tau_hold: np.ndarray, stability_a: np.ndarray, stability_b: np.ndarray, stability_g: np.ndarray
+              ) -> Canonical:
+    """The canonical rows at N+1 gridpoints from q', q'' (N+1, n); the torque tau_a u + tau_b x + tau_hold
+    (N+1, n each); the stability rows stability_a u + stability_b x <= stability_g (N+1, k each). A joint's rows
+    are left out where its limit is inf."""
+    acc, tau = np.isfinite(limits.acceleration), np.isfinite(limits.torque)
+    a_lim, t_lim = limits.acceleration[acc], limits.torque[tau]
+    P = np.hstack([dq[:, acc], -dq[:, acc], tau_a[:, tau], -tau_a[:, tau], stability_a])
+    Q = np.hstack([ddq[:, acc], -ddq[:, acc], tau_b[:, tau], -tau_b[:, tau], stability_b])
+    hold = tau_hold[:, tau]
+    R = np.hstack([np.broadcast_to(a_lim, (len(dq), len(a_lim))), np.broadcast_to(a_lim, (len(dq), len(a_lim))),
+                   t_lim - hold, t_lim + hold, stability_g])
+    with np.errstate(divide="ignore"):
+        sd_max = (limits.velocity / np.abs(dq)).min(axis=1)  # inf where no joint moves
+    return Canonical(P, Q, R, np.minimum(sd_max ** 2, limits.x_cap))
 
 
-def solve(path: GeometricPath, constraints: list, gridpoints: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
-    """Time-optimal rest-to-rest path velocities: sd (N,) at the gridpoints (None when infeasible) and the
-    controllable sets K (N, 2) of squared path velocities (NaN from where the path cannot be followed)."""
-    instance = algo.TOPPRA(constraints, path, gridpoints=gridpoints, solver_wrapper="seidel")
-    _, sd, _, K = instance.compute_parameterization(0.0, 0.0, return_data=True)
-    return sd, K
+def interpolated(rows: Canonical, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The stage rows A u + B x <= C (N, 2m) of the interpolation discretization: gridpoint i's rows at (u, x) and
+    gridpoint i+1's at (u, x + 2 delta_i u)."""
+    delta = np.diff(grid)[:, None]
+    A = np.hstack([rows.P[:-1], rows.P[1:] + 2.0 * delta * rows.Q[1:]])
+    B = np.hstack([rows.Q[:-1], rows.Q[1:]])
+    C = np.hstack([rows.R[:-1], rows.R[1:]])
+    return A, B, C
+
+
+def solve(grid: np.ndarray, rows: Canonical) -> Solution:
+    """Time-optimal rest-to-rest path speeds over ``grid`` (N+1,) under ``rows`` (TOPP-RA in the core)."""
+    A, B, C = interpolated(rows, grid)
+    N = len(grid) - 1
+    u_bounds = np.tile([-np.inf, np.inf], (N, 1))
+    x_bounds = np.column_stack([np.zeros(N + 1), rows.x_max])
+    result = _core.topp_ra(grid, A, B, C, u_bounds, x_bounds, 0.0, 0.0)
+    sd = np.sqrt(result.x) if result.status == "feasible" else None
+    return Solution(sd, result.K, int(result.failed_at))

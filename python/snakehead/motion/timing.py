@@ -2,9 +2,10 @@
 
 :func:`retime` takes waypoints (K, n) -- the states of a plan, or the dense configurations of a Cartesian move --
 joins them by a smooth path q(s) through every one of them that never leaves the range of two neighbouring
-waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018, with the
-``toppra`` package's ``seidel`` solver) that keeps, at every gridpoint (and, the grid refined where needed, between
-them: at every sample):
+waypoints (so never a joint limit), and finds the fastest motion along it (TOPP-RA, Pham and Pham 2018: the
+constraints of every gridpoint in numpy, :mod:`._topp`; the passes and each gridpoint's 2-D LP in the C++ core,
+``snakehead._core.topp_ra``, as the ``toppra`` package's ``seidel`` solver does them) that keeps, at every gridpoint
+(and, the grid refined where needed, between them: at every sample):
 
 * each joint's velocity within ``velocity_limit`` (default :data:`VELOCITY_SHARE` of the URDF's);
 * each joint's acceleration within ``acceleration_limit`` (URDFs have none: default :data:`ACCELERATION_LIMIT`);
@@ -36,7 +37,7 @@ do better there); the result's ``notes`` say where. A waypoint repeated (a zero-
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -47,6 +48,7 @@ from .._validate import MAX_SAMPLES, finite_array, finite_float, positive, sampl
 from ..dynamics import stability
 from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from . import _topp
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
 from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong
 
@@ -202,6 +204,24 @@ class Support:
         com = stability.center_of_mass(robot, q, base, frames=frames)
         static = ((normal * com[:, None, :2]).sum(-1) - offset).min(axis=1)
         return cls(normal, offset, com, static, required_margins(static, zmp_margin))
+
+    def take(self, index: np.ndarray) -> "Support":
+        """The support of the configurations ``index`` (an index array into the N)."""
+        return Support(*(getattr(self, f.name)[index] for f in fields(self)))
+
+    def joined(self, other: "Support") -> "Support":
+        """Both supports, one after the other; the polygons padded to one edge count (repeating the first edge)."""
+        edges = max(self.offset.shape[1], other.offset.shape[1])
+        a, b = self._padded(edges), other._padded(edges)
+        return Support(*(np.concatenate([getattr(a, f.name), getattr(b, f.name)]) for f in fields(self)))
+
+    def _padded(self, edges: int) -> "Support":
+        extra = edges - self.offset.shape[1]
+        if extra == 0:
+            return self
+        pad = np.zeros(self.offset.shape[1] + extra, int)
+        pad[:self.offset.shape[1]] = np.arange(self.offset.shape[1])
+        return replace(self, normal=self.normal[:, pad], offset=self.offset[:, pad])
 
     def margins(self, xy: np.ndarray) -> np.ndarray:
         """Signed distance (m) of points xy (N, 2) inside each polygon: exact inside (the nearest edge), negative
@@ -523,6 +543,39 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     # (the friction polygon is taken in the base's frame): the path is timed at the default placement, and one
     # timing serves every placement (the planner times a lift once per base shape)
     base = BasePlacement()
+    W = _checked_waypoints(robot, waypoints)
+    limits = resolve_limits(robot, velocity_limit=velocity_limit, acceleration_limit=acceleration_limit,
+                            torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
+    dt = positive(dt, "dt")
+    grid_step = positive(grid_step, "grid_step")
+    if not isinstance(check_samples, (bool, np.bool_)):
+        raise InputTypeError(f"check_samples must be True or False, got {check_samples!r}")
+    if interpolation not in INTERPOLATIONS:
+        raise InputError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
+    schedule, holds = _segments(W, stops, hold_s)
+    timeline = _Timeline(robot.n_joints)
+    times = np.zeros(len(W))
+    notes: list[str] = []
+    for kind, i0, i1 in schedule:
+        if kind == "pause":
+            timeline.add_pause(W[i1], float(holds[i0]))
+            times[i1] = timeline.end
+        else:
+            piece = _Piece(robot, base, limits, W, i0, i1, interpolation)
+            grid, sd = piece.time(grid_step, notes)
+            t_grid = timeline.add_piece(piece.f, grid, sd)
+            times[i0:i1 + 1] = t_grid[np.searchsorted(grid, piece.knots)]
+        _check_length(timeline.end, dt)
+    t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
+    q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
+    q[0], q[-1] = W[0], W[-1]
+    check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
+    return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
+                             notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
+
+
+def _checked_waypoints(robot: SnakeRobot, waypoints: npt.ArrayLike) -> np.ndarray:
+    """The waypoints (K, n), K >= 2, within the joint limits; InputError otherwise."""
     n = robot.n_joints
     W = finite_array(waypoints, "waypoints")
     if W.ndim != 2 or W.shape[1] != n:
@@ -534,124 +587,160 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
         k, j = np.argwhere(out)[0]
         raise InputError(f"waypoint {k} has joint {robot.joint_names[j]} at {W[k, j]:.4f} rad, outside its limits "
                          f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]")
-    limits = resolve_limits(robot, velocity_limit=velocity_limit, acceleration_limit=acceleration_limit,
-                            torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
-    dt = positive(dt, "dt")
-    grid_step = positive(grid_step, "grid_step")
-    if not isinstance(check_samples, (bool, np.bool_)):
-        raise InputTypeError(f"check_samples must be True or False, got {check_samples!r}")
-    if interpolation not in INTERPOLATIONS:
-        raise InputError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
-    schedule, holds = _segments(W, stops, hold_s)
+    return W
 
-    from . import _topp  # toppra imports pyplot: only when a path is retimed
 
-    big = 1e6  # toppra needs finite limits; "none" is a limit no motion here comes near
-    # the path is parametrised by its length in joint space (rad): its speed s' is about the joints' speed, which
-    # their limits bound; where the path stands still they do not, and PATH_SPEED_FACTOR times their norm does
-    path_speed = PATH_SPEED_FACTOR * np.linalg.norm(np.minimum(limits.velocity, MAX_JOINT_SPEED))
-    vel_c = _topp.velocity_constraint(SOLVE_SHARE * np.minimum(limits.velocity, big), float(path_speed) ** 2)
-    acc_c = _topp.acceleration_constraint(SOLVE_SHARE * np.minimum(limits.acceleration, big))
-    tau_lim = SOLVE_SHARE * np.minimum(limits.torque, big)
-    solve_limits = RetimingLimits(limits.velocity, limits.acceleration, limits.torque, limits.zmp_margin,
-                                  SOLVE_SHARE * limits.friction)
+class _Piece:
+    """One rest-to-rest piece of the motion: the path f(s) through waypoints i0..i1 (s: its length in joint space,
+    rad, with the waypoints at ``knots``), timed by TOPP-RA on a grid refined where the limits break between
+    gridpoints."""
 
-    # the torque and the stability constraints of one grid share its frames, Newton-Euler passes and support
-    supports: dict[int, tuple[np.ndarray, Support]] = {}
-    passes: dict[int, tuple[np.ndarray, Any]] = {}
-
-    def at_grid(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[Any, Any, np.ndarray, Support]:
-        hit = passes.get(q.shape[0])
-        if hit is None or not np.array_equal(hit[0], q):
-            F = robot.frames_many(q, base)
-            a, b = _path_dynamics(robot, q, dq, ddq, base, F)
-            hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=F)
-            support = supports.get(q.shape[0])
-            if support is None or not np.array_equal(support[0], q):
-                supports[q.shape[0]] = support = (q, Support.of(robot, q, base, limits.zmp_margin, F))
-            passes[q.shape[0]] = hit = (q, (a, b, hold, support[1]))
-        return hit[1]
-
-    def torque_coefficients(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
-        a, b, hold, _ = at_grid(q, dq, ddq)  # tau = M q' s'' + (M q'' + C(q, q')) s'^2 + G_carried(q)
-        return a.tau, b.tau, hold
-
-    def stability_params(q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple[np.ndarray, ...]:
-        a, b, _, support = at_grid(q, dq, ddq)  # w = (dP/dt, dL/dt) = a s'' + b s'^2
-        wa, wb = np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot])
-        F, g = stability_rows(robot, support, solve_limits, SOLVE_ZMP_EXTRA_M)
-        return wa, wb, np.zeros_like(wa), F, g
-
-    tau_c = _topp.box_constraint(tau_lim, torque_coefficients, n, "joint torque")
-    stab_c = _topp.PointwiseLinearConstraint(stability_params, n, identical=False, name="ZMP and friction")
-    constraints = [vel_c, acc_c, tau_c, stab_c]
-    timeline = _Timeline(n)
-    times = np.zeros(len(W))
-    notes: list[str] = []
-    for item in schedule:
-        if item[0] == "pause":
-            k = item[1]
-            timeline.add_pause(W[k + 1], float(holds[k]))
-            times[k + 1] = timeline.end
-            _check_length(timeline.end, dt)
-            continue
-        _, i0, i1 = item
+    def __init__(self, robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, W: np.ndarray, i0: int,
+                 i1: int, interpolation: str) -> None:
+        self.robot, self.base, self.limits, self.i0, self.i1 = robot, base, limits, i0, i1
         pts = W[i0:i1 + 1]
-        knots = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
-        f = _path_function(knots, pts, interpolation)
+        self.knots = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
+        self.f = _path_function(self.knots, pts, interpolation)
+        self.interpolation = interpolation
+
+    def near(self, k: int, grid: np.ndarray) -> int:
+        """The waypoint at or before gridpoint k."""
+        return self.i0 + int(np.searchsorted(self.knots, grid[k], side="right")) - 1
+
+    def first_grid(self, grid_step: float) -> np.ndarray:
+        """Gridpoints at most ``grid_step`` rad apart, at least MIN_GRID_PER_SEGMENT per segment, on every knot."""
+        knots = self.knots
         sample_count(knots[-1], grid_step, "TOPP-RA's grid (the path's length over grid_step)", unit="rad",
                      maximum=MAX_GRID_POINTS)  # before the grid is allocated and solved over
         steps = np.maximum(MIN_GRID_PER_SEGMENT, np.ceil(np.diff(knots) / grid_step).astype(int))
-        grid = np.concatenate([np.linspace(knots[k], knots[k + 1], steps[k] + 1)[:-1] for k in range(len(steps))]
+        return np.concatenate([np.linspace(knots[k], knots[k + 1], steps[k] + 1)[:-1] for k in range(len(steps))]
                               + [knots[-1:]])
-        qg = f(grid, 0)
-        if interpolation == "spline":
-            over = np.maximum(robot.lower - qg, qg - robot.upper).max()
-            if over > 1e-9:
-                raise Infeasible(f"the spline through waypoints {i0}..{i1} overshoots a joint limit by "
-                                 f"{np.degrees(over):.2f} deg; use interpolation='monotone'")
-        support = Support.of(robot, qg, base, limits.zmp_margin)
-        supports[len(grid)] = (qg, support)
 
-        def near(k: int) -> int:  # the waypoint at or before gridpoint k
-            return i0 + int(np.searchsorted(knots, grid[k], side="right")) - 1
-
-        _precheck(robot, base, limits, qg, support, near)
-        if np.any(support.required < limits.zmp_margin):
+    def time(self, grid_step: float, notes: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """The grid and the path speeds s' at its points; Infeasible where no timing keeps the limits."""
+        points = GridPoints.of(self.robot, self.base, self.f, self.first_grid(grid_step), self.limits.zmp_margin)
+        self._precheck(points)
+        support, grid = points.support, points.s
+        if np.any(support.required < self.limits.zmp_margin):
             k = int(np.argmin(support.static))
             notes.append(f"the CoM is only {1000 * support.static[k]:.1f} mm inside the support polygon near waypoint "
-                         f"{near(k)}: the ZMP keeps {1000 * support.required[k]:.1f} mm there instead of "
-                         f"{1000 * limits.zmp_margin:.1f} mm")
-        path = _topp.GeometricPath(f, knots[-1], n)
-        first_size = len(grid)
+                         f"{self.near(k, grid)}: the ZMP keeps {1000 * support.required[k]:.1f} mm there instead of "
+                         f"{1000 * self.limits.zmp_margin:.1f} mm")
+        return self._refine(points, notes)
+
+    def _refine(self, points: "GridPoints", notes: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """Solve; cut the stages that break a limit between their gridpoints; again, up to REFINE_ROUNDS times
+        (the constraints computed once per gridpoint)."""
+        first_size = len(points.s)
+        kept: set[tuple[float, ...]] = set()  # stages (s_i, s_i+1, x_i, x_i+1) probed within the limits
         for refinement in range(REFINE_ROUNDS + 1):
-            sd, K = _topp.solve(path, constraints, grid)
-            if sd is None:
-                bad = np.flatnonzero(np.isnan(K).any(axis=1))
-                k = int(bad.max()) if bad.size else 0
-                raise Infeasible(f"no motion along the path keeps every limit near waypoint {near(k)} (between "
-                                 f"waypoints {i0} and {i1}); loosen the limits or the ZMP margin there")
+            solution = _solve_grid(self.robot, points, self.limits)
+            if solution.sd is None:
+                raise Infeasible(f"no motion along the path keeps every limit near waypoint "
+                                 f"{self.near(max(solution.failed_at, 0), points.s)} (between waypoints {self.i0} and "
+                                 f"{self.i1}); loosen the limits or the ZMP margin there")
             if refinement == REFINE_ROUNDS:
                 break
-            split = _stages_over(robot, base, limits, f, grid, sd, supports[len(grid)][1])
+            # a stage that is the same as one probed within the limits in an earlier round (same ends, same
+            # speeds: the profile there did not change) is within them again: only the others are probed
+            x = solution.sd ** 2
+            stages = list(zip(points.s[:-1].tolist(), points.s[1:].tolist(), x[:-1].tolist(), x[1:].tolist()))
+            todo = np.array([stage not in kept for stage in stages])
+            split = _stages_over(self.robot, self.base, self.limits, self.f, points.s, solution.sd, points.support,
+                                 only=todo)
+            kept.update(stage for stage, probed, over in zip(stages, todo, split) if probed and not over)
             if not split.any():
                 break
-            refined = _refined(grid, split)
+            refined = _refined(points.s, split)
             if len(refined) > REFINE_GROWTH * first_size + REFINE_EXTRA_POINTS:  # not a local defect: say so rather than grow on
-                notes.append(f"waypoints {i0}..{i1}: {split.sum()} of {len(split)} stages still break a limit between "
-                             "gridpoints after refining; see check")
+                notes.append(f"waypoints {self.i0}..{self.i1}: {split.sum()} of {len(split)} stages still break a "
+                             "limit between gridpoints after refining; see check")
                 break
-            grid = refined
-        assert sd is not None  # the loop raised otherwise
-        t_grid = timeline.add_piece(f, grid, sd)
-        times[i0:i1 + 1] = t_grid[np.searchsorted(grid, knots)]
-        _check_length(timeline.end, dt)
-    t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
-    q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
-    q[0], q[-1] = W[0], W[-1]
-    check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
-    return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
-                             notes=tuple(notes), solve_time_s=time.perf_counter() - clock)
+            added = GridPoints.of(self.robot, self.base, self.f, np.setdiff1d(refined, points.s),
+                                  self.limits.zmp_margin)
+            points = points.merged(added)
+        assert solution.sd is not None  # the loop raised otherwise
+        return points.s, solution.sd
+
+    def _precheck(self, points: "GridPoints") -> None:
+        """Clear errors for paths no timing can follow: the spline leaves the joint limits, or holding still already
+        breaks a limit."""
+        robot, grid, support = self.robot, points.s, points.support
+        if self.interpolation == "spline":
+            over = np.maximum(robot.lower - points.q, points.q - robot.upper).max()
+            if over > 1e-9:
+                raise Infeasible(f"the spline through waypoints {self.i0}..{self.i1} overshoots a joint limit by "
+                                 f"{np.degrees(over):.2f} deg; use interpolation='monotone'")
+        if np.any(support.static <= 0):
+            k = int(np.argmin(support.static))
+            raise Infeasible(f"the centre of mass is {-1000 * support.static[k]:.1f} mm outside the support polygon "
+                             f"near waypoint {self.near(k, grid)}: no motion along this path is stable there")
+        hold = np.abs(points.tau_hold) / self.limits.torque
+        if hold.max() > 1.0:
+            k, j = (int(i) for i in np.unravel_index(int(np.argmax(hold)), hold.shape))
+            raise Infeasible(f"joint {robot.joint_names[j]} needs {hold[k, j] * self.limits.torque[j]:.2f} N m to hold "
+                             f"the body still near waypoint {self.near(k, grid)}; its torque limit is "
+                             f"{self.limits.torque[j]:.2f} N m")
+
+
+@dataclass(frozen=True)
+class GridPoints:
+    """What the retiming needs at gridpoints s (N,) of a path q(s), point by point: q, q'(s), q''(s) (N, n); the
+    torques tau_a s'' + tau_b s'^2 + tau_hold (N, n each: Newton-Euler at (q, 0, q'), at (q, q', q'') and the
+    torques that hold q still); the momentum rates w = (dP/dt, dL/dt) = w_a s'' + w_b s'^2 (N, 6 each); the ground
+    support of q. A refined grid computes only its new points (:meth:`merged`)."""
+
+    s: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+    tau_a: np.ndarray
+    tau_b: np.ndarray
+    tau_hold: np.ndarray
+    w_a: np.ndarray
+    w_b: np.ndarray
+    support: Support
+
+    @classmethod
+    def of(cls, robot: SnakeRobot, base: BasePlacement, f: PathFunction, s: np.ndarray, zmp_margin: float
+           ) -> "GridPoints":
+        q, dq, ddq = f(s, 0), f(s, 1), f(s, 2)
+        frames = robot.frames_many(q, base)
+        a, b = _path_dynamics(robot, q, dq, ddq, base, frames)
+        hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=frames)
+        support = Support.of(robot, q, base, zmp_margin, frames)
+        return cls(s, q, dq, ddq, a.tau, b.tau, hold, np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot]),
+                   support)
+
+    def merged(self, other: "GridPoints") -> "GridPoints":
+        """Both sets of points, in the order of s."""
+        order = np.argsort(np.concatenate([self.s, other.s]), kind="stable")
+        arrays = {f.name: np.concatenate([getattr(self, f.name), getattr(other, f.name)])[order]
+                  for f in fields(self) if f.name != "support"}
+        return GridPoints(**arrays, support=self.support.joined(other.support).take(order))
+
+
+def _path_limits(limits: RetimingLimits) -> _topp.PathLimits:
+    """The limits TOPP-RA is given: SOLVE_SHARE of the joints' (see there). The path is parametrised by its length
+    in joint space (rad): its speed s' is about the joints' speed, which their limits bound; where the path stands
+    still they do not, and PATH_SPEED_FACTOR times their norm does."""
+    path_speed = PATH_SPEED_FACTOR * np.linalg.norm(np.minimum(limits.velocity, MAX_JOINT_SPEED))
+    return _topp.PathLimits(SOLVE_SHARE * limits.velocity, SOLVE_SHARE * limits.acceleration,
+                            SOLVE_SHARE * limits.torque, float(path_speed) ** 2)
+
+
+def _stability_limits(limits: RetimingLimits) -> RetimingLimits:
+    """The limits the stability rows are given in the solve: SOLVE_SHARE of the friction."""
+    return replace(limits, friction=SOLVE_SHARE * limits.friction)
+
+
+def _solve_grid(robot: SnakeRobot, points: GridPoints, limits: RetimingLimits) -> _topp.Solution:
+    """TOPP-RA over the gridpoints ``points.s`` under ``limits`` (the solve's shares of them; the stability rows
+    with the ZMP margin plus SOLVE_ZMP_EXTRA_M), rest to rest."""
+    F, g = stability_rows(robot, points.support, _stability_limits(limits), SOLVE_ZMP_EXTRA_M)
+    rows = _topp.canonical(_path_limits(limits), points.dq, points.ddq, points.tau_a, points.tau_b, points.tau_hold,
+                           np.einsum("nkj,nj->nk", F, points.w_a), np.einsum("nkj,nj->nk", F, points.w_b), g)
+    return _topp.solve(points.s, rows)
 
 
 def _check_length(end: float, dt: float) -> None:
@@ -674,16 +763,18 @@ def _refined(grid: np.ndarray, split: np.ndarray) -> np.ndarray:
 
 
 def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, f: PathFunction, grid: np.ndarray,
-                 sd: np.ndarray, support: Support) -> np.ndarray:
+                 sd: np.ndarray, support: Support, only: np.ndarray | None = None) -> np.ndarray:
     """(N-1,) bool: the stages of a solution that break a limit between their gridpoints (TOPP-RA keeps the limits
     at the gridpoints only). Probed at PROBES points inside each stage, with its constant path acceleration; the
-    ZMP against the support polygon of the nearer gridpoint."""
+    ZMP against the support polygon of the nearer gridpoint. ``only``: (N-1,) bool, the stages to probe (the others
+    are reported within the limits)."""
     x = sd ** 2
     ds = np.diff(grid)
     u = (x[1:] - x[:-1]) / (2 * ds)
     frac = (np.arange(PROBES) + 0.5) / PROBES
-    stage = np.repeat(np.arange(len(ds)), PROBES)
-    fr = np.tile(frac, len(ds))
+    probed = np.arange(len(ds)) if only is None else np.flatnonzero(only)
+    stage = np.repeat(probed, PROBES)
+    fr = np.tile(frac, len(probed))
     s = grid[stage] + fr * ds[stage]
     xs = np.maximum(x[stage] + 2 * u[stage] * (s - grid[stage]), 0.0)
     dq, ddq = f(s, 1), f(s, 2)
@@ -700,17 +791,3 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     bad = np.zeros(len(ds), bool)
     bad[stage[over]] = True
     return bad
-
-
-def _precheck(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, q: np.ndarray, support: Support,
-              near: Callable[[int], int]) -> None:
-    """Clear errors for paths no timing can follow: holding still there already breaks a limit."""
-    if np.any(support.static <= 0):
-        k = int(np.argmin(support.static))
-        raise Infeasible(f"the centre of mass is {-1000 * support.static[k]:.1f} mm outside the support polygon near "
-                         f"waypoint {near(k)}: no motion along this path is stable there")
-    hold = np.abs(inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base)) / limits.torque
-    if hold.max() > 1.0:
-        k, j = (int(i) for i in np.unravel_index(int(np.argmax(hold)), hold.shape))
-        raise Infeasible(f"joint {robot.joint_names[j]} needs {hold[k, j] * limits.torque[j]:.2f} N m to hold the body "
-                         f"still near waypoint {near(k)}; its torque limit is {limits.torque[j]:.2f} N m")
