@@ -32,8 +32,7 @@ def test_gravity_and_the_margins_are_defined_once():
     assert definitions("DETOUR_MARGIN") == ["margins.py"]
     assert definitions("OBSTACLE_CLEARANCE") == ["margins.py"]
     assert definitions("EXACT_DISTANCE_WITHIN") == ["margins.py"]
-    # motion/timing.py still defines its own ZMP_MARGIN and SIM_FRICTION (its rewrite imports them): equal meanwhile
-    assert set(definitions("ZMP_MARGIN")) <= {"margins.py", "motion/timing.py"}
+    assert definitions("ZMP_MARGIN") == ["margins.py"]
 
 
 def test_the_users_read_the_one_definition():
@@ -45,7 +44,8 @@ def test_the_users_read_the_one_definition():
                  "sim.tracking"):  # (by module: dynamics.inverse_dynamics is also a function's name)
         assert importlib.import_module(f"snakehead.{name}").GRAVITY is physics.GRAVITY, name
     assert whole_body.OBSTACLE_CLEARANCE is margins.OBSTACLE_CLEARANCE
-    assert timing.ZMP_MARGIN == margins.ZMP_MARGIN and timing.SIM_FRICTION == physics.GROUND_FRICTION
+    assert timing.ZMP_MARGIN is margins.ZMP_MARGIN and timing.GRAVITY is physics.GRAVITY
+    assert timing.FRICTION == 0.5 * physics.GROUND_FRICTION
     # the simulation's ground is the one the retiming's friction is a share of
     assert inspect.signature(mjcf.build_spec).parameters["friction"].default == physics.GROUND_FRICTION
     assert inspect.signature(tracking.simulate_trajectory).parameters["friction"].default == physics.GROUND_FRICTION

@@ -47,6 +47,8 @@ from scipy.interpolate import CubicSpline
 from .._validate import MAX_SAMPLES, finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
 from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
+from ..margins import ZMP_MARGIN
+from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from . import _topp
 from .interpolation import CONTROL_PERIOD, JointTrajectory, MonotoneQuintic, sample_times
@@ -63,16 +65,12 @@ VELOCITY_SHARE = 0.5
 ACCELERATION_LIMIT = 2.0
 #: Share of the URDF's joint effort limits used by default: room for the PD controller's corrections.
 TORQUE_SHARE = 0.8
-#: m: how far inside the support polygon the ZMP stays by default.
-ZMP_MARGIN = 0.005
 #: Where the CoM itself is less than 2 ZMP_MARGIN inside the support polygon, the ZMP must keep ZMP_MARGIN while the
 #: CoM keeps this much more (m) of room for the motion's dynamic terms, or else half the CoM's margin.
 ZMP_DYNAMIC_ROOM = 0.002
-#: The friction coefficient of the MuJoCo model (snakehead.sim: friction=0.8).
-SIM_FRICTION = 0.8
-#: Friction coefficient the retiming allows the base by default: half the simulation's, since the contacts are
-#: unevenly loaded and some slide before the total reaches mu times the total load.
-FRICTION = 0.5 * SIM_FRICTION
+#: Friction coefficient the retiming allows the base by default: half the simulated ground's (GROUND_FRICTION, the
+#: MuJoCo model's), since the contacts are unevenly loaded and some slide before the total reaches mu times the load.
+FRICTION = 0.5 * GROUND_FRICTION
 #: The ground must push with at least this share of the weight (M g + dP_z/dt >= MIN_NORMAL_SHARE M g).
 MIN_NORMAL_SHARE = 0.1
 #: Sides of the polygon inscribed in the friction circle |dP_xy/dt| <= mu N (a linear constraint).
@@ -250,7 +248,7 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, 
     M g + dP_z/dt), the friction polygon inscribed in |dP_xy/dt| <= mu (M g + dP_z/dt), and
     M g + dP_z/dt >= MIN_NORMAL_SHARE M g.
     """
-    Mg = robot.total_mass * stability.GRAVITY
+    Mg = robot.total_mass * GRAVITY
     N, E = support.offset.shape
     margin = np.minimum(required_margins(support.static, limits.zmp_margin) + extra_margin, 0.9 * support.static)
     off = support.offset + margin[:, None]
@@ -325,7 +323,7 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
     used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
     dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
     tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
-    Mg = robot.total_mass * stability.GRAVITY
+    Mg = robot.total_mass * GRAVITY
     normal_force = Mg + Pdot[:, 2]
     lifting = normal_force > 0  # else the ground would have to pull: no ZMP
     safe = np.where(lifting, normal_force, 1.0)
