@@ -251,3 +251,34 @@ def test_an_obstacle_kind_of_the_wrong_type_is_bad_input():
     with pytest.raises(InputError, match="kind must be one of"):
         scene_from_dict({"name": "s", "targets": [{"name": "a", "position": [0.9, 0.3, 0.3], "direction": [1, 0, 0]}],
                          "obstacles": [{"kind": ["box"], "centre": [1, 1, 0.1], "size": [0.1, 0.1, 0.1]}]})
+
+
+def test_the_figure_process_never_collects_the_parents_solvers(monkeypatch):
+    """A TracIK left in a reference cycle when the figure process forks (its worker threads are the parent's) is not
+    collected in the child: the child's collector ran its destructor, which joins threads the child does not have,
+    and the child died (SIGSEGV in 'Garbage-collecting', seen under load). The child's own garbage is collected."""
+    import gc
+    import os
+
+    from snakehead import SnakeRobot, TracIK
+
+    ik = TracIK.from_chain(SnakeRobot.default().body)
+    q0 = np.full(ik.chain.n_joints, 0.1)
+    assert ik.ik(ik.fk(q0), np.zeros_like(q0)) is not None  # its worker threads ran
+    cycle: list = [ik]
+    cycle.append(cycle)  # unreachable once dropped: only the collector frees it
+    del ik
+    del cycle
+    parent = os.getpid()
+
+    def collects(progress):
+        gc.collect()
+        return [f"drawn {'beside' if os.getpid() != parent else 'here'}"]
+
+    monkeypatch.setattr(pipeline, "FIGURE_PROCESS_TIMEOUT_S", 20.0)  # a regression hangs (the join)
+    gc.disable()  # the cycle must still be there at the fork
+    try:
+        assert pipeline._Beside(collects, pipeline.Progress()).files() == ["drawn beside"]
+    finally:
+        gc.enable()
+    assert gc.collect() > 0  # and the parent frees it

@@ -8,6 +8,7 @@ plan -> simulate (MuJoCo) -> compare -> figures -> animation, then one report (`
 from __future__ import annotations
 
 import contextlib
+import gc
 import importlib.util
 import sys
 import time
@@ -375,7 +376,14 @@ class _Beside:
         ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
         self.recv, send = ctx.Pipe(duplex=False)
         self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-figures", daemon=True)
-        self.proc.start()
+        # Every object alive now is moved out of the collector's reach before the fork: the child must never collect
+        # one. A TracIK's destructor joins its worker threads, which a forked child does not have (the collector
+        # running it there was the child's SIGSEGV, "Garbage-collecting" in its fault handler's trace).
+        gc.freeze()
+        try:
+            self.proc.start()
+        finally:
+            gc.unfreeze()
         send.close()
 
     def files(self) -> list[str]:
