@@ -174,8 +174,11 @@ def test_fit_checks_its_input():
     bad[2, 3] = np.nan
     with pytest.raises(InputError, match="finite"):
         fit.fit(bad, np.zeros((5, len(pts), 3)))
-    settings = dict(damping=0.01, iterations=12, step_tolerance=1e-7, clearance=0.002, ground_weight=10.0,
-                    continuity=0.03, self_clearance=0.005, self_step=1e-6)
+    c = cartesian
+    settings = dict(damping=c.TRACKING_DAMPING, iterations=c.TRACKING_ITERATIONS, step_tolerance=c.TRACKING_STEP_TOLERANCE,
+                    clearance=c.TRACKING_CLEARANCE, ground_weight=c.TRACKING_GROUND_WEIGHT,
+                    continuity=c.TRACKING_CONTINUITY, self_clearance=c.TRACKING_SELF_CLEARANCE,
+                    self_step=c.TRACKING_SELF_STEP)
     none = np.zeros(0, np.int64)
     with pytest.raises(InputError, match="lifted joint"):
         _core.TrackingFit(robot.body.model, robot.geometry.core, np.eye(4), np.array([robot.n_joints]), pts, none,

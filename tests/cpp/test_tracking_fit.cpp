@@ -56,6 +56,7 @@ struct Fixture {
     for (int k = 2; k <= 4; ++k) spec.points.push_back(model.link_index("l" + std::to_string(k)));
     for (int k = 1; k <= 4; ++k) spec.lifted_links.push_back(model.link_index("l" + std::to_string(k)));
     spec.self_pairs = {{0, 2}, {0, 3}, {1, 3}};
+    // the test's own settings (Python's TRACKING_* but for wider clearances, so that both terms are active here)
     settings.damping = 0.01;
     settings.iterations = 12;
     settings.step_tolerance = 1e-7;
