@@ -1,6 +1,7 @@
 """The reference for the core's tracking fit (snakehead._core.TrackingFit, include/snakehead/tracking_fit.hpp): the
-numpy code of ``motion.cartesian.tracking_interpolation`` before the core took its inner loop over, unchanged but for
-the split of one step's stacked system into :func:`tracking_system`.
+numpy code of ``motion.cartesian.tracking_interpolation``'s fit before the core took it over, unchanged but for the
+split of one step's stacked system into :func:`tracking_system` (the setup before the fit and the result after it
+are cartesian's own, shared).
 
 ``tracking_interpolation_numpy`` has the signature and result of ``cartesian.tracking_interpolation``;
 ``numpy_tracking()`` swaps it into the planner (``motion.waypoints``) for a block (tests/test_tracking_fit.py,
@@ -15,13 +16,12 @@ import numpy as np
 import numpy.typing as npt
 
 from snakehead.geometry.shapes import pair_distances
-from snakehead.model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from snakehead.model.robot import BasePlacement, SnakeRobot
 from snakehead.motion import waypoints
 from snakehead.motion.cartesian import (TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING,
                                         TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE,
                                         TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation,
-                                        _interpolation_parameters, _self_pairs, tracked_points)
-from snakehead._validate import joint_vector
+                                        _self_pairs, _tracking_interpolation)
 
 
 def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,
@@ -71,25 +71,15 @@ def tracking_system(robot: SnakeRobot, qj: np.ndarray, current: np.ndarray, targ
     return r, J
 
 
-def tracking_interpolation_numpy(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
-                                 base: BasePlacement | None = None) -> TrackingInterpolation:
-    """``cartesian.tracking_interpolation`` in numpy (as it was before the core's TrackingFit)."""
-    robot = as_robot(robot)
-    base = as_base(base)
-    nj = robot.n_joints
-    q_start = joint_vector(q_start, nj, "q_start")
-    q_end = joint_vector(q_end, nj, "q_end")
-    s = _interpolation_parameters(n)
-    lift = np.arange(robot.lift_joints.start, nj)
-    pts_idx = tracked_points(robot)
-    ends = robot.frames_many(np.stack([q_start, q_end]), base)[:, pts_idx][..., :3, 3]  # (2, m, 3)
-    P = (1.0 - s)[:, None, None] * ends[0] + s[:, None, None] * ends[1]  # Eq. 41
-    q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # joints before the lift, and the starting guesses
+def numpy_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, pts_idx: np.ndarray, q: np.ndarray,
+              P: np.ndarray) -> np.ndarray:
+    """The lifted joints of q's interior samples fitted to P by the numpy loop (a ``cartesian.LiftedFit``)."""
+    q = q.copy()
     lo, hi = robot.lower[lift], robot.upper[lift]
     pairs = _self_pairs(robot, lift)
     lam2 = TRACKING_DAMPING ** 2
-    current = q_start[lift].copy()
-    for j in range(1, len(s) - 1):
+    current = q[0, lift].copy()
+    for j in range(1, len(q) - 1):
         qj = q[j].copy()
         qj[lift] = current
         for _ in range(TRACKING_ITERATIONS):
@@ -100,10 +90,13 @@ def tracking_interpolation_numpy(robot: SnakeRobot, q_start: npt.ArrayLike, q_en
                 break
         q[j] = qj
         current = qj[lift]
-    q[0], q[-1] = q_start, q_end
-    actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
-    dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
-    return TrackingInterpolation(q, s, P, actual, dev, float(dev.max()))
+    return q
+
+
+def tracking_interpolation_numpy(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+                                 base: BasePlacement | None = None) -> TrackingInterpolation:
+    """``cartesian.tracking_interpolation`` with the numpy fit (as it was before the core's TrackingFit)."""
+    return _tracking_interpolation(robot, q_start, q_end, n, base, numpy_fit)
 
 
 @contextlib.contextmanager

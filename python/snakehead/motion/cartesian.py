@@ -15,7 +15,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
 
 import numpy.typing as npt
-from typing import Any, Literal
+from typing import Any, Callable, Literal
 from .._errors import InputError
 
 
@@ -263,6 +263,23 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     The fit runs in the C++ core (:func:`tracking_fit`, ``_core.TrackingFit``; the GIL released), step for step what
     the numpy code it replaced did (tests/tracking_reference.py, tests/test_tracking_fit.py).
     """
+    return _tracking_interpolation(robot, q_start, q_end, n, base, _core_fit)
+
+
+#: A fit of the lifted joints: (robot, base, lift, points, q (S, n), targets (S, m, 3)) -> q with rows 1 .. S-2's
+#: lifted joints fitted (:func:`tracking_interpolation`).
+LiftedFit = Callable[[SnakeRobot, BasePlacement, np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+
+def _core_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, points: np.ndarray, q: np.ndarray,
+              P: np.ndarray) -> np.ndarray:
+    return tracking_fit(robot, base, lift, points).fit(q, P)
+
+
+def _tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+                            base: BasePlacement | None, fit: LiftedFit) -> TrackingInterpolation:
+    """:func:`tracking_interpolation` with the lifted joints fitted by ``fit`` (the core's, or the numpy reference's
+    in the tests)."""
     robot = as_robot(robot)
     base = as_base(base)
     nj = robot.n_joints
@@ -274,7 +291,7 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     ends = robot.frames_many(np.stack([q_start, q_end]), base)[:, pts_idx][..., :3, 3]  # (2, m, 3)
     P = (1.0 - s)[:, None, None] * ends[0] + s[:, None, None] * ends[1]  # Eq. 41
     q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # joints before the lift, and the starting guesses
-    q = tracking_fit(robot, base, lift, pts_idx).fit(q, P)  # the lifted joints of the interior samples
+    q = fit(robot, base, lift, pts_idx, q, P)  # the lifted joints of the interior samples
     q[0], q[-1] = q_start, q_end
     actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
     dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
