@@ -6,6 +6,7 @@ start/end pairs with the ground and self terms active and not.
 from __future__ import annotations
 
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -158,6 +159,25 @@ def test_interpolation_is_the_numpy_one(styled):
         compared, ground, selfc = compared + 1, ground + g, selfc + c
     assert compared >= 3 and ground > 0
     assert selfc > 0 or style not in ("default", "head6")
+
+
+def test_one_fit_serves_many_threads():
+    """Threads sharing one TrackingFit (the GIL released in fit) get what each call gets alone."""
+    robot = snakehead.SnakeRobot.default()
+    base = snakehead.BasePlacement()
+    lift, pts, _ = fit_inputs(robot)
+    fit = cartesian.tracking_fit(robot, base, lift, pts)
+    problems = []
+    for qa, qb in planner_like_pairs(robot, 6, seed=9):
+        s = np.linspace(0.0, 1.0, 12)
+        ends = robot.frames_many(np.stack([qa, qb]), base)[:, pts][..., :3, 3]
+        problems.append(((1 - s)[:, None] * qa + s[:, None] * qb,
+                         (1 - s)[:, None, None] * ends[0] + s[:, None, None] * ends[1]))
+    alone = [fit.fit(q, P) for q, P in problems]
+    with ThreadPoolExecutor(4) as pool:
+        together = list(pool.map(lambda p: fit.fit(*p), problems * 3))
+    for k, q in enumerate(together):
+        np.testing.assert_array_equal(q, alone[k % len(problems)])
 
 
 def test_fit_checks_its_input():
