@@ -7,8 +7,9 @@ seed=1)`` warmed up by one plan, as bench/plan_speed.py) plan the same reachable
 (``snakehead.motion.targets.reachable_targets``), handed to them one at a time, alternately, so that both see the
 same load. Each worker records every ``tracking_interpolation`` call its plans make. Prints per set: the plans that
 succeeded, median and worst wall time, the median motion duration, the worst relative difference of the motion
-durations between the two, the calls and the median time per call; then the calls of the first set timed in one
-process with each implementation (the fastest of 3 runs each) and the largest difference of their q.
+durations and of the plans' sum |q| (inf where the sample counts differ), the calls and the median time per call;
+then every recorded call timed in this process with each implementation (the fastest of 3 runs each) and the largest
+difference of their q.
 
     python3 bench/tracking_fit.py [--sets same,shape] [--count 12]
 """
@@ -64,6 +65,7 @@ def worker(mode: str, kind: str, count: int, seed: int) -> None:
             wall = time.perf_counter()
             plan = snakehead.plan([(t.position, t.direction)], controller=controller)
             print(json.dumps({"ok": plan.success, "wall": time.perf_counter() - wall, "motion": plan.duration_s,
+                              "samples": len(plan.q), "q_sum": float(np.abs(plan.q).sum()),
                               "calls": list(calls), "args": list(args)}), flush=True)
 
 
@@ -109,8 +111,8 @@ def main() -> int:
         worker(args.worker[0], args.worker[1], int(args.worker[2]), int(args.worker[3]))
         return 0
     print("| set | fit | planned | median wall (s) | worst wall (s) | median motion (s) | worst motion rel. diff. | "
-          "fit calls | median fit per call (ms) | median fit per plan (ms) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "worst plan sum abs(q) rel. diff. | fit calls | median fit per call (ms) | median fit per plan (ms) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     recorded: list[list] = []
     for kind in args.sets.split(","):
         procs = [subprocess.Popen([sys.executable, __file__, "--worker", mode, kind, str(args.count), str(args.seed)],
@@ -133,15 +135,16 @@ def main() -> int:
         same = [a["ok"] == b["ok"] for a, b in zip(*rows)]
         rel = max((abs(a["motion"] - b["motion"]) / max(abs(a["motion"]), 1e-12)
                    for a, b in zip(*rows) if a["ok"] and b["ok"]), default=0.0)
+        same_q = max((abs(a["q_sum"] - b["q_sum"]) / max(a["q_sum"], 1e-12) if a["samples"] == b["samples"] else float("inf")
+                      for a, b in zip(*rows)), default=0.0)
         for mode, r in zip(MODES, rows):
             calls = [c for x in r for c in x["calls"]]
             print(f"| {kind} | {mode} | {sum(x['ok'] for x in r)}/{len(r)} | "
                   f"{statistics.median(x['wall'] for x in r):.2f} | {max(x['wall'] for x in r):.2f} | "
-                  f"{statistics.median(x['motion'] for x in r):.2f} | {rel:.1e} (same success: {all(same)}) | "
+                  f"{statistics.median(x['motion'] for x in r):.2f} | {rel:.1e} (same success: {all(same)}) | {same_q:.1e} | "
                   f"{len(calls)} | {1e3 * statistics.median(calls) if calls else 0.0:.1f} | "
                   f"{1e3 * statistics.median(sum(x['calls']) for x in r):.1f} |", flush=True)
-        if not recorded:
-            recorded = [a for x in rows[1] for a in x["args"]]
+        recorded += [a for x in rows[1] for a in x["args"]]
     print()
     print("\n".join(per_call(recorded)))
     return 0

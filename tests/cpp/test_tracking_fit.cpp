@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "snakehead/kinematics.hpp"
+#include "snakehead/shape_set.hpp"
 #include "snakehead/tracking_fit.hpp"
 
 namespace {
@@ -78,8 +79,23 @@ TEST(TrackingFit, StepIsTheDampedLeastSquaresStepOfTheResidualsJacobian) {
   const std::vector<double> target = {0.12, 0.01, 0.05, 0.15, 0.08, 0.06, 0.1, 0.12, 0.04};
   const TrackingStep s = fit.step(q, current, target.data());
   const long rows = s.residual.size();
-  const long extra = rows - 9 - 3;  // beyond the 3 points' and the continuity rows
-  ASSERT_GE(extra, 2) << "the configuration should put ground and self rows in the system";
+  // the ground and self rows expected, counted independently: lifted boxes lower than the clearance, pairs closer
+  Frames f;
+  link_frames(fx.model, q, f);
+  std::vector<double> frames(16 * f.size());
+  for (std::size_t k = 0; k < f.size(); ++k)
+    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(frames.data() + 16 * k) = fx.origin * f[k].matrix();
+  const long L = static_cast<long>(f.size());
+  const std::vector<long> all = {0, 1, 2, 3}, pairs = {0, 2, 0, 3, 1, 3};
+  std::vector<double> low(4), dist(3);
+  lowest_z(frames.data(), 1, L, fx.shapes, all.data(), 4, low.data());
+  pair_distances(frames.data(), 1, L, fx.shapes, frames.data(), 1, L, fx.shapes, pairs.data(), 3, 1.0, dist.data());
+  long ground = 0, close = 0;
+  for (double z : low) ground += z < fx.settings.clearance;
+  for (double d : dist) close += d < fx.settings.self_clearance;
+  ASSERT_GT(ground, 0);
+  ASSERT_GT(close, 0);
+  ASSERT_EQ(rows, 9 + ground + close + 3);  // the 3 points', the ground, self and continuity rows
   // the Jacobian against central differences of the residual (the same rows on both sides)
   const double h = 1e-5;
   for (int c = 0; c < 3; ++c) {
