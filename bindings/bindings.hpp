@@ -12,4 +12,5 @@ void bind_shape_set(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
 void bind_path_check(pybind11::module_& m);
 void bind_topp_ra(pybind11::module_& m);
+void bind_tracking_fit(pybind11::module_& m);
 }  // namespace snakehead::bindings

@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA)
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -316,6 +316,22 @@ class ToppRaResult:
     def x(self) -> numpy.typing.NDArray[numpy.float64]:
         """
         (N+1,) squared path speeds (NaN where the forward pass did not reach)
+        """
+class TrackingFit:
+    """
+    The tracking interpolation's damped least-squares fit of the lifted joints to Eq. 41's points, with the ground, self-clearance and continuity terms (tracking_fit.hpp); immutable, safe to share between threads
+    """
+    def __init__(self, model: ChainModel, shapes: ShapeSet, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], lift: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], lifted_links: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], self_pairs: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], *, damping: typing.SupportsFloat | typing.SupportsIndex, iterations: typing.SupportsInt | typing.SupportsIndex, step_tolerance: typing.SupportsFloat | typing.SupportsIndex, clearance: typing.SupportsFloat | typing.SupportsIndex, ground_weight: typing.SupportsFloat | typing.SupportsIndex, continuity: typing.SupportsFloat | typing.SupportsIndex, self_clearance: typing.SupportsFloat | typing.SupportsIndex, self_step: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        model: the chain; shapes: its links' shapes; origin: the chain base's world pose (4, 4); lift (k,): the fitted joints; points (m,): links whose origins track the targets; lifted_links: links kept `clearance` (m) above the ground; self_pairs (P, 2): shape pairs kept `self_clearance` (m) apart; the settings: python/snakehead/motion/cartesian.py's TRACKING_* constants
+        """
+    def fit(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], targets: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        q (S, n) with rows 1 .. S-2's lifted joints fitted to targets (S, m, 3), each sample warm-started from the previous one's fit (row 0's lifted joints are the start); a new array
+        """
+    def step(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], current: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], target: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+        """
+        One damped least-squares step at q (n) towards target (m, 3) from the previous sample's lifted joints current (k): the stacked residual (rows,), its Jacobian (rows, k) and the step (k,), unclipped
         """
 class Cancelled(Exception):
     pass

@@ -9,12 +9,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _core
 from .._validate import finite_array, joint_vector, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
 
 import numpy.typing as npt
-from typing import Any, Literal
+from typing import Any, Callable, Literal
 from .._errors import InputError
 
 
@@ -209,6 +210,8 @@ TRACKING_CONTINUITY = 0.03
 TRACKING_SELF_CLEARANCE = 0.005
 #: Step (rad) of the finite differences of the self-clearance term's distances.
 TRACKING_SELF_STEP = 1e-6
+#: A sample's fit stops after a step (rad, largest joint change) smaller than this.
+TRACKING_STEP_TOLERANCE = 1e-7
 
 
 def _self_pairs(robot: SnakeRobot, lift: np.ndarray) -> np.ndarray:
@@ -222,27 +225,17 @@ def _self_pairs(robot: SnakeRobot, lift: np.ndarray) -> np.ndarray:
     return pairs[(frame[pairs[:, 0]] >= first) | (frame[pairs[:, 1]] >= first)]
 
 
-def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,
-               F: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """The tracking fit's self-clearance rows: residuals (c,) and their Jacobian (c, len(lift)) of the pairs closer
-    than TRACKING_SELF_CLEARANCE (exact signed distances of the shapes; forward differences in the lifted joints),
-    or None when none is."""
-    from ..geometry.shapes import pair_distances
-
-    if pairs.size == 0:
-        return None
-    geom = robot.geometry
-    d = pair_distances(F[None], geom, F[None], geom, pairs, 2 * TRACKING_SELF_CLEARANCE)[0]
-    close = d < TRACKING_SELF_CLEARANCE
-    if not close.any():
-        return None
-    near = pairs[close]
-    steps = np.tile(qj, (len(lift), 1))
-    steps[np.arange(len(lift)), lift] += TRACKING_SELF_STEP
-    Fs = robot.frames_many(steps, base)
-    ds = pair_distances(Fs, geom, Fs, geom, near)  # (len(lift), c)
-    J = ((ds - d[close][None, :]) / TRACKING_SELF_STEP).T
-    return TRACKING_GROUND_WEIGHT * (d[close] - TRACKING_SELF_CLEARANCE), TRACKING_GROUND_WEIGHT * J
+def tracking_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, points: np.ndarray) -> _core.TrackingFit:
+    """The core's fit of :func:`tracking_interpolation` (include/snakehead/tracking_fit.hpp): the joints ``lift``
+    fitted to the origins of the frames ``points``, the ground and self terms of the robot at ``base``, the
+    TRACKING_* settings."""
+    return _core.TrackingFit(robot.body.model, robot.geometry.core, robot.root_pose(base), lift.astype(np.int64),
+                             points.astype(np.int64), np.asarray(robot.lifted_links, np.int64),
+                             np.ascontiguousarray(_self_pairs(robot, lift), np.int64), damping=TRACKING_DAMPING,
+                             iterations=TRACKING_ITERATIONS, step_tolerance=TRACKING_STEP_TOLERANCE,
+                             clearance=TRACKING_CLEARANCE, ground_weight=TRACKING_GROUND_WEIGHT,
+                             continuity=TRACKING_CONTINUITY, self_clearance=TRACKING_SELF_CLEARANCE,
+                             self_step=TRACKING_SELF_STEP)
 
 
 def tracked_points(robot: SnakeRobot) -> np.ndarray:
@@ -266,7 +259,27 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
 
     Where the interpolated points cannot be met (a straight line between two poses shortens the chain, while links
     keep their lengths), the fit is the closest in the least-squares sense; ``deviation`` says how far it is.
+
+    The fit runs in the C++ core (:func:`tracking_fit`, ``_core.TrackingFit``; the GIL released), step for step what
+    the numpy code it replaced did (tests/tracking_reference.py, tests/test_tracking_fit.py).
     """
+    return _tracking_interpolation(robot, q_start, q_end, n, base, _core_fit)
+
+
+#: A fit of the lifted joints: (robot, base, lift, points, q (S, n), targets (S, m, 3)) -> q with rows 1 .. S-2's
+#: lifted joints fitted (:func:`tracking_interpolation`).
+LiftedFit = Callable[[SnakeRobot, BasePlacement, np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+
+def _core_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, points: np.ndarray, q: np.ndarray,
+              P: np.ndarray) -> np.ndarray:
+    return tracking_fit(robot, base, lift, points).fit(q, P)
+
+
+def _tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+                            base: BasePlacement | None, fit: LiftedFit) -> TrackingInterpolation:
+    """:func:`tracking_interpolation` with the lifted joints fitted by ``fit`` (the core's, or the numpy reference's
+    in the tests)."""
     robot = as_robot(robot)
     base = as_base(base)
     nj = robot.n_joints
@@ -278,40 +291,7 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     ends = robot.frames_many(np.stack([q_start, q_end]), base)[:, pts_idx][..., :3, 3]  # (2, m, 3)
     P = (1.0 - s)[:, None, None] * ends[0] + s[:, None, None] * ends[1]  # Eq. 41
     q = (1.0 - s)[:, None] * q_start + s[:, None] * q_end  # joints before the lift, and the starting guesses
-    lo, hi = robot.lower[lift], robot.upper[lift]
-    lifted = robot.lifted_links
-    pairs = _self_pairs(robot, lift)
-    lam2 = TRACKING_DAMPING ** 2
-    current = q_start[lift].copy()
-    for j in range(1, len(s) - 1):
-        qj = q[j].copy()
-        qj[lift] = current
-        for _ in range(TRACKING_ITERATIONS):
-            F = robot.frames(qj, base)
-            r = (F[pts_idx, :3, 3] - P[j]).reshape(-1)
-            J = robot.point_jacobians(F, F[pts_idx, :3, 3], pts_idx)[:, :, lift].reshape(-1, len(lift))
-            # the ground as a stiff one-sided spring on the lifted links' lowest points: stay TRACKING_CLEARANCE up
-            low = robot.lowest_point_per_link(F, lifted)
-            below = low[:, 2] < TRACKING_CLEARANCE
-            if below.any():
-                Jz = robot.point_jacobians(F, low[below], lifted[below])[:, 2, lift]
-                r = np.concatenate([r, TRACKING_GROUND_WEIGHT * (low[below, 2] - TRACKING_CLEARANCE)])
-                J = np.vstack([J, TRACKING_GROUND_WEIGHT * Jz])
-            # and itself: links two or more joints apart stay TRACKING_SELF_CLEARANCE apart
-            selfc = _self_term(robot, qj, lift, pairs, base, F)
-            if selfc is not None:
-                r = np.concatenate([r, selfc[0]])
-                J = np.vstack([J, selfc[1]])
-            # continuity: every joint's change from the previous sample costs TRACKING_CONTINUITY m per rad, so
-            # the fit follows one branch instead of jumping between distant ones
-            r = np.concatenate([r, TRACKING_CONTINUITY * (qj[lift] - current)])
-            J = np.vstack([J, TRACKING_CONTINUITY * np.eye(len(lift))])
-            step = -np.linalg.solve(J.T @ J + lam2 * np.eye(len(lift)), J.T @ r)
-            qj[lift] = np.clip(qj[lift] + step, lo, hi)
-            if np.abs(step).max() < 1e-7:
-                break
-        q[j] = qj
-        current = qj[lift]
+    q = fit(robot, base, lift, pts_idx, q, P)  # the lifted joints of the interior samples
     q[0], q[-1] = q_start, q_end
     actual = robot.frames_many(q, base)[:, pts_idx][..., :3, 3]
     dev = np.linalg.norm(actual - P, axis=2).max(axis=1)
