@@ -7,6 +7,7 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "index_arrays.hpp"
 #include "snakehead/path_check.hpp"
 
 namespace py = pybind11;
@@ -16,19 +17,7 @@ namespace snakehead::bindings {
 namespace {
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using Indices = py::array_t<long, py::array::c_style>;
-
-std::vector<std::array<long, 2>> pairs_of(const char* what, const Indices& pairs) {
-  if (pairs.ndim() != 2 || pairs.shape(1) != 2) throw InputError(std::string(what) + " must have shape (P, 2)");
-  std::vector<std::array<long, 2>> out;
-  for (py::ssize_t p = 0; p < pairs.shape(0); ++p) out.push_back({pairs.at(p, 0), pairs.at(p, 1)});
-  return out;
-}
-
-std::vector<long> list_of(const char* what, const Indices& list) {
-  if (list.ndim() != 1) throw InputError(std::string(what) + " must have shape (k,)");
-  return {list.data(), list.data() + list.shape(0)};
-}
+using Indices = IndexArray;
 
 long samples_of(const char* what, const Doubles& q, long n) {
   if (q.ndim() != 2 || q.shape(1) != n)
@@ -54,9 +43,9 @@ void bind_path_check(py::module_& m) {
                        std::optional<std::reference_wrapper<const ShapeSet>> obstacles,
                        const Indices& obstacle_pairs, double ground_floor, double obstacle_cutoff) {
              PathCheckSpec spec;
-             spec.ground_shapes = list_of("ground_shapes", ground_shapes);
-             spec.self_pairs = pairs_of("self_pairs", self_pairs);
-             spec.obstacle_pairs = pairs_of("obstacle_pairs", obstacle_pairs);
+             spec.ground_shapes = index_list("ground_shapes", ground_shapes);
+             spec.self_pairs = index_pairs("self_pairs", self_pairs);
+             spec.obstacle_pairs = index_pairs("obstacle_pairs", obstacle_pairs);
              spec.ground_floor = ground_floor;
              spec.obstacle_cutoff = obstacle_cutoff;
              return std::make_shared<PathChecker>(model, shapes, origin, std::move(spec),
@@ -144,9 +133,9 @@ void bind_path_check(py::module_& m) {
         if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
         if (samples_of("qd", qd, n) != T) throw InputError("qd must have the shape of q");
         ZmpCheckSpec spec;
-        spec.contact_shapes = list_of("contact_shapes", contact_shapes);
+        spec.contact_shapes = index_list("contact_shapes", contact_shapes);
         spec.points_per_shape = points_per_shape;
-        spec.clearance_shapes = list_of("clearance_shapes", clearance_shapes);
+        spec.clearance_shapes = index_list("clearance_shapes", clearance_shapes);
         spec.ground_key = ground_key;
         spec.key_joints = std::move(key_joints);
         spec.tolerance = tolerance;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "index_arrays.hpp"
 #include "snakehead/tracking_fit.hpp"
 
 namespace py = pybind11;
@@ -15,20 +16,7 @@ namespace snakehead::bindings {
 namespace {
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using Indices = py::array_t<long, py::array::c_style | py::array::forcecast>;
-
-template <typename T>
-std::vector<T> list_of(const char* what, const Indices& list) {
-  if (list.ndim() != 1) throw InputError(std::string(what) + " must have shape (k,)");
-  return {list.data(), list.data() + list.shape(0)};
-}
-
-std::vector<std::array<long, 2>> pairs_of(const Indices& pairs) {
-  if (pairs.ndim() != 2 || pairs.shape(1) != 2) throw InputError("self_pairs must have shape (P, 2)");
-  std::vector<std::array<long, 2>> out;
-  for (py::ssize_t p = 0; p < pairs.shape(0); ++p) out.push_back({pairs.at(p, 0), pairs.at(p, 1)});
-  return out;
-}
+using Indices = IndexArray;
 
 void check_target(const TrackingFit& f, const Doubles& target, py::ssize_t samples, const char* what) {
   const bool one = samples < 0;
@@ -53,10 +41,10 @@ void bind_tracking_fit(py::module_& m) {
                        double clearance, double ground_weight, double continuity, double self_clearance,
                        double self_step) {
              TrackingSpec spec;
-             spec.lift = list_of<int>("lift", lift);
-             spec.points = list_of<long>("points", points);
-             spec.lifted_links = list_of<long>("lifted_links", lifted_links);
-             spec.self_pairs = pairs_of(self_pairs);
+             spec.lift = index_list<int>("lift", lift);
+             spec.points = index_list<long>("points", points);
+             spec.lifted_links = index_list<long>("lifted_links", lifted_links);
+             spec.self_pairs = index_pairs("self_pairs", self_pairs);
              TrackingSettings s;
              s.damping = damping;
              s.iterations = iterations;
