@@ -421,7 +421,7 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
         raise InputError("the base part has no links with collision shapes; no support polygon")
     out = _core.zmp_check(made if made is not None else checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
                           g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
-                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK)
+                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK, GRAVITY)
     margin = out["margin"]
     inside = margin > 0.0
     k = int(np.argmin(margin))

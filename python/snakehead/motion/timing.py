@@ -457,6 +457,14 @@ def _path_function(s: np.ndarray, waypoints: np.ndarray, interpolation: str) -> 
     return f
 
 
+def _path_values(f: PathFunction, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q(s), q'(s), q''(s) (N, n) each: the monotone path's in one pass over its segments."""
+    if isinstance(f, MonotoneQuintic):
+        q, dq, ddq = f.derivatives(s)
+        return q, dq, ddq
+    return f(s, 0), f(s, 1), f(s, 2)
+
+
 def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
               ) -> tuple[list[tuple[str, int, int]], np.ndarray]:
     """The schedule: ("piece", i0, i1) runs of moving segments between rests, ("pause", k) holds; and the pause
@@ -702,7 +710,7 @@ class GridPoints:
     @classmethod
     def of(cls, robot: SnakeRobot, base: BasePlacement, f: PathFunction, s: np.ndarray, zmp_margin: float
            ) -> "GridPoints":
-        q, dq, ddq = f(s, 0), f(s, 1), f(s, 2)
+        q, dq, ddq = _path_values(f, s)
         frames = robot.frames_many(q, base)
         a, b = _path_dynamics(robot, q, dq, ddq, base, frames)
         hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=frames)
@@ -775,8 +783,8 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     fr = np.tile(frac, len(probed))
     s = grid[stage] + fr * ds[stage]
     xs = np.maximum(x[stage] + 2 * u[stage] * (s - grid[stage]), 0.0)
-    dq, ddq = f(s, 1), f(s, 2)
-    q, qd, qdd = f(s, 0), dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
+    q, dq, ddq = _path_values(f, s)
+    qd, qdd = dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
     nearer = np.where(fr < 0.5, stage, stage + 1)
     frames = robot.frames_many(q, base)
     sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base, frames=frames),
