@@ -56,12 +56,10 @@ def lift_shares(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) 
     ramp = positive(ramp, "ramp")
     L = len(robot.link_names)
     links, points = robot.distal_points  # (k,), (k, M, 3) in the link frames
-    row = frames[:, :, 2][:, links]  # (T, k, 4): each frame's z row
-    # the points' heights z = R_z . p + p_z, written out (numpy's three-operand einsum took 4x as long)
-    z = (row[..., None, 0] * points[..., 0] + row[..., None, 1] * points[..., 1] + row[..., None, 2] * points[..., 2]
-         + row[..., None, 3])
+    homogeneous = np.concatenate([points, np.ones(points.shape[:2] + (1,))], axis=2)  # (k, M, 4)
     w = np.ones((frames.shape[0], L))
-    w[:, links] = np.clip(z.min(axis=2) / ramp, 0.0, 1.0)
+    for i, link in enumerate(links):  # the points' heights: the frame's z row times (p, 1), one product per link
+        w[:, link] = np.clip((frames[:, link, 2, :] @ homogeneous[i].T).min(axis=1) / ramp, 0.0, 1.0)
     return w
 
 
