@@ -439,18 +439,23 @@ using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 class SupportRuns {
  public:
   SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes)
-      : spec_(spec), shapes_(shapes), count_(static_cast<long>(spec.contact_shapes.size()) * spec.points_per_shape),
+      : spec_(spec), shapes_(shapes), near_(spec.contact_shapes.size()),
+        count_(static_cast<long>(spec.contact_shapes.size()) * spec.points_per_shape),
         points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2) {
     start_.push_back(0);
   }
 
   // Adds the polygon of a new run: the convex hull of the contact points touching the ground (tolerance) at the
-  // sample whose world frames are `frames`.
-  void add(const double* frames, long L) {
-    lowest_points(frames, 1, L, shapes_, spec_.contact_shapes.data(), static_cast<long>(spec_.contact_shapes.size()),
-                  spec_.points_per_shape, points_.data());
+  // sample whose world frames are `frames`; `low`: the contact shapes' lowest z there. A shape whose lowest z is
+  // above the tolerance (by more than round-off) has no point touching: its candidates are not computed.
+  void add(const double* frames, long L, const double* low) {
+    near_.clear();
+    for (std::size_t i = 0; i < spec_.contact_shapes.size(); ++i)
+      if (low[i] <= spec_.tolerance + kRoundOff) near_.push_back(spec_.contact_shapes[i]);
+    const long k = static_cast<long>(near_.size());
+    lowest_points(frames, 1, L, shapes_, near_.data(), k, spec_.points_per_shape, points_.data());
     long m = 0;
-    for (long p = 0; p < count_; ++p)
+    for (long p = 0; p < k * spec_.points_per_shape; ++p)
       if (points_[3 * p + 2] <= spec_.tolerance) touching_.row(m++) << points_[3 * p], points_[3 * p + 1];
     convex_hull_into(touching_.topRows(m), work_, hull_);
     for (int v : hull_) vertices_.insert(vertices_.end(), {touching_(v, 0), touching_(v, 1)});
@@ -465,8 +470,10 @@ class SupportRuns {
   }
 
  private:
+  static constexpr double kRoundOff = 1e-9;  // m: lowest_z and the candidate points' z agree far closer
   const ZmpCheckSpec& spec_;
   const ShapeSet& shapes_;
+  std::vector<long> near_;      // the contact shapes within the tolerance (and round-off) of the ground
   long count_;                  // candidate points per sample: contact shapes x points_per_shape
   std::vector<double> points_;  // their world positions (count_ x 3)
   Points touching_;             // those on the ground (first rows)
@@ -520,7 +527,7 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     if (C > 0) out.clearance[k] = *std::min_element(low.begin() + K, low.end());
     contact_key(spec, child, shapes, low.data(), q + k * n, key);
     if (k % spec.chunk == 0 || key != previous) {
-      polygons.add(frames.data(), L);
+      polygons.add(frames.data(), L, low.data());
       previous.swap(key);
     }
     run[k] = polygons.runs() - 1;
