@@ -127,7 +127,7 @@ void bind_path_check(py::module_& m) {
       "zmp_check",
       [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
          long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
-         double tolerance, long chunk) {
+         double tolerance, long chunk, double gravity) {
         const long n = c.n_joints();
         const long T = samples_of("q", q, n);
         if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
@@ -140,6 +140,7 @@ void bind_path_check(py::module_& m) {
         spec.key_joints = std::move(key_joints);
         spec.tolerance = tolerance;
         spec.chunk = chunk;
+        spec.gravity = gravity;
         ZmpCheck z;
         {
           py::gil_scoped_release release;
@@ -158,9 +159,10 @@ void bind_path_check(py::module_& m) {
       },
       py::arg("checker"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("contact_shapes"),
       py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
-      py::arg("tolerance"), py::arg("chunk"),
+      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"),
       "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin "
-      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes");
+      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from "
+      "snakehead.model.physics.GRAVITY");
 }
 
 }  // namespace snakehead::bindings

@@ -434,19 +434,62 @@ void contact_key(const ZmpCheckSpec& spec, const std::vector<int>& child, const 
 
 using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
-// A run's support polygon: the convex hull (counter-clockwise vertices) of its touching contact points.
-Points support_hull(const ZmpCheckSpec& spec, const ShapeSet& shapes, const double* frames, long L) {
-  const long k = static_cast<long>(spec.contact_shapes.size()), M = spec.points_per_shape;
-  std::vector<double> pts(static_cast<std::size_t>(3 * k * M));
-  lowest_points(frames, 1, L, shapes, spec.contact_shapes.data(), k, M, pts.data());
-  Points touching(k * M, 2);
-  long m = 0;
-  for (long p = 0; p < k * M; ++p)
-    if (pts[3 * p + 2] <= spec.tolerance) touching.row(m++) << pts[3 * p], pts[3 * p + 1];
-  const std::vector<int> hull = convex_hull(touching.topRows(m));
-  Points out(static_cast<Eigen::Index>(hull.size()), 2);
-  for (std::size_t v = 0; v < hull.size(); ++v) out.row(static_cast<Eigen::Index>(v)) = touching.row(hull[v]);
-  return out;
+// The runs' support polygons, one after the other (their vertices counter-clockwise, flat x, y), and the buffers that
+// build them, allocated once for all the runs of a check.
+class SupportRuns {
+ public:
+  SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes)
+      : spec_(spec), shapes_(shapes), near_(spec.contact_shapes.size()),
+        count_(static_cast<long>(spec.contact_shapes.size()) * spec.points_per_shape),
+        points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2) {
+    start_.push_back(0);
+  }
+
+  // Adds the polygon of a new run: the convex hull of the contact points touching the ground (tolerance) at the
+  // sample whose world frames are `frames`; `low`: the contact shapes' lowest z there. A shape whose lowest z is
+  // above the tolerance (by more than round-off) has no point touching: its candidates are not computed.
+  void add(const double* frames, long L, const double* low) {
+    near_.clear();
+    for (std::size_t i = 0; i < spec_.contact_shapes.size(); ++i)
+      if (low[i] <= spec_.tolerance + kRoundOff) near_.push_back(spec_.contact_shapes[i]);
+    const long k = static_cast<long>(near_.size());
+    lowest_points(frames, 1, L, shapes_, near_.data(), k, spec_.points_per_shape, points_.data());
+    long m = 0;
+    for (long p = 0; p < k * spec_.points_per_shape; ++p)
+      if (points_[3 * p + 2] <= spec_.tolerance) touching_.row(m++) << points_[3 * p], points_[3 * p + 1];
+    convex_hull_into(touching_.topRows(m), work_, hull_);
+    for (int v : hull_) vertices_.insert(vertices_.end(), {touching_(v, 0), touching_(v, 1)});
+    start_.push_back(static_cast<long>(vertices_.size() / 2));
+  }
+
+  long runs() const { return static_cast<long>(start_.size()) - 1; }
+
+  // The signed distance of xy to run r's polygon (hull_margin, the hull not built again).
+  double margin(long r, const Eigen::Vector2d& xy) const {
+    return convex_margin(vertices_.data() + 2 * start_[r], start_[r + 1] - start_[r], xy);
+  }
+
+ private:
+  static constexpr double kRoundOff = 1e-9;  // m: lowest_z and the candidate points' z agree far closer
+  const ZmpCheckSpec& spec_;
+  const ShapeSet& shapes_;
+  std::vector<long> near_;      // the contact shapes within the tolerance (and round-off) of the ground
+  long count_;                  // candidate points per sample: contact shapes x points_per_shape
+  std::vector<double> points_;  // their world positions (count_ x 3)
+  Points touching_;             // those on the ground (first rows)
+  HullWork work_;
+  std::vector<int> hull_;
+  std::vector<double> vertices_;  // every run's hull vertices
+  std::vector<long> start_;       // run r's vertices: rows start_[r] .. start_[r + 1] - 1
+};
+
+void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
+  if (spec.chunk < 1 || spec.points_per_shape < 1) throw InputError("zmp_check: chunk and points_per_shape must be >= 1");
+  if (!(std::isfinite(spec.gravity) && spec.gravity > 0.0)) throw InputError("zmp_check: gravity must be finite and > 0");
+  for (long s : spec.contact_shapes) check_index("contact", s, shapes);
+  for (long s : spec.clearance_shapes) check_index("clearance", s, shapes);
+  for (int j : spec.key_joints)
+    if (j < 0 || j >= n) throw InputError("zmp_check: key joint " + std::to_string(j) + " is outside the chain");
 }
 
 }  // namespace
@@ -459,17 +502,13 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   if (T < 2) throw InputError("zmp_check: at least two samples are needed");
   for (long k = 1; k < T; ++k)
     if (!(t[k] > t[k - 1])) throw InputError("zmp_check: t must increase strictly");
-  if (spec.chunk < 1 || spec.points_per_shape < 1) throw InputError("zmp_check: chunk and points_per_shape must be >= 1");
-  for (long s : spec.contact_shapes) check_index("contact", s, shapes);
-  for (long s : spec.clearance_shapes) check_index("clearance", s, shapes);
-  for (int j : spec.key_joints)
-    if (j < 0 || j >= n) throw InputError("zmp_check: key joint " + std::to_string(j) + " is outside the chain");
+  check_spec(spec, shapes, n);
   ZmpCheck out;
   out.linear.resize(static_cast<std::size_t>(3 * T));
   out.angular.resize(static_cast<std::size_t>(3 * T));
   out.com.resize(static_cast<std::size_t>(3 * T));
   out.clearance.assign(static_cast<std::size_t>(T), kInf);
-  std::vector<Points> polygons;  // each run's support polygon
+  SupportRuns polygons(spec, shapes);
   std::vector<long> run(static_cast<std::size_t>(T));
   std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
   // one lowest_z call per sample for the contact shapes and the clearance shapes after them
@@ -477,8 +516,8 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   lowest_of.insert(lowest_of.end(), spec.clearance_shapes.begin(), spec.clearance_shapes.end());
   const long K = static_cast<long>(spec.contact_shapes.size()), C = static_cast<long>(spec.clearance_shapes.size());
   std::vector<double> low(static_cast<std::size_t>(K + C));
-  const std::vector<int> child = chain.joint_child;
-  Frames work;
+  const std::vector<int>& child = chain.joint_child;
+  Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
   for (long k = 0; k < T; ++k) {
     const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
     model.check_configuration(qk);
@@ -488,32 +527,33 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     if (C > 0) out.clearance[k] = *std::min_element(low.begin() + K, low.end());
     contact_key(spec, child, shapes, low.data(), q + k * n, key);
     if (k % spec.chunk == 0 || key != previous) {
-      polygons.push_back(support_hull(spec, shapes, frames.data(), L));
-      previous = key;
+      polygons.add(frames.data(), L, low.data());
+      previous.swap(key);
     }
-    run[k] = static_cast<long>(polygons.size()) - 1;
+    run[k] = polygons.runs() - 1;
   }
   std::vector<double> Pdot(static_cast<std::size_t>(3 * T)), Ldot(static_cast<std::size_t>(3 * T));
   time_derivative(t, out.linear.data(), T, 3, Pdot.data());    // Eq. 33's dP/dt
   time_derivative(t, out.angular.data(), T, 3, Ldot.data());   // Eq. 34's dL/dt
   double M = 0.0;
   for (double m : chain.mass) M += m;
-  constexpr double kGravity = 9.80665;  // snakehead.dynamics.stability.GRAVITY
+  const double Mg = M * spec.gravity;
   out.zmp.resize(static_cast<std::size_t>(2 * T));
   out.margin.resize(static_cast<std::size_t>(T));
   for (long k = 0; k < T; ++k) {
-    const double den = M * kGravity + Pdot[3 * k + 2];
+    const double den = Mg + Pdot[3 * k + 2];
     const double* c = &out.com[3 * k];
     if (!(den > 0.0)) {  // the ground cannot pull: no ZMP, the body would leave the ground
       out.zmp[2 * k] = out.zmp[2 * k + 1] = std::numeric_limits<double>::quiet_NaN();
       out.margin[k] = -kInf;
       continue;
     }
-    const Eigen::Vector2d p((M * kGravity * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
-                            (M * kGravity * c[1] + Ldot[3 * k]) / den);      // Eq. 40
+    const Eigen::Vector2d p((Mg * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
+                            (Mg * c[1] + Ldot[3 * k]) / den);      // Eq. 40
     out.zmp[2 * k] = p.x();
     out.zmp[2 * k + 1] = p.y();
-    out.margin[k] = hull_margin(polygons[static_cast<std::size_t>(run[k])], p);  // the hull's hull: itself
+    if (!p.allFinite()) throw InputError("zmp_check: the ZMP is not finite (qd or t out of range)");
+    out.margin[k] = polygons.margin(run[k], p);
   }
   return out;
 }

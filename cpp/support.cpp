@@ -43,8 +43,16 @@ long gather_active(const double* points, const unsigned char* active, long t, lo
 }  // namespace
 
 std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
+  HullWork work;
+  std::vector<int> hull;
+  convex_hull_into(points, work, hull);
+  return hull;
+}
+
+void convex_hull_into(const Eigen::Ref<const Points>& points, HullWork& work, std::vector<int>& hull) {
   const int n = static_cast<int>(points.rows());
-  std::vector<int> order(n);
+  std::vector<int>& order = work.order;
+  order.resize(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int i, int j) {
     return points(i, 0) < points(j, 0) || (points(i, 0) == points(j, 0) && points(i, 1) < points(j, 1));
@@ -52,8 +60,8 @@ std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
   double scale = 1.0;
   for (int i = 0; i < n; ++i) scale = std::max({scale, std::abs(points(i, 0)), std::abs(points(i, 1))});
   const double eps = 1e-12 * scale;
-  auto half = [&](auto begin, auto end) {
-    std::vector<int> out;
+  auto half = [&](auto begin, auto end, std::vector<int>& out) {
+    out.clear();
     for (auto it = begin; it != end; ++it) {
       const int i = *it;
       const Eigen::Vector2d p = points.row(i).transpose();
@@ -66,33 +74,44 @@ std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
       if (!out.empty() && (points.row(out.back()).transpose() - p).cwiseAbs().maxCoeff() <= eps) continue;
       out.push_back(i);
     }
-    return out;
   };
-  std::vector<int> lower = half(order.begin(), order.end());
-  std::vector<int> upper = half(order.rbegin(), order.rend());
-  if (lower.size() < 2) return lower;
-  std::vector<int> hull(lower.begin(), lower.end() - 1);
+  const std::vector<int>& lower = work.lower;
+  const std::vector<int>& upper = work.upper;
+  half(order.begin(), order.end(), work.lower);
+  half(order.rbegin(), order.rend(), work.upper);
+  hull.clear();
+  if (lower.size() < 2) {
+    hull.assign(lower.begin(), lower.end());
+    return;
+  }
+  hull.assign(lower.begin(), lower.end() - 1);
   hull.insert(hull.end(), upper.begin(), upper.end() - 1);
-  if (hull.size() < 2) return std::vector<int>(lower.begin(), lower.begin() + std::min<std::size_t>(2, lower.size()));
-  return hull;
+  if (hull.size() < 2) hull.assign(lower.begin(), lower.begin() + std::min<std::size_t>(2, lower.size()));
+}
+
+double convex_margin(const double* vertices, long k, const Eigen::Vector2d& xy) {
+  const auto vertex = [vertices](long i) { return Eigen::Vector2d(vertices[2 * i], vertices[2 * i + 1]); };
+  if (k == 0) return -std::numeric_limits<double>::infinity();
+  if (k == 1) return -(xy - vertex(0)).norm();
+  if (k == 2) return -segment_distance(xy, vertex(0), vertex(1));
+  bool inside = true;
+  double best = std::numeric_limits<double>::infinity();
+  for (long i = 0; i < k; ++i) {
+    const Eigen::Vector2d a = vertex(i), b = vertex((i + 1) % k);
+    const Eigen::Vector2d e = b - a;
+    if (e.x() * (xy.y() - a.y()) - e.y() * (xy.x() - a.x()) < 0.0) inside = false;  // right of a ccw edge
+    best = std::min(best, segment_distance(xy, a, b));
+  }
+  return inside ? best : -best;
 }
 
 double hull_margin(const Eigen::Ref<const Points>& points, const Eigen::Vector2d& xy) {
   if (points.rows() == 0) return -std::numeric_limits<double>::infinity();
   if (!xy.allFinite() || !points.allFinite()) throw InputError("hull_margin: points and xy must be finite");
   const std::vector<int> h = convex_hull(points);
-  const int k = static_cast<int>(h.size());
-  if (k == 1) return -(xy - points.row(h[0]).transpose()).norm();
-  if (k == 2) return -segment_distance(xy, points.row(h[0]).transpose(), points.row(h[1]).transpose());
-  bool inside = true;
-  double best = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < k; ++i) {
-    const Eigen::Vector2d a = points.row(h[i]).transpose(), b = points.row(h[(i + 1) % k]).transpose();
-    const Eigen::Vector2d e = b - a;
-    if (e.x() * (xy.y() - a.y()) - e.y() * (xy.x() - a.x()) < 0.0) inside = false;  // right of a ccw edge
-    best = std::min(best, segment_distance(xy, a, b));
-  }
-  return inside ? best : -best;
+  Points vertices(static_cast<Eigen::Index>(h.size()), 2);
+  for (std::size_t v = 0; v < h.size(); ++v) vertices.row(static_cast<Eigen::Index>(v)) = points.row(h[v]);
+  return convex_margin(vertices.data(), vertices.rows(), xy);
 }
 
 std::vector<double> hull_margins(const double* points, const unsigned char* active, const double* xy, long T,

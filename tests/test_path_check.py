@@ -169,3 +169,32 @@ def test_checker_refuses_bad_input() -> None:
         c.check_path(np.zeros((2, robot.n_joints)), 0.0, 1e-3, True)
     with pytest.raises(InputError, match="waypoints"):
         c.check_path(np.zeros((2, 3)), 0.5, 1e-3, True)
+
+
+def test_zmp_check_takes_gravity_from_the_caller() -> None:
+    """The core's ZMP uses the gravity it is given (model.physics.GRAVITY from Python, defined once): Eqs. 39-40
+    with that g from the core's own momenta (np.gradient's rates); a bad gravity is an InputError."""
+    from snakehead import InputError, _core
+    from snakehead.model.physics import GRAVITY
+
+    robot = SnakeRobot.default()
+    q0 = np.zeros(robot.n_joints)
+    q1 = q0.copy()
+    q1[robot.lift_joints.start] = 0.3
+    t = np.linspace(0.0, 1.0, 101)
+    s = (3 * t ** 2 - 2 * t ** 3)[:, None]
+    q, qd = q0 + s * (q1 - q0), (6 * t * (1 - t))[:, None] * (q1 - q0)
+    g = robot.geometry
+    args = (path_check.checker(robot), t, q, qd, g.shapes_of(robot.shaped_links), g.contact_points_per_shape,
+            g.shapes_of(robot.lifted_links), True, [], stability.CONTACT_TOLERANCE, stability.SAMPLE_CHUNK)
+    M = robot.total_mass
+    for gravity in (GRAVITY, 3.0 * GRAVITY):
+        out = _core.zmp_check(*args, gravity)
+        Pdot, Ldot = np.gradient(out["P"], t, axis=0, edge_order=2), np.gradient(out["L"], t, axis=0, edge_order=2)
+        den = M * gravity + Pdot[:, 2]
+        zmp = np.column_stack([(M * gravity * out["com"][:, 0] - Ldot[:, 1]) / den,
+                               (M * gravity * out["com"][:, 1] + Ldot[:, 0]) / den])
+        np.testing.assert_allclose(out["zmp"], zmp, atol=1e-9, rtol=0)
+    for bad in (np.nan, 0.0, -1.0, np.inf):
+        with pytest.raises(InputError, match="gravity"):
+            _core.zmp_check(*args, bad)

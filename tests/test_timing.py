@@ -117,6 +117,17 @@ def test_retimed_lift_is_faster_and_time_optimal(lift):
     assert not faster.within(0.02, 1e-4), faster
 
 
+def test_timeline_samples_every_order_at_once_as_one_at_a_time(lift):
+    """retime samples q, qd, qdd in one pass (``sample``): the values of the motion's ``spline(t, nu)``."""
+    _, _, _, traj = lift
+    t = np.r_[-0.1, np.linspace(0.0, traj.duration, 777), traj.duration + 0.1]
+    together = traj.spline.sample(t)
+    for nu in (0, 1, 2):
+        np.testing.assert_array_equal(together[nu], traj.spline(t, nu))
+    np.testing.assert_array_equal(traj.spline.sample(t, (2,))[0], together[2])
+    np.testing.assert_array_equal(traj.qd[1:-1], traj.spline(traj.t, 1)[1:-1])
+
+
 def test_timing_does_not_depend_on_the_placement(lift):
     """The planner times a lift once per base shape: at another placement the same waypoints get the same motion,
     and that motion keeps the ZMP inside there too (checked by stability in the world frame of that placement)."""

@@ -566,6 +566,34 @@ def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
     np.testing.assert_allclose(f(times[[0, -1]], 2), 0.0, atol=1e-12)
 
 
+def test_monotone_quintic_horner_form_equals_the_hermite_basis():
+    """The per-segment coefficients (Horner) give the quintic Hermite basis's values and derivatives (written out
+    here, as the class documents them), and ``derivatives`` gives what three calls give."""
+    from snakehead.motion.interpolation import MonotoneQuintic
+
+    rng = np.random.default_rng(13)
+    times = np.cumsum(rng.uniform(0.05, 2.0, 15))
+    way = rng.normal(size=(15, 5))
+    f = MonotoneQuintic(times, way)
+    t = np.r_[rng.uniform(times[0] - 0.5, times[-1] + 0.5, 3000), times]
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    h = (times[k + 1] - times[k])[:, None]
+    s = (t - times[k])[:, None] / h
+    p0, p1, v0, v1 = way[k], way[k + 1], f.v[k], f.v[k + 1]
+    basis = [(1 - 10 * s**3 + 15 * s**4 - 6 * s**5) * p0 + h * (s - 6 * s**3 + 8 * s**4 - 3 * s**5) * v0
+             + (10 * s**3 - 15 * s**4 + 6 * s**5) * p1 + h * (-4 * s**3 + 7 * s**4 - 3 * s**5) * v1,
+             (-30 * s**2 + 60 * s**3 - 30 * s**4) * (p0 - p1) / h + (1 - 18 * s**2 + 32 * s**3 - 15 * s**4) * v0
+             + (-12 * s**2 + 28 * s**3 - 15 * s**4) * v1,
+             (-60 * s + 180 * s**2 - 120 * s**3) * (p0 - p1) / h**2 + (-36 * s + 96 * s**2 - 60 * s**3) * v0 / h
+             + (-24 * s + 84 * s**2 - 60 * s**3) * v1 / h]
+    together = f.derivatives(t)
+    for nu in (0, 1, 2):
+        scale = np.abs(basis[nu]).max()
+        np.testing.assert_allclose(f(t, nu), basis[nu], atol=1e-12 * scale, rtol=0)
+        np.testing.assert_array_equal(together[nu], f(t, nu))
+    np.testing.assert_array_equal(f.derivatives(t, (2, 0))[0], together[2])
+
+
 def test_joint_trajectory_monotone_method_and_bad_method():
     times = np.array([0.0, 1.0, 2.0])
     way = np.array([[0.0], [1.0], [1.0]])

@@ -144,6 +144,7 @@ struct ZmpCheckSpec {
   std::vector<int> shaped_links;      // links with shapes (ground key: which touch)
   double tolerance = 1e-3;
   long chunk = 4096;
+  double gravity = std::numeric_limits<double>::quiet_NaN();  // m/s^2: the caller's (model.physics.GRAVITY)
 };
 
 struct ZmpCheck {

@@ -13,6 +13,21 @@ namespace snakehead {
 // none.
 std::vector<int> convex_hull(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>& points);
 
+// The buffers of convex_hull, for a caller that builds many hulls without allocating each time.
+struct HullWork {
+  std::vector<int> order, lower, upper;
+};
+
+// convex_hull into `hull` (cleared first), with the buffers of `work` (both reused between calls).
+void convex_hull_into(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>& points,
+                 HullWork& work, std::vector<int>& hull);
+
+// Signed distance of `xy` to the convex polygon of `k` vertices (k x 2, row-major) that are already a hull:
+// counter-clockwise, as convex_hull gives them (rows in that order). hull_margin without building the hull again:
+// > 0 inside (the distance to the nearest edge), < 0 outside; two vertices or one: minus the distance to the
+// segment or point; -infinity for none.
+double convex_margin(const double* vertices, long k, const Eigen::Vector2d& xy);
+
 // Signed distance of `xy` to the convex hull of `points` (> 0 inside: the distance to the nearest edge; < 0
 // outside: minus the distance to the polygon). A hull of two points or one has no inside: minus the distance
 // to the segment or point. -infinity when there is no point.

@@ -429,7 +429,7 @@ def urdf_root_link(urdf: str) -> str:
     """
     The root link of a URDF (an XML document or a file path)
     """
-def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex) -> dict:
+def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex, gravity: typing.SupportsFloat | typing.SupportsIndex) -> dict:
     """
-    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes
+    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from snakehead.model.physics.GRAVITY
     """

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "snakehead/support.hpp"
@@ -53,6 +54,34 @@ TEST(HullMargin, InsideOutsideAndDegenerate) {
   seg << 0, 0, 2, 0;
   EXPECT_DOUBLE_EQ(snakehead::hull_margin(seg, Eigen::Vector2d(1.0, 0.5)), -0.5);  // a segment has no inside
   EXPECT_EQ(snakehead::hull_margin(Points(0, 2), Eigen::Vector2d(0, 0)), -std::numeric_limits<double>::infinity());
+}
+
+TEST(ConvexMargin, OnAHullEqualsHullMarginOfThePoints) {
+  // random clouds (and degenerate ones: a segment, a point, none): the margin on the hull's vertices, built with
+  // reused buffers, equals hull_margin of the whole cloud (which builds the hull itself), bit for bit
+  std::srand(3);
+  const auto uniform = [] { return 2.0 * std::rand() / RAND_MAX - 1.0; };
+  snakehead::HullWork work;
+  std::vector<int> hull;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = trial % 9;
+    Points p(n, 2);
+    for (int i = 0; i < n; ++i) p.row(i) << uniform(), trial % 7 == 0 ? 0.5 * p(i, 0) : uniform();  // some collinear
+    snakehead::convex_hull_into(p, work, hull);
+    EXPECT_EQ(hull, snakehead::convex_hull(p));
+    Points v(static_cast<Eigen::Index>(hull.size()), 2);
+    for (std::size_t i = 0; i < hull.size(); ++i) v.row(static_cast<Eigen::Index>(i)) = p.row(hull[i]);
+    for (int k = 0; k < 20; ++k) {
+      const Eigen::Vector2d xy(1.5 * uniform(), 1.5 * uniform());
+      const double margin = snakehead::convex_margin(v.data(), v.rows(), xy);
+      EXPECT_EQ(margin, snakehead::hull_margin(p, xy));
+      EXPECT_EQ(margin, snakehead::hull_margin(v, xy));  // the hull's hull is itself: zmp_check's old margins
+    }
+  }
+  Points square(4, 2);
+  square << 0, 0, 2, 0, 2, 2, 0, 2;  // counter-clockwise already: closed forms
+  EXPECT_DOUBLE_EQ(snakehead::convex_margin(square.data(), 4, Eigen::Vector2d(1.0, 0.5)), 0.5);
+  EXPECT_DOUBLE_EQ(snakehead::convex_margin(square.data(), 4, Eigen::Vector2d(3.0, 1.0)), -1.0);
 }
 
 TEST(HullMargins, ManySamplesWithActiveMasks) {

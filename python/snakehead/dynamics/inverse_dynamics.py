@@ -56,9 +56,10 @@ def lift_shares(robot: SnakeRobot, frames: np.ndarray, ramp: float = LIFT_RAMP) 
     ramp = positive(ramp, "ramp")
     L = len(robot.link_names)
     links, points = robot.distal_points  # (k,), (k, M, 3) in the link frames
-    z = np.einsum("tkj,kmj->tkm", frames[:, links, 2, :3], points) + frames[:, links, 2, 3][..., None]
+    homogeneous = np.concatenate([points, np.ones(points.shape[:2] + (1,))], axis=2)  # (k, M, 4)
     w = np.ones((frames.shape[0], L))
-    w[:, links] = np.clip(z.min(axis=2) / ramp, 0.0, 1.0)
+    for i, link in enumerate(links):  # the points' heights: the frame's z row times (p, 1), one product per link
+        w[:, link] = np.clip((frames[:, link, 2, :] @ homogeneous[i].T).min(axis=1) / ramp, 0.0, 1.0)
     return w
 
 

@@ -131,12 +131,13 @@ def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None 
         frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
     assert frames is not None
     m = robot.masses
-    # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product
-    W = np.zeros((len(m), 3, 4, 3))
+    # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product (over
+    # the whole frames, the bottom rows' coefficients zero: no copy of the top rows)
+    W = np.zeros((len(m), 4, 4, 3))
     for i in range(3):
         W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
         W[:, i, 3, i] = m  # coefficient of p_l[i]
-    c = (np.asarray(frames)[..., :3, :].reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
+    c = (np.asarray(frames).reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
     if not world:
         W = robot.root_pose(base)
         c = c @ W[:3, :3].T + W[:3, 3]
@@ -421,7 +422,7 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
         raise InputError("the base part has no links with collision shapes; no support polygon")
     out = _core.zmp_check(made if made is not None else checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
                           g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
-                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK)
+                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK, GRAVITY)
     margin = out["margin"]
     inside = margin > 0.0
     k = int(np.argmin(margin))

@@ -81,35 +81,43 @@ class MonotoneQuintic:
             hm = np.where(same, 2 * a * b / (a + b), 0.0)
         v[1:-1] = hm
         self.v = v
+        # each segment's quintic in its local s = (t - t_k) / h (Eq. of the Hermite basis above, expanded): q(s) =
+        # sum_i c_i s^i, its coefficients (K-1, 6, n); and those of dq/dt and d^2q/dt^2 in s (the 1/h, 1/h^2 in them)
+        dp, hv0, hv1 = np.diff(self.q, axis=0), h * v[:-1], h * v[1:]
+        c = np.stack([self.q[:-1], hv0, np.zeros_like(dp), 10 * dp - 6 * hv0 - 4 * hv1, -15 * dp + 8 * hv0 + 7 * hv1,
+                      6 * dp - 3 * hv0 - 3 * hv1], axis=1)
+        self._coefficients = (c, c[:, 1:] * np.arange(1.0, 6.0)[None, :, None] / h[:, :, None],
+                              c[:, 2:] * np.array([2.0, 6.0, 12.0, 20.0])[None, :, None] / (h * h)[:, :, None])
 
     #: Samples evaluated at once: the evaluation's temporaries take ~1 kB a sample for 16 joints, so a long
     #: trajectory is evaluated a chunk at a time into its result (the same values).
     CHUNK = 16384
 
     def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, float))
         if nu not in (0, 1, 2):
             raise InputError("nu must be 0, 1 or 2")
+        return self.derivatives(t, (nu,))[0]
+
+    def derivatives(self, t: npt.ArrayLike, orders: tuple[int, ...] = (0, 1, 2)) -> list[np.ndarray]:
+        """The derivatives of the given ``orders`` (0, 1 or 2) at times t (N,): a list of (N, n), the segment of each
+        time looked up once for all (Horner's rule on each segment's polynomial)."""
+        t = np.atleast_1d(np.asarray(t, float))
         if len(t) > self.CHUNK:
-            out = np.empty((len(t), self.q.shape[1]))
+            out = [np.empty((len(t), self.q.shape[1])) for _ in orders]
             for start in range(0, len(t), self.CHUNK):
-                out[start:start + self.CHUNK] = self(t[start:start + self.CHUNK], nu)
+                for o, part in zip(out, self.derivatives(t[start:start + self.CHUNK], orders)):
+                    o[start:start + self.CHUNK] = part
             return out
         k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
-        h = (self.times[k + 1] - self.times[k])[:, None]
-        s = ((t - self.times[k])[:, None]) / h
-        p0, p1, v0, v1 = self.q[k], self.q[k + 1], self.v[k], self.v[k + 1]
-        s2, s3, s4, s5 = s * s, s**3, s**4, s**5
-        if nu == 0:
-            return ((1 - 10 * s3 + 15 * s4 - 6 * s5) * p0 + h * (s - 6 * s3 + 8 * s4 - 3 * s5) * v0
-                    + (10 * s3 - 15 * s4 + 6 * s5) * p1 + h * (-4 * s3 + 7 * s4 - 3 * s5) * v1)
-        if nu == 1:
-            return ((-30 * s2 + 60 * s3 - 30 * s4) * (p0 - p1) / h + (1 - 18 * s2 + 32 * s3 - 15 * s4) * v0
-                    + (-12 * s2 + 28 * s3 - 15 * s4) * v1)
-        if nu == 2:
-            return ((-60 * s + 180 * s2 - 120 * s3) * (p0 - p1) / h**2 + (-36 * s + 96 * s2 - 60 * s3) * v0 / h
-                    + (-24 * s + 84 * s2 - 60 * s3) * v1 / h)
-        raise InputError("nu must be 0, 1 or 2")
+        s = ((t - self.times[k]) / (self.times[k + 1] - self.times[k]))[:, None]
+        out = []
+        for nu in orders:
+            c = self._coefficients[nu][k]  # (N, degree + 1, n)
+            value = c[:, -1]
+            for i in range(c.shape[1] - 2, -1, -1):
+                value = value * s + c[:, i]
+            out.append(value)
+        return out
 
 
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:

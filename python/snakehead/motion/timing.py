@@ -412,8 +412,16 @@ class _Timeline:
         self.end += seconds
 
     def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
+        if nu not in (0, 1, 2):
+            raise InputError("nu must be 0, 1 or 2")
+        return self.sample(t, (nu,))[0]
+
+    def sample(self, t: npt.ArrayLike, orders: tuple[int, ...] = (0, 1, 2)) -> list[np.ndarray]:
+        """The motion's derivatives of the given ``orders`` (0, 1, 2: q, qd, qdd) at times t: a list of (N, n), the
+        path evaluated once for all of them."""
         t = np.atleast_1d(np.asarray(t, float))
-        out = np.zeros((len(t), self.n))
+        out = [np.zeros((len(t), self.n)) for _ in orders]
+        path_orders = tuple(sorted(set(orders) | ({1} if 2 in orders else set())))  # qdd needs q'(s) too
         for k, item in enumerate(self.items):
             last = k == len(self.items) - 1
             tt = item["t"]
@@ -425,23 +433,23 @@ class _Timeline:
             if not mask.any():
                 continue
             if item["kind"] == "pause":
-                if nu == 0:
-                    out[mask] = item["q"]
+                for o, nu in zip(out, orders):
+                    if nu == 0:
+                        o[mask] = item["q"]
                 continue
             i = np.clip(np.searchsorted(tt, t[mask], side="right") - 1, 0, len(tt) - 2)
             tau = np.clip(t[mask] - tt[i], 0.0, tt[i + 1] - tt[i])
             s = np.clip(item["s"][i] + item["sd"][i] * tau + 0.5 * item["u"][i] * tau ** 2, item["s"][i],
                         item["s"][i + 1])
             sd = np.maximum(item["sd"][i] + item["u"][i] * tau, 0.0)
-            f = item["f"]
-            if nu == 0:
-                out[mask] = f(s, 0)
-            elif nu == 1:
-                out[mask] = f(s, 1) * sd[:, None]
-            elif nu == 2:
-                out[mask] = f(s, 1) * item["u"][i][:, None] + f(s, 2) * (sd ** 2)[:, None]
-            else:
-                raise InputError("nu must be 0, 1 or 2")
+            d = dict(zip(path_orders, _path_derivatives(item["f"], s, path_orders)))
+            for o, nu in zip(out, orders):
+                if nu == 0:
+                    o[mask] = d[0]
+                elif nu == 1:
+                    o[mask] = d[1] * sd[:, None]
+                else:
+                    o[mask] = d[1] * item["u"][i][:, None] + d[2] * (sd ** 2)[:, None]
         return out
 
 
@@ -455,6 +463,19 @@ def _path_function(s: np.ndarray, waypoints: np.ndarray, interpolation: str) -> 
         return np.asarray(spline(x, order))
 
     return f
+
+
+def _path_derivatives(f: PathFunction, s: np.ndarray, orders: tuple[int, ...]) -> list[np.ndarray]:
+    """The path's derivatives of the given orders at s (N, n each): the monotone path's in one pass."""
+    if isinstance(f, MonotoneQuintic):
+        return f.derivatives(s, orders)
+    return [f(s, nu) for nu in orders]
+
+
+def _path_values(f: PathFunction, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q(s), q'(s), q''(s) (N, n) each."""
+    q, dq, ddq = _path_derivatives(f, s, (0, 1, 2))
+    return q, dq, ddq
 
 
 def _segments(waypoints: np.ndarray, stops: Sequence[int], hold_s: npt.ArrayLike
@@ -565,7 +586,7 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
             times[i0:i1 + 1] = t_grid[np.searchsorted(grid, piece.knots)]
         _check_length(timeline.end, dt)
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
-    q, qd, qdd = timeline(t, 0), timeline(t, 1), timeline(t, 2)
+    q, qd, qdd = timeline.sample(t)
     q[0], q[-1] = W[0], W[-1]
     check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
     return RetimedTrajectory(t, q, qd, qdd, timeline, waypoint_times=times, limits=limits, check=check,
@@ -702,7 +723,7 @@ class GridPoints:
     @classmethod
     def of(cls, robot: SnakeRobot, base: BasePlacement, f: PathFunction, s: np.ndarray, zmp_margin: float
            ) -> "GridPoints":
-        q, dq, ddq = f(s, 0), f(s, 1), f(s, 2)
+        q, dq, ddq = _path_values(f, s)
         frames = robot.frames_many(q, base)
         a, b = _path_dynamics(robot, q, dq, ddq, base, frames)
         hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=frames)
@@ -775,8 +796,8 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     fr = np.tile(frac, len(probed))
     s = grid[stage] + fr * ds[stage]
     xs = np.maximum(x[stage] + 2 * u[stage] * (s - grid[stage]), 0.0)
-    dq, ddq = f(s, 1), f(s, 2)
-    q, qd, qdd = f(s, 0), dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
+    q, dq, ddq = _path_values(f, s)
+    qd, qdd = dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
     nearer = np.where(fr < 0.5, stage, stage + 1)
     frames = robot.frames_many(q, base)
     sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base, frames=frames),
