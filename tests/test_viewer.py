@@ -318,3 +318,89 @@ def test_snakehead_view_serves_the_folder(browser, planned):
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+# ----------------------------------------------------------------------------------------------
+# a whole-body reach map (snakehead reach) as a still scene
+# ----------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def reach_file(tmp_path_factory) -> Path:
+    """A whole-body map of a tiny grid written by the one map writer, its bits chosen (not computed): every voxel of
+    the lower layer reaches one direction of two (a share of 50 %), one voxel both; the upper layer none."""
+    from snakehead import SnakeRobot
+    from snakehead.motion import reach
+
+    robot = SnakeRobot.default()
+    grid = reach.reach_grid(robot, 0.6, 2)
+    M, N = len(grid.centers), len(grid.directions)
+    bits = np.zeros((M, N), bool)
+    low = grid.layers == 0
+    bits[low, 0] = True
+    bits[np.flatnonzero(low)[0], 1] = True
+    k = robot.lift_joints.start
+    joints = np.where(bits[..., None], 0.0, np.nan) * np.ones((M, N, k))
+    placements = np.where(bits[..., None], 0.0, np.nan) * np.ones((M, N, 3))
+    m = reach._as_map(robot, grid, bits, placements, joints, 1, 0.0, 1, "test")
+    path = tmp_path_factory.mktemp("reach") / "reach.npz"
+    m.save(path)
+    return path
+
+
+def test_reach_scene_shows_the_reached_voxels_around_the_start(reach_file, tmp_path):
+    from snakehead import BasePlacement, SnakeRobot, load_map
+    from snakehead.motion import reach
+
+    robot = SnakeRobot.default()
+    m = load_map(reach_file)
+    scene = viewer.reach_scene(m, robot)
+    bits = m.reached_units()
+    shown = bits.any(axis=1)
+    assert scene.n_frames == 1 and len(scene.voxel_centers) == int(shown.sum()) < len(m)
+    np.testing.assert_allclose(scene.voxel_centers, m.centers[shown])  # the map's frame is the world frame
+    np.testing.assert_allclose(scene.voxel_indices, 100.0 * bits[shown].mean(axis=1))  # the share reached
+    assert sorted(set(scene.voxel_indices.tolist())) == [50.0, 100.0]
+    np.testing.assert_allclose(scene.map_frame_positions, 0.0) and np.testing.assert_allclose(
+        scene.map_frame_wxyz, [[1, 0, 0, 0]])
+    # the robot at the planner's start: its shapes where forward kinematics of the initial configuration puts them
+    q0 = reach.WORKERS.get(reach.RobotRecipe.of(robot), None, "rotated", 1).q_initial
+    shapes = robot.geometry.shapes
+    B = robot.frames(q0, BasePlacement())[[s.frame for s in shapes]] @ np.array([s.origin for s in shapes])
+    np.testing.assert_allclose(scene.shape_positions[0], B[:, :3, 3], atol=1e-9)
+    again = viewer.load_viewer_scene(viewer.save_viewer_scene(scene, tmp_path / f"reach{viewer.SCENE_SUFFIX}"))
+    np.testing.assert_array_equal(again.voxel_indices, scene.voxel_indices)
+    with pytest.raises(ValueError, match="head map"):  # a head map is not a whole-body map
+        viewer.reach_scene(load_map(robot.map_path), robot)
+
+
+def test_snakehead_view_map_shows_the_reach_map(browser, reach_file):
+    """``snakehead view --map reach.npz`` serves the still scene with its voxels shown at once: the page holds the
+    50 % voxels' colour (the index bar's), which a plan's scene (map hidden) does not."""
+    import socket
+
+    from snakehead.viz.workspace import index_colors
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", "--map", str(reach_file), "--port",
+                             str(port)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        line = proc.stdout.readline()
+        assert f"http://127.0.0.1:{port}" in line and "reach" in line, line
+        browser.get(f"http://127.0.0.1:{port}")
+        from selenium.webdriver.common.by import By
+        from selenium.webdriver.support import expected_conditions as EC
+        from selenium.webdriver.support.ui import WebDriverWait
+
+        WebDriverWait(browser, 60).until(EC.presence_of_element_located((By.CSS_SELECTOR, "canvas")))
+        half = np.round(255 * index_colors([50.0])[0]).astype(int)
+        seen = 0
+        for _ in range(60):
+            time.sleep(1.0)
+            seen = _hue_mask(_screenshot(browser), half, tolerance_deg=15.0).sum()
+            if seen > 2000:
+                break
+        assert seen > 2000
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
