@@ -290,14 +290,16 @@ def test_the_page_shows_the_robot_and_the_slider_moves_it(browser, planned, scen
     assert overlap < 0.5, (overlap, tmp_path)
 
 
-def test_snakehead_view_serves_the_folder(browser, planned):
-    """``snakehead view DIR`` serves the scenes of a plan's folder; the page shows the robot."""
+def _pixels_served(browser, args: list, rgb, enough: int, tolerance_deg: float = 20.0) -> tuple[int, str]:
+    """Run ``snakehead view ARGS --port P``, open the page, and count the pixels of ``rgb``'s hue on screenshots
+    until there are ``enough`` (the scene arrives over the websocket and fades in) or a minute has passed; returns
+    the count and the command's first line."""
     import socket
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", str(planned), "--port", str(port)],
+    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", *args, "--port", str(port)],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         line = proc.stdout.readline()
@@ -308,16 +310,22 @@ def test_snakehead_view_serves_the_folder(browser, planned):
         from selenium.webdriver.support.ui import WebDriverWait
 
         WebDriverWait(browser, 60).until(EC.presence_of_element_located((By.CSS_SELECTOR, "canvas")))
-        blue = 0
-        for _ in range(60):  # the robot appears once the scene has arrived over the websocket and faded in
+        seen = 0
+        for _ in range(60):
             time.sleep(1.0)
-            blue = _hue_mask(_screenshot(browser), viewer._rgb("#2e86c1")).sum()  # the head's blue
-            if blue > 300:
+            seen = int(_hue_mask(_screenshot(browser), rgb, tolerance_deg).sum())
+            if seen > enough:
                 break
-        assert blue > 300
+        return seen, line
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def test_snakehead_view_serves_the_folder(browser, planned):
+    """``snakehead view DIR`` serves the scenes of a plan's folder; the page shows the robot."""
+    blue, _ = _pixels_served(browser, [str(planned)], viewer._rgb("#2e86c1"), 300)  # the head's blue
+    assert blue > 300
 
 
 # ----------------------------------------------------------------------------------------------
@@ -374,33 +382,18 @@ def test_reach_scene_shows_the_reached_voxels_around_the_start(reach_file, tmp_p
 
 def test_snakehead_view_map_shows_the_reach_map(browser, reach_file):
     """``snakehead view --map reach.npz`` serves the still scene with its voxels shown at once: the page holds the
-    50 % voxels' colour (the index bar's), which a plan's scene (map hidden) does not."""
-    import socket
-
+    50 % voxels' colour (the index bar's)."""
     from snakehead.viz.workspace import index_colors
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", "--map", str(reach_file), "--port",
-                             str(port)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    try:
-        line = proc.stdout.readline()
-        assert f"http://127.0.0.1:{port}" in line and "reach" in line, line
-        browser.get(f"http://127.0.0.1:{port}")
-        from selenium.webdriver.common.by import By
-        from selenium.webdriver.support import expected_conditions as EC
-        from selenium.webdriver.support.ui import WebDriverWait
+    half = np.round(255 * index_colors([50.0])[0]).astype(int)
+    seen, line = _pixels_served(browser, ["--map", str(reach_file)], half, 300, tolerance_deg=15.0)
+    assert "reach" in line and seen > 300
 
-        WebDriverWait(browser, 60).until(EC.presence_of_element_located((By.CSS_SELECTOR, "canvas")))
-        half = np.round(255 * index_colors([50.0])[0]).astype(int)
-        seen = 0
-        for _ in range(60):
-            time.sleep(1.0)
-            seen = _hue_mask(_screenshot(browser), half, tolerance_deg=15.0).sum()
-            if seen > 2000:
-                break
-        assert seen > 2000
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
+
+def test_view_map_options(tmp_path, capsys, reach_file):
+    from snakehead.app.cli import main
+
+    assert main(["view", "--live", "--map", str(reach_file)]) == 2  # a still scene: not with --live
+    assert "not with --live" in capsys.readouterr().err
+    assert main(["view", str(tmp_path), "--robot", "r.toml"]) == 2  # --robot goes with --map or --live
+    assert main(["view", "--map", str(tmp_path / "missing.npz")]) == 2
