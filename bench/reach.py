@@ -1,7 +1,10 @@
 """The whole body's stable reachability map (snakehead reach) of the default robot: its time on one process and on
 a local Dask cluster of 1, 2 and 4 workers (one thread each), and the agreement of full plans with it.
 
-    python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100]
+    python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100] [--unpruned]
+
+--unpruned adds a one-process run that solves every pose (compute_reach(prune=False): the map before the prunes of
+motion.reach_bounds), side by side; every map must be equal to the first.
 
 Prints a Markdown table. More workers than cores shows the overhead, not a speed-up (say how many cores there are).
 """
@@ -24,6 +27,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, nargs="*", default=[1, 2, 4])
     ap.add_argument("--check", type=int, default=100)
     ap.add_argument("--no-serial", action="store_true", help="skip the one-process run")
+    ap.add_argument("--unpruned", action="store_true", help="also one process without the prunes")
     args = ap.parse_args()
     robot = sh.SnakeRobot.default()
     grid = reach.reach_grid(robot, args.voxel, args.directions)
@@ -35,6 +39,10 @@ def main() -> None:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions))
         rows.append(("1 process", time.perf_counter() - t))
+    if args.unpruned:
+        t = time.perf_counter()
+        maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, prune=False))
+        rows.append(("1 process, unpruned (every pose solved)", time.perf_counter() - t))
     from distributed import Client, LocalCluster
 
     for w in args.workers:
@@ -43,12 +51,13 @@ def main() -> None:
             t = time.perf_counter()
             maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, executor=client))
             rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''}", time.perf_counter() - t))
+        print(f"(done: {rows[-1][0]}, load {os.getloadavg()[0]:.1f})", flush=True)
     print("| run | time (s) | poses reached |")
     print("|---|---:|---:|")
     for (name, seconds), m in zip(rows, maps):
         print(f"| {name} | {seconds:.1f} | {100 * m.reached_units().mean():.1f} % |")
     same = [np.array_equal(maps[0].reached, m.reached) for m in maps[1:]]
-    print(f"\nmaps equal to the first: {same}")
+    print(f"\nmaps equal to the first: {same}; load {os.getloadavg()[0]:.1f}")
     if args.check and maps:
         t = time.perf_counter()
         c = reach.check_reach(maps[0], robot, args.check, seed=0)

@@ -86,3 +86,12 @@ def test_recipe_builds_the_same_robot(robot: sh.SnakeRobot) -> None:
 
     again = pickle.loads(pickle.dumps(RobotRecipe.of(robot))).build()
     assert again.body.hash == robot.body.hash and again.head_chain.hash == robot.head_chain.hash
+
+
+def test_description_arguments_rebuild_the_robot(robot: sh.SnakeRobot) -> None:
+    """The public accessor the recipe reads: a copy (changing it changes nothing) that builds the same robot."""
+    args = robot.description_arguments
+    args["urdf"] = "elsewhere.urdf"
+    assert robot.description_arguments["urdf"] != "elsewhere.urdf"
+    again = sh.SnakeRobot(**robot.description_arguments, **robot.user_frames, map_path=robot.map_path)
+    assert again.body.hash == robot.body.hash and again.parts == robot.parts

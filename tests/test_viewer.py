@@ -290,14 +290,16 @@ def test_the_page_shows_the_robot_and_the_slider_moves_it(browser, planned, scen
     assert overlap < 0.5, (overlap, tmp_path)
 
 
-def test_snakehead_view_serves_the_folder(browser, planned):
-    """``snakehead view DIR`` serves the scenes of a plan's folder; the page shows the robot."""
+def _pixels_served(browser, args: list, rgb, enough: int, tolerance_deg: float = 20.0) -> tuple[int, str]:
+    """Run ``snakehead view ARGS --port P``, open the page, and count the pixels of ``rgb``'s hue on screenshots
+    until there are ``enough`` (the scene arrives over the websocket and fades in) or a minute has passed; returns
+    the count and the command's first line."""
     import socket
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", str(planned), "--port", str(port)],
+    proc = subprocess.Popen([sys.executable, "-m", "snakehead", "view", *args, "--port", str(port)],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         line = proc.stdout.readline()
@@ -308,13 +310,90 @@ def test_snakehead_view_serves_the_folder(browser, planned):
         from selenium.webdriver.support.ui import WebDriverWait
 
         WebDriverWait(browser, 60).until(EC.presence_of_element_located((By.CSS_SELECTOR, "canvas")))
-        blue = 0
-        for _ in range(60):  # the robot appears once the scene has arrived over the websocket and faded in
+        seen = 0
+        for _ in range(60):
             time.sleep(1.0)
-            blue = _hue_mask(_screenshot(browser), viewer._rgb("#2e86c1")).sum()  # the head's blue
-            if blue > 300:
+            seen = int(_hue_mask(_screenshot(browser), rgb, tolerance_deg).sum())
+            if seen > enough:
                 break
-        assert blue > 300
+        return seen, line
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def test_snakehead_view_serves_the_folder(browser, planned):
+    """``snakehead view DIR`` serves the scenes of a plan's folder; the page shows the robot."""
+    blue, _ = _pixels_served(browser, [str(planned)], viewer._rgb("#2e86c1"), 300)  # the head's blue
+    assert blue > 300
+
+
+# ----------------------------------------------------------------------------------------------
+# a whole-body reach map (snakehead reach) as a still scene
+# ----------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def reach_file(tmp_path_factory) -> Path:
+    """A whole-body map of a tiny grid written by the one map writer, its bits chosen (not computed): every voxel of
+    the lower layer reaches one direction of two (a share of 50 %), one voxel both; the upper layer none."""
+    from snakehead import SnakeRobot
+    from snakehead.motion import reach
+
+    robot = SnakeRobot.default()
+    grid = reach.reach_grid(robot, 0.6, 2)
+    M, N = len(grid.centers), len(grid.directions)
+    bits = np.zeros((M, N), bool)
+    low = grid.layers == 0
+    bits[low, 0] = True
+    bits[np.flatnonzero(low)[0], 1] = True
+    k = robot.lift_joints.start
+    joints = np.where(bits[..., None], 0.0, np.nan) * np.ones((M, N, k))
+    placements = np.where(bits[..., None], 0.0, np.nan) * np.ones((M, N, 3))
+    m = reach._as_map(robot, grid, bits, placements, joints, 1, 0.0, 1, "test")
+    path = tmp_path_factory.mktemp("reach") / "reach.npz"
+    m.save(path)
+    return path
+
+
+def test_reach_scene_shows_the_reached_voxels_around_the_start(reach_file, tmp_path):
+    from snakehead import BasePlacement, SnakeRobot, load_map
+    from snakehead.motion import reach
+
+    robot = SnakeRobot.default()
+    m = load_map(reach_file)
+    scene = viewer.reach_scene(m, robot)
+    bits = m.reached_units()
+    shown = bits.any(axis=1)
+    assert scene.n_frames == 1 and len(scene.voxel_centers) == int(shown.sum()) < len(m)
+    np.testing.assert_allclose(scene.voxel_centers, m.centers[shown])  # the map's frame is the world frame
+    np.testing.assert_allclose(scene.voxel_indices, 100.0 * bits[shown].mean(axis=1))  # the share reached
+    assert sorted(set(scene.voxel_indices.tolist())) == [50.0, 100.0]
+    np.testing.assert_allclose(scene.map_frame_positions, 0.0) and np.testing.assert_allclose(
+        scene.map_frame_wxyz, [[1, 0, 0, 0]])
+    # the robot at the planner's start: its shapes where forward kinematics of the initial configuration puts them
+    q0 = reach.WORKERS.get(reach.RobotRecipe.of(robot), None, "rotated", 1).q_initial
+    shapes = robot.geometry.shapes
+    B = robot.frames(q0, BasePlacement())[[s.frame for s in shapes]] @ np.array([s.origin for s in shapes])
+    np.testing.assert_allclose(scene.shape_positions[0], B[:, :3, 3], atol=1e-9)
+    again = viewer.load_viewer_scene(viewer.save_viewer_scene(scene, tmp_path / f"reach{viewer.SCENE_SUFFIX}"))
+    np.testing.assert_array_equal(again.voxel_indices, scene.voxel_indices)
+    with pytest.raises(ValueError, match="head map"):  # a head map is not a whole-body map
+        viewer.reach_scene(load_map(robot.map_path), robot)
+
+
+def test_snakehead_view_map_shows_the_reach_map(browser, reach_file):
+    """``snakehead view --map reach.npz`` serves the still scene with its voxels shown at once: the page holds the
+    50 % voxels' colour (the index bar's)."""
+    from snakehead.viz.workspace import index_colors
+
+    half = np.round(255 * index_colors([50.0])[0]).astype(int)
+    seen, line = _pixels_served(browser, ["--map", str(reach_file)], half, 300, tolerance_deg=15.0)
+    assert "reach" in line and seen > 300
+
+
+def test_view_map_options(tmp_path, capsys, reach_file):
+    from snakehead.app.cli import main
+
+    assert main(["view", "--live", "--map", str(reach_file)]) == 2  # a still scene: not with --live
+    assert "not with --live" in capsys.readouterr().err
+    assert main(["view", str(tmp_path), "--robot", "r.toml"]) == 2  # --robot goes with --map or --live
+    assert main(["view", "--map", str(tmp_path / "missing.npz")]) == 2

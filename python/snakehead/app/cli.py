@@ -400,25 +400,32 @@ def _merge_shards(args: argparse.Namespace, out: Path) -> int:
 # view
 # ----------------------------------------------------------------------------------------------
 def _view(args: argparse.Namespace) -> int:
+    from ..kinematics import workspace
     from ..viz import viewer
 
     if args.live:
+        if args.map is not None:
+            raise UsageError("--map shows a reach map as a still scene: not with --live")
         if args.dir is not None:
             raise UsageError(f"--live plans as you drag the targets and shows no folder: drop {args.dir!r} (--scene "
                              "FILE starts from a scene's targets and obstacles)")
         return _view_live(args)
-    if args.dir is None:
-        raise UsageError("give DIR (the --out folder of 'snakehead plan' or 'demo'), or --live")
-    for option in ("robot", "scene"):
-        if getattr(args, option) is not None:
-            raise UsageError(f"--{option} goes with --live (DIR's scenes hold their robot and targets)")
-    directory = Path(args.dir)
-    if not directory.is_dir():
+    if args.dir is None and args.map is None:
+        raise UsageError("give DIR (the --out folder of 'snakehead plan' or 'demo'), --map REACH.npz, or --live")
+    if args.scene is not None:
+        raise UsageError("--scene goes with --live (DIR's scenes hold their robot and targets)")
+    if args.robot is not None and args.map is None:
+        raise UsageError("--robot goes with --live or --map (DIR's scenes hold their robot)")
+    directory = None if args.dir is None else Path(args.dir)
+    if directory is not None and not directory.is_dir():
         raise UsageError(f"{args.dir!r} is not a directory (give the --out folder of 'snakehead plan' or 'demo')")
-    shown = viewer.serve(directory, host=args.host, port=args.port)
+    extra = [] if args.map is None else [viewer.reach_scene(workspace.load(args.map), _robot(args))]
+    shown = viewer.serve(directory, host=args.host, port=args.port, extra=extra)
     try:  # from here on Ctrl-C is how the viewer ends (the line below tells the user so, and may be interrupted)
-        print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from "
-              f"{directory.resolve()}; Ctrl-C stops", flush=True)
+        where = " and ".join(([str(directory.resolve())] if directory is not None else []) + ([args.map] if args.map
+                                                                                             else []))
+        print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from {where}; "
+              "Ctrl-C stops", flush=True)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
@@ -619,6 +626,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the --out folder of snakehead plan or demo (not with --live)")
     p.add_argument("--live", action="store_true",
                    help="plan as you drag the targets (default: one where the head starts; --scene for a scene's)")
+    p.add_argument("--map", default=None, metavar="REACH.npz",
+                   help="show a whole-body reach map (snakehead reach's DIR/reach.npz; --robot: its robot) as a still "
+                        "scene: the robot at its start and the voxels reached, coloured by the share of directions")
     _add_robot_option(p)
     p.add_argument("--scene", default=None, metavar="SCENE.toml",
                    help="with --live: start from a scene file's targets, obstacles and base (its robot file unless "

@@ -195,6 +195,13 @@ class SnakeRobot:
                    root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
                    packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args)
 
+    @property
+    def description_arguments(self) -> dict[str, Any]:
+        """The arguments this robot's description was read with (``urdf``, ``root``, ``head_axis``, ``packages``,
+        ``limits``, ``xacro_args``, ``source``; a copy): with :attr:`user_frames` and :attr:`map_path`, what builds
+        the same robot again, e.g. in another process."""
+        return dict(self._arguments)
+
     def with_parts(self, base_end: str | None = None, neck_end: str | None = None,
                    head_tip: str | None = None) -> "SnakeRobot":
         """The same description split into parts at other frames (the URDF's names; None keeps the frame); the head's

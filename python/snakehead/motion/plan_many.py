@@ -45,7 +45,7 @@ class RobotRecipe:
     @classmethod
     def of(cls, robot: SnakeRobot) -> RobotRecipe:
         args: dict[str, Any] = {k: (os.fspath(v) if isinstance(v, os.PathLike) else v)
-                                for k, v in robot._arguments.items()}
+                                for k, v in robot.description_arguments.items()}
         for k in ("packages", "limits", "xacro_args"):  # mappings: as sorted pairs, so that the recipe hashes
             if args.get(k) is not None:
                 args[k] = tuple(sorted((str(n), os.fspath(v) if isinstance(v, os.PathLike) else v)

@@ -21,7 +21,12 @@ Making it cheap without changing what it means (no obstacles, a flat ground):
   turned towards the target first): it is solved once per layer, direction and one of :data:`BEARING_BINS` relative
   bearings, for a target beyond the base's own reach, and carried over to the voxels of that layer;
 * with the base kept, only poses within the lifted chain's reach of the frame it lifts from can be reached: those
-  not reached by a relocation are solved one by one (as the planner's first step does).
+  not reached by a relocation are solved one by one (as the planner's first step does);
+* poses that no whole-body pose can reach are not solved (:mod:`~snakehead.motion.reach_bounds`: necessary
+  conditions of the solve's exact checks): with any base, the tip's shape below the ground for every roll, or the
+  last joint higher (lower) than the lifted chain reaches from the frame it lifts from; with the base kept, also
+  that joint beyond the chain's reach of that frame, or a centre of mass that cannot lie inside the support
+  polygon by the margin.
 """
 from __future__ import annotations
 
@@ -39,8 +44,9 @@ from ..kinematics import workspace as ws
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Target
 from .plan_many import WORKERS, RobotRecipe, plan_many
+from .reach_bounds import PoseBounds
 
-__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK", "SOLVE_BUDGET_S"]
+__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK", "SOLVE_BUDGET_S"]
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -54,7 +60,7 @@ MIN_VOXEL_M = 0.02
 MAX_DIRECTIONS = 64
 MAX_SOLVES = 200_000
 #: Poses with the base kept solved per task.
-KEPT_CHUNK = 24
+KEPT_CHUNK = 8
 #: The whole-body solve's time budget (s), recorded in the map's ``timeout``.
 SOLVE_BUDGET_S = 3.0
 
@@ -142,6 +148,25 @@ def _start_lift(robot: SnakeRobot) -> tuple[np.ndarray, float]:
     return (robot.frame(controller.q_initial, robot.lift_frame, BasePlacement())[:2, 3], _lift_reach(robot))
 
 
+def unreachable(robot: SnakeRobot, positions: np.ndarray, directions: np.ndarray, *, kept: bool) -> np.ndarray:
+    """(N,) bool: the (position, direction) poses that no whole-body pose can reach (:class:`PoseBounds`'s
+    necessary conditions): with any base lying flat, or (``kept``) with the base as it lies at the start (the
+    planner's initial configuration at ``BasePlacement()``, its margin ``DETOUR_MARGIN``), where the solve with the
+    base kept cannot succeed."""
+    from ..margins import DETOUR_MARGIN
+
+    controller = WORKERS.get(RobotRecipe.of(robot), None, "rotated", 1)
+    q0, start = controller.q_initial, BasePlacement()
+    bounds = PoseBounds.of(robot, q0)
+    p, d = np.reshape(positions, (-1, 3)), np.reshape(directions, (-1, 3))
+    out = bounds.below_ground(p, d) | bounds.out_of_reach(p, d)
+    if kept:
+        out |= bounds.out_of_reach(p, d, robot.frame(q0, robot.lift_frame, start)[:3, 3])
+        rest = np.flatnonzero(~out)
+        out[rest] = bounds.unstable(p[rest], q0, start, DETOUR_MARGIN)
+    return out
+
+
 # --- the work, in workers ---------------------------------------------------------------------------------------
 def _controller(recipe: RobotRecipe, method: str, seed: int | None) -> HeadController:
     c = WORKERS.get(recipe, None, method, seed)
@@ -186,14 +211,15 @@ def kept_task(recipe: RobotRecipe, method: str, seed: int | None, poses: list) -
 
 # --- the map ----------------------------------------------------------------------------------------------------
 def compute_reach(robot: SnakeRobot, *, voxel: float = 0.1, directions: int = 12, executor: Any = None,
-                  method: str = "rotated", seed: int | None = 1, progress: ReachProgress | None = None
-                  ) -> ws.ReachabilityMap:
+                  method: str = "rotated", seed: int | None = 1, progress: ReachProgress | None = None,
+                  prune: bool = True) -> ws.ReachabilityMap:
     """The whole body's stable reachability map of ``robot`` (see the module's doc): kind ``"whole-body"``; its
     ``reached`` bits say which (voxel, direction) poses are reached, ``base_placements`` (M, N, 3) and
     ``base_joints`` (M, N, k) with which base (a relocated base where one reaches the pose, else the start's).
 
     executor: None (here), a ``concurrent.futures`` executor or a Dask ``distributed.Client``. ``method``, ``seed``:
-    the head IK's, as :func:`snakehead.plan`'s. ``progress(stage, done, total)`` as tasks finish."""
+    the head IK's, as :func:`snakehead.plan`'s. ``progress(stage, done, total)`` as tasks finish. ``prune=False``
+    solves the poses that :func:`unreachable` proves unreachable too (the same map, slower: for comparisons)."""
     t0 = time.perf_counter()
     voxel, directions = check_options(robot, voxel, directions)
     if method not in ("rotated", "free_roll"):
@@ -206,7 +232,7 @@ def compute_reach(robot: SnakeRobot, *, voxel: float = 0.1, directions: int = 12
     lift_xy, reach = _start_lift(robot)
     poses = grid.poses()
     M, N = poses.shape[:2]
-    table = _relocation_table(robot, recipe, grid, lift_xy, reach, pool, method, seed, progress)
+    table = _relocation_table(robot, recipe, grid, lift_xy, reach, pool, method, seed, progress, prune)
     reached = np.zeros((M, N), bool)
     placements = np.full((M, N, 3), np.nan)
     k_joints = robot.lift_joints.start
@@ -227,6 +253,9 @@ def compute_reach(robot: SnakeRobot, *, voxel: float = 0.1, directions: int = 12
     # the base kept, for the poses within its reach that no relocation reaches
     near = _near(grid, lift_xy, reach) & ~reached
     rows, cols = np.nonzero(near)
+    if prune:
+        keep = ~unreachable(robot, poses[rows, cols], grid.directions[cols], kept=True)
+        rows, cols = rows[keep], cols[keep]
     chunks = [list(zip(rows[i:i + KEPT_CHUNK], cols[i:i + KEPT_CHUNK])) for i in range(0, len(rows), KEPT_CHUNK)]
     tasks = [(recipe, method, seed, [(poses[v, k], grid.directions[k]) for v, k in chunk]) for chunk in chunks]
     results = _run(pool, kept_task, tasks, "base kept", progress)
@@ -250,7 +279,8 @@ def _bearing_bins(poses: np.ndarray, directions: np.ndarray, lift_xy: np.ndarray
 
 
 def _relocation_table(robot: SnakeRobot, recipe: RobotRecipe, grid: ReachGrid, lift_xy: np.ndarray, reach: float,
-                      pool: Any, method: str, seed: int | None, progress: ReachProgress | None) -> dict:
+                      pool: Any, method: str, seed: int | None, progress: ReachProgress | None, prune: bool = True
+                      ) -> dict:
     """(layer, direction, bearing bin) -> (reached, target (3,), placement (3,), base joints): the planner's
     relocation for a target of that layer's height, direction and relative bearing, beyond the base's own reach."""
     layers = sorted(set(grid.layers.tolist()))
@@ -266,8 +296,14 @@ def _relocation_table(robot: SnakeRobot, recipe: RobotRecipe, grid: ReachGrid, l
                               cz + 0.5 * grid.voxel * d[2]])
                 keys.append((layer, k, b))
                 poses.append((p, d))
-    tasks = [(recipe, method, seed, [pose]) for pose in poses]
-    results = _run(pool, relocation_task, tasks, "relocation", progress)
+    # poses no base reaches (the same for every bearing of a layer and direction) are not solved
+    todo = np.arange(len(poses))
+    if prune:
+        todo = todo[~unreachable(robot, np.array([p for p, _ in poses]), np.array([d for _, d in poses]), kept=False)]
+    tasks = [(recipe, method, seed, [poses[i]]) for i in todo]
+    results: list = [[(False, None, None)]] * len(poses)
+    for i, res in zip(todo, _run(pool, relocation_task, tasks, "relocation", progress)):
+        results[i] = res
     return {key: (res[0][0], pose[0], res[0][1], res[0][2]) for key, pose, res in zip(keys, poses, results)}
 
 
@@ -321,10 +357,22 @@ class ReachCheck:
     def agreement(self) -> float:
         return float(np.mean(self.mapped == self.planned)) if len(self.mapped) else 1.0
 
+    def agreement_interval(self, z: float = 1.96) -> tuple[float, float]:
+        """The Wilson score interval of the agreement (default 95 %: z = 1.96), as shares."""
+        n = len(self.mapped)
+        if n == 0:
+            return (0.0, 1.0)
+        p = self.agreement
+        centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+        half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+        return (max(0.0, centre - half), min(1.0, centre + half))
+
     def summary(self) -> str:
         r = self.mapped
+        lo, hi = self.agreement_interval()
         return (f"{len(r)} poses ({int(r.sum())} reachable by the map, {int((~r).sum())} not): full plans agree on "
-                f"{100 * self.agreement:.1f} % (reachable: {_share(self.planned[r])}, not: {_share(~self.planned[~r])})")
+                f"{100 * self.agreement:.1f} % (95 % interval {100 * lo:.1f}-{100 * hi:.1f} %; reachable: "
+                f"{_share(self.planned[r])}, not: {_share(~self.planned[~r])})")
 
 
 def _share(a: np.ndarray) -> str:

@@ -16,7 +16,10 @@ Three ways to it:
   client, with the recorded scene inside the file). ``plan`` and ``demo`` write ``NAME.html`` beside the GIF;
   the scene tree (the tree icon at the bottom right) toggles the map, the ZMP, the targets and the obstacles;
 * :func:`serve` (``snakehead view DIR``): a live viser server over the scenes in a folder, with a scenario menu,
-  play/pause, a time slider, a speed menu and check boxes for the layers.
+  play/pause, a time slider, a speed menu and check boxes for the layers;
+* :func:`reach_scene`: a still scene of a whole-body reach map (``snakehead reach``; ``snakehead view --map
+  reach.npz``): the robot at its start and the voxels it reaches, coloured by the share of directions reached,
+  shown at once.
 
 viser is a dependency of snakehead; it is imported only when a page is made or served.
 """
@@ -289,6 +292,38 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
     )
 
 
+def reach_scene(reach_map: ReachabilityMap, robot: Any, *, title: str = "") -> ViewerScene:
+    """A still scene (one frame) of a whole-body reach map (``snakehead reach``) of ``robot``: the robot at the
+    start it was computed from (the planner's initial configuration at ``BasePlacement()``), its support polygon
+    and centre of mass, and the voxels where the map reaches at least one direction, coloured by the share of
+    directions reached (0-100, the index bar). The map's frame is the world frame (the "head base frame" node is
+    at the origin)."""
+    from ..dynamics import stability as st
+    from ..kinematics.workspace import KIND_WHOLE_BODY, require_map
+    from ..model.robot import BasePlacement
+    from ..motion.plan_many import WORKERS, RobotRecipe
+
+    m = require_map(reach_map, robot, kind=KIND_WHOLE_BODY, what="reach_map")
+    q0 = WORKERS.get(RobotRecipe.of(robot), None, "rotated", 1).q_initial
+    base = BasePlacement()
+    frames = robot.frames_many(q0[None], base)
+    meshes = robot_meshes(robot)
+    shape_positions, shape_wxyz = shape_poses(robot, frames, meshes.pop("origins"))
+    shown = np.asarray(m.solved) > 0
+    com = st.center_of_mass(robot, q0, base)
+    poly = st.support_polygon(robot, q0, base, contact="ground")
+    return ViewerScene(
+        name="reach", title=title or f"whole-body reach ({int(shown.sum())} of {len(m)} voxels reached)",
+        times=np.zeros(1), shape_positions=shape_positions, shape_wxyz=shape_wxyz, shape_colors=shape_colors(robot),
+        **meshes, head_tip=frames[:, robot.link_index(robot.parts.head_tip), :3, 3],
+        map_frame_positions=np.zeros((1, 3)), map_frame_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
+        voxel_centers=np.asarray(m.centers, float)[shown], voxel_indices=np.asarray(m.indices, float)[shown],
+        voxel_size=float(m.voxel_size), zmp=com[None, :2], com=com[None], zmp_path=com[None, :2],
+        polygons=poly[None], polygon_of_frame=np.zeros(1, np.int32), target_positions=np.zeros((0, 3)),
+        target_directions=np.zeros((0, 3)), target_names=np.array([], dtype=str), target_diameters=np.zeros(0),
+        **obstacle_arrays([]))
+
+
 def frame_indices(t: np.ndarray, frame_step_s: float = FRAME_STEP_S, max_frames: int = 2000) -> np.ndarray:
     """Indices into the sample times ``t`` (T,) s of the viewer's frames: one every ``frame_step_s`` s of motion, at
     most ``max_frames``, the first and the last sample included."""
@@ -481,7 +516,7 @@ class SceneNodes:
                 f"{root}/head base frame/reachability map", _CUBE_VERTICES, _CUBE_TRIANGLES,
                 batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)), batched_positions=data.voxel_centers,
                 batched_scales=np.full(n, 0.8 * data.voxel_size), batched_colors=rgb, opacity=0.35, lod="off",
-                cast_shadow=False, receive_shadow=False, visible=False)
+                cast_shadow=False, receive_shadow=False, visible=data.n_frames == 1)
         self.polygons = []
         for i, poly in enumerate(data.polygons):
             p = poly[np.all(np.isfinite(poly), axis=1)]
@@ -715,6 +750,8 @@ class Viewer:
             self.time.max = max(round(duration, 2), step)
             self.time.step = step
             self.time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
+            if data.n_frames == 1 and len(data.voxel_centers):  # a still scene (a reach map) is there for its map
+                self.layers["reachability map"].value = True  # type: ignore[misc]  # (as above)
             self._apply_layers()
 
     def _frame_at(self, t_rel: float) -> int:
@@ -755,11 +792,13 @@ class Viewer:
         self.server.stop()
 
 
-def serve(directory: str | Path, *, host: str = "127.0.0.1", port: int = 8080) -> Viewer:
-    """Serve the viewer scenes of ``directory`` (the output of ``snakehead plan`` or ``demo``) at
-    http://HOST:PORT (the next free port if PORT is taken); returns the running :class:`Viewer`."""
-    paths = scenes_in(directory)
-    if not paths:
+def serve(directory: str | Path | None, *, host: str = "127.0.0.1", port: int = 8080,
+          extra: Sequence[ViewerScene] = ()) -> Viewer:
+    """Serve the viewer scenes of ``directory`` (the output of ``snakehead plan`` or ``demo``; None: none) and
+    ``extra`` scenes (e.g. :func:`reach_scene`'s) at http://HOST:PORT (the next free port if PORT is taken);
+    returns the running :class:`Viewer`."""
+    paths = scenes_in(directory) if directory is not None else []
+    if not paths and not extra:
         raise InputError(f"{directory} holds no viewer scenes (*{SCENE_SUFFIX}); 'snakehead plan' and "
                          "'snakehead demo' write them")
-    return Viewer([load_viewer_scene(p) for p in paths], host=host, port=port)
+    return Viewer([load_viewer_scene(p) for p in paths] + list(extra), host=host, port=port)
