@@ -297,15 +297,26 @@ def disturbed(controller):
 
 
 def test_closed_loop_corrects_a_disturbed_start(disturbed):
+    """On its own senses: the head camera sees the target's marker on the way up, the fix from it corrects the
+    disturbance the dead reckoning could not know, and the final approach on the camera brings the head within the
+    paper's accuracy (against MuJoCo's truth)."""
     _, run = disturbed
     assert run.success, run.failure
+    assert run.sensing == "onboard"
     m = run.metrics
-    assert m["position_error_m"] < 0.002 and m["direction_error_deg"] < 1.0
+    assert m["position_error_m"] < 0.005 and m["direction_error_deg"] < 1.0  # the head phases, before the servo
+    assert m["final_position_error_m"] < 0.002 and m["final_direction_error_deg"] < 1.0
     assert m["zmp_inside"]
-    # the loop did not know: its dead reckoning was off by the disturbance until the fix
-    dead = run.fixes[-1]["dead_reckoning"]
+    # the loop did not know: its dead reckoning was off by the disturbance until the head camera's fix
+    fix = run.fixes[-1]
+    assert fix["source"] == "head camera"
+    dead = fix["dead_reckoning"]
     assert dead["position_error_m"] > 0.05 and dead["yaw_error_deg"] > 15.0
-    assert run.fixes[-1]["fix"]["position_error_m"] < 0.002
+    assert fix["fix"]["position_error_m"] < 0.003 and fix["fix"]["yaw_error_deg"] < 0.5
+    # the final approach measured the error it corrected, near the truth (the camera's noise, averaged)
+    first = run.servo[0]
+    assert first["measured_position_error_m"] == pytest.approx(first["true_position_error_m"], abs=0.001)
+    assert run.servo[-1]["true_position_error_m"] <= first["true_position_error_m"]
 
 
 def test_loop_report_and_phases(disturbed):
@@ -316,7 +327,7 @@ def test_loop_report_and_phases(disturbed):
     phases = report["phases"]
     kinds = [p["kind"] for p in phases]
     assert set(kinds) <= set(PHASE_KINDS)
-    assert kinds[0] == "curl" and "lift" in kinds and "move" in kinds and kinds[-1] == "hold"
+    assert kinds[0] == "curl" and "lift" in kinds and "move" in kinds and kinds[-1] in ("hold", "servo")
     for a, b in zip(phases, phases[1:]):
         assert b["t0_s"] == pytest.approx(a["t1_s"]) and b["t1_s"] > b["t0_s"]
     assert report["total_time_s"] == pytest.approx(phases[-1]["t1_s"])
@@ -337,7 +348,12 @@ def test_loop_report_entry(disturbed):
     assert entry["sim"]["base_travel_m"] == pytest.approx(run.base_travel_m)
     assert entry["sim"]["position_error_m"] == pytest.approx(run.metrics["position_error_m"])
     assert entry["targets"] and entry["targets"][0]["solved"]
-    assert any("outside measurement" in n for n in entry["notes"])
+    assert any("own sensors" in n and "nothing outside" in n for n in entry["notes"])
+    assert entry["sim"]["sensing"] == "onboard"
+    over = entry["estimate"]["over_time"]
+    assert 0 < len(over["t_s"]) <= 200 and len(over["position_error_m"]) == len(over["t_s"])
+    assert over["max_position_error_m"] == pytest.approx(max(over["position_error_m"]), rel=0.2)
+    assert entry["final_approach"] and entry["sim"]["final_position_error_m"] < 0.002
     assert entry["files"] == ["x_path.png"]
 
 
@@ -380,7 +396,11 @@ def test_bad_loop_input(disturbed, controller):
     with pytest.raises(ValueError, match="position_noise_m"):
         PoseFix(position_noise_m=-1.0)
     with pytest.raises(ValueError, match="nowhere"):
-        ClosedLoop(loop.scene, controller=controller, fix=PoseFix(frame="nowhere"))
+        ClosedLoop(loop.scene, controller=controller, sensing="outside fix", fix=PoseFix(frame="nowhere"))
+    with pytest.raises(ValueError, match="outside fix"):
+        ClosedLoop(loop.scene, controller=controller, fix=PoseFix())
+    with pytest.raises(ValueError, match="sensing"):
+        ClosedLoop(loop.scene, controller=controller, sensing="gps")
     with pytest.raises(ValueError, match="max_corrections"):
         ClosedLoop(loop.scene, controller=controller, max_corrections=-1)
     with pytest.raises(TypeError, match="Tolerance"):

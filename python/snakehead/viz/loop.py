@@ -31,7 +31,8 @@ from .body import body_faces
 from .._errors import InputError, InputTypeError
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
-KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41"}
+KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41",
+               "servo": "#00838f"}
 PART_COLORS = ("#7f8c8d", "#e67e22", "#2e86c1")  # base, neck, head
 TARGET_COLOR = "#c0392b"
 
