@@ -356,7 +356,7 @@ class ClosedLoop:
     joint rate (rad/s). tolerance: the locomotion's (:class:`snakehead.motion.locomotion.Tolerance`).
     max_gait_runs: per correction; max_corrections: returns to step 2 after a curl before giving up.
     dynamics_check: simulate the head phases from the plan's own start before running them (step 6).
-    sensing: one of SENSING (see the module; "outside fix" uses ``fix``, default :class:`PoseFix`\ ()); sensor_seed:
+    sensing: one of SENSING (see the module; "outside fix" uses ``fix``, default a :class:`PoseFix`); sensor_seed:
     the onboard sensors' noise (:meth:`snakehead.sim.sensors.OnboardSensors.realistic`).
     imu_yaw_drift_deg_per_s, odometry and the other keywords (friction, ...) go to the
     :class:`~snakehead.sim.GaitSimulator`; the head phases' simulation uses the same ground.
