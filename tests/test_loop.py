@@ -407,3 +407,37 @@ def test_bad_loop_input(disturbed, controller):
         ClosedLoop(loop.scene, controller=controller, tolerance=0.1)
     with pytest.raises(TypeError, match="timing"):
         ClosedLoop(loop.scene, controller=controller, timing=0.5)
+
+
+@pytest.mark.slow
+def test_the_hole_from_behind_its_wall(controller):
+    """The paper's hole scene from behind its wall (snakehead plan --scene hole.toml --start 0.2 1.4 3.1416): the
+    body goes around the wall on a planned route, never touching it, and the head gets through the hole on its own
+    senses."""
+    from snakehead.scenes import paper_scene
+    from snakehead.sim.loop import ClosedLoop
+
+    loop = ClosedLoop(paper_scene("hole"), controller=controller)
+    run = loop.run(BasePlacement(0.2, 1.4, 3.1416))
+    assert run.success, run.failure
+    assert run.routes and len(run.routes[0]) >= 3  # around the wall
+    assert run.min_obstacle_distance_m > 0.0
+    assert run.min_obstacle_distance_ground_m > 0.02  # the route's clearance, less the gaits' errors
+    assert run.metrics["final_position_error_m"] < 0.002 and run.metrics["final_direction_error_deg"] < 1.0
+    assert run.report()["sim"]["min_obstacle_distance_m"] == run.min_obstacle_distance_m
+
+
+@pytest.mark.slow
+def test_outside_fix_keeps_the_old_behaviour(controller, disturbed):
+    """sensing="outside fix": perfect joints and IMU, the fix of the neck's base frame, no final approach."""
+    from snakehead.sim.loop import ClosedLoop
+
+    loop, _ = disturbed
+    old = ClosedLoop(loop.scene, controller=controller, sensing="outside fix")
+    nominal = old.straight_start()
+    run = old.run(lc.compose(nominal, BasePlacement(0.0, 0.1, math.radians(20.0))), believed_start=nominal)
+    assert run.success and run.sensing == "outside fix" and run.fix is not None
+    assert "source" not in run.fixes[-1] and run.fixes[-1]["fix"]["position_error_m"] < 0.002
+    assert not run.servo and "final_position_error_m" not in run.metrics
+    assert run.metrics["position_error_m"] < 0.002 and run.metrics["direction_error_deg"] < 1.0
+    assert all(r.sensor_log is None for r in run.ground_runs)

@@ -82,6 +82,7 @@ from .._validate import finite_float, positive
 from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement, SnakeRobot, as_base
+from ..motion import ground_path as gp
 from ..motion import locomotion as lc
 from ..motion.planner import Plan, as_scene, bending_state, plan
 from ..scenes.scene import Scene
@@ -100,6 +101,9 @@ from .._errors import InputError, InputTypeError, InternalError, entry_point, in
 #: (:mod:`snakehead.sim.sensors`), or "outside fix", perfect joint angles and IMU and an outside measurement of the
 #: neck's base frame (:class:`PoseFix`) once the body rests in the bending state.
 SENSING = ("onboard", "outside fix")
+#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle along the leg's
+#: square and along the leg, m; its heading, deg): looser than the goal's, the next leg corrects what is left.
+WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.12, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
 #: The most samples of the estimate's error over time a report holds.
 ESTIMATE_SAMPLES = 200
 #: How long the head holds still where it first looks for a marker (s).
@@ -209,6 +213,7 @@ class LoopRun:
     sensing: str = "outside fix"
     head_extra: list = field(default_factory=list)
     servo: list = field(default_factory=list)
+    routes: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -224,30 +229,38 @@ class LoopRun:
         """Simulated time from the start to the end of the last phase (s)."""
         return float(self.phases[-1].t1_s) if self.phases else 0.0
 
-    def timeline(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The whole sequence as MuJoCo ran it: t (T,) s, the root frame's world pose (T, 4, 4), the joints (T, n)."""
-        ts: list[np.ndarray] = []
-        roots: list[np.ndarray] = []
-        qs: list[np.ndarray] = []
+    def segments(self) -> list[dict]:
+        """What MuJoCo ran, piece by piece in time order: each a dict of ``t`` (T,) s on the loop's clock,
+        ``root`` (T, 4, 4) the root frame's true world pose, ``q`` (T, n) and ``qd`` (T, n) the joints (the
+        ground phases' velocities by finite differences), ``estimate`` (T, 4, 4) the root pose the loop believed
+        (the dead reckoning on the ground, NaN where a run kept none; the placement the head phases were planned
+        from while lifted)."""
+        out = []
         for run in self.ground_runs:
             if run.root_truth is None:  # every ground run of a loop records where the body truly was
                 raise InternalError(f"the loop's ground run {run.name!r} has no recorded root pose")
-            ts.append(run.t)
-            roots.append(run.root_truth)
-            qs.append(run.q)
+            out.append({"t": run.t, "root": run.root_truth, "q": run.q,
+                        "qd": np.gradient(run.q, run.t, axis=0) if len(run.t) > 1 else np.zeros_like(run.q),
+                        "estimate": (run.root_estimate if run.root_estimate is not None
+                                     else np.full((len(run.t), 4, 4), np.nan))})
         lifted = [(t0, r) for _, t0, r in self.head_extra]
         if self.head is not None:
             lifted.append((self.head_t0_s, self.head))
-        for t0, r in sorted(lifted, key=lambda item: item[0]):
-            if r.root_pose is not None:
-                ts.append(t0 + r.t - r.t[0])
-                roots.append(r.root_pose)
-                qs.append(r.q)
-        if not ts:
+        for t0, r in lifted:
+            if r.root_pose is None:
+                continue
+            believed = self.robot.root_pose(self.plan.base if self.plan is not None else r.base)
+            out.append({"t": t0 + r.t - r.t[0], "root": r.root_pose, "q": r.q, "qd": r.qdot,
+                        "estimate": np.repeat(believed[None], len(r.t), axis=0)})
+        return sorted(out, key=lambda seg: float(seg["t"][0]))
+
+    def timeline(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The whole sequence as MuJoCo ran it: t (T,) s, the root frame's world pose (T, 4, 4), the joints (T, n)."""
+        segs = self.segments()
+        if not segs:
             return np.zeros(0), np.zeros((0, 4, 4)), np.zeros((0, self.robot.n_joints))
-        order = np.argsort(np.array([t[0] for t in ts]), kind="stable")
-        return (np.concatenate([ts[i] for i in order]), np.concatenate([roots[i] for i in order]),
-                np.concatenate([qs[i] for i in order]))
+        return (np.concatenate([s["t"] for s in segs]), np.concatenate([s["root"] for s in segs]),
+                np.concatenate([s["q"] for s in segs]))
 
     @property
     def base_travel_m(self) -> float:
@@ -265,6 +278,39 @@ class LoopRun:
         if len(roots) < 1:
             return 0.0
         return float(np.linalg.norm(roots[-1, :2, 3] - roots[0, :2, 3]))
+
+    def obstacle_distances(self, every: int = 5) -> tuple[np.ndarray, np.ndarray]:
+        """The smallest distance (m) of the body's shapes to any obstacle of the scene over the whole run as
+        MuJoCo ran it (:meth:`timeline`, every ``every``-th recorded tick and the last): t (T,) s, distance (T,)
+        m (negative: penetration); empty without obstacles."""
+        from ..geometry.collision import obstacle_shapes
+        from ..geometry.shapes import pair_min_distances
+
+        t, roots, qs = self.timeline()
+        if not self.scene.obstacles or not len(t):
+            return np.zeros(0), np.zeros(0)
+        pick = np.unique(np.r_[np.arange(0, len(t), max(int(every), 1)), len(t) - 1])
+        frames = np.einsum("tij,tljk->tlik", roots[pick], self.robot.body.fk_all_many(qs[pick]))
+        shapes, _ = obstacle_shapes(list(self.scene.obstacles))
+        mine = np.arange(len(self.robot.geometry.shapes))
+        pairs = np.stack(np.meshgrid(mine, np.arange(len(shapes.shapes)), indexing="ij"), -1).reshape(-1, 2)
+        d = pair_min_distances(frames, self.robot.geometry, np.eye(4)[None, None], shapes, pairs)
+        return t[pick], np.asarray(d)
+
+    @property
+    def min_obstacle_distance_m(self) -> float | None:
+        """The smallest distance of the body to any obstacle over the run (m; None without obstacles)."""
+        _, d = self.obstacle_distances()
+        return float(d.min()) if len(d) else None
+
+    @property
+    def min_obstacle_distance_ground_m(self) -> float | None:
+        """The same over the ground phases alone (gaits and curls: the locomotion around the obstacles)."""
+        t, d = self.obstacle_distances()
+        on_ground = np.zeros(len(t), bool)
+        for run in self.ground_runs:
+            on_ground |= (t >= run.t[0] - 1e-9) & (t <= run.t[-1] + 1e-9)
+        return float(d[on_ground].min()) if on_ground.any() else None
 
     def estimate_error_over_time(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The dead reckoning's error through the ground phases, at every recorded tick: t (T,) s, the body
@@ -312,7 +358,9 @@ class LoopRun:
         ``estimate``, ``start``, ``total_time_s``, ``corrections``."""
         sim = dict(self.metrics) if self.metrics is not None else {}
         sim.update(base_travel_m=self.base_travel_m, base_displacement_m=self.base_displacement_m,
-                   total_time_s=self.total_time_s, sensing=self.sensing)
+                   total_time_s=self.total_time_s, sensing=self.sensing,
+                   min_obstacle_distance_m=self.min_obstacle_distance_m,
+                   min_obstacle_distance_ground_m=self.min_obstacle_distance_ground_m)
         return {"phases": [p.as_dict() for p in self.phases],
                 "sim": sim,
                 "estimate": self.estimate_summary(),
@@ -322,7 +370,8 @@ class LoopRun:
                                    "yaw_rad": self.believed_start.yaw},
                 "total_time_s": self.total_time_s, "corrections": self.corrections,
                 "loop_planning_time_s": self.planning_time_s, "loop_notes": list(self.notes),
-                "loop_failure": self.failure, "final_approach": [dict(r) for r in self.servo]}
+                "loop_failure": self.failure, "final_approach": [dict(r) for r in self.servo],
+                "routes": [r.tolist() for r in self.routes]}
 
 
 _STEP = re.compile(r" \(\d+/\d+\)$")
@@ -445,6 +494,19 @@ class ClosedLoop:
             return p.failure
         return self._dynamics_check(p) if self.dynamics_check else None
 
+    def _straight_failure(self, goal: BasePlacement, q_bend: np.ndarray) -> str | None:
+        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal`` (it would
+        lie within the ground path's clearance of an obstacle: the gaits could not bring it there), else None."""
+        if not self.obstacles:
+            return None
+        straight = lc.straight_pose_for(self.robot, goal, q_bend)
+        d = coll.collision_check(self.robot, np.zeros((1, self.robot.n_joints)), self.obstacles, straight,
+                                 exact_within=1.0).distance[0]
+        if d < gp.CLEARANCE_M:
+            return (f"the body would lie straight at {_fmt(straight)} before its curl, {1000 * d:.0f} mm from an "
+                    "obstacle")
+        return None
+
     def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
         """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
         phases are planned successfully and pass the dynamics check, the nearest first; None if there is none."""
@@ -453,9 +515,25 @@ class ClosedLoop:
             candidate = lc.compose(goal, BasePlacement(*offset))
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
                      base_shape=q_bend, timing=self.timing)
-            if self._goal_failure(p) is None:
+            if self._goal_failure(p) is None and self._straight_failure(candidate, q_bend) is None:
                 return candidate
         return None
+
+    def _route(self, here: BasePlacement, straight_goal: BasePlacement, tolerance: lc.Tolerance,
+               routes: list[np.ndarray], say: Callable[[str], None]) -> list[tuple[BasePlacement, lc.Tolerance]]:
+        """The goals of the gaits on the way from ``here`` to ``straight_goal`` (root placements of the straight
+        body) and the tolerance of each: the goal alone when the straight legs are clear of the obstacles, else
+        the waypoints of :func:`snakehead.motion.ground_path.plan_route` (the body's middle at each, square to the
+        leg that reaches it; WAYPOINT_TOLERANCE) and the goal. The route's middle points go to ``routes``."""
+        offset = self._offset
+        route = gp.plan_route(self.robot, self.obstacles, lc.compose(here, offset), lc.compose(straight_goal, offset))
+        if route is None:
+            return [(straight_goal, tolerance)]
+        routes.append(route.waypoints.copy())
+        say(f"around the obstacles: {len(route.waypoints) - 1} legs of {np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum():.2f} m")
+        goals = [(lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(offset)),
+                  WAYPOINT_TOLERANCE) for w, h in zip(route.waypoints[1:-1], route.headings[:-1])]
+        return goals + [(straight_goal, tolerance)]
 
     # --- running ---------------------------------------------------------------------------------------
     @entry_point
@@ -534,6 +612,7 @@ class ClosedLoop:
 
         extra: list[tuple[str, float, SimResult]] = []  # the head's runs outside its plan: lift and look, servo
         servo_log: list[dict] = []
+        routes: list[np.ndarray] = []
         head_sensor = None if self.sensors is None else self.sensors.head
         encoders = None if self.sensors is None else self.sensors.encoders
 
@@ -665,6 +744,8 @@ class ClosedLoop:
                     first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
                                  timing=self.timing)
                     why = self._goal_failure(first)
+                    if why is None and first.failure is None:
+                        why = self._straight_failure(first.base, first.states[0][2])
                     if why is None:
                         goal, q_bend = first.base, first.states[0][2].copy()
                         break
@@ -707,17 +788,20 @@ class ClosedLoop:
                             tolerance=tolerance) is not None:
                 if np.abs(q_now).max() > 0.0:
                     curl(np.zeros(robot.n_joints), "uncurl")
-                for _ in range(self.max_gait_runs):
-                    step = lc.next_step(robot, est.base, straight_goal, rates, tolerance=tolerance,
-                                        frequency=self.frequency)
-                    if step is None:
-                        break
-                    before = est.base
-                    run = sim.run(state, step.gait, step.cycles, start_estimate=est)
-                    direction = {1: "+", -1: "-"}[step.gait.direction]
-                    ground(run, f"{step.gait.name} {direction} ({step.leg}, {step.cycles:.0f} x {step.scale:.2f})",
-                           "gait")
-                    rates.update(step, before, est.base, self._offset)
+                sub_goals = self._route(est.base, straight_goal, tolerance, routes, say)
+                for k, (sub_goal, sub_tolerance) in enumerate(sub_goals, start=1):
+                    leg = "" if len(sub_goals) == 1 else f"leg {k}/{len(sub_goals)}, "
+                    for _ in range(self.max_gait_runs):
+                        step = lc.next_step(robot, est.base, sub_goal, rates, tolerance=sub_tolerance,
+                                            frequency=self.frequency)
+                        if step is None:
+                            break
+                        before = est.base
+                        run = sim.run(state, step.gait, step.cycles, start_estimate=est)
+                        direction = {1: "+", -1: "-"}[step.gait.direction]
+                        ground(run, f"{step.gait.name} {direction} ({leg}{step.leg}, {step.cycles:.0f} x "
+                                    f"{step.scale:.2f})", "gait")
+                        rates.update(step, before, est.base, self._offset)
             # 3. the curl into the bending state
             if np.abs(q_bend - q_now).max() > 1e-9:
                 curl(q_bend, "curl into the bending state")
@@ -759,7 +843,7 @@ class ClosedLoop:
         return LoopRun(robot=robot, scene=self.scene, start=start, believed_start=believed, q_start=q_first,
                        phases=phases, fixes=fixes, plan=head_plan, head=head, metrics=metrics, head_t0_s=head_t0,
                        corrections=max(corrections, 0), planning_time_s=planning, notes=notes, failure=failure,
-                       fix=self.fix, sensing=self.sensing, head_extra=extra, servo=servo_log)
+                       fix=self.fix, sensing=self.sensing, head_extra=extra, servo=servo_log, routes=routes)
 
 
 def look_waypoint(robot: SnakeRobot, p: Plan, camera: sn.HeadSensor) -> int | None:

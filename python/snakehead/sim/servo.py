@@ -25,9 +25,11 @@ from .sensors import HeadReading, mean_pose, so3_log
 
 #: Frames of the head camera averaged per measurement (a 30 Hz camera for under a second).
 HEAD_FRAMES = 25
-#: The final approach stops when the measured error is below these (m, deg), or after SERVO_ITERATIONS moves.
-SERVO_POSITION_TOL_M = 0.0004
-SERVO_DIRECTION_TOL_DEG = 0.2
+#: The final approach stops when the measured error is below these (m, deg), or after SERVO_ITERATIONS moves: about
+#: twice the averaged measurement's own noise (HEAD_POSITION_NOISE_M / 5 per axis, HEAD_DIRECTION_NOISE_DEG / 5
+#: per axis), below which a correction chases the noise.
+SERVO_POSITION_TOL_M = 0.0008
+SERVO_DIRECTION_TOL_DEG = 0.3
 SERVO_ITERATIONS = 4
 #: A measured error beyond these (m, deg) is not the final approach's to correct (a first-order step of the head
 #: chain alone would swing the body): the loop reports it instead.
