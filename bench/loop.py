@@ -2,7 +2,7 @@
 MuJoCo, from random poses, on the robot's own sensors (``--sensing onboard``, the default) or with the outside fix.
 
 ``--poses`` poses (20), drawn with ``--seed``: the tail 0.5-2.5 m from the target's foot (uniform in distance and
-bearing), the body along any heading, lying straight. The target is the paper's sphere 1 (-0.0405, 0.5443, 0.3) m,
+bearing; 1.3-2.5 m for the poses with obstacles), the body along any heading, lying straight. The target is the paper's sphere 1 (-0.0405, 0.5443, 0.3) m,
 head along +y, held 1 s (``--target`` X Y Z for another). Every other pose has obstacles in the way: a wall (a
 0.8 x 0.05 x 0.3 m box) or two 0.25 m boxes, across the line from the start to where the body must lie before its
 curl, where they touch neither (nor the bending state's footprint). Per pose: the distance, the obstacles, the
@@ -34,6 +34,8 @@ from snakehead.scenes import Scene
 from snakehead.sim.loop import ClosedLoop
 
 SPHERE_1 = (-0.0405, 0.5443, 0.3)
+#: Starts with obstacles in the way are at least this far (m) from the target's foot (nearer, none fits between).
+OBSTACLE_MIN_DISTANCE_M = 1.3
 #: Obstacles must stay this far (m) from the start's body, the straight pose before the curl and the bending state.
 KEEP_OUT_M = 0.25
 
@@ -96,11 +98,11 @@ def main() -> None:
     rows = []
     t_all = time.perf_counter()
     for k in range(args.poses):
-        distance = rng.uniform(0.5, 2.5)
+        kind = ("wall", "boxes")[(k // 2) % 2] if k % 2 else "none"
+        distance = rng.uniform(0.5 if kind == "none" else OBSTACLE_MIN_DISTANCE_M, 2.5)
         bearing, heading = rng.uniform(-math.pi, math.pi, 2)
         start = BasePlacement(target[0] + distance * math.cos(bearing), target[1] + distance * math.sin(bearing),
                               heading)
-        kind = ("wall", "boxes")[(k // 2) % 2] if k % 2 else "none"
         obstacles = ([] if kind == "none" else
                      _obstacles_in_the_way(robot, start, straight_goal, q_bend, goal, rng, kind))
         if args.only is not None and k not in args.only:

@@ -145,3 +145,23 @@ def test_route_length_near_the_shortest_on_a_small_grid(robot):
     cells = gp.astar(free, grid.cell([start.x, start.y]), grid.cell([goal.x, goal.y]))
     shortest = _path_cost(cells) * grid.resolution
     assert length <= shortest * 1.15 + 0.2
+
+
+def test_route_starts_by_sidestepping_when_the_body_cannot_turn_where_it_lies(robot):
+    """A box beside the lying body, within its turning disc: the first leg sidewinds at the body's own heading,
+    its straight footprint clear of the box, to where it can turn."""
+    box = BoxObstacle([0.0, 0.45, 0.125], [0.25, 0.25, 0.25])
+    start = BasePlacement(0.0, 0.0, 0.0)
+    goal = BasePlacement(0.0, 2.5, 0.0)
+    route = gp.plan_route(robot, [box], start, goal)
+    assert route is not None
+    W, R = route.waypoints, route.clear_m
+    assert route.headings[0] == start.yaw and abs(W[1, 0] - W[0, 0]) < 1e-12  # square to the body: along y
+    assert W[1, 1] < 0  # away from the box
+    for s in np.linspace(0, 1, 10):
+        p = W[0] + s * (W[1] - W[0])
+        assert _straight_body_distance(robot, p, start.yaw, [box]) > gp.CLEARANCE_M - gp.RESOLUTION_M
+    box_outline = gp.footprints([box])
+    for a, b in zip(W[1:-2], W[2:-1]):
+        for s in np.linspace(0, 1, 100):
+            assert min(_polygon_distance(a + s * (b - a), poly) for poly in box_outline) > R - 1e-9

@@ -441,3 +441,98 @@ def test_outside_fix_keeps_the_old_behaviour(controller, disturbed):
     assert not run.servo and "final_position_error_m" not in run.metrics
     assert run.metrics["position_error_m"] < 0.002 and run.metrics["direction_error_deg"] < 1.0
     assert all(r.sensor_log is None for r in run.ground_runs)
+
+
+@pytest.mark.slow
+def test_the_loop_reproduces_its_run_from_the_sensor_stream_alone(robot, disturbed, monkeypatch):
+    """The loop reads the world only through its sensors: run it in MuJoCo once, recording what the world answered
+    to each command (the ground runs' sensor streams, the lifted body's simulations); then run the controller
+    alone against a stand-in that replays those answers (no MuJoCo world: every estimate recomputed from the
+    recorded sensor stream, each command checked against the recorded one). Same commands, same estimates, same
+    plans, same corrections. (The controller's own dynamics check of a plan -- its internal model, not the world --
+    still simulates.)"""
+    import dataclasses
+
+    from snakehead import HeadController
+    from snakehead.sim import loop as loop_mod
+    from snakehead.sim.gaits import replay_estimate
+    from snakehead.sim.loop import ClosedLoop
+
+    scene = disturbed[0].scene
+    real = loop_mod.simulate_trajectory
+    world: list = []
+
+    def recording(robot, t, q, base=None, *args, state=None, **kw):
+        r = real(robot, t, q, base, *args, state=state, **kw)
+        if state is not None:  # the world moving the lifted body
+            world.append((np.array(t), np.array(q), r))
+        return r
+
+    monkeypatch.setattr(loop_mod, "simulate_trajectory", recording)
+    first = ClosedLoop(scene, controller=HeadController(robot, seed=1))
+    nominal = first.straight_start()
+    start = lc.compose(nominal, BasePlacement(0.0, 0.1, math.radians(20.0)))
+    recorded = first.run(start, believed_start=nominal)
+    assert recorded.success and world
+
+    class ReplayedWorld:
+        """Stands for the GaitSimulator: each command answered by the recorded run, its estimate recomputed from
+        the recorded sensor stream alone."""
+
+        def __init__(self, estimator, runs):
+            self.robot, self.estimator, self.runs = robot, estimator, list(runs)
+            self.q, self.R = runs[0].sensor_log.q0.copy(), runs[0].sensor_log.R0.copy()
+
+        def lying(self, base, q):
+            from snakehead.sim.tracking import SimState
+
+            return SimState(np.zeros(0), np.zeros(0), 0.0)  # the start's clock; the replay needs no world state
+
+        def restore(self, state):
+            pass
+
+        def reset_attitude(self, R):
+            pass
+
+        def measured_joints(self):
+            return self.q.copy()
+
+        def measured_attitude(self):
+            return self.R.copy()
+
+        def _answer(self, start_estimate, same_command):
+            rec = self.runs.pop(0)
+            log = rec.sensor_log
+            assert same_command(rec)
+            assert log.start_xy.tolist() == [start_estimate.base.x, start_estimate.base.y]
+            assert log.start_yaw == start_estimate.base.yaw
+            estimate, self.R = replay_estimate(robot, log)
+            self.q = log.q[-1].copy()
+            return dataclasses.replace(rec, estimate=estimate)
+
+        def run(self, state, gait, cycles, *, start_estimate=None, **kw):
+            return self._answer(start_estimate, lambda rec: rec.gait == gait and rec.cycles == cycles)
+
+        def run_path(self, state, q_path, duration_s, *, start_estimate=None, name="path", **kw):
+            return self._answer(start_estimate, lambda rec: rec.name == name)
+
+    def replaying(robot, t, q, base=None, *args, state=None, **kw):
+        if state is None:  # the controller's own model of a plan
+            return real(robot, t, q, base, *args, state=state, **kw)
+        t0, q0, r = world.pop(0)
+        np.testing.assert_array_equal(t, t0)
+        np.testing.assert_array_equal(q, q0)
+        return r
+
+    monkeypatch.setattr(loop_mod, "simulate_trajectory", replaying)
+    second = ClosedLoop(scene, controller=HeadController(robot, seed=1))
+    second.simulator = ReplayedWorld(second.simulator.estimator, recorded.ground_runs)
+    replayed = second.run(start, believed_start=nominal)
+    assert not world and not second.simulator.runs  # every answer used
+    assert [(p.name, p.kind, p.t0_s, p.t1_s) for p in replayed.phases] == \
+        [(p.name, p.kind, p.t0_s, p.t1_s) for p in recorded.phases]
+    for a, b in zip(replayed.ground_runs, recorded.ground_runs):
+        assert np.array_equal(a.estimate.root, b.estimate.root)
+    assert replayed.fixes == recorded.fixes and replayed.servo == recorded.servo
+    assert np.array_equal(replayed.plan.q, recorded.plan.q)
+    assert replayed.metrics == recorded.metrics

@@ -232,6 +232,26 @@ def half_width(robot: SnakeRobot) -> float:
     return float(np.abs(robot.hull_points(frames)[..., 1]).max())
 
 
+def _sidestep(grid: ClearanceGrid, middle: BasePlacement, length: float, radius: float, side: float
+              ) -> np.ndarray | None:
+    """Where the body lying straight with its middle at ``middle`` can turn (``radius`` clear), reached by
+    sidewinding square to its axis at its own heading with its centre line ``side`` clear all the way: the middle
+    itself when it can turn there, else the nearest such point along its across-axis (MAX_STAGING_M at most), or
+    None."""
+    m = np.array([middle.x, middle.y])
+    if grid.clearance_at(m)[0] > radius:
+        return m
+    n = np.array([-math.sin(middle.yaw), math.cos(middle.yaw)])
+    step = grid.resolution
+    for s in np.arange(step, MAX_STAGING_M, step):
+        for sign in (1.0, -1.0):
+            p = m + sign * s * n
+            if grid.clearance_at(p)[0] > radius and all(
+                    body_clear(grid, m + sign * t * n, middle.yaw, length, side) for t in np.arange(0.0, s + 1e-9, step)):
+                return p
+    return None
+
+
 def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePlacement, goal_middle: BasePlacement,
                *, clearance: float = CLEARANCE_M, resolution: float = RESOLUTION_M) -> Route | None:
     """The route of the straight body's middle from ``start_middle`` to ``goal_middle`` (placements of the virtual
@@ -252,46 +272,40 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
     corner = g + ((a - g) @ (axis[::-1] * [-1.0, 1.0])) * (axis[::-1] * [-1.0, 1.0])
     if segment_clear(grid, a, corner, R) and segment_clear(grid, corner, g, R):
         return None
-    # the last leg: from a staging point on the goal's across-axis, the body at the goal's heading
-    n = np.array([-math.sin(goal_middle.yaw), math.cos(goal_middle.yaw)])
-    staging = None
-    if grid.clearance_at(g)[0] > R:
-        staging = g
-    else:
-        for s in sorted(np.arange(resolution, MAX_STAGING_M, resolution).tolist() * 2, key=abs):
-            for sign in (1.0, -1.0):
-                p = g + sign * s * n
-                if grid.clearance_at(p)[0] > R and all(
-                        body_clear(grid, g + sign * t * n, goal_middle.yaw, L, side)
-                        for t in np.arange(0.0, s + 1e-9, resolution)):
-                    staging = p
-                    break
-            if staging is not None:
-                break
-    if staging is None:
+    # the last leg: from a staging point on the goal's across-axis, the body at the goal's heading; the first, when
+    # the body cannot turn where it lies: sidewinding at its own heading to where it can
+    staging = _sidestep(grid, goal_middle, L, R, side)
+    escape = _sidestep(grid, start_middle, L, R, side)
+    if staging is None or escape is None:
         return None
+    staged, escaped = not np.array_equal(staging, g), not np.array_equal(escape, a)
     # the grid path kept DETOUR_M farther out where it costs little, so that its shortcuts (chords of the rounded
     # corners, each a turn and a run) are few
     clear = grid.clearance
-    cells = astar(clear > R, grid.cell(a), grid.cell(staging), np.where(clear > R + DETOUR_M, 1.0, DETOUR_COST))
+    cells = astar(clear > R, grid.cell(escape), grid.cell(staging), np.where(clear > R + DETOUR_M, 1.0, DETOUR_COST))
     if cells is None:
         return None
-    points = [a] + [grid.point(c) for c in cells[1:-1]] + [staging]
+    points = [escape] + [grid.point(c) for c in cells[1:-1]] + [staging]
     points = shortcut(grid, points, R)
+    if escaped:
+        points.insert(0, a)
     # a leg shorter than MIN_LEG_M (the grid's snap next to the staging point) is no leg: its turn costs a run
-    points = [p for k, p in enumerate(points) if k in (0, len(points) - 1)
-              or float(np.linalg.norm(points[k + 1] - p)) >= MIN_LEG_M]
-    if staging is not g:
+    keep = {0, len(points) - 1} | ({1} if escaped else set())
+    points = [p for k, p in enumerate(points) if k in keep or float(np.linalg.norm(points[k + 1] - p)) >= MIN_LEG_M]
+    if staged:
         points.append(g)
     waypoints = np.array(points)
     headings = []
     for k in range(1, len(waypoints)):
         d = waypoints[k] - waypoints[k - 1]
-        if staging is not g and k == len(waypoints) - 1:
+        if staged and k == len(waypoints) - 1:
             headings.append(goal_middle.yaw)
+            continue
+        if escaped and k == 1:
+            headings.append(start_middle.yaw)
             continue
         square = math.atan2(d[1], d[0]) + 0.5 * math.pi  # the body square to the leg: either of two headings
         prev = headings[-1] if headings else start_middle.yaw
         options = (square, square + math.pi)
         headings.append(min(options, key=lambda h: abs(math.remainder(h - prev, 2 * math.pi))))
-    return Route(waypoints, np.array(headings), staging is not g, R)
+    return Route(waypoints, np.array(headings), staged, R)

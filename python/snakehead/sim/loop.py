@@ -65,7 +65,11 @@ the pose estimated after the last one, as the robot would do it.
 
 The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/curl/lift/move/hold, ``t0_s``,
 ``t1_s``), the estimate's error after every ground phase, how far the tail travelled, and the head's errors.
-Obstacles are in the simulation all along, but the locomotion does not steer around them (it goes straight).
+Obstacles are in the simulation all along. The locomotion goes around them: when the gaits' straight legs would
+come within the body's turning disc of one, step 2 follows a route of the body's middle planned around their
+footprints (:func:`snakehead.motion.ground_path.plan_route`), leg by leg, and a goal whose straight pose before
+the curl would touch one is refused in step 1. ``sim.min_obstacle_distance_m`` is the body's smallest distance to
+any obstacle over the run. (The curl's own sweep on the ground is not checked against them.)
 """
 from __future__ import annotations
 
