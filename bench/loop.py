@@ -2,9 +2,9 @@
 MuJoCo, from random poses, on the robot's own sensors (``--sensing onboard``, the default) or with the outside fix.
 
 ``--poses`` poses (20), drawn with ``--seed``: the tail 0.5-2.5 m from the target's foot (uniform in distance and
-bearing; 1.3-2.5 m for the poses with obstacles), the body along any heading, lying straight. The target is the paper's sphere 1 (-0.0405, 0.5443, 0.3) m,
+bearing; 1.8-2.5 m for the poses with obstacles: a wall between needs room beside the 1.4 m body), the body along any heading, lying straight. The target is the paper's sphere 1 (-0.0405, 0.5443, 0.3) m,
 head along +y, held 1 s (``--target`` X Y Z for another). Every other pose has obstacles in the way: a wall (a
-0.8 x 0.05 x 0.3 m box) or two 0.25 m boxes, across the line from the start to where the body must lie before its
+0.8 x 0.05 x 0.3 m box, 0.5 m long where that does not fit) or two 0.25 m boxes, across the line from the start to where the body must lie before its
 curl, where they touch neither (nor the bending state's footprint). Per pose: the distance, the obstacles, the
 phases (gait runs, corrections), the tail's travel, the simulated time, the dead reckoning's largest error, the
 fix's error, the head's error in MuJoCo after the final approach (position mm, direction deg; the head phases'
@@ -35,9 +35,9 @@ from snakehead.sim.loop import ClosedLoop
 
 SPHERE_1 = (-0.0405, 0.5443, 0.3)
 #: Starts with obstacles in the way are at least this far (m) from the target's foot (nearer, none fits between).
-OBSTACLE_MIN_DISTANCE_M = 1.3
+OBSTACLE_MIN_DISTANCE_M = 1.8
 #: Obstacles must stay this far (m) from the start's body, the straight pose before the curl and the bending state.
-KEEP_OUT_M = 0.25
+KEEP_OUT_M = 0.15
 
 
 def _obstacles_in_the_way(robot, start: BasePlacement, straight_goal: BasePlacement, q_bend, goal: BasePlacement,
@@ -51,10 +51,11 @@ def _obstacles_in_the_way(robot, start: BasePlacement, straight_goal: BasePlacem
     n = np.array([-d[1], d[0]]) / (np.linalg.norm(d) + 1e-12)
     yaw = math.atan2(n[1], n[0])
     zero = np.zeros((1, robot.n_joints))
-    for _ in range(40):
-        c = p + rng.uniform(0.3, 0.7) * d
+    for attempt in range(120):
+        c = p + rng.uniform(0.2, 0.8) * d + rng.uniform(-0.2, 0.2) * n
         if kind == "wall":
-            obs = [BoxObstacle.from_yaw([c[0], c[1], 0.15], [0.8, 0.05, 0.3], yaw)]
+            length = 0.8 if attempt < 60 else 0.5
+            obs = [BoxObstacle.from_yaw([c[0], c[1], 0.15], [length, 0.05, 0.3], yaw)]
         else:
             s = rng.uniform(0.25, 0.4)
             obs = [BoxObstacle.from_yaw([*(c + s * n), 0.125], [0.25, 0.25, 0.25], yaw),
@@ -76,6 +77,7 @@ def main() -> None:
     ap.add_argument("--sensing", choices=("onboard", "outside-fix"), default="onboard")
     ap.add_argument("--only", type=int, nargs="*", default=None, help="run only these pose numbers")
     ap.add_argument("--verbose", action="store_true", help="the loop's steps on stderr")
+    ap.add_argument("--dry", action="store_true", help="only draw the poses and their obstacles")
     args = ap.parse_args()
     robot = ROBOTS[args.robot][1]()
     controller = HeadController(robot, seed=1)
@@ -103,12 +105,16 @@ def main() -> None:
         bearing, heading = rng.uniform(-math.pi, math.pi, 2)
         start = BasePlacement(target[0] + distance * math.cos(bearing), target[1] + distance * math.sin(bearing),
                               heading)
-        obstacles = ([] if kind == "none" else
-                     _obstacles_in_the_way(robot, start, straight_goal, q_bend, goal, rng, kind))
+        obstacles = ([] if kind == "none" else  # their own stream: the poses do not depend on them
+                     _obstacles_in_the_way(robot, start, straight_goal, q_bend, goal,
+                                           np.random.default_rng([args.seed, k]), kind))
         if args.only is not None and k not in args.only:
             continue
         label = kind if obstacles or kind == "none" else f"{kind}: none fits"
         head0 = f"| {k} | ({start.x:.2f}, {start.y:.2f}), {math.degrees(heading):.0f} | {distance:.2f} | {label} |"
+        if args.dry:
+            print(head0)
+            continue
         scene = Scene.from_targets([(target, np.array([0.0, 1.0, 0.0]))], name="target", hold_s=1.0,
                                    obstacles=obstacles)
         loop = ClosedLoop(scene, controller=controller, sensing=sensing)
