@@ -536,3 +536,17 @@ def test_the_loop_reproduces_its_run_from_the_sensor_stream_alone(robot, disturb
     assert replayed.fixes == recorded.fixes and replayed.servo == recorded.servo
     assert np.array_equal(replayed.plan.q, recorded.plan.q)
     assert replayed.metrics == recorded.metrics
+
+
+def test_sensing_option_of_the_command_line():
+    """--sensing reaches the pipeline's settings (and so the loop), both spellings; a wrong one is a usage error."""
+    from snakehead.app.cli import _settings, build_parser
+
+    parser = build_parser()
+    for command in ("plan", "demo"):
+        extra = ["--position", "0", "0.5", "0.3", "--direction", "0", "1", "0"] if command == "plan" else []
+        args = parser.parse_args([command, *extra, "--sensing", "outside-fix"])
+        assert _settings(args).sensing == "outside fix" and _settings(args).as_dict()["sensing"] == "outside fix"
+        assert _settings(parser.parse_args([command, *extra])).sensing == "onboard"
+        with pytest.raises(SystemExit):
+            parser.parse_args([command, *extra, "--sensing", "gps"])
