@@ -544,7 +544,7 @@ def test_sensing_option_of_the_command_line():
 
     parser = build_parser()
     for command in ("plan", "demo"):
-        extra = ["--position", "0", "0.5", "0.3", "--direction", "0", "1", "0"] if command == "plan" else []
+        extra = ["--out", "x"] + (["--position", "0", "0.5", "0.3", "--direction", "0", "1", "0"] if command == "plan" else [])
         args = parser.parse_args([command, *extra, "--sensing", "outside-fix"])
         assert _settings(args).sensing == "outside fix" and _settings(args).as_dict()["sensing"] == "outside fix"
         assert _settings(parser.parse_args([command, *extra])).sensing == "onboard"
