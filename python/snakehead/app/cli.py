@@ -190,7 +190,16 @@ def _settings(args: argparse.Namespace) -> Any:
     from .pipeline import Settings
 
     return Settings(method=args.method, seed=args.seed, fast=args.fast, simulate=not args.no_sim,
-                    relocation=not args.no_relocation)
+                    relocation=not args.no_relocation,
+                    sensing=getattr(args, "sensing", "onboard").replace("outside-fix", "outside fix"))
+
+
+def _add_sensing_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--sensing", choices=("onboard", "outside-fix"), default="onboard",
+                   help="with --start: what the closed loop knows of where it is. onboard (default): the robot's "
+                        "own sensors (joint encoders, an IMU, contact odometry, a head camera that sees markers at "
+                        "the targets); outside-fix: perfect joints and IMU and one outside measurement of the neck's "
+                        "base frame once the body rests in the bending state")
 
 
 def _start(args: argparse.Namespace, paper_default: bool) -> Any:
@@ -531,6 +540,7 @@ def build_parser() -> argparse.ArgumentParser:
                            "bare --start lies where the curl alone brings the base to the scene's placement; "
                            "--start X Y YAW puts the tail at (X, Y) m with the body along YAW rad. Adds "
                            "NAME_path.png and NAME_loop.gif, and phases to the report")
+    _add_sensing_option(demo)
     p = _planning_parser(sub, "plan", _plan, "head targets: --position/--direction, or a scene file",
                          "Plan the head from the bending state on the ground to POSITION pointing along DIRECTION "
                          "(world frame, z up, ground at z = 0), or through the targets of a scene file (--scene; "
@@ -548,6 +558,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(world) and run the closed loop in MuJoCo: gaits that move the body where the targets need "
                         "its base, the curl into the bending state, the head phases. Adds NAME_path.png and "
                         "NAME_loop.gif, and phases to the report")
+    _add_sensing_option(p)
 
     p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
                        description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "

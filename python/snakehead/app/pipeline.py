@@ -69,7 +69,7 @@ class Settings:
     """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
     figures: write figures, the animation and the 3-D viewer's page; parallel: draw what needs only the plan in a
     second process while MuJoCo simulates (Linux); relocation: let the plan move the base (by locomotion, first)
-    when the targets need it."""
+    when the targets need it; sensing: the closed loop's (:data:`snakehead.sim.loop.SENSING`, with ``--start``)."""
 
     method: str = "rotated"
     seed: int | None = 1
@@ -78,11 +78,12 @@ class Settings:
     figures: bool = True
     parallel: bool = True
     relocation: bool = True
+    sensing: str = "onboard"
 
     def as_dict(self) -> dict:
         s = FAST if self.fast else NORMAL
         return {"method": self.method, "seed": self.seed, "fast": bool(self.fast), "animation_frames": s["max_frames"],
-                "relocation": bool(self.relocation),
+                "relocation": bool(self.relocation), "sensing": self.sensing,
                 "simulation": bool(self.simulate and mujoco_available())}
 
 
@@ -195,11 +196,18 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
 #: state alone brings the base to the scene's placement (Fig. 17a before 17b).
 PAPER_START = "paper"
 
-#: What every report of a closed loop says about how it closes (snakehead.sim.loop, step 5).
-LOOP_ASSUMPTION = ("closed loop: gaits and curls are steered by dead reckoning (joint angles, one IMU, friction-balance "
-                   "contact odometry); once the body rests in the bending state, an outside measurement of the pose of "
-                   "the neck's base frame (the paper's 'obtained in time'; here MuJoCo's, with {noise}) fixes the "
-                   "base's placement before the head phases are planned")
+#: What every report of a closed loop says about how it closes (snakehead.sim.loop, step 5), by its sensing.
+LOOP_ASSUMPTION = ("closed loop on the robot's own sensors (snakehead.sim.sensors): gaits and curls are steered by dead "
+                   "reckoning from 12-bit joint encoders, one MEMS IMU (gyro noise and bias random walk, "
+                   "accelerometer noise; an attitude filter) and friction-balance contact odometry; a head camera "
+                   "that sees a fiducial marker 0.15 m ahead of each target ({camera}) fixes the body's pose once "
+                   "the head, on its way up, faces one, and the head's final approach is corrected on its "
+                   "measurement of the last target; nothing outside the robot tells it where it is")
+LOOP_ASSUMPTION_OUTSIDE_FIX = (
+    "closed loop with an outside fix (sensing 'outside fix'): gaits and curls are steered by dead reckoning (perfect "
+    "joint angles, one perfect IMU, friction-balance contact odometry); once the body rests in the bending state, an "
+    "outside measurement of the pose of the neck's base frame (the paper's 'obtained in time'; here MuJoCo's, with "
+    "{noise}) fixes the base's placement before the head phases are planned")
 
 
 def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress,
@@ -213,7 +221,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
 
     s = FAST if settings.fast else NORMAL
     name = scene.name
-    loop = ClosedLoop(scene, controller=controller)
+    loop = ClosedLoop(scene, controller=controller, sensing=settings.sensing)
     if isinstance(start, str):
         if start != PAPER_START:
             raise InputError(f"start must be a BasePlacement or {PAPER_START!r}, got {start!r}")
@@ -225,8 +233,11 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
         run = loop.run(begin, progress=lambda text: progress.say(f"{name}: {text}"))
     if run.metrics is not None:
         m = run.metrics
+        final = ("" if "final_position_error_m" not in m else
+                 f"; after the final approach {1000 * m['final_position_error_m']:.2f} mm / "
+                 f"{m['final_direction_error_deg']:.2f} deg")
         progress.say(f"{name}: simulated head error {1000 * m['position_error_m']:.2f} mm / "
-                     f"{m['direction_error_deg']:.2f} deg; ZMP inside: {m['zmp_inside']}; the tail travelled "
+                     f"{m['direction_error_deg']:.2f} deg{final}; ZMP inside: {m['zmp_inside']}; the tail travelled "
                      f"{run.base_travel_m:.2f} m in {run.total_time_s:.1f} s")
     else:
         progress.say(f"{name}: the loop did not reach the head phases: {run.failure}")
@@ -258,9 +269,17 @@ def loop_entry(run: LoopRun, files: Sequence[str] = ()) -> dict:
     entry.update(part)
     entry["success"] = bool(entry["success"] and run.success)
     entry["failure"] = run.failure or entry.get("failure")
-    noise = ("no fix" if run.fix is None else
-             f"{1000 * run.fix.position_noise_m:g} mm and {run.fix.yaw_noise_deg:g} deg of noise")
-    entry["notes"] = list(entry.get("notes") or []) + list(run.notes) + [LOOP_ASSUMPTION.format(noise=noise)]
+    if run.sensing == "onboard":
+        from ..sim import sensors
+
+        camera = (f"{1000 * sensors.HEAD_POSITION_NOISE_M:g} mm and {sensors.HEAD_DIRECTION_NOISE_DEG:g} deg of noise "
+                  f"per frame, {2 * sensors.HEAD_HALF_FOV_DEG:g} deg field of view, occluded by the obstacles")
+        assumption = LOOP_ASSUMPTION.format(camera=camera)
+    else:
+        noise = ("no fix" if run.fix is None else
+                 f"{1000 * run.fix.position_noise_m:g} mm and {run.fix.yaw_noise_deg:g} deg of noise")
+        assumption = LOOP_ASSUMPTION_OUTSIDE_FIX.format(noise=noise)
+    entry["notes"] = list(entry.get("notes") or []) + list(run.notes) + [assumption]
     entry["files"] = list(files)
     return rep.jsonable(entry)
 

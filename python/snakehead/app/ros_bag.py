@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from .._errors import InternalError, invariant
+from .._errors import invariant
 from .._files import atomic_open, write_text_atomic
 from ..motion.interpolation import CONTROL_PERIOD
 from . import ros_messages as msgs
@@ -352,20 +352,10 @@ def _loop_tracks(run: LoopRun) -> tuple[np.ndarray, np.ndarray]:
     phases' by finite differences of the recorded joints) and the root frame's estimated world pose (T, 4, 4): the
     ground phases' dead reckoning (NaN where a run kept none), in the head phases the placement they were planned
     from."""
-    robot = run.robot
-    qd, est = [], []
-    for r in run.ground_runs:
-        qd.append(np.gradient(r.q, r.t, axis=0) if len(r.t) > 1 else np.zeros_like(r.q))
-        est.append(r.root_estimate if r.root_estimate is not None else np.full((len(r.t), 4, 4), np.nan))
-    if run.head is not None and run.head.root_pose is not None:
-        planned = run.plan
-        if planned is None:
-            raise InternalError("a loop's head phases were simulated without their plan")
-        qd.append(run.head.qdot)
-        est.append(np.repeat(robot.root_pose(planned.base)[None], len(run.head.t), axis=0))
-    if not qd:
-        return np.zeros((0, robot.n_joints)), np.zeros((0, 4, 4))
-    return np.concatenate(qd), np.concatenate(est)
+    segments = run.segments()
+    if not segments:
+        return np.zeros((0, run.robot.n_joints)), np.zeros((0, 4, 4))
+    return np.concatenate([seg["qd"] for seg in segments]), np.concatenate([seg["estimate"] for seg in segments])
 
 
 def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:

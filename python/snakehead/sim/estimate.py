@@ -273,3 +273,46 @@ class BodyPoseEstimator:
                 origin[:2] += weights @ shift[:, :2] / weights.sum()
         origin[2] = -points[:, 2].min()
         self._remember(W, R_root, origin, points)
+
+
+#: Time constant (s) with which the attitude filter pulls its tilt towards the accelerometer's gravity.
+TILT_TIME_CONSTANT_S = 2.0
+
+
+class AttitudeFilter:
+    """The IMU link's world orientation from the IMU's streams alone (:class:`snakehead.sim.sensors.Imu`): the gyro
+    integrated (R <- R exp(omega dt)), the tilt pulled towards the accelerometer's gravity with time constant
+    ``tilt_time_constant_s`` (a complementary filter, Mahony et al., IEEE TAC 2008: omega + k a x R^T z). The
+    heading has no reference: it drifts with the gyro's noise and bias (the estimator keeps it from the start's)."""
+
+    def __init__(self, tilt_time_constant_s: float = TILT_TIME_CONSTANT_S) -> None:
+        if not (np.isfinite(tilt_time_constant_s) and tilt_time_constant_s > 0):
+            raise InputError(f"tilt_time_constant_s must be > 0, got {tilt_time_constant_s!r}")
+        self.gain = 1.0 / float(tilt_time_constant_s)
+        self.R = np.eye(3)
+
+    def reset(self, accel: npt.ArrayLike, yaw: float = 0.0) -> np.ndarray:
+        """Start level with the accelerometer's gravity ``accel`` (3,) (read at rest), heading ``yaw`` rad."""
+        from .sensors import so3_exp
+
+        up = finite_array(accel, "accel", (3,))
+        up = up / np.linalg.norm(up)  # the world's z in the IMU's axes: R^T z
+        z = np.array([0.0, 0.0, 1.0])
+        axis = np.cross(up, z)  # the rotation taking R^T z to z, in the IMU's axes: the tilt
+        s, c = float(np.linalg.norm(axis)), float(up @ z)
+        tilt = so3_exp(axis / s * math.atan2(s, c)) if s > 1e-12 else np.eye(3)
+        Rz = np.array([[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+        self.R = Rz @ tilt
+        return self.R.copy()
+
+    def update(self, gyro: npt.ArrayLike, accel: npt.ArrayLike, dt: float) -> np.ndarray:
+        """One control period of ``dt`` s: the new orientation (3, 3)."""
+        from .sensors import so3_exp
+
+        a = np.asarray(accel, float)
+        norm = float(np.linalg.norm(a))
+        w = np.asarray(gyro, float)
+        if norm > 1e-9:
+            w = w + self.gain * np.cross(a / norm, self.R[2])  # R^T z is R's third row
+        self.R = self.R @ so3_exp(w * dt)
+        return self.R.copy()

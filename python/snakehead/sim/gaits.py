@@ -29,7 +29,8 @@ import numpy as np
 from .._validate import finite_array, finite_float, joint_vector
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..motion.gaits import Gait, virtual_chassis
-from .estimate import BodyPose, BodyPoseEstimator, ShapePoints, pose_error
+from .estimate import AttitudeFilter, BodyPose, BodyPoseEstimator, ShapePoints, pose_error
+from .sensors import OnboardSensors
 from .gains import default_gains
 from .mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
 from .tracking import SimState, _gains
@@ -37,6 +38,38 @@ from .tracking import SimState, _gains
 import numpy.typing as npt
 from typing import Any
 from .._errors import InputError, InputTypeError
+
+
+@dataclass
+class SensorLog:
+    """What the estimator of a ground run read (``sensing="onboard"``): where it started (``q0`` the encoders,
+    ``R0`` the attitude filter's orientation, ``start_xy`` / ``start_yaw`` the pose it was told), then every control
+    tick's encoders ``q`` (K, n) rad, gyro (K, 3) rad/s and accelerometer (K, 3) m/s^2, ``dt`` s apart;
+    ``imu_link`` and ``odometry`` as the estimator's. :func:`replay_estimate` gives the estimate back from it alone."""
+
+    q0: np.ndarray
+    R0: np.ndarray
+    start_xy: np.ndarray
+    start_yaw: float
+    q: np.ndarray
+    gyro: np.ndarray
+    accel: np.ndarray
+    dt: float
+    imu_link: str
+    odometry: str
+    tilt_time_constant_s: float
+
+
+def replay_estimate(robot: SnakeRobot, log: SensorLog) -> tuple[BodyPose, np.ndarray]:
+    """The estimate at the end of a ground run from its :class:`SensorLog` alone (no simulator): the pose and the
+    attitude filter's orientation (3, 3)."""
+    estimator = BodyPoseEstimator(robot, log.imu_link, odometry=log.odometry)
+    attitude = AttitudeFilter(log.tilt_time_constant_s)
+    attitude.R = log.R0.copy()
+    estimator.reset(log.q0, attitude.R, log.start_xy, log.start_yaw)
+    for k in range(len(log.q)):
+        estimator.update(log.q[k], attitude.update(log.gyro[k], log.accel[k], log.dt))
+    return estimator.pose(), attitude.R.copy()
 
 
 @dataclass
@@ -72,6 +105,7 @@ class GaitRun:
     root_truth: np.ndarray | None = None
     root_estimate: np.ndarray | None = None
     start_estimate: BodyPose | None = None
+    sensor_log: SensorLog | None = None
 
     @property
     def estimate_error(self) -> dict:
@@ -112,14 +146,17 @@ class GaitSimulator:
     kp, kd: PD gains (default: derived per joint, :func:`snakehead.sim.gains.default_gains`); imu_link: the frame
     carrying the IMU of the pose estimate (default: mid-body); imu_yaw_drift_deg_per_s: a gyro's heading drift
     (deg/s; the IMU reads the link's true orientation turned by drift x time about the vertical; default 0, a
-    perfect attitude); odometry: the estimate's (:data:`snakehead.sim.estimate.ODOMETRY`); other keywords
+    perfect attitude); odometry: the estimate's (:data:`snakehead.sim.estimate.ODOMETRY`); sensors: the robot's own
+    (:class:`snakehead.sim.sensors.OnboardSensors`: the estimate then reads the encoders and the IMU's gyro and
+    accelerometer through an :class:`~snakehead.sim.estimate.AttitudeFilter`, and every run keeps a
+    :class:`SensorLog`; None, the default: the true joint angles and the IMU link's true orientation); other keywords
     (friction, torque_limit, obstacles, armature, joint_damping, timestep...) go to :func:`snakehead.sim.build_spec`.
     """
 
     def __init__(self, robot: SnakeRobot, *, kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None,
                  imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
                  control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
-                 odometry: str = "friction", **model_options: Any) -> None:
+                 odometry: str = "friction", sensors: OnboardSensors | None = None, **model_options: Any) -> None:
         self._mj = _mujoco()
         self.robot = as_robot(robot)
         n = self.robot.n_joints
@@ -145,6 +182,10 @@ class GaitSimulator:
         self._imu_body = int(self.sim.body_ids[self.estimator.imu_index])
         self._points = ShapePoints(self.robot)
         self._shape_bodies = self.sim.body_ids[self._points.links]
+        if sensors is not None and not isinstance(sensors, OnboardSensors):
+            raise InputTypeError(f"sensors must be an OnboardSensors or None, got {type(sensors).__name__}")
+        self.sensors = sensors
+        self.attitude = AttitudeFilter()
 
     # --- states -------------------------------------------------------------------------------------
     def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
@@ -160,6 +201,10 @@ class GaitSimulator:
         for _ in range(int(round(settle_s / self.control_dt))):
             self._step(q, np.zeros_like(q))
         self.time = 0.0
+        if self.sensors is not None:  # the IMU starts; the attitude levels itself on gravity, heading 0
+            self.sensors.imu.start(self._imu_true())
+            _, accel = self.sensors.imu.read(self._imu_true(), self.control_dt)
+            self.attitude.reset(accel)
         return self._snapshot(0.0)
 
     def _snapshot(self, time: float) -> SimState:
@@ -184,9 +229,37 @@ class GaitSimulator:
         """The joint angles now (the encoders)."""
         return self.data.qpos[self.sim.qpos_adr].copy()
 
+    def _imu_true(self) -> np.ndarray:
+        return self.data.xmat[self._imu_body].reshape(3, 3).copy()
+
+    def measured_joints(self) -> np.ndarray:
+        """The joint angles as the robot knows them: the encoders' reading with sensors, else the true angles."""
+        q = self.joint_angles()
+        return q if self.sensors is None else self.sensors.encoders.read(q)
+
+    def measured_attitude(self) -> np.ndarray:
+        """The IMU link's orientation as the robot knows it: the attitude filter's with sensors, else
+        :meth:`imu_orientation`."""
+        return self.imu_orientation() if self.sensors is None else self.attitude.R.copy()
+
+    def _sense(self) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None]:
+        """One control period's readings: the joints, the attitude and (with sensors) the IMU's (gyro, accel)."""
+        if self.sensors is None:
+            return self.joint_angles(), self.imu_orientation(), None
+        gyro, accel = self.sensors.imu.read(self._imu_true(), self.control_dt)
+        return self.measured_joints(), self.attitude.update(gyro, accel, self.control_dt), (gyro, accel)
+
+    def reset_attitude(self, R: npt.ArrayLike) -> None:
+        """The robot learnt its IMU link's orientation ``R`` (3, 3) otherwise (a fix): the attitude filter starts
+        from it, and the IMU from the link's orientation now (after a motion simulated elsewhere)."""
+        if self.sensors is not None:
+            self.sensors.imu.start(self._imu_true())
+            self.attitude.R = np.array(R, float).reshape(3, 3)
+
     def imu_orientation(self) -> np.ndarray:
-        """What the IMU reads now: its link's world orientation (3, 3), turned about the vertical by the drift."""
-        R = self.data.xmat[self._imu_body].reshape(3, 3).copy()
+        """What a perfect IMU reads now: its link's world orientation (3, 3), turned about the vertical by the
+        drift."""
+        R = self._imu_true()
         if self.imu_yaw_drift:
             a = self.imu_yaw_drift * self.time
             c, s = math.cos(a), math.sin(a)
@@ -255,7 +328,7 @@ class GaitSimulator:
         if duration_s <= 0:
             raise InputError(f"duration_s must be > 0, got {duration_s!r}")
         self.restore(state)
-        q_now = self.joint_angles()
+        q_now = self.measured_joints()
         if np.abs(q_path[0] - q_now).max() > 1e-9:
             q_path = np.vstack([q_now, q_path])
         ticks = max(int(round(duration_s / self.control_dt)), 1)
@@ -289,14 +362,19 @@ class GaitSimulator:
 
         start_truth = truth = self.true_pose()
         est0 = start_truth if start_estimate is None else start_estimate
-        self.estimator.reset(self.joint_angles(), self.imu_orientation(), (est0.base.x, est0.base.y), est0.base.yaw)
+        q0, R0 = self.measured_joints(), self.measured_attitude()
+        self.estimator.reset(q0, R0, (est0.base.x, est0.base.y), est0.base.yaw)
         estimate = self.estimator.pose()
+        readings: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         rec: dict[str, list] = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact", "rt",
                                                 "re")}
         for k in range(len(q_plan)):
             self._step(q_plan[k], qd_plan[k])
             self.time = state.time + (k + 1) * self.control_dt
-            self.estimator.update(self.joint_angles(), self.imu_orientation())
+            q_sensed, R_sensed, imu = self._sense()
+            if imu is not None:
+                readings.append((q_sensed, *imu))
+            self.estimator.update(q_sensed, R_sensed)
             if k % record_every == 0 or k == len(q_plan) - 1:
                 estimate = self.estimator.pose()
                 truth = self.true_pose(truth)
@@ -315,6 +393,13 @@ class GaitSimulator:
             if not np.all(np.isfinite(self.data.qpos)):
                 raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {name} run")
         end = self._snapshot(self.time)
+        log = None
+        if self.sensors is not None:
+            log = SensorLog(q0=q0, R0=R0, start_xy=np.array([est0.base.x, est0.base.y]), start_yaw=est0.base.yaw,
+                            q=np.array([r[0] for r in readings]), gyro=np.array([r[1] for r in readings]),
+                            accel=np.array([r[2] for r in readings]), dt=self.control_dt,
+                            imu_link=self.estimator.imu_link, odometry=self.estimator.odometry,
+                            tilt_time_constant_s=1.0 / self.attitude.gain)
         arr = {k: np.asarray(v) for k, v in rec.items()}
         # headings unwrapped from the start's, so that turns beyond half a revolution count in full
         heading_truth = np.unwrap(np.concatenate([[start_truth.heading], arr["ht"]]))[1:]
@@ -327,5 +412,6 @@ class GaitSimulator:
                                      imu_yaw_drift_deg_per_s=math.degrees(self.imu_yaw_drift),
                                      odometry=self.estimator.odometry, rest_s=float(rest_s), kp=self.kp.tolist(),
                                      kd=self.kd.tolist()),
-                       name=name, root_truth=arr["rt"], root_estimate=arr["re"], start_estimate=est0)
+                       name=name, root_truth=arr["rt"], root_estimate=arr["re"], start_estimate=est0,
+                       sensor_log=log)
 

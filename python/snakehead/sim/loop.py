@@ -19,7 +19,11 @@ the pose estimated after the last one, as the robot would do it.
    (:func:`snakehead.motion.locomotion.next_step`: turning in place and sidewinding) take the straight body to
    where the curl will leave its base at the goal (:func:`~snakehead.motion.locomotion.straight_pose_for`). After
    each run the next is decided from the pose the robot estimates (:mod:`snakehead.sim.estimate`: joint angles, one
-   IMU, contact odometry), never from MuJoCo's.
+   IMU, contact odometry), never from MuJoCo's. With ``sensing="onboard"`` (the default) the estimate reads only
+   the robot's own sensor models (:mod:`snakehead.sim.sensors`: 12-bit encoders, a MEMS IMU's gyro and
+   accelerometer through an attitude filter); every ground run keeps the stream it read
+   (:class:`~snakehead.sim.gaits.SensorLog`), from which :func:`~snakehead.sim.gaits.replay_estimate` gives the
+   same estimate without the simulator.
 3. **The curl** into the bending state: a joint motion on the ground (it slides the body by most of a metre on the
    default robot: predicted by the friction model, followed by the estimate).
 4. **Re-plan** from the estimated pose with the base kept (``allow_relocation=False``, from the joints as measured):
@@ -27,23 +31,45 @@ the pose estimated after the last one, as the robot would do it.
    is already as close to the goal as the gaits bring it, towards another goal nearby whose plan succeeds. (The
    planner times its paths under the ZMP constraint, so a slower plan would not pass where the timed one fails.)
 5. **The fix.** Dead reckoning drifts: by 2-5 % of the distance travelled with the friction odometry, tens of
-   millimetres after a metre, far from the 2 mm the head must reach. The loop closes it the way the paper's
-   simulation does ("the pose of the base frame of the neck part is obtained in time"): once the body rests in
-   the bending state, an outside measurement of the pose of the neck's base frame (``base_end``, the paper's P0;
-   a motion-capture system, or the head's camera fixing known landmarks) with the joint angles gives the root
-   frame's placement (:class:`PoseFix`, with Gaussian noise: 0.5 mm and 0.05 deg by default). This is an
-   assumption of the loop, stated in every report. The head phases are planned again from the fixed pose (base
-   kept); when that plan fails, back to 2, the locomotion starting from the fixed pose.
+   millimetres after a metre, far from the 2 mm the head must reach.
+
+   *Onboard* (``sensing="onboard"``, the default): the head camera (:class:`~snakehead.sim.sensors.HeadSensor`)
+   sees a fiducial marker ahead of each target. The head phases run up to the first waypoint from which the plan
+   expects a marker well inside the camera's view (:func:`look_waypoint`), and the head holds still there; the
+   marker's pose relative to the head (averaged frames) with the encoders gives the root frame's world pose
+   (:func:`snakehead.sim.servo.root_from_head_reading`), and the head phases are planned again from there and the
+   fixed pose (base kept). When that plan fails, the head goes back down along the plan and the loop returns to 2
+   from the fixed pose. When no marker is in view, the head phases go on from dead reckoning (a note says so).
+
+   *Outside fix* (``sensing="outside fix"``, the earlier behaviour): perfect encoders and IMU, and once the body
+   rests in the bending state an outside measurement of the pose of the neck's base frame (``base_end``, the
+   paper's P0: "the pose of the base frame of the neck part is obtained in time"; a motion-capture system) with
+   the joint angles gives the root frame's placement (:class:`PoseFix`, with Gaussian noise: 0.5 mm and 0.05 deg
+   by default). The head phases are planned again from the fixed pose (base kept); when that plan fails, back
+   to 2, the locomotion starting from the fixed pose.
+
+   Each report states which (``sim.sensing`` and a note).
 6. **The head phases**, checked as every plan (ZMP, clearance, obstacles) and in dynamics the way the pipeline
    checks a plan (simulated from the plan's own start, the base where the loop believes it lies: a plan whose
    body tips in it, CHECK_ZMP_OUTSIDE and CHECK_BASE_LIFT, is a failed plan, back to 2; the planner keeps its ZMP
    5 mm inside, which is not always enough in MuJoCo), then run in MuJoCo from the simulation's state
    (:func:`snakehead.sim.simulate_trajectory` with ``state=``) and compared with the plan
    (:func:`snakehead.sim.compare`).
+7. **The final approach** (onboard): the camera measures the last target relative to the head, and the head chain
+   (the neck's lifting joints and the head's; the base's stay, so the support does not change) is corrected by a
+   differential-IK step on that measurement (:func:`snakehead.sim.servo.servo_step`), run in MuJoCo, up to
+   SERVO_ITERATIONS times until the measured error is within SERVO_POSITION_TOL_M and SERVO_DIRECTION_TOL_DEG;
+   a correction that lifts the base is the last. The head's accuracy then depends on the camera and the head
+   chain, not on where the body believes it lies. ``metrics`` gain ``final_position_error_m`` and
+   ``final_direction_error_deg`` (MuJoCo's truth after the last correction); ``LoopRun.servo`` has each look.
 
 The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/curl/lift/move/hold, ``t0_s``,
 ``t1_s``), the estimate's error after every ground phase, how far the tail travelled, and the head's errors.
-Obstacles are in the simulation all along, but the locomotion does not steer around them (it goes straight).
+Obstacles are in the simulation all along. The locomotion goes around them: when the gaits' straight legs would
+come within the body's turning disc of one, step 2 follows a route of the body's middle planned around their
+footprints (:func:`snakehead.motion.ground_path.plan_route`), leg by leg, and a goal whose straight pose before
+the curl would touch one is refused in step 1. ``sim.min_obstacle_distance_m`` is the body's smallest distance to
+any obstacle over the run. (The curl's own sweep on the ground is not checked against them.)
 """
 from __future__ import annotations
 
@@ -61,19 +87,36 @@ from ..control.controller import HeadController
 from ..geometry import collision as coll
 from ..margins import EXACT_DISTANCE_WITHIN
 from ..model.robot import BasePlacement, SnakeRobot, as_base
+from ..motion import ground_path as gp
 from ..motion import locomotion as lc
 from ..motion.plan_result import Plan
 from ..motion.planner import as_scene, plan
 from ..motion.start_state import bending_state
 from ..scenes.scene import Scene
 from .compare import check_plan_span, compare
+from ..motion.gaits import virtual_chassis
 from .estimate import BodyPose, pose_error
 from .gaits import GaitRun, GaitSimulator
+from . import sensors as sn
+from . import servo as sv
+from .sensors import OnboardSensors
+from .tracking import SimState
 from .tracking import SimResult, simulate_trajectory
 from .._errors import InputError, InputTypeError, InternalError, entry_point, inputs_checked
 
-#: The kinds of phases in a loop's report.
-PHASE_KINDS = ("gait", "curl", "lift", "move", "hold")
+#: How the loop knows where it is (:class:`ClosedLoop`'s ``sensing``): "onboard", the robot's own sensors alone
+#: (:mod:`snakehead.sim.sensors`), or "outside fix", perfect joint angles and IMU and an outside measurement of the
+#: neck's base frame (:class:`PoseFix`) once the body rests in the bending state.
+SENSING = ("onboard", "outside fix")
+#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle along the leg's
+#: square and along the leg, m; its heading, deg): looser than the goal's, the next leg corrects what is left.
+WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.12, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
+#: The most samples of the estimate's error over time a report holds.
+ESTIMATE_SAMPLES = 200
+#: How long the head holds still where it first looks for a marker (s).
+LOOK_HOLD_S = 0.5
+#: The kinds of phases in a loop's report ("servo": a correction of the head's final approach on the camera).
+PHASE_KINDS = ("gait", "curl", "lift", "move", "hold", "servo")
 #: The dynamics check of the head phases fails when the simulated ZMP leaves the planned support polygon by more
 #: than this (m) or a base frame rises more than CHECK_BASE_LIFT (m): the body tips (a plan that tips goes out by
 #: tens of millimetres and lifts its base by centimetres; the ZMP grazing the edge at the first tick does not).
@@ -148,11 +191,14 @@ class LoopRun:
     """What a closed loop did (see the module).
 
     start / believed_start: where the body truly lay and where the loop believed it did; phases; fixes: each
-    fix's record (the estimate before it and its error, the fix's error); plan: the plan of the head phases (None
+    fix's record (the estimate before it and its error, the fix's error; ``source`` "head camera" for the
+    onboard one); plan: the plan of the head phases (None
     if the loop never got there); head: their simulation (:class:`~snakehead.sim.SimResult`); metrics: the head
     phases against their plan (:func:`snakehead.sim.compare`); head_t0_s: when the head phases began;
     corrections: how many times the loop went back to step 1 after a curl; planning_time_s: wall time spent
-    planning; notes; failure: None when the head phases were planned and simulated, else why not.
+    planning; notes; failure: None when the head phases were planned and simulated, else why not; sensing: the
+    loop's (SENSING); head_extra: (label, start time s, SimResult) of the head's runs outside its plan (the look,
+    a lowering, the final approach's moves); servo: the final approach's looks (true and measured errors).
     """
 
     robot: SnakeRobot
@@ -171,6 +217,10 @@ class LoopRun:
     notes: list
     failure: str | None
     fix: PoseFix | None = None
+    sensing: str = "outside fix"
+    head_extra: list = field(default_factory=list)
+    servo: list = field(default_factory=list)
+    routes: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -186,24 +236,38 @@ class LoopRun:
         """Simulated time from the start to the end of the last phase (s)."""
         return float(self.phases[-1].t1_s) if self.phases else 0.0
 
-    def timeline(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The whole sequence as MuJoCo ran it: t (T,) s, the root frame's world pose (T, 4, 4), the joints (T, n)."""
-        ts: list[np.ndarray] = []
-        roots: list[np.ndarray] = []
-        qs: list[np.ndarray] = []
+    def segments(self) -> list[dict]:
+        """What MuJoCo ran, piece by piece in time order: each a dict of ``t`` (T,) s on the loop's clock,
+        ``root`` (T, 4, 4) the root frame's true world pose, ``q`` (T, n) and ``qd`` (T, n) the joints (the
+        ground phases' velocities by finite differences), ``estimate`` (T, 4, 4) the root pose the loop believed
+        (the dead reckoning on the ground, NaN where a run kept none; the placement the head phases were planned
+        from while lifted)."""
+        out = []
         for run in self.ground_runs:
             if run.root_truth is None:  # every ground run of a loop records where the body truly was
                 raise InternalError(f"the loop's ground run {run.name!r} has no recorded root pose")
-            ts.append(run.t)
-            roots.append(run.root_truth)
-            qs.append(run.q)
-        if self.head is not None and self.head.root_pose is not None:
-            ts.append(self.head_t0_s + self.head.t - self.head.t[0])
-            roots.append(self.head.root_pose)
-            qs.append(self.head.q)
-        if not ts:
+            out.append({"t": run.t, "root": run.root_truth, "q": run.q,
+                        "qd": np.gradient(run.q, run.t, axis=0) if len(run.t) > 1 else np.zeros_like(run.q),
+                        "estimate": (run.root_estimate if run.root_estimate is not None
+                                     else np.full((len(run.t), 4, 4), np.nan))})
+        lifted = [(t0, r) for _, t0, r in self.head_extra]
+        if self.head is not None:
+            lifted.append((self.head_t0_s, self.head))
+        for t0, r in lifted:
+            if r.root_pose is None:
+                continue
+            believed = self.robot.root_pose(self.plan.base if self.plan is not None else r.base)
+            out.append({"t": t0 + r.t - r.t[0], "root": r.root_pose, "q": r.q, "qd": r.qdot,
+                        "estimate": np.repeat(believed[None], len(r.t), axis=0)})
+        return sorted(out, key=lambda seg: float(seg["t"][0]))
+
+    def timeline(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The whole sequence as MuJoCo ran it: t (T,) s, the root frame's world pose (T, 4, 4), the joints (T, n)."""
+        segs = self.segments()
+        if not segs:
             return np.zeros(0), np.zeros((0, 4, 4)), np.zeros((0, self.robot.n_joints))
-        return np.concatenate(ts), np.concatenate(roots), np.concatenate(qs)
+        return (np.concatenate([s["t"] for s in segs]), np.concatenate([s["root"] for s in segs]),
+                np.concatenate([s["q"] for s in segs]))
 
     @property
     def base_travel_m(self) -> float:
@@ -222,15 +286,75 @@ class LoopRun:
             return 0.0
         return float(np.linalg.norm(roots[-1, :2, 3] - roots[0, :2, 3]))
 
+    def obstacle_distances(self, every: int = 5) -> tuple[np.ndarray, np.ndarray]:
+        """The smallest distance (m) of the body's shapes to any obstacle of the scene over the whole run as
+        MuJoCo ran it (:meth:`timeline`, every ``every``-th recorded tick and the last): t (T,) s, distance (T,)
+        m (negative: penetration); empty without obstacles."""
+        from ..geometry.collision import obstacle_shapes
+        from ..geometry.shapes import pair_min_distances
+
+        t, roots, qs = self.timeline()
+        if not self.scene.obstacles or not len(t):
+            return np.zeros(0), np.zeros(0)
+        pick = np.unique(np.r_[np.arange(0, len(t), max(int(every), 1)), len(t) - 1])
+        frames = np.einsum("tij,tljk->tlik", roots[pick], self.robot.body.fk_all_many(qs[pick]))
+        shapes, _ = obstacle_shapes(list(self.scene.obstacles))
+        mine = np.arange(len(self.robot.geometry.shapes))
+        pairs = np.stack(np.meshgrid(mine, np.arange(len(shapes.shapes)), indexing="ij"), -1).reshape(-1, 2)
+        d = pair_min_distances(frames, self.robot.geometry, np.eye(4)[None, None], shapes, pairs)
+        return t[pick], np.asarray(d)
+
+    @property
+    def min_obstacle_distance_m(self) -> float | None:
+        """The smallest distance of the body to any obstacle over the run (m; None without obstacles)."""
+        _, d = self.obstacle_distances()
+        return float(d.min()) if len(d) else None
+
+    @property
+    def min_obstacle_distance_ground_m(self) -> float | None:
+        """The same over the ground phases alone (gaits and curls: the locomotion around the obstacles)."""
+        t, d = self.obstacle_distances()
+        on_ground = np.zeros(len(t), bool)
+        for run in self.ground_runs:
+            on_ground |= (t >= run.t[0] - 1e-9) & (t <= run.t[-1] + 1e-9)
+        return float(d[on_ground].min()) if on_ground.any() else None
+
+    def estimate_error_over_time(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The dead reckoning's error through the ground phases, at every recorded tick: t (T,) s, the body
+        frame's position error (T,) m in the ground plane and its heading error (T,) deg (the estimate against
+        MuJoCo's truth)."""
+        ts, pos, yaw = [], [], []
+        for run in self.ground_runs:
+            if run.root_truth is None or run.root_estimate is None:
+                continue
+            B = self.robot.body_in_root
+            truth, est = run.root_truth @ B, run.root_estimate @ B
+            ts.append(run.t)
+            pos.append(np.linalg.norm(est[:, :2, 3] - truth[:, :2, 3], axis=1))
+            d = np.arctan2(est[:, 1, 0], est[:, 0, 0]) - np.arctan2(truth[:, 1, 0], truth[:, 0, 0])
+            yaw.append(np.abs(np.degrees((d + np.pi) % (2 * np.pi) - np.pi)))
+        if not ts:
+            return np.zeros(0), np.zeros(0), np.zeros(0)
+        return np.concatenate(ts), np.concatenate(pos), np.concatenate(yaw)
+
     def estimate_summary(self) -> dict:
         """The estimate's error: after every ground phase (dead reckoning, chained from the start or the last
-        fix), the largest, and at each fix."""
+        fix), the largest, at each fix, and over time (``over_time``: at most ESTIMATE_SAMPLES ticks, evenly
+        picked, and its median and largest)."""
         errors = [p.estimate_error for p in self.phases if p.estimate_error is not None]
         out = {"after_ground_phases": [dict(name=p.name, **p.estimate_error) for p in self.phases
                                        if p.estimate_error is not None],
                "max_position_error_m": max((e["position_error_m"] for e in errors), default=None),
                "max_yaw_error_deg": max((e["yaw_error_deg"] for e in errors), default=None),
                "fixes": [dict(f) for f in self.fixes]}
+        t, pos, yaw = self.estimate_error_over_time()
+        pick = np.unique(np.linspace(0, max(len(t) - 1, 0), min(len(t), ESTIMATE_SAMPLES)).astype(int))
+        out["over_time"] = {"t_s": t[pick].tolist(), "position_error_m": pos[pick].tolist(),
+                            "yaw_error_deg": yaw[pick].tolist(),
+                            "median_position_error_m": float(np.median(pos)) if len(t) else None,
+                            "max_position_error_m": float(pos.max()) if len(t) else None,
+                            "median_yaw_error_deg": float(np.median(yaw)) if len(t) else None,
+                            "max_yaw_error_deg": float(yaw.max()) if len(t) else None}
         if self.fix is not None:
             out["fix"] = {"frame": self.fix.frame or self.robot.parts.base_end,
                           "position_noise_m": self.fix.position_noise_m, "yaw_noise_deg": self.fix.yaw_noise_deg}
@@ -241,7 +365,9 @@ class LoopRun:
         ``estimate``, ``start``, ``total_time_s``, ``corrections``."""
         sim = dict(self.metrics) if self.metrics is not None else {}
         sim.update(base_travel_m=self.base_travel_m, base_displacement_m=self.base_displacement_m,
-                   total_time_s=self.total_time_s)
+                   total_time_s=self.total_time_s, sensing=self.sensing,
+                   min_obstacle_distance_m=self.min_obstacle_distance_m,
+                   min_obstacle_distance_ground_m=self.min_obstacle_distance_ground_m)
         return {"phases": [p.as_dict() for p in self.phases],
                 "sim": sim,
                 "estimate": self.estimate_summary(),
@@ -251,7 +377,8 @@ class LoopRun:
                                    "yaw_rad": self.believed_start.yaw},
                 "total_time_s": self.total_time_s, "corrections": self.corrections,
                 "loop_planning_time_s": self.planning_time_s, "loop_notes": list(self.notes),
-                "loop_failure": self.failure}
+                "loop_failure": self.failure, "final_approach": [dict(r) for r in self.servo],
+                "routes": [r.tolist() for r in self.routes]}
 
 
 _STEP = re.compile(r" \(\d+/\d+\)$")
@@ -285,12 +412,15 @@ class ClosedLoop:
     joint rate (rad/s). tolerance: the locomotion's (:class:`snakehead.motion.locomotion.Tolerance`).
     max_gait_runs: per correction; max_corrections: returns to step 2 after a curl before giving up.
     dynamics_check: simulate the head phases from the plan's own start before running them (step 6).
+    sensing: one of SENSING (see the module; "outside fix" uses ``fix``, default a :class:`PoseFix`); sensor_seed:
+    the onboard sensors' noise (:meth:`snakehead.sim.sensors.OnboardSensors.realistic`).
     imu_yaw_drift_deg_per_s, odometry and the other keywords (friction, ...) go to the
     :class:`~snakehead.sim.GaitSimulator`; the head phases' simulation uses the same ground.
     """
 
     def __init__(self, scene: Any, *, controller: HeadController | None = None, robot: SnakeRobot | None = None,
-                 timing: dict[str, Any] | None = None, fix: PoseFix | None = PoseFix(),
+                 timing: dict[str, Any] | None = None, fix: PoseFix | None = None, sensing: str = "onboard",
+                 sensor_seed: int | None = 0,
                  frequency: float = 0.5, curl_speed: float = 0.4, tolerance: lc.Tolerance = lc.Tolerance(),
                  max_gait_runs: int = 16, max_corrections: int = 3, method: str = "rotated", seed: int | None = 1,
                  dynamics_check: bool = True, **sim_options: Any) -> None:
@@ -309,8 +439,15 @@ class ClosedLoop:
         if timing is not None and not isinstance(timing, dict):
             raise InputTypeError(f"timing must be a dict of the retiming's options, got {type(timing).__name__}")
         self.timing = None if timing is None else dict(timing)
+        if sensing not in SENSING:
+            raise InputError(f"sensing must be one of {SENSING}, got {sensing!r}")
+        self.sensing = sensing
         if fix is not None and not isinstance(fix, PoseFix):
             raise InputTypeError(f"fix must be a PoseFix or None, got {type(fix).__name__}")
+        if fix is not None and sensing == "onboard":
+            raise InputError('a PoseFix is the "outside fix" sensing: give sensing="outside fix" with it')
+        if sensing == "outside fix" and fix is None:
+            fix = PoseFix()
         if fix is not None and fix.frame is not None:
             self.robot.link_index(fix.frame)  # ValueError for a frame not on the body
         self.fix = fix
@@ -327,7 +464,9 @@ class ClosedLoop:
         self.dynamics_check = bool(dynamics_check)
         self.obstacles = list(self.scene.obstacles)
         self.sim_options = dict(sim_options)
-        self.simulator = GaitSimulator(self.robot, obstacles=self.obstacles, **self.sim_options)
+        self.sensors = (OnboardSensors.realistic([(tg.position, tg.direction) for tg in self.scene.targets],
+                                                 self.obstacles, sensor_seed) if sensing == "onboard" else None)
+        self.simulator = GaitSimulator(self.robot, obstacles=self.obstacles, sensors=self.sensors, **self.sim_options)
         self._ground_options = {k: v for k, v in self.sim_options.items()
                                 if k in ("friction", "joint_damping", "armature", "timestep", "control_dt",
                                          "hole_slices", "torque_limit")}
@@ -362,6 +501,19 @@ class ClosedLoop:
             return p.failure
         return self._dynamics_check(p) if self.dynamics_check else None
 
+    def _straight_failure(self, goal: BasePlacement, q_bend: np.ndarray) -> str | None:
+        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal`` (it would
+        lie within the ground path's clearance of an obstacle: the gaits could not bring it there), else None."""
+        if not self.obstacles:
+            return None
+        straight = lc.straight_pose_for(self.robot, goal, q_bend)
+        d = coll.collision_check(self.robot, np.zeros((1, self.robot.n_joints)), self.obstacles, straight,
+                                 exact_within=1.0).distance[0]
+        if d < gp.CLEARANCE_M:
+            return (f"the body would lie straight at {_fmt(straight)} before its curl, {1000 * d:.0f} mm from an "
+                    "obstacle")
+        return None
+
     def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
         """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
         phases are planned successfully and pass the dynamics check, the nearest first; None if there is none."""
@@ -370,9 +522,25 @@ class ClosedLoop:
             candidate = lc.compose(goal, BasePlacement(*offset))
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
                      base_shape=q_bend, timing=self.timing)
-            if self._goal_failure(p) is None:
+            if self._goal_failure(p) is None and self._straight_failure(candidate, q_bend) is None:
                 return candidate
         return None
+
+    def _route(self, here: BasePlacement, straight_goal: BasePlacement, tolerance: lc.Tolerance,
+               routes: list[np.ndarray], say: Callable[[str], None]) -> list[tuple[BasePlacement, lc.Tolerance]]:
+        """The goals of the gaits on the way from ``here`` to ``straight_goal`` (root placements of the straight
+        body) and the tolerance of each: the goal alone when the straight legs are clear of the obstacles, else
+        the waypoints of :func:`snakehead.motion.ground_path.plan_route` (the body's middle at each, square to the
+        leg that reaches it; WAYPOINT_TOLERANCE) and the goal. The route's middle points go to ``routes``."""
+        offset = self._offset
+        route = gp.plan_route(self.robot, self.obstacles, lc.compose(here, offset), lc.compose(straight_goal, offset))
+        if route is None:
+            return [(straight_goal, tolerance)]
+        routes.append(route.waypoints.copy())
+        say(f"around the obstacles: {len(route.waypoints) - 1} legs of {np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum():.2f} m")
+        goals = [(lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(offset)),
+                  WAYPOINT_TOLERANCE) for w, h in zip(route.waypoints[1:-1], route.headings[:-1])]
+        return goals + [(straight_goal, tolerance)]
 
     # --- running ---------------------------------------------------------------------------------------
     @entry_point
@@ -398,7 +566,8 @@ class ClosedLoop:
         rng = np.random.default_rng(None if self.fix is None else self.fix.seed)
         state = sim.lying(start, q_now)
         sim.restore(state)
-        est = sim.estimator.reset(sim.joint_angles(), sim.imu_orientation(), (believed.x, believed.y), believed.yaw)
+        est = sim.estimator.reset(sim.measured_joints(), sim.measured_attitude(), (believed.x, believed.y),
+                                  believed.yaw)
         phases: list[Phase] = []
         fixes: list[dict] = []
         notes: list[str] = []
@@ -429,7 +598,7 @@ class ClosedLoop:
         q_bend = bending_state(self.controller, self.controller.q_initial)
         tolerance = self.tolerance
 
-        def head_plan_here(label: str, dynamics_check: bool) -> Plan | None:
+        def head_plan_here(label: str, dynamics_check: bool, q_now: np.ndarray | None = None) -> Plan | None:
             """The head phases from the current estimate, the base kept, starting from the joints as they are
             (measured: they rest a few tenths of a degree from their commands, friction holding the links against
             the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails.
@@ -437,7 +606,7 @@ class ClosedLoop:
             measured joints are clipped to the limits, which the retiming requires of every waypoint."""
             nonlocal planning
             t0 = time.perf_counter()
-            q_measured = np.clip(sim.joint_angles(), robot.lower, robot.upper)
+            q_measured = np.clip(sim.measured_joints() if q_now is None else q_now, robot.lower, robot.upper)
             p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
                      start_q=q_measured, timing=self.timing)
             planning += time.perf_counter() - t0
@@ -447,6 +616,122 @@ class ClosedLoop:
             notes.append(f"{label}: the head phases from {_fmt(est.base)} fail ({why})")
             say(notes[-1])
             return None
+
+        extra: list[tuple[str, float, SimResult]] = []  # the head's runs outside its plan: lift and look, servo
+        servo_log: list[dict] = []
+        routes: list[np.ndarray] = []
+        head_sensor = None if self.sensors is None else self.sensors.head
+        encoders = None if self.sensors is None else self.sensors.encoders
+
+        def simulate_from(at: SimState, t: np.ndarray, q: np.ndarray, base: BasePlacement, label: str,
+                          kind: str, hold: float = 0.0) -> SimResult:
+            """A joint motion of the lifted body in MuJoCo from the state ``at`` (then ``hold`` s still), recorded
+            as a phase."""
+            t0 = float(at.time)
+            r = simulate_trajectory(robot, t, q, base, state=at, settle=0.0, hold=hold, obstacles=self.obstacles,
+                                    **self._ground_options)
+            extra.append((label, t0, r))
+            assert r.end_state is not None
+            if phases and abs(phases[-1].t1_s - t0) < 0.01:  # the last phase ends at the last tick simulated
+                phases[-1].t1_s = t0
+            phases.append(Phase(label, kind, t0, float(r.end_state.time)))
+            return r
+
+        def look(head_pose: np.ndarray, k: int) -> list:
+            assert head_sensor is not None
+            readings = [head_sensor.read(head_pose, k) for _ in range(sv.HEAD_FRAMES)]
+            return [r for r in readings if r is not None]
+
+        def look_first(p: Plan) -> tuple[Plan, SimState, float, int] | None:
+            """The head phases run up to the first waypoint from which the plan expects a marker in the head
+            camera's view (:func:`look_waypoint`), the head held still there; then the camera's fix from the nearest
+            marker in view and the head phases planned again from there and the fixed pose. Returns the plan, the
+            state its simulation starts from, the time its clock starts at and its first sample to simulate; with no
+            marker in view, the rest of the plan from dead reckoning. None (back to step 2, the body lowered again
+            along the plan) when the plan from the fixed pose fails."""
+            nonlocal est, state
+            assert head_sensor is not None and encoders is not None
+            k = look_waypoint(robot, p, head_sensor)
+            if k is None:
+                notes.append("the plan never turns the head camera towards a marker: the head phases from dead "
+                             "reckoning")
+                say(notes[-1])
+                return p, state, float(state.time), 0
+            start_t = float(state.time)
+            looked = simulate_from(state, p.t[:k + 1], p.q[:k + 1], p.base, "head up to look", "lift", LOOK_HOLD_S)
+            assert looked.end_state is not None and looked.root_pose is not None
+            head_pose = looked.head_pose[-1]
+            seen = head_sensor.visible(head_pose)
+            q_look = encoders.read(looked.q[-1])
+            if not seen:
+                notes.append("no marker in the head camera's view where the plan expected one: the head phases from "
+                             "dead reckoning")
+                say(notes[-1])
+                phases.pop()  # the plan's own phases say it
+                return p, looked.end_state, start_t + LOOK_HOLD_S, k
+            nearest = min(seen, key=lambda j: float(np.linalg.norm(head_sensor.markers[j][:3, 3] - head_pose[:3, 3])))
+            T_root = sv.root_from_head_reading(robot, look(head_pose, nearest), head_sensor.markers[nearest], q_look)
+            dead_reckoned, truth = est, _true_pose(robot, looked.root_pose[-1], looked.q[-1])
+            R_imu = T_root[:3, :3] @ robot.body.fk_all(q_look)[sim.estimator.imu_index][:3, :3]
+            body = T_root @ robot.body_in_root
+            est = sim.estimator.reset(q_look, R_imu, body[:2, 3], math.atan2(body[1, 0], body[0, 0]))
+            fixes.append({"t_s": float(looked.end_state.time), "source": "head camera", "target": nearest,
+                          "dead_reckoning": pose_error(dead_reckoned, truth), "fix": pose_error(est, truth)})
+            say(f"the head camera puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
+            again = head_plan_here("after the head camera's fix", self.dynamics_check, q_look)
+            if again is not None:
+                return again, looked.end_state, float(looked.end_state.time), 0
+            # lower the body again into the bending state, back along the plan, and go back to the locomotion
+            lowered = simulate_from(looked.end_state, p.t[:k + 1], p.q[k::-1], p.base, "lower again", "lift", 0.5)
+            assert lowered.end_state is not None
+            state = lowered.end_state
+            sim.restore(state)
+            sim.reset_attitude(R_imu)
+            return None
+
+        def final_approach(p: Plan, head: SimResult) -> dict:
+            """The head corrected on the camera's measurement of the last target (see :mod:`snakehead.sim.servo`);
+            the final errors against the truth."""
+            assert head_sensor is not None and encoders is not None and head.end_state is not None
+            last = max(k for k, tg in enumerate(self.scene.targets) if not tg.via)
+            target = sn.target_frame(self.scene.targets[last].position, self.scene.targets[last].direction)
+            q_cmd, at, now = p.q[-1].copy(), head.end_state, head
+            for it in range(sv.SERVO_ITERATIONS + 1):
+                readings = look(now.head_pose[-1], last)
+                true_error = sv.head_error(np.linalg.solve(now.head_pose[-1], target))
+                record = {"iteration": it, "true_position_error_m": true_error[0],
+                          "true_direction_error_deg": true_error[1], "in_view": bool(readings)}
+                servo_log.append(record)
+                if not readings:
+                    notes.append("the last target's marker is not in the head camera's view: no final approach")
+                    break
+                seen = sn.mean_pose([r.target_in_head for r in readings])
+                record["measured_position_error_m"], record["measured_direction_error_deg"] = sv.head_error(seen)
+                if record["measured_position_error_m"] > sv.SERVO_MAX_POSITION_M \
+                        or record["measured_direction_error_deg"] > sv.SERVO_MAX_DIRECTION_DEG:
+                    notes.append(f"the head camera sees the head {1000 * record['measured_position_error_m']:.0f} mm "
+                                 f"and {record['measured_direction_error_deg']:.1f} deg off: too far for the final "
+                                 "approach on the head chain alone")
+                    break
+                if (record["measured_position_error_m"] < sv.SERVO_POSITION_TOL_M
+                        and record["measured_direction_error_deg"] < sv.SERVO_DIRECTION_TOL_DEG) \
+                        or it == sv.SERVO_ITERATIONS:
+                    break
+                q_new = np.clip(q_cmd + sv.servo_step(robot, encoders.read(now.q[-1]), seen), robot.lower, robot.upper)
+                t = np.array([0.0, sv.SERVO_MOVE_S, sv.SERVO_MOVE_S + sv.SERVO_HOLD_S])
+                q = np.vstack([q_cmd, q_new, q_new])
+                moved = simulate_from(at, t, q, p.base, f"final approach {it + 1}", "servo")
+                check = compare(robot, t, q, moved, base=p.base)
+                record["base_lift_m"] = check["base_lift_m"]
+                assert moved.end_state is not None
+                q_cmd, at, now = q_new, moved.end_state, moved
+                if check["base_lift_m"] > CHECK_BASE_LIFT:
+                    notes.append(f"the final approach lifts the base {1000 * check['base_lift_m']:.1f} mm: stopped")
+                    break
+            final = servo_log[-1]
+            return {"final_position_error_m": final["true_position_error_m"],
+                    "final_direction_error_deg": final["true_direction_error_deg"],
+                    "final_approach_moves": sum(1 for r in servo_log if "base_lift_m" in r)}
 
         while failure is None:
             corrections += 1
@@ -466,6 +751,8 @@ class ClosedLoop:
                     first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
                                  timing=self.timing)
                     why = self._goal_failure(first)
+                    if why is None and first.failure is None:
+                        why = self._straight_failure(first.base, first.states[0][2])
                     if why is None:
                         goal, q_bend = first.base, first.states[0][2].copy()
                         break
@@ -508,17 +795,20 @@ class ClosedLoop:
                             tolerance=tolerance) is not None:
                 if np.abs(q_now).max() > 0.0:
                     curl(np.zeros(robot.n_joints), "uncurl")
-                for _ in range(self.max_gait_runs):
-                    step = lc.next_step(robot, est.base, straight_goal, rates, tolerance=tolerance,
-                                        frequency=self.frequency)
-                    if step is None:
-                        break
-                    before = est.base
-                    run = sim.run(state, step.gait, step.cycles, start_estimate=est)
-                    direction = {1: "+", -1: "-"}[step.gait.direction]
-                    ground(run, f"{step.gait.name} {direction} ({step.leg}, {step.cycles:.0f} x {step.scale:.2f})",
-                           "gait")
-                    rates.update(step, before, est.base, self._offset)
+                sub_goals = self._route(est.base, straight_goal, tolerance, routes, say)
+                for k, (sub_goal, sub_tolerance) in enumerate(sub_goals, start=1):
+                    leg = "" if len(sub_goals) == 1 else f"leg {k}/{len(sub_goals)}, "
+                    for _ in range(self.max_gait_runs):
+                        step = lc.next_step(robot, est.base, sub_goal, rates, tolerance=sub_tolerance,
+                                            frequency=self.frequency)
+                        if step is None:
+                            break
+                        before = est.base
+                        run = sim.run(state, step.gait, step.cycles, start_estimate=est)
+                        direction = {1: "+", -1: "-"}[step.gait.direction]
+                        ground(run, f"{step.gait.name} {direction} ({leg}{step.leg}, {step.cycles:.0f} x "
+                                    f"{step.scale:.2f})", "gait")
+                        rates.update(step, before, est.base, self._offset)
             # 3. the curl into the bending state
             if np.abs(q_bend - q_now).max() > 1e-9:
                 curl(q_bend, "curl into the bending state")
@@ -526,6 +816,7 @@ class ClosedLoop:
             head_plan = head_plan_here("after the curl", self.dynamics_check and self.fix is None)
             if head_plan is None:
                 continue
+            head_state, plan_t0, first_sample = state, float(state.time), 0  # where and when the head phases start
             # 5. the fix, and the plan from it
             if self.fix is not None:
                 dead_reckoned, truth = est, sim.true_pose()
@@ -536,20 +827,51 @@ class ClosedLoop:
                 head_plan = head_plan_here("after the fix", self.dynamics_check)
                 if head_plan is None:
                     continue
+            elif self.sensors is not None and self.sensors.head is not None:
+                # 5'. onboard: lift, look at a marker, fix the pose from it, plan again from the lifted state
+                looked = look_first(head_plan)
+                if looked is None:
+                    continue
+                head_plan, head_state, plan_t0, first_sample = looked
             # 6. the head phases, in MuJoCo from where the body is
             say(f"head phases planned from {_fmt(est.base)}: {head_plan.duration_s:.1f} s; simulating")
-            head_t0 = float(state.time)
-            head = simulate_trajectory(robot, head_plan.t, head_plan.q, head_plan.base, state=state, settle=0.0,
-                                       obstacles=self.obstacles, **self._ground_options)
+            head_t0 = float(head_state.time)
+            head = simulate_trajectory(robot, head_plan.t[first_sample:], head_plan.q[first_sample:], head_plan.base,
+                                       state=head_state, settle=0.0, obstacles=self.obstacles, **self._ground_options)
             check_plan_span(head_plan.t, [tg.time_s for tg in head_plan.targets], head)
             targets = [(tg.time_s, tg.position, tg.direction) for tg in head_plan.targets] or None
             metrics = compare(robot, head_plan.t, head_plan.q, head, targets=targets, base=head_plan.base)
-            phases += head_phases(head_plan, head_t0)
+            phases += head_phases(head_plan, plan_t0)
+            assert head.end_state is not None
+            phases[-1].t1_s = float(head.end_state.time)
+            if self.sensors is not None and self.sensors.head is not None:
+                metrics.update(final_approach(head_plan, head))
             break
         return LoopRun(robot=robot, scene=self.scene, start=start, believed_start=believed, q_start=q_first,
                        phases=phases, fixes=fixes, plan=head_plan, head=head, metrics=metrics, head_t0_s=head_t0,
                        corrections=max(corrections, 0), planning_time_s=planning, notes=notes, failure=failure,
-                       fix=self.fix)
+                       fix=self.fix, sensing=self.sensing, head_extra=extra, servo=servo_log, routes=routes)
+
+
+def look_waypoint(robot: SnakeRobot, p: Plan, camera: sn.HeadSensor) -> int | None:
+    """The sample of plan ``p`` at its first waypoint (after the bending state) from which the head camera would
+    see a marker within half its field of view, the body where the plan believes it lies (the margin allows for
+    the belief's error); None if there is none."""
+    for label, t, q in p.states[1:]:
+        head = robot.head_pose(q, p.base)
+        for k in camera.visible(head):
+            d = camera.markers[k][:3, 3] - head[:3, 3]
+            if float(d @ head[:3, 0]) >= float(np.linalg.norm(d)) * math.cos(0.5 * camera.half_fov_rad):
+                return int(np.argmin(np.abs(p.t - t)))
+    return None
+
+
+def _true_pose(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> BodyPose:
+    """The body's true pose (for the record only) from MuJoCo's root pose (4, 4) and joints (n,)."""
+    frames = root @ robot.body.fk_all(q)
+    centres = robot.link_centres(frames[None])[0]
+    return BodyPose(root=root.copy(), chassis=virtual_chassis(centres, forward=centres[-1] - centres[0]),
+                    body_in_root=robot.body_in_root)
 
 
 def _fmt(b: BasePlacement) -> str:

@@ -31,9 +31,19 @@ from .body import body_faces
 from .._errors import InputError, InputTypeError
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
-KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41"}
+KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41",
+               "servo": "#00838f"}
 PART_COLORS = ("#7f8c8d", "#e67e22", "#2e86c1")  # base, neck, head
 TARGET_COLOR = "#c0392b"
+OBSTACLE_COLOR = "#9e9e9e"
+ROUTE_COLOR = "#455a64"
+
+
+def _obstacle_outlines(run: LoopRun) -> list[np.ndarray]:
+    """The ground-level outlines of the scene's obstacles (walls, boxes) seen from above."""
+    from ..motion.ground_path import footprints
+
+    return footprints(run.scene.obstacles)
 
 def _part_colors(robot: SnakeRobot, per_polygon: bool = False) -> list[str]:
     """A colour per collision shape (of ``robot.geometry``), or per polygon of
@@ -78,6 +88,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     _check(run)
     from matplotlib.collections import PolyCollection
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     robot = run.robot
     fig = Figure(figsize=size)
@@ -91,7 +102,16 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         ax.add_collection(PolyCollection(list(fp), facecolors=colors, edgecolors="k", linewidths=0.3, alpha=alpha,
                                          zorder=zorder))
 
-    legend = []
+    legend: list[Any] = []
+    walls = _obstacle_outlines(run)
+    if walls:
+        ax.add_collection(PolyCollection(walls, facecolors=OBSTACLE_COLOR, edgecolors="k", linewidths=0.4, alpha=0.7,
+                                         zorder=1))
+        legend.append(Patch(facecolor=OBSTACLE_COLOR, edgecolor="k", alpha=0.7, label="obstacles (on the ground)"))
+    for route in run.routes:  # the body's middle, planned around the obstacles
+        ax.plot(route[:, 0], route[:, 1], ":o", color=ROUTE_COLOR, lw=1.0, ms=3, zorder=2)
+    if run.routes:
+        legend.append(Line2D([], [], color=ROUTE_COLOR, ls=":", marker="o", ms=3, label="planned route (body's middle)"))
     if len(t_all):
         body(roots[0], qs[0], 0.35)
         ax.annotate("start", (roots[0, 0, 3], roots[0, 1, 3]), fontsize=7, xytext=(4, -10), textcoords="offset points")
@@ -109,7 +129,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         legend.append(Line2D([], [], color=c, lw=1.6, label=f"{k} {literal(ph.name)} ({ph.t0_s:.1f}-{ph.t1_s:.1f} s)"))
     if len(t_all):
         body(roots[-1], qs[-1], 0.9, zorder=4)
-    for f in run.fixes:  # where the outside fix reset the estimate
+    for f in run.fixes:  # where a fix (outside, or the head camera's) reset the estimate
         k = int(np.argmin(np.abs(t_all - f["t_s"])))
         ax.plot(*roots[k, :2, 3], "*", color="k", ms=9, zorder=6)
     for tg in run.scene.targets:
@@ -117,7 +137,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
         ax.annotate(f"{literal(tg.name)} (z {tg.position[2]:.2f} m)", (tg.position[0], tg.position[1]), fontsize=7,
                     color=TARGET_COLOR, xytext=(5, 5), textcoords="offset points", zorder=6)
     legend += [Line2D([], [], color="k", ls="--", lw=0.9, label="estimated (dead reckoning)"),
-               Line2D([], [], color="k", marker="*", ls="", label="outside fix"),
+               Line2D([], [], color="k", marker="*", ls="", label="fix" if run.sensing == "onboard" else "outside fix"),
                Line2D([], [], color=TARGET_COLOR, marker="x", ls="", label="targets")]
     ax.autoscale_view()
     ax.margins(0.08)

@@ -1,0 +1,167 @@
+"""The body's route around obstacles (snakehead.motion.ground_path): A* against Dijkstra on the same graph
+(scipy), the footprints' grid against the polygons, routes clear of the inflated obstacles (checked densely and
+against the exact geometry of the straight body), and the shortcut never worse than the grid path."""
+import math
+
+import numpy as np
+import pytest
+from scipy.sparse import lil_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from snakehead import BasePlacement, SnakeRobot
+from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
+from snakehead.motion import ground_path as gp
+
+
+def _dijkstra_cost(free, start, goal, weight=None):
+    """The cheapest path's cost on the same 8-connected grid graph, by scipy's Dijkstra (brute force)."""
+    H, W = free.shape
+    idx = np.arange(H * W).reshape(H, W)
+    G = lil_matrix((H * W, H * W))
+    for i in range(H):
+        for j in range(W):
+            for di in (-1, 0, 1):
+                for dj in (-1, 0, 1):
+                    n = (i + di, j + dj)
+                    if (di or dj) and 0 <= n[0] < H and 0 <= n[1] < W and (free[n] or n == goal):
+                        G[idx[i, j], idx[n]] = math.hypot(di, dj) * (1.0 if weight is None else weight[n])
+    return dijkstra(G.tocsr(), indices=idx[start])[idx[goal]]
+
+
+def _path_cost(path, weight=None):
+    return sum(math.hypot(b[0] - a[0], b[1] - a[1]) * (1.0 if weight is None else weight[b])
+               for a, b in zip(path, path[1:]))
+
+
+def test_astar_is_shortest_against_dijkstra():
+    rng = np.random.default_rng(0)
+    for trial in range(12):
+        free = rng.uniform(size=(14, 17)) > 0.3
+        start, goal = (0, 0), (13, 16)
+        free[start] = free[goal] = True
+        weight = rng.uniform(1.0, 3.0, free.shape) if trial % 2 else None
+        path = gp.astar(free, start, goal, weight)
+        ref = _dijkstra_cost(free, start, goal, weight)
+        if not np.isfinite(ref):
+            assert path is None
+            continue
+        assert path[0] == start and path[-1] == goal
+        assert all(free[c] for c in path[1:-1])
+        assert all(max(abs(a[0] - b[0]), abs(a[1] - b[1])) == 1 for a, b in zip(path, path[1:]))
+        assert _path_cost(path, weight) == pytest.approx(ref, rel=1e-12)
+
+
+def test_footprint_grid_covers_the_obstacles():
+    box = BoxObstacle.from_yaw([0.3, -0.2, 0.1], [0.4, 0.1, 0.2], 0.5)
+    high = BoxObstacle([0.0, 1.0, 1.0], [0.2, 0.2, 0.2])  # floating above the body's reach
+    grid = gp.clearance_grid([box, high], [[0.0, 0.0]], 0.3)
+    assert len(gp.footprints([box, high])) == 1
+    # every point inside the box's outline lies in an occupied cell; points 2 cells away from it are free
+    rng = np.random.default_rng(1)
+    R = box.rotation[:2, :2]
+    inside = (rng.uniform(-0.5, 0.5, (500, 2)) * box.size[:2]) @ R.T + box.centre[:2]
+    assert all(grid.occupied[grid.cell(p)] for p in inside)
+    assert np.all(grid.clearance_at(inside) <= 0.0)
+    far = box.centre[:2] + (np.array([0.2 + 3 * grid.resolution, 0.0]) @ R.T)
+    assert not grid.occupied[grid.cell(far)]
+    # the clearance field is a lower bound of the true distance to the box's outline
+    extent = grid.resolution * (np.array(grid.occupied.shape[::-1]) - 1)
+    pts = rng.uniform(grid.origin, grid.origin + extent, (300, 2))
+    local = (pts - box.centre[:2]) @ R  # in the box's axes
+    true = np.linalg.norm(np.maximum(np.abs(local) - 0.5 * box.size[:2], 0.0), axis=1)
+    outside = true > 0
+    assert np.all(grid.clearance_at(pts[outside]) <= true[outside] + 1e-9)
+    assert np.all(grid.clearance_at(pts[outside]) >= true[outside] - 2 * math.sqrt(2) * grid.resolution - 1e-9)
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return SnakeRobot.default()
+
+
+def _straight_body_distance(robot, middle, heading, obstacles):
+    """The exact distance of the straight body lying with its middle at ``middle`` along ``heading`` to the
+    obstacles (the geometry layer)."""
+    from snakehead.geometry import collision as coll
+    from snakehead.motion import locomotion as lc
+
+    root = lc.compose(BasePlacement(middle[0], middle[1], heading), lc.inverse(lc.chassis_offset(robot)))
+    return coll.collision_check(robot, np.zeros((1, robot.n_joints)), obstacles, root, exact_within=10.0).distance[0]
+
+
+def test_route_around_a_wall_keeps_the_turning_disc_clear(robot):
+    wall = WallWithHole.standing([0.2, 0.5, 0.4], [0, 1, 0], [0.7, 0.58, 0.01], 0.07)
+    start = BasePlacement(-0.49, 1.4, math.pi)
+    goal = BasePlacement(0.0, 0.287, 3.1248)
+    route = gp.plan_route(robot, [wall], start, goal)
+    assert route is not None and route.staging
+    W = route.waypoints
+    np.testing.assert_allclose(W[0], [start.x, start.y])
+    np.testing.assert_allclose(W[-1], [goal.x, goal.y])
+    assert len(W) <= 6  # a few legs, not the grid's steps
+    R = 0.5 * robot.body_length + gp.CLEARANCE_M
+    outlines = gp.footprints([wall])
+    # every leg but the last keeps the turning disc's radius from the wall's outline (checked densely, exactly)
+    for a, b in zip(W[:-2], W[1:-1]):
+        for s in np.linspace(0, 1, 200):
+            p = a + s * (b - a)
+            assert min(_polygon_distance(p, poly) for poly in outlines) > R - 1e-9
+    # the last leg: the straight body at the goal's heading, from the staging point to the goal, clear of the wall
+    for s in np.linspace(0, 1, 12):
+        p = W[-2] + s * (W[-1] - W[-2])
+        assert _straight_body_distance(robot, p, goal.yaw, [wall]) > gp.CLEARANCE_M - gp.RESOLUTION_M
+    # legs are square to the body's heading (the body sidewinds along them), but the staging leg's at the goal's
+    for k, h in enumerate(route.headings[:-1]):
+        d = W[k + 1] - W[k]
+        assert abs(math.cos(h) * d[0] + math.sin(h) * d[1]) < 1e-9 * np.linalg.norm(d) + 1e-12
+    assert route.headings[-1] == goal.yaw
+    # nothing in the way: no route (the straight legs)
+    assert gp.plan_route(robot, [wall], BasePlacement(-2.0, -1.0, 0.0), BasePlacement(-2.0, -2.0, 0.0)) is None
+    assert gp.plan_route(robot, [], start, goal) is None
+
+
+def _polygon_distance(p, poly):
+    """Distance from point p to a convex polygon (0 inside), brute force over its edges."""
+    a, b = poly, np.roll(poly, -1, axis=0)
+    e = b - a
+    t = np.clip(np.einsum("ij,ij->i", p - a, e) / np.einsum("ij,ij->i", e, e), 0, 1)
+    d = np.linalg.norm(a + t[:, None] * e - p, axis=1).min()
+    cross = e[:, 0] * (p[1] - a[:, 1]) - e[:, 1] * (p[0] - a[:, 0])
+    return 0.0 if np.all(cross >= 0) else d
+
+
+def test_route_length_near_the_shortest_on_a_small_grid(robot):
+    """Between two boxes: the route is no longer than the grid's cheapest path at the disc's clearance (A* on
+    the same grid, unit weights, found by Dijkstra), within the detour's allowance."""
+    boxes = [BoxObstacle([0.0, 0.0, 0.1], [0.3, 1.6, 0.2]), BoxObstacle([1.9, 1.0, 0.1], [0.3, 1.6, 0.2])]
+    start, goal = BasePlacement(-1.2, 0.0, 0.0), BasePlacement(2.9, 0.9, 0.0)
+    route = gp.plan_route(robot, boxes, start, goal)
+    assert route is not None
+    length = np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum()
+    grid = gp.clearance_grid(boxes, [[start.x, start.y], [goal.x, goal.y]],
+                             0.5 * robot.body_length + gp.CLEARANCE_M + gp.GRID_MARGIN_M)
+    R = 0.5 * robot.body_length + gp.CLEARANCE_M
+    free = grid.distance - grid.resolution * math.sqrt(0.5) > R
+    cells = gp.astar(free, grid.cell([start.x, start.y]), grid.cell([goal.x, goal.y]))
+    shortest = _path_cost(cells) * grid.resolution
+    assert length <= shortest * 1.15 + 0.2
+
+
+def test_route_starts_by_sidestepping_when_the_body_cannot_turn_where_it_lies(robot):
+    """A box beside the lying body, within its turning disc: the first leg sidewinds at the body's own heading,
+    its straight footprint clear of the box, to where it can turn."""
+    box = BoxObstacle([0.0, 0.45, 0.125], [0.25, 0.25, 0.25])
+    start = BasePlacement(0.0, 0.0, 0.0)
+    goal = BasePlacement(0.0, 2.5, 0.0)
+    route = gp.plan_route(robot, [box], start, goal)
+    assert route is not None
+    W, R = route.waypoints, route.clear_m
+    assert route.headings[0] == start.yaw and abs(W[1, 0] - W[0, 0]) < 1e-12  # square to the body: along y
+    assert W[1, 1] < 0  # away from the box
+    for s in np.linspace(0, 1, 10):
+        p = W[0] + s * (W[1] - W[0])
+        assert _straight_body_distance(robot, p, start.yaw, [box]) > gp.CLEARANCE_M - gp.RESOLUTION_M
+    box_outline = gp.footprints([box])
+    for a, b in zip(W[1:-2], W[2:-1]):
+        for s in np.linspace(0, 1, 100):
+            assert min(_polygon_distance(a + s * (b - a), poly) for poly in box_outline) > R - 1e-9
