@@ -15,9 +15,10 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import subprocess
 import sys
 import time
+
+from _alternate import run_alternately  # bench/_alternate.py
 
 
 def worker(kind: str, count: int, seed: int) -> None:
@@ -55,23 +56,8 @@ def main() -> int:
           "median wall ratio to the first |")
     print("|---|---|---|---|---|---|---|---|")
     for kind in args.sets.split(","):
-        procs = [subprocess.Popen([py, __file__, "--python", py, "--worker", kind, str(args.count), str(args.seed)],
-                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for py in args.python]
-        for p in procs:
-            if p.stdout is None or p.stdout.readline().strip() != "ready":
-                raise SystemExit(f"a worker did not start: {p.args}")
-        rows: list[list[dict]] = [[] for _ in procs]
-        for i in range(args.count):
-            for p, r in zip(procs, rows):
-                assert p.stdin is not None and p.stdout is not None
-                p.stdin.write(f"{i}\n")
-                p.stdin.flush()
-                r.append(json.loads(p.stdout.readline()))
-            print(f"  {kind} {i + 1}/{args.count}", file=sys.stderr, flush=True)
-        for p in procs:
-            assert p.stdin is not None
-            p.stdin.close()
-            p.wait()
+        rows = run_alternately([[py, __file__, "--python", py, "--worker", kind, str(args.count), str(args.seed)]
+                                for py in args.python], args.count, kind)
         for py, r in zip(args.python, rows):
             wall = [x["wall"] for x in r]
             ratio = statistics.median(a["wall"] / b["wall"] for a, b in zip(rows[0], r))

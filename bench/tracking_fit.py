@@ -18,12 +18,13 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from _alternate import run_alternately  # noqa: E402  (bench/_alternate.py)
 
 MODES = ("numpy", "core")
 
@@ -115,23 +116,8 @@ def main() -> int:
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     recorded: list[list] = []
     for kind in args.sets.split(","):
-        procs = [subprocess.Popen([sys.executable, __file__, "--worker", mode, kind, str(args.count), str(args.seed)],
-                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for mode in MODES]
-        for p in procs:
-            if p.stdout is None or p.stdout.readline().strip() != "ready":
-                raise SystemExit(f"a worker did not start: {p.args}")
-        rows: list[list[dict]] = [[] for _ in procs]
-        for i in range(args.count):
-            for p, r in zip(procs, rows):
-                assert p.stdin is not None and p.stdout is not None
-                p.stdin.write(f"{i}\n")
-                p.stdin.flush()
-                r.append(json.loads(p.stdout.readline()))
-            print(f"  {kind} {i + 1}/{args.count}", file=sys.stderr, flush=True)
-        for p in procs:
-            assert p.stdin is not None
-            p.stdin.close()
-            p.wait()
+        rows = run_alternately([[sys.executable, __file__, "--worker", mode, kind, str(args.count), str(args.seed)]
+                                for mode in MODES], args.count, kind)
         same = [a["ok"] == b["ok"] for a, b in zip(*rows)]
         rel = max((abs(a["motion"] - b["motion"]) / max(abs(a["motion"]), 1e-12)
                    for a, b in zip(*rows) if a["ok"] and b["ok"]), default=0.0)
