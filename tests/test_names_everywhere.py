@@ -156,7 +156,8 @@ def make_loop_run(robot: SnakeRobot, motion: dict, scene: Scene) -> Any:
     roots = np.repeat(np.eye(4)[None], len(t), axis=0)
     roots[:, 0, 3] = np.linspace(-0.2, 0.0, len(t))
     ground = types.SimpleNamespace(t=t, root_truth=roots, root_estimate=roots.copy(), q=np.zeros_like(q))
-    head = types.SimpleNamespace(t=t, root_pose=np.repeat(roots[-1:], len(t), axis=0), q=q)  # the head phases
+    head = types.SimpleNamespace(t=t, root_pose=np.repeat(roots[-1:], len(t), axis=0), q=q,  # the head phases
+                                 qdot=np.gradient(q, t, axis=0), base=motion["base"])
     name = scene.targets[0].name
     phases = [Phase("serpenoid forward (head, 1 x 1.00)", "gait", 0.0, 1.0, None, ground),
               Phase(name, "move", 1.0, 1.5), Phase(f"{name} (hold)", "hold", 1.5, 2.0)]

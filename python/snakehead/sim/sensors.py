@@ -33,6 +33,7 @@ import numpy.typing as npt
 
 from .._errors import InputError
 from .._validate import finite_float
+from ..model.physics import GRAVITY  # the simulated world's (sim.mjcf sets MuJoCo's gravity to it)
 
 #: Encoder counts per joint revolution: 12-bit absolute magnetic encoders (AS5045/AS5048-class; the Dynamixel
 #: X-series servos also report 4096 counts/rev): a step of 0.088 deg.
@@ -46,8 +47,6 @@ GYRO_BIAS_RANDOM_WALK = 2.0e-5
 #: Accelerometer white noise density (m/s^2/sqrt(Hz)): 200 micro-g/sqrt(Hz) (MPU-6000: 400, ICM-20948: 230,
 #: BMI088: 160).
 ACCEL_NOISE_DENSITY = 2.0e-3
-#: Standard gravity (m/s^2), as MuJoCo's default.
-GRAVITY = 9.81
 #: Head camera: noise of one frame's marker pose at 0.1-0.6 m (a calibrated camera and a fiducial marker: about
 #: a millimetre and half a degree per frame), per axis of the position and about the direction.
 HEAD_POSITION_NOISE_M = 0.001
