@@ -160,12 +160,8 @@ void bind_model(py::module_& m) {
                py::gil_scoped_release release;
                Frames f;
                const Eigen::Matrix4d O = origin ? *origin : Eigen::Matrix4d::Identity();
-               for (Eigen::Index t = 0; t < qs.rows(); ++t) {
-                 link_frames(c, qs.row(t).transpose(), f);
-                 for (py::ssize_t k = 0; k < n_links; ++k)
-                   Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(data + (t * n_links + k) * 16) =
-                       O * f[k].matrix();
-               }
+               for (Eigen::Index t = 0; t < qs.rows(); ++t)
+                 world_link_frames(c, O, qs.row(t).transpose(), f, data + t * n_links * 16);
              }
              return out;
            },

@@ -45,6 +45,13 @@ void link_frames(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd
     out[k] = links[k].segment < 0 ? links[k].offset : tips[links[k].segment] * links[k].offset;
 }
 
+void world_link_frames(const ChainModel& model, const Eigen::Matrix4d& origin, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       Frames& local, double* out) {
+  link_frames(model, q, local);
+  for (std::size_t k = 0; k < local.size(); ++k)
+    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(out + 16 * k) = origin * local[k].matrix();
+}
+
 void tip_jacobian(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Jacobian& jac,
                   Eigen::Isometry3d& tip) {
   const auto& segs = model.segments();

@@ -91,9 +91,7 @@ void PathChecker::world_frames(const Eigen::VectorXd& q, double* out) const {
 }
 
 void PathChecker::world_frames(const Eigen::VectorXd& q, double* out, Frames& f) const {
-  link_frames(model_, q, f);
-  for (std::size_t k = 0; k < f.size(); ++k)
-    Eigen::Map<Row4>(out + 16 * k) = origin_.matrix() * f[k].matrix();  // as ChainModel.fk_all_many(qs, origin)
+  world_link_frames(model_, origin_.matrix(), q, f, out);
 }
 
 void PathChecker::joints_at(const Eigen::VectorXd& q, Joints& out, std::vector<double>& frames) const {

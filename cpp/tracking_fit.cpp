@@ -102,18 +102,15 @@ TrackingFit::TrackingFit(const ChainModel& model, const ShapeSet& shapes, const 
 
 namespace {
 
-// World poses of the links at q, as Isometries and as the shape queries' row-major buffer (origin times the chain's
-// frames, as ChainModel.fk_all_many(qs, origin) multiplies them).
+// World poses of the links at q (world_link_frames), as the shape queries' row-major buffer and, given ``world``, as
+// Isometries too.
 void world_frames(const ChainModel& model, const Eigen::Isometry3d& origin, const Eigen::VectorXd& q, Frames& local,
                   Frames* world, std::vector<double>& out) {
-  link_frames(model, q, local);
-  out.resize(16 * local.size());
-  if (world != nullptr) world->resize(local.size());
-  for (std::size_t k = 0; k < local.size(); ++k) {
-    const Eigen::Matrix4d m = origin.matrix() * local[k].matrix();
-    Eigen::Map<Row4>(out.data() + 16 * k) = m;
-    if (world != nullptr) (*world)[k].matrix() = m;
-  }
+  out.resize(16 * model.links().size());
+  world_link_frames(model, origin.matrix(), q, local, out.data());
+  if (world == nullptr) return;
+  world->resize(local.size());
+  for (std::size_t k = 0; k < local.size(); ++k) (*world)[k].matrix() = Eigen::Map<const Row4>(out.data() + 16 * k);
 }
 
 }  // namespace

@@ -20,6 +20,12 @@ Eigen::Isometry3d forward_kinematics(const ChainModel& model, const Eigen::Ref<c
 // Poses of every link of model.links() in the base frame.
 void link_frames(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Frames& out);
 
+// Poses of every link in the frame where the chain's base frame has pose ``origin``: origin * link_frames(q), written
+// row-major, 16 doubles per link, to ``out`` (room for model.links().size() of them). ``local`` is the caller's work
+// buffer (link_frames's output). q is not checked.
+void world_link_frames(const ChainModel& model, const Eigen::Matrix4d& origin, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       Frames& local, double* out);
+
 // 6 x n geometric Jacobian of the tip, rows (v; omega), expressed in the base frame with the
 // reference point at the tip origin (KDL's ChainJntToJacSolver convention). Also returns the tip pose.
 void tip_jacobian(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Jacobian& jac,
