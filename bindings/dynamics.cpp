@@ -72,6 +72,56 @@ void bind_dynamics(py::module_& m) {
       "(force (T, 3), moment about the frames' origin (T, 3), in their axes; frames in an inertial frame where the "
       "root link is still)");
   m.def(
+      "newton_euler_along",
+      [](const ChainModel& model, Eigen::Matrix4d origin, Array q, Array qd, Array qdd, std::vector<int> joint_child,
+         Array axes, Array masses, Array coms, Array inertias, std::optional<std::vector<int>> lift_links,
+         std::optional<Array> lift_points, double ramp, Eigen::Vector3d gravity) {
+        const long n = static_cast<long>(joint_child.size());
+        const long L = static_cast<long>(model.links().size());
+        expect_shape(q, {-1, n}, "q (T, n)");
+        const long T = static_cast<long>(q.shape(0));
+        expect_shape(qd, {T, n}, "qd (T, n)");
+        expect_shape(qdd, {T, n}, "qdd (T, n)");
+        expect_shape(axes, {n, 3}, "axes (n, 3)");
+        expect_shape(masses, {L}, "masses (L,)");
+        expect_shape(coms, {L, 3}, "coms (L, 3)");
+        expect_shape(inertias, {L, 3, 3}, "inertias (L, 3, 3)");
+        const RigidBodyChain chain = make_chain(joint_child, axes, masses, coms, inertias);
+        std::optional<LiftPoints> lift;
+        if (lift_links) {
+          if (!lift_points) throw InputError("lift_points are needed with lift_links");
+          const auto k = static_cast<py::ssize_t>(lift_links->size());
+          expect_shape(*lift_points, {k, -1, 3}, "lift_points (k, M, 3)");
+          lift.emplace();
+          lift->link = *lift_links;
+          lift->ramp = ramp;
+          for (py::ssize_t i = 0; i < k; ++i) {
+            std::vector<Eigen::Vector3d> pts;
+            for (py::ssize_t j = 0; j < lift_points->shape(1); ++j)
+              pts.emplace_back(lift_points->at(i, j, 0), lift_points->at(i, j, 1), lift_points->at(i, j, 2));
+            lift->points.push_back(std::move(pts));
+          }
+        }
+        const auto Ts = static_cast<py::ssize_t>(T);
+        Array tau({Ts, static_cast<py::ssize_t>(n)}), force({Ts, py::ssize_t{3}}), moment({Ts, py::ssize_t{3}}),
+            com({Ts, py::ssize_t{3}});
+        double *tp = tau.mutable_data(), *fp = force.mutable_data(), *mp = moment.mutable_data(),
+               *cp = com.mutable_data();
+        {
+          py::gil_scoped_release release;
+          newton_euler_along(model, origin, chain, lift ? &*lift : nullptr, q.data(), qd.data(), qdd.data(), gravity,
+                             T, tp, fp, mp, cp);
+        }
+        return py::make_tuple(tau, force, moment, com);
+      },
+      py::arg("model"), py::arg("origin"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("joint_child"),
+      py::arg("axes"), py::arg("masses"), py::arg("coms"), py::arg("inertias"), py::arg("lift_links"),
+      py::arg("lift_points"), py::arg("ramp"), py::arg("gravity"),
+      "newton_euler along configurations q (T, n), the link frames (origin times the model's FK) and the lifted "
+      "shares (lift_links, lift_points (k, M, 3) in the links' frames, ramp m; None: every weight in full) computed "
+      "in the core: torques (T, n), the inertial wrench across the first joint (force, moment (T, 3)) and the "
+      "centre of mass (T, 3)");
+  m.def(
       "momenta",
       [](Array frames, Array qd, std::vector<int> joint_child, Array axes, Array masses, Array coms, Array inertias) {
         expect_shape(frames, {-1, -1, 4, 4}, "frames (T, L, 4, 4)");

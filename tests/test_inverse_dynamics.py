@@ -170,3 +170,51 @@ def test_core_passes_from_many_threads_and_bad_shapes():
         _core.momenta(frames[:, :, :3], qd[:3], *args)
     with pytest.raises(ValueError, match="child"):
         _core.newton_euler(frames, qd[:3], qdd[:3], [0] * robot.n_joints, *args[1:], None, np.zeros(3))
+
+
+def test_pass_along_q_equals_the_pass_over_given_frames(robot):
+    """Without frames the core computes each sample's frames, lifted shares and CoM in place: the same torques and
+    momentum rates as the pass over ``frames_many``'s frames with the lifted shares of ``lift_shares`` (numpy), and
+    the CoM of ``stability.center_of_mass``; with links on, near and off the ground."""
+    rng = np.random.default_rng(5)
+    q = np.array([robot.random_configuration(rng) for _ in range(60)])
+    q[:30, robot.joint_kinds.index("pitch")::2] *= 0.02  # nearly flat: shares strictly between 0 and 1
+    q = np.clip(q, robot.lower, robot.upper)
+    qd, qdd = rng.normal(size=q.shape), rng.normal(size=q.shape)
+    base = snakehead.BasePlacement(0.4, -0.2, 0.7)
+    frames = robot.frames_many(q, base)
+    shares = lift_shares(robot, frames)
+    assert np.any((shares > 0) & (shares < 1)), "the test needs links partly lifted"
+    for gravity in ("carried", "full", "none"):
+        along = newton_euler(robot, q, qd, qdd, base, gravity=gravity)
+        given = newton_euler(robot, q, qd, qdd, base, gravity=gravity, frames=frames)
+        scale = max(1.0, np.abs(given.tau).max())
+        assert np.abs(along.tau - given.tau).max() < 1e-12 * scale
+        np.testing.assert_allclose(along.Pdot, given.Pdot, rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(along.Ldot, given.Ldot, rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(along.com, stability.center_of_mass(robot, q, base), rtol=0, atol=1e-14)
+        assert given.com is None
+    one = newton_euler(robot, q[0], qd[0], qdd[0], base)
+    assert one.com.shape == (3,) and np.allclose(one.tau, newton_euler(robot, q, qd, qdd, base).tau[0])
+
+
+def test_pass_along_q_rejects_bad_shapes():
+    from snakehead import _core
+
+    robot = snakehead.SnakeRobot.default()
+    model = robot.body.model
+    q = np.zeros((3, robot.n_joints))
+    args = (list(model.joint_child_links), model.joint_axes, robot.masses, robot.coms, robot.inertias)
+    links, points = robot.distal_points
+    links = [int(k) for k in links]
+    origin = robot.root_pose(None)
+    with pytest.raises(ValueError, match="qdd"):
+        _core.newton_euler_along(model, origin, q, q, q[:2], *args, links, points, 0.005, np.zeros(3))
+    with pytest.raises(ValueError, match="lift_points"):
+        _core.newton_euler_along(model, origin, q, q, q, *args, links, points[:-1], 0.005, np.zeros(3))
+    with pytest.raises(ValueError, match="lift_points are needed"):
+        _core.newton_euler_along(model, origin, q, q, q, *args, links, None, 0.005, np.zeros(3))
+    with pytest.raises(ValueError, match="ramp"):
+        _core.newton_euler_along(model, origin, q, q, q, *args, links, points, 0.0, np.zeros(3))
+    with pytest.raises(ValueError, match="lifted link"):
+        _core.newton_euler_along(model, origin, q, q, q, *args, [999] + links[1:], points, 0.005, np.zeros(3))

@@ -232,20 +232,6 @@ def test_dynamic_stability_by_chunks_equals_it_on_the_whole_frames(planned, monk
     assert starts == list(range(0, len(t), 37)) and all(n == b - a <= 37 for a, b, n in seen) and seen[-1][1] == len(t)
 
 
-def test_monotone_interpolation_by_chunks_equals_it_at_once(monkeypatch):
-    from snakehead.motion.interpolation import MonotoneQuintic
-
-    rng = np.random.default_rng(0)
-    f = MonotoneQuintic(np.cumsum(rng.uniform(0.1, 1.0, 30)), rng.normal(size=(30, 4)))
-    t = np.linspace(f.times[0], f.times[-1], 1000)
-    whole = [f(t, nu) for nu in (0, 1, 2)]
-    monkeypatch.setattr(MonotoneQuintic, "CHUNK", 37)
-    for nu in (0, 1, 2):
-        np.testing.assert_array_equal(f(t, nu), whole[nu])
-    with pytest.raises(ValueError, match="nu must be 0, 1 or 2"):
-        f(t, 3)
-
-
 def test_the_plan_keeps_its_checks(planned):
     """The plan's checks (in the core, one pass) agree with the Python check of the whole trajectory at once: the
     ground exactly, the ZMP margins to round-off (the core sums the momenta in another order)."""

@@ -566,8 +566,8 @@ def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
     np.testing.assert_allclose(f(times[[0, -1]], 2), 0.0, atol=1e-12)
 
 
-def test_monotone_quintic_horner_form_equals_the_hermite_basis():
-    """The per-segment coefficients (Horner) give the quintic Hermite basis's values and derivatives (written out
+def test_monotone_quintic_piecewise_polynomial_equals_the_hermite_basis():
+    """The per-segment coefficients (scipy's PPoly) give the quintic Hermite basis's values and derivatives (written out
     here, as the class documents them), and ``derivatives`` gives what three calls give."""
     from snakehead.motion.interpolation import MonotoneQuintic
 
@@ -592,6 +592,8 @@ def test_monotone_quintic_horner_form_equals_the_hermite_basis():
         np.testing.assert_allclose(f(t, nu), basis[nu], atol=1e-12 * scale, rtol=0)
         np.testing.assert_array_equal(together[nu], f(t, nu))
     np.testing.assert_array_equal(f.derivatives(t, (2, 0))[0], together[2])
+    with pytest.raises(ValueError, match="orders must be 0, 1 or 2"):
+        f.derivatives(t, (3,))
 
 
 def test_joint_trajectory_monotone_method_and_bad_method():

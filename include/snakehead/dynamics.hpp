@@ -7,6 +7,8 @@
 
 #include <vector>
 
+#include "snakehead/model.hpp"
+
 namespace snakehead {
 
 // The chain's constant data for newton_euler: per joint its child link and its axis (child link's frame), per link
@@ -28,6 +30,24 @@ struct RigidBodyChain {
 void newton_euler(const RigidBodyChain& chain, const double* frames, const double* qd, const double* qdd,
                   const double* share, const Eigen::Vector3d& gravity, long T, long L, double* tau,
                   double* force, double* moment);
+
+// Where each link leaves the ground, for its lifted share (snakehead.dynamics.inverse_dynamics.lift_shares): the
+// shaped links and, in each one's frame, the points of its shapes farthest along the body. A link's share is
+// clamp(h / ramp, 0, 1), h the lowest of its points' heights; links without points have share 1.
+struct LiftPoints {
+  std::vector<int> link;
+  std::vector<std::vector<Eigen::Vector3d>> points;
+  double ramp = 0.005;
+  void validate(long n_links) const;  // throws InputError naming what is inconsistent
+};
+
+// newton_euler along configurations q (T x n) without a frames array: each sample's link frames (origin times the
+// chain's FK, model.links() order, the same links as chain's) are computed in place, its lifted shares from them
+// (lift == nullptr: every weight in full), and its centre of mass (Eq. 23) written to com (T x 3). q is not checked.
+void newton_euler_along(const ChainModel& model, const Eigen::Matrix4d& origin, const RigidBodyChain& chain,
+                        const LiftPoints* lift, const double* q, const double* qd, const double* qdd,
+                        const Eigen::Vector3d& gravity, long T, double* tau, double* force, double* moment,
+                        double* com);
 
 // The paper's momenta (Eqs. 25-31) for T samples: linear momentum P, angular momentum L about the frames' origin,
 // and the centre of mass (Eq. 23), each T x 3, from the links' frames (T x L x 4 x 4, an inertial frame in which

@@ -88,12 +88,13 @@ class InverseDynamics:
     tau (T, n) N m: the joint torques. Pdot (T, 3) N and Ldot (T, 3) N m: the rates of the linear momentum and of the
     angular momentum about the world origin (world axes) of the body (Eqs. 33-34): the inertial part of the wrench
     that the root link exerts on the rest of the body across the first joint (the rest of that wrench holds the
-    carried weight).
+    carried weight). com (T, 3) m: the centre of mass (Eq. 23) when the pass ran along q without frames (else None).
     """
 
     tau: np.ndarray
     Pdot: np.ndarray
     Ldot: np.ndarray
+    com: np.ndarray | None = None
 
 
 def _samples(robot: SnakeRobot, x: npt.ArrayLike, name: str, n_samples: int | None) -> np.ndarray:
@@ -144,21 +145,30 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
 
     # in the world frame: the root link is still, so its frame is as good as any inertial one, and the momentum rates
     # come out about the world origin (Eqs. 33-34) directly
-    shape = (T, len(robot.link_names), 4, 4)
-    F = robot.frames_many(qs, base) if frames is None or np.shape(frames) != shape else np.asarray(frames, float)
     g = np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)
-    share = lift_shares(robot, F, ramp) if gravity == "carried" else None  # (T, L)
+    chain = robot.body.model
+    masses = (list(chain.joint_child_links), chain.joint_axes, robot.masses, robot.coms, robot.inertias)
     # the pass itself (C++ core, per sample): forward, the links' angular velocities and accelerations and their
     # frames' accelerations from the root; backward, the wrench each link's parent exerts on it and on everything
     # beyond it, the weight's part scaled link by link by the lifted share. The inertial wrench across the first
     # joint (its moment about the world origin) is the momentum rate: the root link does not move
-    tau, Pdot, Ldot = _core.newton_euler(F, qds, qdds, list(robot.body.model.joint_child_links),
-                                         robot.body.model.joint_axes, robot.masses, robot.coms, robot.inertias,
-                                         share, g)
-    tau = tau[0] if single else tau
+    shape = (T, len(robot.link_names), 4, 4)
+    com = None
+    if frames is None or np.shape(frames) != shape:
+        # no frames given: the core computes each sample's frames, lifted shares and CoM in place (no (T, L, 4, 4)
+        # array in between)
+        links, points = robot.distal_points if gravity == "carried" else (None, None)
+        tau, Pdot, Ldot, com = _core.newton_euler_along(
+            chain, robot.root_pose(base), np.ascontiguousarray(qs), np.ascontiguousarray(qds),
+            np.ascontiguousarray(qdds), *masses, None if links is None else [int(k) for k in links], points,
+            positive(ramp, "ramp"), g)
+    else:
+        F = np.asarray(frames, float)
+        share = lift_shares(robot, F, ramp) if gravity == "carried" else None  # (T, L)
+        tau, Pdot, Ldot = _core.newton_euler(F, qds, qdds, *masses, share, g)
     if single:
-        Pdot, Ldot = Pdot[0], Ldot[0]
-    return InverseDynamics(tau, Pdot, Ldot)
+        return InverseDynamics(tau[0], Pdot[0], Ldot[0], None if com is None else com[0])
+    return InverseDynamics(tau, Pdot, Ldot, com)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import BSpline, make_interp_spline
+from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from .._validate import finite_array, finite_float, joint_vector, positive, sample_count
 
@@ -81,17 +81,15 @@ class MonotoneQuintic:
             hm = np.where(same, 2 * a * b / (a + b), 0.0)
         v[1:-1] = hm
         self.v = v
-        # each segment's quintic in its local s = (t - t_k) / h (Eq. of the Hermite basis above, expanded): q(s) =
-        # sum_i c_i s^i, its coefficients (K-1, 6, n); and those of dq/dt and d^2q/dt^2 in s (the 1/h, 1/h^2 in them)
+        # each segment's quintic in its local s = (t - t_k) / h (the Hermite basis above, expanded): q(s) =
+        # sum_i c_i s^i; scipy's PPoly holds it in t - t_k (c_i / h^i, highest power first) and evaluates it and its
+        # derivatives in compiled code (an order of magnitude faster than Horner's rule in numpy)
         dp, hv0, hv1 = np.diff(self.q, axis=0), h * v[:-1], h * v[1:]
         c = np.stack([self.q[:-1], hv0, np.zeros_like(dp), 10 * dp - 6 * hv0 - 4 * hv1, -15 * dp + 8 * hv0 + 7 * hv1,
-                      6 * dp - 3 * hv0 - 3 * hv1], axis=1)
-        self._coefficients = (c, c[:, 1:] * np.arange(1.0, 6.0)[None, :, None] / h[:, :, None],
-                              c[:, 2:] * np.array([2.0, 6.0, 12.0, 20.0])[None, :, None] / (h * h)[:, :, None])
-
-    #: Samples evaluated at once: the evaluation's temporaries take ~1 kB a sample for 16 joints, so a long
-    #: trajectory is evaluated a chunk at a time into its result (the same values).
-    CHUNK = 16384
+                      6 * dp - 3 * hv0 - 3 * hv1], axis=1)  # (K-1, 6, n)
+        c = c / h[:, :, None] ** np.arange(6.0)[None, :, None]
+        position = PPoly(np.ascontiguousarray(c[:, ::-1].transpose(1, 0, 2)), self.times)
+        self._pieces = (position, position.derivative(1), position.derivative(2))
 
     def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
         if nu not in (0, 1, 2):
@@ -99,25 +97,12 @@ class MonotoneQuintic:
         return self.derivatives(t, (nu,))[0]
 
     def derivatives(self, t: npt.ArrayLike, orders: tuple[int, ...] = (0, 1, 2)) -> list[np.ndarray]:
-        """The derivatives of the given ``orders`` (0, 1 or 2) at times t (N,): a list of (N, n), the segment of each
-        time looked up once for all (Horner's rule on each segment's polynomial)."""
+        """The derivatives of the given ``orders`` (0, 1 or 2) at times t (N,): a list of (N, n). Outside the
+        waypoints' times, the first and last segments' quintics continue."""
+        if any(nu not in (0, 1, 2) for nu in orders):
+            raise InputError(f"orders must be 0, 1 or 2, got {orders}")
         t = np.atleast_1d(np.asarray(t, float))
-        if len(t) > self.CHUNK:
-            out = [np.empty((len(t), self.q.shape[1])) for _ in orders]
-            for start in range(0, len(t), self.CHUNK):
-                for o, part in zip(out, self.derivatives(t[start:start + self.CHUNK], orders)):
-                    o[start:start + self.CHUNK] = part
-            return out
-        k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
-        s = ((t - self.times[k]) / (self.times[k + 1] - self.times[k]))[:, None]
-        out = []
-        for nu in orders:
-            c = self._coefficients[nu][k]  # (N, degree + 1, n)
-            value = c[:, -1]
-            for i in range(c.shape[1] - 2, -1, -1):
-                value = value * s + c[:, i]
-            out.append(value)
-        return out
+        return [self._pieces[nu](t) for nu in orders]
 
 
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:

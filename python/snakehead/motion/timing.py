@@ -46,7 +46,7 @@ from scipy.interpolate import CubicSpline
 
 from .._validate import MAX_SAMPLES, finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
-from ..dynamics.inverse_dynamics import inverse_dynamics, newton_euler
+from ..dynamics.inverse_dynamics import InverseDynamics, inverse_dynamics, newton_euler
 from ..margins import ZMP_MARGIN
 from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
@@ -318,10 +318,13 @@ class LimitCheck:
 
 
 def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
-            qd: np.ndarray, qdd: np.ndarray, frames: np.ndarray | None = None) -> dict[str, np.ndarray]:
+            qd: np.ndarray, qdd: np.ndarray, frames: np.ndarray | None = None, dyn: InverseDynamics | None = None
+            ) -> dict[str, np.ndarray]:
     """Per sample (T,): the largest |value| / limit of the joint velocities, accelerations and torques, the friction
-    used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one."""
-    dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
+    used (|dP_xy/dt| / (mu (M g + dP_z/dt))), the ZMP's margin in ``support`` and its slack over the required one.
+    ``dyn``: the samples' Newton-Euler pass when the caller has it."""
+    if dyn is None:
+        dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
     tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
     Mg = robot.total_mass * GRAVITY
     normal_force = Mg + Pdot[:, 2]
@@ -799,10 +802,11 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     q, dq, ddq = _path_values(f, s)
     qd, qdd = dq * np.sqrt(xs)[:, None], dq * u[stage][:, None] + ddq * xs[:, None]
     nearer = np.where(fr < 0.5, stage, stage + 1)
-    frames = robot.frames_many(q, base)
-    sub = Support(support.normal[nearer], support.offset[nearer], stability.center_of_mass(robot, q, base, frames=frames),
-                  support.static[nearer], support.required[nearer])
-    r = _ratios(robot, base, limits, sub, q, qd, qdd, frames)
+    dyn = newton_euler(robot, q, qd, qdd, base)  # in the core along q: no frames array, the CoM with it
+    assert dyn.com is not None
+    sub = Support(support.normal[nearer], support.offset[nearer], dyn.com, support.static[nearer],
+                  support.required[nearer])
+    r = _ratios(robot, base, limits, sub, q, qd, qdd, dyn=dyn)
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
         over |= r[key] > 1.0
