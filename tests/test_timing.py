@@ -126,6 +126,10 @@ def test_timeline_samples_every_order_at_once_as_one_at_a_time(lift):
         np.testing.assert_array_equal(together[nu], traj.spline(t, nu))
     np.testing.assert_array_equal(traj.spline.sample(t, (2,))[0], together[2])
     np.testing.assert_array_equal(traj.qd[1:-1], traj.spline(traj.t, 1)[1:-1])
+    # times in any order: each one's value, whatever the others (the pieces are looked up in time order)
+    shuffled = np.random.default_rng(0).permutation(t)
+    for nu in (0, 1, 2):
+        np.testing.assert_array_equal(traj.spline(shuffled, nu), [traj.spline(x, nu)[0] for x in shuffled])
 
 
 def test_timing_does_not_depend_on_the_placement(lift):

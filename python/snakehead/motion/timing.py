@@ -421,38 +421,41 @@ class _Timeline:
 
     def sample(self, t: npt.ArrayLike, orders: tuple[int, ...] = (0, 1, 2)) -> list[np.ndarray]:
         """The motion's derivatives of the given ``orders`` (0, 1, 2: q, qd, qdd) at times t: a list of (N, n), the
-        path evaluated once for all of them."""
+        path evaluated once for all of them. Times before the motion take its first item, after it its last."""
         t = np.atleast_1d(np.asarray(t, float))
+        if np.any(np.diff(t) < 0):  # in time order, then back in the caller's
+            order = np.argsort(t, kind="stable")
+            result = self.sample(t[order], orders)
+            for r in result:
+                r[order] = r.copy()
+            return result
         out = [np.zeros((len(t), self.n)) for _ in orders]
         path_orders = tuple(sorted(set(orders) | ({1} if 2 in orders else set())))  # qdd needs q'(s) too
-        for k, item in enumerate(self.items):
-            last = k == len(self.items) - 1
-            tt = item["t"]
-            mask = (t >= tt[0]) & ((t <= tt[-1]) if last else (t < tt[-1]))
-            if k == 0:
-                mask |= t < tt[0]
-            if last:
-                mask |= t > tt[-1]
-            if not mask.any():
+        # item k holds the times in [start_k, start_k+1) (the last item also its end and after): one search for all
+        starts = np.array([item["t"][0] for item in self.items[1:]])
+        bounds = np.r_[0, np.searchsorted(t, starts, side="left"), len(t)]
+        for item, lo, hi in zip(self.items, bounds[:-1], bounds[1:]):
+            if hi <= lo:
                 continue
             if item["kind"] == "pause":
                 for o, nu in zip(out, orders):
                     if nu == 0:
-                        o[mask] = item["q"]
+                        o[lo:hi] = item["q"]
                 continue
-            i = np.clip(np.searchsorted(tt, t[mask], side="right") - 1, 0, len(tt) - 2)
-            tau = np.clip(t[mask] - tt[i], 0.0, tt[i + 1] - tt[i])
+            tt = item["t"]
+            i = np.clip(np.searchsorted(tt, t[lo:hi], side="right") - 1, 0, len(tt) - 2)
+            tau = np.clip(t[lo:hi] - tt[i], 0.0, tt[i + 1] - tt[i])
             s = np.clip(item["s"][i] + item["sd"][i] * tau + 0.5 * item["u"][i] * tau ** 2, item["s"][i],
                         item["s"][i + 1])
             sd = np.maximum(item["sd"][i] + item["u"][i] * tau, 0.0)
             d = dict(zip(path_orders, _path_derivatives(item["f"], s, path_orders)))
             for o, nu in zip(out, orders):
                 if nu == 0:
-                    o[mask] = d[0]
+                    o[lo:hi] = d[0]
                 elif nu == 1:
-                    o[mask] = d[1] * sd[:, None]
+                    o[lo:hi] = d[1] * sd[:, None]
                 else:
-                    o[mask] = d[1] * item["u"][i][:, None] + d[2] * (sd ** 2)[:, None]
+                    o[lo:hi] = d[1] * item["u"][i][:, None] + d[2] * (sd ** 2)[:, None]
         return out
 
 
@@ -729,7 +732,7 @@ class GridPoints:
         q, dq, ddq = _path_values(f, s)
         frames = robot.frames_many(q, base)
         a, b = _path_dynamics(robot, q, dq, ddq, base, frames)
-        hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base, frames=frames)
+        hold = inverse_dynamics(robot, q, np.zeros_like(q), np.zeros_like(q), base)  # along q in the core
         support = Support.of(robot, q, base, zmp_margin, frames)
         return cls(s, q, dq, ddq, a.tau, b.tau, hold, np.hstack([a.Pdot, a.Ldot]), np.hstack([b.Pdot, b.Ldot]),
                    support)
