@@ -180,11 +180,11 @@ def test_base_kept_when_not_allowed_to_move(default):
 
 def test_failure_reasons(default):
     robot, controller, prob = default
-    high = wb.solve_target(controller, [0.3, 0.3, 3.0], [0, 0, 1], problem=prob, time_budget=0.5)
+    high = wb.solve_target(controller, [0.3, 0.3, 3.0], [0, 0, 1], problem=prob, budget=8)
     assert high.reason == "out of reach" and high.stage is None
     # a box over the only region the head can reach from here: no clear pose with the base kept
     sol = wb.solve_target(controller, [0.15, 0.5, 0.4], [0, 1, 0], problem=prob, allow_base_move=False,
-                          obstacles=[snakehead.BoxObstacle([0.15, 0.3, 0.3], [1.5, 0.3, 0.6])], time_budget=0.5)
+                          obstacles=[snakehead.BoxObstacle([0.15, 0.3, 0.3], [1.5, 0.3, 0.6])], budget=8)
     assert sol.reason in ("no clear pose", "out of reach")
 
 
