@@ -512,10 +512,10 @@ def check_solutions(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, posi
     ground = robot.geometry.lowest_z(frames, lifted).min(axis=1) if len(lifted) else np.full(len(qs), np.inf)
     selfc = pair_min_distances(frames, robot.geometry, frames, robot.geometry, robot.self_collision_pairs)
     obst = (coll.collision_check(robot, qs, list(obstacles), base, exact_within=0.01).distance if obstacles
-            else [None] * len(qs))
+            else None)
     out = []
     for k in range(len(qs)):
-        o = None if obst[k] is None else float(obst[k])
+        o = None if obst is None else float(obst[k])
         if pe[k] > POSITION_TOLERANCE or np.radians(de[k]) > DIRECTION_TOLERANCE:
             reason: str | None = "out of reach"
         elif margin[k] < min_margin:
@@ -740,9 +740,13 @@ class _TargetSearch:
         self.segmented: Any = None  # the segmented solution, once stage 1 has run
         self.rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
 
-    def spend(self) -> None:
-        """One solve of stage 3 made (a segmented solve, a batch of IK, a refinement)."""
+    def afford(self) -> bool:
+        """Whether stage 3 may make one more solve (a segmented solve, a batch of IK, a refinement) within its
+        ``budget``; counts it when it may."""
+        if self.out_of_work():
+            return False
         self.spent += 1
+        return True
 
     def out_of_work(self) -> bool:
         """Whether stage 3 has made its ``budget`` of solves."""
@@ -871,9 +875,8 @@ class _TargetSearch:
             if self.out_of_work():
                 break
         for q0, b0 in moved_starts:
-            if self.out_of_work():
+            if not self.afford():
                 break
-            self.spend()
             q, b = refine(self.prob, q0, b0, self.position, self.direction, move_base=True, obstacles=self.obstacles,
                           min_margin=self.min_margin)
             if found := self.moved(np.clip(q, self.robot.lower, self.robot.upper), b, len(moved_starts)):
@@ -885,7 +888,7 @@ class _TargetSearch:
         """The base with base joints qb: the placement that brings the target into the neck's accepted range
         (Section 3.3 (3)) and its segmented solution (added to ``moved_starts``), then the lifted chain's IK
         candidates there and at the other candidate placements (:func:`placements`), while the shape passes and
-        time is left."""
+        the budget lasts (:meth:`afford`)."""
         from . import neck as nk
 
         robot, controller, base = self.robot, self.controller, self.base
@@ -895,23 +898,19 @@ class _TargetSearch:
         placed = None if controller.neck_length <= 0 else nk.base_move_into_range(
             self.position, P0_local, base, controller.Lc, controller.neck_length, controller.slack,
             robot.body_axis_height)
-        if placed is not None:
-            self.spend()
+        if placed is not None and self.afford():
             s = self.segmented_at(q, placed, clear=False)
             if s.success and (found := self.moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
         for b in ([placed] if placed is not None else []) + placements(self.prob, P0_local, self.position,
                                                                       self.direction):
-            if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes:
+            if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes or not self.afford():
                 break
-            self.spend()
             candidates = lifted_candidates(self.prob, q, b, self.position, self.direction, self.seed)
             for qc, chk in zip(candidates, self.check_many(candidates, b)):
                 if found := self.moved(qc, b, 0, chk):
                     return found
-            if self.out_of_work():
-                break
         return None
 
 
