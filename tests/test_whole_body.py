@@ -394,3 +394,19 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
     before = (len(calls), len(kept_calls))
     sol = target_solves.solve_kept(controller, target.position, target.direction, q_shape, chosen, [], memo)
     assert sol.success and (len(calls), len(kept_calls)) == before  # the plan's solve: kept from the choice
+
+
+def test_rolled_frames_are_roll_about_x():
+    """The candidates' rolled frames (one call for every angle) are head.roll_about_x's, bit for bit (the IK's
+    seeded results, and so the plans, depend on them)."""
+    from snakehead.control.head import frame_from_direction, roll_about_x
+
+    T = frame_from_direction([0.3, -0.2, 0.4], [0.2, 0.5, 0.8])
+    angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
+    got = wb._rolled(T, angles)
+    for k, a in enumerate(angles):
+        np.testing.assert_array_equal(got[k], roll_about_x(T, a))
+        # independent: the rotation about the frame's own x-axis keeps x and turns y towards z by the angle
+        np.testing.assert_allclose(got[k][:3, 0], T[:3, 0], atol=1e-15)
+        assert got[k][:3, 1] @ T[:3, 1] == pytest.approx(np.cos(a), abs=1e-12)
+        assert got[k][:3, 1] @ T[:3, 2] == pytest.approx(np.sin(a), abs=1e-12)

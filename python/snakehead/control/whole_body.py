@@ -613,7 +613,7 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
     chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
     frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
-    from .head import frame_along, roll_about_x
+    from .head import frame_along
 
     robot = prob.robot
     ik = prob.lifted_ik(seed)
@@ -621,7 +621,7 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     T0 = robot.frame(q_now, robot.lift_frame, base)
     target = np.linalg.inv(T0) @ frame_along(position, direction)
     angles = 2 * np.pi * np.arange(CANDIDATE_ROLLS) / CANDIDATE_ROLLS
-    poses = np.stack([roll_about_x(target, a) for a in angles] * CANDIDATE_SEEDS)
+    poses = np.concatenate([_rolled(target, angles)] * CANDIDATE_SEEDS)
     rng = np.random.default_rng(seed)
     inits = np.vstack([np.tile(q_now[start:], (CANDIDATE_ROLLS, 1))]
                       + [rng.uniform(ik.lower, ik.upper, (CANDIDATE_ROLLS, ik.n_joints))
@@ -632,6 +632,16 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
         q = q_now.copy()
         q[start:] = qk
         out.append(q)
+    return out
+
+
+def _rolled(T: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """``head.roll_about_x`` of a frame (4, 4) made here (valid) by each of ``angles`` (rad): (k, 4, 4), the same
+    arithmetic without checking the frame again for every angle."""
+    out = np.repeat(T[None], len(angles), axis=0)
+    for k, angle in enumerate(angles):
+        c, s = np.cos(float(angle)), np.sin(float(angle))
+        out[k, :3, :3] = T[:3, :3] @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
     return out
 
 
