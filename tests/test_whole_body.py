@@ -362,9 +362,10 @@ def test_solve_is_deterministic_and_its_work_counted(default):
 
 
 def test_relocation_solves_nothing_twice(default, monkeypatch):
-    """choose_base for a target reached only from another base shape: with the plan's PlanSolves, no segmented solve
-    and no solve with the base kept is made twice with the same arguments (the relocation's search takes the
-    failed solve with the base kept from the first failure), and the plan's own solve of the target is a hit."""
+    """choose_base for a target reached only from another base shape: with the plan's PlanSolves, no segmented solve,
+    no batch of the lifted chain's IK and no solve with the base kept is made twice with the same arguments (the
+    relocation's search takes the failed solve with the base kept from the first failure), and the plan's own
+    solve of the target is a hit."""
     from snakehead.motion import base_choice, target_solves
     from snakehead.motion.targets import reachable_targets
 
@@ -383,17 +384,31 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
         kept_calls.append((self.position.tobytes(), self.q_now.tobytes(), self.base))
         return base_kept(self, near)
 
+    ik_calls = []
+    lifted_candidates = wb.lifted_candidates
+
+    def counted_ik(prob, q_now, base, position, direction, seed=0):
+        ik_calls.append((q_now.tobytes(), base, position.tobytes(), direction.tobytes(), seed))
+        return lifted_candidates(prob, q_now, base, position, direction, seed)
+
     monkeypatch.setattr(type(controller), "solve_checked", counted)
     monkeypatch.setattr(wb._TargetSearch, "base_kept", counted_kept)
+    monkeypatch.setattr(wb, "lifted_candidates", counted_ik)
     t = reachable_targets(controller, "shape", 1, np.random.default_rng(3))[0]
     target = snakehead.scenes.Target("t", t.position, t.direction)
     memo = wb.PlanSolves()
     chosen, q_shape, relocation, _ = base_choice.choose_base(controller, [target], solved=memo)
     assert relocation is not None  # the target needs another base
     assert len(calls) == len(set(calls)) and len(kept_calls) == len(set(kept_calls))
-    before = (len(calls), len(kept_calls))
+    assert len(ik_calls) == len(set(ik_calls))
+    before = (len(calls), len(kept_calls), len(ik_calls))
     sol = target_solves.solve_kept(controller, target.position, target.direction, q_shape, chosen, [], memo)
-    assert sol.success and (len(calls), len(kept_calls)) == before  # the plan's solve: kept from the choice
+    assert sol.success and (len(calls), len(kept_calls), len(ik_calls)) == before  # the plan's: from the choice
+    # without the plan's PlanSolves the same choice repeats solves (what the memo saves), and chooses the same base
+    calls.clear(), ik_calls.clear()
+    again = base_choice.choose_base(controller, [target], solved=None)
+    assert again[0] == chosen and np.array_equal(again[1], q_shape)
+    assert len(calls) + len(ik_calls) > len(set(calls)) + len(set(ik_calls))
 
 
 def test_rolled_frames_are_roll_about_x():

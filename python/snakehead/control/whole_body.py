@@ -124,15 +124,17 @@ class WholeBodySolution:
 class PlanSolves:
     """The solves of one plan's targets that its steps share (the base's choice, the relocation's search and the
     targets' solves ask for the same ones): the whole-body solves with the base kept (``kept``: the planner's
-    :func:`~snakehead.motion.target_solves.solve_kept` keys them) and the segmented solves
-    (:meth:`HeadController.solve_checked <snakehead.control.controller.HeadController.solve_checked>`) of
-    :func:`solve_checked_target`. Both solves are deterministic (the same arguments give the same solution), so an
-    entry stands for a solve again. Owned by one plan: its controller and obstacles are fixed for its life, and it
+    :func:`~snakehead.motion.target_solves.solve_kept` keys them), and the segmented solves
+    (:meth:`HeadController.solve_checked <snakehead.control.controller.HeadController.solve_checked>`) and the lifted
+    chain's IK candidates (:func:`lifted_candidates`) of :func:`solve_checked_target`. Every one is deterministic
+    (the same arguments give the same solution: the IK is seeded, its searches bounded by counts), so an entry
+    stands for a solve again. Owned by one plan: its controller and obstacles are fixed for its life, and it
     is dropped with the plan (no bound on its size: a plan solves a bounded number of targets)."""
 
     def __init__(self) -> None:
         self.kept: dict[tuple, WholeBodySolution] = {}
         self.segmented: dict[tuple, Any] = {}
+        self.candidates: dict[tuple, list[np.ndarray]] = {}
 
 
 class BodyProblem:
@@ -814,7 +816,7 @@ class _TargetSearch:
                     return found
             if found := self.segmented_solve():
                 return found
-            candidates = lifted_candidates(self.prob, self.q_now, self.base, self.position, self.direction, self.seed)
+            candidates = self.candidates_at(self.q_now, self.base)
             for k, (q, chk) in enumerate(zip(candidates, self.check_many(candidates, self.base))):
                 if found := self.consider(q, self.base, STAGES[1], k + 1, chk):
                     return found
@@ -826,6 +828,17 @@ class _TargetSearch:
         seg = self.segmented_at(self.q_now, self.base, clear=True)
         self.segmented = seg
         return self.consider(seg.q, seg.base, STAGES[0], 0)
+
+    def candidates_at(self, q: np.ndarray, base: BasePlacement) -> list[np.ndarray]:
+        """:func:`lifted_candidates` from ``q`` at ``base`` (copies), kept in the plan's :class:`PlanSolves`: the
+        relocation's search and the solve with the base kept at the base it finds solve the same batch."""
+        key = (self.position.tobytes(), self.direction.tobytes(), q.tobytes(), base, self.seed)
+        found = None if self.memo is None else self.memo.candidates.get(key)
+        if found is None:
+            found = lifted_candidates(self.prob, q, base, self.position, self.direction, self.seed)
+            if self.memo is not None:
+                self.memo.candidates[key] = found
+        return [c.copy() for c in found]
 
     def segmented_at(self, q_prev: np.ndarray, base: BasePlacement, clear: bool) -> Any:
         """The segmented solve (:meth:`HeadController.solve_checked`, the base kept) from ``q_prev`` at ``base``,
@@ -917,7 +930,7 @@ class _TargetSearch:
                                                                       self.direction):
             if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes or not self.afford():
                 break
-            candidates = lifted_candidates(self.prob, q, b, self.position, self.direction, self.seed)
+            candidates = self.candidates_at(q, b)
             for qc, chk in zip(candidates, self.check_many(candidates, b)):
                 if found := self.moved(qc, b, 0, chk):
                     return found
