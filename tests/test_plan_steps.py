@@ -148,7 +148,7 @@ def test_no_lift_where_the_initial_state_is_in_an_obstacle(controller):
 def run_of(scene, controller):
     lines = plan_bounds.check_size(scene)
     return planner._Run(controller, scene, lines, controller.base, [], Waypoints(controller.robot, controller.base),
-                        [], {}, planner._Progress(None, scene, 0.0, controller.robot, None))
+                        [], wb.PlanSolves(), planner._Progress(None, scene, 0.0, controller.robot, None))
 
 
 def test_reach_targets_groups_the_line_approaches_into_runs(controller):
@@ -197,16 +197,16 @@ def test_reach_target_moves_to_the_solution_and_stops(controller, reachable):
 # --- the base's choice -------------------------------------------------------------------------------------------
 def test_first_failure(controller, reachable):
     q0 = controller.q_initial
-    assert base_choice._first_failure(controller, controller.base, q0, reachable, [], {}) == (None, None)
+    assert base_choice._first_failure(controller, controller.base, q0, reachable, [], wb.PlanSolves()) == (None, None)
     far = Target("far", [3.0, 0.0, 0.3], [1.0, 0.0, 0.0])
-    first, sol = base_choice._first_failure(controller, controller.base, q0, list(reachable) + [far], [], {})
+    first, sol = base_choice._first_failure(controller, controller.base, q0, list(reachable) + [far], [], wb.PlanSolves())
     assert first is far and not sol.success
     q_bend = start_state.bending_state(controller)
     P = controller.robot.frames(q_bend, controller.base)[:, :3, 3].mean(axis=0)
     on_start = BoxObstacle(centre=[P[0], P[1], 0.02], size=[0.3, 0.3, 0.04])
-    assert base_choice._first_failure(controller, controller.base, q0, reachable, [on_start], {}) == ("the start",
+    assert base_choice._first_failure(controller, controller.base, q0, reachable, [on_start], wb.PlanSolves()) == ("the start",
                                                                                                      None)
-    assert base_choice._first_failure(controller, controller.base, np.zeros_like(q0), reachable, [], {}) == (
+    assert base_choice._first_failure(controller, controller.base, np.zeros_like(q0), reachable, [], wb.PlanSolves()) == (
         "no curl", None)
 
 
@@ -225,8 +225,8 @@ def test_relocated_for_a_target_out_of_reach(controller):
     moved = snakehead.BasePlacement(0.6, 0.3, 0.5)
     H = robot.head_pose(q_far, moved)
     far = Target("far", H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])
-    assert base_choice._first_failure(controller, controller.base, q_far, [far], [], {})[0] is far
-    found = base_choice._relocated_for(controller, far, q_far, [far], [], {})
+    assert base_choice._first_failure(controller, controller.base, q_far, [far], [], wb.PlanSolves())[0] is far
+    found = base_choice._relocated_for(controller, far, q_far, [far], [], wb.PlanSolves())
     assert found is not None
     base, q_shape = found
     assert base != controller.base
@@ -240,7 +240,7 @@ def test_relocated_for_a_target_out_of_reach(controller):
 
 # --- the whole-body solve's steps --------------------------------------------------------------------------------
 def search_for(controller, position, direction, **kw):
-    options = dict(q_prev=None, base=None, obstacles=(), min_margin=DETOUR_MARGIN, time_budget=3.0, problem=None,
+    options = dict(q_prev=None, base=None, obstacles=(), min_margin=DETOUR_MARGIN, budget=wb.SOLVE_BUDGET, problem=None,
                    seed=0, shape_ok=None) | kw
     return wb._TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), **options)
 
@@ -289,6 +289,6 @@ def test_base_moved_reaches_beyond_and_respects_shape_ok(controller):
     assert sol is not None and sol.success and sol.stage == wb.STAGES[2] and sol.base != controller.base
     H = robot.head_pose(sol.q, sol.base)
     assert np.linalg.norm(H[:3, 3] - position) <= wb.POSITION_TOLERANCE
-    refused = search_for(controller, position, direction, shape_ok=lambda q: False, time_budget=1.0)
+    refused = search_for(controller, position, direction, shape_ok=lambda q: False)
     assert refused.base_moved() is None
     assert refused.best is None or refused.best.stage is None or refused.best.base == controller.base

@@ -428,3 +428,36 @@ def test_zmp_undefined_when_the_ground_would_pull(robot):
     assert np.array_equal(np.isnan(p).any(axis=1), pulls)
     res = st.dynamic_stability(robot, t, q)
     assert np.all(res.margin[pulls] == -np.inf) and not res.stable and res.min_margin == -np.inf
+
+
+@pytest.mark.parametrize("contact", ["ground", "footprint"])
+def test_static_margins_of_a_batch_match_qhull(robot, contact):
+    """static_margins_of_frames (one call for a batch, the core's hull per sample) against Qhull's hull of each
+    sample's box corners on the ground and the centre of mass summed link by link; static_margin (one
+    configuration) gives the same. The batch mixes flat shapes and lifted poses whose neck or head touch the
+    ground, so that the samples' contacts differ."""
+    from hull_reference import com_reference, margin_to_hull
+    from shape_reference import box_corners
+
+    rng = np.random.default_rng(11)
+    base = BasePlacement(0.3, -0.2, 0.7)
+    qs = np.zeros((30, 16))
+    qs[:, :7] = rng.uniform(-0.6, 0.6, (30, 7)) * (robot.joint_kinds[0] == "yaw")
+    qs[:, 7:] = rng.normal(0.0, 0.3, (30, 9))
+    qs[::3, 7:] = 0.0  # lying flat: the neck and head support the body too ("ground")
+    qs = np.clip(qs, robot.lower, robot.upper)
+    qs[:, [k for k in range(7) if robot.joint_kinds[k] != "yaw"]] = 0.0
+    frames = robot.frames_many(qs, base)
+    com = st.center_of_mass(robot, qs, base)
+    got = st.static_margins_of_frames(robot, frames, com, contact)
+    links = robot.shaped_links if contact == "ground" else np.intersect1d(robot.base_links, robot.shaped_links)
+    # each box's lowest corners (as many as the contact model takes per shape: its lowest face, or the edge a tilted
+    # box rests on) that are on the ground
+    corners = box_corners(robot, frames, links).reshape(len(qs), -1, 8, 3)
+    order = np.argsort(corners[..., 2], axis=-1, kind="stable")[..., :robot.geometry.contact_points_per_shape]
+    corners = np.take_along_axis(corners, order[..., None], axis=2).reshape(len(qs), -1, 3)
+    for k in range(len(qs)):
+        touching = corners[k][corners[k][:, 2] <= st.CONTACT_TOLERANCE, :2]
+        ref = margin_to_hull(touching, com_reference(robot, frames[k])[:2])
+        assert got[k] == pytest.approx(ref, abs=1e-9)
+        assert st.static_margin(robot, qs[k], base, contact=contact) == pytest.approx(ref, abs=1e-9)

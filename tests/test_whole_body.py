@@ -180,11 +180,11 @@ def test_base_kept_when_not_allowed_to_move(default):
 
 def test_failure_reasons(default):
     robot, controller, prob = default
-    high = wb.solve_target(controller, [0.3, 0.3, 3.0], [0, 0, 1], problem=prob, time_budget=0.5)
+    high = wb.solve_target(controller, [0.3, 0.3, 3.0], [0, 0, 1], problem=prob, budget=8)
     assert high.reason == "out of reach" and high.stage is None
     # a box over the only region the head can reach from here: no clear pose with the base kept
     sol = wb.solve_target(controller, [0.15, 0.5, 0.4], [0, 1, 0], problem=prob, allow_base_move=False,
-                          obstacles=[snakehead.BoxObstacle([0.15, 0.3, 0.3], [1.5, 0.3, 0.6])], time_budget=0.5)
+                          obstacles=[snakehead.BoxObstacle([0.15, 0.3, 0.3], [1.5, 0.3, 0.6])], budget=8)
     assert sol.reason in ("no clear pose", "out of reach")
 
 
@@ -237,3 +237,191 @@ def test_margin_alone_equals_margin_and_gradient(default, generated):
             expected = prob.margin_and_gradient(F, base)[0]
             got = prob.margin(F)
             assert got == expected or abs(got - expected) < 1e-12, (got, expected)
+
+
+def _mixed_batch(robot, controller, prob, rng, count):
+    """Configurations around the initial one: the base's flat shape and the lifted joints perturbed (some lean on a
+    lifted link, some tip over, some touch themselves)."""
+    qs = np.tile(controller.q_initial, (count, 1))
+    lifted = np.arange(robot.lift_joints.start, robot.n_joints)
+    yaw = np.flatnonzero(prob.ground_yaw)
+    qs[:, lifted] += rng.normal(0.0, 0.6, (count, len(lifted)))
+    qs[1::2, yaw] += rng.normal(0.0, 0.4, (count // 2, len(yaw)))
+    return np.clip(qs, robot.lower, robot.upper)
+
+
+def test_body_problem_margins_of_a_batch_match_qhull(default):
+    """BodyProblem.margins (a batch at once: the contacts masked, the core's hull per sample) against Qhull's hull of
+    each sample's ground-link box corners within CONTACT_BAND of each link's lowest, and the centre of mass summed
+    link by link; collinear contacts give -inf."""
+    from hull_reference import com_reference, hull_vertices, margin_to_hull
+    from shape_reference import box_corners
+
+    robot, controller, prob = default
+    rng = np.random.default_rng(21)
+    base = BasePlacement(-0.3, 0.5, 2.0)
+    qs = _mixed_batch(robot, controller, prob, rng, 40)
+    qs[0, :robot.lift_joints.start] = 0.0  # a straight base: its contacts are two lines (a rectangle)
+    frames = robot.frames_many(qs, base)
+    got = prob.margins(frames)
+    for k in range(len(qs)):
+        kept = []
+        for link in prob.ground_links:
+            c = box_corners(robot, frames[k:k + 1], [link])[0]
+            kept.append(c[c[:, 2] <= c[:, 2].min() + wb.CONTACT_BAND, :2])
+        pts = np.concatenate(kept)
+        xy = com_reference(robot, frames[k])[:2]
+        ref = margin_to_hull(pts, xy) if hull_vertices(pts) is not None else -np.inf
+        assert got[k] == pytest.approx(ref, abs=1e-9), k
+        assert prob.margin(frames[k]) == got[k]
+    # a degenerate support (every contact on one line): -inf, as the single margin says
+    line = np.zeros((1,) + frames.shape[1:])
+    line[0] = frames[0]
+    assert prob.margins(line)[0] == prob.margin(frames[0])
+
+
+def test_check_solutions_of_a_batch_match_independent_checks(default):
+    """check_solutions (a batch in one pass) field by field against independent computations per configuration:
+    the head by forward kinematics (robot.head_pose), the static margin by Qhull over the box corners on the ground
+    (the smaller of every link's and the ground links' own), the lowest lifted box corner, the self clearance and
+    the obstacle clearance by the one-configuration routines; and the verdict by the rule written out."""
+    from hull_reference import com_reference, hull_vertices, margin_to_hull
+    from shape_reference import box_corners
+
+    robot, controller, prob = default
+    rng = np.random.default_rng(22)
+    base = BasePlacement(0.1, -0.2, 0.3)
+    qs = _mixed_batch(robot, controller, prob, rng, 24)
+    obstacles = [snakehead.BoxObstacle(robot.head_pose(qs[3], base)[:3, 3] + [0.0, 0.0, 0.06], [0.1, 0.1, 0.05])]
+    reasons = set()
+    for target in (0, 3, 5):  # the head pose of one configuration of the batch: that one reaches it
+        H = robot.head_pose(qs[target], base)
+        got = wb.check_solutions(robot, qs, base, H[:3, 3], H[:3, 0], obstacles, min_margin=wb.MIN_MARGIN,
+                                 problem=prob)
+        for k, chk in enumerate(got):
+            F = robot.frames(qs[k], base)
+            Hk = F[robot.link_index(robot.parts.head_tip)]
+            pe = np.linalg.norm(Hk[:3, 3] - H[:3, 3])
+            de = np.degrees(np.arccos(np.clip(Hk[:3, 0] @ H[:3, 0], -1, 1)))
+            corners = box_corners(robot, F[None], robot.shaped_links)[0]
+            order = np.argsort(corners.reshape(-1, 8, 3)[..., 2], axis=-1, kind="stable")
+            lowest = np.take_along_axis(corners.reshape(-1, 8, 3), order[..., None], 1)[:, :4].reshape(-1, 3)
+            xy = com_reference(robot, F)[:2]
+            whole = margin_to_hull(lowest[lowest[:, 2] <= stability.CONTACT_TOLERANCE, :2], xy)
+            own = []
+            for link in prob.ground_links:
+                c = box_corners(robot, F[None], [link])[0]
+                own.append(c[c[:, 2] <= c[:, 2].min() + wb.CONTACT_BAND, :2])
+            own_pts = np.concatenate(own)
+            base_own = margin_to_hull(own_pts, xy) if hull_vertices(own_pts) is not None else -np.inf
+            margin = min(whole, base_own)
+            ground = box_corners(robot, F[None], robot.lifted_links)[0][:, 2].min()
+            selfc = coll.self_clearance(robot, qs[k], base)[0]
+            obst = coll.collision_check(robot, qs[k][None], obstacles, base, exact_within=0.01).distance[0]
+            assert chk["position_error_m"] == pytest.approx(pe, abs=1e-12)
+            assert chk["direction_error_deg"] == pytest.approx(de, abs=1e-6)
+            assert chk["static_margin_m"] == pytest.approx(margin, abs=1e-9)
+            assert chk["ground_clearance_m"] == pytest.approx(ground, abs=1e-12)
+            assert chk["self_clearance_m"] == pytest.approx(selfc, abs=1e-12)
+            assert chk["obstacle_clearance_m"] == pytest.approx(obst, abs=1e-12)
+            reason = ("out of reach" if pe > wb.POSITION_TOLERANCE or np.radians(de) > wb.DIRECTION_TOLERANCE else
+                      "no stable pose" if margin < wb.MIN_MARGIN else
+                      "no clear pose" if (ground < -coll.GROUND_TOLERANCE or selfc <= 0.0
+                                          or obst <= wb.OBSTACLE_CLEARANCE) else None)
+            assert chk["reason"] == reason
+            reasons.add(reason)
+            one = wb.check_solution(robot, qs[k], base, H[:3, 3], H[:3, 0], obstacles, problem=prob)
+            assert one["reason"] == chk["reason"]
+            for key in ("position_error_m", "static_margin_m", "ground_clearance_m", "self_clearance_m"):
+                assert one[key] == pytest.approx(chk[key], abs=1e-12)
+    assert "out of reach" in reasons and len(reasons) >= 2  # the rule's branches are exercised
+
+
+def test_solve_is_deterministic_and_its_work_counted(default):
+    """The same target, placement and seed give the same solution twice (the search is bounded by a count of
+    solves, not by the clock); a smaller budget bounds stage 3's solves and solve_whole_body's starts."""
+    robot, controller, prob = default
+    moved = BasePlacement(0.6, 0.3, 0.5)
+    H = robot.head_pose(controller.q_initial, moved)
+    position, direction = H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0]
+    first = wb.solve_target(controller, position, direction, problem=prob)
+    again = wb.solve_target(controller, position, direction, problem=prob)
+    assert first.success and first.stage == wb.STAGES[2]
+    np.testing.assert_array_equal(first.q, again.q)
+    assert (first.base, first.reason, first.static_margin_m) == (again.base, again.reason, again.static_margin_m)
+    far = np.array([3.0, 0.0, 0.05])  # out of reach of every placement the search tries
+    for budget in (1, 3, 7):
+        search = wb._TargetSearch(controller, far, np.array([0.0, 0.0, 1.0]), None, None, (), wb.MIN_MARGIN, budget,
+                                  prob, 0, None)
+        assert search.base_moved() is None and search.spent == budget
+    sol = wb.solve_whole_body(robot, far, [0, 0, 1], [(controller.q_initial, controller.base)] * 3, problem=prob,
+                              budget=2)
+    assert sol.starts == 2 and not sol.success
+    with pytest.raises(ValueError, match="budget"):
+        wb.solve_target(controller, far, [0, 0, 1], problem=prob, budget=0)
+
+
+def test_relocation_solves_nothing_twice(default, monkeypatch):
+    """choose_base for a target reached only from another base shape: with the plan's PlanSolves, no segmented solve,
+    no batch of the lifted chain's IK and no solve with the base kept is made twice with the same arguments (the
+    relocation's search takes the failed solve with the base kept from the first failure), and the plan's own
+    solve of the target is a hit."""
+    from snakehead.motion import base_choice, target_solves
+    from snakehead.motion.targets import reachable_targets
+
+    robot, controller, prob = default
+    calls: list[tuple] = []
+    solve_checked = type(controller).solve_checked
+
+    def counted(self, position, direction, q_prev=None, base=None, accept=None, allow_base_move=None):
+        calls.append((np.asarray(position).tobytes(), np.asarray(q_prev).tobytes(), base, accept is None))
+        return solve_checked(self, position, direction, q_prev, base, accept, allow_base_move)
+
+    kept_calls = []
+    base_kept = wb._TargetSearch.base_kept
+
+    def counted_kept(self, near):
+        kept_calls.append((self.position.tobytes(), self.q_now.tobytes(), self.base))
+        return base_kept(self, near)
+
+    ik_calls = []
+    lifted_candidates = wb.lifted_candidates
+
+    def counted_ik(prob, q_now, base, position, direction, seed=0):
+        ik_calls.append((q_now.tobytes(), base, position.tobytes(), direction.tobytes(), seed))
+        return lifted_candidates(prob, q_now, base, position, direction, seed)
+
+    monkeypatch.setattr(type(controller), "solve_checked", counted)
+    monkeypatch.setattr(wb._TargetSearch, "base_kept", counted_kept)
+    monkeypatch.setattr(wb, "lifted_candidates", counted_ik)
+    t = reachable_targets(controller, "shape", 1, np.random.default_rng(3))[0]
+    target = snakehead.scenes.Target("t", t.position, t.direction)
+    memo = wb.PlanSolves()
+    chosen, q_shape, relocation, _ = base_choice.choose_base(controller, [target], solved=memo)
+    assert relocation is not None  # the target needs another base
+    assert len(calls) == len(set(calls)) and len(kept_calls) == len(set(kept_calls))
+    assert len(ik_calls) == len(set(ik_calls))
+    before = (len(calls), len(kept_calls), len(ik_calls))
+    sol = target_solves.solve_kept(controller, target.position, target.direction, q_shape, chosen, [], memo)
+    assert sol.success and (len(calls), len(kept_calls), len(ik_calls)) == before  # the plan's: from the choice
+    # without the plan's PlanSolves the same choice repeats solves (what the memo saves), and chooses the same base
+    calls.clear(), ik_calls.clear()
+    again = base_choice.choose_base(controller, [target], solved=None)
+    assert again[0] == chosen and np.array_equal(again[1], q_shape)
+    assert len(calls) + len(ik_calls) > len(set(calls)) + len(set(ik_calls))
+
+
+def test_rolled_frames_are_roll_about_x():
+    """The candidates' rolled frames (one call for every angle) are head.roll_about_x's, bit for bit (the IK's
+    seeded results, and so the plans, depend on them)."""
+    from snakehead.control.head import frame_from_direction, roll_about_x
+
+    T = frame_from_direction([0.3, -0.2, 0.4], [0.2, 0.5, 0.8])
+    angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
+    got = wb._rolled(T, angles)
+    for k, a in enumerate(angles):
+        np.testing.assert_array_equal(got[k], roll_about_x(T, a))
+        # independent: the rotation about the frame's own x-axis keeps x and turns y towards z by the angle
+        np.testing.assert_allclose(got[k][:3, 0], T[:3, 0], atol=1e-15)
+        assert got[k][:3, 1] @ T[:3, 1] == pytest.approx(np.cos(a), abs=1e-12)
+        assert got[k][:3, 1] @ T[:3, 2] == pytest.approx(np.sin(a), abs=1e-12)

@@ -46,6 +46,8 @@ def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.
     """``x`` as a float64 array; ValueError unless finite and (when given) of ``shape`` (None = any size).
 
     TypeError for text, booleans or None (numpy would read ``"1"`` and True as 1.0, None as NaN)."""
+    if type(x) is np.ndarray and x.dtype == np.float64:  # the common case inside the library: shape and finiteness
+        return _shaped_finite(x, name, shape)
     if _not_a_number(x):
         raise InputTypeError(f"{name} must be numbers, got {type(x).__name__} {_shown(x)}")
     try:
@@ -61,11 +63,16 @@ def finite_array(x: npt.ArrayLike, name: str, shape: tuple | None = None) -> np.
         a = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as exc:  # None, complex, objects, ints beyond a float
         raise InputError(f"{name} must be an array of numbers: {exc}") from None
+    return _shaped_finite(a, name, shape)
+
+
+def _shaped_finite(a: np.ndarray, name: str, shape: tuple | None) -> np.ndarray:
+    """:func:`finite_array`'s last checks of a float64 array: its shape (when given) and every value finite."""
     if shape is not None:
         if a.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, a.shape)):
             want = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
             raise InputError(f"{name} has shape {a.shape}; expected {want}")
-    if not np.all(np.isfinite(a)):
+    if not np.isfinite(a).all():
         raise InputError(f"{name} contains NaN or inf")
     return a
 

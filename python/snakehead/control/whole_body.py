@@ -27,11 +27,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
-from .._validate import finite_float, unit_vector3, vector3
+from .. import _core
+from .._validate import finite_float, integer, joint_vector, unit_vector3, vector3
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE
-from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_robot
+from ..geometry.shapes import pair_min_distances
+from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_base, as_robot
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Callable, Sequence
@@ -51,6 +53,15 @@ POSITION_TOLERANCE = 1e-4
 DIRECTION_TOLERANCE = np.radians(0.05)
 #: SLSQP's iteration budget per start.
 MAX_ITERATIONS = 40
+#: The most solves (a segmented solve, a batch of the lifted chain's IK, an SLSQP run from one start) the whole-body
+#: solve makes with the base moved (stage 3 of :func:`solve_target`; stages 1 and 2 make at most four), and the most
+#: starts :func:`solve_whole_body` refines: the bound on the work for a target out of reach, counted rather than
+#: timed so that the same inputs and seed give the same answer whatever the machine's load. 60 is stage 3's whole
+#: search on the default robot (five base shapes, each one segmented solve and ten placements' IK, then five
+#: refinements; ~2 s of CPU when nothing passes), which the 3 s time budget it replaces allowed on an idle machine;
+#: targets reachable by construction take at most 8 (bench/plan_speed.py's sets). A caller that needs a tighter
+#: bound passes a smaller ``budget`` (40 leaves out the refinements: ~0.5 s).
+SOLVE_BUDGET = 60
 #: Capsule pairs farther apart than this at a start (m) are left out of that start's constraints (and checked
 #: exactly at the end like every pair).
 PAIR_RANGE = 0.25
@@ -108,6 +119,22 @@ class WholeBodySolution:
     @property
     def neck(self) -> Any:
         return getattr(self.segmented, "neck", None) if self.stage == STAGES[0] else None
+
+
+class PlanSolves:
+    """The solves of one plan's targets that its steps share (the base's choice, the relocation's search and the
+    targets' solves ask for the same ones): the whole-body solves with the base kept (``kept``: the planner's
+    :func:`~snakehead.motion.target_solves.solve_kept` keys them), and the segmented solves
+    (:meth:`HeadController.solve_checked <snakehead.control.controller.HeadController.solve_checked>`) and the lifted
+    chain's IK candidates (:func:`lifted_candidates`) of :func:`solve_checked_target`. Every one is deterministic
+    (the same arguments give the same solution: the IK is seeded, its searches bounded by counts), so an entry
+    stands for a solve again. Owned by one plan: its controller and obstacles are fixed for its life, and it
+    is dropped with the plan (no bound on its size: a plan solves a bounded number of targets)."""
+
+    def __init__(self) -> None:
+        self.kept: dict[tuple, WholeBodySolution] = {}
+        self.segmented: dict[tuple, Any] = {}
+        self.candidates: dict[tuple, list[np.ndarray]] = {}
 
 
 class BodyProblem:
@@ -189,10 +216,12 @@ class BodyProblem:
         return pts[keep], owner[keep]
 
     def _link_coms(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The links that have a mass (k,) and their centres of mass (k, 3), world, from frames F (n_links, 4, 4)."""
+        """The links that have a mass (k,) and their centres of mass (..., k, 3), world, from frames
+        (..., n_links, 4, 4)."""
         r = self.robot
         heavy = np.flatnonzero(r.masses > 0)
-        return heavy, F[heavy, :3, 3] + np.einsum("lij,lj->li", F[heavy, :3, :3], r.coms[heavy])
+        G = F[..., heavy, :, :]
+        return heavy, G[..., :3, 3] + np.einsum("...lij,lj->...li", G[..., :3, :3], r.coms[heavy])
 
     def com_and_jacobian(self, F: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray]:
         m = self.robot.masses
@@ -202,15 +231,31 @@ class BodyProblem:
         return (m[heavy, None] * c_i).sum(0) / M, np.einsum("l,lij->ij", m[heavy], J) / M
 
     def margin(self, F: np.ndarray) -> float:
-        """:meth:`margin_and_gradient`'s margin alone (no Jacobians: for checks)."""
+        """:meth:`margin_and_gradient`'s margin alone (no Jacobians: for checks), from the frames (n_links, 4, 4)."""
+        return float(self.margins(F[None])[0])
+
+    def margins(self, frames: np.ndarray) -> np.ndarray:
+        """:meth:`margin` of many configurations at once, from their world frames (K, n_links, 4, 4): (K,). The
+        contacts of each (:meth:`contact_points`: a ground link's shape points within CONTACT_BAND of its lowest)
+        are masked, and every polygon's margin is taken in one call of the core's hull (``hull_margins``); a
+        polygon of fewer than three vertices (collinear contacts) has no interior: -inf."""
         m = self.robot.masses
-        heavy, c_i = self._link_coms(F)
-        c = (m[heavy, None] * c_i).sum(0) / m[heavy].sum()
-        pts, _ = self.contact_points(F)
-        if len(stability.hull_indices(pts[:, :2])) < 3:
-            return -np.inf
-        # the same signed distance: inside, to the nearest edge; outside, to the polygon
-        return float(stability.polygon_margin_many(pts[None, :, :2], np.ones((1, len(pts)), bool), c[None, :2])[0])
+        pts, owner = self.robot.lowest_points(frames, self.ground_links)  # (K, P, 3), (P,)
+        z = pts[..., 2]
+        lowest = np.empty_like(z)
+        for link in np.unique(owner):
+            mine = owner == link
+            lowest[:, mine] = z[:, mine].min(axis=1, keepdims=True)
+        keep = z <= lowest + CONTACT_BAND
+        heavy, c_i = self._link_coms(frames)
+        c = (m[heavy, None] * c_i).sum(-2) / m[heavy].sum()
+        xy = np.ascontiguousarray(pts[..., :2])
+        margins = _core.hull_margins(xy, np.ascontiguousarray(keep), np.ascontiguousarray(c[:, :2]))
+        # a degenerate hull's margin (minus the distance to its segment) is <= 0: only those samples are looked at
+        for k in np.flatnonzero(margins <= 0):
+            if len(_core.convex_hull_2d(np.ascontiguousarray(xy[k, keep[k]]))) < 3:
+                margins[k] = -np.inf
+        return margins
 
     def margin_and_gradient(self, F: np.ndarray, base: BasePlacement) -> tuple[float, np.ndarray]:
         """Signed distance of the CoM's ground projection to the support polygon's nearest edge (> 0 inside) and
@@ -440,27 +485,52 @@ def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, positi
     because a lifted link rests on the ground cannot be reached from the air (the body tips just before the link
     touches down), so a planner must not be given one."""
     robot = as_robot(robot)
-    H = robot.head_pose(q, base)
-    pe = float(np.linalg.norm(H[:3, 3] - position))
-    de = float(np.degrees(np.arccos(np.clip(H[:3, 0] @ direction, -1.0, 1.0))))
-    margin = float(stability.static_margin(robot, q, base, contact="ground"))
+    q = joint_vector(q, robot.n_joints)
+    checks = check_solutions(robot, q[None], as_base(base), vector3(position, "position"),
+                             unit_vector3(direction, "direction"), obstacles,
+                             min_margin=finite_float(min_margin, "min_margin"),
+                             self_clearance=finite_float(self_clearance, "self_clearance"),
+                             obstacle_clearance=finite_float(obstacle_clearance, "obstacle_clearance"), problem=problem)
+    return checks[0]
+
+
+def check_solutions(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, position: np.ndarray,
+                    direction: np.ndarray, obstacles: Sequence[Any] = (), *, min_margin: float = MIN_MARGIN,
+                    self_clearance: float = 0.0, obstacle_clearance: float = OBSTACLE_CLEARANCE,
+                    problem: BodyProblem | None = None) -> list[dict]:
+    """:func:`check_solution` of many configurations qs (K, n) at one placement, each check over the whole batch
+    in one call (the frames by the core's batched forward kinematics, the support polygons by its hull, the shapes'
+    lowest points and distances by its shape sets): the library's inner loop (the whole-body solve's candidates),
+    whose arguments were checked where they entered (float64, finite, of the right shapes)."""
+    frames = robot._frames_many_checked(qs, base)
+    head = frames[:, robot.link_index(robot.parts.head_tip)]
+    pe = np.linalg.norm(head[:, :3, 3] - position, axis=1)
+    de = np.degrees(np.arccos(np.clip(head[:, :3, 0] @ direction, -1.0, 1.0)))
+    com = stability.center_of_mass(robot, qs, base, frames=frames)
+    margin = stability.static_margins_of_frames(robot, frames, com, "ground", stability.CONTACT_TOLERANCE)
     if problem is not None:
-        margin = min(margin, problem.margin(problem.frames(q, base)))
-    ground = float(coll.ground_clearance(robot, q, base)[0, robot.lifted_links].min())
-    selfc = float(coll.self_clearance(robot, q, base)[0])
-    obst = None
-    if obstacles:
-        obst = float(coll.collision_check(robot, q[None], list(obstacles), base, exact_within=0.01).distance[0])
-    if pe > POSITION_TOLERANCE or np.radians(de) > DIRECTION_TOLERANCE:
-        reason = "out of reach"
-    elif margin < min_margin:
-        reason = "no stable pose"
-    elif ground < -coll.GROUND_TOLERANCE or selfc <= self_clearance or (obst is not None and obst <= obstacle_clearance):
-        reason = "no clear pose"
-    else:
-        reason = None
-    return {"position_error_m": pe, "direction_error_deg": de, "static_margin_m": margin,
-            "ground_clearance_m": ground, "self_clearance_m": selfc, "obstacle_clearance_m": obst, "reason": reason}
+        margin = np.minimum(margin, problem.margins(frames))
+    lifted = robot.lifted_links
+    ground = robot.geometry.lowest_z(frames, lifted).min(axis=1) if len(lifted) else np.full(len(qs), np.inf)
+    selfc = pair_min_distances(frames, robot.geometry, frames, robot.geometry, robot.self_collision_pairs)
+    obst = (coll.collision_check(robot, qs, list(obstacles), base, exact_within=0.01).distance if obstacles
+            else None)
+    out = []
+    for k in range(len(qs)):
+        o = None if obst is None else float(obst[k])
+        if pe[k] > POSITION_TOLERANCE or np.radians(de[k]) > DIRECTION_TOLERANCE:
+            reason: str | None = "out of reach"
+        elif margin[k] < min_margin:
+            reason = "no stable pose"
+        elif (ground[k] < -coll.GROUND_TOLERANCE or selfc[k] <= self_clearance
+              or (o is not None and o <= obstacle_clearance)):
+            reason = "no clear pose"
+        else:
+            reason = None
+        out.append({"position_error_m": float(pe[k]), "direction_error_deg": float(de[k]),
+                    "static_margin_m": float(margin[k]), "ground_clearance_m": float(ground[k]),
+                    "self_clearance_m": float(selfc[k]), "obstacle_clearance_m": o, "reason": reason})
+    return out
 
 
 def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np.ndarray, direction: np.ndarray, *,
@@ -483,34 +553,32 @@ def refine(prob: BodyProblem, q0: np.ndarray, base0: BasePlacement, position: np
 def solve_whole_body(robot: SnakeRobot, position: npt.ArrayLike, direction: npt.ArrayLike, starts: Sequence[Any], *,
                      move_base: bool = True, obstacles: Sequence[Any] = (), min_margin: float = MIN_MARGIN,
                      self_clearance: float = SELF_CLEARANCE, obstacle_clearance: float = OBSTACLE_CLEARANCE,
-                     problem: BodyProblem | None = None, time_budget: float = 3.0) -> WholeBodySolution:
+                     problem: BodyProblem | None = None, budget: int = SOLVE_BUDGET) -> WholeBodySolution:
     """The whole-body solve from ``starts``, a sequence of (q (n,), BasePlacement) in the order to try; the first
     whose refined solution passes every exact check is returned (stage "whole-body, base kept" when its base is
     the first start's, else "whole-body, base moved"), else the best attempt with the reason it fails.
-    ``time_budget`` (s) stops trying more starts."""
+    At most ``budget`` starts are refined (a count, not a time: the answer does not depend on the machine's load)."""
     t0 = time.perf_counter()
     robot = as_robot(robot)
     position, direction = vector3(position, "position"), unit_vector3(direction, "direction")
     prob = problem if problem is not None else BodyProblem(robot)
     min_margin = finite_float(min_margin, "min_margin")
+    budget = integer(budget, "budget", least=1)
     starts = list(starts)
     if not starts:
         raise InputError("the whole-body solve needs at least one start (q, base)")
     base_first = starts[0][1]
     best: tuple[np.ndarray, BasePlacement, dict] | None = None
     best_key: tuple[int, float] | None = None
-    rank = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
     tried = 0
-    for q0, b0 in starts:
-        if tried and time.perf_counter() - t0 > time_budget:
-            break
+    for q0, b0 in starts[:budget]:
         tried += 1
         q, b = refine(prob, np.asarray(q0, float), b0, position, direction, move_base=move_base, obstacles=obstacles,
                       min_margin=min_margin, self_clearance=self_clearance, obstacle_clearance=obstacle_clearance)
         q = np.clip(q, robot.lower, robot.upper)
-        chk = check_solution(robot, q, b, position, direction, obstacles, min_margin=min_margin,
-                             obstacle_clearance=obstacle_clearance)
-        key = (rank[chk["reason"]], chk["static_margin_m"] if chk["reason"] != "out of reach" else -chk["position_error_m"])
+        chk = check_solutions(robot, q[None], b, position, direction, obstacles, min_margin=min_margin,
+                              obstacle_clearance=obstacle_clearance)[0]
+        key = _rank_of(chk)
         if best is None or best_key is None or key > best_key:
             best, best_key = (q, b, chk), key
         if chk["reason"] is None:
@@ -547,7 +615,7 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     """Whole-body configurations that put the head at the target with the base as it is: TRAC-IK on the lifted
     chain (the neck from where it lifts, and the head: ``lift_frame -> head_tip``) towards ``CANDIDATE_ROLLS``
     frames rolled about the direction (Fig. 9), each from the current joints and from random ones."""
-    from .head import frame_along, roll_about_x
+    from .head import frame_along
 
     robot = prob.robot
     ik = prob.lifted_ik(seed)
@@ -555,7 +623,7 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     T0 = robot.frame(q_now, robot.lift_frame, base)
     target = np.linalg.inv(T0) @ frame_along(position, direction)
     angles = 2 * np.pi * np.arange(CANDIDATE_ROLLS) / CANDIDATE_ROLLS
-    poses = np.stack([roll_about_x(target, a) for a in angles] * CANDIDATE_SEEDS)
+    poses = np.concatenate([_rolled(target, angles)] * CANDIDATE_SEEDS)
     rng = np.random.default_rng(seed)
     inits = np.vstack([np.tile(q_now[start:], (CANDIDATE_ROLLS, 1))]
                       + [rng.uniform(ik.lower, ik.upper, (CANDIDATE_ROLLS, ik.n_joints))
@@ -566,6 +634,16 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
         q = q_now.copy()
         q[start:] = qk
         out.append(q)
+    return out
+
+
+def _rolled(T: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """``head.roll_about_x`` of a frame (4, 4) made here (valid) by each of ``angles`` (rad): (k, 4, 4), the same
+    arithmetic without checking the frame again for every angle."""
+    out = np.repeat(T[None], len(angles), axis=0)
+    for k, angle in enumerate(angles):
+        c, s = np.cos(float(angle)), np.sin(float(angle))
+        out[k, :3, :3] = T[:3, :3] @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
     return out
 
 
@@ -590,7 +668,7 @@ def _continue_from(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement, po
 
 def solve_target(controller: HeadController, position: npt.ArrayLike, direction: npt.ArrayLike, *,
                  q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None, obstacles: Sequence[Any] = (),
-                 allow_base_move: bool = True, min_margin: float = MIN_MARGIN, time_budget: float = 3.0,
+                 allow_base_move: bool = True, min_margin: float = MIN_MARGIN, budget: int = SOLVE_BUDGET,
                  problem: BodyProblem | None = None, seed: int = 0, near: bool = False,
                  shape_ok: Callable[[np.ndarray], bool] | None = None) -> WholeBodySolution:
     """Every joint (and, when allowed, the base's placement and flat shape) for one head target.
@@ -618,21 +696,34 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
     """
     return solve_checked_target(controller, vector3(position, "position"), unit_vector3(direction, "direction"),
                                 q_prev=q_prev, base=base, obstacles=obstacles, allow_base_move=allow_base_move,
-                                min_margin=min_margin, time_budget=time_budget, problem=problem, seed=seed, near=near,
+                                min_margin=finite_float(min_margin, "min_margin"),
+                                budget=integer(budget, "budget", least=1), problem=problem, seed=seed, near=near,
                                 shape_ok=shape_ok)
 
 
 def solve_checked_target(controller: HeadController, position: np.ndarray, direction: np.ndarray, *,
                          q_prev: npt.ArrayLike | None = None, base: BasePlacement | None = None,
                          obstacles: Sequence[Any] = (), allow_base_move: bool = True, min_margin: float = MIN_MARGIN,
-                         time_budget: float = 3.0, problem: BodyProblem | None = None, seed: int = 0,
-                         near: bool = False, shape_ok: Callable[[np.ndarray], bool] | None = None
+                         budget: int = SOLVE_BUDGET, problem: BodyProblem | None = None, seed: int = 0,
+                         near: bool = False, shape_ok: Callable[[np.ndarray], bool] | None = None,
+                         kept: WholeBodySolution | None = None, memo: PlanSolves | None = None
                          ) -> WholeBodySolution:
     """:func:`solve_target` of a target already checked where it entered (a :class:`~snakehead.scenes.Target`'s
-    position (3,) and unit direction (3,)): the planner's entry, which does not check them again."""
-    search = _TargetSearch(controller, position, direction, q_prev, base, obstacles, min_margin, time_budget,
-                           problem, seed, shape_ok)
-    found = search.base_kept(near and q_prev is not None)
+    position (3,) and unit direction (3,)): the planner's entry, which does not check them again.
+
+    ``kept``: this solve's result with the base kept (the same arguments with ``allow_base_move=False``), when the
+    caller has it (:func:`~snakehead.motion.target_solves.solve_kept`): stages 1 and 2 are not repeated (they are
+    deterministic: the same arguments give the same solution), and a solution among them is returned as it is.
+    ``memo``: the plan's :class:`PlanSolves`, whose segmented solves this solve shares."""
+    search = _TargetSearch(controller, position, direction, q_prev, base, obstacles, min_margin, budget,
+                           problem, seed, shape_ok, memo)
+    if kept is not None:
+        if kept.success:
+            return kept
+        search.best, search.segmented = kept, kept.segmented
+        found = None
+    else:
+        found = search.base_kept(near and q_prev is not None)
     if found is None and allow_base_move:
         found = search.base_moved()
     return found if found is not None else _attempted(search.best)
@@ -645,8 +736,8 @@ class _TargetSearch:
 
     def __init__(self, controller: HeadController, position: np.ndarray, direction: np.ndarray,
                  q_prev: npt.ArrayLike | None, base: BasePlacement | None, obstacles: Sequence[Any],
-                 min_margin: float, time_budget: float, problem: BodyProblem | None, seed: int,
-                 shape_ok: Callable[[np.ndarray], bool] | None) -> None:
+                 min_margin: float, budget: int, problem: BodyProblem | None, seed: int,
+                 shape_ok: Callable[[np.ndarray], bool] | None, memo: PlanSolves | None = None) -> None:
         self.t0 = time.perf_counter()
         self.controller, self.robot = controller, controller.robot
         self.position, self.direction = position, direction
@@ -654,23 +745,42 @@ class _TargetSearch:
         self.q_now = controller.q_initial.copy() if q_prev is None else np.asarray(q_prev, float).copy()
         self.prob = problem if problem is not None else BodyProblem(self.robot)
         self.obstacles = list(obstacles)
-        self.min_margin, self.time_budget, self.seed, self.shape_ok = min_margin, time_budget, seed, shape_ok
+        self.min_margin, self.budget, self.seed, self.shape_ok = min_margin, budget, seed, shape_ok
+        self.spent = 0  # the solves of stage 3 so far (SOLVE_BUDGET)
+        self.memo = memo
         self.best: WholeBodySolution | None = None
         self.segmented: Any = None  # the segmented solution, once stage 1 has run
         self.rejected_shapes: set = set()  # shapes that failed shape_ok (its cost may be that of a search)
 
-    def out_of_time(self) -> bool:
-        return time.perf_counter() - self.t0 > self.time_budget
+    def afford(self) -> bool:
+        """Whether stage 3 may make one more solve (a segmented solve, a batch of IK, a refinement) within its
+        ``budget``; counts it when it may."""
+        if self.out_of_work():
+            return False
+        self.spent += 1
+        return True
+
+    def out_of_work(self) -> bool:
+        """Whether stage 3 has made its ``budget`` of solves."""
+        return self.spent >= self.budget
 
     def check(self, q: np.ndarray, b: BasePlacement) -> dict:
-        return check_solution(self.robot, q, b, self.position, self.direction, self.obstacles,
-                              min_margin=self.min_margin, problem=self.prob)
+        return self.check_many([q], b)[0]
+
+    def check_many(self, qs: Sequence[np.ndarray], b: BasePlacement) -> list[dict]:
+        """:func:`check_solutions` of configurations at one placement (one batch)."""
+        if not len(qs):
+            return []
+        return check_solutions(self.robot, np.asarray(qs, float), b, self.position, self.direction, self.obstacles,
+                               min_margin=self.min_margin, problem=self.prob)
 
     def consider(self, q: np.ndarray, b: BasePlacement, stage: str, starts: int,
                  chk: dict | None = None) -> WholeBodySolution | None:
         """Check a configuration (unless its check ``chk`` is given); keep the best attempt; return the solution
         when it passes."""
         chk = self.check(q, b) if chk is None else chk
+        if chk["reason"] is not None and self.best is not None and _rank_of(chk) <= _rank(self.best):
+            return None  # neither a solution nor a better attempt
         sol = WholeBodySolution(q=q, base=b, stage=stage if chk["reason"] is None else None, reason=chk["reason"],
                                 position_error_m=chk["position_error_m"],
                                 direction_error_deg=chk["direction_error_deg"],
@@ -706,29 +816,51 @@ class _TargetSearch:
                     return found
             if found := self.segmented_solve():
                 return found
-            candidates = lifted_candidates(self.prob, self.q_now, self.base, self.position, self.direction, self.seed)
-            for k, q in enumerate(candidates):
-                if found := self.consider(q, self.base, STAGES[1], k + 1):
+            candidates = self.candidates_at(self.q_now, self.base)
+            for k, (q, chk) in enumerate(zip(candidates, self.check_many(candidates, self.base))):
+                if found := self.consider(q, self.base, STAGES[1], k + 1, chk):
                     return found
         return self.refine_kept()
 
     def segmented_solve(self) -> WholeBodySolution | None:
         """Stage 1: the paper's segmented solve (:meth:`HeadController.solve_checked`) from the base as it is,
         clear of the obstacles."""
-        accept = (lambda q, b: clear_of_obstacles(self.robot, q, self.obstacles, b)) if self.obstacles else None
-        seg = self.controller.solve_checked(self.position, self.direction, q_prev=self.q_now, base=self.base,
-                                            accept=accept, allow_base_move=False)
+        seg = self.segmented_at(self.q_now, self.base, clear=True)
         self.segmented = seg
         return self.consider(seg.q, seg.base, STAGES[0], 0)
+
+    def candidates_at(self, q: np.ndarray, base: BasePlacement) -> list[np.ndarray]:
+        """:func:`lifted_candidates` from ``q`` at ``base`` (copies), kept in the plan's :class:`PlanSolves`: the
+        relocation's search and the solve with the base kept at the base it finds solve the same batch."""
+        key = (self.position.tobytes(), self.direction.tobytes(), q.tobytes(), base, self.seed)
+        found = None if self.memo is None else self.memo.candidates.get(key)
+        if found is None:
+            found = lifted_candidates(self.prob, q, base, self.position, self.direction, self.seed)
+            if self.memo is not None:
+                self.memo.candidates[key] = found
+        return [c.copy() for c in found]
+
+    def segmented_at(self, q_prev: np.ndarray, base: BasePlacement, clear: bool) -> Any:
+        """The segmented solve (:meth:`HeadController.solve_checked`, the base kept) from ``q_prev`` at ``base``,
+        its solution required to clear the obstacles when ``clear``; kept in the plan's :class:`PlanSolves` (the
+        relocation's search and the solve at the base it finds ask for the same one)."""
+        clear = clear and bool(self.obstacles)
+        key = (self.position.tobytes(), self.direction.tobytes(), np.asarray(q_prev, float).tobytes(), base, clear)
+        if self.memo is not None and key in self.memo.segmented:
+            return self.memo.segmented[key]
+        accept = (lambda q, b: clear_of_obstacles(self.robot, q, self.obstacles, b)) if clear else None
+        seg = self.controller.solve_checked(self.position, self.direction, q_prev=q_prev, base=base, accept=accept,
+                                            allow_base_move=False)
+        if self.memo is not None:
+            self.memo.segmented[key] = seg
+        return seg
 
     def refine_kept(self) -> WholeBodySolution | None:
         """The whole-body optimisation over the lifted joints from the best attempt, only when it reached the head
         and failed stability or clearance (a local optimisation can move the body from there; a target out of
         reach from this base is the placement's problem: stage 3)."""
         starts = [self.best.q] if self.best is not None and self.best.reason != "out of reach" else []
-        for q0 in starts:
-            if self.out_of_time():
-                break
+        for q0 in starts:  # (stages 1 and 2 make at most four solves: no budget)
             q, b = refine(self.prob, q0, self.base, self.position, self.direction, move_base=False,
                           obstacles=self.obstacles, min_margin=self.min_margin)
             if found := self.consider(np.clip(q, self.robot.lower, self.robot.upper), b, STAGES[1], len(starts)):
@@ -745,10 +877,12 @@ class _TargetSearch:
             return False
         return True
 
-    def moved(self, q: np.ndarray, b: BasePlacement, starts: int) -> WholeBodySolution | None:
+    def moved(self, q: np.ndarray, b: BasePlacement, starts: int, chk: dict | None = None
+              ) -> WholeBodySolution | None:
         """:meth:`consider` for a moved base, whose shape must pass ``shape_ok`` too (asked only of a configuration
-        that passes every other check; one whose shape fails is not kept as the best attempt either)."""
-        chk = self.check(q, b)
+        that passes every other check; one whose shape fails is not kept as the best attempt either). ``chk``: its
+        check, when made already."""
+        chk = self.check(q, b) if chk is None else chk
         if self.shape_ok is not None and chk["reason"] is None and not self.shape_passes(q):
             return None
         return self.consider(q, b, STAGES[2], starts, chk)
@@ -761,10 +895,10 @@ class _TargetSearch:
         for qb in [self.q_now[self.robot.parts.base]] + _base_shapes(self.controller):
             if found := self.from_shape(qb, moved_starts):
                 return found
-            if self.out_of_time():
+            if self.out_of_work():
                 break
         for q0, b0 in moved_starts:
-            if self.out_of_time():
+            if not self.afford():
                 break
             q, b = refine(self.prob, q0, b0, self.position, self.direction, move_base=True, obstacles=self.obstacles,
                           min_margin=self.min_margin)
@@ -777,7 +911,7 @@ class _TargetSearch:
         """The base with base joints qb: the placement that brings the target into the neck's accepted range
         (Section 3.3 (3)) and its segmented solution (added to ``moved_starts``), then the lifted chain's IK
         candidates there and at the other candidate placements (:func:`placements`), while the shape passes and
-        time is left."""
+        the budget lasts (:meth:`afford`)."""
         from . import neck as nk
 
         robot, controller, base = self.robot, self.controller, self.base
@@ -787,20 +921,19 @@ class _TargetSearch:
         placed = None if controller.neck_length <= 0 else nk.base_move_into_range(
             self.position, P0_local, base, controller.Lc, controller.neck_length, controller.slack,
             robot.body_axis_height)
-        if placed is not None:
-            s = controller.solve_checked(self.position, self.direction, q_prev=q, base=placed, allow_base_move=False)
+        if placed is not None and self.afford():
+            s = self.segmented_at(q, placed, clear=False)
             if s.success and (found := self.moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
         for b in ([placed] if placed is not None else []) + placements(self.prob, P0_local, self.position,
                                                                       self.direction):
-            if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes:
+            if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes or not self.afford():
                 break
-            for qc in lifted_candidates(self.prob, q, b, self.position, self.direction, self.seed):
-                if found := self.moved(qc, b, 0):
+            candidates = self.candidates_at(q, b)
+            for qc, chk in zip(candidates, self.check_many(candidates, b)):
+                if found := self.moved(qc, b, 0, chk):
                     return found
-            if self.out_of_time():
-                break
         return None
 
 
@@ -839,6 +972,15 @@ def placements(prob: BodyProblem, P0_local: np.ndarray, position: np.ndarray, di
     return out
 
 
+_ORDER = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
+
+
 def _rank(s: WholeBodySolution) -> tuple:
-    order = {None: 3, "no clear pose": 2, "no stable pose": 1, "out of reach": 0}
-    return order[s.reason], s.static_margin_m if s.reason != "out of reach" else -s.position_error_m
+    """How good an attempt is: solved, then the reason's order, then its margin (or, out of reach, how near)."""
+    return _ORDER[s.reason], s.static_margin_m if s.reason != "out of reach" else -s.position_error_m
+
+
+def _rank_of(chk: dict) -> tuple:
+    """:func:`_rank` of a check (:func:`check_solutions`) before it is made a solution."""
+    reason = chk["reason"]
+    return _ORDER[reason], chk["static_margin_m"] if reason != "out of reach" else -chk["position_error_m"]

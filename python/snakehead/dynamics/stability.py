@@ -201,9 +201,24 @@ def static_margin(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | Non
     robot = as_robot(robot)
     base = as_base(base)
     q = joint_vector(q, robot.n_joints)
-    poly = support_polygon(robot, q, base, contact=contact, tolerance=tolerance)
-    c = center_of_mass(robot, q, base)
-    return float(polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), c[None, :2])[0])
+    tolerance = float(finite_array(tolerance, "tolerance", ()))
+    frames = robot.frames_many(q[None, :], base)
+    return float(static_margins_of_frames(robot, frames, center_of_mass(robot, q[None, :], base, frames=frames),
+                                          contact, tolerance)[0])
+
+
+def static_margins_of_frames(robot: SnakeRobot, frames: np.ndarray, com: np.ndarray, contact: str = "endpoints",
+                             tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+    """:func:`static_margin` of many configurations at once from their world frames (T, n_links, 4, 4)
+    (:meth:`SnakeRobot.frames_many`) and centres of mass (T, 3) (:func:`center_of_mass`): (T,) m. Each sample's
+    support polygon is the hull of its own touching contact points (the C++ core's hull, one per sample, without
+    the GIL). The arrays are taken as they are (for the library's inner loops, e.g. the whole-body solve's checks of
+    a batch of candidates). ``Infeasible`` when a sample has no base link on the ground."""
+    pts, active = _contact_points_many(robot, frames, contact, tolerance)
+    if not active.any(axis=1).all():
+        raise Infeasible("no base link touches the ground: there is no support polygon")
+    return _core.hull_margins(np.ascontiguousarray(pts, dtype=np.float64), np.ascontiguousarray(active),
+                              np.ascontiguousarray(com[:, :2], dtype=np.float64))
 
 
 def is_statically_stable(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,

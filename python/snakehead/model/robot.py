@@ -650,7 +650,14 @@ class SnakeRobot:
 
     def root_pose(self, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of the root frame when the base lies on the ground at ``base`` (default placement)."""
-        return self.body_pose(base) @ np.linalg.inv(self._body_in_root)
+        return self.body_pose(base) @ self._root_in_body
+
+    @cached_property
+    def _root_in_body(self) -> np.ndarray:
+        """The root frame (4, 4) in the body frame (the inverse of ``body_in_root``, made once)."""
+        T = np.linalg.inv(self._body_in_root)
+        T.setflags(write=False)
+        return T
 
     @cached_property
     def urdf_text(self) -> str:
@@ -681,6 +688,12 @@ class SnakeRobot:
     def frames_many(self, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
         """``frames`` along a trajectory: qs (T, n) -> (T, n_links, 4, 4)."""
         return self.body.fk_all_many(qs, self.root_pose(base))
+
+    def _frames_many_checked(self, qs: np.ndarray, base: BasePlacement) -> np.ndarray:
+        """:meth:`frames_many` of joint vectors already checked where they entered (float64 (T, n), finite) at a
+        placement: the core's batched forward kinematics without checking them again (the library's inner loops,
+        e.g. the whole-body solve's checks of its candidates)."""
+        return self.body.model.fk_all_many(np.ascontiguousarray(qs, dtype=np.float64), self.root_pose(base))
 
     def frame(self, q: np.ndarray, name: str, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of one named frame (a link or a marker)."""

@@ -12,6 +12,7 @@ import numpy.typing as npt
 from .._errors import Infeasible
 from .._validate import joint_vector
 from ..control.controller import HeadController
+from ..control.whole_body import PlanSolves
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import shape_key
@@ -62,7 +63,8 @@ def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.n
 
 def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = (),
                 allow_relocation: bool = True, base_shape: npt.ArrayLike | None = None, *,
-                solved: dict | None = None) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
+                solved: PlanSolves | None = None
+                ) -> tuple[BasePlacement, np.ndarray, Relocation | None, list[str]]:
     """One base (placement and flat shape) for a whole scene: the controller's when every target is solved from it
     (:func:`~snakehead.control.whole_body.solve_target` with the base kept) and the body starts clear of the
     obstacles; else the first base that the whole-body solve with the base moved finds for a target (the failing
@@ -71,8 +73,9 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     e.g., may hold none). ``base_shape``: a configuration whose base joints (and those of
     the neck's links that stay on the ground) give the base's flat shape at the controller's placement (default:
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
-    (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: a
-    dict that keeps the solves with the base kept (:func:`solve_kept`) for the plan to reuse."""
+    (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: the
+    plan's :class:`~snakehead.control.whole_body.PlanSolves`, which keeps the solves (:func:`solve_kept`, and the
+    segmented solves of the relocation's search) for the plan to reuse."""
     robot = controller.robot
     obstacles = list(obstacles)
     targets = list(targets)
@@ -103,7 +106,7 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
 
 
 def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.ndarray, targets: Sequence[Any],
-                   obstacles: Sequence[Any], solved: dict | None) -> tuple[Any, Any]:
+                   obstacles: Sequence[Any], solved: PlanSolves | None) -> tuple[Any, Any]:
     """The first of ``targets`` not solved (with the base kept, :func:`solve_kept`) from the base at ``base`` with
     the flat shape of ``q_shape``, and its solution; (None, None) when all are; ("no curl", None) when the base's
     shape holds no stable curl of the neck and head, ("the start", None) when the start state is in an obstacle."""
@@ -138,7 +141,8 @@ def has_curl(controller: HeadController, q: np.ndarray) -> bool:
 
 
 def _relocated_for(controller: HeadController, target: Any, q0: np.ndarray, targets: Sequence[Any],
-                   obstacles: Sequence[Any], solved: dict | None) -> tuple[BasePlacement, np.ndarray] | None:
+                   obstacles: Sequence[Any], solved: PlanSolves | None
+                   ) -> tuple[BasePlacement, np.ndarray] | None:
     """The base (placement, a configuration with its flat shape) that the whole-body solve with the base moved
     finds for ``target`` from the controller's base and the shape of ``q0``, when it is another base, at most
     MAX_RELOCATION_M away, whose shape holds a stable curl of the neck and head (the bending state the plan lifts
@@ -147,9 +151,12 @@ def _relocated_for(controller: HeadController, target: Any, q0: np.ndarray, targ
     from ..control.whole_body import solve_checked_target
 
     robot, start = controller.robot, controller.base
+    # the solve with the base kept is the first failure's (or, for a later target, made once and kept in solved)
+    kept = solve_kept(controller, target.position, target.direction, q0, start, obstacles, solved)
     sol = solve_checked_target(controller, target.position, target.direction, q_prev=q0, base=start,
                                obstacles=obstacles, allow_base_move=True, problem=controller.body_problem,
-                               min_margin=DETOUR_MARGIN, shape_ok=lambda q: has_curl(controller, q))
+                               min_margin=DETOUR_MARGIN, shape_ok=lambda q: has_curl(controller, q), kept=kept,
+                               memo=solved)
     if not sol.success or (sol.base == start and np.array_equal(sol.q[:robot.lift_joints.start],
                                                                q0[:robot.lift_joints.start])):
         return None

@@ -36,7 +36,7 @@ import numpy.typing as npt
 from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
 from .._validate import integer, joint_vector
 from ..control.controller import HeadController
-from ..control.whole_body import clear_of_obstacles
+from ..control.whole_body import PlanSolves, clear_of_obstacles
 from ..geometry import path_check
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
@@ -139,7 +139,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     obstacles = list(scene.obstacles)
     notes: list[str] = [controller.dexterous_note] if controller.dexterous_threshold < 100.0 else []
     report = _Progress(progress, scene, t_start, robot, timing)
-    solved: dict = {}  # the solves with the base kept, shared by choose_base and the targets below
+    solved = PlanSolves()  # the plan's solves, shared by choose_base and the targets below
     reported = len(scene.reported)
     report.stage("base", f"solving the {reported} target{'' if reported == 1 else 's'} from the start to choose the "
                          "base")
@@ -285,7 +285,7 @@ class _Run:
     obstacles: list[Any]
     way: Waypoints
     notes: list[str]
-    solved: dict  # the solves with the base kept, shared with choose_base
+    solved: PlanSolves  # the plan's solves, shared with choose_base
     report: _Progress
     results: list[TargetResult] = field(default_factory=list)
 

@@ -8,31 +8,33 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..control.controller import HeadController
+from ..control.whole_body import PlanSolves
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement
 
 
 def solve_kept(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
-                base: BasePlacement, obstacles: Sequence[Any], solved: dict | None, near: bool = False) -> Any:
+               base: BasePlacement, obstacles: Sequence[Any], solved: PlanSolves | None, near: bool = False) -> Any:
     """``control.whole_body.solve_target`` with the base kept, kept in ``solved`` (one plan's: its obstacles are
     fixed) so that choose_base's solves of the chosen base are not repeated by the plan (the solve is
-    deterministic: the same inputs give the same solution)."""
+    deterministic: the same inputs give the same solution); the segmented solves it makes are shared there too."""
     from ..control.whole_body import solve_checked_target
 
     key = (np.asarray(position, float).tobytes(), np.asarray(direction, float).tobytes(),
            np.asarray(q_prev, float).tobytes(), base, near)
-    if solved is not None and key in solved:
-        return solved[key]
+    if solved is not None and key in solved.kept:
+        return solved.kept[key]
     sol = solve_checked_target(controller, position, direction, q_prev=q_prev, base=base, obstacles=obstacles,
-                       allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN, near=near)
+                               allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN,
+                               near=near, memo=solved)
     if solved is not None:
-        solved[key] = sol
+        solved.kept[key] = sol
     return sol
 
 
 def solve_noted(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,
            base: BasePlacement, obstacles: Sequence[Any], name: str, notes: list, near: bool = False,
-           solved: dict | None = None) -> Any:
+           solved: PlanSolves | None = None) -> Any:
     """One target with the base kept (:func:`solve_kept`); a note when it fails."""
     sol = solve_kept(controller, position, direction, q_prev, base, obstacles, solved, near)
     if not sol.success:
@@ -40,5 +42,4 @@ def solve_noted(controller: HeadController, position: np.ndarray, direction: np.
     return sol
 
 
-
-__all__ = ["solve_kept", "solve_noted"]
+__all__ = ["PlanSolves", "solve_kept", "solve_noted"]
