@@ -268,6 +268,7 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
             lifts.put(key, (np.array(way.qs[first:]), method))
     way.lift_index = way.stop()
     way.lift_cache = controller.plan_cache.timed_lifts
+    way.checked_lifts = controller.plan_cache.checked_lifts
     return q
 
 

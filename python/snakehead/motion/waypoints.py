@@ -87,6 +87,8 @@ class Waypoints:
         self.timing_failure: str | None = None  # why the path could not be timed, when it could not
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: KeptMap[tuple[bytes, str], Any] | None = None  # timed lifts: controller.plan_cache's
+        # the lift's part of the ZMP check per placement: controller.plan_cache's checked_lifts (finish_checks)
+        self.checked_lifts: KeptMap[tuple[bytes, str, str], stability.KeptSamples] | None = None
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
         # the timed lift's key in lift_cache and its samples at the start of the motion, when sample() used a kept
         # lift (finish_checks keeps their part of the ZMP check there too)
@@ -307,16 +309,16 @@ class Waypoints:
                       ) -> tuple[stability.DynamicStability, np.ndarray, np.ndarray | None, path_check.MotionReport]:
         """The checks of the timed motion t, q, qd (``geometry.path_check.finish_checks``: the ZMP and the ground
         clearance at every sample, the ground, self and obstacle clearances proven between them), with the lift's
-        part of the ZMP check kept in ``lift_cache`` for the next plan from a base of this shape and placement (the
+        part of the ZMP check kept in ``checked_lifts`` for the next plan from a base of this shape and placement (the
         motion begins with the same samples: ``dynamics.stability.KeptSamples``; the result is the same to the
         bit)."""
         kept = None
-        if self._lift_rows is not None and self.lift_cache is not None:
+        if self._lift_rows is not None and self.checked_lifts is not None:
             (shape, timing), rows = self._lift_rows
-            key = (shape, f"{timing} ZMP check at {self.base!r}")  # the check depends on where the base lies
-            kept = self.lift_cache.get(key)
-            if not isinstance(kept, stability.KeptSamples) or kept.samples != rows:
-                kept = self.lift_cache.put(key, stability.KeptSamples(rows))
+            key = (shape, timing, repr(self.base))  # the check depends on where the base lies
+            kept = self.checked_lifts.get(key)
+            if kept is None or kept.samples != rows:
+                kept = self.checked_lifts.put(key, stability.KeptSamples(rows))
         return path_check.finish_checks(self.robot, self.base, t, q, qd, self.obstacles, PLAN_CONTACT,
                                         made=self.checker, kept=kept)
 
