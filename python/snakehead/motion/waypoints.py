@@ -346,13 +346,15 @@ def concatenate_motions(a: Any, b: Any) -> Any:
     # the first's own samples where its grid is this one's (the same times): its spline's values there, except its
     # ends, which retime set to the waypoints exactly (q only)
     shared = min(m, len(a.t))
-    same = np.flatnonzero(a.t[:shared] == t[:shared])
+    redo = np.ones(m, bool)  # the rows the first's spline is evaluated at
+    redo[:shared] = a.t[:shared] != t[:shared]
+    redo[[0, shared - 1]] = True
     arrays = [np.empty((len(t), a.q.shape[1])) for _ in range(3)]
     for x, own in zip(arrays, (a.q, a.qd, a.qdd)):
-        x[same] = own[same]
-    redo = np.union1d(np.setdiff1d(np.arange(m), same), [0, min(m, len(a.t)) - 1])
-    for x, v in zip(arrays, _sample_all(a, t[redo])):
-        x[redo] = v
+        x[:shared] = own[:shared]
+    rows = np.flatnonzero(redo)
+    for x, v in zip(arrays, _sample_all(a, t[rows])):
+        x[rows] = v
     for x, v in zip(arrays, _sample_all(b, t[m:] - offset)):
         x[m:] = v
     arrays[0][-1] = b.q[-1]
