@@ -162,7 +162,8 @@ void bind_path_check(py::module_& m) {
       "zmp_check",
       [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
          long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
-         double tolerance, long chunk, double gravity, std::shared_ptr<const ZmpPrefix> resume, long keep) {
+         double tolerance, long chunk, double gravity, std::optional<std::shared_ptr<const ZmpPrefix>> resume,
+         long keep) {
         const long n = c.n_joints();
         const long T = samples_of("q", q, n);
         if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
@@ -181,7 +182,8 @@ void bind_path_check(py::module_& m) {
         {
           py::gil_scoped_release release;
           const RigidBodyChain chain = chain_dynamics(c.model());
-          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T, resume.get(), keep, kept.get());
+          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T, resume ? resume->get() : nullptr, keep,
+                        kept.get());
         }
         const auto N = static_cast<py::ssize_t>(T);
         py::dict d;
@@ -197,7 +199,7 @@ void bind_path_check(py::module_& m) {
       },
       py::arg("checker"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("contact_shapes"),
       py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
-      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"), py::arg("resume") = nullptr, py::arg("keep") = 0,
+      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"), py::arg("resume") = py::none(), py::arg("keep") = 0,
       "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin "
       "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from "
       "snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when "
