@@ -6,7 +6,11 @@ Plans reachable-by-construction targets (``snakehead.motion.targets.reachable_ta
 and the timed motions the plan's end checks), then times on the same inputs, alternately:
 
 * the end checks (``motion.planner._finish``): the Python ``dynamic_stability`` with the lowest points of the neck
-  and head (as released) against ``geometry.path_check.finish_checks`` (one C++ pass);
+  and head (as released) against ``geometry.path_check.finish_checks`` (one C++ pass), from scratch and with the
+  lift's part kept from an earlier plan (``stability.KeptSamples``, as ``Waypoints.finish_checks`` does);
+* the clearances of the timed motions between their samples: every 2 ms sample (``sample_clearances``, as the end
+  checks did) against ``check_motion`` (coarse samples, the total-variation bound) at several first steps, with an
+  obstacle box beside each motion's head path;
 * the path checks (``Waypoints.move``): the released ``_feasible`` at the ``_checked`` configurations (every
   MOVE_CHECK_STEP) against ``geometry.path_check.path_feasible`` (clearances proven between samples, static margin at
   the same configurations), and ``check_path`` alone at several first steps (configurations evaluated, time).
@@ -83,9 +87,10 @@ def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
         return real_path(way, path, checked, margin)
 
     def spy_finish(robot: Any, base: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray, obstacles: Any,
-                   contact: str) -> Any:
-        motions.append((robot, base, t, q, qd))
-        return real_finish(robot, base, t, q, qd, obstacles, contact)
+                   contact: str, **kwargs: Any) -> Any:
+        kept = kwargs.get("kept")
+        motions.append((robot, base, t, q, qd, kept.samples if kept is not None else 0))
+        return real_finish(robot, base, t, q, qd, obstacles, contact, **kwargs)
 
     path_check.path_feasible, path_check.finish_checks = spy_path, spy_finish
     plans = []
@@ -96,6 +101,68 @@ def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
     finally:
         path_check.path_feasible, path_check.finish_checks = real_path, real_finish
     return paths, motions, plans
+
+
+def end_checks(motions: list, repeat: int) -> None:
+    """The end checks of the recorded motions: released Python, the C++ pass from scratch and resumed."""
+    from snakehead.dynamics import stability
+    from snakehead.geometry import path_check
+
+    rows: dict[str, list[float]] = {"old": [], "scratch": [], "kept": [], "zmp": [], "zmp kept": [], "proof": []}
+    samples, taken = [], 0
+    for robot, base, t, q, qd, lift_rows in motions:
+        made = path_check.checker(robot, base)
+        kept = stability.KeptSamples(lift_rows) if lift_rows else None
+        if kept is not None:  # as an earlier plan from this base leaves it
+            stability.dynamic_stability_with_clearance(robot, t, q, base, qd, made=made, kept=kept)
+        rows["old"].append(best_of(lambda: old_finish_checks(robot, base, t, q, qd), repeat))
+        rows["scratch"].append(best_of(lambda: path_check.finish_checks(robot, base, t, q, qd, [], "ground", made=made),
+                                       repeat))
+        rows["kept"].append(best_of(lambda: path_check.finish_checks(robot, base, t, q, qd, [], "ground", made=made,
+                                                                     kept=kept), repeat))
+        rows["zmp"].append(best_of(lambda: stability.dynamic_stability_with_clearance(robot, t, q, base, qd, made=made),
+                                   repeat))
+        rows["zmp kept"].append(best_of(lambda: stability.dynamic_stability_with_clearance(
+            robot, t, q, base, qd, made=made, kept=kept), repeat))
+        rows["proof"].append(best_of(lambda: path_check.check_motion(robot, q, base, made=made), repeat))
+        samples.append(len(t))
+        taken += kept.resumed if kept is not None else 0
+    print(f"| end checks (_finish: ZMP, ground; {len(motions)} motions, median {statistics.median(samples):.0f} samples, "
+          f"{taken / max(1, sum(samples)):.0%} of the samples' ZMP part kept) | median (ms) | total (ms) |")
+    print("|---|---|---|")
+    for key, label in (("old", "Python (released): ZMP and ground at every sample"),
+                       ("scratch", "finish_checks from scratch: ZMP and ground at every sample, check_motion"),
+                       ("kept", "finish_checks, the lift's ZMP part kept (as plans from one base)"),
+                       ("zmp", "of which the ZMP pass from scratch"), ("zmp kept", "of which the ZMP pass, kept"),
+                       ("proof", "of which check_motion (ground, self between the samples)")):
+        print(f"| {label} | {1e3 * statistics.median(rows[key]):.1f} | {1e3 * sum(rows[key]):.0f} |")
+    print()
+
+
+def between_samples(motions: list, repeat: int) -> None:
+    """Ground, self and an obstacle beside the head's path: every 2 ms sample against check_motion's proof."""
+    from snakehead.geometry import BoxObstacle, path_check
+
+    print("| clearances of the timed motions, an obstacle beside the head | configurations evaluated | proven clear "
+          "| total (ms) |")
+    print("|---|---|---|---|")
+    cases = []
+    for robot, base, t, q, qd, _ in motions:
+        head = robot.frames_many(q[len(q) // 2:len(q) // 2 + 1], base)[0, -1, :3, 3]
+        box = BoxObstacle(centre=head + [0.0, 0.15, 0.0], size=(0.1, 0.05, 0.1))
+        cases.append((robot, base, q, [box], path_check.checker(robot, base, [box])))
+    total = sum(best_of(lambda: path_check.sample_clearances(r, q, b, o, made=m), repeat) for r, b, q, o, m in cases)
+    clear = sum(bool((path_check.sample_clearances(r, q, b, o, made=m)[2] > 0).all()) for r, b, q, o, m in cases)
+    print(f"| every sample (sample_clearances: ground, self, obstacle) | {sum(len(c[2]) for c in cases)} | "
+          f"{clear}/{len(cases)} at the samples | {1e3 * total:.1f} |")
+    for step in (0.05, 0.1, 0.2, 0.4):
+        total, n, clear = 0.0, 0, 0
+        for r, b, q, o, m in cases:
+            total += best_of(lambda: path_check.check_motion(r, q, b, o, first_step=step, made=m), repeat)
+            report = path_check.check_motion(r, q, b, o, first_step=step, made=m)
+            n, clear = n + report.samples, clear + report.clear
+        print(f"| check_motion, first_step {step:g} rad | {n} | {clear}/{len(cases)} | {1e3 * total:.1f} |")
+    print()
 
 
 def main() -> int:
@@ -111,18 +178,8 @@ def main() -> int:
     paths, motions, plans = record(args.count, args.sets.split(","), args.seed)
     print(f"{len(plans)} plans ({sum(p.success for p in plans)} succeeded), {len(motions)} timed motions, "
           f"{len(paths)} move paths checked\n")
-    old_t, new_t, samples = [], [], []
-    for robot, base, t, q, qd in motions:
-        old_t.append(best_of(lambda: old_finish_checks(robot, base, t, q, qd), args.repeat))
-        new_t.append(best_of(lambda: path_check.finish_checks(robot, base, t, q, qd, [], "ground"), args.repeat))
-        samples.append(len(t))
-    print("| end checks (_finish: ZMP, ground) | samples per plan (median) | median (ms) | total (ms) |")
-    print("|---|---|---|---|")
-    print(f"| Python (released) | {statistics.median(samples):.0f} | {1e3 * statistics.median(old_t):.1f} | "
-          f"{1e3 * sum(old_t):.0f} |")
-    print(f"| C++ (finish_checks) | {statistics.median(samples):.0f} | {1e3 * statistics.median(new_t):.1f} | "
-          f"{1e3 * sum(new_t):.0f} |")
-    print()
+    end_checks(motions, args.repeat)
+    between_samples(motions, args.repeat)
     old_p, new_p, agree, old_n = [], [], 0, 0
     for way, path, checked in paths:
         old_p.append(best_of(lambda: old_feasible(way, checked).all(), args.repeat))

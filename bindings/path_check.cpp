@@ -121,13 +121,49 @@ void bind_path_check(py::module_& m) {
           py::arg("stop_at_violation") = true,
           "Proves the straight joint segments between waypoints (K, n) clear: a dict with clear, segments (K-1,) "
           "bool, samples evaluated, intervals proven / unproven (at the floor), violations (samples below a floor) "
-          "and the smallest ground, self, obstacle values evaluated");
+          "and the smallest ground, self, obstacle values evaluated")
+      .def(
+          "check_motion",
+          [](const PathChecker& c, const Doubles& qs, double first_step, double floor_step) {
+            const long T = samples_of("qs", qs, c.n_joints());
+            PathOptions o;
+            o.first_step = first_step;
+            o.floor_step = floor_step;
+            MotionVerdict v;
+            {
+              py::gil_scoped_release release;
+              v = c.check_motion(qs.data(), T, o);
+            }
+            py::dict d;
+            d["clear"] = v.clear();
+            d["samples"] = v.samples;
+            d["proven"] = v.proven;
+            d["unproven"] = v.unproven;
+            d["violations"] = v.violations;
+            d["ground"] = v.ground;
+            d["self"] = v.self;
+            d["obstacle"] = v.obstacle;
+            d["obstacle_lower"] = array_of(v.obstacle_lower, {static_cast<py::ssize_t>(T)});
+            return d;
+          },
+          py::arg("qs"), py::arg("first_step"), py::arg("floor_step") = 1e-3,
+          "Proves a sampled motion qs (T, n) clear at and between its samples (joined by straight joint segments; "
+          "path_check.hpp): evaluated where a joint has travelled first_step (rad) since the last, each interval "
+          "proven with the joints' total variation or halved. A dict as check_path's (without segments) and "
+          "obstacle_lower (T,): a lower bound of the obstacle distance from each sample to the next");
+
+  py::class_<ZmpPrefix, std::shared_ptr<ZmpPrefix>>(
+      m, "ZmpPrefix",
+      "What zmp_check computed sample by sample over the first samples of a motion, for a later check of a motion "
+      "that begins with the same samples (path_check.hpp); immutable")
+      .def_property_readonly("samples", &ZmpPrefix::size, "how many samples it holds");
 
   m.def(
       "zmp_check",
       [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
          long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
-         double tolerance, long chunk, double gravity) {
+         double tolerance, long chunk, double gravity, std::optional<std::shared_ptr<const ZmpPrefix>> resume,
+         long keep) {
         const long n = c.n_joints();
         const long T = samples_of("q", q, n);
         if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
@@ -142,10 +178,12 @@ void bind_path_check(py::module_& m) {
         spec.chunk = chunk;
         spec.gravity = gravity;
         ZmpCheck z;
+        std::shared_ptr<ZmpPrefix> kept = keep > 0 ? std::make_shared<ZmpPrefix>() : nullptr;
         {
           py::gil_scoped_release release;
           const RigidBodyChain chain = chain_dynamics(c.model());
-          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T);
+          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T, resume ? resume->get() : nullptr, keep,
+                        kept.get());
         }
         const auto N = static_cast<py::ssize_t>(T);
         py::dict d;
@@ -155,14 +193,18 @@ void bind_path_check(py::module_& m) {
         d["L"] = array_of(z.angular, {N, 3});
         d["com"] = array_of(z.com, {N, 3});
         d["clearance"] = array_of(z.clearance, {N});
+        d["resumed"] = z.resumed;
+        d["kept"] = kept ? py::cast(std::shared_ptr<const ZmpPrefix>(kept)) : py::none();
         return d;
       },
       py::arg("checker"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("contact_shapes"),
       py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
-      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"),
+      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"), py::arg("resume") = py::none(), py::arg("keep") = 0,
       "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin "
       "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from "
-      "snakehead.model.physics.GRAVITY");
+      "snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when "
+      "everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the "
+      "ZmpPrefix of the first keep samples (else None)");
 }
 
 }  // namespace snakehead::bindings

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -275,28 +276,41 @@ class PathProof {
       if (!passes(c_.items_[i], s.lower[i]) && !passes(c_.items_[i], exact(s, i))) ++v_.violations;
   }
 
-  Status interval(Sample& a, Sample& b) {
-    bounds(a, b, B_, Z_);
-    bool split = false;
+  // The interval a -> b along which joint j travels at most dq[j]; obstacle_ is left at the smallest lower bound of
+  // the obstacle distances over it (the cone bound, or the value at a violated end).
+  Status interval(Sample& a, Sample& b, const Eigen::VectorXd& dq) {
+    bounds(a, b, dq, B_, Z_);
+    bool split = false, violated = false;
+    obstacle_ = kInf;
     for (std::size_t i = 0; i < c_.items_.size(); ++i) {
       const PathChecker::Item& it = c_.items_[i];
       const double bound = it.kind == ItemKind::Ground ? Z_[it.a] : it.kind == ItemKind::Obstacle ? B_[it.a] : pair_[i];
-      if (passes(it, 0.5 * (a.lower[i] + b.lower[i] - bound))) continue;
+      const double cone = 0.5 * (a.lower[i] + b.lower[i] - bound);
+      if (passes(it, cone)) {
+        if (it.kind == ItemKind::Obstacle) obstacle_ = std::min(obstacle_, cone);
+        continue;
+      }
       const double ea = exact(a, i), eb = exact(b, i);
-      if (!passes(it, ea) || !passes(it, eb)) return Status::Violated;
-      if (!passes(it, 0.5 * (ea + eb - bound))) split = true;
+      if (it.kind == ItemKind::Obstacle) obstacle_ = std::min(obstacle_, std::min(0.5 * (ea + eb - bound), std::min(ea, eb)));
+      if (!passes(it, ea) || !passes(it, eb)) {
+        if (!complete_) return Status::Violated;
+        violated = true;  // a motion's other items are still bounded (obstacle_ covers them all)
+      } else if (!passes(it, 0.5 * (ea + eb - bound)))
+        split = true;
     }
-    return split ? Status::Split : Status::Clear;
+    return violated ? Status::Violated : split ? Status::Split : Status::Clear;
   }
 
  public:
   // The motion bounds of the straight segment a -> b (see the header): B_S and Z_S per robot shape, and each self
   // pair's bound (pair_), the sum over the joints between the pair's links only.
-  void bounds(const Sample& a, const Sample& b, std::vector<double>& B, std::vector<double>& Z) {
+  // dq[j]: how far joint j travels between a and b (|b.q - a.q| along a straight segment, the total variation
+  // along a motion).
+  void bounds(const Sample& a, const Sample& b, const Eigen::VectorXd& dq, std::vector<double>& B,
+              std::vector<double>& Z) {
     const int S = c_.shapes_.size(), n = c_.model_.n_joints();
     B.assign(static_cast<std::size_t>(S), 0.0);
     Z.assign(static_cast<std::size_t>(S), 0.0);
-    const Eigen::VectorXd dq = (b.q - a.q).cwiseAbs();
     turned_.assign(static_cast<std::size_t>(n) + 1, 0.0);  // turned_[j]: sum_{i < j} |dq_i|
     for (int j = 0; j < n; ++j) turned_[j + 1] = turned_[j] + dq[j];
     radius_.assign(static_cast<std::size_t>(S * n), 0.0);  // r_{j,S} + rho
@@ -330,7 +344,8 @@ class PathProof {
  private:
   // Proves [a, b]; splits it (down to the floor) where the bound is too loose.
   bool prove(Sample& a, Sample& b, int depth) {
-    const Status s = interval(a, b);
+    const Status s = interval(a, b, (b.q - a.q).cwiseAbs());
+    if (s != Status::Split) leaf_obstacle_ = std::min(leaf_obstacle_, obstacle_);
     if (s == Status::Clear) {
       ++v_.proven;
       return true;
@@ -342,6 +357,7 @@ class PathProof {
     }
     if ((b.q - a.q).cwiseAbs().maxCoeff() <= o_.floor_step || depth >= kMaxDepth) {
       ++v_.unproven;
+      leaf_obstacle_ = std::min(leaf_obstacle_, obstacle_);
       return false;
     }
     Sample mid = evaluate(0.5 * (a.q + b.q));
@@ -366,22 +382,113 @@ class PathProof {
     return clear && !stopped_;
   }
 
+  // ---- a sampled motion (check_motion) ----
+
+ public:
+  MotionVerdict run_motion(const double* qs, long T) {
+    const long n = c_.model_.n_joints();
+    if (T < 1) throw InputError("check_motion: at least one sample is needed");
+    if (!(o_.first_step > 0.0) || !(o_.floor_step >= 0.0) || !std::isfinite(o_.first_step))
+      throw InputError("check_motion: first_step must be finite and > 0, floor_step >= 0");
+    qs_ = qs;
+    complete_ = true;
+    // travel_(k, j): joint j's total variation from sample 0 to sample k along the straight segments
+    travel_.resize(T, n);
+    travel_.row(0).setZero();
+    for (long k = 1; k < T; ++k)
+      for (long j = 0; j < n; ++j) travel_(k, j) = travel_(k - 1, j) + std::abs(qs[k * n + j] - qs[(k - 1) * n + j]);
+    lower_.assign(static_cast<std::size_t>(T), kInf);
+    Sample prev = evaluate(row(0));
+    if (T == 1) single(prev);
+    lower_[0] = obstacle_at(prev);
+    long a = 0;
+    while (a + 1 < T) {
+      long b = a + 1;  // the next sample to evaluate: where some joint has travelled first_step since a
+      while (b + 1 < T && (travel_.row(b + 1) - travel_.row(a)).maxCoeff() <= o_.first_step) ++b;
+      Sample next = evaluate(row(b));
+      motion(a, b, prev, next);
+      prev = std::move(next);
+      a = b;
+    }
+    lower_[static_cast<std::size_t>(T - 1)] = std::min(lower_[static_cast<std::size_t>(T - 1)], obstacle_at(prev));
+    MotionVerdict out;
+    out.samples = v_.samples;
+    out.proven = v_.proven;
+    out.unproven = v_.unproven;
+    out.violations = v_.violations;
+    out.ground = v_.ground;
+    out.self = v_.self;
+    out.obstacle = v_.obstacle;
+    out.obstacle_lower = std::move(lower_);
+    return out;
+  }
+
+ private:
+  Eigen::Map<const Eigen::VectorXd> row(long k) const {
+    const long n = c_.model_.n_joints();
+    return Eigen::Map<const Eigen::VectorXd>(qs_ + k * n, n);
+  }
+
+  // The smallest obstacle value known at an evaluated sample (exact where its cheap bound is below the cutoff, as
+  // PathChecker::sample reports it).
+  double obstacle_at(Sample& s) {
+    double m = kInf;
+    for (std::size_t i = 0; i < c_.items_.size(); ++i) {
+      if (c_.items_[i].kind != ItemKind::Obstacle) continue;
+      m = std::min(m, s.lower[i] < c_.spec_.obstacle_cutoff ? exact(s, i) : s.lower[i]);
+    }
+    return m;
+  }
+
+  // Samples a..b (evaluated: sa, sb) of the motion: proven with the joints' total variation, else halved by sample
+  // index; two consecutive samples are proven along their straight segment (prove). Writes lower_[a..b-1].
+  void motion(long a, long b, Sample& sa, Sample& sb) {
+    const Eigen::VectorXd dq = (travel_.row(b) - travel_.row(a)).transpose();
+    const Status s = interval(sa, sb, dq);
+    if (s == Status::Clear || s == Status::Violated) {
+      if (s == Status::Clear) ++v_.proven; else ++v_.violations;
+      for (long k = a; k < b; ++k) lower_[static_cast<std::size_t>(k)] = obstacle_;
+      return;
+    }
+    if (b == a + 1) {
+      leaf_obstacle_ = kInf;
+      const bool clear = prove(sa, sb, 0);
+      lower_[static_cast<std::size_t>(a)] = clear ? leaf_obstacle_ : std::min(leaf_obstacle_, 0.0);
+      return;
+    }
+    const long m = a + (b - a) / 2;
+    Sample mid = evaluate(row(m));
+    motion(a, m, sa, mid);
+    motion(m, b, mid, sb);
+  }
+
   const PathChecker& c_;
   const PathOptions& o_;
   PathVerdict v_;
   bool stopped_ = false;
   std::vector<double> B_, Z_, pair_, turned_, radius_;
+  double obstacle_ = kInf, leaf_obstacle_ = kInf;
+  bool complete_ = false;  // interval() bounds every item, also after a violated one (check_motion)
+  const double* qs_ = nullptr;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> travel_;
+  std::vector<double> lower_;
 };
 
 PathVerdict PathChecker::check_path(const double* waypoints, long K, const PathOptions& options) const {
   return PathProof(*this, options).run(waypoints, K);
 }
 
+MotionVerdict PathChecker::check_motion(const double* qs, long T, const PathOptions& options) const {
+  PathOptions o = options;
+  o.stop_at_violation = false;  // every interval is reported (obstacle_lower)
+  return PathProof(*this, o).run_motion(qs, T);
+}
+
 void PathChecker::motion_bounds(const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, std::vector<double>& B,
                                 std::vector<double>& Z) const {
   const PathOptions options;
   PathProof proof(*this, options);
-  proof.bounds(proof.evaluate(qa), proof.evaluate(qb), B, Z);
+  proof.bounds(proof.evaluate(qa), proof.evaluate(qb), (qb - qa).cwiseAbs(), B, Z);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -462,6 +569,18 @@ class SupportRuns {
 
   long runs() const { return static_cast<long>(start_.size()) - 1; }
 
+  // The runs of a kept prefix (ZmpPrefix) in place of these.
+  void restore(const std::vector<double>& vertices, const std::vector<long>& start) {
+    vertices_ = vertices;
+    start_ = start;
+  }
+
+  // The first `runs` runs' polygons into vertices and start (as ZmpPrefix holds them).
+  void keep(long runs, std::vector<double>& vertices, std::vector<long>& start) const {
+    start.assign(start_.begin(), start_.begin() + runs + 1);
+    vertices.assign(vertices_.begin(), vertices_.begin() + 2 * start.back());
+  }
+
   // The signed distance of xy to run r's polygon (hull_margin, the hull not built again).
   double margin(long r, const Eigen::Vector2d& xy) const {
     return convex_margin(vertices_.data() + 2 * start_[r], start_[r + 1] - start_[r], xy);
@@ -492,44 +611,42 @@ void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
 
 }  // namespace
 
-ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, const ZmpCheckSpec& spec,
-                   const double* t, const double* q, const double* qd, long T) {
-  const ChainModel& model = checker.model();
-  const ShapeSet& shapes = checker.shapes();
-  const long n = model.n_joints(), L = checker.links();
-  if (T < 2) throw InputError("zmp_check: at least two samples are needed");
-  for (long k = 1; k < T; ++k)
-    if (!(t[k] > t[k - 1])) throw InputError("zmp_check: t must increase strictly");
-  check_spec(spec, shapes, n);
-  ZmpCheck out;
-  out.linear.resize(static_cast<std::size_t>(3 * T));
-  out.angular.resize(static_cast<std::size_t>(3 * T));
-  out.com.resize(static_cast<std::size_t>(3 * T));
-  out.clearance.assign(static_cast<std::size_t>(T), kInf);
-  SupportRuns polygons(spec, shapes);
-  std::vector<long> run(static_cast<std::size_t>(T));
-  std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
-  // one lowest_z call per sample for the contact shapes and the clearance shapes after them
-  std::vector<long> lowest_of(spec.contact_shapes);
-  lowest_of.insert(lowest_of.end(), spec.clearance_shapes.begin(), spec.clearance_shapes.end());
-  const long K = static_cast<long>(spec.contact_shapes.size()), C = static_cast<long>(spec.clearance_shapes.size());
-  std::vector<double> low(static_cast<std::size_t>(K + C));
-  const std::vector<int>& child = chain.joint_child;
-  Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
-  for (long k = 0; k < T; ++k) {
-    const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
-    model.check_configuration(qk);
-    checker.world_frames(qk, frames.data(), work);
-    momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
-    lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), K + C, low.data());
-    if (C > 0) out.clearance[k] = *std::min_element(low.begin() + K, low.end());
-    contact_key(spec, child, shapes, low.data(), q + k * n, key);
-    if (k % spec.chunk == 0 || key != previous) {
-      polygons.add(frames.data(), L, low.data());
-      previous.swap(key);
-    }
-    run[k] = polygons.runs() - 1;
+namespace {
+
+bool same_spec(const ZmpCheckSpec& a, const ZmpCheckSpec& b) {
+  return a.contact_shapes == b.contact_shapes && a.points_per_shape == b.points_per_shape &&
+         a.clearance_shapes == b.clearance_shapes && a.ground_key == b.ground_key && a.key_joints == b.key_joints &&
+         a.shaped_links == b.shaped_links && a.tolerance == b.tolerance && a.chunk == b.chunk;
+}
+
+// Whether zmp_check may take `prefix` over for this check (see ZmpPrefix): everything it was made from is the same.
+bool takes_over(const ZmpPrefix& prefix, const PathChecker& checker, const ZmpCheckSpec& spec, const double* q,
+                const double* qd, long T) {
+  const long m = prefix.size(), n = checker.n_joints();
+  if (m < 1 || m > T || prefix.model != &checker.model() || prefix.shapes != &checker.shapes()) return false;
+  if (prefix.origin != checker.origin().matrix() || !same_spec(prefix.spec, spec)) return false;
+  if (static_cast<long>(prefix.q.size()) != m * n || static_cast<long>(prefix.qd.size()) != m * n) return false;
+  const auto bytes = static_cast<std::size_t>(m * n) * sizeof(double);
+  return std::memcmp(prefix.q.data(), q, bytes) == 0 && std::memcmp(prefix.qd.data(), qd, bytes) == 0;
+}
+
+// Where each clearance shape's lowest z is among the contact shapes' (one lowest_z per shape and sample): indices
+// into `lowest_of` (the contact shapes, then the clearance shapes that are not contact shapes).
+std::vector<long> clearance_slots(const ZmpCheckSpec& spec, std::vector<long>& lowest_of) {
+  lowest_of = spec.contact_shapes;
+  std::vector<long> slot;
+  for (long s : spec.clearance_shapes) {
+    const auto at = std::find(lowest_of.begin(), lowest_of.end(), s);
+    slot.push_back(static_cast<long>(at - lowest_of.begin()));
+    if (at == lowest_of.end()) lowest_of.push_back(s);
   }
+  return slot;
+}
+
+// Eqs. 33-40 over the whole motion from its per-sample momenta and CoM (out.linear, angular, com) and each sample's
+// run (its polygon in `polygons`): the ZMP and its margin.
+void zmp_and_margins(const RigidBodyChain& chain, const ZmpCheckSpec& spec, const double* t, long T,
+                     const std::vector<long>& run, const SupportRuns& polygons, ZmpCheck& out) {
   std::vector<double> Pdot(static_cast<std::size_t>(3 * T)), Ldot(static_cast<std::size_t>(3 * T));
   time_derivative(t, out.linear.data(), T, 3, Pdot.data());    // Eq. 33's dP/dt
   time_derivative(t, out.angular.data(), T, 3, Ldot.data());   // Eq. 34's dL/dt
@@ -553,6 +670,86 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     if (!p.allFinite()) throw InputError("zmp_check: the ZMP is not finite (qd or t out of range)");
     out.margin[k] = polygons.margin(run[k], p);
   }
+}
+
+}  // namespace
+
+ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, const ZmpCheckSpec& spec,
+                   const double* t, const double* q, const double* qd, long T, const ZmpPrefix* resume, long keep,
+                   ZmpPrefix* kept) {
+  const ChainModel& model = checker.model();
+  const ShapeSet& shapes = checker.shapes();
+  const long n = model.n_joints(), L = checker.links();
+  if (T < 2) throw InputError("zmp_check: at least two samples are needed");
+  for (long k = 1; k < T; ++k)
+    if (!(t[k] > t[k - 1])) throw InputError("zmp_check: t must increase strictly");
+  check_spec(spec, shapes, n);
+  if (keep < 0) throw InputError("zmp_check: keep must be >= 0");
+  if (keep > 0 && resume != nullptr) throw InputError("zmp_check: give a prefix to resume from or one to keep, not both");
+  ZmpCheck out;
+  out.linear.resize(static_cast<std::size_t>(3 * T));
+  out.angular.resize(static_cast<std::size_t>(3 * T));
+  out.com.resize(static_cast<std::size_t>(3 * T));
+  out.clearance.assign(static_cast<std::size_t>(T), kInf);
+  SupportRuns polygons(spec, shapes);
+  std::vector<long> run(static_cast<std::size_t>(T));
+  std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
+  std::vector<std::vector<double>> run_key;  // each run's contact key (a kept prefix ends with its last)
+  long k0 = 0;
+  if (resume != nullptr && takes_over(*resume, checker, spec, q, qd, T)) {  // its samples, to the bit
+    k0 = resume->size();
+    std::copy(resume->linear.begin(), resume->linear.end(), out.linear.begin());
+    std::copy(resume->angular.begin(), resume->angular.end(), out.angular.begin());
+    std::copy(resume->com.begin(), resume->com.end(), out.com.begin());
+    std::copy(resume->clearance.begin(), resume->clearance.end(), out.clearance.begin());
+    std::copy(resume->run.begin(), resume->run.end(), run.begin());
+    polygons.restore(resume->vertices, resume->start);
+    previous = resume->last_key;
+    run_key.resize(static_cast<std::size_t>(polygons.runs()));
+    run_key.back() = previous;
+    out.resumed = k0;
+  }
+  // one lowest_z per shape and sample: the contact shapes, then the clearance shapes that are not among them
+  std::vector<long> lowest_of;
+  const std::vector<long> slot = clearance_slots(spec, lowest_of);
+  const long U = static_cast<long>(lowest_of.size());
+  std::vector<double> low(static_cast<std::size_t>(U));
+  const std::vector<int>& child = chain.joint_child;
+  Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
+  for (long k = k0; k < T; ++k) {
+    const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
+    model.check_configuration(qk);
+    checker.world_frames(qk, frames.data(), work);
+    momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
+    lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), U, low.data());
+    for (long c : slot) out.clearance[k] = std::min(out.clearance[k], low[static_cast<std::size_t>(c)]);
+    contact_key(spec, child, shapes, low.data(), q + k * n, key);
+    if (k % spec.chunk == 0 || key != previous) {
+      polygons.add(frames.data(), L, low.data());
+      previous.swap(key);
+      if (keep > 0 && k < keep) run_key.push_back(previous);
+    }
+    run[k] = polygons.runs() - 1;
+  }
+  if (keep > 0 && kept != nullptr) {
+    const long m = std::min(keep, T);
+    const auto m3 = static_cast<std::size_t>(3 * m), mn = static_cast<std::size_t>(m * n);
+    ZmpPrefix& p = *kept;
+    p.model = &model;
+    p.shapes = &shapes;
+    p.origin = checker.origin().matrix();
+    p.spec = spec;
+    p.q.assign(q, q + mn);
+    p.qd.assign(qd, qd + mn);
+    p.linear.assign(out.linear.begin(), out.linear.begin() + m3);
+    p.angular.assign(out.angular.begin(), out.angular.begin() + m3);
+    p.com.assign(out.com.begin(), out.com.begin() + m3);
+    p.clearance.assign(out.clearance.begin(), out.clearance.begin() + m);
+    p.run.assign(run.begin(), run.begin() + m);
+    polygons.keep(run[m - 1] + 1, p.vertices, p.start);
+    p.last_key = run_key[static_cast<std::size_t>(run[m - 1])];
+  }
+  zmp_and_margins(chain, spec, t, T, run, polygons, out);
   return out;
 }
 

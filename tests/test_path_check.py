@@ -122,6 +122,119 @@ def test_check_path_finds_a_violation_between_clear_waypoints() -> None:
     assert not report.clear and report.violations >= 1 and report.obstacle <= 0.0
 
 
+def _lifted(robot: SnakeRobot, angle: float) -> np.ndarray:
+    """The straight body with the neck's first pitch joint at +-angle, the sign that raises the head."""
+    q = np.zeros(robot.n_joints)
+    q[robot.lift_joints.start] = angle
+    return q if robot.head_pose(q)[2, 3] >= robot.head_pose(-q)[2, 3] else -q
+
+
+def _smooth_motion(robot: SnakeRobot, rng: np.random.Generator, samples: int, spread: float) -> np.ndarray:
+    """A smooth motion (samples, n) through three random configurations with the head raised (the neck's first
+    pitch lifting by 0.3-0.7 rad, the joints after it spread around 0, the base's yaw joints a little): a cubic
+    spline, as a timed motion's path."""
+    from scipy.interpolate import CubicSpline
+
+    pitch = robot.lift_joints.start
+    W = np.array([_lifted(robot, rng.uniform(0.3, 0.7)) for _ in range(3)])
+    W[:, pitch + 1:] += rng.normal(0.0, spread, (3, robot.n_joints - pitch - 1))
+    yaw = [j for j in range(pitch) if robot.joint_kinds[j] == "yaw"]  # the base stays flat on the ground
+    W[:, yaw] += rng.normal(0.0, 0.05, (3, len(yaw)))
+    q = CubicSpline([0.0, 0.5, 1.0], W, axis=0)(np.linspace(0.0, 1.0, samples))
+    return np.clip(q, robot.lower, robot.upper)
+
+
+@settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 2**32 - 1), which=st.sampled_from(["default", "reu", "sea", "mesh"]),
+       first_step=st.sampled_from([0.05, 0.2, 0.6]), spread=st.sampled_from([0.1, 0.3]))
+def test_check_motion_is_a_proof_against_brute_force(robots: dict[str, SnakeRobot], seed: int, which: str,
+                                                     first_step: float, spread: float) -> None:
+    """check_motion (coarse samples, total-variation bound) against brute force at 8 points of every straight
+    segment between consecutive samples: a motion it proves clear is clear at every fine point (ground, self and
+    exact obstacle distances), and its obstacle_lower[k] is at most the exact smallest distance from sample k to
+    k + 1."""
+    robot = robots[which]
+    rng = np.random.default_rng(seed)
+    base = BasePlacement(*rng.uniform(-0.2, 0.2, 3))
+    q = _smooth_motion(robot, rng, 60, spread)
+    Hq = robot.frames_many(q[::20], base)[:, -1, :3, 3]  # near the head's path: close calls
+    box = BoxObstacle(centre=Hq[rng.integers(len(Hq))] + rng.normal(0.0, 0.15, 3) * [1, 1, 0.3],
+                      size=rng.uniform(0.02, 0.1, 3))
+    report = path_check.check_motion(robot, q, base, [box], first_step=first_step)
+    alone = path_check.check_motion(robot, q, base, [], first_step=first_step)  # ground and self only
+    fine = 8
+    s = (np.arange(fine) / fine)[None, :, None]
+    qs = np.concatenate([(q[:-1, None] + s * (q[1:] - q[:-1])[:, None]).reshape(-1, robot.n_joints), q[-1:]])
+    ground = coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min(axis=1)
+    self_ = coll.self_clearance(robot, qs, base)
+    d = coll.collision_check(robot, qs, [box], base, exact_within=np.inf).distance
+    if alone.clear:
+        assert ground.min() >= -coll.GROUND_TOLERANCE and self_.min() > 0.0
+    if report.clear:
+        assert alone.clear and d.min() > 0.0
+    # per interval [k, k + 1]: its fine points and sample k + 1
+    per = np.minimum(np.append(d[:-1].reshape(len(q) - 1, fine).min(axis=1), d[-1]),
+                     np.append(d[fine::fine], np.inf))
+    assert (report.obstacle_lower <= per + 1e-9).all()
+    assert report.samples <= len(q) + 64 * (report.unproven + report.violations) + 64
+
+
+def test_check_motion_catches_a_thin_obstacle_between_coarse_samples() -> None:
+    """The head sweeps sideways through a 2 mm plate. Densely sampled (0.01 rad steps) and evaluated every 0.2 rad,
+    none of the evaluated samples touches it: the proof finds it (halving); sampled sparsely so that no sample
+    touches it at all (what a check at the samples would pass), the proof still finds it between them."""
+    robot = SnakeRobot.default()
+    q0 = _lifted(robot, 0.5)
+    pitch = robot.lift_joints.start
+    yaw = [j for j in range(pitch, robot.n_joints) if robot.joint_kinds[j] == "yaw"][0]
+    H = robot.head_pose(q0)
+    plate = BoxObstacle(centre=H[:3, 3], size=(0.1, 0.002, 0.1))
+    sweep = np.linspace(-0.3, 0.3, 61)
+    q = np.repeat(q0[None], len(sweep), axis=0)
+    q[:, yaw] = sweep
+    evaluated = q[::20]  # where some joint has travelled 0.2 rad
+    assert (path_check.sample_clearances(robot, evaluated, None, [plate])[2] > 0).all()
+    dense = path_check.check_motion(robot, q, None, [plate], first_step=0.2)
+    assert not dense.clear and dense.violations >= 1 and dense.obstacle_lower.min() <= 0.0
+    sparse = q[[0, 15, 45, 60]]  # yaw -0.3, -0.15, 0.15, 0.3
+    assert (path_check.sample_clearances(robot, sparse, None, [plate])[2] > 0).all()
+    report = path_check.check_motion(robot, sparse, None, [plate], first_step=0.2)
+    assert not report.clear and report.obstacle_lower[1] <= 0.0
+    assert (report.obstacle_lower[[0, 2]] > 0.0).all()  # the other intervals stay clear of it
+    clear = path_check.check_motion(robot, sparse, None, [], first_step=0.2)
+    assert clear.clear and np.isinf(clear.obstacle_lower).all()
+
+
+def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
+    """A check that takes over the first samples' part of an earlier one (KeptSamples: a motion beginning with the
+    same samples) equals the check from scratch bit for bit; a motion whose first samples differ, or another
+    placement, is computed from scratch."""
+    robot = SnakeRobot.default()
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 2.0, 301)
+    lift = _smooth_motion(robot, rng, 301, 0.2)
+    qd_lift = np.gradient(lift, t, axis=0)
+    other = _smooth_motion(robot, rng, 301, 0.2)
+    m = 120
+    q = np.concatenate([lift[:m], other[m:]])
+    qd = np.concatenate([qd_lift[:m], np.gradient(other, t, axis=0)[m:]])
+    base = BasePlacement(0.1, 0.2, 0.3)
+    kept = stability.KeptSamples(m)
+    stability.dynamic_stability_with_clearance(robot, t, lift, base, qd_lift, kept=kept)
+    assert kept.core is not None and kept.core.samples == m and kept.resumed == 0
+    for motion, velocity, where, takes_over in ((q, qd, base, True), (other, np.gradient(other, t, axis=0), base, False),
+                                                (q, qd, BasePlacement(0.1, 0.2, 0.31), False)):
+        fresh, fresh_clear = stability.dynamic_stability_with_clearance(robot, t, motion, where, velocity)
+        again, clear = stability.dynamic_stability_with_clearance(robot, t, motion, where, velocity, kept=kept)
+        assert kept.resumed == (m if takes_over else 0)
+        for name in ("zmp", "margin", "P", "L", "com"):
+            np.testing.assert_array_equal(getattr(again, name), getattr(fresh, name), err_msg=name)
+        np.testing.assert_array_equal(clear, fresh_clear)
+        assert (again.argmin, again.stable) == (fresh.argmin, fresh.stable)
+    runs = stability._polygons_along(robot, lift[:m], base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+    assert runs > 2, "the kept samples must hold several contact runs"
+
+
 def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) -> None:
     """The C++ dynamic stability (contact "ground" and "footprint") equals the Python path to 1e-9: the same
     contact runs (chunks of a few samples, to cross their boundaries), ZMP and margins."""

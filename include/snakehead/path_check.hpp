@@ -27,6 +27,19 @@
 // clear. Others are split in two, down to a floor on the largest joint change, below which they are reported.
 // Prismatic joints are refused (their arm lengths are not constant).
 //
+// A timed motion (check_motion). Nothing above needs the path to be straight: along any continuous joint path
+// q(t), t in [a, b], whose joint j travels at most V_j = integral |dq_j/dt| dt (its total variation), every point
+// of S moves at most sum_j V_j (r_{j,S} + rho) with r_{j,S} as above and V in place of |dq| (the instantaneous
+// speed of a point of S is at most sum_j |dq_j/dt| dist(p, axis_j), and dist(c, axis_j) at any t in [a, b] is
+// within sum_{i > j} V_i reach(i, S) of its value at a or b; the axis tilts at most sum_{i < j} V_i), and the cone
+// bound holds with B in the arc length u(t) = sum_j integral |dq_j/dt| (r_{j,S} + rho) dt, in which f is
+// 1-Lipschitz. check_motion takes the motion as the sequence of its 2 ms samples joined by straight joint segments
+// (what a position-controlled joint is commanded between two control periods), so over samples a..b
+// V_j = sum_{a <= k < b} |q_{k+1,j} - q_{k,j}| exactly (>= |q_{b,j} - q_{a,j}|). It evaluates the samples where a
+// joint has travelled first_step since the last (in total variation), proves each interval with V, halves the
+// intervals that it does not prove by sample index, and proves an unproven interval between two consecutive samples
+// by halving its straight segment as check_path does.
+//
 // Every function is pure over immutable inputs: a PathChecker may be shared by any number of threads.
 #pragma once
 
@@ -78,6 +91,18 @@ struct PathVerdict {
   bool clear() const;
 };
 
+// The verdict of check_motion over T samples.
+struct MotionVerdict {
+  long samples = 0, proven = 0, unproven = 0, violations = 0;  // as PathVerdict's
+  double ground = std::numeric_limits<double>::infinity();      // smallest values evaluated
+  double self = std::numeric_limits<double>::infinity();
+  double obstacle = std::numeric_limits<double>::infinity();
+  // (T): a lower bound of the smallest obstacle distance from sample k to sample k + 1 (the last: at it); <= 0 where
+  // an interval is violated or unproven; +inf without obstacle pairs
+  std::vector<double> obstacle_lower;
+  bool clear() const { return violations == 0 && unproven == 0; }
+};
+
 class PathChecker {
  public:
   // The model, shapes and obstacles are referenced, not copied: they must outlive the checker. origin: the world
@@ -97,8 +122,13 @@ class PathChecker {
   // Proves the straight segments between consecutive waypoints (K x n) clear (see the header's comment).
   PathVerdict check_path(const double* waypoints, long K, const PathOptions& options) const;
 
+  // Proves a sampled motion (T x n) clear at and between its samples (see the header's comment: the samples joined
+  // by straight segments); options.first_step is the total joint travel between the first evaluated samples.
+  MotionVerdict check_motion(const double* qs, long T, const PathOptions& options) const;
+
   const ChainModel& model() const { return model_; }
   const ShapeSet& shapes() const { return shapes_; }
+  const Eigen::Isometry3d& origin() const { return origin_; }
   int n_joints() const { return model_.n_joints(); }
   long links() const { return static_cast<long>(model_.links().size()); }
   // World frames of the links at q (links() x 4 x 4 row-major) into out.
@@ -149,10 +179,35 @@ struct ZmpCheckSpec {
 
 struct ZmpCheck {
   std::vector<double> zmp, margin, linear, angular, com, clearance;  // T x 2, T, T x 3 (three), T
+  long resumed = 0;  // samples taken over from a ZmpPrefix
 };
 
+// What zmp_check computed sample by sample (momenta, CoM, clearance, the contact runs and their polygons) over the
+// first samples of a motion, kept so that a later check of a motion that begins with the same samples (the lift
+// from the bending state is the same for every target from a base of one shape) takes it over instead of computing
+// it again. zmp_check takes it over only when the checker (the same model and shapes, the same origin), the spec
+// and the prefix's q and qd are those it was made with, bit for bit (else it computes everything): the result is
+// then the same as without it, to the bit (the per-sample values depend on their own sample only, the runs on
+// the samples before; the time derivatives and the ZMP are computed over the whole motion afterwards).
+struct ZmpPrefix {
+  const ChainModel* model = nullptr;
+  const ShapeSet* shapes = nullptr;
+  Eigen::Matrix4d origin = Eigen::Matrix4d::Zero();
+  ZmpCheckSpec spec;
+  std::vector<double> q, qd;                           // the samples it was made from (m x n each)
+  std::vector<double> linear, angular, com, clearance;  // m x 3 (three), m
+  std::vector<long> run;                                // m: each sample's run
+  std::vector<double> vertices;                         // the runs' hull vertices (flat x, y)
+  std::vector<long> start;                              // run r's vertices: start[r] .. start[r + 1] - 1
+  std::vector<double> last_key;                         // the contact key of the last sample's run
+  long size() const { return static_cast<long>(run.size()); }
+};
+
+// resume: a prefix to take over (when it matches, see ZmpPrefix); keep > 0: the first min(keep, T) samples' part
+// is written to *kept.
 ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, const ZmpCheckSpec& spec,
-                   const double* t, const double* q, const double* qd, long T);
+                   const double* t, const double* q, const double* qd, long T, const ZmpPrefix* resume = nullptr,
+                   long keep = 0, ZmpPrefix* kept = nullptr);
 
 // The chain's masses, centres of mass, inertias, joint axes and child links for momenta / newton_euler.
 RigidBodyChain chain_dynamics(const ChainModel& model);

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -271,6 +271,10 @@ class PathChecker:
         """
         model: the chain; shapes: its links' shapes; origin: the chain base's world pose (4, 4); ground_shapes (k,): shapes whose lowest point must stay >= ground_floor (m); self_pairs (P, 2): shape pairs that must stay apart; obstacles: a ShapeSet on one world frame (or None) and obstacle_pairs (Q, 2) (robot shape, obstacle shape); obstacle_cutoff (m): per-sample obstacle distances are exact below it
         """
+    def check_motion(self, qs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], first_step: typing.SupportsFloat | typing.SupportsIndex, floor_step: typing.SupportsFloat | typing.SupportsIndex = 0.001) -> dict:
+        """
+        Proves a sampled motion qs (T, n) clear at and between its samples (joined by straight joint segments; path_check.hpp): evaluated where a joint has travelled first_step (rad) since the last, each interval proven with the joints' total variation or halved. A dict as check_path's (without segments) and obstacle_lower (T,): a lower bound of the obstacle distance from each sample to the next
+        """
     def check_path(self, waypoints: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], first_step: typing.SupportsFloat | typing.SupportsIndex = 0.05, floor_step: typing.SupportsFloat | typing.SupportsIndex = 0.001, stop_at_violation: bool = True) -> dict:
         """
         Proves the straight joint segments between waypoints (K, n) clear: a dict with clear, segments (K-1,) bool, samples evaluated, intervals proven / unproven (at the floor), violations (samples below a floor) and the smallest ground, self, obstacle values evaluated
@@ -282,6 +286,15 @@ class PathChecker:
     def sample(self, qs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
         """
         Each configuration's (T, n) smallest ground clearance, self clearance and obstacle distance (m): three (T,) arrays, +inf where nothing is checked
+        """
+class ZmpPrefix:
+    """
+    What zmp_check computed sample by sample over the first samples of a motion, for a later check of a motion that begins with the same samples (path_check.hpp); immutable
+    """
+    @property
+    def samples(self) -> int:
+        """
+        how many samples it holds
         """
 class ToppRaResult:
     """
@@ -387,10 +400,6 @@ def newton_euler(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]
     """
     Newton-Euler with the root link still: joint torques (T, n) and the inertial wrench across the first joint (force (T, 3), moment about the frames' origin (T, 3), in their axes; frames in an inertial frame where the root link is still)
     """
-def newton_euler_along(model: ChainModel, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], lift_links: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] | None, lift_points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None, ramp: typing.SupportsFloat | typing.SupportsIndex, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
-    """
-    newton_euler along configurations q (T, n), the link frames (origin times the model's FK) and the lifted shares (lift_links, lift_points (k, M, 3) in the links' frames, ramp m; None: every weight in full) computed in the core: torques (T, n), the inertial wrench across the first joint (force, moment (T, 3)) and the centre of mass (T, 3)
-    """
 def pose_error(target: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], current: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
     The IK pose error (vx vy vz wx wy wz) of `current` relative to `target`, in the target frame.
@@ -433,7 +442,7 @@ def urdf_root_link(urdf: str) -> str:
     """
     The root link of a URDF (an XML document or a file path)
     """
-def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex, gravity: typing.SupportsFloat | typing.SupportsIndex) -> dict:
+def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex, gravity: typing.SupportsFloat | typing.SupportsIndex, resume: ZmpPrefix | None = None, keep: typing.SupportsInt | typing.SupportsIndex = 0) -> dict:
     """
-    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from snakehead.model.physics.GRAVITY
+    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the ZmpPrefix of the first keep samples (else None)
     """

@@ -400,14 +400,32 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
 CORE_CONTACT_MODELS = ("ground", "footprint")
 
 
+@dataclass
+class KeptSamples:
+    """The per-sample part of a C++ dynamic-stability check over a motion's first ``samples`` samples
+    (``_core.ZmpPrefix``: momenta, CoM, clearance, contact runs and their polygons), kept by the caller so that a later
+    check of a motion that begins with the same samples (a plan's lift from the bending state, the same for every
+    target from a base of one shape and placement) takes it over instead of computing it again
+    (:func:`dynamic_stability_with_clearance`'s ``kept``). ``core`` is None until a check has filled it; ``resumed``:
+    how many samples the last check took over (0 when the motion did not begin with them: the core compares them bit
+    for bit, with the robot, placement and contact model, and computes everything otherwise)."""
+
+    samples: int
+    core: _core.ZmpPrefix | None = None
+    resumed: int = 0
+
+
 def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike,
                                      base: BasePlacement | None = None, qd: npt.ArrayLike | None = None, *,
                                      contact: str = "ground", tolerance: float = CONTACT_TOLERANCE,
-                                     made: _core.PathChecker | None = None) -> tuple[DynamicStability, np.ndarray]:
+                                     made: _core.PathChecker | None = None, kept: KeptSamples | None = None
+                                     ) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` (contact "ground" or "footprint") and, from the same frames in the same C++ pass,
     the lowest point of the neck and head links above the ground at each sample (T,) m (as
     ``geometry.collision.ground_clearance`` over ``robot.lifted_links``). ``made``: the
-    ``geometry.path_check.checker`` of the robot at ``base``, when the caller keeps one."""
+    ``geometry.path_check.checker`` of the robot at ``base``, when the caller keeps one. ``kept``: the first samples'
+    part of an earlier check to take over (filled by this check when empty; see :class:`KeptSamples`): the result is
+    the same, to the bit."""
     robot = as_robot(robot)
     base = as_base(base)
     tolerance = float(finite_array(tolerance, "tolerance", ()))
@@ -415,15 +433,15 @@ def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     if contact not in CORE_CONTACT_MODELS:
         raise InputError(f"contact must be one of {CORE_CONTACT_MODELS}, got {contact!r}")
-    return _stability_in_core(robot, t, q, base, qd, contact, tolerance, made)
+    return _stability_in_core(robot, t, q, base, qd, contact, tolerance, made, kept)
 
 
 def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
-                       contact: str, tolerance: float, made: _core.PathChecker | None = None
-                       ) -> tuple[DynamicStability, np.ndarray]:
+                       contact: str, tolerance: float, made: _core.PathChecker | None = None,
+                       kept: KeptSamples | None = None) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
     differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
-    and the neck and head's lowest point per sample."""
+    and the neck and head's lowest point per sample; ``kept`` as :func:`dynamic_stability_with_clearance`'s."""
     from ..geometry.path_check import checker
 
     g = robot.geometry
@@ -435,9 +453,15 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
         key_joints = list(range(robot.n_joints))[robot.parts.base]
     if len(links) == 0:
         raise InputError("the base part has no links with collision shapes; no support polygon")
+    resume = kept.core if kept is not None else None
+    keep = kept.samples if kept is not None and resume is None else 0
     out = _core.zmp_check(made if made is not None else checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
                           g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
-                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK, GRAVITY)
+                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK, GRAVITY, resume, max(0, keep))
+    if kept is not None:
+        kept.resumed = int(out["resumed"])
+        if out["kept"] is not None:
+            kept.core = out["kept"]
     margin = out["margin"]
     inside = margin > 0.0
     k = int(np.argmin(margin))

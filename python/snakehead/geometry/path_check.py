@@ -7,8 +7,12 @@
   far the links can move (below); an interval that the bound does not prove clear is halved, down to ``floor_step``.
 * :func:`feasible`, :func:`path_feasible` -- the planner's checks of configurations and of paths (ground, static
   margin, self, obstacles), on those.
-* :func:`finish_checks` -- the checks of a timed motion at every 2 ms sample: the ZMP in the support polygon
-  (``dynamics.stability.dynamic_stability``, its inner loop in C++), the ground clearance and the obstacles.
+* :func:`check_motion` -- a *proof* that a timed motion, its 2 ms samples joined by straight joint segments, is
+  clear at and between its samples: evaluated only where some joint has travelled ``first_step`` since the last
+  evaluated sample, each interval bounded by the joints' total variation over it (below).
+* :func:`finish_checks` -- the checks of a timed motion: the ZMP in the support polygon at every 2 ms sample
+  (``dynamics.stability.dynamic_stability``, in C++), the neck and head's ground clearance at every sample (from the
+  same pass) and :func:`check_motion` (ground, self and obstacles proven between the samples).
 
 **The motion bound** (proof in path_check.hpp). Along a straight joint segment q(s) = q_a + s (q_b - q_a), s in
 [0, 1], of a chain of revolute joints with a fixed root, every point of a shape S moves at most
@@ -22,6 +26,17 @@ at most Z_S = sum_j |dq_j| h_j (r_{j,S} + rho_S), h_j <= 1 bounding the horizont
 vertical yaw axis whose earlier joints do not move); a self pair's distance changes at most by the sum over the joints
 between its two links only. A clearance f that is B-Lipschitz in s has min f >= (f(0) + f(1) - B) / 2: an interval
 where that is above the floor is proven clear.
+
+**Between the samples of a timed motion** (:func:`check_motion`). The bound needs no straight segment: along any
+continuous joint path over which joint j travels at most V_j (its total variation, the integral of |dq_j/dt|),
+every point of S moves at most sum_j V_j (r_{j,S} + rho_S) (the speed of a point of S is at most
+sum_j |dq_j/dt| dist(p, axis_j), and r_{j,S} bounds that distance over the whole interval with V in place of |dq|),
+and the cone bound holds in the arc length u(t) = integral sum_j |dq_j/dt| (r_{j,S} + rho_S) dt. The motion checked
+is the one the joints are commanded: its 2 ms samples joined by straight joint segments, over which
+V_j = sum_k |q_{k+1,j} - q_{k,j}| exactly, between any two samples, from the samples themselves (no bound on the
+spline's or TOPP-RA's velocities is needed). The samples evaluated are those where a joint has travelled
+``first_step`` since the last one; an interval the bound does not prove is halved by sample index, and one between
+two consecutive samples along its straight segment as :func:`check_path` does.
 """
 from __future__ import annotations
 
@@ -36,7 +51,7 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base
 from .collision import GROUND_TOLERANCE, obstacle_shapes
 
 if TYPE_CHECKING:
-    from ..dynamics.stability import DynamicStability
+    from ..dynamics.stability import DynamicStability, KeptSamples
 
 #: rad: the first sampling of a path that :func:`check_path` proves clear (largest joint change between samples).
 #: Measured with bench/path_check.py on the move paths of 12 plans (1759 configurations checked at MOVE_CHECK_STEP =
@@ -46,9 +61,12 @@ if TYPE_CHECKING:
 PATH_FIRST_STEP = 0.5
 #: rad: intervals are not split below this largest joint change; one still unproven there fails the path.
 PATH_FLOOR_STEP = 1e-3
+#: rad: :func:`check_motion` evaluates a timed motion's samples where some joint has travelled this far (total
+#: variation) since the last one evaluated. Measured with bench/path_check.py on 16 plans' motions: see the bench.
+MOTION_FIRST_STEP = 0.2
 
-__all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "PathReport", "checker",
-           "sample_clearances", "check_path", "feasible", "path_feasible", "finish_checks"]
+__all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "PathReport", "MotionReport", "checker",
+           "sample_clearances", "check_path", "check_motion", "feasible", "path_feasible", "finish_checks"]
 
 
 def checker(robot: SnakeRobot, base: BasePlacement | None = None, obstacles: Sequence[Any] = ()) -> _core.PathChecker:
@@ -134,16 +152,59 @@ def path_feasible(way: Any, path: np.ndarray, checked: np.ndarray, margin: float
     return bool((way._margins(np.asarray(checked, float)) >= margin).all())
 
 
+@dataclass(frozen=True)
+class MotionReport:
+    """What :func:`check_motion` proved about a sampled motion of T samples: ``clear`` (no violation, nothing
+    unproven), the configurations evaluated (``samples``), intervals ``proven`` and ``unproven`` (between two
+    consecutive samples, at the floor), ``violations`` (intervals with an evaluated configuration below a floor), the
+    smallest ground, self and obstacle values evaluated (m) and ``obstacle_lower`` (T,) m: a lower bound of the
+    smallest obstacle distance from each sample to the next (the last: at it), <= 0 where an interval is violated
+    or unproven, +inf without obstacles."""
+
+    clear: bool
+    samples: int
+    proven: int
+    unproven: int
+    violations: int
+    ground: float
+    self_clearance: float
+    obstacle: float
+    obstacle_lower: np.ndarray
+
+    def describe(self) -> str:
+        """One line: what was evaluated and proven, and what was not."""
+        return (f"{self.samples} configurations evaluated, {self.proven} intervals proven, {self.unproven} unproven, "
+                f"{self.violations} violated; smallest ground {1000 * self.ground:.1f} mm, self "
+                f"{1000 * self.self_clearance:.1f} mm, obstacles {1000 * self.obstacle:.1f} mm")
+
+
+def check_motion(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None = None, obstacles: Sequence[Any] = (),
+                 *, first_step: float = MOTION_FIRST_STEP, floor_step: float = PATH_FLOOR_STEP,
+                 made: _core.PathChecker | None = None) -> MotionReport:
+    """Proves a sampled motion qs (T, n) (its samples joined by straight joint segments) clear of the ground (neck
+    and head links, by -GROUND_TOLERANCE), of itself and of ``obstacles`` at and between its samples, evaluating
+    only some (the module's docstring)."""
+    Q = np.ascontiguousarray(qs, float).reshape(-1, robot.n_joints)
+    d = (made if made is not None else checker(robot, base, obstacles)).check_motion(Q, float(first_step), float(floor_step))
+    return MotionReport(bool(d["clear"]), int(d["samples"]), int(d["proven"]), int(d["unproven"]),
+                        int(d["violations"]), float(d["ground"]), float(d["self"]), float(d["obstacle"]),
+                        d["obstacle_lower"])
+
+
 def finish_checks(robot: SnakeRobot, base: BasePlacement, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
-                  obstacles: Sequence[Any], contact: str, made: _core.PathChecker | None = None
-                  ) -> tuple[DynamicStability, np.ndarray, np.ndarray | None]:
-    """The checks of a timed motion at every sample (``motion.planner._finish``): the dynamic stability
-    (``stability.dynamic_stability``: momenta, ZMP and its margin, in C++ in one call), the lowest point of the neck
-    and head links above the ground (exact, per sample) and the obstacle distance (exact below
-    EXACT_DISTANCE_WITHIN, a lower bound above it; None without obstacles), all in C++ without the GIL."""
+                  obstacles: Sequence[Any], contact: str, made: _core.PathChecker | None = None,
+                  kept: KeptSamples | None = None
+                  ) -> tuple[DynamicStability, np.ndarray, np.ndarray | None, MotionReport]:
+    """The checks of a timed motion (``Waypoints.finish_checks``): the dynamic stability at every sample
+    (``stability.dynamic_stability``: momenta, ZMP and its margin, in C++ in one call; ``kept``: the first samples'
+    part of an earlier check, see ``stability.KeptSamples``), the lowest point of the neck and head links above the
+    ground at every sample (exact, from the same pass), and :func:`check_motion`: the ground, self and obstacle
+    clearances proven at and between the samples. Returns those, and the obstacle distance per sample (the proof's
+    ``obstacle_lower``: a lower bound from each sample to the next; None without obstacles)."""
     from ..dynamics import stability
 
     made = made if made is not None else checker(robot, base, obstacles)
-    dyn, clearance = stability.dynamic_stability_with_clearance(robot, t, q, base, qd, contact=contact, made=made)
-    distance = sample_clearances(robot, q, base, obstacles, made=made)[2] if obstacles else None
-    return dyn, clearance, distance
+    dyn, clearance = stability.dynamic_stability_with_clearance(robot, t, q, base, qd, contact=contact, made=made,
+                                                                kept=kept)
+    proof = check_motion(robot, q, base, obstacles, made=made)
+    return dyn, clearance, (proof.obstacle_lower if obstacles else None), proof

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Generic, TypeVar
 import numpy as np
 
 if TYPE_CHECKING:
+    from ..dynamics.stability import KeptSamples
     from .timing import RetimedTrajectory
 
 #: Lifts (checked paths, timed motions) a controller keeps: one per base shape planned from.
@@ -83,6 +84,10 @@ class PlanCache:
     timed_lifts: (the lift's waypoints rounded to 1e-9 rad as bytes, ``repr`` of the sorted retiming options) ->
         the lift retimed (``motion.timing.retime``). Invalid when the retiming's defaults change (the options given
         are in the key, the defaults are not): call :meth:`clear` then.
+    checked_lifts: (timed_lifts' key, and where the base lies) -> the lift's part of the plan's ZMP check
+        (``dynamics.stability.KeptSamples``, filled by the first plan's check; the core takes it over only when the
+        motion begins with the very samples it was made from). Unlike the others, a function of the placement too:
+        it is in the key.
     """
 
     bending_states: KeptMap[bytes, np.ndarray] = field(default_factory=lambda: KeptMap(KEPT_SHAPES))
@@ -90,10 +95,12 @@ class PlanCache:
     lift_paths: KeptMap[tuple[bytes, bytes], tuple[np.ndarray, str]] = field(
         default_factory=lambda: KeptMap(KEPT_LIFTS))
     timed_lifts: KeptMap[tuple[bytes, str], RetimedTrajectory] = field(default_factory=lambda: KeptMap(KEPT_LIFTS))
+    checked_lifts: KeptMap[tuple[bytes, str, str], KeptSamples] = field(default_factory=lambda: KeptMap(KEPT_LIFTS))
 
     def clear(self) -> None:
         """Forget every entry."""
-        for kept in (self.bending_states, self.shapes_without_curl, self.lift_paths, self.timed_lifts):
+        for kept in (self.bending_states, self.shapes_without_curl, self.lift_paths, self.timed_lifts,
+                     self.checked_lifts):
             kept.clear()
 
 

@@ -76,7 +76,10 @@ class Plan:
     states: (label, time s, q (n,)) of every waypoint. targets: :class:`TargetResult` per reported target.
     stability: ``dynamics.DynamicStability`` (ZMP and its margin at every sample). ground_clearance (T,) m: the
     lowest neck or head box corner above the ground. obstacles and obstacle_distance (T,) m (None without
-    obstacles). segments: (segment, interpolation used). notes: what the planner had to do or could not.
+    obstacles): a lower bound of the smallest distance to them from each sample to the next (exact at the samples
+    the proof evaluated). motion_proof: ``geometry.path_check.MotionReport``, the proof that the motion is clear of
+    the ground, itself and the obstacles between its samples too (None when not checked). segments: (segment,
+    interpolation used). notes: what the planner had to do or could not.
     """
 
     name: str
@@ -98,6 +101,7 @@ class Plan:
     relocation: Relocation | None = None  # the change of base the targets need, before the plan (locomotion)
     timing_failure: str | None = None  # why the path could not be timed within the limits, when it could not
     out_of_range: str | None = None  # why no relocation was tried: a target beyond MAX_RELOCATION_M of the start
+    motion_proof: Any = None  # geometry.path_check.MotionReport of the motion (None: not checked)
 
     @property
     def min_zmp_margin_m(self) -> float:
@@ -137,6 +141,8 @@ class Plan:
         if self.touches_obstacle and self.obstacle_distance is not None:
             k = int(np.argmax(self.obstacle_distance <= 0))
             return f"a link touches an obstacle at t = {self.t[k]:.2f} s"
+        if self.motion_proof is not None and not self.motion_proof.clear:
+            return f"the motion is not proven clear between its samples: {self.motion_proof.describe()}"
         return None
 
     @property

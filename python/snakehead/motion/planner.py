@@ -46,7 +46,7 @@ from .plan_bounds import check_size, check_timing
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
 from .start_state import LIFT_STEPS, bending_state
 from .target_solves import solve_noted
-from .waypoints import PLAN_CONTACT, Waypoints
+from .waypoints import Waypoints
 
 if TYPE_CHECKING:
     from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
@@ -269,6 +269,7 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
             lifts.put(key, (np.array(way.qs[first:]), method))
     way.lift_index = way.stop()
     way.lift_cache = controller.plan_cache.timed_lifts
+    way.checked_lifts = controller.plan_cache.checked_lifts
     return q
 
 
@@ -385,14 +386,14 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
                     + (", obstacles)" if obstacles else ")"))
     for tg in targets:  # the waypoint each target was reached at -> when
         tg.time_s = plan.times[tg.time_s]
-    # the ZMP, the ground and the obstacles at every sample, in C++ (geometry.path_check.finish_checks)
-    dyn, clearance, distance = path_check.finish_checks(robot, base, t, q, qd, obstacles, PLAN_CONTACT,
-                                                          made=plan.checker)
+    # the ZMP and the ground at every sample, the ground, self and obstacles proven between them, in C++
+    # (Waypoints.finish_checks: geometry.path_check.finish_checks)
+    dyn, clearance, distance, proof = plan.finish_checks(t, q, qd)
     states = [(lab, float(when), qk) for lab, when, qk in zip(plan.labels, plan.times, plan.qs)]
     return Plan(name=name, robot=robot, base=base, t=t, q=q, qd=qd, states=states, targets=targets,
                 stability=dyn, ground_clearance=clearance, obstacles=list(obstacles), obstacle_distance=distance,
                 planning_time_s=time.perf_counter() - t_start, notes=notes, segments=list(plan.methods), scene=scene,
-                timing_failure=plan.timing_failure)
+                timing_failure=plan.timing_failure, motion_proof=proof)
 
 
 __all__ = ["plan", "as_scene"]

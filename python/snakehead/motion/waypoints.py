@@ -87,7 +87,12 @@ class Waypoints:
         self.timing_failure: str | None = None  # why the path could not be timed, when it could not
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: KeptMap[tuple[bytes, str], Any] | None = None  # timed lifts: controller.plan_cache's
+        # the lift's part of the ZMP check per placement: controller.plan_cache's checked_lifts (finish_checks)
+        self.checked_lifts: KeptMap[tuple[bytes, str, str], stability.KeptSamples] | None = None
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
+        # the timed lift's key in lift_cache and its samples at the start of the motion, when sample() used a kept
+        # lift (finish_checks keeps their part of the ZMP check there too)
+        self._lift_rows: tuple[tuple[bytes, str], int] | None = None
         self._least = (0, 0.0)  # (waypoints counted, s): least_duration's sum so far
 
     def least_duration(self, velocity: np.ndarray) -> float:
@@ -277,6 +282,7 @@ class Waypoints:
                 rest = replace(rest, t=rest.t[-1:].copy(), q=rest.q[-1:].copy(), qd=rest.qd[-1:].copy(),
                                qdd=rest.qdd[-1:].copy())
                 traj = concatenate_motions(lift, rest)
+                self._lift_rows = (key, int(np.count_nonzero(traj.t <= float(lift.t[-1]))))
             else:
                 traj = retime(self.robot, Q, self.base, hold_s=hold_s, stops=stops, **timing)
         except MotionTooLong:  # no slower fallback either: the motion is already too long
@@ -299,6 +305,33 @@ class Waypoints:
         return traj
 
 
+    def finish_checks(self, t: np.ndarray, q: np.ndarray, qd: np.ndarray
+                      ) -> tuple[stability.DynamicStability, np.ndarray, np.ndarray | None, path_check.MotionReport]:
+        """The checks of the timed motion t, q, qd (``geometry.path_check.finish_checks``: the ZMP and the ground
+        clearance at every sample, the ground, self and obstacle clearances proven between them), with the lift's
+        part of the ZMP check kept in ``checked_lifts`` for the next plan from a base of this shape and placement (the
+        motion begins with the same samples: ``dynamics.stability.KeptSamples``; the result is the same to the
+        bit)."""
+        kept = None
+        if self._lift_rows is not None and self.checked_lifts is not None:
+            (shape, timing), rows = self._lift_rows
+            key = (shape, timing, repr(self.base))  # the check depends on where the base lies
+            kept = self.checked_lifts.get(key)
+            if kept is None or kept.samples != rows:
+                kept = self.checked_lifts.put(key, stability.KeptSamples(rows))
+        return path_check.finish_checks(self.robot, self.base, t, q, qd, self.obstacles, PLAN_CONTACT,
+                                        made=self.checker, kept=kept)
+
+
+def _sample_all(motion: Any, t: np.ndarray) -> list[np.ndarray]:
+    """q, qd, qdd (N, n) of a timed motion at times t, its path evaluated once for all three when its spline can
+    (``motion.timing``'s timeline: the same values as three calls)."""
+    spline = motion.spline
+    if hasattr(spline, "sample"):
+        return list(spline.sample(t, (0, 1, 2)))
+    return [spline(t, nu) for nu in (0, 1, 2)]
+
+
 def concatenate_motions(a: Any, b: Any) -> Any:
     """Two retimed motions (``motion.timing.RetimedTrajectory``), the second starting where and when (at rest) the
     first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
@@ -309,12 +342,21 @@ def concatenate_motions(a: Any, b: Any) -> Any:
     dt = float(a.t[1] - a.t[0]) if len(a.t) > 1 else interp.CONTROL_PERIOD
     t = interp.sample_times(0.0, offset + float(b.t[-1]), dt)
     first = t <= offset
-    arrays = []
-    for nu in (0, 1, 2):
-        x = np.empty((len(t), a.q.shape[1]))
-        x[first] = a.spline(t[first], nu)
-        x[~first] = b.spline(t[~first] - offset, nu)
-        arrays.append(x)
+    m = int(np.count_nonzero(first))  # the first's samples come first
+    # the first's own samples where its grid is this one's (the same times): its spline's values there, except its
+    # ends, which retime set to the waypoints exactly (q only)
+    shared = min(m, len(a.t))
+    redo = np.ones(m, bool)  # the rows the first's spline is evaluated at
+    redo[:shared] = a.t[:shared] != t[:shared]
+    redo[[0, shared - 1]] = True
+    arrays = [np.empty((len(t), a.q.shape[1])) for _ in range(3)]
+    for x, own in zip(arrays, (a.q, a.qd, a.qdd)):
+        x[:shared] = own[:shared]
+    rows = np.flatnonzero(redo)
+    for x, v in zip(arrays, _sample_all(a, t[rows])):
+        x[rows] = v
+    for x, v in zip(arrays, _sample_all(b, t[m:] - offset)):
+        x[m:] = v
     arrays[0][-1] = b.q[-1]
     return RetimedTrajectory(t, arrays[0], arrays[1], arrays[2], None,
                              waypoint_times=np.concatenate([a.waypoint_times, b.waypoint_times[1:] + offset]),
