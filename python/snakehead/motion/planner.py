@@ -37,7 +37,6 @@ from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, in
 from .._validate import integer, joint_vector
 from ..control.controller import HeadController
 from ..control.whole_body import PlanSolves, clear_of_obstacles
-from ..geometry import path_check
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import plan_bounds
