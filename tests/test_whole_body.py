@@ -404,10 +404,12 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
     before = (len(calls), len(kept_calls), len(ik_calls))
     sol = target_solves.solve_kept(controller, target.position, target.direction, q_shape, chosen, [], memo)
     assert sol.success and (len(calls), len(kept_calls), len(ik_calls)) == before  # the plan's: from the choice
-    # without the plan's PlanSolves the same choice repeats solves (what the memo saves), and chooses the same base
+    # without a PlanSolves the same steps repeat solves (what the memo saves), and find the same base
     calls.clear(), ik_calls.clear()
-    again = base_choice.choose_base(controller, [target], solved=None)
-    assert again[0] == chosen and np.array_equal(again[1], q_shape)
+    q0 = controller.q_initial
+    assert base_choice._first_failure(controller, controller.base, q0, [target], [], None)[0] is target
+    again = base_choice._relocated_for(controller, target, q0, [target], [], None)
+    assert again is not None and again[0] == chosen and np.array_equal(again[1], q_shape)
     assert len(calls) + len(ik_calls) > len(set(calls)) + len(set(ik_calls))
 
 

@@ -75,7 +75,9 @@ def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[An
     the controller's initial configuration's). Returns the placement, a configuration with the base's shape
     (the initial configuration's otherwise), the relocation (None when the base stays) and notes. ``solved``: the
     plan's :class:`~snakehead.control.whole_body.PlanSolves`, which keeps the solves (:func:`solve_kept`, and the
-    segmented solves of the relocation's search) for the plan to reuse."""
+    segmented solves and IK batches of the relocation's search) for the plan to reuse (default: one for this call,
+    shared by its own steps)."""
+    solved = PlanSolves() if solved is None else solved
     robot = controller.robot
     obstacles = list(obstacles)
     targets = list(targets)

@@ -17,7 +17,7 @@ def solve_kept(controller: HeadController, position: np.ndarray, direction: np.n
                base: BasePlacement, obstacles: Sequence[Any], solved: PlanSolves | None, near: bool = False) -> Any:
     """``control.whole_body.solve_target`` with the base kept, kept in ``solved`` (one plan's: its obstacles are
     fixed) so that choose_base's solves of the chosen base are not repeated by the plan (the solve is
-    deterministic: the same inputs give the same solution); the segmented solves it makes are shared there too."""
+    deterministic: the same inputs give the same solution); its segmented solves and IK batches are shared there too."""
     from ..control.whole_body import solve_checked_target
 
     key = (np.asarray(position, float).tobytes(), np.asarray(direction, float).tobytes(),
