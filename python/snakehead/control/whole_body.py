@@ -62,6 +62,9 @@ MAX_ITERATIONS = 40
 #: targets reachable by construction take at most 8 (bench/plan_speed.py's sets). A caller that needs a tighter
 #: bound passes a smaller ``budget`` (40 leaves out the refinements: ~0.5 s).
 SOLVE_BUDGET = 60
+#: TRAC-IK's budget per call (s) on the lifted chain. (It races its two solvers until one succeeds or this runs
+#: out: the one part of a whole-body solve that still depends on the machine's speed.)
+LIFTED_IK_TIMEOUT_S = 0.002
 #: Capsule pairs farther apart than this at a start (m) are left out of that start's constraints (and checked
 #: exactly at the end like every pair).
 PAIR_RANGE = 0.25
@@ -179,7 +182,7 @@ class BodyProblem:
 
         if seed not in self._iks:
             chain = self.robot.sub_chain(self.robot.lift_frame, self.robot.parts.head_tip)
-            self._iks[seed] = TracIK.from_chain(chain, timeout=0.002, seed=seed)
+            self._iks[seed] = TracIK.from_chain(chain, timeout=LIFTED_IK_TIMEOUT_S, seed=seed)
         return self._iks[seed]
 
     # --- kinematics of world points ---------------------------------------------------------------------------

@@ -46,7 +46,7 @@ from ..scenes.scene import Target
 from .plan_many import WORKERS, RobotRecipe, plan_many
 from .reach_bounds import PoseBounds
 
-__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK", "SOLVE_BUDGET_S"]
+__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK"]
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -55,14 +55,13 @@ if TYPE_CHECKING:
 #: relocation is solved per layer and direction; a voxel takes the nearest one's answer.
 BEARING_BINS = 4
 #: The finest voxel and the most directions of a reach map, and the most whole-body solves one may need (each up to
-#: the whole-body solve's time budget, 3 s): bounds on its run time, checked before any work.
+#: the whole-body solve's budget, ``control.whole_body.SOLVE_BUDGET`` solves): bounds on its run time, checked
+#: before any work.
 MIN_VOXEL_M = 0.02
 MAX_DIRECTIONS = 64
 MAX_SOLVES = 200_000
 #: Poses with the base kept solved per task.
 KEPT_CHUNK = 8
-#: The whole-body solve's time budget (s), recorded in the map's ``timeout``.
-SOLVE_BUDGET_S = 3.0
 
 #: Called as ``progress(stage, done, total)``: stage "relocation" (the table of moved bases) or "base kept".
 ReachProgress = Callable[[str, int, int], None]
@@ -326,11 +325,11 @@ def _run(pool: Any, fn: Callable[..., list], tasks: list, stage: str, progress: 
 
 def _as_map(robot: SnakeRobot, grid: ReachGrid, reached: np.ndarray, placements: np.ndarray, joints: np.ndarray,
             seed: int | None, seconds: float, workers: int, command: str) -> ws.ReachabilityMap:
-    from ..control.whole_body import POSITION_TOLERANCE
+    from ..control.whole_body import LIFTED_IK_TIMEOUT_S, POSITION_TOLERANCE
 
     M, N = reached.shape
     params = dict(voxel_size=grid.voxel, directions=N, rolls=0, any_roll=True, free_roll=True, approach_axis="x",
-                  timeout=SOLVE_BUDGET_S, epsilon=POSITION_TOLERANCE, cloud_samples=ws.MIN_CLOUD_SAMPLES,
+                  timeout=LIFTED_IK_TIMEOUT_S, epsilon=POSITION_TOLERANCE, cloud_samples=ws.MIN_CLOUD_SAMPLES,
                   seed=0 if seed is None else int(seed), hull="convex", shrink=0.0)
     return ws.ReachabilityMap(
         centers=grid.centers, solved=reached.sum(axis=1).astype(np.int32), voxel_ids=grid.ids, tried=N,
