@@ -62,7 +62,11 @@ PATH_FIRST_STEP = 0.5
 #: rad: intervals are not split below this largest joint change; one still unproven there fails the path.
 PATH_FLOOR_STEP = 1e-3
 #: rad: :func:`check_motion` evaluates a timed motion's samples where some joint has travelled this far (total
-#: variation) since the last one evaluated. Measured with bench/path_check.py on 16 plans' motions: see the bench.
+#: variation) since the last one evaluated. Measured on the motions of 12 plans (~7,000 samples each, no obstacles;
+#: 2026-12-02, loaded 2-core machine): 0.05 evaluates ~260 configurations per motion (6.0 ms), 0.1 ~140 (3.8 ms),
+#: 0.2 ~83 (2.7 ms), 0.4 ~70 (3.0 ms), every motion proven clear at each; with an obstacle beside the head
+#: (bench/path_check.py, 6 motions) 0.05: 1510 configurations, 54 ms; 0.1: 936, 15 ms; 0.2: 692, 9.4 ms; 0.4: 608,
+#: 10.3 ms (every 2 ms sample: 42,174, 1456 ms).
 MOTION_FIRST_STEP = 0.2
 
 __all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "PathReport", "MotionReport", "checker",
