@@ -25,6 +25,18 @@ long samples_of(const char* what, const Doubles& q, long n) {
   return static_cast<long>(q.shape(0));
 }
 
+// What a proof evaluated (PathVerdict's and MotionVerdict's counts and smallest values) into d.
+template <class Verdict>
+void put_counts(py::dict& d, const Verdict& v) {
+  d["samples"] = v.samples;
+  d["proven"] = v.proven;
+  d["unproven"] = v.unproven;
+  d["violations"] = v.violations;
+  d["ground"] = v.ground;
+  d["self"] = v.self;
+  d["obstacle"] = v.obstacle;
+}
+
 py::array_t<double> array_of(const std::vector<double>& v, std::vector<py::ssize_t> shape) {
   py::array_t<double> out(shape);
   std::copy(v.begin(), v.end(), out.mutable_data());
@@ -108,13 +120,7 @@ void bind_path_check(py::module_& m) {
             py::dict d;
             d["clear"] = v.clear() && v.violations == 0;
             d["segments"] = segments;
-            d["samples"] = v.samples;
-            d["proven"] = v.proven;
-            d["unproven"] = v.unproven;
-            d["violations"] = v.violations;
-            d["ground"] = v.ground;
-            d["self"] = v.self;
-            d["obstacle"] = v.obstacle;
+            put_counts(d, v);
             return d;
           },
           py::arg("waypoints"), py::arg("first_step") = 0.05, py::arg("floor_step") = 1e-3,
@@ -136,13 +142,7 @@ void bind_path_check(py::module_& m) {
             }
             py::dict d;
             d["clear"] = v.clear();
-            d["samples"] = v.samples;
-            d["proven"] = v.proven;
-            d["unproven"] = v.unproven;
-            d["violations"] = v.violations;
-            d["ground"] = v.ground;
-            d["self"] = v.self;
-            d["obstacle"] = v.obstacle;
+            put_counts(d, v);
             d["obstacle_lower"] = array_of(v.obstacle_lower, {static_cast<py::ssize_t>(T)});
             return d;
           },

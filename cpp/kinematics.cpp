@@ -1,5 +1,7 @@
 #include "snakehead/kinematics.hpp"
 
+#include <cmath>
+
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
@@ -45,11 +47,66 @@ void link_frames(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd
     out[k] = links[k].segment < 0 ? links[k].offset : tips[links[k].segment] * links[k].offset;
 }
 
+namespace {
+
+// (R, p) <- (R, p) * T: a fixed transform of the chain, most of them pure translations (their rotation not applied).
+inline void compose(Eigen::Matrix3d& R, Eigen::Vector3d& p, const Eigen::Isometry3d& T) {
+  p += R * T.translation();
+  if (!T.linear().isIdentity(0.0)) R = R * T.linear();
+}
+
+// R <- R * Rot(axis, q). About a coordinate axis (URDF joints mostly are) only two columns change, by the angle's
+// cosine and sine; any other axis through Eigen's angle-axis matrix.
+inline void rotate(Eigen::Matrix3d& R, const Eigen::Vector3d& axis, double q) {
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;  // about e_k: e_i -> c e_i + s e_j, e_j -> c e_j - s e_i
+    if (std::abs(axis[k]) != 1.0 || axis[i] != 0.0 || axis[j] != 0.0) continue;
+    const double a = axis[k] > 0.0 ? q : -q, c = std::cos(a), s = std::sin(a);
+    const Eigen::Vector3d ci = R.col(i), cj = R.col(j);
+    R.col(i) = c * ci + s * cj;
+    R.col(j) = c * cj - s * ci;
+    return;
+  }
+  R = R * Eigen::AngleAxisd(q, axis).toRotationMatrix();
+}
+
+}  // namespace
+
 void world_link_frames(const ChainModel& model, const Eigen::Matrix4d& origin, const Eigen::Ref<const Eigen::VectorXd>& q,
                        Frames& local, double* out) {
-  link_frames(model, q, local);
-  for (std::size_t k = 0; k < local.size(); ++k)
-    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(out + 16 * k) = origin * local[k].matrix();
+  using Row4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+  const auto& links = model.links();
+  if (origin.row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)) {  // not a rigid placement: the general product
+    link_frames(model, q, local);
+    for (std::size_t k = 0; k < local.size(); ++k) Eigen::Map<Row4>(out + 16 * k) = origin * local[k].matrix();
+    return;
+  }
+  // the chain from the origin on (origin * link_frames(q), the origin folded in first), the joints' tips in `local`
+  const auto& segs = model.segments();
+  local.resize(segs.size() + 1);
+  Eigen::Matrix3d R = origin.topLeftCorner<3, 3>();
+  Eigen::Vector3d p = origin.topRightCorner<3, 1>();
+  local.back().linear() = R;  // the base frame's pose, for links before the first joint
+  local.back().translation() = p;
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    compose(R, p, segs[i].pre);
+    if (segs[i].prismatic)
+      p += R * (segs[i].axis * q[static_cast<Eigen::Index>(i)]);
+    else
+      rotate(R, segs[i].axis, q[static_cast<Eigen::Index>(i)]);
+    compose(R, p, segs[i].post);
+    local[i].linear() = R;
+    local[i].translation() = p;
+  }
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    const Eigen::Isometry3d& tip = local[links[k].segment < 0 ? segs.size() : static_cast<std::size_t>(links[k].segment)];
+    Eigen::Map<Row4> f(out + 16 * k);
+    if (links[k].offset.matrix().isIdentity(0.0))
+      f = tip.matrix();
+    else
+      f = (tip * links[k].offset).matrix();
+    f.row(3) << 0.0, 0.0, 0.0, 1.0;
+  }
 }
 
 void tip_jacobian(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, Jacobian& jac,

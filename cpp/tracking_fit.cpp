@@ -109,8 +109,8 @@ void world_frames(const ChainModel& model, const Eigen::Isometry3d& origin, cons
   out.resize(16 * model.links().size());
   world_link_frames(model, origin.matrix(), q, local, out.data());
   if (world == nullptr) return;
-  world->resize(local.size());
-  for (std::size_t k = 0; k < local.size(); ++k) (*world)[k].matrix() = Eigen::Map<const Row4>(out.data() + 16 * k);
+  world->resize(model.links().size());  // (local is world_link_frames's work buffer, not one frame per link)
+  for (std::size_t k = 0; k < world->size(); ++k) (*world)[k].matrix() = Eigen::Map<const Row4>(out.data() + 16 * k);
 }
 
 }  // namespace

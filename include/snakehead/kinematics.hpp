@@ -22,7 +22,9 @@ void link_frames(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd
 
 // Poses of every link in the frame where the chain's base frame has pose ``origin``: origin * link_frames(q), written
 // row-major, 16 doubles per link, to ``out`` (room for model.links().size() of them). ``local`` is the caller's work
-// buffer (link_frames's output). q is not checked.
+// buffer (the joints' world poses). q is not checked. For a rigid origin (last row 0 0 0 1) the chain is composed
+// from the origin on, fixed rotations that are the identity not applied and a joint about a coordinate axis turning
+// two columns only (equal to the product up to round-off; tests/cpp/test_kinematics.cpp).
 void world_link_frames(const ChainModel& model, const Eigen::Matrix4d& origin, const Eigen::Ref<const Eigen::VectorXd>& q,
                        Frames& local, double* out);
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 #include "snakehead/kinematics.hpp"
 #include "snakehead/model.hpp"
@@ -86,6 +87,34 @@ TEST(Kinematics, MixedJointsMatchKdl) {
   EXPECT_EQ(m.joints()[2].type, snakehead::JointType::Prismatic);
   EXPECT_FALSE(std::isfinite(m.lower()[1]));
   expect_matches_kdl(m, 1000);
+}
+
+TEST(Kinematics, WorldLinkFramesAreTheOriginTimesTheLinkFrames) {
+  // the composed world frames (coordinate-axis joints turning two columns, identity rotations skipped) against the
+  // plain product origin * link_frames, on the snake (yaw and pitch joints) and the mixed chain (other axes, a
+  // prismatic joint); and a non-rigid origin (the general product)
+  std::mt19937 rng(4);
+  for (const auto& m : {ChainModel::from_urdf_file(kSnake, "link_0", "head_tip"),
+                        ChainModel::from_urdf_file(kMixed, "world", "tool")}) {
+    const long L = static_cast<long>(m.links().size());
+    std::vector<double> out(static_cast<std::size_t>(16 * L));
+    snakehead::Frames local, f;
+    for (int trial = 0; trial < 200; ++trial) {
+      const Eigen::VectorXd q = random_q(m, rng);
+      Eigen::Isometry3d o = Eigen::Isometry3d::Identity();
+      o.linear() = Eigen::AngleAxisd(0.3 * trial, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+      o.translation() = Eigen::Vector3d(0.1 * trial, -0.2, 0.05);
+      Eigen::Matrix4d origin = o.matrix();
+      if (trial % 10 == 9) origin(3, 0) = 0.5;  // not rigid
+      snakehead::world_link_frames(m, origin, q, local, out.data());
+      snakehead::link_frames(m, q, f);
+      for (long k = 0; k < L; ++k) {
+        const Eigen::Matrix4d want = origin * f[static_cast<std::size_t>(k)].matrix();
+        const Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> got(out.data() + 16 * k);
+        EXPECT_LT((got - want).cwiseAbs().maxCoeff(), 1e-12) << "link " << k << " trial " << trial;
+      }
+    }
+  }
 }
 
 TEST(Kinematics, FixedLinkFramesFollowTheirParent) {

@@ -110,15 +110,25 @@ TEST(PathCheck, YawAboutAVerticalAxisMovesNothingUpOrDown) {
   }
 }
 
-TEST(PathCheck, ProvenClearPathIsClearAtFineSamples) {
-  const Fixture fx;
-  const ShapeSet shapes(fx.shapes_of());
+// The chain 5 cm above the ground, its boxes' lowest points to stay >= 0.
+Eigen::Isometry3d raised() {
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
   origin.translation().z() = 0.05;
+  return origin;
+}
+
+PathChecker ground_checker(const Fixture& fx, const ShapeSet& shapes) {
   PathCheckSpec spec;
   spec.ground_shapes = {0, 1, 2, 3};
   spec.ground_floor = 0.0;
-  const PathChecker checker(fx.model, shapes, origin.matrix(), spec);
+  return PathChecker(fx.model, shapes, raised().matrix(), spec);
+}
+
+TEST(PathCheck, ProvenClearPathIsClearAtFineSamples) {
+  const Fixture fx;
+  const ShapeSet shapes(fx.shapes_of());
+  const Eigen::Isometry3d origin = raised();
+  const PathChecker checker = ground_checker(fx, shapes);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> angle(-0.6, 0.6);
   int proven = 0;
@@ -144,12 +154,8 @@ TEST(PathCheck, ProvenClearMotionIsClearBetweenItsSamples) {
   // samples; and a motion proven clear at one first step is proven at the others
   const Fixture fx;
   const ShapeSet shapes(fx.shapes_of());
-  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
-  origin.translation().z() = 0.05;
-  PathCheckSpec spec;
-  spec.ground_shapes = {0, 1, 2, 3};
-  spec.ground_floor = 0.0;
-  const PathChecker checker(fx.model, shapes, origin.matrix(), spec);
+  const Eigen::Isometry3d origin = raised();
+  const PathChecker checker = ground_checker(fx, shapes);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> angle(-0.5, 0.5), phase(0.0, 6.3);
   int proven = 0, failed = 0;

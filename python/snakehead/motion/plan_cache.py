@@ -1,9 +1,10 @@
 """What a :class:`~snakehead.control.HeadController` keeps from one plan for the next (:class:`PlanCache`, its
 ``plan_cache``): the start states of the base shapes it has planned from, and the lift of the head from them, as a
-checked path and as a timed motion.
+checked path and as a timed motion, and the lift's part of the plan's ZMP check.
 
 Every entry is a function of the controller's robot (fixed for the controller's life) and of the key, never of
-where the base lies (the checks and the retiming are the same at every placement on the flat ground), so an entry
+where the base lies (the checks and the retiming are the same at every placement on the flat ground; the ZMP
+check's part, in world coordinates, has the placement in its key), so an entry
 stays valid as long as the controller does; what each key must hold for that is said with each field. Each map
 holds at most a bounded number of entries and is emptied when full (the plans of a session use a few base shapes;
 recomputing an entry gives the same value). The maps may be read and written from several threads planning with
