@@ -376,25 +376,33 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
 #: s: the longest the forked figure process may take before it is taken for hung (the paper's scenes take ~10 s,
 #: 1000 targets ~60 s on a loaded 2-core machine); the figures are then drawn in the main process.
 FIGURE_PROCESS_TIMEOUT_S = 900.0
+#: s: the same for a lane of scenes (:func:`run_scenes`), which plans and simulates them as well.
+LANE_PROCESS_TIMEOUT_S = 4 * FIGURE_PROCESS_TIMEOUT_S
 
 
 class _Beside:
-    """Runs ``work(progress)`` (-> list of file names) beside the caller: in a forked child process on Linux, so
-    that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
-    elsewhere, or with ``parallel=False``. :meth:`files` waits for it; the child's stage times join ``progress``."""
+    """Runs ``work(progress)`` beside the caller: in a forked child process on Linux, so that it runs on the second
+    core (the figures that need only the plan while MuJoCo simulates; a lane of scenes, :func:`run_scenes`); at once
+    elsewhere, or with ``parallel=False``. :meth:`result` waits for its value (pickled back); the child's stage
+    times join ``progress``, their names ending in ``suffix``. ``daemon=False`` lets the child fork children of its
+    own (a lane draws its figures beside it)."""
 
-    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True) -> None:
+    def __init__(self, work: Callable[[Progress], Any], progress: Progress, parallel: bool = True, *,
+                 suffix: str = " [in a second process]", daemon: bool = True,
+                 timeout_s: float = FIGURE_PROCESS_TIMEOUT_S) -> None:
         import multiprocessing
 
         self.progress = progress
         self.work = work
+        self.suffix = suffix
+        self.timeout_s = timeout_s
         self.proc = None
         if not (parallel and sys.platform.startswith("linux")):
-            self._files = work(progress)
+            self._value = work(progress)
             return
         ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
         self.recv, send = ctx.Pipe(duplex=False)
-        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-figures", daemon=True)
+        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-beside", daemon=daemon)
         # Every object alive now is moved out of the collector's reach before the fork: the child must never collect
         # one. A TracIK's destructor joins its worker threads, which a forked child does not have (the collector
         # running it there was the child's SIGSEGV, "Garbage-collecting" in its fault handler's trace).
@@ -406,31 +414,35 @@ class _Beside:
         send.close()
 
     def files(self) -> list[str]:
+        """:meth:`result` of work that returns the names of the files it wrote."""
+        return list(self.result())
+
+    def result(self) -> Any:
         if self.proc is None:
-            return self._files
+            return self._value
         try:
             answer: tuple[bool, Any, list[dict]] | None = (
-                self.recv.recv() if self.recv.poll(FIGURE_PROCESS_TIMEOUT_S) else None)
-        except EOFError:  # the forked child died (a fork of a process with threads can crash): draw here instead
+                self.recv.recv() if self.recv.poll(self.timeout_s) else None)
+        except EOFError:  # the forked child died (a fork of a process with threads can crash): run it here instead
             self.proc.join()
-            self.progress.say(f"the process drawing the figures died (exit code {self.proc.exitcode}); drawing them "
+            self.progress.say(f"the process beside this one died (exit code {self.proc.exitcode}); doing its work "
                               "in this process instead")
             return self.work(self.progress)
-        if answer is None:  # hung (a lock another thread held at the fork): stop it and draw here
+        if answer is None:  # hung (a lock another thread held at the fork): stop it and run it here
             self.proc.kill()
             self.proc.join()
-            self.progress.say(f"the process drawing the figures gave no answer in {FIGURE_PROCESS_TIMEOUT_S:g} s; "
-                              "drawing them in this process instead")
+            self.progress.say(f"the process beside this one gave no answer in {self.timeout_s:g} s; doing its work "
+                              "in this process instead")
             return self.work(self.progress)
         ok, value, stages = answer
         self.proc.join()
-        self.progress.stages += [{**st, "stage": st["stage"] + " [in a second process]"} for st in stages]
+        self.progress.stages += [{**st, "stage": st["stage"] + self.suffix} for st in stages]
         if not ok:
             kind, message = value
             if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
                 raise InputError(message)
-            raise RuntimeError(f"drawing the figures failed: {message}")
-        return list(value)
+            raise RuntimeError(f"the work beside this process failed: {message}")
+        return value
 
 
 def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
@@ -456,9 +468,13 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
     file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed). ``start``: run
     every scene from the body lying there instead (:func:`run_loop_scene`: a placement of the tail, or
-    :data:`PAPER_START`)."""
+    :data:`PAPER_START`).
+
+    With ``settings.parallel`` (Linux, more than one core and one scene, no ``controller``, ``on_controller`` or
+    ``start`` given) the scenes run in lanes, one a core (:func:`scene_lanes`): the first in this process, the
+    others each in a forked process with a controller of its own, made alike (the same map, method and seed: the
+    same plans as one controller planning every scene in turn)."""
     from ..control.controller import HeadController
-    from ..kinematics import workspace
     from ..model.robot import SnakeRobot
 
     scenes = _distinct_names(scenes)
@@ -466,35 +482,30 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     progress = progress or Progress()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    lanes = [list(scenes)]
+    beside: list[_Beside] = []
     if controller is None:
         if robot is None:
             first = scenes[0].robot_file
             robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
+        if on_controller is None and start is None:
+            lanes = scene_lanes(scenes, settings)
         with progress.stage("the head's reachability map and its dexterous centre G0"):
-            if workspace_map is None:
-                if robot.map_path is None:
-                    progress.say("this robot has no map: computing one (cached for the next run)")
-                workspace_map = workspace.map_for(robot, progress=not progress.quiet)
-                if workspace_map.path is not None:
-                    progress.say(f"the head's map: {workspace_map.path}")
+            workspace_map = _head_map(robot, workspace_map, progress)
+            if len(lanes) > 1:  # forked before this process makes its controller (a TracIK: not fork-safe)
+                if settings.figures:
+                    _preload_figures(progress)
+                beside = [_lane_beside(lane, robot, workspace_map, out, settings, progress, solution_figure)
+                          for lane in lanes[1:]]
             controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
         if controller.dexterous_threshold < 100.0:
             progress.say(controller.dexterous_note)
     if on_controller is not None:
         on_controller(controller)
-    entries = {}
-    drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
-    for scene in scenes:
-        if start is not None:
-            entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
-                                                 solution_figure=solution_figure)
-            continue
-        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
-        if drawing is not None:
-            drawing.finish()
-        entries[scene.name], drawing = pending.entry, pending
-    if drawing is not None:
-        drawing.finish()
+    entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start)
+    for lane in beside:
+        entries.update(lane.result())
+    entries = {scene.name: entries[scene.name] for scene in scenes}
     robot = controller.robot
     report = {"command": command, "scenarios": entries,
               "settings": {**settings.as_dict(), "map": _map_label(controller.map)},
@@ -508,6 +519,73 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     rep.write_json(report, out / "report.json")
     rep.write_summary(report, out / "summary.md")
     return report
+
+
+def scene_lanes(scenes: Sequence[Scene], settings: Settings) -> list[list[Scene]]:
+    """The scenes dealt round-robin into lanes that run side by side, one a core (at most one a scene); one lane
+    (every scene in this process) without ``settings.parallel``, off Linux (no fork) or on one core."""
+    import os
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    n = min(cores, len(scenes)) if settings.parallel and sys.platform.startswith("linux") else 1
+    return [list(scenes[k::n]) for k in range(max(n, 1))]
+
+
+def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress: Progress) -> ReachabilityMap:
+    """``workspace_map``, else the robot's head map (cached, or computed and cached)."""
+    from ..kinematics import workspace
+
+    if workspace_map is not None:
+        return workspace_map
+    if robot.map_path is None:
+        progress.say("this robot has no map: computing one (cached for the next run)")
+    workspace_map = workspace.map_for(robot, progress=not progress.quiet)
+    if workspace_map.path is not None:
+        progress.say(f"the head's map: {workspace_map.path}")
+    return workspace_map
+
+
+def _preload_figures(progress: Progress) -> None:
+    """Import what the figures draw with (matplotlib, its 3-D axes, the viewer's page) once, before the lanes and
+    their figure processes are forked: each would import it again (~0.4 s apiece)."""
+    with progress.stage("the figures' libraries (matplotlib)"):
+        from matplotlib.backends import backend_agg  # noqa: F401
+        from mpl_toolkits.mplot3d import Axes3D  # noqa: F401
+
+        from ..viz import animation, body, dynamics, viewer  # noqa: F401
+
+
+def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: ReachabilityMap, out: Path,
+                 settings: Settings, progress: Progress, solution_figure: bool) -> _Beside:
+    """A lane of scenes run in a forked process with a controller of its own; its result: their report entries."""
+
+    def work(p: Progress) -> dict:
+        from ..control.controller import HeadController
+
+        controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
+        return _run_lane(lane, controller, out, settings, p, solution_figure, None)
+
+    return _Beside(work, progress, parallel=True, suffix="", daemon=False, timeout_s=LANE_PROCESS_TIMEOUT_S)
+
+
+def _run_lane(scenes: Sequence[Scene], controller: HeadController, out: Path, settings: Settings,
+              progress: Progress, solution_figure: bool, start: BasePlacement | str | None) -> dict:
+    """The scenes one after the other with ``controller``, each planned while the previous one's last figures are
+    drawn; their report entries by name."""
+    entries = {}
+    drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
+    for scene in scenes:
+        if start is not None:
+            entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
+                                                 solution_figure=solution_figure)
+            continue
+        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+        if drawing is not None:
+            drawing.finish()
+        entries[scene.name], drawing = pending.entry, pending
+    if drawing is not None:
+        drawing.finish()
+    return entries
 
 
 def _distinct_names(scenes: Sequence) -> tuple:

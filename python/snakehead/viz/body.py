@@ -37,6 +37,8 @@ from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_C
 OBSTACLE_COLOR = "#8d6e63"
 #: Segments around a cylinder's or a sphere's axis in the figures.
 FIGURE_SEGMENTS = 16
+#: in: blank figure on either side of the snapshots' panels, for the tick labels that reach beyond them.
+SNAPSHOT_SIDE_IN = 0.5
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -367,7 +369,11 @@ def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_pan
     spheres = plan_spheres(plan) if spheres is None else list(spheres)
     picks = snapshot_states(plan, n_panels)
     rows = -(-len(picks) // columns)
-    fig = new_figure(figsize=(3.0 * columns, 3.8 * rows + 0.6))
+    # The panels span 0.97 of 3 in a column; the 3-D axes' tick labels reach up to ~0.3 in beyond them, so the
+    # figure has SNAPSHOT_SIDE_IN on either side (the saved figure is cropped to what is drawn: a margin only
+    # keeps everything on the canvas, which save() then draws once)
+    panels_in = 3.0 * columns
+    fig = new_figure(figsize=(panels_in + 2 * SNAPSHOT_SIDE_IN, 3.8 * rows + 0.6))
     lo, hi = scene_bounds(plan, spheres)
     elev, azim = view_angles(plan)
     for k, (label, time, q) in enumerate(picks):
@@ -381,8 +387,9 @@ def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_pan
     _part_legend(fig, plan, spheres)
     fig.suptitle(title or f"{literal(plan.name)}: the body at the scenario's states (axes in m, equal scales)",
                  fontsize=11)
-    fig.subplots_adjust(left=0.0, right=0.97, bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(),
-                        wspace=0.12, hspace=0.12)
+    width = fig.get_figwidth()
+    fig.subplots_adjust(left=SNAPSHOT_SIDE_IN / width, right=(SNAPSHOT_SIDE_IN + 0.97 * panels_in) / width,
+                        bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(), wspace=0.12, hspace=0.12)
     return fig
 
 
