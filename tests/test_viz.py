@@ -345,3 +345,23 @@ def test_save_falls_back_to_savefig_for_what_reaches_beyond_the_figure(tmp_path)
     fig.text(-0.05, 0.5, "beyond the left edge", fontsize=14)
     image = imread(save(fig, tmp_path / "over.png"))
     assert image.shape[1] > fig.get_figwidth() * 150
+
+
+def test_save_snapshots_draws_plot_snapshots_picture(plan, tmp_path):
+    """save_snapshots (one panel's still picture drawn once and copied, the states drawn per panel) writes the
+    picture that save(plot_snapshots(...)) draws: the same size to a pixel, and the same pixels up to sub-pixel
+    placement (the panels sit on whole pixels): under 2 % of them differ by more than a quarter of the range."""
+    from matplotlib.image import imread
+
+    scenery = [((0.3, 0.0, 0.25), 0.05)]
+    fast = imread(body.save_snapshots(plan, tmp_path / "fast.png", spheres=scenery, n_panels=5, columns=3))
+    full = imread(save(body.plot_snapshots(plan, spheres=scenery, n_panels=5, columns=3), tmp_path / "full.png"))
+    assert abs(fast.shape[0] - full.shape[0]) <= 1 and abs(fast.shape[1] - full.shape[1]) <= 1
+    h, w = min(fast.shape[0], full.shape[0]), min(fast.shape[1], full.shape[1])
+    differ = np.abs(fast[:h, :w, :3] - full[:h, :w, :3]).max(axis=2) > 0.25
+    assert differ.mean() < 0.02
+    # every panel's body is there: the part colours cover as much of the picture in both
+    for colour in (body.BASE_COLOR, body.NECK_COLOR, body.HEAD_COLOR):
+        rgb = np.array(matplotlib.colors.to_rgb(colour))
+        near = [np.abs(im[..., :3] - rgb).max(axis=2) < 0.08 for im in (fast, full)]
+        assert near[1].sum() > 100 and abs(near[0].sum() - near[1].sum()) < 0.05 * near[1].sum()

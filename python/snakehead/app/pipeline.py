@@ -340,10 +340,10 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
                               out / f"{name}_solution.png").name)
         cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3
         n_panels = 12 if cols == 4 else 9
-        snapshots = body.plot_snapshots(result, n_panels=n_panels, columns=cols,
-                                        title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                              "the body at its states (collision shapes; axes in m, equal scales)")
-        files.append(save(snapshots, out / f"{name}_snapshots.png").name)
+        files.append(body.save_snapshots(result, out / f"{name}_snapshots.png", n_panels=n_panels, columns=cols,
+                                         title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                               "the body at its states (collision shapes; axes in m, equal scales)")
+                     .name)
     with progress.stage(f"{name}: animation"):
         files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
     with progress.stage(f"{name}: 3-D viewer page"):

@@ -97,37 +97,44 @@ def _write_png_drawn_once(figure: Figure, file: IO[bytes], dpi: float) -> bool:
     """Write the figure as a PNG cropped to what is drawn with matplotlib's padding around it (as
     ``savefig(bbox_inches="tight")``), drawing it once. ``savefig`` draws a figure twice for a tight box -- once to
     measure every artist's extent, once at the cropped size, where every text is measured again -- and that was
-    most of the time of the pipeline's figures. Here the figure is drawn once on its canvas and cut to the pixels
-    that differ from its background (a few pixels tighter than the artists' boxes, which count a text's empty
-    ascent). False (nothing written) when the drawing touches the canvas's edge: something may reach beyond the
-    figure, and only ``savefig`` draws that."""
-    import matplotlib as mpl
+    most of the time of the pipeline's figures. Here the figure is drawn once on its canvas and cut by
+    :func:`crop_and_write_png`. False (nothing written) when the drawing touches the canvas's edge."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.colors import to_rgba
 
     old_dpi = figure.dpi
     figure.set_dpi(dpi)
     try:
         canvas = figure.canvas if isinstance(figure.canvas, FigureCanvasAgg) else FigureCanvasAgg(figure)
         canvas.draw()
-        drawn = np.asarray(canvas.buffer_rgba())
-        background = np.round(255 * np.array(to_rgba(figure.get_facecolor()))).astype(np.uint8)
-        ink = (drawn != background).any(axis=2)
-        rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
-        height, width = ink.shape
-        if not len(rows) or rows[0] == 0 or cols[0] == 0 or rows[-1] == height - 1 or cols[-1] == width - 1:
-            return False
-        pad = int(round(mpl.rcParams["savefig.pad_inches"] * dpi))
-        out = np.empty((rows[-1] - rows[0] + 1 + 2 * pad, cols[-1] - cols[0] + 1 + 2 * pad, 4), np.uint8)
-        out[...] = background  # the padding may reach beyond the canvas: the figure's colour, as savefig's
-        top, left = rows[0] - pad, cols[0] - pad
-        r0, c0 = max(top, 0), max(left, 0)
-        r1, c1 = min(rows[-1] + 1 + pad, height), min(cols[-1] + 1 + pad, width)
-        out[r0 - top:r1 - top, c0 - left:c1 - left] = drawn[r0:r1, c0:c1]
-        _write_png(file, out, dpi)
-        return True
+        return crop_and_write_png(figure, np.asarray(canvas.buffer_rgba()), file, dpi)
     finally:
         figure.set_dpi(old_dpi)
+
+
+def crop_and_write_png(figure: Figure, drawn: np.ndarray, file: IO[bytes], dpi: float) -> bool:
+    """Write the figure's drawing ``drawn`` (RGBA rows from the top) as a PNG cut to the pixels that differ from the
+    figure's background (a few pixels tighter than savefig's tight box, which counts a text's empty ascent) with
+    matplotlib's padding around them (the figure's colour where the padding reaches beyond the canvas, as
+    savefig's). False (nothing written) when the drawing touches the canvas's edge: something may reach beyond
+    the figure, and only ``savefig`` draws that."""
+    import matplotlib as mpl
+    from matplotlib.colors import to_rgba
+
+    background = np.round(255 * np.array(to_rgba(figure.get_facecolor()))).astype(np.uint8)
+    ink = (drawn != background).any(axis=2)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    height, width = ink.shape
+    if not len(rows) or rows[0] == 0 or cols[0] == 0 or rows[-1] == height - 1 or cols[-1] == width - 1:
+        return False
+    pad = int(round(mpl.rcParams["savefig.pad_inches"] * dpi))
+    out = np.empty((rows[-1] - rows[0] + 1 + 2 * pad, cols[-1] - cols[0] + 1 + 2 * pad, 4), np.uint8)
+    out[...] = background  # the padding may reach beyond the canvas: the figure's colour, as savefig's
+    top, left = rows[0] - pad, cols[0] - pad
+    r0, c0 = max(top, 0), max(left, 0)
+    r1, c1 = min(rows[-1] + 1 + pad, height), min(cols[-1] + 1 + pad, width)
+    out[r0 - top:r1 - top, c0 - left:c1 - left] = drawn[r0:r1, c0:c1]
+    _write_png(file, out, dpi)
+    return True
 
 
 def _write_png(file: IO[bytes], pixels: np.ndarray, dpi: float) -> None:
