@@ -30,9 +30,10 @@ from snakehead.app.report import cpu_name
 from snakehead.scenes import paper_scene
 
 # (what a stage's name contains, the kind it is counted as), the first that matches
-KINDS = (("planning", "planning"), ("MuJoCo", "MuJoCo simulation"), ("momenta and ZMP", "figures (momenta, ZMP)"),
+KINDS = (("libraries", "imports before the lanes fork"), ("planning", "planning"), ("MuJoCo", "MuJoCo simulation"),
+         ("momenta", "figures (momenta, ZMP)"), ("ZMP figure", "figures (momenta, ZMP)"),
          ("figures", "figures (snapshots, solution)"), ("animation", "GIF"), ("viewer", "3-D viewer page"),
-         ("map", "map and G0"), ("libraries", "imports before the lanes fork"), ("ROS 2", "ROS 2 bag and joint trajectory"))
+         ("map", "map and G0"), ("ROS 2", "ROS 2 bag and joint trajectory"))
 
 
 def main() -> None:

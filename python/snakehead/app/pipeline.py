@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from . import report as rep
-from .._errors import InputError
+from .._errors import Infeasible, InputError, InputTypeError, InternalError
 
 
 if TYPE_CHECKING:
@@ -184,9 +184,9 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
     pending = []
-    if drawing is not None:
-        pending = [drawing, _Beside(lambda p: _dynamics_figures(scene, result, sim_result, out, p), progress,
-                                    parallel=settings.parallel)]
+    if drawing is not None:  # the two figures of the dynamics each in a process: they end the scene's work
+        pending = [drawing] + [_Beside(lambda p, kind=kind: _dynamics_figures(scene, result, sim_result, out, p, (kind,)),
+                                       progress, parallel=settings.parallel) for kind in DYNAMICS_FIGURES]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return PendingScene(entry, files, pending)
@@ -251,7 +251,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
             files += _loop_figures(scene, run, out, s, progress)
         if run.plan is not None:
             files += _plan_outputs(scene, run.plan, out, s, progress, solution_figure, controller.map)
-            files += _dynamics_figures(scene, run.plan, run.head, out, progress)
+            files += _dynamics_figures(scene, run.plan, run.head, out, progress)  # both, here
     return loop_entry(run, files)
 
 
@@ -353,8 +353,14 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
     return files
 
 
-def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress) -> list[str]:
-    """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
+#: The figures of a scene's dynamics: the momenta (Figs. 18-19) and the ZMP (Fig. 20).
+DYNAMICS_FIGURES = ("momenta", "zmp")
+
+
+def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress,
+                      kinds: Sequence[str] = DYNAMICS_FIGURES) -> list[str]:
+    """The momenta and the ZMP (``kinds`` of :data:`DYNAMICS_FIGURES`), planned and (with ``sim_result``)
+    simulated."""
     from ..viz import dynamics, save
     from ..viz._common import literal
 
@@ -362,15 +368,17 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
     _, mom, zmp = rep.PAPER.get(name, {}).get("figures", (None, None, None))
     label = literal(scene.description or name)  # shown as it is in the titles (a "$" is not math)
     simulated = " and simulated" if sim_result is not None else ""
-    with progress.stage(f"{name}: momenta and ZMP figures"):
-        figures = {
-            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
-                                             figures=mom or (None, None),
-                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
-            "zmp": dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base, stability=result.stability,
-                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
-        }
-        return [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
+    draw = {
+        "momenta": lambda: dynamics.plot_momenta(result.t, result.stability.P, result.stability.L,
+                                                 simulated=sim_result, figures=mom or (None, None),
+                                                 title=f"{label}: momenta about the world origin, planned{simulated}"),
+        "zmp": lambda: dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base,
+                                         stability=result.stability, simulated=sim_result, figure=zmp,
+                                         title=f"{label}: zero-moment point"),
+    }
+    what = " and ".join({"momenta": "momenta", "zmp": "ZMP"}[kind] for kind in kinds)
+    with progress.stage(f"{name}: {what} figure{'s' if len(kinds) > 1 else ''}"):
+        return [save(draw[kind](), out / f"{name}_{kind}.png").name for kind in kinds]
 
 
 #: s: the longest the forked figure process may take before it is taken for hung (the paper's scenes take ~10 s,
@@ -389,13 +397,13 @@ class _Beside:
 
     def __init__(self, work: Callable[[Progress], Any], progress: Progress, parallel: bool = True, *,
                  suffix: str = " [in a second process]", daemon: bool = True,
-                 timeout_s: float = FIGURE_PROCESS_TIMEOUT_S) -> None:
+                 timeout_s: float | None = None) -> None:
         import multiprocessing
 
         self.progress = progress
         self.work = work
         self.suffix = suffix
-        self.timeout_s = timeout_s
+        self.timeout_s = FIGURE_PROCESS_TIMEOUT_S if timeout_s is None else timeout_s  # read now: tests shorten it
         self.proc = None
         if not (parallel and sys.platform.startswith("linux")):
             self._value = work(progress)
@@ -438,14 +446,17 @@ class _Beside:
         self.proc.join()
         self.progress.stages += [{**st, "stage": st["stage"] + self.suffix} for st in stages]
         if not ok:
-            kind, message = value
+            kind, message, error = value
+            if isinstance(error, (Infeasible, InternalError, InputTypeError)):
+                raise error  # snakehead's own fault, e.g. from planning in a lane: as this process would raise it
             if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
                 raise InputError(message)
             raise RuntimeError(f"the work beside this process failed: {message}")
         return value
 
 
-def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
+def _child(work: Callable[[Progress], Any], progress: Progress, send: Any) -> None:
+    import pickle
     import traceback
 
     progress.stages = []
@@ -454,7 +465,11 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any)
     except BaseException as exc:  # noqa: BLE001 -- reported to the parent, which raises
         kind = "InputError" if isinstance(exc, InputError) else type(exc).__name__
         text = str(exc) if kind == "InputError" else f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"
-        send.send((False, (kind, text), progress.stages))
+        try:  # the error itself when it pickles (snakehead's do): the parent raises what this process raised
+            error: BaseException | None = pickle.loads(pickle.dumps(exc)) if isinstance(exc, Exception) else None
+        except Exception:  # noqa: BLE001 -- any error of pickling: the text then
+            error = None
+        send.send((False, (kind, text, error), progress.stages))
     finally:
         send.close()
 
