@@ -8,6 +8,7 @@ plan -> simulate (MuJoCo) -> compare -> figures -> animation, then one report (`
 from __future__ import annotations
 
 import contextlib
+import functools
 import gc
 import importlib.util
 import sys
@@ -185,8 +186,9 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
 
     pending = []
     if drawing is not None:  # the two figures of the dynamics each in a process: they end the scene's work
-        pending = [drawing] + [_Beside(lambda p, kind=kind: _dynamics_figures(scene, result, sim_result, out, p, (kind,)),
-                                       progress, parallel=settings.parallel) for kind in DYNAMICS_FIGURES]
+        pending = [drawing] + [_Beside(functools.partial(_dynamics_figures, scene, result, sim_result, out,
+                                                         kinds=(kind,)), progress, parallel=settings.parallel)
+                               for kind in DYNAMICS_FIGURES]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return PendingScene(entry, files, pending)

@@ -11,7 +11,7 @@ draw would make (``computed_zorder=False``: artists are drawn by zorder, then in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import IO, TYPE_CHECKING, Iterator, Sequence
+from typing import IO, TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -124,14 +124,16 @@ def _clock(fig: Figure, before: str, times: np.ndarray, after: str) -> Text:
     """The clock at the top, centred: "NAME: t = 12.3 s  (x2.4 speed)". Only the time changes from frame to frame,
     so it is the only text drawn anew per frame (the returned artist, right-aligned in the room of the longest
     time); the words around it are still (drawn once, with the background). Text is most of a frame's drawing."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.transforms import IdentityTransform
 
-    style = dict(va="top", fontsize=9, transform=IdentityTransform())  # placed in pixels, once measured
+    style: dict[str, Any] = dict(va="top", fontsize=9, transform=IdentityTransform())  # in pixels, once measured
     y = 0.98 * fig.bbox.height
     parts = [fig.text(0, y, before, ha="left", **style),
              fig.text(0, y, max((_clock_time(v) for v in (times[0], times[-1])), key=len), ha="right", **style),
              fig.text(0, y, after, ha="left", **style)]
-    renderer = fig.canvas.get_renderer()
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    renderer = canvas.get_renderer()
     widths = [part.get_window_extent(renderer).width for part in parts]
     x = 0.5 * (fig.bbox.width - sum(widths))
     parts[0].set_x(x)

@@ -382,6 +382,8 @@ def save_snapshots(plan: Plan, path: str | os.PathLike, *, spheres: Sequence[Sph
     drawn once and copied into the others, and only what differs -- the body, the head tip, the panel's title and
     the scenery drawn over the body -- is drawn per panel (as :func:`snakehead.viz.animation.animate` draws its
     frames). The panels sit on whole pixels (they move by less than half a pixel)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
     from .._files import atomic_open
     from ._common import DEFAULT_DPI, crop_and_write_png
 
@@ -392,7 +394,7 @@ def save_snapshots(plan: Plan, path: str | os.PathLike, *, spheres: Sequence[Sph
     moving = layout.draw_state(ax, 0)
     for artist in moving:
         artist.set_animated(True)  # left out of the still picture
-    canvas = fig.canvas
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     canvas.draw()
     renderer = canvas.get_renderer()
     pixels = np.asarray(canvas.buffer_rgba())
