@@ -153,11 +153,11 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
-    drawing = None
-    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates (forked first: see _Beside)
-        drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
-                          progress, parallel=settings.parallel)
-    files += _ros_outputs(name, out, progress, result)
+    # what needs only the plan (its figures, the ROS outputs) is made while MuJoCo simulates (forked first: see
+    # _Beside), off the scene's critical path (plan -> MuJoCo -> the figures of the dynamics)
+    beside = _Beside(lambda p: _ros_outputs(name, out, p, result)
+                     + (_plan_outputs(scene, result, out, s, p, solution_figure, controller.map)
+                        if settings.figures else []), progress, parallel=settings.parallel)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -184,11 +184,10 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
-    pending = []
-    if drawing is not None:  # the two figures of the dynamics each in a process: they end the scene's work
-        pending = [drawing] + [_Beside(functools.partial(_dynamics_figures, scene, result, sim_result, out,
-                                                         kinds=(kind,)), progress, parallel=settings.parallel)
-                               for kind in DYNAMICS_FIGURES]
+    pending = [beside]
+    if settings.figures:  # the two figures of the dynamics each in a process: they end the scene's work
+        pending += [_Beside(functools.partial(_dynamics_figures, scene, result, sim_result, out, kinds=(kind,)),
+                            progress, parallel=settings.parallel) for kind in DYNAMICS_FIGURES]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return PendingScene(entry, files, pending)
