@@ -8,8 +8,13 @@ say so beside any number). Not a test.
 
     python3 bench/demo_stages.py [--fast] [--serial] [--no-sim]
 
---serial draws the figures after the simulation in the same process (the pipeline's behaviour before it drew
-what needs only the plan in a second process while MuJoCo simulates).
+--serial runs everything in one process: the scenes one after the other, the figures after each simulation (the
+pipeline's behaviour before it drew what needs only the plan in a second process while MuJoCo simulates, and before
+it ran the scenes in lanes side by side, one a core).
+
+The stage times of the lanes and of the figure processes overlap: their sum is the work, not the wall-clock time.
+The critical path is the longest lane: the stages before the lanes fork, then its scenes' planning, ROS outputs and
+MuJoCo, then waiting for its figures.
 """
 from __future__ import annotations
 
@@ -25,9 +30,10 @@ from snakehead.app.report import cpu_name
 from snakehead.scenes import paper_scene
 
 # (what a stage's name contains, the kind it is counted as), the first that matches
-KINDS = (("planning", "planning"), ("MuJoCo", "MuJoCo simulation"), ("momenta and ZMP", "figures (momenta, ZMP)"),
+KINDS = (("libraries", "imports before the lanes fork"), ("planning", "planning"), ("MuJoCo", "MuJoCo simulation"),
+         ("momenta", "figures (momenta, ZMP)"), ("ZMP figure", "figures (momenta, ZMP)"),
          ("figures", "figures (snapshots, solution)"), ("animation", "GIF"), ("viewer", "3-D viewer page"),
-         ("map", "map and G0"))
+         ("map", "map and G0"), ("ROS 2", "ROS 2 bag and joint trajectory"))
 
 
 def main() -> None:

@@ -282,3 +282,16 @@ def test_the_figure_process_never_collects_the_parents_solvers(monkeypatch):
     finally:
         gc.enable()
     assert gc.collect() > 0  # and the parent frees it
+
+
+def test_a_process_beside_raises_snakeheads_own_errors_as_they_are():
+    """A lane of scenes plans in a forked process: an Infeasible or an InternalError raised there is raised in the
+    parent as it is (its fault and exit code), not as a bug of the process beside."""
+    from snakehead import Infeasible, InternalError, MotionTooLong
+
+    for error in (Infeasible("no base placement"), MotionTooLong("too long"), InternalError("broken invariant")):
+        def fails(progress, error=error):
+            raise error
+
+        with pytest.raises(type(error), match=str(error)):
+            pipeline._Beside(fails, pipeline.Progress()).result()

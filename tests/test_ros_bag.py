@@ -477,3 +477,36 @@ def test_the_pipeline_writes_a_loops_bag(loop_run, tmp_path):
     nothing = dataclasses.replace(loop_run, phases=[], plan=None, head=None, failure="no plan reaches the targets")
     assert _ros_outputs("none", tmp_path, Progress(quiet=True), None, nothing) == []
     assert not (tmp_path / "none.mcap").exists()
+
+
+def test_the_yamls_float_rows_read_back_exactly() -> None:
+    """The rows of floats (written from the list's repr at once) are each float's shortest repr with the "." YAML
+    1.1 needs before an exponent, and read back bit for bit by PyYAML; the same text as float by float."""
+    rng = np.random.default_rng(0)
+    row = np.r_[rng.standard_normal(500) * 10.0 ** rng.integers(-30, 30, 500), 1e-5, -1e-5, 1e16, -3e20, 0.0, -0.0,
+                1.0, 5e-324, 1.7976931348623157e308, 123456789012345678.0]
+    text = ros_bag._yaml_floats(row)
+    assert text == ", ".join(map(ros_bag._yaml_float, row.tolist()))
+    back = yaml.safe_load(f"[{text}]")
+    assert all(isinstance(x, float) for x in back)
+    np.testing.assert_array_equal(np.array(back), row)
+    assert "1.0e-05" in text and "-3.0e+20" in text
+
+
+def test_the_trajectory_csv_is_csvs_row_by_row(tmp_path: Path) -> None:
+    """The CSV (rows formatted a block at a time) is what the csv module writes row by row: time to 1 us, angles to
+    1e-7 rad, "\\r\\n" line ends, over more rows than one block."""
+    from snakehead.app import report
+
+    rng = np.random.default_rng(1)
+    n_rows = report._CSV_BLOCK + 7
+    plan = SimpleNamespace(t=np.arange(n_rows) * 0.002, q=rng.standard_normal((n_rows, 3)) * [1.0, 1e-8, -0.0])
+    names = ["a", "b,c", 'd"e']
+    path = write_trajectory_csv(plan, tmp_path / "t.csv", names)
+    reference = tmp_path / "ref.csv"
+    with open(reference, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["time_s"] + [f"{n}_rad" for n in names])
+        for when, row in zip(plan.t, plan.q):
+            w.writerow([f"{when:.6f}"] + [f"{v:.7f}" for v in row])
+    assert path.read_bytes() == reference.read_bytes()

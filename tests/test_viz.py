@@ -202,7 +202,7 @@ def test_the_gif_frames_are_full_redraws(plan, tmp_path):
     for k in (0, 3):
         body_art.set_verts(body.body_faces(robot, anim._frames[k])[0])
         trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
-        clock.set_text(f"{plan.name}: t = {anim.times[k]:5.1f} s  (x{anim._speedup:.1f} speed)")
+        clock.set_text(animation._clock_time(anim.times[k]))  # the clock's time: its words are still
         canvas.draw()
         full = np.asarray(canvas.buffer_rgba())
         assert np.abs(full.astype(int) - frames[k]).max() <= 1, k
@@ -218,6 +218,23 @@ def test_the_gif_frames_are_full_redraws(plan, tmp_path):
         animation.animate(plan, fps=0)
     with pytest.raises(ValueError, match="max_frames"):
         animation.animate(plan, max_frames=1)
+
+
+def test_the_gif_clock_reads_as_one_centred_line(plan):
+    """The clock is its still words and the time, drawn apart (only the time changes per frame): read left to
+    right they are "NAME: t = 1.2 s  (x3.4 speed)", side by side without overlap, centred on the figure."""
+    anim = animation.animate(plan, max_frames=4)
+    list(anim.images())  # leaves the last frame's time
+    fig = anim.figure
+    renderer = fig.canvas.get_renderer()
+    top = [t for t in fig.texts if t.get_text()]
+    boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in top), key=lambda b: b[0].x0)
+    assert "".join(text for _, text in boxes) == (f"{plan.name}: t = {anim.times[-1]:.1f} s  "
+                                                  f"(x{anim._speedup:.1f} speed)")
+    for (a, _), (b, _) in zip(boxes, boxes[1:]):
+        assert a.x1 <= b.x0 + 0.5 and abs(a.y1 - b.y1) < 1.0
+    middle = 0.5 * (boxes[0][0].x0 + boxes[-1][0].x1)
+    assert abs(middle - fig.bbox.width / 2) < 3.0  # pixels; the time's room is the longest time's
 
 
 def test_viewer_scene_of_a_generated_snake(plan, tmp_path):
@@ -280,3 +297,71 @@ def test_distinct_support_polygons_are_the_samples_own_without_repeats(plan, con
     assert len(got) == len(expected)
     for a, b in zip(got, expected):
         np.testing.assert_allclose(a, b, atol=1e-9)
+
+
+def _ink_box(image: np.ndarray) -> tuple[int, int, int, int]:
+    ink = (image[..., :3] != 255).any(axis=2)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    return rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+
+
+def _momenta_figure() -> Figure:
+    t = np.linspace(0.0, 5.0, 500)
+    P = np.column_stack([np.sin(t), np.cos(t), 0.01 * t])
+    return dynamics.plot_momenta(t, P, 0.3 * P, title="a title wider than the panels' labels")
+
+
+def test_save_draws_a_png_once_as_savefig_draws_it_twice(tmp_path, monkeypatch):
+    """save() draws a PNG once and cuts it to the ink plus matplotlib's padding; savefig(bbox_inches="tight")
+    draws it twice. The same picture: the same ink within a pixel of the same place, the same padding."""
+    from matplotlib.image import imread
+
+    draws = []
+    original = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: draws.append(1) or original(self, renderer))
+    ours = imread(save(_momenta_figure(), tmp_path / "ours.png"))
+    assert len(draws) == 1
+    draws.clear()
+    _momenta_figure().savefig(tmp_path / "ref.png", dpi=150, bbox_inches="tight")
+    assert len(draws) == 2
+    ref = imread(tmp_path / "ref.png")
+    ours, ref = (np.round(255 * im).astype(int) for im in (ours, ref))
+    (a0, a1, b0, b1), (c0, c1, d0, d1) = _ink_box(ours), _ink_box(ref)
+    assert abs((a1 - a0) - (c1 - c0)) <= 1 and abs((b1 - b0) - (d1 - d0)) <= 1  # the same ink, to a pixel
+    pad = round(0.1 * 150)  # savefig.pad_inches at save()'s dpi
+    assert (a0, b0, ours.shape[0] - a1, ours.shape[1] - b1) == (pad, pad, pad, pad)
+    assert min(c0, d0, ref.shape[0] - c1, ref.shape[1] - d1) >= pad - 1  # savefig's: the artists' boxes, padded
+    h, w = min(a1 - a0, c1 - c0), min(b1 - b0, d1 - d0)
+    inked = ours[a0:a0 + h, b0:b0 + w, :3], ref[c0:c0 + h, d0:d0 + w, :3]
+    assert np.mean(np.abs(inked[0] - inked[1]) > 64) < 0.02  # the same picture, up to sub-pixel placement
+
+
+def test_save_falls_back_to_savefig_for_what_reaches_beyond_the_figure(tmp_path):
+    """Text hanging over the figure's edge touches the canvas's edge: save() leaves it to savefig, whose tight box
+    takes it in whole (the PNG is wider than the figure)."""
+    from matplotlib.image import imread
+
+    fig = _momenta_figure()
+    fig.text(-0.05, 0.5, "beyond the left edge", fontsize=14)
+    image = imread(save(fig, tmp_path / "over.png"))
+    assert image.shape[1] > fig.get_figwidth() * 150
+
+
+def test_save_snapshots_draws_plot_snapshots_picture(plan, tmp_path):
+    """save_snapshots (one panel's still picture drawn once and copied, the states drawn per panel) writes the
+    picture that save(plot_snapshots(...)) draws: the same size to a pixel, and the same pixels up to sub-pixel
+    placement (the panels sit on whole pixels): under 2 % of them differ by more than a quarter of the range."""
+    from matplotlib.image import imread
+
+    scenery = [((0.3, 0.0, 0.25), 0.05)]
+    fast = imread(body.save_snapshots(plan, tmp_path / "fast.png", spheres=scenery, n_panels=5, columns=3))
+    full = imread(save(body.plot_snapshots(plan, spheres=scenery, n_panels=5, columns=3), tmp_path / "full.png"))
+    assert abs(fast.shape[0] - full.shape[0]) <= 1 and abs(fast.shape[1] - full.shape[1]) <= 1
+    h, w = min(fast.shape[0], full.shape[0]), min(fast.shape[1], full.shape[1])
+    differ = np.abs(fast[:h, :w, :3] - full[:h, :w, :3]).max(axis=2) > 0.25
+    assert differ.mean() < 0.02
+    # every panel's body is there: the part colours cover as much of the picture in both
+    for colour in (body.BASE_COLOR, body.NECK_COLOR, body.HEAD_COLOR):
+        rgb = np.array(matplotlib.colors.to_rgb(colour))
+        near = [np.abs(im[..., :3] - rgb).max(axis=2) < 0.08 for im in (fast, full)]
+        assert near[1].sum() > 100 and abs(near[0].sum() - near[1].sum()) < 0.05 * near[1].sum()

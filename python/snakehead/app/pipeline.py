@@ -8,6 +8,7 @@ plan -> simulate (MuJoCo) -> compare -> figures -> animation, then one report (`
 from __future__ import annotations
 
 import contextlib
+import functools
 import gc
 import importlib.util
 import sys
@@ -17,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from . import report as rep
-from .._errors import InputError
+from .._errors import Infeasible, InputError, InputTypeError, InternalError
 
 
 if TYPE_CHECKING:
@@ -152,11 +153,11 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                  + "; ".join(f"{tg.name} {1000 * tg.position_error_m:.3f} mm / {tg.direction_error_deg:.3f} deg"
                              for tg in result.targets))
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
-    drawing = None
-    if settings.figures:  # what needs only the plan is drawn while MuJoCo simulates (forked first: see _Beside)
-        drawing = _Beside(lambda p: _plan_outputs(scene, result, out, s, p, solution_figure, controller.map),
-                          progress, parallel=settings.parallel)
-    files += _ros_outputs(name, out, progress, result)
+    # what needs only the plan (its figures, the ROS outputs) is made while MuJoCo simulates (forked first: see
+    # _Beside), off the scene's critical path (plan -> MuJoCo -> the figures of the dynamics)
+    beside = _Beside(lambda p: _ros_outputs(name, out, p, result)
+                     + (_plan_outputs(scene, result, out, s, p, solution_figure, controller.map)
+                        if settings.figures else []), progress, parallel=settings.parallel)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -183,10 +184,10 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
-    pending = []
-    if drawing is not None:
-        pending = [drawing, _Beside(lambda p: _dynamics_figures(scene, result, sim_result, out, p), progress,
-                                    parallel=settings.parallel)]
+    pending = [beside]
+    if settings.figures:  # the two figures of the dynamics each in a process: they end the scene's work
+        pending += [_Beside(functools.partial(_dynamics_figures, scene, result, sim_result, out, kinds=(kind,)),
+                            progress, parallel=settings.parallel) for kind in DYNAMICS_FIGURES]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return PendingScene(entry, files, pending)
@@ -251,7 +252,7 @@ def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings
             files += _loop_figures(scene, run, out, s, progress)
         if run.plan is not None:
             files += _plan_outputs(scene, run.plan, out, s, progress, solution_figure, controller.map)
-            files += _dynamics_figures(scene, run.plan, run.head, out, progress)
+            files += _dynamics_figures(scene, run.plan, run.head, out, progress)  # both, here
     return loop_entry(run, files)
 
 
@@ -340,10 +341,10 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
                               out / f"{name}_solution.png").name)
         cols = 4 if len(result.targets) + 2 > 9 or len(body.plan_spheres(result)) else 3
         n_panels = 12 if cols == 4 else 9
-        snapshots = body.plot_snapshots(result, n_panels=n_panels, columns=cols,
-                                        title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
-                                              "the body at its states (collision shapes; axes in m, equal scales)")
-        files.append(save(snapshots, out / f"{name}_snapshots.png").name)
+        files.append(body.save_snapshots(result, out / f"{name}_snapshots.png", n_panels=n_panels, columns=cols,
+                                         title=f"{label}{f' (cf. the paper Fig. {snap})' if snap else ''}: "
+                                               "the body at its states (collision shapes; axes in m, equal scales)")
+                     .name)
     with progress.stage(f"{name}: animation"):
         files.append(save(animation.animate(result, max_frames=s["max_frames"]), out / f"{name}.gif").name)
     with progress.stage(f"{name}: 3-D viewer page"):
@@ -353,8 +354,14 @@ def _plan_outputs(scene: Scene, result: Any, out: Path, s: dict, progress: Progr
     return files
 
 
-def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress) -> list[str]:
-    """The momenta and the ZMP, planned and (with ``sim_result``) simulated."""
+#: The figures of a scene's dynamics: the momenta (Figs. 18-19) and the ZMP (Fig. 20).
+DYNAMICS_FIGURES = ("momenta", "zmp")
+
+
+def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, progress: Progress,
+                      kinds: Sequence[str] = DYNAMICS_FIGURES) -> list[str]:
+    """The momenta and the ZMP (``kinds`` of :data:`DYNAMICS_FIGURES`), planned and (with ``sim_result``)
+    simulated."""
     from ..viz import dynamics, save
     from ..viz._common import literal
 
@@ -362,39 +369,49 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
     _, mom, zmp = rep.PAPER.get(name, {}).get("figures", (None, None, None))
     label = literal(scene.description or name)  # shown as it is in the titles (a "$" is not math)
     simulated = " and simulated" if sim_result is not None else ""
-    with progress.stage(f"{name}: momenta and ZMP figures"):
-        figures = {
-            "momenta": dynamics.plot_momenta(result.t, result.stability.P, result.stability.L, simulated=sim_result,
-                                             figures=mom or (None, None),
-                                             title=f"{label}: momenta about the world origin, planned{simulated}"),
-            "zmp": dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base, stability=result.stability,
-                                     simulated=sim_result, figure=zmp, title=f"{label}: zero-moment point"),
-        }
-        return [save(fig, out / f"{name}_{kind}.png").name for kind, fig in figures.items()]
+    draw = {
+        "momenta": lambda: dynamics.plot_momenta(result.t, result.stability.P, result.stability.L,
+                                                 simulated=sim_result, figures=mom or (None, None),
+                                                 title=f"{label}: momenta about the world origin, planned{simulated}"),
+        "zmp": lambda: dynamics.plot_zmp(result.robot, result.t, result.q, base=result.base,
+                                         stability=result.stability, simulated=sim_result, figure=zmp,
+                                         title=f"{label}: zero-moment point"),
+    }
+    what = " and ".join({"momenta": "momenta", "zmp": "ZMP"}[kind] for kind in kinds)
+    with progress.stage(f"{name}: {what} figure{'s' if len(kinds) > 1 else ''}"):
+        return [save(draw[kind](), out / f"{name}_{kind}.png").name for kind in kinds]
 
 
 #: s: the longest the forked figure process may take before it is taken for hung (the paper's scenes take ~10 s,
 #: 1000 targets ~60 s on a loaded 2-core machine); the figures are then drawn in the main process.
 FIGURE_PROCESS_TIMEOUT_S = 900.0
+#: s: the same for a lane of scenes (:func:`run_scenes`), which plans and simulates them as well.
+LANE_PROCESS_TIMEOUT_S = 4 * FIGURE_PROCESS_TIMEOUT_S
 
 
 class _Beside:
-    """Runs ``work(progress)`` (-> list of file names) beside the caller: in a forked child process on Linux, so
-    that the figures that need only the plan are drawn on the second core while MuJoCo simulates; at once
-    elsewhere, or with ``parallel=False``. :meth:`files` waits for it; the child's stage times join ``progress``."""
+    """Runs ``work(progress)`` beside the caller: in a forked child process on Linux, so that it runs on the second
+    core (the figures that need only the plan while MuJoCo simulates; a lane of scenes, :func:`run_scenes`); at once
+    elsewhere, or with ``parallel=False``. :meth:`result` waits for its value (pickled back); the child's stage
+    times join ``progress``, their names ending in ``suffix``. ``daemon=False`` lets the child fork children of its
+    own (a lane draws its figures beside it)."""
 
-    def __init__(self, work: Callable[[Progress], list[str]], progress: Progress, parallel: bool = True) -> None:
+    def __init__(self, work: Callable[[Progress], Any], progress: Progress, parallel: bool = True, *,
+                 suffix: str = " [in a second process]", daemon: bool = True,
+                 timeout_s: float | None = None) -> None:
         import multiprocessing
 
         self.progress = progress
         self.work = work
+        self.suffix = suffix
+        self.timeout_s = FIGURE_PROCESS_TIMEOUT_S if timeout_s is None else timeout_s  # read now: tests shorten it
         self.proc = None
         if not (parallel and sys.platform.startswith("linux")):
-            self._files = work(progress)
+            self._value = work(progress)
             return
         ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
         self.recv, send = ctx.Pipe(duplex=False)
-        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-figures", daemon=True)
+        self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-beside", daemon=daemon)
         # Every object alive now is moved out of the collector's reach before the fork: the child must never collect
         # one. A TracIK's destructor joins its worker threads, which a forked child does not have (the collector
         # running it there was the child's SIGSEGV, "Garbage-collecting" in its fault handler's trace).
@@ -406,34 +423,41 @@ class _Beside:
         send.close()
 
     def files(self) -> list[str]:
+        """:meth:`result` of work that returns the names of the files it wrote."""
+        return list(self.result())
+
+    def result(self) -> Any:
         if self.proc is None:
-            return self._files
+            return self._value
         try:
             answer: tuple[bool, Any, list[dict]] | None = (
-                self.recv.recv() if self.recv.poll(FIGURE_PROCESS_TIMEOUT_S) else None)
-        except EOFError:  # the forked child died (a fork of a process with threads can crash): draw here instead
+                self.recv.recv() if self.recv.poll(self.timeout_s) else None)
+        except EOFError:  # the forked child died (a fork of a process with threads can crash): run it here instead
             self.proc.join()
-            self.progress.say(f"the process drawing the figures died (exit code {self.proc.exitcode}); drawing them "
+            self.progress.say(f"the process beside this one died (exit code {self.proc.exitcode}); doing its work "
                               "in this process instead")
             return self.work(self.progress)
-        if answer is None:  # hung (a lock another thread held at the fork): stop it and draw here
+        if answer is None:  # hung (a lock another thread held at the fork): stop it and run it here
             self.proc.kill()
             self.proc.join()
-            self.progress.say(f"the process drawing the figures gave no answer in {FIGURE_PROCESS_TIMEOUT_S:g} s; "
-                              "drawing them in this process instead")
+            self.progress.say(f"the process beside this one gave no answer in {self.timeout_s:g} s; doing its work "
+                              "in this process instead")
             return self.work(self.progress)
         ok, value, stages = answer
         self.proc.join()
-        self.progress.stages += [{**st, "stage": st["stage"] + " [in a second process]"} for st in stages]
+        self.progress.stages += [{**st, "stage": st["stage"] + self.suffix} for st in stages]
         if not ok:
-            kind, message = value
+            kind, message, error = value
+            if isinstance(error, (Infeasible, InternalError, InputTypeError)):
+                raise error  # snakehead's own fault, e.g. from planning in a lane: as this process would raise it
             if kind == "InputError":  # e.g. an output that could not be written: the same fault as in this process
                 raise InputError(message)
-            raise RuntimeError(f"drawing the figures failed: {message}")
-        return list(value)
+            raise RuntimeError(f"the work beside this process failed: {message}")
+        return value
 
 
-def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any) -> None:
+def _child(work: Callable[[Progress], Any], progress: Progress, send: Any) -> None:
+    import pickle
     import traceback
 
     progress.stages = []
@@ -442,7 +466,11 @@ def _child(work: Callable[[Progress], list[str]], progress: Progress, send: Any)
     except BaseException as exc:  # noqa: BLE001 -- reported to the parent, which raises
         kind = "InputError" if isinstance(exc, InputError) else type(exc).__name__
         text = str(exc) if kind == "InputError" else f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"
-        send.send((False, (kind, text), progress.stages))
+        try:  # the error itself when it pickles (snakehead's do): the parent raises what this process raised
+            error: BaseException | None = pickle.loads(pickle.dumps(exc)) if isinstance(exc, Exception) else None
+        except Exception:  # noqa: BLE001 -- any error of pickling: the text then
+            error = None
+        send.send((False, (kind, text, error), progress.stages))
     finally:
         send.close()
 
@@ -456,9 +484,13 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     ``out`` and returns the report. ``controller`` defaults to one for ``robot`` (default: the first scene's robot
     file, else the default robot) with ``workspace_map`` (default: the robot's, cached or computed). ``start``: run
     every scene from the body lying there instead (:func:`run_loop_scene`: a placement of the tail, or
-    :data:`PAPER_START`)."""
+    :data:`PAPER_START`).
+
+    With ``settings.parallel`` (Linux, more than one core and one scene, no ``controller``, ``on_controller`` or
+    ``start`` given) the scenes run in lanes, one a core (:func:`scene_lanes`): the first in this process, the
+    others each in a forked process with a controller of its own, made alike (the same map, method and seed: the
+    same plans as one controller planning every scene in turn)."""
     from ..control.controller import HeadController
-    from ..kinematics import workspace
     from ..model.robot import SnakeRobot
 
     scenes = _distinct_names(scenes)
@@ -466,35 +498,30 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     progress = progress or Progress()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    lanes = [list(scenes)]
+    beside: list[_Beside] = []
     if controller is None:
         if robot is None:
             first = scenes[0].robot_file
             robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
+        if on_controller is None and start is None:
+            lanes = scene_lanes(scenes, settings)
         with progress.stage("the head's reachability map and its dexterous centre G0"):
-            if workspace_map is None:
-                if robot.map_path is None:
-                    progress.say("this robot has no map: computing one (cached for the next run)")
-                workspace_map = workspace.map_for(robot, progress=not progress.quiet)
-                if workspace_map.path is not None:
-                    progress.say(f"the head's map: {workspace_map.path}")
+            workspace_map = _head_map(robot, workspace_map, progress)
+            if len(lanes) > 1:  # forked before this process makes its controller (a TracIK: not fork-safe)
+                if settings.figures:
+                    _preload_figures(progress)
+                beside = [_lane_beside(lane, robot, workspace_map, out, settings, progress, solution_figure)
+                          for lane in lanes[1:]]
             controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
         if controller.dexterous_threshold < 100.0:
             progress.say(controller.dexterous_note)
     if on_controller is not None:
         on_controller(controller)
-    entries = {}
-    drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
-    for scene in scenes:
-        if start is not None:
-            entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
-                                                 solution_figure=solution_figure)
-            continue
-        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
-        if drawing is not None:
-            drawing.finish()
-        entries[scene.name], drawing = pending.entry, pending
-    if drawing is not None:
-        drawing.finish()
+    entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start)
+    for lane in beside:
+        entries.update(lane.result())
+    entries = {scene.name: entries[scene.name] for scene in scenes}
     robot = controller.robot
     report = {"command": command, "scenarios": entries,
               "settings": {**settings.as_dict(), "map": _map_label(controller.map)},
@@ -508,6 +535,73 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     rep.write_json(report, out / "report.json")
     rep.write_summary(report, out / "summary.md")
     return report
+
+
+def scene_lanes(scenes: Sequence[Scene], settings: Settings) -> list[list[Scene]]:
+    """The scenes dealt round-robin into lanes that run side by side, one a core (at most one a scene); one lane
+    (every scene in this process) without ``settings.parallel``, off Linux (no fork) or on one core."""
+    import os
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    n = min(cores, len(scenes)) if settings.parallel and sys.platform.startswith("linux") else 1
+    return [list(scenes[k::n]) for k in range(max(n, 1))]
+
+
+def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress: Progress) -> ReachabilityMap:
+    """``workspace_map``, else the robot's head map (cached, or computed and cached)."""
+    from ..kinematics import workspace
+
+    if workspace_map is not None:
+        return workspace_map
+    if robot.map_path is None:
+        progress.say("this robot has no map: computing one (cached for the next run)")
+    workspace_map = workspace.map_for(robot, progress=not progress.quiet)
+    if workspace_map.path is not None:
+        progress.say(f"the head's map: {workspace_map.path}")
+    return workspace_map
+
+
+def _preload_figures(progress: Progress) -> None:
+    """Import what the figures draw with (matplotlib, its 3-D axes, the viewer's page) once, before the lanes and
+    their figure processes are forked: each would import it again (~0.4 s apiece)."""
+    with progress.stage("the figures' libraries (matplotlib)"):
+        from matplotlib.backends import backend_agg  # noqa: F401
+        from mpl_toolkits.mplot3d import Axes3D  # noqa: F401
+
+        from ..viz import animation, body, dynamics, viewer  # noqa: F401
+
+
+def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: ReachabilityMap, out: Path,
+                 settings: Settings, progress: Progress, solution_figure: bool) -> _Beside:
+    """A lane of scenes run in a forked process with a controller of its own; its result: their report entries."""
+
+    def work(p: Progress) -> dict:
+        from ..control.controller import HeadController
+
+        controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
+        return _run_lane(lane, controller, out, settings, p, solution_figure, None)
+
+    return _Beside(work, progress, parallel=True, suffix="", daemon=False, timeout_s=LANE_PROCESS_TIMEOUT_S)
+
+
+def _run_lane(scenes: Sequence[Scene], controller: HeadController, out: Path, settings: Settings,
+              progress: Progress, solution_figure: bool, start: BasePlacement | str | None) -> dict:
+    """The scenes one after the other with ``controller``, each planned while the previous one's last figures are
+    drawn; their report entries by name."""
+    entries = {}
+    drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
+    for scene in scenes:
+        if start is not None:
+            entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
+                                                 solution_figure=solution_figure)
+            continue
+        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+        if drawing is not None:
+            drawing.finish()
+        entries[scene.name], drawing = pending.entry, pending
+    if drawing is not None:
+        drawing.finish()
+    return entries
 
 
 def _distinct_names(scenes: Sequence) -> tuple:

@@ -396,8 +396,15 @@ def _yaml_float(x: float) -> str:
     return text.replace("e", ".0e") if "e" in text and "." not in text else text
 
 
+#: A float's repr without a "." before its exponent ("1e-05", "-3e+20"): YAML 1.1 reads it as a string.
+_BARE_EXPONENT = re.compile(r"(?<![\d.])(\d+)e")
+
+
 def _yaml_floats(row: np.ndarray) -> str:
-    return ", ".join(map(_yaml_float, row.tolist()))
+    """``row``'s floats as :func:`_yaml_float` writes them, joined by ", " (the list's repr, made in C: a plan's
+    YAML has ~10^5 floats)."""
+    text = repr(row.tolist())[1:-1]
+    return _BARE_EXPONENT.sub(r"\1.0e", text) if "e" in text else text
 
 
 def _yaml_string(text: str) -> str:

@@ -353,7 +353,7 @@ class ReachabilityMap:
         small changes of the map. ``rule="index"`` takes the cluster whose centroid falls in the voxel
         of highest index (a centroid can fall between the voxels of a curved cluster), ties broken by size.
         """
-        from sklearn.cluster import KMeans
+        from .kmeans import kmeans
 
         self.require_whole_for()  # the clusters of a shard's voxels are not the map's (G0 moved by 37 cm)
         if not isinstance(k, (int, np.integer)) or k < 1:
@@ -364,20 +364,20 @@ class ReachabilityMap:
         pts = self.dexterous(threshold)
         if len(pts) < k:
             raise InputError(f"{len(pts)} voxels have an index >= {threshold}; {k} clusters need at least {k}")
-        km = KMeans(n_clusters=int(k), init="k-means++", n_init=10, random_state=random_state).fit(pts)
-        sizes = np.bincount(km.labels_, minlength=k)
+        km = kmeans(pts, int(k), n_init=10, random_state=random_state)  # scikit-learn's KMeans, without its import
+        sizes = np.bincount(km.labels, minlength=k)
         # Order clusters by decreasing size (then by centroid coordinates) so that labels are stable.
-        order = sorted(range(k), key=lambda c: (-sizes[c], *km.cluster_centers_[c]))
+        order = sorted(range(k), key=lambda c: (-sizes[c], *km.centers[c]))
         relabel = np.empty(k, dtype=int)
         relabel[order] = np.arange(k)
-        centroids = km.cluster_centers_[order]
+        centroids = km.centers[order]
         sizes = sizes[order]
         if rule == "largest":
             chosen = 0
         else:
             at = self.index_at(centroids)
             chosen = int(max(range(k), key=lambda c: (at[c], sizes[c])))
-        return Clusters(pts, relabel[km.labels_], centroids, sizes, chosen, rule)
+        return Clusters(pts, relabel[km.labels], centroids, sizes, chosen, rule)
 
     def center(self, k: int = 3, threshold: float | None = None, rule: str = "largest",
                random_state: int = 0) -> np.ndarray:

@@ -11,7 +11,7 @@ draw would make (``computed_zorder=False``: artists are drawn by zorder, then in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import IO, TYPE_CHECKING, Iterator, Sequence
+from typing import IO, TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -38,7 +38,7 @@ class BodyAnimation:
     fps: float
     _frames: np.ndarray = field(repr=False)  # (F, L, 4, 4) world frames of the body at each frame
     _plan: Plan = field(repr=False)
-    _artists: tuple[Poly3DCollection, Line3D, Text] = field(repr=False)  # what moves: body, tip trace, clock
+    _artists: tuple[Poly3DCollection, Line3D, Text] = field(repr=False)  # what moves: body, tip trace, clock time
     _speedup: float = 1.0
 
     def __len__(self) -> int:
@@ -70,7 +70,7 @@ class BodyAnimation:
             body.set_verts(body_faces(robot, self._frames[k])[0])
             body.do_3d_projection()
             trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
-            clock.set_text(f"{literal(plan.name)}: t = {self.times[k]:5.1f} s  (x{self._speedup:.1f} speed)")
+            clock.set_text(_clock_time(self.times[k]))
             for artist in (body, *over):
                 ax.draw_artist(artist)
             fig.draw_artist(clock)
@@ -110,8 +110,35 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
     draw_scenery(ax, plan, spheres)
     body = draw_body(ax, robot, frames[0])
     (trace,) = ax.plot(tip[:1, 0], tip[:1, 1], tip[:1, 2], ":", color="k", lw=1.0)
-    clock = fig.text(0.5, 0.98, f"{literal(plan.name)}: t = {t[idx[0]]:5.1f} s  (x{speedup:.1f} speed)", ha="center", va="top",
-             fontsize=9)
+    clock = _clock(fig, f"{literal(plan.name)}: t = ", t[idx], f" s  (x{speedup:.1f} speed)")
     fig.subplots_adjust(left=0.0, right=0.96, bottom=0.02, top=0.98)
     return BodyAnimation(figure=fig, times=t[idx], fps=fps, _frames=frames, _plan=plan,
                          _artists=(body, trace, clock), _speedup=speedup)
+
+
+def _clock_time(t: float) -> str:
+    return f"{t:.1f}"
+
+
+def _clock(fig: Figure, before: str, times: np.ndarray, after: str) -> Text:
+    """The clock at the top, centred: "NAME: t = 12.3 s  (x2.4 speed)". Only the time changes from frame to frame,
+    so it is the only text drawn anew per frame (the returned artist, right-aligned in the room of the longest
+    time); the words around it are still (drawn once, with the background). Text is most of a frame's drawing."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.transforms import IdentityTransform
+
+    style: dict[str, Any] = dict(va="top", fontsize=9, transform=IdentityTransform())  # in pixels, once measured
+    y = 0.98 * fig.bbox.height
+    parts = [fig.text(0, y, before, ha="left", **style),
+             fig.text(0, y, max((_clock_time(v) for v in (times[0], times[-1])), key=len), ha="right", **style),
+             fig.text(0, y, after, ha="left", **style)]
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    renderer = canvas.get_renderer()
+    widths = [part.get_window_extent(renderer).width for part in parts]
+    x = 0.5 * (fig.bbox.width - sum(widths))
+    parts[0].set_x(x)
+    parts[1].set_x(x + widths[0] + widths[1])
+    parts[2].set_x(x + widths[0] + widths[1])
+    parts[1].set_text(_clock_time(times[0]))
+    return parts[1]
+

@@ -17,7 +17,9 @@ m, times in s, world frame with z up and the ground at z = 0.
 """
 from __future__ import annotations
 
+import os
 import weakref
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
@@ -37,6 +39,8 @@ from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_C
 OBSTACLE_COLOR = "#8d6e63"
 #: Segments around a cylinder's or a sphere's axis in the figures.
 FIGURE_SEGMENTS = 16
+#: in: blank figure on either side of the snapshots' panels, for the tick labels that reach beyond them.
+SNAPSHOT_SIDE_IN = 0.5
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -362,28 +366,144 @@ def plot_snapshots(plan: Plan, *, spheres: Sequence[Sphere] | None = None, n_pan
     """Figs. 17 / 22: the body in 3-D at up to ``n_panels`` states of ``plan`` (see :func:`snapshot_states`),
     base grey, neck orange, head blue (collision shapes), with the scenery: ``spheres`` [(centre (3,) m, diameter
     m)] (default: the plan's scene's, :func:`plan_spheres`), the plan's obstacles (boxes and walls), and each head
-    target as an arrow along its direction. Equal axis scales."""
-    robot = plan.robot
-    spheres = plan_spheres(plan) if spheres is None else list(spheres)
-    picks = snapshot_states(plan, n_panels)
-    rows = -(-len(picks) // columns)
-    fig = new_figure(figsize=(3.0 * columns, 3.8 * rows + 0.6))
-    lo, hi = scene_bounds(plan, spheres)
-    elev, azim = view_angles(plan)
-    for k, (label, time, q) in enumerate(picks):
-        ax = fig.add_subplot(rows, columns, k + 1, projection="3d", computed_zorder=False)
-        setup_axes3d(ax, lo, hi, elev, azim, labels=False, zoom=1.2)
-        draw_scenery(ax, plan, spheres)
-        draw_body(ax, robot, robot.frames(q, plan.base))
-        tip = robot.head_pose(q, plan.base)[:3, 3]
-        ax.scatter(*tip, color="k", s=6)
+    target as an arrow along its direction. Equal axis scales. (:func:`save_snapshots` writes the same picture
+    faster.)"""
+    layout = _SnapshotLayout(plan, spheres, n_panels, columns, title)
+    for k in range(len(layout.picks)):
+        ax = layout.panel(k)
+        layout.draw_state(ax, k)
+    return layout.figure
+
+
+def save_snapshots(plan: Plan, path: str | os.PathLike, *, spheres: Sequence[Sphere] | None = None,
+                   n_panels: int = 12, columns: int = 4, title: str = "") -> Path:
+    """:func:`plot_snapshots`' figure written as a PNG (cropped as :func:`snakehead.viz.save` crops), drawn in a
+    fraction of the time: every panel shows the same axes, ground and scenery, so one panel's still picture is
+    drawn once and copied into the others, and only what differs -- the body, the head tip, the panel's title and
+    the scenery drawn over the body -- is drawn per panel (as :func:`snakehead.viz.animation.animate` draws its
+    frames). The panels sit on whole pixels (they move by less than half a pixel)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from .._files import atomic_open
+    from ._common import DEFAULT_DPI, crop_and_write_png
+
+    path = Path(path)
+    layout = _SnapshotLayout(plan, spheres, n_panels, columns, title)
+    fig = layout.figure
+    ax = layout.panel(0)
+    moving = layout.draw_state(ax, 0)
+    for artist in moving:
+        artist.set_animated(True)  # left out of the still picture
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    pixels = np.asarray(canvas.buffer_rgba())
+    height = pixels.shape[0]
+    still = _PanelPicture(pixels, ax.get_tightbbox(renderer), height)
+    first = np.array(ax.get_position(original=True).p0)
+    original, active = ax.get_position(original=True), ax.get_position()
+    title_at = ax.title.get_position()  # where the drawing put it (set_title on 3-D axes puts it lower)
+    for k in range(len(layout.picks)):
+        # the offset of panel k from panel (a), to whole pixels
+        shift = np.round((np.array(layout.cell(k).p0) - first) * fig.bbox.size) if k else np.zeros(2)
+        if k:
+            still.paste(pixels, int(shift[0]), int(shift[1]))
+            moving = layout.draw_state(ax, k)
+            ax.title.set_position(title_at)
+        move = shift / fig.bbox.size
+        ax.set_position(original.translated(*move), which="original")
+        ax.set_position(active.translated(*move), which="active")
+        for artist in moving:
+            if hasattr(artist, "do_3d_projection"):
+                artist.do_3d_projection()
+            ax.draw_artist(artist)
+        for artist in moving[:2]:  # the body and the tip are the state's own; the rest is still
+            artist.remove()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_open(path, "wb") as f:
+        if crop_and_write_png(fig, pixels, f, DEFAULT_DPI):
+            return path
+    from ._common import save
+
+    return save(plot_snapshots(plan, spheres=spheres, n_panels=n_panels, columns=columns, title=title), path)
+
+
+class _PanelPicture:
+    """One panel's still picture, cut from a drawing (its axes' tight box): laid over another place of the drawing,
+    only its ink (what differs from the figure's background) covers what is there, as a full drawing lays one
+    panel's tick labels that reach beyond its box over its neighbour's."""
+
+    def __init__(self, pixels: np.ndarray, tight: Any, height: int) -> None:
+        self.left, self.top = max(int(np.floor(tight.x0)), 0), max(int(np.floor(height - tight.y1)), 0)
+        right, bottom = int(np.ceil(tight.x1)), int(np.ceil(height - tight.y0))
+        self.image = pixels[self.top:bottom, self.left:right].copy()
+        self.ink = (self.image != pixels[0, 0]).any(axis=2)  # the figure's corner: its background
+
+    def paste(self, pixels: np.ndarray, dx: int, dy: int) -> None:
+        """Lay the picture over ``pixels`` moved by (dx, dy) pixels (y up), clipped to the canvas."""
+        h, w = self.image.shape[:2]
+        top, left = self.top - dy, self.left + dx
+        r0, c0 = max(top, 0), max(left, 0)
+        r1, c1 = min(top + h, pixels.shape[0]), min(left + w, pixels.shape[1])
+        if r1 <= r0 or c1 <= c0:
+            return
+        part = (slice(r0 - top, r1 - top), slice(c0 - left, c1 - left))
+        target = pixels[r0:r1, c0:c1]
+        ink = self.ink[part]
+        target[ink] = self.image[part][ink]
+
+
+class _SnapshotLayout:
+    """The snapshots' figure: its states, the panels' grid, the legend and the title; :meth:`panel` makes panel k
+    (axes, ground and scenery), :meth:`draw_state` puts state k's body, head tip and title on an axes."""
+
+    def __init__(self, plan: Plan, spheres: Sequence[Sphere] | None, n_panels: int, columns: int,
+                 title: str) -> None:
+        self.plan = plan
+        self.spheres = plan_spheres(plan) if spheres is None else list(spheres)
+        self.picks = snapshot_states(plan, n_panels)
+        self.rows = -(-len(self.picks) // columns)
+        self.columns = columns
+        # The panels span 0.97 of 3 in a column; the 3-D axes' tick labels reach up to ~0.3 in beyond them, so the
+        # figure has SNAPSHOT_SIDE_IN on either side (the saved figure is cropped to what is drawn: a margin only
+        # keeps everything on the canvas, which save() then draws once)
+        panels_in = 3.0 * columns
+        fig = new_figure(figsize=(panels_in + 2 * SNAPSHOT_SIDE_IN, 3.8 * self.rows + 0.6))
+        self.lo, self.hi = scene_bounds(plan, self.spheres)
+        self.elev, self.azim = view_angles(plan)
+        _part_legend(fig, plan, self.spheres)
+        fig.suptitle(title or f"{literal(plan.name)}: the body at the scenario's states (axes in m, equal scales)",
+                     fontsize=11)
+        width = fig.get_figwidth()
+        fig.subplots_adjust(left=SNAPSHOT_SIDE_IN / width, right=(SNAPSHOT_SIDE_IN + 0.97 * panels_in) / width,
+                            bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(), wspace=0.12,
+                            hspace=0.12)
+        self.figure = fig
+        self.grid = fig.add_gridspec(self.rows, columns)  # at the figure's subplot parameters, set above
+
+    def cell(self, k: int) -> Any:
+        """Panel k's place in the figure (a Bbox in figure fractions)."""
+        return self.grid[k].get_position(self.figure)
+
+    def panel(self, k: int) -> Axes3D:
+        ax = self.figure.add_subplot(self.grid[k], projection="3d", computed_zorder=False)
+        setup_axes3d(ax, self.lo, self.hi, self.elev, self.azim, labels=False, zoom=1.2)
+        draw_scenery(ax, self.plan, self.spheres)
+        return ax
+
+    def draw_state(self, ax: Axes3D, k: int) -> list[Any]:
+        """State k on ``ax``: its body, its head tip and its title; returns what a full drawing draws of them and
+        after them, in order: the body, the tip, the still artists of a higher zorder than the body's, the title."""
+        robot, plan = self.plan.robot, self.plan
+        label, time, q = self.picks[k]
+        body = draw_body(ax, robot, robot.frames(q, plan.base))
+        tip = ax.scatter(*robot.head_pose(q, plan.base)[:3, 3], color="k", s=6)
         ax.set_title(f"({chr(ord('a') + k)}) {literal(label)}\nt = {time:.1f} s", fontsize=8)
-    _part_legend(fig, plan, spheres)
-    fig.suptitle(title or f"{literal(plan.name)}: the body at the scenario's states (axes in m, equal scales)",
-                 fontsize=11)
-    fig.subplots_adjust(left=0.0, right=0.97, bottom=0.5 / fig.get_figheight(), top=1 - 0.5 / fig.get_figheight(),
-                        wspace=0.12, hspace=0.12)
-    return fig
+        children = ax.get_children()
+        over = sorted([a for a in (*ax.collections, *ax.lines, *ax.patches, *ax.texts)
+                       if a not in (body, tip) and a.get_zorder() > body.get_zorder()],
+                      key=lambda a: (a.get_zorder(), children.index(a)))
+        return [body, tip, *over, ax.title]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -556,4 +676,4 @@ def plot_interpolation_comparison(robot: SnakeRobot, q_start: npt.ArrayLike, q_e
 
 __all__ = ["part_colors", "body_faces", "convex_facets", "shape_footprints", "box_faces", "mesh_obstacle_faces",
            "wall_faces", "hole_rim", "plan_spheres", "scene_bounds", "view_angles", "draw_scenery", "draw_body",
-           "body_points", "snapshot_states", "plot_snapshots", "plot_head_solution", "plot_interpolation_comparison"]
+           "body_points", "snapshot_states", "plot_snapshots", "save_snapshots", "plot_head_solution", "plot_interpolation_comparison"]
