@@ -22,6 +22,8 @@ from snakehead.model import published
 from snakehead.motion.plan_many import plan_many
 from snakehead.motion.targets import reachable_targets
 
+from conftest import plan_agrees
+
 STYLE = "sea"
 #: The reach map's grid: voxels of a quarter of its side (the coarsest allowed: 4 x 4 voxels per layer), 2 directions.
 DIRECTIONS = 2
@@ -93,17 +95,6 @@ def body_map(sea: tuple[sh.SnakeRobot, Path], tmp_path_factory: pytest.TempPathF
     return ws.require_map(sh.load_map(out / "reach.npz"), robot, kind=ws.KIND_WHOLE_BODY)
 
 
-def _plan_agrees(robot: sh.SnakeRobot, m: ws.ReachabilityMap, pairs: np.ndarray) -> list:
-    """Each (voxel, direction) planned in full: whether snakehead.plan agrees with the map (independent check)."""
-    bits = m.reached_units()
-    out = []
-    for v, k in pairs:
-        d = m.sphere_directions[k]
-        p = m.centers[v] + 0.5 * m.voxel_size * d
-        out.append(sh.plan([(p, d)], robot=robot).success == bits[v, k])
-    return out
-
-
 def test_reach_map_of_the_published_robot(sea: tuple[sh.SnakeRobot, Path], body_map: ws.ReachabilityMap) -> None:
     robot, _ = sea
     assert body_map.kind == ws.KIND_WHOLE_BODY and len(body_map.sphere_directions) == DIRECTIONS
@@ -113,7 +104,7 @@ def test_reach_map_of_the_published_robot(sea: tuple[sh.SnakeRobot, Path], body_
     assert np.all(np.isfinite(body_map.base_placements[bits])) and np.all(np.isnan(body_map.base_placements[~bits]))
     rng = np.random.default_rng(0)
     pairs = np.concatenate([yes[rng.choice(len(yes), 1, replace=False)], no[rng.choice(len(no), 1, replace=False)]])
-    assert all(_plan_agrees(robot, body_map, pairs))
+    assert all(plan_agrees(robot, body_map, pairs))
 
 
 @pytest.mark.slow  # every reached pose of the tiny grid, and as many unreached ones, planned in full (minutes)
@@ -124,4 +115,4 @@ def test_every_reached_pose_of_the_published_robot_is_planned(sea: tuple[sh.Snak
     yes, no = np.argwhere(bits), np.argwhere(~bits)
     rng = np.random.default_rng(1)
     pairs = np.concatenate([yes, no[rng.choice(len(no), min(len(no), len(yes)), replace=False)]])
-    assert np.mean(_plan_agrees(robot, body_map, pairs)) >= 0.98
+    assert np.mean(plan_agrees(robot, body_map, pairs)) >= 0.98
