@@ -17,13 +17,14 @@ import time
 import numpy as np
 
 import snakehead as sh
+from snakehead import sweep_defaults as defaults
 from snakehead.motion import reach
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--voxel", type=float, default=0.1)
-    ap.add_argument("--directions", type=int, default=12)
+    ap.add_argument("--voxel", type=float, default=defaults.REACH_VOXEL_M)
+    ap.add_argument("--directions", type=int, default=defaults.REACH_DIRECTIONS)
     ap.add_argument("--workers", type=int, nargs="*", default=[1, 2, 4])
     ap.add_argument("--check", type=int, default=100)
     ap.add_argument("--no-serial", action="store_true", help="skip the one-process run")

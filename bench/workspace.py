@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from snakehead import SnakeRobot, TracIK, default_robot_file
+from snakehead import sweep_defaults as defaults
 from snakehead.app.report import cpu_name
 from snakehead.kinematics import base_placement as bp
 from snakehead.kinematics import workspace as ws
@@ -45,7 +46,8 @@ PAPER = {  # Table 2 and Section 2.2 of the paper
     "head": {"bins": [8.22, 15.87, 16.96, 25.80, 33.15], "max": 100.0, "above90": 14.79, "at100": 3.69},
     "head6": {"bins": [29.82, 31.28, 28.14, 10.76, 0.0], "max": 76.0, "above90": 0.0, "at100": 0.0},
 }
-TARGET = dict(voxel=0.05, directions=20, rolls=4, timeout=3e-4)
+TARGET = dict(voxel=defaults.HEAD_VOXEL_M, directions=defaults.HEAD_DIRECTIONS, rolls=defaults.HEAD_ROLLS,
+              timeout=defaults.HEAD_TIMEOUT_S)  # the defaults of a head map
 SHIPPED = dict(voxel=0.05, directions=20, rolls=10, timeout=1e-3)
 FREE_ROLL = [0.0, 0.0, 0.0, np.inf, 0.0, 0.0]
 
@@ -100,7 +102,9 @@ def sweep(previous: str, folder: Path) -> dict:
     print("| options | hull | release | voxels | IK calls | wall time | CPU time | mean index | wall ratio | CPU ratio |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     maps = {}
-    for name, options in (("target: 20 x 4 rolls, 0.3 ms", TARGET), ("shipped: 20 x 10 rolls, 1 ms", SHIPPED)):
+    labels = {"target": TARGET, "shipped": SHIPPED}
+    for name, options in ((f"{label}: {o['directions']} x {o['rolls']} rolls, {o['timeout'] * 1e3:g} ms", o)
+                          for label, o in labels.items()):
         rows = {}
         for release, exe, extra in (("previous", previous, ()), ("this", new, ("--hull", "convex"))):
             out = folder / f"{release}-{options['rolls']}.npz"
@@ -130,7 +134,8 @@ def agreement(robot, maps: dict, samples: int, slow_timeout: float) -> None:
     rng = np.random.default_rng(2024)
     pick = np.sort(rng.choice(len(ref), size=min(samples, len(ref)), replace=False))
     t0 = time.perf_counter()
-    slow = ws.evaluate(robot, ref.centers[pick], voxel=ref.voxel_size, directions=20, rolls=4, timeout=slow_timeout,
+    slow = ws.evaluate(robot, ref.centers[pick], voxel=ref.voxel_size, directions=TARGET["directions"],
+                       rolls=TARGET["rolls"], timeout=slow_timeout,
                        seed=99)
     wall = time.perf_counter() - t0
     print(f"\n### Agreement of the target maps with a slow run ({len(pick)} random voxels, each alone, every frame "

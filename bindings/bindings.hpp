@@ -13,4 +13,5 @@ void bind_dynamics(pybind11::module_& m);
 void bind_path_check(pybind11::module_& m);
 void bind_topp_ra(pybind11::module_& m);
 void bind_tracking_fit(pybind11::module_& m);
+void bind_limits(pybind11::module_& m);
 }  // namespace snakehead::bindings

@@ -25,7 +25,8 @@ PYBIND11_MODULE(_core, m) {
   m.doc() =
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
       "convex-shape distances (FCL), "
-      "inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit";
+      "inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, "
+      "and the limits on what callers may ask for";
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
   snakehead::bindings::bind_workspace(m);
@@ -35,6 +36,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_path_check(m);
   snakehead::bindings::bind_topp_ra(m);
   snakehead::bindings::bind_tracking_fit(m);
+  snakehead::bindings::bind_limits(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");

@@ -23,6 +23,8 @@
 #include <random>
 #include <thread>
 
+#include <unistd.h>  // getpid: the worker pool's fork safety
+
 namespace snakehead {
 namespace {
 
@@ -100,49 +102,37 @@ Rng& thread_rng() {
 // The worker pool: threads made once. A job is shared between its submitter and the worker that runs it, so
 // a caller may either wait for it (a batch, whose jobs write into the caller's arrays) or abandon it (a
 // race, whose SQP half owns everything it touches and is told to stop).
+//
+// Fork. The threads and their queue (a crew) belong to the process that made them: a forked child has none of
+// the threads, and the crew's mutex may be held there forever (a worker held it at the fork). So the pool
+// remembers each crew's process: in a forked child it neither uses nor joins the parent's crew (that copy is
+// left as it is, a small leak per fork) and makes a crew of its own when it is first used there.
 
 class WorkerPool {
  public:
   struct Job {
     explicit Job(std::function<void()> f) : fn(std::move(f)) {}
     std::function<void()> fn;
-    bool running = false;  // guarded by the pool mutex
+    bool running = false;  // guarded by the crew's mutex
     std::mutex m;
     std::condition_variable cv;
     bool done = false;  // guarded by m
   };
   using JobPtr = std::shared_ptr<Job>;
 
-  explicit WorkerPool(int n) {
-    for (int i = 0; i < n; ++i) threads_.emplace_back([this] { loop(); });
-  }
+  explicit WorkerPool(int n) : size_(n), crew_(new Crew(n)) {}
   ~WorkerPool() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      quit_ = true;
-    }
-    cv_.notify_all();
-    for (auto& t : threads_) t.join();
+    Crew* crew = crew_.load(std::memory_order_acquire);
+    if (crew->owner == ::getpid()) delete crew;  // joins its threads; a parent's copy in a child is left alone
   }
-  int size() const { return static_cast<int>(threads_.size()); }
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+  int size() const { return size_; }
 
-  void submit(const JobPtr& job) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back(job);
-    }
-    cv_.notify_one();
-  }
+  void submit(const JobPtr& job) { crew().submit(job); }
 
   // Removes the job if no worker has taken it yet. Returns false when it is already running (or done).
-  bool cancel(const JobPtr& job) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (job->running) return false;
-    auto it = std::find(queue_.begin(), queue_.end(), job);
-    if (it == queue_.end()) return false;
-    queue_.erase(it);
-    return true;
-  }
+  bool cancel(const JobPtr& job) { return crew().cancel(job); }
 
   // Removes the job if it is still queued, else waits until it has finished.
   void cancel_or_wait(const JobPtr& job) {
@@ -152,31 +142,75 @@ class WorkerPool {
   }
 
  private:
-  void loop() {
-    for (;;) {
-      JobPtr job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        cv_.wait(lock, [&] { return quit_ || !queue_.empty(); });
-        if (queue_.empty()) return;  // quitting; queued jobs are still run (they are told to stop)
-        job = std::move(queue_.front());
-        queue_.pop_front();
-        job->running = true;
-      }
-      job->fn();  // jobs catch their own exceptions
-      {
-        std::lock_guard<std::mutex> lock(job->m);
-        job->done = true;
-      }
-      job->cv.notify_all();
+  // The threads of one process and their queue.
+  struct Crew {
+    explicit Crew(int n) : owner(::getpid()) {
+      for (int i = 0; i < n; ++i) threads.emplace_back([this] { loop(); });
     }
+    ~Crew() {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        quit = true;
+      }
+      cv.notify_all();
+      for (auto& t : threads) t.join();
+    }
+    void submit(const JobPtr& job) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        queue.push_back(job);
+      }
+      cv.notify_one();
+    }
+    bool cancel(const JobPtr& job) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (job->running) return false;
+      auto it = std::find(queue.begin(), queue.end(), job);
+      if (it == queue.end()) return false;
+      queue.erase(it);
+      return true;
+    }
+    void loop() {
+      for (;;) {
+        JobPtr job;
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          cv.wait(lock, [&] { return quit || !queue.empty(); });
+          if (queue.empty()) return;  // quitting; queued jobs are still run (they are told to stop)
+          job = std::move(queue.front());
+          queue.pop_front();
+          job->running = true;
+        }
+        job->fn();  // jobs catch their own exceptions
+        {
+          std::lock_guard<std::mutex> lock(job->m);
+          job->done = true;
+        }
+        job->cv.notify_all();
+      }
+    }
+
+    const pid_t owner;  // the process whose threads these are
+    std::vector<std::thread> threads;
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<JobPtr> queue;
+    bool quit = false;
+  };
+
+  // This process's crew: the one made in the constructor, or in a forked child one of its own, made by the
+  // child's first user (a compare-exchange, so that threads of the child that come at once agree on one crew).
+  Crew& crew() {
+    Crew* crew = crew_.load(std::memory_order_acquire);
+    const pid_t me = ::getpid();  // one system call: nothing beside a thread hand-off
+    if (crew->owner == me) return *crew;
+    auto mine = std::make_unique<Crew>(size_);
+    if (crew_.compare_exchange_strong(crew, mine.get(), std::memory_order_acq_rel)) return *mine.release();
+    return *crew;  // another thread of this child made it first (ours is joined and freed)
   }
 
-  std::vector<std::thread> threads_;
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::deque<JobPtr> queue_;
-  bool quit_ = false;
+  const int size_;
+  std::atomic<Crew*> crew_;
 };
 
 // ---------------------------------------------------------------------------------------------------------
@@ -547,7 +581,7 @@ struct TracIK::Impl {
   std::shared_ptr<const ChainModel> model;
   TracIKOptions options;
   Eigen::VectorXd sample_lo, sample_hi;
-  mutable WorkerPool pool;  // thread-safe: its own mutex guards it
+  mutable WorkerPool pool;  // thread-safe (its crew's mutex guards it) and fork-safe
 
   Impl(std::shared_ptr<const ChainModel> m, const TracIKOptions& o)
       : model(std::move(m)), options(o), pool(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {

@@ -36,6 +36,20 @@ autodoc_typehints = "signature"
 autodoc_default_options = {"members": True, "undoc-members": True, "show-inheritance": True,
                            "ignore-module-all": True}
 myst_heading_anchors = 3
+
+
+def shared_numbers() -> str:
+    """Substitutions for the numbers the pages quote, from where each is defined (``|reach_voxel|`` ...), so that
+    the pages cannot drift from the code: the sweeps' defaults (snakehead.sweep_defaults) and limits."""
+    from snakehead import sweep_defaults as defaults
+    from snakehead.motion import reach as rc
+
+    numbers = {"reach_voxel": f"{defaults.REACH_VOXEL_M:g}", "reach_directions": defaults.REACH_DIRECTIONS,
+               "reach_min_voxel": f"{rc.MIN_VOXEL_M:g}", "reach_max_directions": rc.MAX_DIRECTIONS}
+    return "\n".join(f".. |{name}| replace:: {value}" for name, value in numbers.items())
+
+
+rst_epilog = shared_numbers()
 # The pages include Markdown files (bench/RESULTS.md) whose first heading is not level 1.
 suppress_warnings = ["myst.header"]
 

@@ -40,3 +40,17 @@ def small_map():
 def mixed_urdf() -> str:
     """A chain with revolute, continuous, prismatic and fixed joints (tests/data/mixed_chain.urdf)."""
     return str(DATA / "mixed_chain.urdf")
+
+
+def plan_agrees(robot, m, pairs) -> list:
+    """Each (voxel, direction) of the whole-body reach map ``m`` planned in full with snakehead.plan: whether the plan's
+    success agrees with the map's bit (an independent check of the map)."""
+    import snakehead
+
+    bits = m.reached_units()
+    out = []
+    for v, k in pairs:
+        d = m.sphere_directions[k]
+        p = m.centers[v] + 0.5 * m.voxel_size * d
+        out.append(snakehead.plan([(p, d)], robot=robot).success == bits[v, k])
+    return out

@@ -255,8 +255,9 @@ def test_an_obstacle_kind_of_the_wrong_type_is_bad_input():
 
 def test_the_figure_process_never_collects_the_parents_solvers(monkeypatch):
     """A TracIK left in a reference cycle when the figure process forks (its worker threads are the parent's) is not
-    collected in the child: the child's collector ran its destructor, which joins threads the child does not have,
-    and the child died (SIGSEGV in 'Garbage-collecting', seen under load). The child's own garbage is collected."""
+    collected in the child (gc.freeze: the child's collections leave the parent's objects alone). That once kept the
+    child alive -- the destructor joined threads the child does not have (SIGSEGV in 'Garbage-collecting'); the core
+    is fork-safe now (test_trac_ik_fork.py). The child's own garbage is collected."""
     import gc
     import os
 

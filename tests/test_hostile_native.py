@@ -19,13 +19,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead import Chain, TracIK, _core, default_urdf_path
+from snakehead import Chain, TracIK, _core, default_urdf_path, limits
 from snakehead.kinematics import workspace as ws
 
 URDF = default_urdf_path()
-MAX_TIMEOUT_S = 86400.0  # limits::kMaxTimeoutSeconds
-MAX_DEPTH = 100  # limits::kMaxUrdfDepth
-MAX_URDF_BYTES = 8 << 20  # limits::kMaxUrdfBytes
+MAX_TIMEOUT_S = limits.MAX_TIMEOUT_S  # the core's (include/snakehead/limits.hpp)
+MAX_DEPTH = limits.MAX_URDF_DEPTH
+MAX_URDF_BYTES = limits.MAX_URDF_BYTES
 SMALL = dict(voxel=0.2, directions=2, rolls=1, cloud_samples=200, timeout=1e-3)
 
 

@@ -9,6 +9,8 @@ from snakehead.app import cli
 from snakehead.kinematics import workspace as ws
 from snakehead.motion import reach
 
+from conftest import plan_agrees
+
 VOXEL, DIRECTIONS = 0.6, 2  # a tiny grid: 5 x 5 voxels x 2 layers, 2 directions
 
 
@@ -25,30 +27,19 @@ def body_map(robot: sh.SnakeRobot, tmp_path_factory: pytest.TempPathFactory) -> 
     return m
 
 
-def _plan_agrees(robot: sh.SnakeRobot, m: ws.ReachabilityMap, pairs: np.ndarray) -> list:
-    """Each (voxel, direction) planned in full: whether snakehead.plan agrees with the map (independent check)."""
-    bits = m.reached_units()
-    out = []
-    for v, k in pairs:
-        d = m.sphere_directions[k]
-        p = m.centers[v] + 0.5 * m.voxel_size * d
-        out.append(sh.plan([(p, d)], robot=robot).success == bits[v, k])
-    return out
-
-
 def test_reached_poses_are_planned(robot: sh.SnakeRobot, body_map: ws.ReachabilityMap) -> None:
     bits = body_map.reached_units()
     yes, no = np.argwhere(bits), np.argwhere(~bits)
     assert len(yes) and len(no)  # the grid holds both
     rng = np.random.default_rng(0)
     pairs = np.concatenate([yes[rng.choice(len(yes), 2, replace=False)], no[rng.choice(len(no), 1, replace=False)]])
-    assert all(_plan_agrees(robot, body_map, pairs))
+    assert all(plan_agrees(robot, body_map, pairs))
 
 
 @pytest.mark.slow  # every reached pose of the tiny grid planned in full (~2 min)
 def test_every_reached_pose_is_planned(robot: sh.SnakeRobot, body_map: ws.ReachabilityMap) -> None:
     yes = np.argwhere(body_map.reached_units())
-    agree = _plan_agrees(robot, body_map, yes)
+    agree = plan_agrees(robot, body_map, yes)
     assert np.mean(agree) >= 0.98
 
 

@@ -19,6 +19,10 @@
 // const and keeps all per-call state on the stack or in that shared call state: one TracIK may be called
 // from any number of threads at once.
 //
+// Fork. A TracIK may be used and destroyed in a forked child of the process that made it (os.fork, a fork-context
+// process pool): the child neither uses nor joins the parent's workers, which it does not have, and starts
+// workers of its own when it first needs them.
+//
 // Determinism. Without a seed, restarts draw from a per-thread random generator and the race is decided
 // by timing. With a seed, the call is a pure function of (model, target, q_init, options): both solvers
 // run interleaved in the calling thread (KDL-RR alone first, as in a raced call; then whichever solver has

@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, and the limits on what callers may ask for
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -346,6 +346,20 @@ class TrackingFit:
         """
         One damped least-squares step at q (n) towards target (m, 3) from the previous sample's lifted joints current (k): the stacked residual (rows,), its Jacobian (rows, k) and the step (k,), unclipped
         """
+class Limits:
+    """
+    The C++ core's limits on what callers may ask for (include/snakehead/limits.hpp), as class attributes; snakehead.limits gives them their Python names.
+    """
+    MAX_CLOUD_SAMPLES: typing.ClassVar[int] = 10000000
+    MAX_DIRECTIONS: typing.ClassVar[int] = 4096
+    MAX_FRAMES_PER_VOXEL: typing.ClassVar[int] = 4096
+    MAX_IK_JOINTS: typing.ClassVar[int] = 1000
+    MAX_ROLLS: typing.ClassVar[int] = 360
+    MAX_THREADS: typing.ClassVar[int] = 256
+    MAX_TIMEOUT_S: typing.ClassVar[float] = 86400.0
+    MAX_URDF_BYTES: typing.ClassVar[int] = 8388608
+    MAX_URDF_DEPTH: typing.ClassVar[int] = 100
+    MAX_VOXELS_PER_AXIS: typing.ClassVar[int] = 256
 class Cancelled(Exception):
     pass
 def approach_frame(point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], roll: typing.SupportsFloat | typing.SupportsIndex = 0.0, axis: str = 'x') -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
@@ -399,6 +413,10 @@ def momenta(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd:
 def newton_euler(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], share: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
     Newton-Euler with the root link still: joint torques (T, n) and the inertial wrench across the first joint (force (T, 3), moment about the frames' origin (T, 3), in their axes; frames in an inertial frame where the root link is still)
+    """
+def newton_euler_along(model: ChainModel, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], lift_links: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] | None, lift_points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None, ramp: typing.SupportsFloat | typing.SupportsIndex, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    newton_euler along configurations q (T, n), the link frames (origin times the model's FK) and the lifted shares (lift_links, lift_points (k, M, 3) in the links' frames, ramp m; None: every weight in full) computed in the core: torques (T, n), the inertial wrench across the first joint (force, moment (T, 3)) and the centre of mass (T, 3)
     """
 def pose_error(target: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], current: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """

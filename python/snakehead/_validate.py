@@ -19,12 +19,13 @@ import numpy as np
 import numpy.typing as npt
 
 from ._errors import InputError, InputTypeError
+from .limits import MAX_TIMEOUT_S
 
 ORTHONORMAL_TOLERANCE = 1e-6
 
 #: The longest duration (s) any argument may ask for: one day, the C++ core's limit on timeouts
-#: (``limits::kMaxTimeoutSeconds``). A plan, a simulation or a gait run of more than a day is a mistake.
-MAX_DURATION_S = 86400.0
+#: (:data:`snakehead.limits.MAX_TIMEOUT_S`). A plan, a simulation or a gait run of more than a day is a mistake.
+MAX_DURATION_S = MAX_TIMEOUT_S
 
 #: The most samples a trajectory, a simulation's record or a sampled curve may have: 2000 s at the 2 ms control
 #: period, ~130 MB for a 16-joint robot's joint angles in float64. Beyond it an allocation would exhaust memory.

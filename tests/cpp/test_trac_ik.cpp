@@ -1,10 +1,13 @@
 // TRAC-IK and its pose error: derivatives against finite differences, solutions checked with KDL's own FK,
-// solve types, free roll, seeded determinism, many threads on one solver, timeouts, bad input.
+// solve types, free roll, seeded determinism, many threads on one solver, a forked child, timeouts, bad input.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <random>
 #include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "snakehead/kinematics.hpp"
 #include "snakehead/pose_error.hpp"
@@ -355,6 +358,50 @@ TEST(TracIK, BatchMatchesSingleCallsAndIsSeededPerTarget) {
   fast.solve_many(targets, q0, q1, ok1);
   for (int k = 0; k < T; ++k)
     if (ok1[k]) expect_solution(*model, targets[k], q1.col(k), o.epsilon);
+}
+
+// Targets of random configurations (reachable) and random starts; how many a batch solves.
+int solve_batch(const TracIK& ik, std::uint32_t seed) {
+  const ChainModel& m = ik.model();
+  std::mt19937 rng(seed);
+  const int T = 24;
+  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets;
+  Eigen::MatrixXd q0(m.n_joints(), T), q;
+  for (int k = 0; k < T; ++k) {
+    targets.push_back(forward_kinematics(m, random_q(m, rng)));
+    q0.col(k) = random_q(m, rng);
+  }
+  std::vector<bool> ok;
+  ik.solve_many(targets, q0, q, ok);
+  int solved = 0;
+  for (int k = 0; k < T; ++k)
+    solved += ok[k] && pose_reached(targets[k], kdl_forward_kinematics(m, q.col(k)), ik.options().bounds,
+                                    ik.options().epsilon);
+  for (int k = 0; k < 4; ++k) {  // unseeded single calls: the race hands the SQP half to a worker
+    Eigen::VectorXd qk;
+    solved += ik.solve(targets[k], random_q(m, rng), qk);
+  }
+  return solved;
+}
+
+TEST(TracIK, AForkedChildUsesAndDestroysTheParentsSolver) {
+  TracIKOptions o;
+  o.timeout = 0.5 * kClockScale;  // far above what these targets need: a loaded machine fails none
+  auto ik = std::make_unique<TracIK>(head7(), o);
+  ASSERT_EQ(solve_batch(*ik, 1), 28);  // the parent's workers exist and have worked
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {  // the child: its own workers, and a destructor that does not join the parent's
+    alarm(static_cast<unsigned>(120 * kClockScale));  // hung: SIGALRM ends it, and the parent sees the signal
+    const int solved = solve_batch(*ik, 2);
+    ik.reset();
+    _exit(solved == 28 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status)) << "the child died of signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0);
+  EXPECT_EQ(solve_batch(*ik, 3), 28);  // the parent's solver still works
 }
 
 TEST(TracIK, UnreachableTargetFailsInAboutTheTimeout) {

@@ -568,22 +568,23 @@ def build_parser() -> argparse.ArgumentParser:
                                    "executable installed with the package (workspace_gen --help).")
     p.add_argument("--out", required=True, metavar="MAP.npz", help="output file (.npz)")
     _add_robot_option(p)
+    from .. import sweep_defaults as defaults
     from ..kinematics import workspace as ws
 
     p.add_argument("--voxel", type=_positive_float, default=None, metavar="M",
                    help="voxel edge (m; default: a twelfth of the head's reach rounded to 5 mm, 0.045 on the default "
                         f"robot); the grid, of side 2 x the head's reach, must hold {ws.MIN_VOXELS_PER_AXIS} to "
                         f"{ws.MAX_VOXELS_PER_AXIS} voxels per axis (so a voxel under 2/3 of the reach)")
-    p.add_argument("--directions", type=_bounded_int(1, ws.MAX_DIRECTIONS), default=20, metavar="N",
-                   help=f"points per voxel sphere, 1 to {ws.MAX_DIRECTIONS} (default 20)")
-    p.add_argument("--rolls", type=_bounded_int(1, ws.MAX_ROLLS), default=4, metavar="R",
+    p.add_argument("--directions", type=_bounded_int(1, ws.MAX_DIRECTIONS), default=defaults.HEAD_DIRECTIONS,
+                   metavar="N", help=f"points per voxel sphere, 1 to {ws.MAX_DIRECTIONS} (default %(default)s)")
+    p.add_argument("--rolls", type=_bounded_int(1, ws.MAX_ROLLS), default=defaults.HEAD_ROLLS, metavar="R",
                    help=f"frames about the approach axis per point, 1 to {ws.MAX_ROLLS}, and directions x rolls at "
-                        f"most {ws.MAX_FRAMES_PER_VOXEL} (default 4)")
+                        f"most {ws.MAX_FRAMES_PER_VOXEL} (default %(default)s)")
     p.add_argument("--free-roll", action="store_true", help="one IK call per point with the roll left free")
-    p.add_argument("--timeout", type=_positive_float, default=3e-4, metavar="S",
-                   help=f"TRAC-IK budget per call (s, over 0 and at most {ws.MAX_TIMEOUT_S:g}; default 0.0003)")
-    p.add_argument("--seed", type=_bounded_int(0, ws.MAX_SEED), default=1, metavar="N",
-                   help="random seed, 0 to 2^64 - 1 (default 1)")
+    p.add_argument("--timeout", type=_positive_float, default=defaults.HEAD_TIMEOUT_S, metavar="S",
+                   help=f"TRAC-IK budget per call (s, over 0 and at most {ws.MAX_TIMEOUT_S:g}; default %(default)g)")
+    p.add_argument("--seed", type=_bounded_int(0, ws.MAX_SEED), default=defaults.HEAD_SEED, metavar="N",
+                   help="random seed, 0 to 2^64 - 1 (default %(default)s)")
     p.add_argument("--threads", type=_bounded_int(1, ws.MAX_THREADS), default=None, metavar="N",
                    help=f"worker threads, 1 to {ws.MAX_THREADS} (default all cores)")
     p.add_argument("--shard", type=_shard, default=None, metavar="i/N",
@@ -605,12 +606,12 @@ def build_parser() -> argparse.ArgumentParser:
                                    "placement: a map of kind 'whole-body' written to DIR/reach.npz "
                                    "(snakehead.load_map(path).reachable(positions, directions) answers from it).")
     _add_robot_option(p)
-    p.add_argument("--voxel", type=_positive_float, default=0.1, metavar="M",
-                   help=f"voxel edge (m, default 0.1; at least {rc.MIN_VOXEL_M:g})")
-    p.add_argument("--directions", type=_bounded_int(1, rc.MAX_DIRECTIONS), default=12, metavar="N",
-                   help=f"directions per voxel, 1 to {rc.MAX_DIRECTIONS} (default 12)")
+    p.add_argument("--voxel", type=_positive_float, default=defaults.REACH_VOXEL_M, metavar="M",
+                   help=f"voxel edge (m, default %(default)g; at least {rc.MIN_VOXEL_M:g})")
+    p.add_argument("--directions", type=_bounded_int(1, rc.MAX_DIRECTIONS), default=defaults.REACH_DIRECTIONS,
+                   metavar="N", help=f"directions per voxel, 1 to {rc.MAX_DIRECTIONS} (default %(default)s)")
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=_bounded_int(1, 256), default=None, metavar="N",
+    where.add_argument("--workers", type=_bounded_int(1, rc.MAX_WORKERS), default=None, metavar="N",
                        help="a pool of N worker processes on this machine (default: this process)")
     where.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="a Dask scheduler (tcp://host:port) whose workers do the work")

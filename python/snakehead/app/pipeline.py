@@ -412,9 +412,10 @@ class _Beside:
         ctx = multiprocessing.get_context("fork")  # the child inherits the plan: nothing to pickle
         self.recv, send = ctx.Pipe(duplex=False)
         self.proc = ctx.Process(target=_child, args=(work, progress, send), name="snakehead-beside", daemon=daemon)
-        # Every object alive now is moved out of the collector's reach before the fork: the child must never collect
-        # one. A TracIK's destructor joins its worker threads, which a forked child does not have (the collector
-        # running it there was the child's SIGSEGV, "Garbage-collecting" in its fault handler's trace).
+        # Every object alive now is moved out of the collector's reach before the fork, so that the child's
+        # collections neither walk nor write the parent's objects (their pages stay shared, not copied). (It once also
+        # kept the child from destroying a TracIK, whose destructor joined threads a forked child does not have; the
+        # core is fork-safe now: tests/test_trac_ik_fork.py.)
         gc.freeze()
         try:
             self.proc.start()

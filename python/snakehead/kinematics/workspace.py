@@ -30,7 +30,8 @@ from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
 import numpy as np
 
-from .. import _core
+from .. import _core, limits
+from .. import sweep_defaults as defaults
 from .._errors import InputError, InputTypeError
 from .._executors import as_executor, run_tasks, worker_count
 from ..model.chain import Chain
@@ -58,26 +59,27 @@ TABLE2_BINS = (0.0, 20.0, 40.0, 60.0, 80.0, 100.0)
 DEXTEROUS_MIN_SHARE = 0.01
 
 # The limits of a sweep's options, checked in Python before any work (an InputError naming the option, never a
-# number handed to the bindings' 32- or 64-bit fields). Most are the C++ core's (include/snakehead/limits.hpp).
+# number handed to the bindings' 32- or 64-bit fields). The upper ones are the C++ core's (snakehead.limits, read from
+# include/snakehead/limits.hpp); the others are this module's.
 #: Points per voxel sphere (``directions``), and frames about the approach axis per point (``rolls``).
-MAX_DIRECTIONS, MAX_ROLLS = 4096, 360
+MAX_DIRECTIONS, MAX_ROLLS = limits.MAX_DIRECTIONS, limits.MAX_ROLLS
 #: Frames per voxel: directions x rolls (unless free roll).
-MAX_FRAMES_PER_VOXEL = 4096
-#: Voxels per axis of the grid (whose side is 2 x the chain's reach): at most 256 (256^3 = 16.8 million voxels), at
-#: least 4, so a voxel is under a third of the grid's side (2/3 of the reach; a larger one gives a map of a few
-#: voxels of index 0 and no dexterous workspace).
-MAX_VOXELS_PER_AXIS, MIN_VOXELS_PER_AXIS = 256, 4
+MAX_FRAMES_PER_VOXEL = limits.MAX_FRAMES_PER_VOXEL
+#: Voxels per axis of the grid (whose side is 2 x the chain's reach): at most the core's 256 (256^3 = 16.8 million
+#: voxels), at least 4, so a voxel is under a third of the grid's side (2/3 of the reach; a larger one gives a map of a
+#: few voxels of index 0 and no dexterous workspace).
+MAX_VOXELS_PER_AXIS, MIN_VOXELS_PER_AXIS = limits.MAX_VOXELS_PER_AXIS, 4
 #: Random configurations sampled for the hull (``cloud_samples``).
-MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES = 100, 10_000_000
+MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES = 100, limits.MAX_CLOUD_SAMPLES
 #: Worker threads (0 or None: all cores).
-MAX_THREADS = 256
+MAX_THREADS = limits.MAX_THREADS
 #: The seed is an unsigned 64-bit integer.
 MAX_SEED = 2**64 - 1
-#: Shards of one map: a shard is a set of tiles of 4 x 4 lines of voxels, and the largest grid has (256 / 4)^2 tiles
-#: (more shards than the grid's tiles are empty).
-MAX_SHARDS = 4096
+#: Shards of one map: a shard is a set of tiles of 4 x 4 lines of voxels, and the largest grid has
+#: (MAX_VOXELS_PER_AXIS / 4)^2 tiles (more shards than the grid's tiles are empty).
+MAX_SHARDS = (MAX_VOXELS_PER_AXIS // 4) ** 2
 #: TRAC-IK's budget per call (s): a day at most.
-MAX_TIMEOUT_S = 86400.0
+MAX_TIMEOUT_S = limits.MAX_TIMEOUT_S
 #: Voxels the dexterous centre G0 needs at least: its k-means++ makes three clusters (Section 2.3).
 G0_MIN_VOXELS = 3
 _MERGE_HINT = ("merge the shards (snakehead workspace --merge SHARD.npz ... --out MAP.npz, or "
@@ -619,10 +621,11 @@ def _compute_shard(urdf: str, base: str, tip: str, kwargs: dict, index: int, cou
     return _from_result(d, o, f"snakehead.workspace.compute(shard={index}/{count})")
 
 
-def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = 0.05, directions: int = 20, rolls: int = 4,
-            any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x", timeout: float = 3e-4,
-            epsilon: float = 1e-5, cloud_samples: int = 50000, seed: int = 1, hull: str = "boundary",
-            shrink: float = 0.5, threads: int | None = None, shard: Any = None, executor: Any = None,
+def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = defaults.HEAD_VOXEL_M,
+            directions: int = defaults.HEAD_DIRECTIONS, rolls: int = defaults.HEAD_ROLLS, any_roll: bool = True,
+            free_roll: bool = False, approach_axis: str = "x", timeout: float = defaults.HEAD_TIMEOUT_S,
+            epsilon: float = defaults.HEAD_EPSILON, cloud_samples: int = defaults.HEAD_CLOUD_SAMPLES,
+            seed: int = defaults.HEAD_SEED, hull: str = "boundary", shrink: float = defaults.HEAD_SHRINK, threads: int | None = None, shard: Any = None, executor: Any = None,
             shards: int | None = None,
             urdf: str | os.PathLike | None = None, progress: bool = True) -> ReachabilityMap:
     """Compute a reachability map (Algorithm 1) of a chain, or of a SnakeRobot's head chain.
@@ -724,9 +727,11 @@ def _compute_local(chain: Chain, options: Any, progress: bool) -> ReachabilityMa
     return _from_result(d, options, "snakehead.workspace.compute")
 
 
-def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = 0.05, directions: int = 20,
-             rolls: int = 4, any_roll: bool = True, free_roll: bool = False, approach_axis: str = "x",
-             timeout: float = 3e-4, epsilon: float = 1e-5, seed: int = 1, threads: int | None = None) -> np.ndarray:
+def evaluate(chain_or_robot: Chain | SnakeRobot, centers: npt.ArrayLike, *, voxel: float = defaults.HEAD_VOXEL_M,
+             directions: int = defaults.HEAD_DIRECTIONS, rolls: int = defaults.HEAD_ROLLS, any_roll: bool = True,
+             free_roll: bool = False, approach_axis: str = "x", timeout: float = defaults.HEAD_TIMEOUT_S,
+             epsilon: float = defaults.HEAD_EPSILON, seed: int = defaults.HEAD_SEED,
+             threads: int | None = None) -> np.ndarray:
     """Reachability index of voxels at arbitrary centres, each on its own and as Algorithm 1 states it (every
     frame from a random initial guess with the full budget: none of the sweep's shortcuts).
 
@@ -1018,12 +1023,14 @@ def merge(shards: Iterable[ReachabilityMap]) -> ReachabilityMap:
 
 
 def default_map_options(chain_or_robot: Chain | SnakeRobot) -> dict:
-    """Options of :func:`compute` for a robot's head that has no map yet: the shipped maps' parameters (20
-    directions x 4 rolls, 0.3 ms per IK call), with voxels scaled to the head (a twelfth of its reach, 0.05 m on
+    """Options of :func:`compute` for a robot's head that has no map yet: :mod:`snakehead.sweep_defaults` (20
+    directions x 4 rolls, 0.3 ms per IK call), with voxels scaled to the head (a twelfth of its reach, 0.045 m on
     the default robot's 7-DOF head, rounded to 5 mm) so that every head gets a grid of about the same size."""
     chain = _resolve_chain(chain_or_robot)
-    voxel = max(0.005, round(chain.reach / 12 / 0.005) * 0.005)
-    return dict(voxel=voxel, directions=20, rolls=4, timeout=3e-4, seed=1)
+    step = defaults.HEAD_VOXEL_STEP_M
+    voxel = max(step, round(chain.reach * defaults.HEAD_VOXEL_PER_REACH / step) * step)
+    return dict(voxel=voxel, directions=defaults.HEAD_DIRECTIONS, rolls=defaults.HEAD_ROLLS,
+                timeout=defaults.HEAD_TIMEOUT_S, seed=defaults.HEAD_SEED)
 
 
 def cache_dir() -> Path:

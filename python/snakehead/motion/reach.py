@@ -37,7 +37,8 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .. import _core
+from .. import _core, limits
+from .. import sweep_defaults as defaults
 from .._errors import InputError, InputTypeError
 from .._executors import as_executor, run_tasks, worker_count
 from ..kinematics import workspace as ws
@@ -46,7 +47,7 @@ from ..scenes.scene import Target
 from .plan_many import WORKERS, RobotRecipe, plan_many
 from .reach_bounds import PoseBounds
 
-__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "KEPT_CHUNK"]
+__all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "MAX_WORKERS", "KEPT_CHUNK"]
 
 if TYPE_CHECKING:
     from ..control.controller import HeadController
@@ -60,6 +61,8 @@ BEARING_BINS = 4
 MIN_VOXEL_M = 0.02
 MAX_DIRECTIONS = 64
 MAX_SOLVES = 200_000
+#: Worker processes of a pool on one machine (``snakehead reach --workers``): at most the core's worker threads.
+MAX_WORKERS = limits.MAX_THREADS
 #: Poses with the base kept solved per task.
 KEPT_CHUNK = 8
 
@@ -95,7 +98,8 @@ def top_height(robot: SnakeRobot) -> float:
     return float(robot.body_axis_height) + _lift_reach(robot)
 
 
-def check_options(robot: Any, voxel: Any = 0.1, directions: Any = 12) -> tuple[float, int]:
+def check_options(robot: Any, voxel: Any = defaults.REACH_VOXEL_M,
+                  directions: Any = defaults.REACH_DIRECTIONS) -> tuple[float, int]:
     """``voxel`` (m) and ``directions`` checked (InputError naming the option) before any work; returns them."""
     if not isinstance(robot, SnakeRobot):
         raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
@@ -209,7 +213,8 @@ def kept_task(recipe: RobotRecipe, method: str, seed: int | None, poses: list) -
 
 
 # --- the map ----------------------------------------------------------------------------------------------------
-def compute_reach(robot: SnakeRobot, *, voxel: float = 0.1, directions: int = 12, executor: Any = None,
+def compute_reach(robot: SnakeRobot, *, voxel: float = defaults.REACH_VOXEL_M,
+                  directions: int = defaults.REACH_DIRECTIONS, executor: Any = None,
                   method: str = "rotated", seed: int | None = 1, progress: ReachProgress | None = None,
                   prune: bool = True) -> ws.ReachabilityMap:
     """The whole body's stable reachability map of ``robot`` (see the module's doc): kind ``"whole-body"``; its

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..control.whole_body import MIN_MARGIN
 from ..dynamics import stability
 from ..geometry import collision as coll
 from ..model.robot import BasePlacement
@@ -52,7 +53,7 @@ class ReachableTarget:
 
 
 def reachable_targets(controller: HeadController, kind: str, count: int, rng: np.random.Generator | None = None, *,
-                      min_margin: float = 0.005, reach: float = 1.0, max_draws: int = 200000) -> list[ReachableTarget]:
+                      min_margin: float = MIN_MARGIN, reach: float = 1.0, max_draws: int = 200000) -> list[ReachableTarget]:
     """``count`` targets reachable by construction of the given ``kind`` (see the module's docstring) for the
     controller's robot, from its initial configuration and placement."""
     if kind not in KINDS:
