@@ -11,6 +11,8 @@ import contextlib
 import functools
 import gc
 import importlib.util
+import os
+import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -387,6 +389,8 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
 FIGURE_PROCESS_TIMEOUT_S = 900.0
 #: s: the same for a lane of scenes (:func:`run_scenes`), which plans and simulates them as well.
 LANE_PROCESS_TIMEOUT_S = 4 * FIGURE_PROCESS_TIMEOUT_S
+#: s a process beside this one has to stop after a Ctrl-C before it is killed.
+STOP_GRACE_S = 5.0
 
 
 class _Beside:
@@ -422,6 +426,17 @@ class _Beside:
         finally:
             gc.unfreeze()
         send.close()
+
+    def stop(self) -> None:
+        """Stop the child if it still runs (the caller was interrupted or failed): a Ctrl-C to it first, so that it
+        stops its own children as this process does, then a kill after STOP_GRACE_S."""
+        if self.proc is None or not self.proc.is_alive():
+            return
+        os.kill(self.proc.pid, signal.SIGINT)
+        self.proc.join(STOP_GRACE_S)
+        if self.proc.is_alive():
+            self.proc.kill()
+            self.proc.join()
 
     def files(self) -> list[str]:
         """:meth:`result` of work that returns the names of the files it wrote."""
@@ -519,9 +534,14 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
             progress.say(controller.dexterous_note)
     if on_controller is not None:
         on_controller(controller)
-    entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start)
-    for lane in beside:
-        entries.update(lane.result())
+    try:
+        entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start)
+        for lane in beside:
+            entries.update(lane.result())
+    except BaseException:  # interrupted or failed: the lanes beside stop too (they would run on, and be waited for)
+        for lane in beside:
+            lane.stop()
+        raise
     entries = {scene.name: entries[scene.name] for scene in scenes}
     robot = controller.robot
     report = {"command": command, "scenarios": entries,
