@@ -40,8 +40,9 @@ from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 #: Grid resolution (m).
 RESOLUTION_M = 0.025
-#: How far off its line a gait leg may end (m): a sidewinding run drifts a few centimetres along the body's axis, a
-#: turn shifts the middle by a few; the loop's waypoint tolerance off the line (snakehead.sim.loop).
+#: The execution margin (m): how much of a route's clearance the body may lose off its line before the route is
+#: planned again from where it is (snakehead.sim.loop: a sidewinding run drifts a few centimetres along the body's
+#: axis, a turn shifts the middle by a few), and what every gait run's predicted sweep keeps from the obstacles.
 EXECUTION_M = 0.06
 #: How far the dead reckoning drifts over a route (m): the onboard estimate drifts 2-5 % of the distance the body
 #: travels (30-110 mm over the 4 m routes of bench/loop.py's box poses, bench/RESULTS.md).
@@ -341,6 +342,19 @@ def _escape(grid: ClearanceGrid, start: BasePlacement, length: float, radius: fl
     return None if along is None else (along, True)
 
 
+def _drop_short_legs(grid: ClearanceGrid, points: list[np.ndarray], radius: float, first: int) -> list[np.ndarray]:
+    """``points`` without the waypoints (from index ``first`` on, never the last) whose leg to the next is shorter
+    than MIN_LEG_M (the grid's snap next to the staging point: its turn costs a run), where the leg that replaces
+    both keeps ``radius`` from the obstacles."""
+    out = points[:first]
+    for k in range(first, len(points) - 1):
+        if float(np.linalg.norm(points[k + 1] - points[k])) < MIN_LEG_M \
+                and segment_clear(grid, out[-1], points[k + 1], radius):
+            continue
+        out.append(points[k])
+    return out + [points[-1]]
+
+
 def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePlacement, goal_middle: BasePlacement,
                *, clearance: float = CLEARANCE_M, resolution: float = RESOLUTION_M,
                grid: ClearanceGrid | None = None) -> Route | None:
@@ -390,9 +404,7 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
     points = shortcut(grid, points, R)
     if escaped:
         points.insert(0, a)
-    # a leg shorter than MIN_LEG_M (the grid's snap next to the staging point) is no leg: its turn costs a run
-    keep = {0, len(points) - 1} | ({1} if escaped else set())
-    points = [p for k, p in enumerate(points) if k in keep or float(np.linalg.norm(points[k + 1] - p)) >= MIN_LEG_M]
+    points = _drop_short_legs(grid, points, R, 2 if escaped else 1)
     if staged:
         points.append(g)
     waypoints = np.array(points)

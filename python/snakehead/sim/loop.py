@@ -108,9 +108,13 @@ from .._errors import Infeasible, InputError, InputTypeError, InternalError, ent
 #: (:mod:`snakehead.sim.sensors`), or "outside fix", perfect joint angles and IMU and an outside measurement of the
 #: neck's base frame (:class:`PoseFix`) once the body rests in the bending state.
 SENSING = ("onboard", "outside fix")
-#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle along the leg's
-#: square and along the leg, m; its heading, deg): looser than the goal's, the next leg corrects what is left.
-WAYPOINT_TOLERANCE = lc.Tolerance(along_m=gp.EXECUTION_M, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
+#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle off the leg's line, m,
+#: and along it, m; its heading, deg): looser than the goal's, the next leg corrects what is left. Off the line it
+#: is loosest: a turn square to the line and back to correct it shifts the middle by as much again (turning in
+#: place moves the middle by up to 0.05 body lengths a cycle), and where being off the line matters the route is
+#: planned again (ClosedLoop._route_holds: the leg from where the body is must keep the clearance less
+#: ground_path.EXECUTION_M).
+WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.25, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
 #: The most legs of a route the locomotion follows (each at most max_gait_runs runs) before it gives up.
 MAX_LEGS = 8
 #: The most samples of the estimate's error over time a report holds.
