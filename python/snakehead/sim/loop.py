@@ -115,6 +115,9 @@ SENSING = ("onboard", "outside fix")
 #: planned again (ClosedLoop._route_holds: the leg from where the body is must keep the clearance less
 #: ground_path.EXECUTION_M).
 WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.25, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
+#: Every this many steps of the curl's path (of locomotion.CURL_STEPS) the goal's check puts the curling body
+#: against the obstacles.
+CURL_CHECKS = 4
 #: The most legs of a route the locomotion follows (each at most max_gait_runs runs) before it gives up.
 MAX_LEGS = 8
 #: The most samples of the estimate's error over time a report holds.
@@ -508,27 +511,41 @@ class ClosedLoop:
         return self._dynamics_check(p) if self.dynamics_check else None
 
     def _straight_failure(self, goal: BasePlacement, q_bend: np.ndarray) -> str | None:
-        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal`` (it would
-        lie within the ground path's clearance of an obstacle: the gaits could not bring it there), else None."""
+        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal``, or cannot
+        curl from there: the straight body, or the body at any CURL_CHECKS-th step of the curl where the friction
+        model slides it (:func:`snakehead.dynamics.sliding.predict_slide`), would come within GOAL_CLEARANCE_M
+        of an obstacle (the gaits bring it there within their execution margin, its estimate off by the drift);
+        else None."""
         if not self.obstacles:
             return None
-        straight = lc.straight_pose_for(self.robot, goal, q_bend)
-        d = coll.collision_check(self.robot, np.zeros((1, self.robot.n_joints)), self.obstacles, straight,
-                                 exact_within=1.0).distance[0]
-        if d < gp.GOAL_CLEARANCE_M:
-            return (f"the body would lie straight at {_fmt(straight)} before its curl, {1000 * d:.0f} mm from an "
-                    "obstacle")
+        from ..dynamics.sliding import predict_slide
+
+        robot = self.robot
+        straight = lc.straight_pose_for(robot, goal, q_bend)
+        path = lc.curl_path(np.zeros(robot.n_joints), q_bend)
+        slide = predict_slide(robot, path, straight)
+        for k in list(range(0, len(path), CURL_CHECKS)) + [len(path) - 1]:
+            d = coll.collision_check(robot, path[k][None], self.obstacles, slide[k], exact_within=1.0).distance[0]
+            if d < gp.GOAL_CLEARANCE_M:
+                where = "lie straight" if k == 0 else f"pass, {100 * k // (len(path) - 1)} % into its curl,"
+                return (f"the body would {where} at {_fmt(slide[k])} {1000 * d:.0f} mm from an obstacle "
+                        f"(straight at {_fmt(straight)} before its curl)")
         return None
 
-    def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
-        """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
-        phases are planned successfully and pass the dynamics check, the nearest first; None if there is none."""
+    def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray, rings: int = 1) -> BasePlacement | None:
+        """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned; ``rings`` times
+        that at the most) from which the head phases are planned successfully and pass the dynamics check, and
+        whose straight pose and curl keep clear of the obstacles (:meth:`_straight_failure`), the nearest first;
+        None if there is none."""
         d, a = NEARBY_STEP_M, math.radians(NEARBY_STEP_DEG)
-        for offset in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a)):
+        for offset in [(f * x, f * y, f * t) for f in range(1, rings + 1)
+                       for x, y, t in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a))]:
             candidate = lc.compose(goal, BasePlacement(*offset))
+            if self._straight_failure(candidate, q_bend) is not None:
+                continue
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
                      base_shape=q_bend, timing=self.timing)
-            if self._goal_failure(p) is None and self._straight_failure(candidate, q_bend) is None:
+            if self._goal_failure(p) is None:
                 return candidate
         return None
 
@@ -536,10 +553,15 @@ class ClosedLoop:
                routes: list[np.ndarray], say: Callable[[str], None]) -> gp.Route | None:
         """The route from ``here`` to ``straight_goal`` (root placements of the straight body):
         :func:`snakehead.motion.ground_path.plan_route` between their middles (None: the straight legs are clear),
-        recorded in ``routes``. :class:`~snakehead.Infeasible` when there is none."""
-        offset = self._offset
-        route = gp.plan_route(self.robot, self.obstacles, lc.compose(here, offset), lc.compose(straight_goal, offset),
-                              grid=grid)
+        keeping CLEARANCE_M beyond the gaits' sweep, or where no such route exists EXECUTION_M alone; recorded in
+        ``routes``. :class:`~snakehead.Infeasible` when there is none."""
+        a, b = lc.compose(here, self._offset), lc.compose(straight_goal, self._offset)
+        try:
+            route = gp.plan_route(self.robot, self.obstacles, a, b, grid=grid)
+        except Infeasible as exc:  # no room for the drift's budget: the execution margin alone, said so
+            route = gp.plan_route(self.robot, self.obstacles, a, b, grid=grid, clearance=gp.EXECUTION_M)
+            say(f"{exc}: the route keeps {1000 * gp.EXECUTION_M:.0f} mm beyond the gaits' sweep, without the dead "
+                "reckoning's drift")
         if route is not None:
             routes.append(route.waypoints.copy())
             say(f"around the obstacles: {len(route.waypoints) - 1} legs of "
@@ -861,8 +883,8 @@ class ClosedLoop:
                     tried.append(f"from {_fmt(candidate)}: {why}")
                     notes.append(f"the plan from {_fmt(candidate)} fails ({why})")
                     say(notes[-1])
-                if goal is None and tipped is not None:
-                    goal = self._nearby_goal(tipped.base, tipped.states[0][2])
+                if goal is None and tipped is not None:  # (two rings: an obstacle in the way needs a larger step)
+                    goal = self._nearby_goal(tipped.base, tipped.states[0][2], rings=2)
                     if goal is not None:
                         q_bend = tipped.states[0][2].copy()
                 planning += time.perf_counter() - t0
