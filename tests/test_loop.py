@@ -363,6 +363,49 @@ def test_locomotion_leaves_two_boxes_and_goes_round_them(robot):
             assert _straight_distance(robot, boxes, lc.compose(m, lc.inverse(offset))) > 0.0, (name, s)
 
 
+def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(robot):
+    """The goal check puts the body at every CURL_CHECKS-th step of its predicted curl against the obstacles: a
+    wall that the straight body before the curl clears by 0.2 m but the curling body (at the sliding model's
+    placements, every step, exact geometry) comes within GOAL_CLEARANCE_M of is refused, naming the curl; the same
+    wall moved 1 m away is not."""
+    from snakehead.dynamics.sliding import predict_slide
+    from snakehead.geometry import collision as coll
+    from snakehead.geometry.obstacles import BoxObstacle
+    from snakehead.motion import ground_path as gp
+    from snakehead.motion.planner import bending_state
+    from snakehead.scenes import Scene
+    from snakehead.sim.loop import ClosedLoop
+
+    goal = BasePlacement(0.0, 0.0, 0.0)
+    probe = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))]), robot=robot)
+    q_bend = bending_state(probe.controller, probe.controller.q_initial)
+    straight = lc.straight_pose_for(robot, goal, q_bend)
+    path = lc.curl_path(np.zeros(robot.n_joints), q_bend)
+    slide = predict_slide(robot, path, straight)
+    # the curling body's point farthest from the straight body's line: a wall just beyond it, square to that line
+    pts = np.concatenate([robot.hull_points(robot.frames(q, b)[None])[0].reshape(-1, 3) for q, b in zip(path, slide)])
+    axis = np.array([math.cos(straight.yaw), math.sin(straight.yaw)])
+    normal = np.array([-axis[1], axis[0]])
+    side = (pts[:, :2] - [straight.x, straight.y]) @ normal
+    sign = 1.0 if side.max() > -side.min() else -1.0
+    reach = float((sign * side).max())
+    results = {}
+    for shift in (0.04, 1.0):
+        c = np.array([straight.x, straight.y]) + 0.5 * robot.body_length * axis + sign * (reach + shift + 0.025) * normal
+        wall = BoxObstacle.from_yaw([c[0], c[1], 0.15], [3.0, 0.05, 0.3], straight.yaw)
+        zero = np.zeros((1, robot.n_joints))
+        assert coll.collision_check(robot, zero, [wall], straight, exact_within=5.0).distance[0] > 0.2 or shift > 0.5
+        dense = min(coll.collision_check(robot, q[None], [wall], b, exact_within=5.0).distance[0]
+                    for q, b in zip(path, slide))
+        loop = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))], obstacles=[wall]),
+                          robot=robot)
+        results[shift] = (dense, loop._straight_failure(goal, q_bend))
+    dense, why = results[0.04]
+    assert dense < gp.GOAL_CLEARANCE_M and why is not None and "into its curl" in why
+    dense, why = results[1.0]
+    assert dense > gp.GOAL_CLEARANCE_M and why is None
+
+
 @pytest.fixture(scope="module")
 def controller(robot):
     from snakehead import HeadController

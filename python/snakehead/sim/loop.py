@@ -67,9 +67,11 @@ The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/cur
 ``t1_s``), the estimate's error after every ground phase, how far the tail travelled, and the head's errors.
 Obstacles are in the simulation all along. The locomotion goes around them: when the gaits' straight legs would
 come within the body's turning disc of one, step 2 follows a route of the body's middle planned around their
-footprints (:func:`snakehead.motion.ground_path.plan_route`), leg by leg, and a goal whose straight pose before
-the curl would touch one is refused in step 1. ``sim.min_obstacle_distance_m`` is the body's smallest distance to
-any obstacle over the run. (The curl's own sweep on the ground is not checked against them.)
+footprints (:func:`snakehead.motion.ground_path.plan_route`), planned again from the estimate whenever the body
+drifts off it, every gait run's predicted sweep checked before it runs
+(:func:`snakehead.motion.ground_path.sweep_clear`); a goal whose straight pose before the curl, or the curl
+itself as the friction model predicts it, would come within GOAL_CLEARANCE_M of one is refused in step 1.
+``sim.min_obstacle_distance_m`` is the body's smallest distance to any obstacle over the run.
 """
 from __future__ import annotations
 
@@ -865,9 +867,10 @@ class ClosedLoop:
                 # 1. where must the base go? The plan from where the curl would leave it, relocated if need be,
                 # checked in dynamics at its own start (a relocated base's plan can pass its static checks and still
                 # tip the body in MuJoCo: then every attempt to reach that goal fails); when it fails, the scene's
-                # own placement (the default one for a scene without); then placements near a plan that tipped
+                # own placement (the default one for a scene without); then placements near each plan that tipped or
+                # whose straight pose or curl came too near an obstacle
                 after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-                tried, tipped = [], None
+                tried, refused = [], []
                 t0 = time.perf_counter()
                 for candidate in (after_curl, as_base(self.scene.base)):
                     first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
@@ -878,15 +881,16 @@ class ClosedLoop:
                     if why is None:
                         goal, q_bend = first.base, first.states[0][2].copy()
                         break
-                    if first.failure is None and tipped is None:
-                        tipped = first
+                    if first.failure is None:
+                        refused.append(first)
                     tried.append(f"from {_fmt(candidate)}: {why}")
                     notes.append(f"the plan from {_fmt(candidate)} fails ({why})")
                     say(notes[-1])
-                if goal is None and tipped is not None:  # (two rings: an obstacle in the way needs a larger step)
-                    goal = self._nearby_goal(tipped.base, tipped.states[0][2], rings=2)
+                for near in refused if goal is None else []:  # (two rings: an obstacle in the way needs a larger step)
+                    goal = self._nearby_goal(near.base, near.states[0][2], rings=2)
                     if goal is not None:
-                        q_bend = tipped.states[0][2].copy()
+                        q_bend = near.states[0][2].copy()
+                        break
                 planning += time.perf_counter() - t0
                 if goal is None:
                     failure = "no plan reaches the targets " + "; nor ".join(tried)
