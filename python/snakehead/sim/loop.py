@@ -612,10 +612,11 @@ class ClosedLoop:
         planned = 0  # routes planned since the last run
         runs_here = 0  # gait runs towards the current waypoint
         for _ in range(self.max_gait_runs * MAX_LEGS):
-            if grid is not None and (route is None or not self._route_holds(route, k, est.base, grid)):
+            if grid is not None and (route is None or (not self._route_holds(route, k, est.base, grid)
+                                                       and planned == 0)):
+                # (a route just planned from here is followed even where its first leg does not keep the margin
+                # on the grid's cells: each run's sweep is still checked)
                 planned += 1
-                if planned > 2:  # a route planned from here that does not hold from here
-                    raise InternalError(f"the route planned from {_fmt(est.base)} does not hold there")
                 try:  # the first, or the body drifted off its route: plan it again from the estimate
                     route, k, runs_here = self._route(est.base, straight_goal, grid, routes, say), 1, 0
                 except Infeasible as exc:
