@@ -8,7 +8,7 @@ import pytest
 from scipy.sparse import lil_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from snakehead import BasePlacement, SnakeRobot
+from snakehead import BasePlacement, Infeasible, SnakeRobot
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.motion import ground_path as gp
 
@@ -98,18 +98,18 @@ def test_route_around_a_wall_keeps_the_turning_disc_clear(robot):
     W = route.waypoints
     np.testing.assert_allclose(W[0], [start.x, start.y])
     np.testing.assert_allclose(W[-1], [goal.x, goal.y])
-    assert len(W) <= 6  # a few legs, not the grid's steps
-    R = 0.5 * robot.body_length + gp.CLEARANCE_M
+    assert len(W) <= 7  # a few legs, not the grid's steps
+    R = route.clear_m
+    assert R == pytest.approx(gp.swept_radius(robot) + gp.CLEARANCE_M)
     outlines = gp.footprints([wall])
     # every leg but the last keeps the turning disc's radius from the wall's outline (checked densely, exactly)
     for a, b in zip(W[:-2], W[1:-1]):
         for s in np.linspace(0, 1, 200):
             p = a + s * (b - a)
             assert min(_polygon_distance(p, poly) for poly in outlines) > R - 1e-9
-    # the last leg: the straight body at the goal's heading, from the staging point to the goal, clear of the wall
-    for s in np.linspace(0, 1, 12):
-        p = W[-2] + s * (W[-1] - W[-2])
-        assert _straight_body_distance(robot, p, goal.yaw, [wall]) > gp.CLEARANCE_M - gp.RESOLUTION_M
+    # the last leg: the straight body at the goal's heading, from the staging point to the goal, its sidewinding
+    # band (the swept half width + EXECUTION_M about its axis) clear of the wall, or no nearer than at the goal
+    _assert_straight_leg_keeps(robot, W[-1], W[-2], goal.yaw, [wall], gp.swept_half_width(robot) + gp.EXECUTION_M)
     # legs are square to the body's heading (the body sidewinds along them), but the staging leg's at the goal's
     for k, h in enumerate(route.headings[:-1]):
         d = W[k + 1] - W[k]
@@ -118,6 +118,17 @@ def test_route_around_a_wall_keeps_the_turning_disc_clear(robot):
     # nothing in the way: no route (the straight legs)
     assert gp.plan_route(robot, [wall], BasePlacement(-2.0, -1.0, 0.0), BasePlacement(-2.0, -2.0, 0.0)) is None
     assert gp.plan_route(robot, [], start, goal) is None
+
+
+def _assert_straight_leg_keeps(robot, start, end, heading, obstacles, side):
+    """The straight body's centre line, moved from ``start`` to ``end`` at ``heading``, keeps ``side`` from the
+    obstacles or, where it lies nearer at ``start``, no nearer than there (the exact geometry; the grid's lower
+    bound is conservative by at most two cell diagonals)."""
+    w = gp.half_width(robot)
+    keep = min(side, _straight_body_distance(robot, start, heading, obstacles) + w)
+    for s in np.linspace(0, 1, 15)[1:]:
+        p = start + s * (end - start)
+        assert _straight_body_distance(robot, p, heading, obstacles) + w >= keep - 1e-6
 
 
 def _polygon_distance(p, poly):
@@ -134,13 +145,12 @@ def test_route_length_near_the_shortest_on_a_small_grid(robot):
     """Between two boxes: the route is no longer than the grid's cheapest path at the disc's clearance (A* on
     the same grid, unit weights, found by Dijkstra), within the detour's allowance."""
     boxes = [BoxObstacle([0.0, 0.0, 0.1], [0.3, 1.6, 0.2]), BoxObstacle([1.9, 1.0, 0.1], [0.3, 1.6, 0.2])]
-    start, goal = BasePlacement(-1.2, 0.0, 0.0), BasePlacement(2.9, 0.9, 0.0)
+    start, goal = BasePlacement(-1.2, 0.0, 0.0), BasePlacement(3.1, 0.9, 0.0)
     route = gp.plan_route(robot, boxes, start, goal)
-    assert route is not None
+    assert route is not None and not route.staging
     length = np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum()
-    grid = gp.clearance_grid(boxes, [[start.x, start.y], [goal.x, goal.y]],
-                             0.5 * robot.body_length + gp.CLEARANCE_M + gp.GRID_MARGIN_M)
-    R = 0.5 * robot.body_length + gp.CLEARANCE_M
+    R = route.clear_m
+    grid = gp.clearance_grid(boxes, [[start.x, start.y], [goal.x, goal.y]], R + gp.GRID_MARGIN_M)
     free = grid.distance - grid.resolution * math.sqrt(0.5) > R
     cells = gp.astar(free, grid.cell([start.x, start.y]), grid.cell([goal.x, goal.y]))
     shortest = _path_cost(cells) * grid.resolution
@@ -158,10 +168,112 @@ def test_route_starts_by_sidestepping_when_the_body_cannot_turn_where_it_lies(ro
     W, R = route.waypoints, route.clear_m
     assert route.headings[0] == start.yaw and abs(W[1, 0] - W[0, 0]) < 1e-12  # square to the body: along y
     assert W[1, 1] < 0  # away from the box
-    for s in np.linspace(0, 1, 10):
-        p = W[0] + s * (W[1] - W[0])
-        assert _straight_body_distance(robot, p, start.yaw, [box]) > gp.CLEARANCE_M - gp.RESOLUTION_M
+    _assert_straight_leg_keeps(robot, W[0], W[1], start.yaw, [box], gp.swept_half_width(robot) + gp.EXECUTION_M)
+    assert not route.creep
     box_outline = gp.footprints([box])
     for a, b in zip(W[1:-2], W[2:-1]):
         for s in np.linspace(0, 1, 100):
             assert min(_polygon_distance(a + s * (b - a), poly) for poly in box_outline) > R - 1e-9
+
+
+def test_swept_extents_against_dense_sampling(robot):
+    """The gaits' swept radius and half width: against the body's hull points sampled 4 times as densely over a
+    cycle of each gait, in the frame of the link centres' principal axes found by an eigen-decomposition (not
+    the SVD of virtual_chassis); the straight body's own reach is the smallest the radius can be."""
+    from snakehead.motion.gaits import make_gait
+
+    radius, half = gp.swept_extents(robot)
+    ref_r = ref_w = 0.0
+    for name in ("turning", "sidewinding"):
+        for direction in (1, -1):
+            g = make_gait(name, direction)
+            t = g.ramp_s + np.linspace(0.0, g.period_s, 4 * gp.SWEEP_SAMPLES, endpoint=False)
+            F = robot.frames_many(g.joint_angles(robot, t, 1.0))
+            for c, pts in zip(robot.link_centres(F), robot.hull_points(F)):
+                mid = c.mean(axis=0)
+                w, v = np.linalg.eigh(np.cov((c - mid).T))
+                x, y = v[:, 2], np.cross(v[:, 0] if v[2, 0] > 0 else -v[:, 0], v[:, 2])
+                rel = pts.reshape(-1, 3) - mid
+                ref_r = max(ref_r, float(np.hypot(rel @ x, rel @ y).max()))
+                ref_w = max(ref_w, float(np.abs(rel @ y).max()))
+    straight = robot.hull_points(robot.frames_many(np.zeros((1, robot.n_joints))))[0].reshape(-1, 3)
+    centres = robot.link_centres(robot.frames_many(np.zeros((1, robot.n_joints))))[0]
+    ref_r = max(ref_r, float(np.abs(straight[:, 0] - centres[:, 0].mean()).max()))
+    assert radius == pytest.approx(ref_r, abs=0.003)
+    assert half == pytest.approx(ref_w, abs=0.003)
+    assert half > 3 * gp.half_width(robot)  # the sidewinding wave reaches far beyond the straight body's width
+
+
+def _box_distance(box, pts):
+    """Exact distance of points (P, 2) to a box's ground outline (closed form in the box's axes)."""
+    R = box.rotation[:2, :2]
+    local = (pts - box.centre[:2]) @ R
+    return np.linalg.norm(np.maximum(np.abs(local) - 0.5 * box.size[:2], 0.0), axis=1)
+
+
+def test_escape_along_the_axis_between_two_boxes(robot):
+    """The body lying with its head between two boxes can neither turn nor sidewind: the route's first leg
+    creeps back along its own axis (linear progression), its straight body no nearer the boxes than at the start
+    (exact geometry), to where the turning disc is clear of their outlines."""
+    from snakehead.motion import locomotion as lc
+
+    boxes = [BoxObstacle([0.45, 0.3, 0.125], [0.25, 0.25, 0.25]), BoxObstacle([0.45, -0.3, 0.125], [0.25, 0.25, 0.25])]
+    start = BasePlacement(0.0, 0.0, 0.0)  # the middle at the origin, the head towards +x between the boxes
+    goal = BasePlacement(-0.5, 2.5, 0.0)
+    route = gp.plan_route(robot, boxes, start, goal)
+    W = route.waypoints
+    assert route.creep and route.escape and route.headings[0] == start.yaw
+    assert abs(W[1, 1]) < 1e-12 and W[1, 0] < 0  # back along the axis
+    _assert_straight_leg_keeps(robot, W[0], W[1], start.yaw, boxes, gp.half_width(robot) + gp.EXECUTION_M)
+    assert min(_box_distance(b, W[1][None])[0] for b in boxes) > route.clear_m - 2 * math.sqrt(2) * gp.RESOLUTION_M
+    # the loop's step for that leg: linear progression towards the tail
+    rates = lc.GaitRates.first_guess(robot)
+    offset = lc.chassis_offset(robot)
+    here = lc.compose(start, lc.inverse(offset))
+    there = lc.compose(BasePlacement(W[1, 0], W[1, 1], start.yaw), lc.inverse(offset))
+    step = lc.next_step(robot, here, there, rates, creep=True)
+    assert (step.gait.name, step.gait.direction, step.leg) == ("linear_progression", -1, "along")
+    # boxed in on every side: no route
+    ring = boxes + [BoxObstacle([-0.95, 0.0, 0.125], [0.25, 1.0, 0.25]), BoxObstacle([1.1, 0.0, 0.125], [0.25, 1.0, 0.25]),
+                    BoxObstacle([0.0, 0.6, 0.125], [2.5, 0.25, 0.25]), BoxObstacle([0.0, -0.6, 0.125], [2.5, 0.25, 0.25])]
+    with pytest.raises(Infeasible):
+        gp.plan_route(robot, ring, start, goal)
+
+
+def test_sweep_check_against_brute_force(robot):
+    """sweep_clear against the exact distance of densely sampled swept points to a box: turning (the disc of the
+    swept radius about both ends), sidewinding (the band of the wave's half width about the moving axis) and
+    linear progression (the straight body's band): sound (what it passes keeps the margin, or no less than its
+    ends do) and not much stricter than the truth (a grid of two cell diagonals)."""
+    box = BoxObstacle.from_yaw([0.0, 0.0, 0.125], [0.25, 0.25, 0.25], 0.3)
+    radius, wave = gp.swept_extents(robot)
+    straight, L, m = gp.half_width(robot), robot.body_length, gp.EXECUTION_M
+    slack = 2 * math.sqrt(2) * gp.RESOLUTION_M
+    rng = np.random.default_rng(3)
+    seen = {True: 0, False: 0}
+    for trial in range(60):
+        gait = ("turning", "sidewinding", "linear_progression")[trial % 3]
+        a = rng.uniform(-1.3, 1.3, 2)
+        yaw = rng.uniform(-math.pi, math.pi)
+        move = rng.uniform(-0.4, 0.4) * (np.array([-math.sin(yaw), math.cos(yaw)]) if gait == "sidewinding"
+                                        else np.array([math.cos(yaw), math.sin(yaw)]))
+        b = a + (move if gait != "turning" else 0.0)
+        scale = rng.uniform(0.1, 1.0)
+        grid = gp.clearance_grid([box], [a, b], 1.5)
+        ok = gp.sweep_clear(grid, robot, gait, BasePlacement(*a, yaw), BasePlacement(*b, yaw), scale)
+        seen[ok] += 1
+        if gait == "turning":
+            true = min(_box_distance(box, a[None])[0], _box_distance(box, b[None])[0])
+            need = radius + m
+        else:
+            axis = np.array([math.cos(yaw), math.sin(yaw)])
+            width = straight + (scale * (wave - straight) if gait == "sidewinding" else 0.0)
+            lines = [_box_distance(box, (a + s * (b - a))[None] + np.linspace(-0.5, 0.5, 300)[:, None] * L * axis).min()
+                     for s in np.linspace(0, 1, 60)]
+            true = min(lines)
+            need = min(width + m, max(min(lines[0], lines[-1]), width))
+        if ok:  # (the brute force samples the body every 4.6 mm: its minimum may be a millimetre high)
+            assert true >= need - 1e-3, (trial, gait, true, need)
+        elif true > need + slack + 0.01:
+            pytest.fail(f"trial {trial}: {gait} refused at {true:.3f} m, {need:.3f} m needed")
+    assert seen[True] > 5 and seen[False] > 5

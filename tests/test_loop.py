@@ -179,6 +179,28 @@ def test_gait_runs_and_rates():
     assert rates.sideways_m == pytest.approx(0.4) and rates.sideways_angle_rad == pytest.approx(math.pi / 2)
 
 
+def test_predicted_run_is_what_the_rates_learn(robot):
+    """GaitRates.predicted against GaitRates.update: a run that went exactly where it was predicted leaves the
+    rates as they were (each gait: sidewinding either way at half amplitude, turning, linear progression); and
+    linear progression's prediction is along the body's axis, the commanded way, by its rate times the cycles."""
+    offset = lc.chassis_offset(robot)
+    start = BasePlacement(0.4, -0.3, 0.8)
+    for name, direction, amount, rate_name in (("sidewinding", 1, 0.1, "sideways_m"), ("sidewinding", -1, 0.5, "sideways_m"),
+                                              ("turning", -1, 0.5, "turn_rad"), ("linear_progression", 1, 0.3, "forward_m"),
+                                              ("linear_progression", -1, 0.05, "forward_m")):
+        rates = lc.GaitRates(sideways_m=0.3, sideways_angle_rad=1.4, turn_rad=0.7, forward_m=0.18)
+        step = lc.gait_run(name, direction, amount, getattr(rates, rate_name))
+        end = lc.compose(rates.predicted(step, start, offset), lc.inverse(offset))
+        before = (rates.sideways_m, rates.sideways_angle_rad, rates.turn_rad, rates.forward_m)
+        rates.update(step, start, end, offset)
+        after = (rates.sideways_m, rates.sideways_angle_rad, rates.turn_rad, rates.forward_m)
+        np.testing.assert_allclose(after, before, rtol=1e-9, err_msg=name)
+        if name == "linear_progression":
+            d = lc.relative(lc.compose(start, offset), lc.compose(end, offset))
+            full = step.cycles * step.scale ** lc.AMPLITUDE_EXPONENT[name]
+            assert d.x == pytest.approx(direction * full * 0.18) and abs(d.y) < 1e-12
+
+
 @pytest.mark.parametrize("call, error, match", [
     (lambda: lc.gait_run("slithering", 1, 0.1, 0.3), ValueError, "unknown gait 'slithering'"),
     (lambda: lc.gait_run("sidewinding", 1, -0.1, 0.3), ValueError, "amount must be a positive"),
@@ -272,6 +294,116 @@ def test_simulate_trajectory_continues_from_a_state(robot):
     other = GaitSimulator(pitch_first()).lying()
     with pytest.raises(ValueError, match="another robot"):
         simulate_trajectory(robot, t, q, state=other)
+
+
+class _ExactGaits:
+    """A stand-in for the GaitSimulator whose gait runs go exactly where the loop's rates predict (for the
+    locomotion's logic alone: routes, re-planning, sweep checks), recording every run."""
+
+    def __init__(self, robot, rates):
+        self.robot, self.rates, self.offset, self.runs = robot, rates, lc.chassis_offset(robot), []
+
+    def run(self, state, gait, cycles, start_estimate):
+        from types import SimpleNamespace
+
+        default = make_gait(gait.name, gait.direction)
+        key = "amplitude" if "amplitude" in gait.parameters else "yaw_amplitude"
+        step = lc.LocomotionStep(gait, cycles, "", gait.parameters[key] / default.parameters[key])
+        end = lc.compose(self.rates.predicted(step, start_estimate.base, self.offset), lc.inverse(self.offset))
+        self.runs.append((gait.name, step.scale, start_estimate.base, end))
+        return SimpleNamespace(estimate=SimpleNamespace(base=end), state=None)
+
+
+def _straight_distance(robot, obstacles, base):
+    from snakehead.geometry import collision as coll
+
+    return coll.collision_check(robot, np.zeros((1, robot.n_joints)), obstacles, base, exact_within=10.0).distance[0]
+
+
+def test_locomotion_leaves_two_boxes_and_goes_round_them(robot):
+    """The loop's locomotion (routes planned again from the estimate, escape, sweep checks) on bench/loop.py's
+    pose 11 (the body's head between two boxes), its gait runs going exactly where predicted: it reaches the
+    straight goal, its first runs creep back along the body's axis, and the straight body, at every run's ends
+    and every 2 cm or 2 deg between them (moved as the run predicts: turning about the middle, the others
+    sliding), keeps clear of the boxes by the exact geometry (the sidewinding wave's own reach is the sweep
+    check's, tested against brute force in test_ground_path.py)."""
+    from types import SimpleNamespace
+
+    from snakehead.geometry.obstacles import BoxObstacle
+    from snakehead.scenes import Scene
+    from snakehead.sim.loop import ClosedLoop
+
+    boxes = [BoxObstacle.from_yaw([0.5925, 1.1913, 0.125], [0.25, 0.25, 0.25], -0.3018),
+             BoxObstacle.from_yaw([0.0189, 1.3699, 0.125], [0.25, 0.25, 0.25], -0.3018)]
+    start = BasePlacement(0.6548, 2.3504, math.radians(-107.78))
+    straight_goal = BasePlacement(-0.0778, -0.2977, 1.7180)
+    scene = Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))], obstacles=boxes)
+    loop = ClosedLoop(scene, robot=robot)
+    rates = lc.GaitRates.first_guess(robot)
+    fake = _ExactGaits(robot, rates)
+    est = SimpleNamespace(base=start)
+
+    def ground(run, name, kind):
+        est.base = run.estimate.base
+
+    routes = []
+    why = loop._locomotion(fake, est, straight_goal, lc.Tolerance(), rates, routes, lambda text: None, ground,
+                           lambda: None)
+    assert why is None and routes
+    off = lc.relative(straight_goal, est.base)
+    assert abs(off.x) <= 0.08 and abs(off.y) <= 0.03 and abs(math.degrees(off.yaw)) <= 4.0
+    assert fake.runs[0][0] == "linear_progression"
+    offset = lc.chassis_offset(robot)
+    for name, scale, a, b in fake.runs:
+        ma, mb = lc.compose(a, offset), lc.compose(b, offset)
+        turn = lc.wrap_angle(mb.yaw - ma.yaw)
+        n = int(max(math.hypot(mb.x - ma.x, mb.y - ma.y) / 0.02, abs(math.degrees(turn)) / 2.0)) + 1
+        for s in np.linspace(0.0, 1.0, n + 1):
+            m = BasePlacement(ma.x + s * (mb.x - ma.x), ma.y + s * (mb.y - ma.y), ma.yaw + s * turn)
+            assert _straight_distance(robot, boxes, lc.compose(m, lc.inverse(offset))) > 0.0, (name, s)
+
+
+def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(robot):
+    """The goal check puts the body at every CURL_CHECKS-th step of its predicted curl against the obstacles: a
+    wall that the straight body before the curl clears by 0.2 m but the curling body (at the sliding model's
+    placements, every step, exact geometry) comes within GOAL_CLEARANCE_M of is refused, naming the curl; the same
+    wall moved 1 m away is not."""
+    from snakehead.dynamics.sliding import predict_slide
+    from snakehead.geometry import collision as coll
+    from snakehead.geometry.obstacles import BoxObstacle
+    from snakehead.motion import ground_path as gp
+    from snakehead.motion.planner import bending_state
+    from snakehead.scenes import Scene
+    from snakehead.sim.loop import ClosedLoop
+
+    goal = BasePlacement(0.0, 0.0, 0.0)
+    probe = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))]), robot=robot)
+    q_bend = bending_state(probe.controller, probe.controller.q_initial)
+    straight = lc.straight_pose_for(robot, goal, q_bend)
+    path = lc.curl_path(np.zeros(robot.n_joints), q_bend)
+    slide = predict_slide(robot, path, straight)
+    # the curling body's point farthest from the straight body's line: a wall just beyond it, square to that line
+    pts = np.concatenate([robot.hull_points(robot.frames(q, b)[None])[0].reshape(-1, 3) for q, b in zip(path, slide)])
+    axis = np.array([math.cos(straight.yaw), math.sin(straight.yaw)])
+    normal = np.array([-axis[1], axis[0]])
+    side = (pts[:, :2] - [straight.x, straight.y]) @ normal
+    sign = 1.0 if side.max() > -side.min() else -1.0
+    reach = float((sign * side).max())
+    results = {}
+    for shift in (0.04, 1.0):
+        c = np.array([straight.x, straight.y]) + 0.5 * robot.body_length * axis + sign * (reach + shift + 0.025) * normal
+        wall = BoxObstacle.from_yaw([c[0], c[1], 0.15], [3.0, 0.05, 0.3], straight.yaw)
+        zero = np.zeros((1, robot.n_joints))
+        assert coll.collision_check(robot, zero, [wall], straight, exact_within=5.0).distance[0] > 0.2 or shift > 0.5
+        dense = min(coll.collision_check(robot, q[None], [wall], b, exact_within=5.0).distance[0]
+                    for q, b in zip(path, slide))
+        loop = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))], obstacles=[wall]),
+                          robot=robot)
+        results[shift] = (dense, loop._straight_failure(goal, q_bend))
+    dense, why = results[0.04]
+    assert dense < gp.GOAL_CLEARANCE_M and why is not None and "into its curl" in why
+    dense, why = results[1.0]
+    assert dense > gp.GOAL_CLEARANCE_M and why is None
 
 
 @pytest.fixture(scope="module")

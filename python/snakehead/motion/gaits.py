@@ -26,6 +26,10 @@ The gaits (:data:`GAITS`, :func:`make_gait`), each with its commanded direction 
 * :func:`turning` (in place): sidewinding with the pitch wave tapered through zero mid-body: the head half
   sidewinds one way and the tail half the other, so the body turns about its middle. direction +1:
   counter-clockwise seen from above (the head to the left).
+* :func:`linear_progression`: a pitch wave alone (a vertical travelling wave, the "linear progression" of modular
+  snake robots): the links in contact stay put while the lifted crests travel along the body, so the body creeps
+  along its own axis, the one way the other gaits cannot move it on an isotropic friction ground. direction +1:
+  towards the head. Its sweep is the straight body's own outline, lengthened along the axis.
 * :func:`lateral_undulation`: a yaw wave alone, running from the head to the tail. It propels a snake only on a
   ground that resists sideways slip more than forward slip; on snakehead's isotropic friction ground it barely
   moves (bench/RESULTS.md).
@@ -264,6 +268,16 @@ def turning(direction: int = 1, *, yaw_amplitude: float = 0.6, pitch_amplitude: 
                      ramp_s=ramp_s))
 
 
+def linear_progression(direction: int = 1, *, amplitude: float = 0.5, waves: float = 1.0, frequency: float = 0.5,
+                       ramp_s: float = 1.0) -> Gait:
+    """Creep along the body's axis; direction +1 towards the head (a pitch wave running towards the head: on the
+    default robot 0.17 m per cycle at the defaults, bench/RESULTS.md). amplitude (rad) of the pitch joints, waves
+    per body length, frequency Hz."""
+    direction = _direction(direction)
+    return Gait("linear_progression", Wave(0.0), Wave(amplitude, direction * waves), frequency, direction, "forward",
+                ramp_s, dict(amplitude=amplitude, waves=waves, frequency=frequency, ramp_s=ramp_s))
+
+
 def lateral_undulation(direction: int = 1, *, amplitude: float = 0.6, waves: float = 1.0, frequency: float = 0.5,
                        ramp_s: float = 1.0) -> Gait:
     """A yaw wave running from the head to the tail (direction +1: meant to go forward, towards the head). Needs a
@@ -274,7 +288,9 @@ def lateral_undulation(direction: int = 1, *, amplitude: float = 0.6, waves: flo
 
 
 #: The gaits by name.
-GAITS: dict[str, Callable[..., Gait]] = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning, "lateral_undulation": lateral_undulation}
+GAITS: dict[str, Callable[..., Gait]] = {"rolling": rolling, "sidewinding": sidewinding, "turning": turning,
+                                        "linear_progression": linear_progression,
+                                        "lateral_undulation": lateral_undulation}
 
 
 def make_gait(name: str, direction: int = 1, **parameters: Any) -> Gait:

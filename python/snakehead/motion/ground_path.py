@@ -3,36 +3,57 @@
 :func:`~snakehead.motion.locomotion.chassis_offset`) passes on its way from where it lies to where the curl into
 the bending state must start.
 
-Why the body's middle as a disc: the gaits are turning in place (the straight body sweeps the disc of half its
-length about its middle) and sidewinding (it sweeps the band of its length, square to its axis, along the way).
-Both stay inside the disc of radius L / 2 swept along the middle's path. So the middle's path is planned on a grid
-(:data:`RESOLUTION_M`) over the free space of the obstacles' footprints (the ground-level outline of their convex
-shapes) inflated by L / 2 plus a clearance: grid A* (8-connected, octile heuristic: :func:`astar`), then shortcut
-by line of sight (:func:`shortcut`). The body then turns at each waypoint square to the next leg and sidewinds
-along it.
+Why the body's middle as a disc: the gaits are turning in place and sidewinding, and each keeps the body within
+:func:`swept_radius` of its middle (the virtual chassis) and within :func:`swept_half_width` of its axis,
+measured on the gaits' own shapes over a cycle (the straight body reaches 0.695 m from its middle on the default
+robot, the gaits' waves 0.657 m; the sidewinding wave 0.12 m across its axis where the straight body is 0.022 m
+wide). So the middle's path is planned on a grid (:data:`RESOLUTION_M`) over the free space of the obstacles'
+footprints (the ground-level outline of their convex shapes) inflated by that radius plus :data:`CLEARANCE_M`:
+grid A* (8-connected, octile heuristic: :func:`astar`), then shortcut by line of sight (:func:`shortcut`). The body
+then turns at each waypoint square to the next leg and sidewinds along it.
+
+The clearance is a budget, stated once: :data:`EXECUTION_M` (how far a gait leg ends off its line: the loop's
+waypoint tolerance) plus :data:`DRIFT_M` (how far the dead reckoning drifts over a route between fixes).
 
 The goal itself usually lies nearer an obstacle than that (the bending state stands beside the wall whose hole
 the head goes through): the last leg comes from a *staging point* on the goal's own across-axis
-(:func:`plan_route`), where the body can turn, then sidewinds at the goal's heading to the goal, its straight
-footprint (the body's centre line inflated by half its width plus the clearance) kept clear on the way.
+(:func:`plan_route`), where the body can turn, then sidewinds at the goal's heading to the goal, its swept band
+(the axis inflated by :func:`swept_half_width` plus EXECUTION_M) nowhere nearer an obstacle than the goal's own.
+Likewise a start too near an obstacle to turn is left first by an *escape* leg: sidewinding across its axis, or,
+when that is blocked too (the body lying between two boxes), creeping along its axis
+(:func:`~snakehead.motion.gaits.linear_progression`, whose sweep is the straight body's outline). Each gait run is
+checked before it runs (:func:`sweep_clear`): its predicted sweep must keep EXECUTION_M from the obstacles.
 """
 from __future__ import annotations
 
 import heapq
 import math
+import weakref
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import Infeasible
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 #: Grid resolution (m).
 RESOLUTION_M = 0.025
-#: Clearance (m) kept from every obstacle beyond the body's own extent (the gaits' execution errors: a sidewinding
-#: run goes a few centimetres off its line, a turn shifts the middle by a few).
-CLEARANCE_M = 0.08
+#: The execution margin (m): how much of a route's clearance the body may lose off its line before the route is
+#: planned again from where it is (snakehead.sim.loop: a sidewinding run drifts a few centimetres along the body's
+#: axis, a turn shifts the middle by a few), and what every gait run's predicted sweep keeps from the obstacles.
+EXECUTION_M = 0.06
+#: How far the dead reckoning drifts over a route (m): the onboard estimate drifts 2-5 % of the distance the body
+#: travels (30-110 mm over the 4 m routes of bench/loop.py's box poses, bench/RESULTS.md).
+DRIFT_M = 0.12
+#: Clearance (m) a route keeps from every obstacle beyond the gaits' swept extent: the budget of both.
+CLEARANCE_M = EXECUTION_M + DRIFT_M
+#: The straight pose before the curl (the goal of the locomotion) must keep this from every obstacle (m): the gaits
+#: bring the body there within EXECUTION_M, and its last leg sweeps the band of swept_half_width about its axis.
+GOAL_CLEARANCE_M = 0.08
+#: Samples per gait cycle of the swept extents.
+SWEEP_SAMPLES = 60
 #: Obstacle shapes whose lowest point is above this height (m) do not stand in the body's way on the ground.
 GROUND_HEIGHT_M = 0.1
 #: Margin of the grid around the start, the goal and the obstacles (m, beyond half the body's length).
@@ -205,24 +226,21 @@ def shortcut(grid: ClearanceGrid, points: list[np.ndarray], radius: float) -> li
     return out
 
 
-def body_clear(grid: ClearanceGrid, middle: np.ndarray, heading: float, length: float, radius: float) -> bool:
-    """Whether the straight body (its centre line of ``length`` m about ``middle`` along ``heading`` rad) keeps
-    ``radius`` m from the obstacles."""
-    a = np.array([math.cos(heading), math.sin(heading)])
-    return segment_clear(grid, middle - 0.5 * length * a, middle + 0.5 * length * a, radius)
-
-
 @dataclass
 class Route:
     """The middle's way to the goal: ``waypoints`` (K, 2) m (the start's middle first, the goal's last), each
     leg's body heading ``headings`` (K - 1,) rad (square to the leg; the last leg's is the goal's heading, from the
-    staging point), ``staging``: whether the last leg comes from a staging point; ``clear_m``: the turning disc's
-    radius the path keeps from the obstacles (L / 2 + clearance)."""
+    staging point; an escape leg's the start's), ``staging``: whether the last leg comes from a staging point;
+    ``clear_m``: the turning disc's radius the path keeps from the obstacles (swept radius + clearance);
+    ``escape``: whether the first leg is an escape (at the start's heading, nearer the obstacles than clear_m);
+    ``creep``: whether it is one along the body's axis (linear progression)."""
 
     waypoints: np.ndarray
     headings: np.ndarray
     staging: bool
     clear_m: float
+    creep: bool = False
+    escape: bool = False
 
 
 def half_width(robot: SnakeRobot) -> float:
@@ -232,40 +250,130 @@ def half_width(robot: SnakeRobot) -> float:
     return float(np.abs(robot.hull_points(frames)[..., 1]).max())
 
 
-def _sidestep(grid: ClearanceGrid, middle: BasePlacement, length: float, radius: float, side: float
-              ) -> np.ndarray | None:
-    """Where the body lying straight with its middle at ``middle`` can turn (``radius`` clear), reached by
-    sidewinding square to its axis at its own heading with its centre line ``side`` clear all the way: the middle
-    itself when it can turn there, else the nearest such point along its across-axis (MAX_STAGING_M at most), or
+def _chassis_extents(robot: SnakeRobot, q: np.ndarray) -> tuple[float, float]:
+    """The largest distance (m) in the ground plane of the body's hull points from its virtual chassis' origin, and
+    across its axis, over the shapes ``q`` (T, n)."""
+    from .gaits import virtual_chassis
+
+    F = robot.frames_many(q)
+    pts, centres = robot.hull_points(F), robot.link_centres(F)
+    radius = across = 0.0
+    for c, p in zip(centres, pts):
+        T = virtual_chassis(c, forward=c[-1] - c[0])
+        local = (p.reshape(-1, 3) - T[:3, 3]) @ T[:3, :3]
+        radius = max(radius, float(np.hypot(local[:, 0], local[:, 1]).max()))
+        across = max(across, float(np.abs(local[:, 1]).max()))
+    return radius, across
+
+
+#: swept_extents of each robot met so far (a robot's shapes do not change).
+_SWEPT: "weakref.WeakKeyDictionary[SnakeRobot, tuple[float, float]]" = weakref.WeakKeyDictionary()
+
+
+def swept_extents(robot: SnakeRobot) -> tuple[float, float]:
+    """(radius, half width) m: how far from its middle and from its axis the body reaches while lying straight
+    or in any shape of a full-amplitude cycle of turning or sidewinding (SWEEP_SAMPLES shapes a cycle; the
+    smaller-amplitude runs stay within them)."""
+    from .gaits import make_gait
+
+    robot = as_robot(robot)
+    if robot in _SWEPT:
+        return _SWEPT[robot]
+    shapes = [np.zeros((1, robot.n_joints))]
+    for name in ("turning", "sidewinding"):
+        for direction in (1, -1):
+            g = make_gait(name, direction)
+            t = g.ramp_s + np.linspace(0.0, g.period_s, SWEEP_SAMPLES, endpoint=False)
+            shapes.append(g.joint_angles(robot, t, 1.0))
+    _SWEPT[robot] = _chassis_extents(robot, np.vstack(shapes))
+    return _SWEPT[robot]
+
+
+def swept_radius(robot: SnakeRobot) -> float:
+    """How far from its middle the body reaches in the gaits (m; :func:`swept_extents`)."""
+    return swept_extents(robot)[0]
+
+
+def swept_half_width(robot: SnakeRobot) -> float:
+    """How far from its axis the body reaches in the gaits (m; :func:`swept_extents`)."""
+    return swept_extents(robot)[1]
+
+
+def band_clearance(grid: ClearanceGrid, middle: np.ndarray, heading: float, length: float) -> float:
+    """A lower bound of the distance (m) of the straight body's centre line (``length`` m about ``middle`` along
+    ``heading`` rad) to the obstacles."""
+    a = np.array([math.cos(heading), math.sin(heading)])
+    n = max(int(math.ceil(length / (0.5 * grid.resolution))), 1)
+    s = np.linspace(-0.5, 0.5, n + 1)[:, None] * length
+    return float(grid.clearance_at(middle + s * a).min())
+
+
+def _sidestep(grid: ClearanceGrid, middle: BasePlacement, length: float, radius: float, side: float,
+              along: bool = False) -> np.ndarray | None:
+    """Where the body lying straight with its middle at ``middle`` can turn (``radius`` clear), reached by a
+    straight leg at its own heading: across its axis (sidewinding; ``along``: along it, creeping), its centre line
+    keeping ``side`` from the obstacles all the way, or, where it already lies nearer, no nearer than it lies at
+    ``middle``: the middle itself when it can turn there, else the nearest such point (MAX_STAGING_M at most), or
     None."""
     m = np.array([middle.x, middle.y])
     if grid.clearance_at(m)[0] > radius:
         return m
-    n = np.array([-math.sin(middle.yaw), math.cos(middle.yaw)])
+    n = (np.array([math.cos(middle.yaw), math.sin(middle.yaw)]) if along
+         else np.array([-math.sin(middle.yaw), math.cos(middle.yaw)]))
+    keep = min(side, band_clearance(grid, m, middle.yaw, length))
     step = grid.resolution
     for s in np.arange(step, MAX_STAGING_M, step):
         for sign in (1.0, -1.0):
             p = m + sign * s * n
             if grid.clearance_at(p)[0] > radius and all(
-                    body_clear(grid, m + sign * t * n, middle.yaw, length, side) for t in np.arange(0.0, s + 1e-9, step)):
+                    band_clearance(grid, m + sign * t * n, middle.yaw, length) >= keep
+                    for t in np.arange(step, s + 1e-9, step)):
                 return p
     return None
 
 
+def _escape(grid: ClearanceGrid, start: BasePlacement, length: float, radius: float, side_across: float,
+            side_along: float) -> tuple[np.ndarray, bool] | None:
+    """The escape from the start (see the module): (where, creeping along the axis?) or None."""
+    across = _sidestep(grid, start, length, radius, side_across)
+    if across is not None:
+        return across, False
+    along = _sidestep(grid, start, length, radius, side_along, along=True)
+    return None if along is None else (along, True)
+
+
+def _drop_short_legs(grid: ClearanceGrid, points: list[np.ndarray], radius: float, first: int) -> list[np.ndarray]:
+    """``points`` without the waypoints (from index ``first`` on, never the last) whose leg to the next is shorter
+    than MIN_LEG_M (the grid's snap next to the staging point: its turn costs a run), where the leg that replaces
+    both keeps ``radius`` from the obstacles."""
+    out = points[:first]
+    for k in range(first, len(points) - 1):
+        if float(np.linalg.norm(points[k + 1] - points[k])) < MIN_LEG_M \
+                and segment_clear(grid, out[-1], points[k + 1], radius):
+            continue
+        out.append(points[k])
+    return out + [points[-1]]
+
+
 def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePlacement, goal_middle: BasePlacement,
-               *, clearance: float = CLEARANCE_M, resolution: float = RESOLUTION_M) -> Route | None:
+               *, clearance: float = CLEARANCE_M, resolution: float = RESOLUTION_M,
+               grid: ClearanceGrid | None = None) -> Route | None:
     """The route of the straight body's middle from ``start_middle`` to ``goal_middle`` (placements of the virtual
     chassis: x, y m and the body's heading rad) around ``obstacles`` (see the module), or None when the straight
     legs of :func:`snakehead.motion.locomotion.next_step` are already clear of them (no obstacle within the turning
-    disc of the start or along the way) or no route exists."""
+    disc of the start or along the way). :class:`~snakehead.Infeasible` when there is no route. ``grid``: the
+    obstacles' (:func:`clearance_grid`, reaching the swept radius plus the clearance beyond them; default: one
+    over the start, the goal and the obstacles at ``resolution``), so that other checks see the same cells."""
     robot = as_robot(robot)
     L = robot.body_length
-    R = 0.5 * L + clearance
-    side = half_width(robot) + clearance
+    reach, wave = swept_extents(robot)
+    R = reach + clearance
+    side, straight_side = wave + EXECUTION_M, half_width(robot) + EXECUTION_M
     a, g = np.array([start_middle.x, start_middle.y]), np.array([goal_middle.x, goal_middle.y])
     if not obstacles:
         return None
-    grid = clearance_grid(obstacles, [a, g], 0.5 * L + clearance + GRID_MARGIN_M, resolution)
+    if grid is None:
+        grid = clearance_grid(obstacles, [a, g], R + GRID_MARGIN_M, resolution)
     # next_step's own legs (turn at the start, sidewind along the goal's axis to the corner, turn there, sidewind
     # across to the goal) swept within the discs along them: clear, no route needed
     axis = np.array([math.cos(goal_middle.yaw), math.sin(goal_middle.yaw)])
@@ -273,29 +381,34 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
     if segment_clear(grid, a, corner, R) and segment_clear(grid, corner, g, R):
         return None
     # the last leg: from a staging point on the goal's across-axis, the body at the goal's heading; the first, when
-    # the body cannot turn where it lies: sidewinding at its own heading to where it can
+    # the body cannot turn where it lies: sidewinding or creeping at its own heading to where it can
     staging = _sidestep(grid, goal_middle, L, R, side)
-    escape = _sidestep(grid, start_middle, L, R, side)
-    if staging is None or escape is None:
-        return None
-    staged, escaped = not np.array_equal(staging, g), not np.array_equal(escape, a)
+    escape = _escape(grid, start_middle, L, R, side, straight_side)
+    if staging is None:
+        raise Infeasible(f"no staging point within {MAX_STAGING_M} m of the goal's middle ({g[0]:.2f}, {g[1]:.2f}) "
+                         f"m lets the body turn {R:.2f} m clear of the obstacles")
+    if escape is None:
+        raise Infeasible(f"the body lying with its middle at ({a[0]:.2f}, {a[1]:.2f}) m can neither turn nor leave "
+                         f"by a straight leg {R:.2f} m clear of the obstacles")
+    escape_point, creep = escape
+    staged, escaped = not np.array_equal(staging, g), not np.array_equal(escape_point, a)
     # the grid path kept DETOUR_M farther out where it costs little, so that its shortcuts (chords of the rounded
     # corners, each a turn and a run) are few
     clear = grid.clearance
-    cells = astar(clear > R, grid.cell(escape), grid.cell(staging), np.where(clear > R + DETOUR_M, 1.0, DETOUR_COST))
+    cells = astar(clear > R, grid.cell(escape_point), grid.cell(staging),
+                  np.where(clear > R + DETOUR_M, 1.0, DETOUR_COST))
     if cells is None:
-        return None
-    points = [escape] + [grid.point(c) for c in cells[1:-1]] + [staging]
+        raise Infeasible(f"no way {R:.2f} m clear of the obstacles from ({a[0]:.2f}, {a[1]:.2f}) m to "
+                         f"({g[0]:.2f}, {g[1]:.2f}) m")
+    points = [escape_point] + [grid.point(c) for c in cells[1:-1]] + [staging]
     points = shortcut(grid, points, R)
     if escaped:
         points.insert(0, a)
-    # a leg shorter than MIN_LEG_M (the grid's snap next to the staging point) is no leg: its turn costs a run
-    keep = {0, len(points) - 1} | ({1} if escaped else set())
-    points = [p for k, p in enumerate(points) if k in keep or float(np.linalg.norm(points[k + 1] - p)) >= MIN_LEG_M]
+    points = _drop_short_legs(grid, points, R, 2 if escaped else 1)
     if staged:
         points.append(g)
     waypoints = np.array(points)
-    headings = []
+    headings: list[float] = []
     for k in range(1, len(waypoints)):
         d = waypoints[k] - waypoints[k - 1]
         if staged and k == len(waypoints) - 1:
@@ -308,4 +421,27 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
         prev = headings[-1] if headings else start_middle.yaw
         options = (square, square + math.pi)
         headings.append(min(options, key=lambda h: abs(math.remainder(h - prev, 2 * math.pi))))
-    return Route(waypoints, np.array(headings), staged, R)
+    return Route(waypoints, np.array(headings), staged, R, creep and escaped, escaped)
+
+
+def sweep_clear(grid: ClearanceGrid, robot: SnakeRobot, gait: str, start_middle: BasePlacement,
+                end_middle: BasePlacement, scale: float = 1.0, margin: float = EXECUTION_M) -> bool:
+    """Whether a gait run (``gait`` at amplitude ``scale``) that takes the body's middle from ``start_middle`` to
+    ``end_middle`` (predicted) stays clear of the obstacles: turning, the disc of :func:`swept_radius` about the
+    middle at both ends, ``margin`` clear; sidewinding and linear progression, the band about the body's axis
+    (the straight body's half width, plus the sidewinding wave's reach beyond it times ``scale``) moved from
+    start to end at the start's heading, ``margin`` clear, or, where the run starts or ends nearer than that, no
+    nearer than the nearer of its two ends and never touching."""
+    robot = as_robot(robot)
+    reach, wave = swept_extents(robot)
+    a = np.array([start_middle.x, start_middle.y])
+    b = np.array([end_middle.x, end_middle.y])
+    if gait == "turning":
+        return bool(min(grid.clearance_at(a)[0], grid.clearance_at(b)[0]) > reach + margin)
+    straight = half_width(robot)
+    width = straight + (scale * (wave - straight) if gait == "sidewinding" else 0.0)
+    L = robot.body_length
+    n = max(int(math.ceil(float(np.linalg.norm(b - a)) / (0.5 * grid.resolution))), 1)
+    along = [band_clearance(grid, a + s * (b - a), start_middle.yaw, L) for s in np.linspace(0.0, 1.0, n + 1)]
+    need = min(width + margin, max(min(along[0], along[-1]), width + 1e-9))
+    return bool(min(along) >= need)

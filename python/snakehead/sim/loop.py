@@ -67,9 +67,11 @@ The result, :class:`LoopRun`, has the phases (``name``, ``kind`` one of gait/cur
 ``t1_s``), the estimate's error after every ground phase, how far the tail travelled, and the head's errors.
 Obstacles are in the simulation all along. The locomotion goes around them: when the gaits' straight legs would
 come within the body's turning disc of one, step 2 follows a route of the body's middle planned around their
-footprints (:func:`snakehead.motion.ground_path.plan_route`), leg by leg, and a goal whose straight pose before
-the curl would touch one is refused in step 1. ``sim.min_obstacle_distance_m`` is the body's smallest distance to
-any obstacle over the run. (The curl's own sweep on the ground is not checked against them.)
+footprints (:func:`snakehead.motion.ground_path.plan_route`), planned again from the estimate whenever the body
+drifts off it, every gait run's predicted sweep checked before it runs
+(:func:`snakehead.motion.ground_path.sweep_clear`); a goal whose straight pose before the curl, or the curl
+itself as the friction model predicts it, would come within GOAL_CLEARANCE_M of one is refused in step 1.
+``sim.min_obstacle_distance_m`` is the body's smallest distance to any obstacle over the run.
 """
 from __future__ import annotations
 
@@ -102,15 +104,24 @@ from . import servo as sv
 from .sensors import OnboardSensors
 from .tracking import SimState
 from .tracking import SimResult, simulate_trajectory
-from .._errors import InputError, InputTypeError, InternalError, entry_point, inputs_checked
+from .._errors import Infeasible, InputError, InputTypeError, InternalError, entry_point, inputs_checked
 
 #: How the loop knows where it is (:class:`ClosedLoop`'s ``sensing``): "onboard", the robot's own sensors alone
 #: (:mod:`snakehead.sim.sensors`), or "outside fix", perfect joint angles and IMU and an outside measurement of the
 #: neck's base frame (:class:`PoseFix`) once the body rests in the bending state.
 SENSING = ("onboard", "outside fix")
-#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle along the leg's
-#: square and along the leg, m; its heading, deg): looser than the goal's, the next leg corrects what is left.
-WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.12, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
+#: How near the gaits bring the body to a waypoint of a route around obstacles (its middle off the leg's line, m,
+#: and along it, m; its heading, deg): looser than the goal's, the next leg corrects what is left. Off the line it
+#: is loosest: a turn square to the line and back to correct it shifts the middle by as much again (turning in
+#: place moves the middle by up to 0.05 body lengths a cycle), and where being off the line matters the route is
+#: planned again (ClosedLoop._route_holds: the leg from where the body is must keep the clearance less
+#: ground_path.EXECUTION_M).
+WAYPOINT_TOLERANCE = lc.Tolerance(along_m=0.25, across_m=0.08, yaw_deg=8.0, align_deg=8.0)
+#: Every this many steps of the curl's path (of locomotion.CURL_STEPS) the goal's check puts the curling body
+#: against the obstacles.
+CURL_CHECKS = 4
+#: The most legs of a route the locomotion follows (each at most max_gait_runs runs) before it gives up.
+MAX_LEGS = 8
 #: The most samples of the estimate's error over time a report holds.
 ESTIMATE_SAMPLES = 200
 #: How long the head holds still where it first looks for a marker (s).
@@ -502,45 +513,159 @@ class ClosedLoop:
         return self._dynamics_check(p) if self.dynamics_check else None
 
     def _straight_failure(self, goal: BasePlacement, q_bend: np.ndarray) -> str | None:
-        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal`` (it would
-        lie within the ground path's clearance of an obstacle: the gaits could not bring it there), else None."""
+        """Why the body cannot lie straight where the curl into ``q_bend`` must start to reach ``goal``, or cannot
+        curl from there: the straight body, or the body at any CURL_CHECKS-th step of the curl where the friction
+        model slides it (:func:`snakehead.dynamics.sliding.predict_slide`), would come within GOAL_CLEARANCE_M
+        of an obstacle (the gaits bring it there within their execution margin, its estimate off by the drift);
+        else None."""
         if not self.obstacles:
             return None
-        straight = lc.straight_pose_for(self.robot, goal, q_bend)
-        d = coll.collision_check(self.robot, np.zeros((1, self.robot.n_joints)), self.obstacles, straight,
-                                 exact_within=1.0).distance[0]
-        if d < gp.CLEARANCE_M:
-            return (f"the body would lie straight at {_fmt(straight)} before its curl, {1000 * d:.0f} mm from an "
-                    "obstacle")
+        from ..dynamics.sliding import predict_slide
+
+        robot = self.robot
+        straight = lc.straight_pose_for(robot, goal, q_bend)
+        path = lc.curl_path(np.zeros(robot.n_joints), q_bend)
+        slide = predict_slide(robot, path, straight)
+        for k in list(range(0, len(path), CURL_CHECKS)) + [len(path) - 1]:
+            d = coll.collision_check(robot, path[k][None], self.obstacles, slide[k], exact_within=1.0).distance[0]
+            if d < gp.GOAL_CLEARANCE_M:
+                where = "lie straight" if k == 0 else f"pass, {100 * k // (len(path) - 1)} % into its curl,"
+                return (f"the body would {where} at {_fmt(slide[k])} {1000 * d:.0f} mm from an obstacle "
+                        f"(straight at {_fmt(straight)} before its curl)")
         return None
 
-    def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray) -> BasePlacement | None:
-        """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned) from which the head
-        phases are planned successfully and pass the dynamics check, the nearest first; None if there is none."""
+    def _nearby_goal(self, goal: BasePlacement, q_bend: np.ndarray, rings: int = 1) -> BasePlacement | None:
+        """A placement near ``goal`` (NEARBY_STEP_M along and across, NEARBY_STEP_DEG turned; ``rings`` times
+        that at the most) from which the head phases are planned successfully and pass the dynamics check, and
+        whose straight pose and curl keep clear of the obstacles (:meth:`_straight_failure`), the nearest first;
+        None if there is none."""
         d, a = NEARBY_STEP_M, math.radians(NEARBY_STEP_DEG)
-        for offset in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a)):
+        for offset in [(f * x, f * y, f * t) for f in range(1, rings + 1)
+                       for x, y, t in ((d, 0, 0), (-d, 0, 0), (0, d, 0), (0, -d, 0), (0, 0, a), (0, 0, -a))]:
             candidate = lc.compose(goal, BasePlacement(*offset))
+            if self._straight_failure(candidate, q_bend) is not None:
+                continue
             p = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=False,
                      base_shape=q_bend, timing=self.timing)
-            if self._goal_failure(p) is None and self._straight_failure(candidate, q_bend) is None:
+            if self._goal_failure(p) is None:
                 return candidate
         return None
 
-    def _route(self, here: BasePlacement, straight_goal: BasePlacement, tolerance: lc.Tolerance,
-               routes: list[np.ndarray], say: Callable[[str], None]) -> list[tuple[BasePlacement, lc.Tolerance]]:
-        """The goals of the gaits on the way from ``here`` to ``straight_goal`` (root placements of the straight
-        body) and the tolerance of each: the goal alone when the straight legs are clear of the obstacles, else
-        the waypoints of :func:`snakehead.motion.ground_path.plan_route` (the body's middle at each, square to the
-        leg that reaches it; WAYPOINT_TOLERANCE) and the goal. The route's middle points go to ``routes``."""
-        offset = self._offset
-        route = gp.plan_route(self.robot, self.obstacles, lc.compose(here, offset), lc.compose(straight_goal, offset))
-        if route is None:
-            return [(straight_goal, tolerance)]
-        routes.append(route.waypoints.copy())
-        say(f"around the obstacles: {len(route.waypoints) - 1} legs of {np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum():.2f} m")
-        goals = [(lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(offset)),
-                  WAYPOINT_TOLERANCE) for w, h in zip(route.waypoints[1:-1], route.headings[:-1])]
-        return goals + [(straight_goal, tolerance)]
+    def _route(self, here: BasePlacement, straight_goal: BasePlacement, grid: gp.ClearanceGrid,
+               routes: list[np.ndarray], say: Callable[[str], None]) -> gp.Route | None:
+        """The route from ``here`` to ``straight_goal`` (root placements of the straight body):
+        :func:`snakehead.motion.ground_path.plan_route` between their middles (None: the straight legs are clear),
+        keeping CLEARANCE_M beyond the gaits' sweep, or where no such route exists EXECUTION_M alone; recorded in
+        ``routes``. :class:`~snakehead.Infeasible` when there is none."""
+        a, b = lc.compose(here, self._offset), lc.compose(straight_goal, self._offset)
+        try:
+            route = gp.plan_route(self.robot, self.obstacles, a, b, grid=grid)
+        except Infeasible as exc:  # no room for the drift's budget: the execution margin alone, said so
+            route = gp.plan_route(self.robot, self.obstacles, a, b, grid=grid, clearance=gp.EXECUTION_M)
+            say(f"{exc}: the route keeps {1000 * gp.EXECUTION_M:.0f} mm beyond the gaits' sweep, without the dead "
+                "reckoning's drift")
+        if route is not None:
+            routes.append(route.waypoints.copy())
+            say(f"around the obstacles: {len(route.waypoints) - 1} legs of "
+                f"{np.linalg.norm(np.diff(route.waypoints, axis=0), axis=1).sum():.2f} m")
+        return route
+
+    def _route_holds(self, route: gp.Route, k: int, here: BasePlacement, grid: gp.ClearanceGrid) -> bool:
+        """Whether the body, its middle estimated at ``here``'s, can go on to waypoint ``k`` of ``route``: the
+        leg from there keeps the route's clearance less EXECUTION_M (the waypoint tolerance) from the obstacles
+        (``grid``: the route's). An escape or a staging leg holds (both run nearer than that by design; each run's
+        sweep is checked)."""
+        if (k == 1 and route.escape) or (route.staging and k == len(route.waypoints) - 1):
+            return True
+        m = lc.compose(here, self._offset)
+        return gp.segment_clear(grid, np.array([m.x, m.y]), route.waypoints[k], route.clear_m - gp.EXECUTION_M)
+
+    def _grid(self, here: BasePlacement, straight_goal: BasePlacement) -> gp.ClearanceGrid:
+        """The obstacles' grid of one locomotion (:func:`snakehead.motion.ground_path.clearance_grid`): over the
+        body's middle here and at the goal, reaching beyond the obstacles by the routes' clearance and more."""
+        a, b = lc.compose(here, self._offset), lc.compose(straight_goal, self._offset)
+        reach = gp.swept_radius(self.robot) + gp.CLEARANCE_M + gp.GRID_MARGIN_M
+        return gp.clearance_grid(self.obstacles, [[a.x, a.y], [b.x, b.y]], reach)
+
+    def _sweep_failure(self, here: BasePlacement, step: lc.LocomotionStep, rates: lc.GaitRates,
+                       grid: gp.ClearanceGrid) -> str | None:
+        """Why the gait run ``step`` from the estimated root placement ``here`` would sweep too near an obstacle
+        (:func:`snakehead.motion.ground_path.sweep_clear` on its predicted end, on ``grid``), else None."""
+        a = lc.compose(here, self._offset)
+        b = rates.predicted(step, here, self._offset)
+        if gp.sweep_clear(grid, self.robot, step.gait.name, a, b, step.scale):
+            return None
+        return (f"the {step.gait.name} run ({step.cycles:.0f} x {step.scale:.2f}) from {_fmt(a)} would sweep within "
+                f"{1000 * gp.EXECUTION_M:.0f} mm of an obstacle")
+
+    def _locomotion(self, sim: GaitSimulator, est: BodyPose, straight_goal: BasePlacement, tolerance: lc.Tolerance,
+                    rates: lc.GaitRates, routes: list[np.ndarray], say: Callable[[str], None],
+                    ground: Callable[[GaitRun, str, str], None], current_state: Callable[[], SimState]) -> str | None:
+        """Step 2's gait runs to ``straight_goal``: along the route (:meth:`_route`), planned again from the
+        estimate whenever the body drifts off it (:meth:`_route_holds`, after every run), each run's sweep checked before it runs (:meth:`_sweep_failure`: a run that fails it
+        is made smaller, one cycle at half its amplitude, until it passes or is as small as a run gets);
+        ``ground`` records each run and moves the estimate; ``current_state`` the simulation's state now. None
+        when done (at the goal, or out of runs), else why the body cannot go on."""
+        grid = self._grid(est.base, straight_goal) if self.obstacles else None
+        route: gp.Route | None = None
+        k = 0  # the route's waypoint the gaits go to
+        planned = 0  # routes planned since the last run
+        runs_here = 0  # gait runs towards the current waypoint
+        for _ in range(self.max_gait_runs * MAX_LEGS):
+            if grid is not None and (route is None or (not self._route_holds(route, k, est.base, grid)
+                                                       and planned == 0)):
+                # (a route just planned from here is followed even where its first leg does not keep the margin
+                # on the grid's cells: each run's sweep is still checked)
+                planned += 1
+                try:  # the first, or the body drifted off its route: plan it again from the estimate
+                    route, k, runs_here = self._route(est.base, straight_goal, grid, routes, say), 1, 0
+                except Infeasible as exc:
+                    return f"no route around the obstacles from {_fmt(est.base)}: {exc}"
+            last = route is None or k == len(route.waypoints) - 1
+            step = (None if runs_here >= self.max_gait_runs else
+                    self._leg_step(est.base, route, k, straight_goal, tolerance, rates))
+            if step is None:  # at the waypoint (or as near as max_gait_runs runs bring it): on to the next
+                if last:
+                    return None
+                k, runs_here = k + 1, 0
+                continue
+            step, why = self._checked_step(est.base, step, rates, grid)
+            if why is not None:
+                return why
+            before = est.base
+            run = sim.run(current_state(), step.gait, step.cycles, start_estimate=est)
+            direction = {1: "+", -1: "-"}[step.gait.direction]
+            ground(run, f"{step.gait.name} {direction} ({'' if last else 'route, '}{step.leg}, {step.cycles:.0f} x "
+                        f"{step.scale:.2f})", "gait")
+            est, planned, runs_here = run.estimate, 0, runs_here + 1
+            rates.update(step, before, est.base, self._offset)
+        return None
+
+    def _leg_step(self, here: BasePlacement, route: gp.Route | None, k: int, straight_goal: BasePlacement,
+                  tolerance: lc.Tolerance, rates: lc.GaitRates) -> lc.LocomotionStep | None:
+        """The next gait run from ``here`` towards waypoint ``k`` of ``route`` (the body's middle there, square
+        to the leg that reaches it, within WAYPOINT_TOLERANCE; an escape along the axis creeps), or towards
+        ``straight_goal`` within ``tolerance`` when it is the last (or there is no route); None when there."""
+        if route is None or k == len(route.waypoints) - 1:
+            return lc.next_step(self.robot, here, straight_goal, rates, tolerance=tolerance, frequency=self.frequency)
+        w, h = route.waypoints[k], route.headings[k - 1]
+        goal = lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(self._offset))
+        return lc.next_step(self.robot, here, goal, rates, tolerance=WAYPOINT_TOLERANCE, frequency=self.frequency,
+                            creep=route.creep and k == 1)
+
+    def _checked_step(self, here: BasePlacement, step: lc.LocomotionStep, rates: lc.GaitRates,
+                      grid: gp.ClearanceGrid | None) -> tuple[lc.LocomotionStep, str | None]:
+        """``step`` when its sweep is clear (:meth:`_sweep_failure`), else one cycle at half its amplitude, and
+        so on (a smaller run sweeps less: its waves are smaller, it goes less far; the next run goes on) down to
+        MIN_AMPLITUDE_SCALE; and why the last tried is not clear (None when it is)."""
+        if grid is None:
+            return step, None
+        why = self._sweep_failure(here, step, rates, grid)
+        while why is not None and step.scale > lc.MIN_AMPLITUDE_SCALE:
+            step = lc.gait_run(step.gait.name, step.gait.direction, 1.0, 1.0, max_cycles=1, frequency=self.frequency,
+                               scale=0.5 * step.scale, leg=step.leg)
+            why = self._sweep_failure(here, step, rates, grid)
+        return step, why
 
     # --- running ---------------------------------------------------------------------------------------
     @entry_point
@@ -743,9 +868,10 @@ class ClosedLoop:
                 # 1. where must the base go? The plan from where the curl would leave it, relocated if need be,
                 # checked in dynamics at its own start (a relocated base's plan can pass its static checks and still
                 # tip the body in MuJoCo: then every attempt to reach that goal fails); when it fails, the scene's
-                # own placement (the default one for a scene without); then placements near a plan that tipped
+                # own placement (the default one for a scene without); then placements near each plan that tipped or
+                # whose straight pose or curl came too near an obstacle
                 after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-                tried, tipped = [], None
+                tried, refused = [], []
                 t0 = time.perf_counter()
                 for candidate in (after_curl, as_base(self.scene.base)):
                     first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
@@ -756,15 +882,16 @@ class ClosedLoop:
                     if why is None:
                         goal, q_bend = first.base, first.states[0][2].copy()
                         break
-                    if first.failure is None and tipped is None:
-                        tipped = first
+                    if first.failure is None:
+                        refused.append(first)
                     tried.append(f"from {_fmt(candidate)}: {why}")
                     notes.append(f"the plan from {_fmt(candidate)} fails ({why})")
                     say(notes[-1])
-                if goal is None and tipped is not None:
-                    goal = self._nearby_goal(tipped.base, tipped.states[0][2])
+                for near in refused if goal is None else []:  # (two rings: an obstacle in the way needs a larger step)
+                    goal = self._nearby_goal(near.base, near.states[0][2], rings=2)
                     if goal is not None:
-                        q_bend = tipped.states[0][2].copy()
+                        q_bend = near.states[0][2].copy()
+                        break
                 planning += time.perf_counter() - t0
                 if goal is None:
                     failure = "no plan reaches the targets " + "; nor ".join(tried)
@@ -795,20 +922,11 @@ class ClosedLoop:
                             tolerance=tolerance) is not None:
                 if np.abs(q_now).max() > 0.0:
                     curl(np.zeros(robot.n_joints), "uncurl")
-                sub_goals = self._route(est.base, straight_goal, tolerance, routes, say)
-                for k, (sub_goal, sub_tolerance) in enumerate(sub_goals, start=1):
-                    leg = "" if len(sub_goals) == 1 else f"leg {k}/{len(sub_goals)}, "
-                    for _ in range(self.max_gait_runs):
-                        step = lc.next_step(robot, est.base, sub_goal, rates, tolerance=sub_tolerance,
-                                            frequency=self.frequency)
-                        if step is None:
-                            break
-                        before = est.base
-                        run = sim.run(state, step.gait, step.cycles, start_estimate=est)
-                        direction = {1: "+", -1: "-"}[step.gait.direction]
-                        ground(run, f"{step.gait.name} {direction} ({leg}{step.leg}, {step.cycles:.0f} x "
-                                    f"{step.scale:.2f})", "gait")
-                        rates.update(step, before, est.base, self._offset)
+                blocked = self._locomotion(sim, est, straight_goal, tolerance, rates, routes, say, ground,
+                                           lambda: state)
+                if blocked is not None:
+                    failure = blocked
+                    break
             # 3. the curl into the bending state
             if np.abs(q_bend - q_now).max() > 1e-9:
                 curl(q_bend, "curl into the bending state")
