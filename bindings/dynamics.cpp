@@ -37,6 +37,16 @@ RigidBodyChain make_chain(const std::vector<int>& joint_child, const Array& axes
   }
   return chain;
 }
+// make_chain after checking the arrays' shapes against n joints and L links.
+RigidBodyChain checked_chain(const std::vector<int>& joint_child, const Array& axes, const Array& masses,
+                             const Array& coms, const Array& inertias, long L) {
+  const long n = static_cast<long>(joint_child.size());
+  expect_shape(axes, {n, 3}, "axes (n, 3)");
+  expect_shape(masses, {L}, "masses (L,)");
+  expect_shape(coms, {L, 3}, "coms (L, 3)");
+  expect_shape(inertias, {L, 3, 3}, "inertias (L, 3, 3)");
+  return make_chain(joint_child, axes, masses, coms, inertias);
+}
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
@@ -49,12 +59,8 @@ void bind_dynamics(py::module_& m) {
         const long n = static_cast<long>(joint_child.size());
         expect_shape(qd, {T, n}, "qd (T, n)");
         expect_shape(qdd, {T, n}, "qdd (T, n)");
-        expect_shape(axes, {n, 3}, "axes (n, 3)");
-        expect_shape(masses, {L}, "masses (L,)");
-        expect_shape(coms, {L, 3}, "coms (L, 3)");
-        expect_shape(inertias, {L, 3, 3}, "inertias (L, 3, 3)");
         if (share) expect_shape(*share, {T, L}, "share (T, L)");
-        const RigidBodyChain chain = make_chain(joint_child, axes, masses, coms, inertias);
+        const RigidBodyChain chain = checked_chain(joint_child, axes, masses, coms, inertias, L);
         Array tau({static_cast<py::ssize_t>(T), static_cast<py::ssize_t>(n)});
         Array force({static_cast<py::ssize_t>(T), static_cast<py::ssize_t>(3)});
         Array moment({static_cast<py::ssize_t>(T), static_cast<py::ssize_t>(3)});
@@ -82,11 +88,7 @@ void bind_dynamics(py::module_& m) {
         const long T = static_cast<long>(q.shape(0));
         expect_shape(qd, {T, n}, "qd (T, n)");
         expect_shape(qdd, {T, n}, "qdd (T, n)");
-        expect_shape(axes, {n, 3}, "axes (n, 3)");
-        expect_shape(masses, {L}, "masses (L,)");
-        expect_shape(coms, {L, 3}, "coms (L, 3)");
-        expect_shape(inertias, {L, 3, 3}, "inertias (L, 3, 3)");
-        const RigidBodyChain chain = make_chain(joint_child, axes, masses, coms, inertias);
+        const RigidBodyChain chain = checked_chain(joint_child, axes, masses, coms, inertias, L);
         std::optional<LiftPoints> lift;
         if (lift_links) {
           if (!lift_points) throw InputError("lift_points are needed with lift_links");
@@ -128,11 +130,7 @@ void bind_dynamics(py::module_& m) {
         const long T = static_cast<long>(frames.shape(0)), L = static_cast<long>(frames.shape(1));
         const long n = static_cast<long>(joint_child.size());
         expect_shape(qd, {T, n}, "qd (T, n)");
-        expect_shape(axes, {n, 3}, "axes (n, 3)");
-        expect_shape(masses, {L}, "masses (L,)");
-        expect_shape(coms, {L, 3}, "coms (L, 3)");
-        expect_shape(inertias, {L, 3, 3}, "inertias (L, 3, 3)");
-        const RigidBodyChain chain = make_chain(joint_child, axes, masses, coms, inertias);
+        const RigidBodyChain chain = checked_chain(joint_child, axes, masses, coms, inertias, L);
         Array P({static_cast<py::ssize_t>(T), py::ssize_t{3}});
         Array Lm({static_cast<py::ssize_t>(T), py::ssize_t{3}});
         Array c({static_cast<py::ssize_t>(T), py::ssize_t{3}});
