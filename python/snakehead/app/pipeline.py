@@ -432,7 +432,8 @@ class _Beside:
         stops its own children as this process does, then a kill after STOP_GRACE_S."""
         if self.proc is None or not self.proc.is_alive():
             return
-        os.kill(self.proc.pid, signal.SIGINT)
+        if self.proc.pid is not None:  # (started: it has one)
+            os.kill(self.proc.pid, signal.SIGINT)
         self.proc.join(STOP_GRACE_S)
         if self.proc.is_alive():
             self.proc.kill()
