@@ -33,6 +33,8 @@ def test_gravity_and_the_margins_are_defined_once():
     assert definitions("OBSTACLE_CLEARANCE") == ["margins.py"]
     assert definitions("EXACT_DISTANCE_WITHIN") == ["margins.py"]
     assert definitions("ZMP_MARGIN") == ["margins.py"]
+    assert definitions("SELF_CLEARANCE") == ["margins.py"]
+    assert definitions("SOLUTION_MARGIN") == ["margins.py"]
 
 
 def test_the_users_read_the_one_definition():
@@ -44,6 +46,7 @@ def test_the_users_read_the_one_definition():
                  "sim.tracking"):  # (by module: dynamics.inverse_dynamics is also a function's name)
         assert importlib.import_module(f"snakehead.{name}").GRAVITY is physics.GRAVITY, name
     assert whole_body.OBSTACLE_CLEARANCE is margins.OBSTACLE_CLEARANCE
+    assert whole_body.SELF_CLEARANCE is margins.SELF_CLEARANCE and whole_body.MIN_MARGIN is margins.SOLUTION_MARGIN
     assert timing.ZMP_MARGIN is margins.ZMP_MARGIN and timing.GRAVITY is physics.GRAVITY
     assert timing.FRICTION == 0.5 * physics.GROUND_FRICTION
     # the simulation's ground is the one the retiming's friction is a share of
@@ -56,3 +59,4 @@ def test_the_values_are_the_documented_ones():
     assert physics.GRAVITY == 9.80665 and physics.GROUND_FRICTION == 0.8
     assert margins.ZMP_MARGIN == 0.005 and margins.DETOUR_MARGIN == 0.01 == 2 * margins.ZMP_MARGIN
     assert margins.OBSTACLE_CLEARANCE == 0.002 and margins.EXACT_DISTANCE_WITHIN == 0.005
+    assert margins.SELF_CLEARANCE == 0.002 and margins.SOLUTION_MARGIN == margins.ZMP_MARGIN

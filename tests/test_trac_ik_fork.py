@@ -187,3 +187,39 @@ def test_a_fork_context_process_pool_uses_the_parents_solver(chain):
         use(_POOL_SOLVER, chain, seed=50)
     finally:
         _POOL_SOLVER = None
+
+
+def test_a_fork_while_another_thread_draws_from_the_solvers_generator(chain):
+    """numpy's generator lock is copied into a forked child as it was: held, when another thread of the parent was
+    drawing starts then. The child renews each solver's generator (kinematics.ik._renew_generators), so it draws its
+    own starts (ik_many without q_inits, random_configuration) and exits; the parent's generator is untouched."""
+    solver = TracIK.from_chain(chain, timeout=TIMEOUT_S)
+    poses, _ = reachable_targets(chain, 6, seed=7)
+    lock = solver._rng.bit_generator.lock
+    before = solver._rng.bit_generator.state
+
+    def child() -> None:
+        assert solver._rng.bit_generator.state == before  # the same stream, continued
+        q = solver.random_configuration()
+        assert np.all(q >= chain.lower) and np.all(q <= chain.upper)
+        _, ok = solver.ik_many(poses)  # starts drawn from the generator
+        assert ok.all()
+
+    held, release = threading.Event(), threading.Event()
+
+    def draw_slowly() -> None:  # a thread of the parent in the middle of a draw at the moment of the fork
+        with lock:
+            held.set()
+            release.wait()
+
+    drawer = threading.Thread(target=draw_slowly)
+    drawer.start()
+    held.wait()
+    try:
+        status = fork_and_run(child)
+    finally:
+        release.set()
+        drawer.join()
+    assert status == 0
+    assert solver._rng.bit_generator.state == before
+    assert solver._rng.bit_generator.lock is lock

@@ -31,7 +31,8 @@ from .. import _core
 from .._validate import finite_float, integer, joint_vector, unit_vector3, vector3
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE
+from .. import margins
+from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE, SELF_CLEARANCE
 from ..geometry.shapes import pair_min_distances
 from ..model.robot import PITCH, BasePlacement, SnakeRobot, as_base, as_robot
 
@@ -42,10 +43,8 @@ from .._errors import InputError, InternalError
 if TYPE_CHECKING:
     from ..control.controller import HeadController
 
-#: Default required static margin of a solution (m).
-MIN_MARGIN = 0.005
-#: Default least gap between the boxes of two links that are not neighbours (m), and from obstacles.
-SELF_CLEARANCE = 0.002
+#: Default required static margin of a solution (m): the plans' (``margins.SOLUTION_MARGIN``).
+MIN_MARGIN = margins.SOLUTION_MARGIN
 #: A ground link's shape points within this height (m) of its lowest point touch the ground (its support).
 CONTACT_BAND = 1e-3
 #: Tolerances of a solution: head position (m) and direction (rad).

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import os
+import weakref
 
 import numpy as np
 
@@ -65,6 +66,24 @@ def _seed(seed: int | None) -> int | None:
     return None if seed is None else integer(seed, "seed", least=0, most=2**64 - 1)
 
 
+#: The solvers alive in this process, whose generators a forked child renews (:func:`_renew_generators`).
+_LIVE_SOLVERS: "weakref.WeakSet[TracIK]" = weakref.WeakSet()
+
+
+def _renew_generators() -> None:
+    """In a forked child: each solver's generator continues from its state with a lock of its own. (numpy's lock
+    was copied as it was at the fork: held, if another thread of the parent was drawing then, and never released
+    in the child, whose next draw would wait for ever.)"""
+    for solver in list(_LIVE_SOLVERS):
+        old = solver._rng.bit_generator
+        new = type(old)()
+        new.state = old.state
+        solver._rng = np.random.Generator(new)
+
+
+os.register_at_fork(after_in_child=_renew_generators)
+
+
 class TracIK:
     """TRAC-IK for the chain ``base`` -> ``tip`` of a URDF (a path or an XML string).
 
@@ -96,6 +115,7 @@ class TracIK:
         self._solver = _core.TracIK(chain.model, duration(timeout, "timeout"), positive(epsilon, "epsilon"),
                                     solve_type, _bounds(np.zeros(6) if bounds is None else bounds), _seed(seed))
         self._rng = np.random.default_rng(seed)
+        _LIVE_SOLVERS.add(self)
         self._lo, self._hi = self._solver.lower.tolist(), self._solver.upper.tolist()
 
     # --- description -------------------------------------------------------------------------
