@@ -130,6 +130,8 @@ def test_timeline_samples_every_order_at_once_as_one_at_a_time(lift):
     shuffled = np.random.default_rng(0).permutation(t)
     for nu in (0, 1, 2):
         np.testing.assert_array_equal(traj.spline(shuffled, nu), [traj.spline(x, nu)[0] for x in shuffled])
+    with pytest.raises(ValueError, match="t .*NaN"):
+        traj.spline(np.r_[0.0, np.nan])
 
 
 def test_timing_does_not_depend_on_the_placement(lift):

@@ -422,7 +422,7 @@ class _Timeline:
     def sample(self, t: npt.ArrayLike, orders: tuple[int, ...] = (0, 1, 2)) -> list[np.ndarray]:
         """The motion's derivatives of the given ``orders`` (0, 1, 2: q, qd, qdd) at times t: a list of (N, n), the
         path evaluated once for all of them. Times before the motion take its first item, after it its last."""
-        t = np.atleast_1d(np.asarray(t, float))
+        t = np.atleast_1d(finite_array(t, "t"))
         if np.any(np.diff(t) < 0):  # in time order, then back in the caller's
             order = np.argsort(t, kind="stable")
             result = self.sample(t[order], orders)
