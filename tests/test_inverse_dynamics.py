@@ -172,7 +172,24 @@ def test_core_passes_from_many_threads_and_bad_shapes():
         _core.newton_euler(frames, qd[:3], qdd[:3], [0] * robot.n_joints, *args[1:], None, np.zeros(3))
 
 
+@pytest.fixture(scope="module")
+def sea_robot(tmp_path_factory):
+    """A snake written as published ones are: a rotated dummy root, modules along z of two links each, cylinders and
+    a mesh tail (``snakehead.model.published``, style "sea")."""
+    from snakehead.model import published
+
+    return snakehead.SnakeRobot.from_file(published.write_robot("sea", tmp_path_factory.mktemp("sea")))
+
+
 def test_pass_along_q_equals_the_pass_over_given_frames(robot):
+    check_pass_along_q(robot)
+
+
+def test_pass_along_q_on_a_published_snake(sea_robot):
+    check_pass_along_q(sea_robot)
+
+
+def check_pass_along_q(robot):
     """Without frames the core computes each sample's frames, lifted shares and CoM in place: the same torques and
     momentum rates as the pass over ``frames_many``'s frames with the lifted shares of ``lift_shares`` (numpy), and
     the CoM of ``stability.center_of_mass``; with links on, near and off the ground."""
