@@ -96,3 +96,22 @@ def test_what_it_refuses_is_not_reached(controller, request):
             assert search.check(seg.q, seg.base)["reason"] is not None
     assert refused >= 3
     assert closer >= (request.node.callspec.params["controller"] != "pitch_first")
+
+
+def test_choice_of_base_past_the_proof_is_deterministic(controller):
+    """A target the proof refuses from the start: the base's choice (its relocation search) gives the same base,
+    shape and solution twice, each with its own plan's solves, and that base reaches the target with the base kept
+    (the solve's own check)."""
+    from snakehead.motion import base_choice
+    from snakehead.scenes import Target
+
+    refused = next(t for t in reachable_targets(controller, "shape", 30, np.random.default_rng(4))
+                   if _search(controller, t.position, t.direction).beyond_reach())
+    target = Target("t", refused.position, refused.direction)
+    first = base_choice.choose_base(controller, [target], solved=wb.PlanSolves())
+    again = base_choice.choose_base(controller, [target], solved=wb.PlanSolves())
+    assert first[0] == again[0] and first[2] is not None and first[2] == again[2]
+    np.testing.assert_array_equal(first[1], again[1])
+    sol = wb.solve_target(controller, refused.position, refused.direction, q_prev=first[1], base=first[0],
+                          allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
+    assert sol.success
