@@ -541,12 +541,22 @@ using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
 // The runs' support polygons, one after the other (their vertices counter-clockwise, flat x, y), and the buffers that
 // build them, allocated once for all the runs of a check.
+//
+// Runs follow each other sample by sample where links on the ground move (a neck lifting off it: ~3000 runs in a
+// lift of 4000 samples), while most contact shapes (the base's) lie still. The hull of the contact points is
+// therefore built from a kept part: the hull of the touching points of the shapes that lay still between two runs,
+// kept while their links' world frames stay the same to the bit (their points then are the same), and the points of
+// the other near shapes. The hull of a set is the hull of its hull's vertices and the other points, so the polygon is
+// the same (the monotone chain may differ only where it drops a vertex as collinear, by a sine of 1e-9, or as
+// coincident, 1e-12 m: the margins then differ by as little).
 class SupportRuns {
  public:
-  SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes)
+  SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes, long L)
       : spec_(spec), shapes_(shapes), near_(spec.contact_shapes.size()),
         count_(static_cast<long>(spec.contact_shapes.size()) * spec.points_per_shape),
-        points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2) {
+        points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2), kept_points_(count_, 2),
+        previous_(static_cast<std::size_t>(16 * L)), kept_frames_(static_cast<std::size_t>(16 * L)),
+        kept_shape_(spec.contact_shapes.size(), 0), still_(spec.contact_shapes.size(), 0) {
     start_.push_back(0);
   }
 
@@ -554,17 +564,28 @@ class SupportRuns {
   // sample whose world frames are `frames`; `low`: the contact shapes' lowest z there. A shape whose lowest z is
   // above the tolerance (by more than round-off) has no point touching: its candidates are not computed.
   void add(const double* frames, long L, const double* low) {
+    const std::size_t S = spec_.contact_shapes.size();
+    const bool reuse = has_kept_ && kept_still(frames);
     near_.clear();
-    for (std::size_t i = 0; i < spec_.contact_shapes.size(); ++i)
-      if (low[i] <= spec_.tolerance + kRoundOff) near_.push_back(spec_.contact_shapes[i]);
+    near_index_.clear();
+    for (std::size_t i = 0; i < S; ++i)
+      if (low[i] <= spec_.tolerance + kRoundOff && !(reuse && kept_shape_[i])) {
+        near_.push_back(spec_.contact_shapes[i]);
+        near_index_.push_back(static_cast<long>(i));
+      }
     const long k = static_cast<long>(near_.size());
     lowest_points(frames, 1, L, shapes_, near_.data(), k, spec_.points_per_shape, points_.data());
     long m = 0;
+    if (reuse)  // the kept hull's vertices, then the other shapes' touching points
+      for (long v = 0; v < kept_count_; ++v) touching_.row(m++) = kept_points_.row(v);
     for (long p = 0; p < k * spec_.points_per_shape; ++p)
       if (points_[3 * p + 2] <= spec_.tolerance) touching_.row(m++) << points_[3 * p], points_[3 * p + 1];
     convex_hull_into(touching_.topRows(m), work_, hull_);
     for (int v : hull_) vertices_.insert(vertices_.end(), {touching_(v, 0), touching_(v, 1)});
     start_.push_back(static_cast<long>(vertices_.size() / 2));
+    if (!reuse) keep_still_part(frames, L, k);
+    std::copy(frames, frames + 16 * L, previous_.begin());
+    has_previous_ = true;
   }
 
   long runs() const { return static_cast<long>(start_.size()) - 1; }
@@ -588,6 +609,53 @@ class SupportRuns {
 
  private:
   static constexpr double kRoundOff = 1e-9;  // m: lowest_z and the candidate points' z agree far closer
+
+  // Link l's world frame is the same, to the bit, in frames a and b.
+  static bool same_frame(const double* a, const double* b, int l) {
+    return std::memcmp(a + 16 * l, b + 16 * l, 12 * sizeof(double)) == 0;  // (the last row is always 0 0 0 1)
+  }
+
+  // Every kept shape's link lies where it lay when the kept hull was made.
+  bool kept_still(const double* frames) const {
+    for (std::size_t i = 0; i < kept_shape_.size(); ++i)
+      if (kept_shape_[i] && !same_frame(frames, kept_frames_.data(), link_of(i))) return false;
+    return true;
+  }
+
+  int link_of(std::size_t i) const { return shapes_.shape(static_cast<int>(spec_.contact_shapes[i])).frame; }
+
+  // After a polygon built from all the k near shapes (near_, their points in points_): keeps the hull of the touching
+  // points of those whose links did not move since the previous run (none kept when none did, or all did not).
+  void keep_still_part(const double* frames, long L, long k) {
+    has_kept_ = false;
+    if (!has_previous_) return;
+    long still = 0;
+    for (long j = 0; j < k; ++j) {
+      const std::size_t i = static_cast<std::size_t>(near_index_[static_cast<std::size_t>(j)]);
+      still_[i] = same_frame(frames, previous_.data(), link_of(i));
+      still += still_[i];
+    }
+    if (still == 0 || still == k) return;  // nothing to keep, or nothing else to add to it
+    long m = 0;
+    std::fill(kept_shape_.begin(), kept_shape_.end(), 0);
+    for (long j = 0; j < k; ++j) {
+      const std::size_t i = static_cast<std::size_t>(near_index_[static_cast<std::size_t>(j)]);
+      if (!still_[i]) continue;
+      kept_shape_[i] = 1;
+      for (long c = 0; c < spec_.points_per_shape; ++c) {
+        const double* point = &points_[3 * (j * spec_.points_per_shape + c)];
+        if (point[2] <= spec_.tolerance) kept_points_.row(m++) << point[0], point[1];
+      }
+    }
+    convex_hull_into(kept_points_.topRows(m), work_, hull_);
+    for (std::size_t v = 0; v < hull_.size(); ++v) touching_.row(static_cast<Eigen::Index>(v)) = kept_points_.row(hull_[v]);
+    kept_count_ = static_cast<long>(hull_.size());
+    kept_points_.topRows(kept_count_) = touching_.topRows(kept_count_);
+    std::copy(frames, frames + 16 * L, kept_frames_.begin());
+    has_kept_ = true;
+  }
+
+  std::vector<long> near_index_;  // near_'s indices among the contact shapes
   const ZmpCheckSpec& spec_;
   const ShapeSet& shapes_;
   std::vector<long> near_;      // the contact shapes within the tolerance (and round-off) of the ground
@@ -598,6 +666,13 @@ class SupportRuns {
   std::vector<int> hull_;
   std::vector<double> vertices_;  // every run's hull vertices
   std::vector<long> start_;       // run r's vertices: rows start_[r] .. start_[r + 1] - 1
+  // the kept part (see the class's note): the hull's vertices of the still shapes' touching points, which shapes
+  // (kept_shape_, by index among the contact shapes), the frames it was made at; the previous run's frames
+  Points kept_points_;
+  long kept_count_ = 0;
+  bool has_kept_ = false, has_previous_ = false;
+  std::vector<double> previous_, kept_frames_;
+  std::vector<char> kept_shape_, still_;
 };
 
 void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
@@ -691,7 +766,7 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   out.angular.resize(static_cast<std::size_t>(3 * T));
   out.com.resize(static_cast<std::size_t>(3 * T));
   out.clearance.assign(static_cast<std::size_t>(T), kInf);
-  SupportRuns polygons(spec, shapes);
+  SupportRuns polygons(spec, shapes, L);
   std::vector<long> run(static_cast<std::size_t>(T));
   std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
   std::vector<std::vector<double>> run_key;  // each run's contact key (a kept prefix ends with its last)

@@ -270,6 +270,37 @@ def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) ->
         assert runs > 2, "the motion must change its contacts (the head lifts)"
 
 
+def test_zmp_check_with_a_still_base_and_a_moving_one_equals_the_python_reference() -> None:
+    """The C++ check builds each run's polygon from the kept hull of the contact shapes that lay still and the points
+    of the others (the neck lifting off a still base: a run per sample); where the base then turns (a base yaw: the
+    shapes after it move, the kept hull is made again) and the neck lifts again, the margins still equal the Python
+    path's, whose hulls are made from all the points, to 1e-9."""
+    robot = SnakeRobot.default()
+    pitch = robot.lift_joints.start
+    yaw = [j for j in range(pitch) if robot.joint_kinds[j] == "yaw"]
+    q0 = np.zeros(robot.n_joints)
+    q1 = _lifted(robot, 0.6)
+    q2 = q1.copy()
+    q2[yaw[len(yaw) // 2]] += 0.3  # the base turns in the middle: its links after that joint move
+    q3 = _lifted(robot, 0.2)
+    q3[yaw[len(yaw) // 2]] += 0.3
+    t = np.linspace(0.0, 3.0, 601)
+    s = np.clip(t % 1.0 + (t >= 3.0), 0.0, 1.0)
+    ease = (3 * s ** 2 - 2 * s ** 3)[:, None]
+    leg = np.minimum(t.astype(int), 2)
+    starts, ends = np.array([q0, q1, q2]), np.array([q1, q2, q3])
+    q = starts[leg] + ease * (ends[leg] - starts[leg])
+    qd = np.gradient(q, t, axis=0)
+    base = BasePlacement(-0.3, 0.5, 1.1)
+    core, _ = stability.dynamic_stability_with_clearance(robot, t, q, base, qd)
+    ref = stability._dynamic_stability_python(robot, t, q, base, qd, "ground", stability.CONTACT_TOLERANCE, None,
+                                              None)
+    np.testing.assert_allclose(core.margin, ref.margin, atol=1e-9, rtol=0)
+    assert core.argmin == ref.argmin and core.stable == ref.stable
+    runs = stability._polygons_along(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2]
+    assert runs.max() + 1 > 200, "the neck must lift through many runs"
+
+
 def test_checker_refuses_bad_input() -> None:
     robot = SnakeRobot.default()
     from snakehead import InputError, _core
