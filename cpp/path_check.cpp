@@ -791,7 +791,20 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   std::vector<double> low(static_cast<std::size_t>(U));
   const std::vector<int>& child = chain.joint_child;
   Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
+  const auto nbytes = static_cast<std::size_t>(n) * sizeof(double);
   for (long k = k0; k < T; ++k) {
+    if (k > 0 && k % spec.chunk != 0 && std::memcmp(q + k * n, q + (k - 1) * n, nbytes) == 0 &&
+        std::memcmp(qd + k * n, qd + (k - 1) * n, nbytes) == 0) {
+      // the sample repeats the one before (a hold: ~500 samples a target): its values are that one's, to the bit
+      for (int c = 0; c < 3; ++c) {
+        out.linear[3 * k + c] = out.linear[3 * (k - 1) + c];
+        out.angular[3 * k + c] = out.angular[3 * (k - 1) + c];
+        out.com[3 * k + c] = out.com[3 * (k - 1) + c];
+      }
+      out.clearance[k] = out.clearance[k - 1];
+      run[k] = run[k - 1];
+      continue;
+    }
     const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
     model.check_configuration(qk);
     checker.world_frames(qk, frames.data(), work);
