@@ -596,6 +596,16 @@ class SupportRuns {
     start_ = start;
   }
 
+  // Every polygon so far turned by (c, s) about the origin and moved by (x, y) (a kept prefix made at another
+  // placement of the base on the ground).
+  void move(double c, double s, double x, double y) {
+    for (std::size_t v = 0; v + 1 < vertices_.size(); v += 2) {
+      const double vx = vertices_[v], vy = vertices_[v + 1];
+      vertices_[v] = c * vx - s * vy + x;
+      vertices_[v + 1] = s * vx + c * vy + y;
+    }
+  }
+
   // The first `runs` runs' polygons into vertices and start (as ZmpPrefix holds them).
   void keep(long runs, std::vector<double>& vertices, std::vector<long>& start) const {
     start.assign(start_.begin(), start_.begin() + runs + 1);
@@ -694,15 +704,54 @@ bool same_spec(const ZmpCheckSpec& a, const ZmpCheckSpec& b) {
          a.shaped_links == b.shaped_links && a.tolerance == b.tolerance && a.chunk == b.chunk;
 }
 
-// Whether zmp_check may take `prefix` over for this check (see ZmpPrefix): everything it was made from is the same.
-bool takes_over(const ZmpPrefix& prefix, const PathChecker& checker, const ZmpCheckSpec& spec, const double* q,
-                const double* qd, long T) {
+// How zmp_check may take a kept prefix over (see ZmpPrefix): not at all, as it is (made at this origin: to the bit), or
+// moved (made at another placement of the base on the ground: the origins' z rows are the same to the bit, so every
+// world frame's z row, every height and every contact run is; the momenta, CoM and polygons move with the placement:
+// P' = R P, c' = R c + t, L' = R L + t x P' for the turn R about z and the shift t from the prefix's origin to this).
+struct Takeover {
+  enum Kind { kNone, kSame, kMoved } kind = kNone;
+  double c = 1.0, s = 0.0, x = 0.0, y = 0.0;  // the turn's cosine and sine and the shift, when moved
+};
+
+Takeover takeover(const ZmpPrefix& prefix, const PathChecker& checker, const ZmpCheckSpec& spec, const double* q,
+                  const double* qd, long T) {
   const long m = prefix.size(), n = checker.n_joints();
-  if (m < 1 || m > T || prefix.model != &checker.model() || prefix.shapes != &checker.shapes()) return false;
-  if (prefix.origin != checker.origin().matrix() || !same_spec(prefix.spec, spec)) return false;
-  if (static_cast<long>(prefix.q.size()) != m * n || static_cast<long>(prefix.qd.size()) != m * n) return false;
+  if (m < 1 || m > T || prefix.model != &checker.model() || prefix.shapes != &checker.shapes()) return {};
+  if (!same_spec(prefix.spec, spec)) return {};
+  if (static_cast<long>(prefix.q.size()) != m * n || static_cast<long>(prefix.qd.size()) != m * n) return {};
   const auto bytes = static_cast<std::size_t>(m * n) * sizeof(double);
-  return std::memcmp(prefix.q.data(), q, bytes) == 0 && std::memcmp(prefix.qd.data(), qd, bytes) == 0;
+  if (std::memcmp(prefix.q.data(), q, bytes) != 0 || std::memcmp(prefix.qd.data(), qd, bytes) != 0) return {};
+  const Eigen::Matrix4d& from = prefix.origin;
+  const Eigen::Matrix4d to = checker.origin().matrix();
+  if (from == to) return {Takeover::kSame};
+  if (from.row(2) != to.row(2) || from.row(3) != to.row(3) || to.row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0))
+    return {};
+  // D = to * from^-1 keeps z (the z rows are the same): a turn about z and a shift in x, y
+  const Eigen::Matrix3d R = to.topLeftCorner<3, 3>() * from.topLeftCorner<3, 3>().transpose();
+  const Eigen::Vector3d t = to.topRightCorner<3, 1>() - R * from.topRightCorner<3, 1>();
+  const double norm = std::hypot(R(0, 0), R(1, 0));
+  if (!(norm > 0.5)) return {};  // (cannot happen for two rotations with the same z row)
+  return {Takeover::kMoved, R(0, 0) / norm, R(1, 0) / norm, t.x(), t.y()};
+}
+
+// The first m samples' momenta and CoM of a prefix made at another placement, moved to this one (see Takeover).
+void move_samples(const Takeover& how, long m, ZmpCheck& out) {
+  for (long k = 0; k < m; ++k) {
+    double* P = &out.linear[3 * k];
+    double* L = &out.angular[3 * k];
+    double* c = &out.com[3 * k];
+    const double Px = how.c * P[0] - how.s * P[1], Py = how.s * P[0] + how.c * P[1];
+    const double Lx = how.c * L[0] - how.s * L[1], Ly = how.s * L[0] + how.c * L[1];
+    const double cx = how.c * c[0] - how.s * c[1] + how.x, cy = how.s * c[0] + how.c * c[1] + how.y;
+    P[0] = Px;
+    P[1] = Py;
+    // L about the world origin: + t x P' with t = (x, y, 0)
+    L[0] = Lx + how.y * P[2];
+    L[1] = Ly - how.x * P[2];
+    L[2] = L[2] + how.x * Py - how.y * Px;
+    c[0] = cx;
+    c[1] = cy;
+  }
 }
 
 // Where each clearance shape's lowest z is among the contact shapes' (one lowest_z per shape and sample): indices
@@ -771,7 +820,8 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
   std::vector<std::vector<double>> run_key;  // each run's contact key (a kept prefix ends with its last)
   long k0 = 0;
-  if (resume != nullptr && takes_over(*resume, checker, spec, q, qd, T)) {  // its samples, to the bit
+  const Takeover how = resume != nullptr ? takeover(*resume, checker, spec, q, qd, T) : Takeover{};
+  if (how.kind != Takeover::kNone) {  // its samples (to the bit at its own placement; moved at another)
     k0 = resume->size();
     std::copy(resume->linear.begin(), resume->linear.end(), out.linear.begin());
     std::copy(resume->angular.begin(), resume->angular.end(), out.angular.begin());
@@ -779,6 +829,10 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     std::copy(resume->clearance.begin(), resume->clearance.end(), out.clearance.begin());
     std::copy(resume->run.begin(), resume->run.end(), run.begin());
     polygons.restore(resume->vertices, resume->start);
+    if (how.kind == Takeover::kMoved) {
+      move_samples(how, k0, out);
+      polygons.move(how.c, how.s, how.x, how.y);
+    }
     previous = resume->last_key;
     run_key.resize(static_cast<std::size_t>(polygons.runs()));
     run_key.back() = previous;

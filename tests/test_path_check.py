@@ -207,8 +207,8 @@ def test_check_motion_catches_a_thin_obstacle_between_coarse_samples() -> None:
 
 def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
     """A check that takes over the first samples' part of an earlier one (KeptSamples: a motion beginning with the
-    same samples) equals the check from scratch bit for bit; a motion whose first samples differ, or another
-    placement, is computed from scratch."""
+    same samples) equals the check from scratch bit for bit; a motion whose first samples differ is computed from
+    scratch; at another placement on the ground the prefix is moved there (test below)."""
     robot = SnakeRobot.default()
     rng = np.random.default_rng(3)
     t = np.linspace(0.0, 2.0, 301)
@@ -222,8 +222,7 @@ def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
     kept = stability.KeptSamples(m)
     stability.dynamic_stability_with_clearance(robot, t, lift, base, qd_lift, kept=kept)
     assert kept.core is not None and kept.core.samples == m and kept.resumed == 0
-    for motion, velocity, where, takes_over in ((q, qd, base, True), (other, np.gradient(other, t, axis=0), base, False),
-                                                (q, qd, BasePlacement(0.1, 0.2, 0.31), False)):
+    for motion, velocity, where, takes_over in ((q, qd, base, True), (other, np.gradient(other, t, axis=0), base, False)):
         fresh, fresh_clear = stability.dynamic_stability_with_clearance(robot, t, motion, where, velocity)
         again, clear = stability.dynamic_stability_with_clearance(robot, t, motion, where, velocity, kept=kept)
         assert kept.resumed == (m if takes_over else 0)
@@ -233,6 +232,49 @@ def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
         assert (again.argmin, again.stable) == (fresh.argmin, fresh.stable)
     runs = stability._polygons_along(robot, lift[:m], base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
     assert runs > 2, "the kept samples must hold several contact runs"
+
+
+@pytest.mark.parametrize("which", ["default", "sea"])
+def test_zmp_check_moves_a_prefix_kept_at_another_placement(robots: dict[str, SnakeRobot], which: str) -> None:
+    """A prefix kept at one placement, taken over at others (the base turned about z and moved on the ground: a lift
+    checked once for every placement of a base shape): the momenta, CoM, ZMP and margins equal the check from scratch
+    to round-off (1e-12), the clearances and the verdict exactly; a placement off the ground plane's motions (another
+    height) is computed from scratch. (sea: a rotated root.)"""
+    robot = robots[which]
+    rng = np.random.default_rng(8)
+    t = np.linspace(0.0, 2.0, 301)
+    lift = _smooth_motion(robot, rng, 301, 0.2)
+    qd_lift = np.gradient(lift, t, axis=0)
+    other = _smooth_motion(robot, rng, 301, 0.2)
+    m = 120
+    q = np.concatenate([lift[:m], other[m:]])
+    qd = np.concatenate([qd_lift[:m], np.gradient(other, t, axis=0)[m:]])
+    kept = stability.KeptSamples(m)
+    stability.dynamic_stability_with_clearance(robot, t, lift, BasePlacement(0.1, 0.2, 0.3), qd_lift, kept=kept)
+    for where in (BasePlacement(-1.3, 0.7, -2.9), BasePlacement(0.1, 0.2, 0.31), BasePlacement(25.0, -40.0, 1.0)):
+        fresh, fresh_clear = stability.dynamic_stability_with_clearance(robot, t, q, where, qd)
+        again, clear = stability.dynamic_stability_with_clearance(robot, t, q, where, qd, kept=kept)
+        assert kept.resumed == m
+        scale = max(1.0, abs(where.x), abs(where.y))
+        for name in ("zmp", "margin", "P", "L", "com"):
+            np.testing.assert_allclose(getattr(again, name), getattr(fresh, name), rtol=0, atol=1e-12 * scale,
+                                       err_msg=name)
+        np.testing.assert_array_equal(clear, fresh_clear)
+        assert again.stable == fresh.stable and again.argmin == fresh.argmin
+        assert np.abs(again.margin[:m] - again.margin[:m].mean()).max() > 1e-4  # the prefix's margins vary: compared
+    # an origin 1 cm higher (not a placement on the ground: the heights differ): computed from scratch
+    from snakehead import _core
+    from snakehead.geometry.collision import GROUND_TOLERANCE
+    from snakehead.margins import EXACT_DISTANCE_WITHIN
+
+    origin = robot.root_pose(BasePlacement(0.1, 0.2, 0.3))
+    origin[2, 3] += 0.01
+    g = robot.geometry
+    high = _core.PathChecker(robot.body.model, g.core, origin, g.shapes_of(robot.lifted_links),
+                             np.ascontiguousarray(robot.self_collision_pairs, np.int64), None,
+                             np.zeros((0, 2), np.int64), -GROUND_TOLERANCE, EXACT_DISTANCE_WITHIN)
+    stability.dynamic_stability_with_clearance(robot, t, q, BasePlacement(0.1, 0.2, 0.3), qd, made=high, kept=kept)
+    assert kept.resumed == 0
 
 
 def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) -> None:
