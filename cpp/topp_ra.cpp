@@ -382,8 +382,9 @@ ToppRaResult topp_ra_canonical(const Eigen::Ref<const Eigen::VectorXd>& grid, co
   CanonicalStages stages{grid, P, Q, R};
   // as UnitRows: where some row's squares overflow (|a| or |b| > 1e154), every row is scaled by hypot (the rows are
   // looked at one by one only when their coefficients' bound leaves room for that: |a|, |b| < 1e153 cannot)
-  const double big = std::max(P.cwiseAbs().maxCoeff() + 2.0 * (grid(N) - grid(0)) * Q.cwiseAbs().maxCoeff(),
-                              Q.cwiseAbs().maxCoeff());
+  const double big = m == 0 ? 0.0
+                            : std::max(P.cwiseAbs().maxCoeff() + 2.0 * (grid(N) - grid(0)) * Q.cwiseAbs().maxCoeff(),
+                                       Q.cwiseAbs().maxCoeff());
   for (Eigen::Index i = 0; i < N && !stages.overflow && !(big < 1e153); ++i) {
     const double twice = 2.0 * (grid(i + 1) - grid(i));
     for (Eigen::Index k = 0; k < m; ++k) {

@@ -164,6 +164,11 @@ def test_canonical_solve_refuses_malformed_rows() -> None:
     P, Q, R = np.ones((6, 2)), np.zeros((6, 2)), np.ones((6, 2))
     x_max = np.ones(6)
     assert _core.topp_ra_canonical(grid, P, Q, R, x_max).status == "feasible"
+    none = np.zeros((6, 0))  # no rows: x_max alone bounds the path, as topp_ra with no stage rows
+    ours = _core.topp_ra_canonical(grid, none, none, none, x_max)
+    ref = _core.topp_ra(grid, np.zeros((5, 0)), np.zeros((5, 0)), np.zeros((5, 0)), np.tile([-np.inf, np.inf], (5, 1)),
+                        np.column_stack([np.zeros(6), x_max]))
+    np.testing.assert_array_equal(ours.x, ref.x)
     bad = P.copy()
     bad[2, 1] = np.nan
     for args, match in (((grid, bad, Q, R, x_max), "P must be finite"),
