@@ -134,6 +134,32 @@ def test_timeline_samples_every_order_at_once_as_one_at_a_time(lift):
         traj.spline(np.r_[0.0, np.nan])
 
 
+def test_end_only_sample_is_the_full_samplings_last(lift):
+    """``sample=False`` (for a caller that samples the spline itself) keeps the last sample only: bit for bit the
+    full sampling's, the same timeline and waypoint times."""
+    _, robot, W, traj = lift
+    end = timing.retime(robot, W, sample=False, check_samples=False)
+    assert end.t.shape == (1,) and end.q.shape == (1, robot.n_joints)
+    for a, b in ((end.t, traj.t), (end.q, traj.q), (end.qd, traj.qd), (end.qdd, traj.qdd)):
+        np.testing.assert_array_equal(a, b[-1:])
+    np.testing.assert_array_equal(end.waypoint_times, traj.waypoint_times)
+    t = np.linspace(0.0, traj.duration, 101)
+    np.testing.assert_array_equal(end.spline(t, 1), traj.spline(t, 1))
+
+
+def test_stage_keys_match_exactly_equal_stages():
+    """The refinement's memory of stages probed within the limits: a stage matches only one with the same four
+    numbers (a bit apart is another stage)."""
+    s, x = np.array([0.0, 0.1, 0.3, 0.4]), np.array([0.0, 0.25, 0.5, 0.0])
+    keys = timing._stage_keys(s, x)
+    assert keys.shape == (3,)
+    s2 = np.array([0.0, 0.1, 0.2, 0.3, 0.4])
+    x2 = np.array([0.0, 0.25, 0.4, 0.5, np.nextafter(0.0, 1.0)])
+    assert np.isin(timing._stage_keys(s2, x2), keys).tolist() == [True, False, False, False]
+    assert np.isin(keys, timing._stage_keys(s, x.copy())).all()
+    assert not np.isin(keys, timing._stage_keys(np.zeros(0), np.zeros(0))).any()
+
+
 def test_timing_does_not_depend_on_the_placement(lift):
     """The planner times a lift once per base shape: at another placement the same waypoints get the same motion,
     and that motion keeps the ZMP inside there too (checked by stability in the world frame of that placement)."""
@@ -261,6 +287,8 @@ def test_bad_input():
         (dict(interpolation="linear"), ValueError, "interpolation"),
         (dict(base="here"), TypeError, "base"),
         (dict(check_samples="yes"), TypeError, "check_samples"),
+        (dict(sample=1), TypeError, "sample"),
+        (dict(sample=False), ValueError, "check_samples=True needs sample=True"),
     ]
     for kw, error, match in cases:
         args = dict(waypoints=W)

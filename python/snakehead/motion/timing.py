@@ -531,8 +531,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
            velocity_limit: npt.ArrayLike | None = None, acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
            torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION,
            dt: float = CONTROL_PERIOD, hold_s: npt.ArrayLike = HOLD_S, stops: Sequence[int] = (),
-           interpolation: str = "monotone", grid_step: float = GRID_STEP, check_samples: bool = True
-           ) -> RetimedTrajectory:
+           interpolation: str = "monotone", grid_step: float = GRID_STEP, check_samples: bool = True,
+           sample: bool = True) -> RetimedTrajectory:
     """The fastest motion through ``waypoints`` that keeps the robot's limits and its balance.
 
     Parameters
@@ -555,6 +555,9 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     check_samples : measure every sample against the limits (:func:`check_limits`: the result's ``check``); False
         leaves ``check`` None, for a caller that checks the samples itself (the refined grid keeps the limits
         between gridpoints either way).
+    sample : sample the motion every ``dt`` (default); False keeps only its last sample (t, q, qd, qdd: its end,
+        the same values as the last of the full sampling), for a caller that samples the result's ``spline`` itself
+        (``check_samples`` must then be False).
 
     Returns a :class:`RetimedTrajectory` (a JointTrajectory with ``duration``, ``waypoint_times``, ``check``).
     Raises ValueError when no motion along the path keeps the limits (the CoM outside the support polygon, the
@@ -573,8 +576,11 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
                             torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
     dt = positive(dt, "dt")
     grid_step = positive(grid_step, "grid_step")
-    if not isinstance(check_samples, (bool, np.bool_)):
-        raise InputTypeError(f"check_samples must be True or False, got {check_samples!r}")
+    for name, flag in (("check_samples", check_samples), ("sample", sample)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise InputTypeError(f"{name} must be True or False, got {flag!r}")
+    if check_samples and not sample:
+        raise InputError("check_samples=True needs sample=True (the samples are what it checks)")
     if interpolation not in INTERPOLATIONS:
         raise InputError(f"interpolation must be one of {INTERPOLATIONS}, got {interpolation!r}")
     schedule, holds = _segments(W, stops, hold_s)
@@ -592,6 +598,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
             times[i0:i1 + 1] = t_grid[np.searchsorted(grid, piece.knots)]
         _check_length(timeline.end, dt)
     t = sample_times(0.0, timeline.end, dt) if timeline.end > 0 else np.array([0.0])
+    if not sample:
+        t = t[-1:]  # the end only: each sample is evaluated on its own, so these are the full sampling's last
     q, qd, qdd = timeline.sample(t)
     q[0], q[-1] = W[0], W[-1]
     check = check_limits(robot, q, qd, qdd, base, limits) if check_samples else None
@@ -657,7 +665,7 @@ class _Piece:
         """Solve; cut the stages that break a limit between their gridpoints; again, up to REFINE_ROUNDS times
         (the constraints computed once per gridpoint)."""
         first_size = len(points.s)
-        kept: set[tuple[float, ...]] = set()  # stages (s_i, s_i+1, x_i, x_i+1) probed within the limits
+        kept = _stage_keys(np.zeros(0), np.zeros(0))  # stages (s_i, s_i+1, x_i, x_i+1) probed within the limits
         for refinement in range(REFINE_ROUNDS + 1):
             solution = _solve_grid(self.robot, points, self.limits)
             if solution.sd is None:
@@ -669,11 +677,11 @@ class _Piece:
             # a stage that is the same as one probed within the limits in an earlier round (same ends, same
             # speeds: the profile there did not change) is within them again: only the others are probed
             x = solution.sd ** 2
-            stages = list(zip(points.s[:-1].tolist(), points.s[1:].tolist(), x[:-1].tolist(), x[1:].tolist()))
-            todo = np.array([stage not in kept for stage in stages])
+            stages = _stage_keys(points.s, x)
+            todo = ~np.isin(stages, kept)
             split = _stages_over(self.robot, self.base, self.limits, self.f, points.s, solution.sd, points.support,
                                  only=todo)
-            kept.update(stage for stage, probed, over in zip(stages, todo, split) if probed and not over)
+            kept = np.concatenate([kept, stages[todo & ~split]])
             if not split.any():
                 break
             refined = _refined(points.s, split)
@@ -706,6 +714,13 @@ class _Piece:
             raise Infeasible(f"joint {robot.joint_names[j]} needs {hold[k, j] * self.limits.torque[j]:.2f} N m to hold "
                              f"the body still near waypoint {self.near(k, grid)}; its torque limit is "
                              f"{self.limits.torque[j]:.2f} N m")
+
+
+def _stage_keys(s: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """(N-1,) keys of the stages of gridpoints s with x = s'^2 there (N,): the bytes of (s_i, s_i+1, x_i, x_i+1),
+    equal exactly when the four numbers are (s and x are never -0.0 or NaN here), for np.isin."""
+    rows = np.ascontiguousarray(np.column_stack([s[:-1], s[1:], x[:-1], x[1:]]), dtype=float)
+    return rows.view(np.dtype((np.void, 4 * rows.itemsize))).ravel()
 
 
 @dataclass(frozen=True)
