@@ -9,6 +9,7 @@ value; the same gridpoint fails when a path is infeasible."""
 from __future__ import annotations
 
 import concurrent.futures
+import dataclasses
 import tempfile
 from pathlib import Path
 
@@ -281,6 +282,35 @@ def test_refined_grid_points_equal_a_fresh_computation() -> None:
     assert np.allclose(merged.support.margins(xy), fresh.support.margins(xy), atol=1e-12)
     assert np.array_equal(timing._topp.solve(merged.s, _canonical(robot, merged, limits)).sd,
                           timing._topp.solve(fresh.s, _canonical(robot, fresh, limits)).sd)
+
+
+def test_refined_grid_rows_equal_rows_computed_on_the_refined_grid() -> None:
+    """The solve's rows a refinement carries over (the old points' kept, the new points' computed, padded to one edge
+    count and merged) are bit for bit those computed on the merged grid at once; the solve over them the same. Both
+    ways round: the kept points' polygons with more edges than the new points', and with fewer."""
+    robot = snakehead.SnakeRobot.default()
+    rng = np.random.default_rng(2)
+    limits = timing.resolve_limits(robot)
+    piece, coarse = grid_points(robot, random_waypoints(robot, rng), limits, 0.05)
+
+    def points(s: np.ndarray) -> timing.GridPoints:
+        return timing.GridPoints.of(robot, piece.base, piece.f, s, limits.zmp_margin)
+
+    mids = 0.5 * (coarse.s[:-1] + coarse.s[1:])
+    few = [m for m in mids if points(np.array([m])).support.offset.shape[1] < coarse.support.offset.shape[1]]
+    added = points(np.array(few))
+    assert added.support.offset.shape[1] < coarse.support.offset.shape[1]  # the padding is exercised
+    for kept, new in ((coarse, added), (added, coarse)):
+        kept, new = dataclasses.replace(kept, rows={}), dataclasses.replace(new, rows={})
+        timing._grid_rows(robot, kept, limits)
+        merged = kept.merged(new)
+        carried = timing._grid_rows(robot, merged, limits)
+        fresh = timing._grid_rows(robot, dataclasses.replace(merged, rows={}), limits)
+        for name in ("P", "Q", "R", "x_max"):
+            np.testing.assert_array_equal(getattr(carried.canonical, name), getattr(fresh.canonical, name), name)
+        assert (carried.joint, carried.edges) == (fresh.joint, fresh.edges) == (carried.joint, coarse.support.offset.shape[1])
+        np.testing.assert_array_equal(timing._topp.solve(merged.s, _canonical(robot, merged, limits)).sd,
+                                      timing._solve_grid(robot, merged, limits).sd)
 
 
 def test_first_grid_and_checked_waypoints() -> None:

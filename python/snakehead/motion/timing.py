@@ -740,6 +740,10 @@ class GridPoints:
     w_a: np.ndarray
     w_b: np.ndarray
     support: Support
+    #: the solve's rows at these points (:func:`_grid_rows`), by id of the limits: (robot, limits, _Rows); a merged
+    #: grid carries them over, computing only the new points' rows
+    rows: dict[int, tuple[SnakeRobot, RetimingLimits, "_Rows"]] = field(default_factory=dict, compare=False,
+                                                                        repr=False)
 
     @classmethod
     def of(cls, robot: SnakeRobot, base: BasePlacement, f: PathFunction, s: np.ndarray, zmp_margin: float
@@ -755,9 +759,40 @@ class GridPoints:
     def merged(self, other: "GridPoints") -> "GridPoints":
         """Both sets of points, in the order of s."""
         order = np.argsort(np.concatenate([self.s, other.s]), kind="stable")
-        arrays = {f.name: np.concatenate([getattr(self, f.name), getattr(other, f.name)])[order]
-                  for f in fields(self) if f.name != "support"}
-        return GridPoints(**arrays, support=self.support.joined(other.support).take(order))
+        arrays: dict[str, Any] = {f.name: np.concatenate([getattr(self, f.name), getattr(other, f.name)])[order]
+                                  for f in fields(self) if f.name not in ("support", "rows")}
+        merged = GridPoints(**arrays, support=self.support.joined(other.support).take(order))
+        for key, (robot, limits, rows) in self.rows.items():
+            merged.rows[key] = (robot, limits, rows.merged(_grid_rows(robot, other, limits), order))
+        return merged
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """The solve's canonical rows at some gridpoints (:func:`_grid_rows`) and their layout: ``joint`` columns (the
+    joints' accelerations and torques), then one per support-polygon edge (``edges``), then the friction's."""
+
+    canonical: _topp.Canonical
+    joint: int
+    edges: int
+
+    def padded(self, edges: int) -> "_Rows":
+        """The rows of polygons padded to ``edges`` edges as :meth:`Support.joined` pads them (repeating the first
+        edge): the first edge's columns repeated after the last edge's."""
+        extra = edges - self.edges
+        if extra == 0:
+            return self
+        end = self.joint + self.edges
+        cols = np.r_[np.arange(end), np.full(extra, self.joint), np.arange(end, self.canonical.P.shape[1])]
+        c = self.canonical
+        return _Rows(_topp.Canonical(c.P[:, cols], c.Q[:, cols], c.R[:, cols], c.x_max), self.joint, edges)
+
+    def merged(self, other: "_Rows", order: np.ndarray) -> "_Rows":
+        """Both sets of rows, padded to one edge count, in ``order`` (as :meth:`GridPoints.merged`)."""
+        edges = max(self.edges, other.edges)
+        a, b = self.padded(edges).canonical, other.padded(edges).canonical
+        return _Rows(_topp.Canonical(*(np.concatenate([getattr(a, name), getattr(b, name)])[order]
+                                       for name in ("P", "Q", "R", "x_max"))), self.joint, edges)
 
 
 def _path_limits(limits: RetimingLimits) -> _topp.PathLimits:
@@ -777,10 +812,22 @@ def _stability_limits(limits: RetimingLimits) -> RetimingLimits:
 def _solve_grid(robot: SnakeRobot, points: GridPoints, limits: RetimingLimits) -> _topp.Solution:
     """TOPP-RA over the gridpoints ``points.s`` under ``limits`` (the solve's shares of them; the stability rows
     with the ZMP margin plus SOLVE_ZMP_EXTRA_M), rest to rest."""
+    return _topp.solve(points.s, _grid_rows(robot, points, limits).canonical)
+
+
+def _grid_rows(robot: SnakeRobot, points: GridPoints, limits: RetimingLimits) -> _Rows:
+    """The canonical rows of :func:`_solve_grid` at ``points``: computed once per gridpoint (kept in
+    ``points.rows``; a refined grid's merge computes its new points' only: each row depends on its point alone)."""
+    cached = points.rows.get(id(limits))
+    if cached is not None and cached[0] is robot and cached[1] is limits:
+        return cached[2]
     F, g = stability_rows(robot, points.support, _stability_limits(limits), SOLVE_ZMP_EXTRA_M)
-    rows = _topp.canonical(_path_limits(limits), points.dq, points.ddq, points.tau_a, points.tau_b, points.tau_hold,
-                           np.einsum("nkj,nj->nk", F, points.w_a), np.einsum("nkj,nj->nk", F, points.w_b), g)
-    return _topp.solve(points.s, rows)
+    canonical = _topp.canonical(_path_limits(limits), points.dq, points.ddq, points.tau_a, points.tau_b,
+                                points.tau_hold, np.einsum("nkj,nj->nk", F, points.w_a),
+                                np.einsum("nkj,nj->nk", F, points.w_b), g)
+    rows = _Rows(canonical, canonical.P.shape[1] - g.shape[1], points.support.offset.shape[1])
+    points.rows[id(limits)] = (robot, limits, rows)
+    return rows
 
 
 def _check_length(end: float, dt: float) -> None:
