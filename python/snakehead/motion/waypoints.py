@@ -3,7 +3,6 @@ where the straight path is not safe, pauses and stops, then timed by the time-op
 2 ms control period (:class:`Waypoints`)."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -274,13 +273,11 @@ class Waypoints:
                 if lift is None:
                     lift = self.lift_cache.put(key, retime(self.robot, Q[:k + 1], self.base, hold_s=hold_s[:k],
                                                            stops=[i for i in stops if i <= k], **timing))
+                # the whole motion is sampled from the pieces' splines (concatenate_motions), which reads only the
+                # rest's end: the rest is not sampled on its own
                 rest = retime(self.robot, Q[k:], self.base, hold_s=hold_s[k:], stops=[i - k for i in stops if i >= k],
-                              **timing)
+                              sample=False, **timing)
                 check_motion_length(float(lift.t[-1]) + float(rest.t[-1]))
-                # the whole motion is sampled again from the pieces' splines: the rest's samples (~400 B each) are
-                # dropped first, so that they and the whole motion's are never held at once
-                rest = replace(rest, t=rest.t[-1:].copy(), q=rest.q[-1:].copy(), qd=rest.qd[-1:].copy(),
-                               qdd=rest.qdd[-1:].copy())
                 traj = concatenate_motions(lift, rest)
                 self._lift_rows = (key, int(np.count_nonzero(traj.t <= float(lift.t[-1]))))
             else:
