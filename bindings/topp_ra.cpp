@@ -67,6 +67,21 @@ void bind_topp_ra(py::module_& m) {
       "TOPP-RA over grid (N+1,) with stage rows A u + B x <= C (N, m each), u_bounds (N, 2), x_bounds (N+1, 2): "
       "the controllable sets and the greedy forward pass from x_start to x_end (include/snakehead/topp_ra.hpp)");
   m.def(
+      "topp_ra_canonical",
+      [](Array grid, Array P, Array Q, Array R, Array x_max, double x_start, double x_end) {
+        if (grid.ndim() != 1) throw InputError("grid must be one-dimensional (N+1,)");
+        if (x_max.ndim() != 1) throw InputError("x_max must be one-dimensional (N+1,)");
+        const Eigen::Map<const Eigen::VectorXd> s(grid.data(), grid.shape(0)), xm(x_max.data(), x_max.shape(0));
+        const auto p = matrix(P, -1, "P (N+1, m)"), q = matrix(Q, -1, "Q (N+1, m)"), r = matrix(R, -1, "R (N+1, m)");
+        py::gil_scoped_release release;
+        return topp_ra_canonical(s, p, q, r, xm, x_start, x_end);
+      },
+      py::arg("grid"), py::arg("P"), py::arg("Q"), py::arg("R"), py::arg("x_max"), py::arg("x_start") = 0.0,
+      py::arg("x_end") = 0.0,
+      "TOPP-RA over grid (N+1,) with the gridpoints' rows P u + Q x <= R (N+1, m each) and x <= x_max (N+1,), "
+      "discretized as toppra's interpolation discretization in the core: topp_ra's result for the stage rows "
+      "motion._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)");
+  m.def(
       "solve_lp2d",
       [](double v_u, double v_x, Array rows_array, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
         const auto rows = matrix(rows_array, 3, "rows (m, 3): a, b, c of a u + b x <= c");

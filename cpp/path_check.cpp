@@ -541,12 +541,22 @@ using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
 // The runs' support polygons, one after the other (their vertices counter-clockwise, flat x, y), and the buffers that
 // build them, allocated once for all the runs of a check.
+//
+// Runs follow each other sample by sample where links on the ground move (a neck lifting off it: ~3000 runs in a
+// lift of 4000 samples), while most contact shapes (the base's) lie still. The hull of the contact points is
+// therefore built from a kept part: the hull of the touching points of the shapes that lay still between two runs,
+// kept while their links' world frames stay the same to the bit (their points then are the same), and the points of
+// the other near shapes. The hull of a set is the hull of its hull's vertices and the other points, so the polygon is
+// the same (the monotone chain may differ only where it drops a vertex as collinear, by a sine of 1e-9, or as
+// coincident, 1e-12 m: the margins then differ by as little).
 class SupportRuns {
  public:
-  SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes)
+  SupportRuns(const ZmpCheckSpec& spec, const ShapeSet& shapes, long L)
       : spec_(spec), shapes_(shapes), near_(spec.contact_shapes.size()),
         count_(static_cast<long>(spec.contact_shapes.size()) * spec.points_per_shape),
-        points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2) {
+        points_(static_cast<std::size_t>(3 * count_)), touching_(count_, 2), kept_points_(count_, 2),
+        previous_(static_cast<std::size_t>(16 * L)), kept_frames_(static_cast<std::size_t>(16 * L)),
+        kept_shape_(spec.contact_shapes.size(), 0), still_(spec.contact_shapes.size(), 0) {
     start_.push_back(0);
   }
 
@@ -554,17 +564,28 @@ class SupportRuns {
   // sample whose world frames are `frames`; `low`: the contact shapes' lowest z there. A shape whose lowest z is
   // above the tolerance (by more than round-off) has no point touching: its candidates are not computed.
   void add(const double* frames, long L, const double* low) {
+    const std::size_t S = spec_.contact_shapes.size();
+    const bool reuse = has_kept_ && kept_still(frames);
     near_.clear();
-    for (std::size_t i = 0; i < spec_.contact_shapes.size(); ++i)
-      if (low[i] <= spec_.tolerance + kRoundOff) near_.push_back(spec_.contact_shapes[i]);
+    near_index_.clear();
+    for (std::size_t i = 0; i < S; ++i)
+      if (low[i] <= spec_.tolerance + kRoundOff && !(reuse && kept_shape_[i])) {
+        near_.push_back(spec_.contact_shapes[i]);
+        near_index_.push_back(static_cast<long>(i));
+      }
     const long k = static_cast<long>(near_.size());
     lowest_points(frames, 1, L, shapes_, near_.data(), k, spec_.points_per_shape, points_.data());
     long m = 0;
+    if (reuse)  // the kept hull's vertices, then the other shapes' touching points
+      for (long v = 0; v < kept_count_; ++v) touching_.row(m++) = kept_points_.row(v);
     for (long p = 0; p < k * spec_.points_per_shape; ++p)
       if (points_[3 * p + 2] <= spec_.tolerance) touching_.row(m++) << points_[3 * p], points_[3 * p + 1];
     convex_hull_into(touching_.topRows(m), work_, hull_);
     for (int v : hull_) vertices_.insert(vertices_.end(), {touching_(v, 0), touching_(v, 1)});
     start_.push_back(static_cast<long>(vertices_.size() / 2));
+    if (!reuse) keep_still_part(frames, L, k);
+    std::copy(frames, frames + 16 * L, previous_.begin());
+    has_previous_ = true;
   }
 
   long runs() const { return static_cast<long>(start_.size()) - 1; }
@@ -573,6 +594,16 @@ class SupportRuns {
   void restore(const std::vector<double>& vertices, const std::vector<long>& start) {
     vertices_ = vertices;
     start_ = start;
+  }
+
+  // Every polygon so far turned by (c, s) about the origin and moved by (x, y) (a kept prefix made at another
+  // placement of the base on the ground).
+  void move(double c, double s, double x, double y) {
+    for (std::size_t v = 0; v + 1 < vertices_.size(); v += 2) {
+      const double vx = vertices_[v], vy = vertices_[v + 1];
+      vertices_[v] = c * vx - s * vy + x;
+      vertices_[v + 1] = s * vx + c * vy + y;
+    }
   }
 
   // The first `runs` runs' polygons into vertices and start (as ZmpPrefix holds them).
@@ -588,6 +619,53 @@ class SupportRuns {
 
  private:
   static constexpr double kRoundOff = 1e-9;  // m: lowest_z and the candidate points' z agree far closer
+
+  // Link l's world frame is the same, to the bit, in frames a and b.
+  static bool same_frame(const double* a, const double* b, int l) {
+    return std::memcmp(a + 16 * l, b + 16 * l, 12 * sizeof(double)) == 0;  // (the last row is always 0 0 0 1)
+  }
+
+  // Every kept shape's link lies where it lay when the kept hull was made.
+  bool kept_still(const double* frames) const {
+    for (std::size_t i = 0; i < kept_shape_.size(); ++i)
+      if (kept_shape_[i] && !same_frame(frames, kept_frames_.data(), link_of(i))) return false;
+    return true;
+  }
+
+  int link_of(std::size_t i) const { return shapes_.shape(static_cast<int>(spec_.contact_shapes[i])).frame; }
+
+  // After a polygon built from all the k near shapes (near_, their points in points_): keeps the hull of the touching
+  // points of those whose links did not move since the previous run (none kept when none did, or all did not).
+  void keep_still_part(const double* frames, long L, long k) {
+    has_kept_ = false;
+    if (!has_previous_) return;
+    long still = 0;
+    for (long j = 0; j < k; ++j) {
+      const std::size_t i = static_cast<std::size_t>(near_index_[static_cast<std::size_t>(j)]);
+      still_[i] = same_frame(frames, previous_.data(), link_of(i));
+      still += still_[i];
+    }
+    if (still == 0 || still == k) return;  // nothing to keep, or nothing else to add to it
+    long m = 0;
+    std::fill(kept_shape_.begin(), kept_shape_.end(), 0);
+    for (long j = 0; j < k; ++j) {
+      const std::size_t i = static_cast<std::size_t>(near_index_[static_cast<std::size_t>(j)]);
+      if (!still_[i]) continue;
+      kept_shape_[i] = 1;
+      for (long c = 0; c < spec_.points_per_shape; ++c) {
+        const double* point = &points_[3 * (j * spec_.points_per_shape + c)];
+        if (point[2] <= spec_.tolerance) kept_points_.row(m++) << point[0], point[1];
+      }
+    }
+    convex_hull_into(kept_points_.topRows(m), work_, hull_);
+    for (std::size_t v = 0; v < hull_.size(); ++v) touching_.row(static_cast<Eigen::Index>(v)) = kept_points_.row(hull_[v]);
+    kept_count_ = static_cast<long>(hull_.size());
+    kept_points_.topRows(kept_count_) = touching_.topRows(kept_count_);
+    std::copy(frames, frames + 16 * L, kept_frames_.begin());
+    has_kept_ = true;
+  }
+
+  std::vector<long> near_index_;  // near_'s indices among the contact shapes
   const ZmpCheckSpec& spec_;
   const ShapeSet& shapes_;
   std::vector<long> near_;      // the contact shapes within the tolerance (and round-off) of the ground
@@ -598,6 +676,13 @@ class SupportRuns {
   std::vector<int> hull_;
   std::vector<double> vertices_;  // every run's hull vertices
   std::vector<long> start_;       // run r's vertices: rows start_[r] .. start_[r + 1] - 1
+  // the kept part (see the class's note): the hull's vertices of the still shapes' touching points, which shapes
+  // (kept_shape_, by index among the contact shapes), the frames it was made at; the previous run's frames
+  Points kept_points_;
+  long kept_count_ = 0;
+  bool has_kept_ = false, has_previous_ = false;
+  std::vector<double> previous_, kept_frames_;
+  std::vector<char> kept_shape_, still_;
 };
 
 void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
@@ -619,15 +704,54 @@ bool same_spec(const ZmpCheckSpec& a, const ZmpCheckSpec& b) {
          a.shaped_links == b.shaped_links && a.tolerance == b.tolerance && a.chunk == b.chunk;
 }
 
-// Whether zmp_check may take `prefix` over for this check (see ZmpPrefix): everything it was made from is the same.
-bool takes_over(const ZmpPrefix& prefix, const PathChecker& checker, const ZmpCheckSpec& spec, const double* q,
-                const double* qd, long T) {
+// How zmp_check may take a kept prefix over (see ZmpPrefix): not at all, as it is (made at this origin: to the bit), or
+// moved (made at another placement of the base on the ground: the origins' z rows are the same to the bit, so every
+// world frame's z row, every height and every contact run is; the momenta, CoM and polygons move with the placement:
+// P' = R P, c' = R c + t, L' = R L + t x P' for the turn R about z and the shift t from the prefix's origin to this).
+struct Takeover {
+  enum Kind { kNone, kSame, kMoved } kind = kNone;
+  double c = 1.0, s = 0.0, x = 0.0, y = 0.0;  // the turn's cosine and sine and the shift, when moved
+};
+
+Takeover takeover(const ZmpPrefix& prefix, const PathChecker& checker, const ZmpCheckSpec& spec, const double* q,
+                  const double* qd, long T) {
   const long m = prefix.size(), n = checker.n_joints();
-  if (m < 1 || m > T || prefix.model != &checker.model() || prefix.shapes != &checker.shapes()) return false;
-  if (prefix.origin != checker.origin().matrix() || !same_spec(prefix.spec, spec)) return false;
-  if (static_cast<long>(prefix.q.size()) != m * n || static_cast<long>(prefix.qd.size()) != m * n) return false;
+  if (m < 1 || m > T || prefix.model != &checker.model() || prefix.shapes != &checker.shapes()) return {};
+  if (!same_spec(prefix.spec, spec)) return {};
+  if (static_cast<long>(prefix.q.size()) != m * n || static_cast<long>(prefix.qd.size()) != m * n) return {};
   const auto bytes = static_cast<std::size_t>(m * n) * sizeof(double);
-  return std::memcmp(prefix.q.data(), q, bytes) == 0 && std::memcmp(prefix.qd.data(), qd, bytes) == 0;
+  if (std::memcmp(prefix.q.data(), q, bytes) != 0 || std::memcmp(prefix.qd.data(), qd, bytes) != 0) return {};
+  const Eigen::Matrix4d& from = prefix.origin;
+  const Eigen::Matrix4d to = checker.origin().matrix();
+  if (from == to) return {Takeover::kSame};
+  if (from.row(2) != to.row(2) || from.row(3) != to.row(3) || to.row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0))
+    return {};
+  // D = to * from^-1 keeps z (the z rows are the same): a turn about z and a shift in x, y
+  const Eigen::Matrix3d R = to.topLeftCorner<3, 3>() * from.topLeftCorner<3, 3>().transpose();
+  const Eigen::Vector3d t = to.topRightCorner<3, 1>() - R * from.topRightCorner<3, 1>();
+  const double norm = std::hypot(R(0, 0), R(1, 0));
+  if (!(norm > 0.5)) return {};  // (cannot happen for two rotations with the same z row)
+  return {Takeover::kMoved, R(0, 0) / norm, R(1, 0) / norm, t.x(), t.y()};
+}
+
+// The first m samples' momenta and CoM of a prefix made at another placement, moved to this one (see Takeover).
+void move_samples(const Takeover& how, long m, ZmpCheck& out) {
+  for (long k = 0; k < m; ++k) {
+    double* P = &out.linear[3 * k];
+    double* L = &out.angular[3 * k];
+    double* c = &out.com[3 * k];
+    const double Px = how.c * P[0] - how.s * P[1], Py = how.s * P[0] + how.c * P[1];
+    const double Lx = how.c * L[0] - how.s * L[1], Ly = how.s * L[0] + how.c * L[1];
+    const double cx = how.c * c[0] - how.s * c[1] + how.x, cy = how.s * c[0] + how.c * c[1] + how.y;
+    P[0] = Px;
+    P[1] = Py;
+    // L about the world origin: + t x P' with t = (x, y, 0)
+    L[0] = Lx + how.y * P[2];
+    L[1] = Ly - how.x * P[2];
+    L[2] = L[2] + how.x * Py - how.y * Px;
+    c[0] = cx;
+    c[1] = cy;
+  }
 }
 
 // Where each clearance shape's lowest z is among the contact shapes' (one lowest_z per shape and sample): indices
@@ -691,12 +815,13 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   out.angular.resize(static_cast<std::size_t>(3 * T));
   out.com.resize(static_cast<std::size_t>(3 * T));
   out.clearance.assign(static_cast<std::size_t>(T), kInf);
-  SupportRuns polygons(spec, shapes);
+  SupportRuns polygons(spec, shapes, L);
   std::vector<long> run(static_cast<std::size_t>(T));
   std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
   std::vector<std::vector<double>> run_key;  // each run's contact key (a kept prefix ends with its last)
   long k0 = 0;
-  if (resume != nullptr && takes_over(*resume, checker, spec, q, qd, T)) {  // its samples, to the bit
+  const Takeover how = resume != nullptr ? takeover(*resume, checker, spec, q, qd, T) : Takeover{};
+  if (how.kind != Takeover::kNone) {  // its samples (to the bit at its own placement; moved at another)
     k0 = resume->size();
     std::copy(resume->linear.begin(), resume->linear.end(), out.linear.begin());
     std::copy(resume->angular.begin(), resume->angular.end(), out.angular.begin());
@@ -704,6 +829,10 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     std::copy(resume->clearance.begin(), resume->clearance.end(), out.clearance.begin());
     std::copy(resume->run.begin(), resume->run.end(), run.begin());
     polygons.restore(resume->vertices, resume->start);
+    if (how.kind == Takeover::kMoved) {
+      move_samples(how, k0, out);
+      polygons.move(how.c, how.s, how.x, how.y);
+    }
     previous = resume->last_key;
     run_key.resize(static_cast<std::size_t>(polygons.runs()));
     run_key.back() = previous;
@@ -716,7 +845,20 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   std::vector<double> low(static_cast<std::size_t>(U));
   const std::vector<int>& child = chain.joint_child;
   Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
+  const auto nbytes = static_cast<std::size_t>(n) * sizeof(double);
   for (long k = k0; k < T; ++k) {
+    if (k > 0 && k % spec.chunk != 0 && std::memcmp(q + k * n, q + (k - 1) * n, nbytes) == 0 &&
+        std::memcmp(qd + k * n, qd + (k - 1) * n, nbytes) == 0) {
+      // the sample repeats the one before (a hold: ~500 samples a target): its values are that one's, to the bit
+      for (int c = 0; c < 3; ++c) {
+        out.linear[3 * k + c] = out.linear[3 * (k - 1) + c];
+        out.angular[3 * k + c] = out.angular[3 * (k - 1) + c];
+        out.com[3 * k + c] = out.com[3 * (k - 1) + c];
+      }
+      out.clearance[k] = out.clearance[k - 1];
+      run[k] = run[k - 1];
+      continue;
+    }
     const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
     model.check_configuration(qk);
     checker.world_frames(qk, frames.data(), work);

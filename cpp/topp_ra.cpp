@@ -77,6 +77,14 @@ bool optimum_on_line(const double v[2], const HalfPlane& h, const HalfPlane* row
   return true;
 }
 
+// Row (a, b, c) with a unit normal as UnitRows scales it: multiplied by 1 / sqrt(a^2 + b^2) (as it is when that is
+// 0), so that a row scaled here and one scaled there are the same to the bit.
+HalfPlane unit_row(double a, double b, double c) {
+  const double norm = std::sqrt(a * a + b * b);
+  const double scale = norm > 0.0 ? 1.0 / norm : 1.0;
+  return {a * scale, b * scale, c * scale};
+}
+
 // The stage rows with unit normals (a, b), all at once (rows 0 u + 0 x <= c as they are).
 struct UnitRows {
   RowMatrixXd a, b, c;
@@ -100,6 +108,46 @@ void fill_stage(std::vector<HalfPlane>& rows, double delta, double K_lo, double 
   rows[1] = normalized({-2.0 * delta, -1.0, -K_lo});
   for (Eigen::Index k = 0; k < stage.a.cols(); ++k) rows[2 + k] = {stage.a(i, k), stage.b(i, k), stage.c(i, k)};
 }
+
+// The stage rows of topp_ra_canonical, made stage by stage where they are used (no N x 2m matrices: the two passes
+// make each stage's rows once each, which costs less than writing and reading them back): stage i's rows are the
+// gridpoint rows of i at (u, x), then those of i+1 at (u, x + 2 delta_i u), each scaled as UnitRows scales them (the
+// interpolation discretization as motion._topp.interpolated makes it, to the bit).
+struct CanonicalStages {
+  const Eigen::Ref<const Eigen::VectorXd>& grid;
+  const Eigen::Ref<const RowMatrixXd>& P;
+  const Eigen::Ref<const RowMatrixXd>& Q;
+  const Eigen::Ref<const RowMatrixXd>& R;
+  bool overflow = false;  // some row's squares overflow: every row is scaled by hypot instead, as UnitRows does
+
+  Eigen::Index cols() const { return 2 * P.cols(); }
+
+  HalfPlane scaled(double a, double b, double c) const {
+    if (!overflow) return unit_row(a, b, c);
+    const double norm = std::hypot(a, b);
+    const double scale = norm > 0.0 ? 1.0 / norm : 1.0;
+    return {a * scale, b * scale, c * scale};
+  }
+
+  void fill(std::vector<HalfPlane>& rows, double delta, double K_lo, double K_hi, Eigen::Index i) const {
+    rows[0] = normalized({2.0 * delta, 1.0, K_hi});
+    rows[1] = normalized({-2.0 * delta, -1.0, -K_lo});
+    const Eigen::Index m = P.cols();
+    const double twice = 2.0 * delta;
+    HalfPlane* out = rows.data() + 2;
+    for (Eigen::Index k = 0; k < m; ++k) out[k] = scaled(P(i, k), Q(i, k), R(i, k));
+    for (Eigen::Index k = 0; k < m; ++k) out[m + k] = scaled(P(i + 1, k) + twice * Q(i + 1, k), Q(i + 1, k), R(i + 1, k));
+  }
+};
+
+// UnitRows' view of topp_ra's stage matrices (rows copied from them).
+struct MatrixStages {
+  const UnitRows& stage;
+  Eigen::Index cols() const { return stage.a.cols(); }
+  void fill(std::vector<HalfPlane>& rows, double delta, double K_lo, double K_hi, Eigen::Index i) const {
+    fill_stage(rows, delta, K_lo, K_hi, stage, i);
+  }
+};
 
 // The box of stage i's LP: its own bounds, sides at most kVarLimit, and x >= 0 (x = s'^2).
 void stage_box(const Eigen::Ref<const RowMatrixX2d>& u_bounds, const Eigen::Ref<const RowMatrixX2d>& x_bounds,
@@ -208,14 +256,15 @@ bool max_u_at(double x, const HalfPlane* rows, int m, double u_lo, double u_hi, 
   return true;
 }
 
-ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<const RowMatrixXd>& A,
-                     const Eigen::Ref<const RowMatrixXd>& B, const Eigen::Ref<const RowMatrixXd>& C,
-                     const Eigen::Ref<const RowMatrixX2d>& u_bounds, const Eigen::Ref<const RowMatrixX2d>& x_bounds,
-                     double x_start, double x_end) {
-  validate(grid, A, B, C, u_bounds, x_bounds, x_start, x_end);
-  const UnitRows stage(A, B, C);
+namespace {
+
+// The backward and forward passes over the stages' rows (Stages: MatrixStages or CanonicalStages).
+template <class Stages>
+ToppRaResult passes(const Eigen::Ref<const Eigen::VectorXd>& grid, const Stages& stage,
+                    const Eigen::Ref<const RowMatrixX2d>& u_bounds, const Eigen::Ref<const RowMatrixX2d>& x_bounds,
+                    double x_start, double x_end) {
   const int N = static_cast<int>(grid.size() - 1);
-  const int rows_count = static_cast<int>(A.cols()) + 2;
+  const int rows_count = static_cast<int>(stage.cols()) + 2;
   ToppRaResult res;
   res.x.assign(N + 1, kNaN);
   res.u.assign(N, kNaN);
@@ -237,7 +286,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
   res.K(N, 0) = res.K(N, 1) = x_end;
   int warm_max[2] = {-1, -1}, warm_min[2] = {-1, -1};
   for (int i = N - 1; i >= 0; --i) {
-    fill_stage(rows, grid(i + 1) - grid(i), res.K(i + 1, 0), res.K(i + 1, 1), stage, i);
+    stage.fill(rows, grid(i + 1) - grid(i), res.K(i + 1, 0), res.K(i + 1, 1), i);
     stage_box(u_bounds, x_bounds, i, lo, hi);
     warm_order(shuffled, warm_max, order);
     const Lp2dSolution top = solve_lp2d(-kTieWeight, 1.0, rows.data(), rows_count, lo, hi, order.data());
@@ -265,7 +314,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
   int tries = 0;
   for (int i = 0; i < N;) {
     const double delta = grid(i + 1) - grid(i);
-    fill_stage(rows, delta, res.K(i + 1, 0), res.K(i + 1, 1), stage, i);
+    stage.fill(rows, delta, res.K(i + 1, 0), res.K(i + 1, 1), i);
     stage_box(u_bounds, x_bounds, i, lo, hi);
     double u = 0.0;
     ++res.lp_count;
@@ -289,6 +338,64 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
   }
   for (int i = 0; i < N; ++i) res.u[i] = (res.x[i + 1] - res.x[i]) / (2.0 * (grid(i + 1) - grid(i)));
   return res;
+}
+
+}  // namespace
+
+ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<const RowMatrixXd>& A,
+                     const Eigen::Ref<const RowMatrixXd>& B, const Eigen::Ref<const RowMatrixXd>& C,
+                     const Eigen::Ref<const RowMatrixX2d>& u_bounds, const Eigen::Ref<const RowMatrixX2d>& x_bounds,
+                     double x_start, double x_end) {
+  validate(grid, A, B, C, u_bounds, x_bounds, x_start, x_end);
+  const UnitRows rows(A, B, C);
+  return passes(grid, MatrixStages{rows}, u_bounds, x_bounds, x_start, x_end);
+}
+
+ToppRaResult topp_ra_canonical(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<const RowMatrixXd>& P,
+                               const Eigen::Ref<const RowMatrixXd>& Q, const Eigen::Ref<const RowMatrixXd>& R,
+                               const Eigen::Ref<const Eigen::VectorXd>& x_max, double x_start, double x_end) {
+  const Eigen::Index points = grid.size();
+  if (points < 2) throw InputError("grid needs at least two gridpoints, got " + std::to_string(points));
+  const Eigen::Index m = P.cols();
+  if (points - 1 > std::numeric_limits<int>::max() / 2 || m > std::numeric_limits<int>::max() / 4 - 2)
+    throw InputError("grid or rows too large for TOPP-RA");
+  auto shape = [&](const Eigen::Ref<const RowMatrixXd>& M, const char* name) {
+    if (M.rows() != points || M.cols() != m)
+      throw InputError(std::string(name) + " must have shape (N + 1, m) = (" + std::to_string(points) + ", " +
+                       std::to_string(m) + ") like P, got (" + std::to_string(M.rows()) + ", " +
+                       std::to_string(M.cols()) + ")");
+    if (!M.allFinite()) throw InputError(std::string(name) + " must be finite");
+  };
+  shape(P, "P");
+  shape(Q, "Q");
+  shape(R, "R");
+  if (x_max.size() != points) throw InputError("x_max must have shape (N + 1,) = (" + std::to_string(points) + ",)");
+  const Eigen::Index N = points - 1;
+  RowMatrixX2d u_bounds(N, 2), x_bounds(points, 2);
+  u_bounds.col(0).setConstant(-std::numeric_limits<double>::infinity());
+  u_bounds.col(1).setConstant(std::numeric_limits<double>::infinity());
+  x_bounds.col(0).setZero();
+  x_bounds.col(1) = x_max;
+  // the grid, x_max (NaN), x_start and x_end are checked as topp_ra checks them; its stage matrices are not made
+  validate(grid, RowMatrixXd::Zero(N, 0), RowMatrixXd::Zero(N, 0), RowMatrixXd::Zero(N, 0), u_bounds, x_bounds,
+           x_start, x_end);
+  CanonicalStages stages{grid, P, Q, R};
+  // as UnitRows: where some row's squares overflow (|a| or |b| > 1e154), every row is scaled by hypot (the rows are
+  // looked at one by one only when their coefficients' bound leaves room for that: |a|, |b| < 1e153 cannot)
+  const double big = m == 0 ? 0.0
+                            : std::max(P.cwiseAbs().maxCoeff() + 2.0 * (grid(N) - grid(0)) * Q.cwiseAbs().maxCoeff(),
+                                       Q.cwiseAbs().maxCoeff());
+  for (Eigen::Index i = 0; i < N && !stages.overflow && !(big < 1e153); ++i) {
+    const double twice = 2.0 * (grid(i + 1) - grid(i));
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const double a0 = P(i, k), b0 = Q(i, k), a1 = P(i + 1, k) + twice * Q(i + 1, k), b1 = Q(i + 1, k);
+      if (!std::isfinite(std::sqrt(a0 * a0 + b0 * b0)) || !std::isfinite(std::sqrt(a1 * a1 + b1 * b1))) {
+        stages.overflow = true;
+        break;
+      }
+    }
+  }
+  return passes(grid, stages, u_bounds, x_bounds, x_start, x_end);
 }
 
 }  // namespace snakehead

@@ -137,6 +137,50 @@ def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRo
     assert kinds["feasible"] >= 2, kinds
 
 
+def test_canonical_solve_equals_the_stage_solve_to_the_bit(robot: snakehead.SnakeRobot) -> None:
+    """_topp.solve (the core discretizes the gridpoints' rows itself, _core.topp_ra_canonical) gives the result of
+    _core.topp_ra over the stage matrices of _topp.interpolated, to the bit: feasible and infeasible paths."""
+    rng = np.random.default_rng(23)
+    kinds = set()
+    for _ in range(12):
+        W, limits = random_waypoints(robot, rng), random_limits(robot, rng)
+        try:
+            _, points = grid_points(robot, W, limits, rng.uniform(0.01, 0.05))
+        except Infeasible:
+            continue
+        rows = _canonical(robot, points, limits)
+        ours, ref = _topp.solve(points.s, rows), _topp.solve_stages(points.s, rows)
+        assert ours.failed_at == ref.failed_at
+        np.testing.assert_array_equal(ours.K, ref.K)
+        assert (ours.sd is None) == (ref.sd is None)
+        if ours.sd is not None:
+            np.testing.assert_array_equal(ours.sd, ref.sd)
+        kinds.add(ours.sd is not None)
+    assert True in kinds
+
+
+def test_canonical_solve_refuses_malformed_rows() -> None:
+    grid = np.linspace(0.0, 1.0, 6)
+    P, Q, R = np.ones((6, 2)), np.zeros((6, 2)), np.ones((6, 2))
+    x_max = np.ones(6)
+    assert _core.topp_ra_canonical(grid, P, Q, R, x_max).status == "feasible"
+    none = np.zeros((6, 0))  # no rows: x_max alone bounds the path, as topp_ra with no stage rows
+    ours = _core.topp_ra_canonical(grid, none, none, none, x_max)
+    ref = _core.topp_ra(grid, np.zeros((5, 0)), np.zeros((5, 0)), np.zeros((5, 0)), np.tile([-np.inf, np.inf], (5, 1)),
+                        np.column_stack([np.zeros(6), x_max]))
+    np.testing.assert_array_equal(ours.x, ref.x)
+    bad = P.copy()
+    bad[2, 1] = np.nan
+    for args, match in (((grid, bad, Q, R, x_max), "P must be finite"),
+                        ((grid, P, Q[:, :1], R, x_max), "Q must have shape"),
+                        ((grid, P, Q, R[:5], x_max), "R must have shape"),
+                        ((grid, P, Q, R, x_max[:5]), "x_max"),
+                        ((grid, P, Q, R, np.where(np.arange(6) == 3, np.nan, x_max)), "NaN"),
+                        ((grid[::-1], P, Q, R, x_max), "increasing")):
+        with pytest.raises(InputError, match=match):
+            _core.topp_ra_canonical(*args)
+
+
 def _canonical(robot: snakehead.SnakeRobot, points: timing.GridPoints, limits: timing.RetimingLimits
                ) -> _topp.Canonical:
     F, g = timing.stability_rows(robot, points.support, timing._stability_limits(limits), timing.SOLVE_ZMP_EXTRA_M)

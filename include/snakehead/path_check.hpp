@@ -185,10 +185,14 @@ struct ZmpCheck {
 // What zmp_check computed sample by sample (momenta, CoM, clearance, the contact runs and their polygons) over the
 // first samples of a motion, kept so that a later check of a motion that begins with the same samples (the lift
 // from the bending state is the same for every target from a base of one shape) takes it over instead of computing
-// it again. zmp_check takes it over only when the checker (the same model and shapes, the same origin), the spec
-// and the prefix's q and qd are those it was made with, bit for bit (else it computes everything): the result is
-// then the same as without it, to the bit (the per-sample values depend on their own sample only, the runs on
-// the samples before; the time derivatives and the ZMP are computed over the whole motion afterwards).
+// it again. zmp_check takes it over only when the checker's model and shapes, the spec and the prefix's q and qd are
+// those it was made with, bit for bit (else it computes everything). At the same origin the result is then the same
+// as without it, to the bit (the per-sample values depend on their own sample only, the runs on the samples before;
+// the time derivatives and the ZMP are computed over the whole motion afterwards). At an origin that differs only by
+// where the base lies on the ground (the origins' z rows the same to the bit: a turn about z and a shift in x, y)
+// the heights, clearances and contact runs are the same to the bit (every world frame's z row is), and the momenta,
+// CoM and polygons are moved with the placement (P' = R P, c' = R c + t, L' = R L + t x P'): the same as computed
+// there up to round-off (~1e-15 m; the ZMP's margins to 1e-12 m).
 struct ZmpPrefix {
   const ChainModel* model = nullptr;
   const ShapeSet* shapes = nullptr;

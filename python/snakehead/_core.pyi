@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -455,6 +455,10 @@ def solve_lp2d(v_u: typing.SupportsFloat | typing.SupportsIndex, v_x: typing.Sup
 def topp_ra(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], C: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], u_bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_start: typing.SupportsFloat | typing.SupportsIndex = 0.0, x_end: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> ToppRaResult:
     """
     TOPP-RA over grid (N+1,) with stage rows A u + B x <= C (N, m each), u_bounds (N, 2), x_bounds (N+1, 2): the controllable sets and the greedy forward pass from x_start to x_end (include/snakehead/topp_ra.hpp)
+    """
+def topp_ra_canonical(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], P: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], Q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], R: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_max: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_start: typing.SupportsFloat | typing.SupportsIndex = 0.0, x_end: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> ToppRaResult:
+    """
+    TOPP-RA over grid (N+1,) with the gridpoints' rows P u + Q x <= R (N+1, m each) and x <= x_max (N+1,), discretized as toppra's interpolation discretization in the core: topp_ra's result for the stage rows motion._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)
     """
 def urdf_root_link(urdf: str) -> str:
     """

@@ -206,6 +206,63 @@ TEST(ToppRa, SameResultFromManyThreads) {
   }
 }
 
+// topp_ra_canonical discretizes the gridpoints' rows itself: the same result, to the bit, as topp_ra over the stage
+// matrices of the interpolation discretization (A = [P_i, P_{i+1} + 2 delta_i Q_{i+1}], B = [Q_i, Q_{i+1}],
+// C = [R_i, R_{i+1}]) on random rows, feasible and not, and on the bang-bang path; malformed rows throw.
+TEST(ToppRa, CanonicalRowsGiveTheStageMatricesResult) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coefficient(-2.0, 2.0), room(0.2, 3.0), step(0.005, 0.05);
+  int feasible = 0, infeasible = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int N = 20 + trial, m = 1 + trial % 9;
+    Eigen::VectorXd grid(N + 1);
+    grid(0) = 0.0;
+    for (int i = 0; i < N; ++i) grid(i + 1) = grid(i) + step(rng);
+    RowMatrixXd P(N + 1, m), Q(N + 1, m), R(N + 1, m);
+    for (int i = 0; i <= N; ++i)
+      for (int k = 0; k < m; ++k) {
+        P(i, k) = coefficient(rng);
+        Q(i, k) = coefficient(rng);
+        R(i, k) = trial % 4 == 3 && i == N / 2 && k == 0 ? -room(rng) : room(rng);  // some paths infeasible
+      }
+    Eigen::VectorXd x_max = Eigen::VectorXd::Constant(N + 1, 4.0);
+    RowMatrixXd A(N, 2 * m), B(N, 2 * m), C(N, 2 * m);
+    for (int i = 0; i < N; ++i) {
+      const double delta = grid(i + 1) - grid(i);
+      A.row(i) << P.row(i), P.row(i + 1) + 2.0 * delta * Q.row(i + 1);
+      B.row(i) << Q.row(i), Q.row(i + 1);
+      C.row(i) << R.row(i), R.row(i + 1);
+    }
+    RowMatrixX2d u_bounds(N, 2), x_bounds(N + 1, 2);
+    u_bounds.col(0).setConstant(-std::numeric_limits<double>::infinity());
+    u_bounds.col(1).setConstant(std::numeric_limits<double>::infinity());
+    x_bounds.col(0).setZero();
+    x_bounds.col(1) = x_max;
+    const snakehead::ToppRaResult ref = snakehead::topp_ra(grid, A, B, C, u_bounds, x_bounds, 0.0, 0.0);
+    const snakehead::ToppRaResult ours = snakehead::topp_ra_canonical(grid, P, Q, R, x_max, 0.0, 0.0);
+    ASSERT_EQ(ours.status, ref.status) << trial;
+    EXPECT_EQ(ours.failed_at, ref.failed_at) << trial;
+    EXPECT_EQ(ours.lp_count, ref.lp_count) << trial;
+    for (int i = 0; i <= N; ++i) {
+      EXPECT_TRUE(ours.x[i] == ref.x[i] || (std::isnan(ours.x[i]) && std::isnan(ref.x[i]))) << trial << " " << i;
+      for (int c = 0; c < 2; ++c)
+        EXPECT_TRUE(ours.K(i, c) == ref.K(i, c) || (std::isnan(ours.K(i, c)) && std::isnan(ref.K(i, c))));
+    }
+    (ref.status == ToppRaStatus::kFeasible ? feasible : infeasible) += 1;
+  }
+  EXPECT_GE(feasible, 5);
+  EXPECT_GE(infeasible, 5);
+  using snakehead::InputError;
+  const Eigen::VectorXd grid = Eigen::VectorXd::LinSpaced(4, 0.0, 1.0), x_max = Eigen::VectorXd::Ones(4);
+  const RowMatrixXd P = RowMatrixXd::Ones(4, 2);
+  RowMatrixXd bad = P;
+  bad(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(snakehead::topp_ra_canonical(grid, bad, P, P, x_max, 0, 0), InputError);
+  EXPECT_THROW(snakehead::topp_ra_canonical(grid, P, P.topRows(3), P, x_max, 0, 0), InputError);
+  EXPECT_THROW(snakehead::topp_ra_canonical(grid, P, P, P, x_max.head(3), 0, 0), InputError);
+  EXPECT_THROW(snakehead::topp_ra_canonical(grid.reverse(), P, P, P, x_max, 0, 0), InputError);
+}
+
 TEST(ToppRa, MalformedInputThrows) {
   const StraightPath p;
   using snakehead::InputError;

@@ -79,7 +79,17 @@ def interpolated(rows: Canonical, grid: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 def solve(grid: np.ndarray, rows: Canonical) -> Solution:
-    """Time-optimal rest-to-rest path speeds over ``grid`` (N+1,) under ``rows`` (TOPP-RA in the core)."""
+    """Time-optimal rest-to-rest path speeds over ``grid`` (N+1,) under ``rows`` (TOPP-RA in the core,
+    ``_core.topp_ra_canonical``: the stages of :func:`interpolated` made there, stage by stage, with u free and
+    x in [0, x_max]; the same result as ``_core.topp_ra`` over :func:`interpolated`'s matrices, to the bit)."""
+    result = _core.topp_ra_canonical(grid, rows.P, rows.Q, rows.R, rows.x_max, 0.0, 0.0)
+    sd = np.sqrt(result.x) if result.status == "feasible" else None
+    return Solution(sd, result.K, int(result.failed_at))
+
+
+def solve_stages(grid: np.ndarray, rows: Canonical) -> Solution:
+    """:func:`solve` over the stage matrices of :func:`interpolated` (``_core.topp_ra``): the reference of
+    :func:`solve`."""
     A, B, C = interpolated(rows, grid)
     N = len(grid) - 1
     u_bounds = np.tile([-np.inf, np.inf], (N, 1))

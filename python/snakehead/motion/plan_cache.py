@@ -85,10 +85,10 @@ class PlanCache:
     timed_lifts: (the lift's waypoints rounded to 1e-9 rad as bytes, ``repr`` of the sorted retiming options) ->
         the lift retimed (``motion.timing.retime``). Invalid when the retiming's defaults change (the options given
         are in the key, the defaults are not): call :meth:`clear` then.
-    checked_lifts: (timed_lifts' key, and where the base lies) -> the lift's part of the plan's ZMP check
+    checked_lifts: timed_lifts' key (any placement: KeptSamples moves it) -> the lift's part of the plan's ZMP check
         (``dynamics.stability.KeptSamples``, filled by the first plan's check; the core takes it over only when the
-        motion begins with the very samples it was made from). Unlike the others, a function of the placement too:
-        it is in the key.
+        motion begins with the very samples it was made from; at another placement of the base on the ground it
+        moves the kept momenta, CoM and polygons there, the same to ~1e-15 m).
     """
 
     bending_states: KeptMap[bytes, np.ndarray] = field(default_factory=lambda: KeptMap(KEPT_SHAPES))
@@ -96,7 +96,7 @@ class PlanCache:
     lift_paths: KeptMap[tuple[bytes, bytes], tuple[np.ndarray, str]] = field(
         default_factory=lambda: KeptMap(KEPT_LIFTS))
     timed_lifts: KeptMap[tuple[bytes, str], RetimedTrajectory] = field(default_factory=lambda: KeptMap(KEPT_LIFTS))
-    checked_lifts: KeptMap[tuple[bytes, str, str], KeptSamples] = field(default_factory=lambda: KeptMap(KEPT_LIFTS))
+    checked_lifts: KeptMap[tuple[bytes, str], KeptSamples] = field(default_factory=lambda: KeptMap(KEPT_LIFTS))
 
     def clear(self) -> None:
         """Forget every entry."""

@@ -89,7 +89,7 @@ class Waypoints:
         self.lift_index: int | None = None  # the waypoint where the lift from the bending state ends (a stop)
         self.lift_cache: KeptMap[tuple[bytes, str], Any] | None = None  # timed lifts: controller.plan_cache's
         # the lift's part of the ZMP check per placement: controller.plan_cache's checked_lifts (finish_checks)
-        self.checked_lifts: KeptMap[tuple[bytes, str, str], stability.KeptSamples] | None = None
+        self.checked_lifts: KeptMap[tuple[bytes, str], stability.KeptSamples] | None = None
         self._problem: Any = None  # control.whole_body.BodyProblem, made when first needed (_base_margins)
         # the timed lift's key in lift_cache and its samples at the start of the motion, when sample() used a kept
         # lift (finish_checks keeps their part of the ZMP check there too)
@@ -346,13 +346,13 @@ class Waypoints:
                       ) -> tuple[stability.DynamicStability, np.ndarray, np.ndarray | None, path_check.MotionReport]:
         """The checks of the timed motion t, q, qd (``geometry.path_check.finish_checks``: the ZMP and the ground
         clearance at every sample, the ground, self and obstacle clearances proven between them), with the lift's
-        part of the ZMP check kept in ``checked_lifts`` for the next plan from a base of this shape and placement (the
-        motion begins with the same samples: ``dynamics.stability.KeptSamples``; the result is the same to the
-        bit)."""
+        part of the ZMP check kept in ``checked_lifts`` for the next plan from a base of this shape (the motion begins
+        with the same samples: ``dynamics.stability.KeptSamples``; at the placement it was made at the result is the
+        same to the bit, at another the kept momenta, CoM and polygons are moved there: the same to ~1e-15 m)."""
         kept = None
         if self._lift_rows is not None and self.checked_lifts is not None:
             (shape, timing), rows = self._lift_rows
-            key = (shape, timing, repr(self.base))  # the check depends on where the base lies
+            key = (shape, timing)  # at another placement the core moves the kept part there (KeptSamples)
             kept = self.checked_lifts.get(key)
             if kept is None or kept.samples != rows:
                 kept = self.checked_lifts.put(key, stability.KeptSamples(rows))
