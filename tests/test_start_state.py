@@ -104,3 +104,34 @@ def test_a_straight_base_has_no_curl_by_either_search():
     for search in (ss.ground_curl, ss.ground_curl_exhaustive):
         with pytest.raises(Infeasible, match="no curl of the neck and head"):
             search(robot, np.zeros(robot.n_joints))
+
+
+@pytest.fixture(scope="module")
+def reu(tmp_path_factory):
+    from snakehead.control.controller import HeadController
+    from snakehead.model import published
+
+    robot = snakehead.SnakeRobot.from_file(published.write_robot("reu", tmp_path_factory.mktemp("reu") / "reu"))
+    return HeadController(robot, method="free_roll", seed=1)
+
+
+def test_a_shape_whose_lift_ends_unsafe_is_no_base_to_choose(reu):
+    """On the published reu snake the initial state's neck and head over a flatter base arc (half its angles) are
+    statically stable by less than DETOUR_MARGIN: the curl is stable, but the plan could not lift from it (it went
+    straight from the curl on the ground to the target, 45 mm into the ground: bench/targets.py --generated
+    published:reu, place 12). The base's choice skips such shapes; the initial shape is fine."""
+    from snakehead.geometry import path_check
+    from snakehead.margins import DETOUR_MARGIN
+    from snakehead.motion import base_choice
+    from snakehead.motion.waypoints import Waypoints
+
+    start = reu.robot.lift_joints.start
+    flat = reu.q_initial.copy()
+    flat[:start] *= 0.5
+    ss.bending_state(reu, flat)  # a stable curl
+    lifted = base_choice.shape_of(reu.robot, flat, reu.q_initial)
+    way = Waypoints(reu.robot, snakehead.BasePlacement(0.7, -0.6, 2.8))  # independent: the checks one by one
+    ground, self_, _ = path_check.sample_clearances(reu.robot, lifted[None], way.base, made=way.checker)
+    assert ground[0] >= 0.0 and self_[0] > 0.0 and 0.0 < way._margins(lifted[None])[0] < DETOUR_MARGIN
+    assert not ss.lift_ends_safe(reu, flat) and not base_choice.has_curl(reu, flat)
+    assert ss.lift_ends_safe(reu, reu.q_initial) and base_choice.has_curl(reu, reu.q_initial)

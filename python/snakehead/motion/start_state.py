@@ -11,7 +11,7 @@ from .._errors import Infeasible
 from ..control.controller import HeadController
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..model.robot import SnakeRobot
+from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import shape_key
 
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
@@ -41,6 +41,19 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     if q is None:
         q = kept.put(key, ground_curl(robot, shape))
     return q.copy()
+
+
+def lift_ends_safe(controller: HeadController, q_shape: np.ndarray) -> bool:
+    """Whether the lift from the bending state ends in a safe state on a base of the flat shape of ``q_shape``: the
+    initial state's neck and head on that base (``motion.planner._lift``'s end) above the ground, clear of itself
+    and statically stable with DETOUR_MARGIN (``Waypoints.feasible``; the same at every placement on the flat
+    ground; obstacles are the plan's to check). Without it the plan's first move goes from the curl on the ground
+    straight to the target, for which there is often no safe path."""
+    from .base_choice import shape_of
+    from .waypoints import Waypoints
+
+    q = shape_of(controller.robot, np.asarray(q_shape, float), controller.q_initial)
+    return bool(Waypoints(controller.robot, BasePlacement()).feasible(q[None])[0])
 
 
 def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
@@ -184,5 +197,5 @@ def _line_margins(hull: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return (cross / np.hypot(edge[:, 0], edge[:, 1])).min(axis=1)
 
 
-__all__ = ["bending_state", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
+__all__ = ["bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
            "BENDING_CLEARANCE"]
