@@ -135,3 +135,17 @@ def test_a_shape_whose_lift_ends_unsafe_is_no_base_to_choose(reu):
     assert ground[0] >= 0.0 and self_[0] > 0.0 and 0.0 < way._margins(lifted[None])[0] < DETOUR_MARGIN
     assert not ss.lift_ends_safe(reu, flat) and not base_choice.has_curl(reu, flat)
     assert ss.lift_ends_safe(reu, reu.q_initial) and base_choice.has_curl(reu, reu.q_initial)
+
+
+def test_a_composition_that_disagrees_with_the_kinematics_falls_back_to_the_exhaustive_search(monkeypatch):
+    """The fast centres of mass are checked against the robot's own at the curls ranked and at a spread of all;
+    were they wrong (a chain the composition does not model), the exhaustive search answers."""
+    robot = snakehead.SnakeRobot.default()
+    q = base_shapes(robot, 1, seed=11)[0]
+    want = ss.ground_curl_exhaustive(robot, q)
+    composed = ss._curl_com
+    calls = []
+    monkeypatch.setattr(ss, "_curl_com", lambda *a: composed(*a)[::-1].copy())  # every curl's mass misplaced
+    monkeypatch.setattr(ss, "ground_curl_exhaustive", lambda *a: calls.append(1) or want)
+    np.testing.assert_array_equal(ss.ground_curl(robot, q), want)
+    assert calls == [1]
