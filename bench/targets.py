@@ -9,7 +9,7 @@ check that failed), the stage that solved it, whether the base had to be relocat
 sample of the successful plans is executed in MuJoCo (``snakehead.simulate``) with the head errors at the target
 and the ZMP check.
 
-    python3 bench/targets.py [--count 50] [--sim 20] [--robot ROBOT.toml | --generated NAME] [--seed 0] [--write]
+    python3 bench/targets.py [--count 50] [--sim 20] [--robot ROBOT.toml | --generated NAME] [--seed 0] [--rows FILE] [--write]
 
 Prints tables; with --write, puts them in bench/RESULTS.md (section "Targets") with the date and the machine.
 """
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import os
 import statistics
 import sys
@@ -44,7 +45,7 @@ def failure_cause(plan) -> str:
     return text[:40]
 
 
-def run_set(controller, name: str, targets, sim_left: list, sim_rows: list) -> dict:
+def run_set(controller, name: str, targets, sim_left: list, sim_rows: list, log=None) -> dict:
     rows = []
     for position, direction in targets:
         t0 = time.perf_counter()
@@ -60,6 +61,10 @@ def run_set(controller, name: str, targets, sim_left: list, sim_rows: list) -> d
                              "direction_deg": s.direction_error_deg, "zmp_inside": s.zmp_inside,
                              "zmp_margin_mm": 1000 * s.metrics["zmp_min_margin_m"],
                              "slide_mm": 1000 * s.metrics["base_slide_m"]})
+        if log is not None:  # one JSON line per target: runs of two releases compared target by target
+            log.write(json.dumps({"set": name, "target": len(rows), **{k: rows[-1][k] for k in
+                                  ("success", "cause", "time", "relocated", "duration")}}) + "\n")
+            log.flush()
         print(f"  {name} {len(rows):3d}: {'ok ' if plan.success else 'NO '} {dt:6.2f} s "
               f"{stage or rows[-1]['cause']}{' (relocated)' if plan.relocation is not None else ''}",
               file=sys.stderr, flush=True)
@@ -81,6 +86,7 @@ def main() -> int:
                     "pitch_first), with a coarse map computed here (voxel twice the default, 6 directions, 1 roll)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--sets", default=",".join(KINDS + ("random",)), help="comma-separated sets to run")
+    ap.add_argument("--rows", default=None, help="also write each target's row (JSON lines) to this file")
     ap.add_argument("--write", action="store_true", help="write the tables into bench/RESULTS.md")
     args = ap.parse_args()
     if args.generated is not None:
@@ -103,13 +109,16 @@ def main() -> int:
     snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
                    controller=controller)  # warm-up: caches of the controller (bending state, IK solvers)
     load0 = os.getloadavg()[0]
+    log = open(args.rows, "w") if args.rows else None
     for name in args.sets.split(","):
         if name == "random":
             targets = random_targets(controller, args.count, rng)
         else:
             targets = [(t.position, t.direction) for t in reachable_targets(controller, name, args.count, rng)]
-        results.append(run_set(controller, name, targets, sim_left, sim_rows))
+        results.append(run_set(controller, name, targets, sim_left, sim_rows, log))
     load1 = os.getloadavg()[0]
+    if log is not None:
+        log.close()
 
     which = f" --generated {args.generated}" if args.generated else f" --robot {args.robot}" if args.robot else ""
     lines = [f"`python3 bench/targets.py --count {args.count} --sim {args.sim} --seed {args.seed}{which}` on "

@@ -16,7 +16,7 @@ from ..control.whole_body import PlanSolves
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import shape_key
-from .start_state import bending_state
+from .start_state import bending_state, lift_ends_safe
 from .target_solves import solve_kept
 
 #: The farthest (m) the planner moves the base by locomotion before a plan (a relocation). A target farther than
@@ -129,7 +129,8 @@ def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.
 
 def has_curl(controller: HeadController, q: np.ndarray) -> bool:
     """Whether the flat shape of q (its joints before the lift) holds a stable curl of the neck and head (a
-    bending state); the shapes that hold none are kept in ``controller.plan_cache.shapes_without_curl``."""
+    bending state) from which the lift ends in a safe state (:func:`~snakehead.motion.start_state.lift_ends_safe`);
+    the shapes that do not are kept in ``controller.plan_cache.shapes_without_curl``."""
     no_curl = controller.plan_cache.shapes_without_curl
     key = shape_key(q, controller.robot.lift_joints.start, 12)
     if key in no_curl:
@@ -137,6 +138,9 @@ def has_curl(controller: HeadController, q: np.ndarray) -> bool:
     try:
         bending_state(controller, q)
     except Infeasible:
+        no_curl.put(key, True)
+        return False
+    if not lift_ends_safe(controller, q):
         no_curl.put(key, True)
         return False
     return True

@@ -77,8 +77,9 @@ class PlanCache:
     bending_states: base shape (:func:`shape_key`, exact) -> the bending state (n,) rad from that shape
         (:func:`~snakehead.motion.start_state.bending_state`); handed out as copies.
     shapes_without_curl: base shapes (:func:`shape_key` rounded to 1e-12 rad) that hold no stable curl of the neck
-        and head (:func:`~snakehead.motion.start_state.bending_state` raised ``Infeasible``): the base's choice skips
-        them.
+        and head (:func:`~snakehead.motion.start_state.bending_state` raised ``Infeasible``) or whose lift from it
+        ends in no safe state (:func:`~snakehead.motion.start_state.lift_ends_safe`): the base's choice skips them
+        (``motion.base_choice.has_curl``).
     lift_paths: (bending state, initial state with that base shape), both rounded to 1e-9 rad as bytes -> (the
         checked path of the lift between them (K, n) rad, the method that made it) (``Waypoints.move``). Kept for
         scenes without obstacles only (with them the lift is checked again).

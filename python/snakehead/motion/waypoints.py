@@ -32,6 +32,7 @@ DENSIFY = 3  # configurations checked between consecutive waypoints of a move, a
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
 DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
+MARGIN_TIE = 1e-12  # m: smallest margins this close are equal (their round-off differs with the batch)
 
 
 def _subdivide(qs: np.ndarray, step: float, least: int = 1) -> np.ndarray:
@@ -216,8 +217,8 @@ class Waypoints:
         reproducible; the joints before it keep their straight path, since their links lie on the ground and a
         detour would sweep them across it, the ground's friction pushing the base) whose every
         configuration passes (tried shortest first, DETOUR_BATCH at a time, each screened at DENSIFY
-        configurations per step and then checked as densely as a move); else the one with the largest worst
-        margin (the scenario's checks report it).
+        configurations per step, :meth:`_screened`, and then checked as densely as a move); else the one with the
+        largest worst margin (:meth:`_steadiest`; the plan's checks then find what is wrong with it, and fail it).
         """
         s = np.linspace(0.0, 1.0, n)[:, None]
         straight = split_steps(qa + s * (qb - qa))
@@ -231,16 +232,52 @@ class Waypoints:
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], axis=1)
         length = np.abs(np.diff(paths, axis=1)).sum(axis=(1, 2))
         order = np.argsort(length, kind="stable")
+        dense = densify(paths)
         for batch in np.array_split(order, max(1, len(order) // DETOUR_BATCH)):
-            flat = densify(paths[batch]).reshape(-1, qa.size)
-            ok = self.feasible(flat).reshape(len(batch), -1).all(axis=1)
-            for k in batch[ok]:
+            for k in batch[self._screened(dense[batch], n - 1)]:
                 path = split_steps(paths[k])
                 if self.path_feasible(path):
                     return path, "joint space via a stable detour"
-        flat = densify(paths).reshape(-1, qa.size)
-        worst = self._margins(flat).reshape(len(W), -1).min(axis=1)
-        return split_steps(paths[int(np.argmax(worst))]), "joint space (no stable detour found)"
+        return split_steps(paths[self._steadiest(dense, n - 1)]), "joint space (no stable detour found)"
+
+    def _screened(self, dense: np.ndarray, middle: int) -> np.ndarray:
+        """(T,) bool: whether every configuration of each densified path dense (T, D, n) (:func:`densify` of paths of
+        waypoints whose ``middle``-th is the detour's) is :meth:`feasible`. Cheap first: the detour waypoints, then
+        every waypoint, then the rest, each only on the paths that passed the one before (a path that fails at some
+        configurations fails: the answer is the check of every configuration's)."""
+        T, D = dense.shape[:2]
+        every = np.arange(0, D, DENSIFY + 1)  # the paths' waypoints
+        stages = [np.array([middle * (DENSIFY + 1)]), every, np.setdiff1d(np.arange(D), every)]
+        ok = np.ones(T, bool)
+        for columns in stages:
+            rows = np.flatnonzero(ok)
+            if rows.size == 0:
+                break
+            ok[rows] = self.feasible(dense[rows][:, columns].reshape(-1, dense.shape[2])).reshape(
+                len(rows), -1).all(axis=1)
+        return ok
+
+    def _steadiest(self, dense: np.ndarray, middle: int) -> int:
+        """The index of the densified path dense (T, D, n) whose smallest static margin (:meth:`_margins`) is the
+        largest: the first path within MARGIN_TIE of the largest (paths often share their smallest margin, at an
+        end they share, equal but for round-off that depends on which configurations are computed together). Each
+        path's margins are computed only while it may be that one: its smallest margin is at most its ends' and its
+        detour waypoint's, so the paths are taken by that bound, largest first, until every bound left is below the
+        best found by more than twice MARGIN_TIE."""
+        T, D, nj = dense.shape
+        ends = np.array([0, middle * (DENSIFY + 1), D - 1])
+        bound = self._margins(dense[:, ends].reshape(-1, nj)).reshape(T, len(ends)).min(axis=1)
+        worst = np.full(T, np.nan)
+        order = np.argsort(-bound, kind="stable")
+        for batch in np.array_split(order, max(1, T // DETOUR_BATCH)):
+            best = np.nanmax(worst) if np.isfinite(worst).any() else -np.inf
+            batch = batch[bound[batch] >= best - 2 * MARGIN_TIE]
+            if batch.size == 0:
+                break
+            worst[batch] = self._margins(dense[batch].reshape(-1, nj)).reshape(len(batch), D).min(axis=1)
+        if not np.isfinite(worst).any():  # no configuration stands (e.g. none touches the ground): the first
+            return 0
+        return int(np.flatnonzero(worst >= np.nanmax(worst) - MARGIN_TIE)[0])
 
     def hold(self, seconds: float) -> None:
         """A pause of ``seconds`` at the last waypoint (which becomes a stop)."""
@@ -363,4 +400,4 @@ def concatenate_motions(a: Any, b: Any) -> Any:
 
 __all__ = ["Waypoints", "split_steps", "check_points", "densify", "concatenate_motions", "PLAN_CONTACT",
            "DETOUR_TRIALS", "DETOUR_SPREAD", "DETOUR_SEED", "JOINT_STEP_CHECK", "FALLBACK_SPEED", "DENSIFY", "MOVE_CHECK_STEP",
-           "MAX_WAYPOINT_STEP", "DETOUR_BATCH"]
+           "MAX_WAYPOINT_STEP", "DETOUR_BATCH", "MARGIN_TIE"]
