@@ -332,7 +332,7 @@ def _centers_of_pressure(points: list, forces: list) -> np.ndarray:
 
 class _TickLog:
     """What the tracking loop records at each control tick: MuJoCo's arrays copied as they are (the state into
-    arrays made for every tick, the contacts and their constraint forces into lists), and after the loop the
+    arrays made for every tick, the contacts and their constraint forces into growing arrays), and after the loop the
     :class:`SimResult`'s quantities computed from them, all ticks at once. They are the numbers
     :func:`momenta_of_state`, :func:`ground_contacts` and :func:`center_of_pressure` give tick by tick, to the bit
     (tested), for a fifth of the loop's Python, which cost more than MuJoCo's physics."""
@@ -344,7 +344,12 @@ class _TickLog:
         self.qpos, self.qvel, self.tau = np.empty((N, m.nq)), np.empty((N, m.nv)), np.empty((N, m.nu))
         self.linvel, self.angmom, self.com = np.empty((N, 3)), np.empty((N, 3)), np.empty((N, 3))
         self.live = not _contacts_decodable(m)  # else the ground contacts are measured tick by tick
-        self.contacts: list = []
+        self.contacts: list = []  # (live) each tick's ground_contacts
+        # every contact of every tick, one row each, and every tick's constraint forces, in growing arrays
+        self.ncon, self.nefc = np.zeros(N, int), np.zeros(N, int)
+        self.geom, self.address = _Rows((2,), np.int32), _Rows((), np.int32)
+        self.pos, self.frame, self.friction = _Rows((3,), float), _Rows((9,), float), _Rows((2,), float)
+        self.efc = _Rows((), float)
 
     def state(self, k: int, d: Any) -> None:
         """Tick ``k``'s state, after ``mj_step1``."""
@@ -365,8 +370,13 @@ class _TickLog:
             self.contacts.append(ground_contacts(self.sim, d))
             return
         c = d.contact
-        self.contacts.append((np.array(c.geom), np.array(c.pos), np.array(c.frame), np.array(c.efc_address),
-                              np.array(c.friction[:, :2]), d.efc_force.copy()))
+        self.ncon[k], self.nefc[k] = d.ncon, d.nefc
+        self.geom.add(c.geom)
+        self.pos.add(c.pos)
+        self.frame.add(c.frame)
+        self.address.add(c.efc_address)
+        self.friction.add(c.friction[:, :2])
+        self.efc.add(d.efc_force)
 
     def result(self) -> dict:
         """The SimResult's recorded fields (q, qdot, tau, head_pose, root_pose, base_positions, P, L, com, zmp,
@@ -396,25 +406,45 @@ class _TickLog:
         """Every tick's :func:`ground_contacts`: the points and forces of the robot-floor contacts."""
         if self.live:
             return [p for p, _ in self.contacts], [f for _, f in self.contacts]
-        geoms, positions, frames, addresses, frictions, efcs = zip(*self.contacts)
-        counts = np.array([len(g) for g in geoms])
-        efc_start = np.cumsum([0] + [len(e) for e in efcs])  # each tick's constraint forces in one array
+        counts = self.ncon
+        efc_start = np.concatenate([[0], np.cumsum(self.nefc)])  # each tick's constraint forces in one array
         tick = np.repeat(np.arange(len(counts)), counts)
-        geom = np.concatenate(geoms).reshape(-1, 2)
+        geom = self.geom.array()
         floor = self.sim.floor_geom
         rows = np.flatnonzero((geom[:, 0] == floor) | (geom[:, 1] == floor))
-        adr = np.concatenate(addresses)[rows]
-        efc = np.concatenate(efcs + (np.zeros(4),))  # (padded: a row without constraints reads 0 below)
+        adr = self.address.array()[rows]
+        efc = np.concatenate([self.efc.array(), np.zeros(4)])  # (padded: a row without constraints reads 0 below)
         edges = np.where(adr[:, None] >= 0,
                          efc[np.where(adr >= 0, efc_start[tick[rows]] + adr, 0)[:, None] + np.arange(4)], 0.0)
-        mu = np.concatenate(frictions).reshape(-1, 2)[rows]
+        mu = self.friction.array()[rows]
         local = np.column_stack([edges.sum(axis=1), (edges[:, 0] - edges[:, 1]) * mu[:, 0],
                                  (edges[:, 2] - edges[:, 3]) * mu[:, 1]])
-        f = np.einsum("kij,ki->kj", np.concatenate(frames).reshape(-1, 3, 3)[rows], local)
+        f = np.einsum("kij,ki->kj", self.frame.array()[rows].reshape(-1, 3, 3), local)
         f[geom[rows, 0] != floor] *= -1.0  # on the robot
-        points = np.concatenate(positions).reshape(-1, 3)[rows]
-        split = np.cumsum(np.bincount(tick[rows], minlength=len(counts)))[:-1]
-        return np.split(points, split), np.split(f, split)
+        points = self.pos.array()[rows]
+        end = np.cumsum(np.bincount(tick[rows], minlength=len(counts))).tolist()
+        start = [0] + end[:-1]
+        return [points[a:b] for a, b in zip(start, end)], [f[a:b] for a, b in zip(start, end)]
+
+
+class _Rows:
+    """Rows of one shape added a few at a time into one array that grows (doubling): no array per addition to
+    join after."""
+
+    def __init__(self, shape: tuple, dtype: Any, capacity: int = 4096) -> None:
+        self.data = np.empty((capacity, *shape), dtype)
+        self.n = 0
+
+    def add(self, rows: np.ndarray) -> None:
+        end = self.n + len(rows)
+        if end > len(self.data):
+            self.data = np.concatenate([self.data[:self.n], np.empty((max(end, 2 * len(self.data)) - self.n,
+                                                                       *self.data.shape[1:]), self.data.dtype)])
+        self.data[self.n:end] = rows
+        self.n = end
+
+    def array(self) -> np.ndarray:
+        return self.data[:self.n]
 
 
 def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
