@@ -245,14 +245,22 @@ def search_for(controller, position, direction, **kw):
     return wb._TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), **options)
 
 
-def test_beyond_reach_is_the_lifted_chain_reach(controller):
+def test_beyond_reach_is_the_reach_of_the_last_joint(controller):
+    """The head link is rigid with the tip: the last joint is its length behind the tip, along the direction, and
+    no farther from the frame the neck lifts from than the chain between them."""
     robot = controller.robot
     origin = robot.frame(controller.q_initial, robot.lift_frame, controller.base)[:3, 3]
     reach = robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach
-    up = np.array([0.0, 0.0, 1.0])
-    inside = search_for(controller, origin + (reach - 1e-3) * up, [1.0, 0.0, 0.0])
-    outside = search_for(controller, origin + (reach + 2 * wb.POSITION_TOLERANCE) * up, [1.0, 0.0, 0.0])
+    up, ahead = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    inside = search_for(controller, origin + (reach - 1e-3) * up, up)  # the chain straight up
+    outside = search_for(controller, origin + (reach + 2 * wb.POSITION_TOLERANCE) * up, up)
     assert not inside.beyond_reach() and outside.beyond_reach()
+    # pointing ahead, the last joint is the head link's length behind the tip
+    link = robot.head_link_length
+    assert not search_for(controller, origin + (reach - link - 1e-3) * up + link * ahead, ahead).beyond_reach()
+    assert search_for(controller, origin + (reach - link + 2 * wb.POSITION_TOLERANCE) * up + link * ahead,
+                      ahead).beyond_reach()
+    assert search_for(controller, origin + (reach - 1e-3) * up, ahead).beyond_reach()  # the old bound's inside
 
 
 def test_consider_keeps_the_best_attempt_and_returns_only_a_solution(controller, reachable):

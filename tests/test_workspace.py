@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from snakehead import Chain, SnakeRobot, default_robot_file
+from snakehead import sweep_defaults
 from snakehead.kinematics import workspace as ws
 from conftest import SMALL_MAP, head6_robot
 
@@ -338,6 +339,15 @@ def test_workspace_gen_unwritable_output_and_help(robot, tmp_path):
     assert r.returncode != 0 and "cannot write" in r.stderr
     r = subprocess.run([workspace_gen(), "--help"], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and "--free-roll" in r.stdout and "--shard" in r.stdout
+    # the defaults it prints are the core's own (the numbers the Python API reads, sweep_defaults)
+    sd = sweep_defaults
+    for flag, value in [("--voxel", sd.HEAD_VOXEL_M), ("--directions", sd.HEAD_DIRECTIONS), ("--rolls", sd.HEAD_ROLLS),
+                        ("--timeout", sd.HEAD_TIMEOUT_S), ("--epsilon", sd.HEAD_EPSILON),
+                        ("--cloud-samples", sd.HEAD_CLOUD_SAMPLES), ("--shrink", sd.HEAD_SHRINK),
+                        ("--seed", sd.HEAD_SEED)]:
+        line = next(x for x in r.stdout.splitlines() if x.strip().startswith(flag + " "))
+        printed = line.split("(default ")[1].split(")")[0].split(",")[0]
+        assert float(printed) == value, (flag, printed, value)
     r = subprocess.run([workspace_gen()], capture_output=True, text=True, timeout=60)
     assert r.returncode != 0 and "required" in r.stderr
 

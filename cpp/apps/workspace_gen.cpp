@@ -16,8 +16,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "snakehead/model.hpp"
 #include "snakehead/npz.hpp"
@@ -25,7 +27,15 @@
 
 namespace {
 
-const char* kUsage = R"(usage: workspace_gen --urdf FILE --base LINK --tip LINK --out MAP.npz [options]
+// The usage text; its defaults are read from WorkspaceOptions, so that they are written once (workspace.hpp).
+std::string usage() {
+  const snakehead::WorkspaceOptions d;
+  auto num = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
+  std::string text = R"(usage: workspace_gen --urdf FILE --base LINK --tip LINK --out MAP.npz [options]
 
 Computes the reachability map of the chain BASE -> TIP (Algorithm 1 of the paper): voxels of the
 cube of side 2 * reach centred on BASE that lie inside the boundary of random tip positions get the
@@ -41,25 +51,33 @@ required:
   --tip LINK             the chain's tip link
   --out FILE             output .npz (numpy.load reads it)
 options:
-  --voxel M              voxel edge in metres (default 0.05)
-  --directions N         points per voxel sphere, Fibonacci lattice (default 20)
-  --rolls R              frames about the approach axis per point (default 4)
+  --voxel M              voxel edge in metres (default {voxel})
+  --directions N         points per voxel sphere, Fibonacci lattice (default {directions})
+  --rolls R              frames about the approach axis per point (default {rolls})
   --free-roll            instead of rolls: one IK call per point with the roll left free
   --each-roll            count every (point, roll) frame; by default a point counts as reached
                          when any of its rolls is solved (the paper's Algorithm 1)
   --approach-axis x|z    tip axis that approaches the sphere point (default x, the head's direction)
-  --timeout S            IK budget per call in seconds (default 0.0003)
-  --epsilon E            IK tolerance (default 1e-5)
-  --cloud-samples N      random configurations for the hull (default 50000)
+  --timeout S            IK budget per call in seconds (default {timeout})
+  --epsilon E            IK tolerance (default {epsilon})
+  --cloud-samples N      random configurations for the hull (default {cloud})
   --hull boundary|convex the voxels inside the cloud's boundary (the paper's boundary(P): an alpha
                          shape chosen as MATLAB's boundary() does; default) or its convex hull
-  --shrink S             the boundary's shrink factor in [0, 1] (default 0.5, MATLAB's default)
-  --seed N               random seed (default 1); the map is a function of the seed
+  --shrink S             the boundary's shrink factor in [0, 1] (default {shrink}, MATLAB's default)
+  --seed N               random seed (default {seed}); the map is a function of the seed
   --threads N            worker threads (default: all cores); does not change the map
   --shard i/N            compute only shard i of N (0 <= i < N); merge the N files afterwards
   --quiet                no progress line
   --help                 this text
 )";
+  const std::pair<const char*, std::string> fields[] = {
+      {"{voxel}", num(d.voxel_size)},       {"{directions}", std::to_string(d.directions)},
+      {"{rolls}", std::to_string(d.rolls)}, {"{timeout}", num(d.timeout)},
+      {"{epsilon}", num(d.epsilon)},        {"{cloud}", std::to_string(d.cloud_samples)},
+      {"{shrink}", num(d.shrink)},          {"{seed}", std::to_string(d.seed)}};
+  for (const auto& [key, value] : fields) text.replace(text.find(key), std::string(key).size(), value);
+  return text;
+}
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -135,7 +153,7 @@ int main(int argc, char** argv) {
         return argv[++k];
       };
       if (a == "--help" || a == "-h") {
-        std::cout << kUsage;
+        std::cout << usage();
         return 0;
       } else if (a == "--urdf") {
         urdf = value();

@@ -10,39 +10,15 @@
 
 #include "snakehead/kinematics.hpp"
 #include "snakehead/path_check.hpp"
+#include "four_link_chain.hpp"
 
 namespace {
 
 using namespace snakehead;
 
-std::string chain_urdf() {
-  std::string s = "<robot name='c'><link name='l0'/>";
-  const char* axes[] = {"0 0 1", "0 1 0", "0 0 1", "0 1 0"};
-  for (int j = 0; j < 4; ++j) {
-    const std::string me = "l" + std::to_string(j + 1), parent = "l" + std::to_string(j);
-    s += "<link name='" + me + "'><collision><origin xyz='0.05 0 0'/><geometry><box size='0.1 0.04 0.04'/>"
-         "</geometry></collision></link>";
-    s += "<joint name='j" + std::to_string(j) + "' type='revolute'><parent link='" + parent + "'/><child link='" +
-         me + "'/><origin xyz='" + (j == 0 ? "0" : "0.1") + " 0 0'/><axis xyz='" + axes[j] +
-         "'/><limit lower='-3' upper='3' effort='1' velocity='1'/></joint>";
-  }
-  return s + "</robot>";
-}
-
 struct Fixture {
-  ChainModel model = ChainModel::from_urdf(chain_urdf(), "l0", "l4");
-  std::vector<ConvexShape> shapes_of() const {
-    std::vector<ConvexShape> out;
-    for (int k = 1; k <= 4; ++k) {
-      ConvexShape s;
-      s.kind = ShapeKind::Box;
-      s.frame = model.link_index("l" + std::to_string(k));
-      s.origin.translation() = Eigen::Vector3d(0.05, 0.0, 0.0);
-      s.size = Eigen::Vector3d(0.1, 0.04, 0.04);
-      out.push_back(s);
-    }
-    return out;
-  }
+  ChainModel model = test::four_link_chain(0.1);
+  std::vector<ConvexShape> shapes_of() const { return test::four_link_boxes(model, 0.1); }
 };
 
 // World corners (3 x 8) of shape s at configuration q.

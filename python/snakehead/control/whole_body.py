@@ -174,6 +174,26 @@ class BodyProblem:
         self.axis_local = np.asarray(robot.body.model.joint_axes, float)
         self.head_index = robot.link_index(robot.parts.head_tip)
         self._iks: dict = {}
+        self._pose_bounds: Any = None
+
+    @property
+    def pose_bounds(self) -> Any:
+        """The robot's necessary conditions of a pose (``motion.reach_bounds.PoseBounds``), made once: the solve
+        asks them before an IK batch or a segmented solve that they prove cannot succeed."""
+        if self._pose_bounds is None:
+            from ..motion.reach_bounds import PoseBounds
+
+            self._pose_bounds = PoseBounds.of(self.robot, np.zeros(self.robot.n_joints))
+        return self._pose_bounds
+
+    def out_of_reach(self, q: np.ndarray, base: BasePlacement, position: np.ndarray, direction: np.ndarray) -> bool:
+        """Whether no pose of the lifted chain from the frame it lifts from in ``q`` at ``base`` (the links before
+        it kept) puts the head at ``position`` along ``direction`` within the checks' tolerances: the first frame
+        rigid with the tip is then farther from that frame than the chain between them
+        (``PoseBounds.out_of_reach``, its soundness tested in tests/test_reach_bounds.py). The lifted chain's IK
+        cannot succeed there either: its tolerance (``epsilon``, 1e-5 per axis) is inside the checks'."""
+        origin = self.robot.frame(q, self.robot.lift_frame, base)[:3, 3]
+        return bool(self.pose_bounds.out_of_reach(position, direction, origin)[0])
 
     def lifted_ik(self, seed: int = 0) -> Any:
         """TRAC-IK of the lifted chain (lift_frame -> head_tip), seeded (made once per seed)."""
@@ -620,6 +640,8 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     from .head import frame_along
 
     robot = prob.robot
+    if prob.out_of_reach(q_now, base, position, direction):
+        return []  # (what the batch would find: every IK fails)
     ik = prob.lifted_ik(seed)
     start = robot.lift_joints.start
     T0 = robot.frame(q_now, robot.lift_frame, base)
@@ -797,13 +819,21 @@ class _TargetSearch:
         return sol if sol.success else None
 
     def beyond_reach(self) -> bool:
-        """With the base kept, the frame the neck lifts from stays where it is, and no point of the lifted chain
-        gets farther from it than the chain's reach: whether the target is beyond that (by more than the position
-        tolerance), where stages 1 and 2 cannot succeed and their IK would spend its whole time budget finding so."""
-        robot = self.robot
-        lift_origin = robot.frame(self.q_now, robot.lift_frame, self.base)[:3, 3]
-        reach = robot.sub_chain(robot.lift_frame, robot.parts.head_tip).reach
-        return bool(np.linalg.norm(self.position - lift_origin) > reach + POSITION_TOLERANCE)
+        """With the base kept, the frame the neck lifts from stays where it is: whether the target is out of the
+        lifted chain's reach from there (:meth:`BodyProblem.out_of_reach`), where stages 1 and 2 cannot succeed and
+        their IK would spend its whole budget finding so. The segmented solve lifts the neck from the initial
+        configuration's joints before the lift (``HeadController.solve_checked``): the target must be out of reach
+        from that frame too."""
+        q = self.q_now
+        lift = self.robot.lift_joints.start
+        neck = self.robot.parts.neck.start
+        if not self.prob.out_of_reach(q, self.base, self.position, self.direction):
+            return False
+        if neck >= lift or np.array_equal(q[neck:lift], self.controller.q_initial[neck:lift]):
+            return True
+        q = q.copy()
+        q[neck:lift] = self.controller.q_initial[neck:lift]
+        return self.prob.out_of_reach(q, self.base, self.position, self.direction)
 
     def base_kept(self, near: bool) -> WholeBodySolution | None:
         """The base as it is: with ``near``, the lifted chain's IK continued from the current joints
