@@ -320,13 +320,12 @@ def _centers_of_pressure(points: list, forces: list) -> np.ndarray:
         return zmp
     p, f = np.concatenate(points), np.concatenate(forces)
     fz = f[:, 2]
-    mx = p[:, 0] * fz - p[:, 2] * f[:, 0]
-    my = p[:, 1] * fz - p[:, 2] * f[:, 1]
-    end = np.cumsum([len(x) for x in points])
-    for k, (a, b) in enumerate(zip(end - [len(x) for x in points], end)):
-        total = fz[a:b].sum()
+    terms = np.stack([fz, p[:, 0] * fz - p[:, 2] * f[:, 0], p[:, 1] * fz - p[:, 2] * f[:, 1]])  # (3, K): rows
+    end = np.cumsum([len(x) for x in points])  # summed along, pairwise as a 1-D sum is: the same bits
+    for k, (a, b) in enumerate(zip((end - [len(x) for x in points]).tolist(), end.tolist())):
+        total, mx, my = terms[:, a:b].sum(axis=1).tolist()
         if b > a and total > 1e-9:
-            zmp[k] = mx[a:b].sum() / total, my[a:b].sum() / total
+            zmp[k] = mx / total, my / total
     return zmp
 
 
