@@ -77,7 +77,7 @@ def main() -> None:
                 totals[kind] += st["seconds"]
                 break
     print()
-    for _, kind in KINDS:
+    for kind in dict.fromkeys(kind for _, kind in KINDS):
         if kind in totals:
             print(f"{'total: ' + kind:<78} {totals[kind]:6.1f}")
     children = (cpu1.children_user + cpu1.children_system) - (cpu0.children_user + cpu0.children_system)
