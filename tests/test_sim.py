@@ -292,6 +292,19 @@ def test_the_loop_records_what_each_tick_measures(robot, lift):
     np.testing.assert_array_equal(np.concatenate(res.contact_forces), np.concatenate(ref["forces"]))
 
 
+def test_contacts_measured_tick_by_tick_when_not_decodable(robot, monkeypatch):
+    """A model whose contacts the log cannot decode after the loop (another friction cone or contact dimension) has
+    them measured tick by tick with ground_contacts: the same result as the decoded ones here."""
+    t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.1)
+    decoded = sim.simulate_trajectory(robot, t, q, settle=0.05)
+    monkeypatch.setattr(tracking, "_contacts_decodable", lambda model: False)
+    live = sim.simulate_trajectory(robot, t, q, settle=0.05)
+    np.testing.assert_array_equal(live.zmp, decoded.zmp)
+    for a, b in zip(live.contact_forces, decoded.contact_forces):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+    assert sum(len(f) for f in live.contact_forces) > 3 * len(live.t)
+
+
 def test_weak_servos_cannot_lift_the_head_part(robot):
     """3 N m servos cannot raise the 1.3 kg head part from flat (joint 10 needs ~3.9 N m): the simulation
     shows it. This is why snake16.urdf declares 10 N m (our choice; the paper gives no effort)."""
