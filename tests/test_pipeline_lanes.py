@@ -54,6 +54,20 @@ def test_lanes_write_the_report_one_process_writes(tmp_path: Path, monkeypatch) 
     stages = [st["stage"] for st in lanes["stages"]]
     assert any(st.startswith("hole: planning") for st in stages) and any(st.startswith("spheres: planning")
                                                                        for st in stages)
+    # every core runs a lane: each lane makes its outputs itself (more processes would only share the cores)
+    assert any("ROS 2" in st for st in stages) and not any(st.endswith("[in a second process]") for st in stages)
     for name, entry in lanes["scenarios"].items():
         for file in entry["files"]:
             assert (tmp_path / "True" / file).read_bytes() == (tmp_path / "False" / file).read_bytes(), file
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="figures beside fork")
+def test_one_lane_makes_its_outputs_beside_it_on_a_spare_core(tmp_path: Path, monkeypatch) -> None:
+    """One scene on two cores: what needs only the plan (here the ROS outputs) is made in a process beside the
+    lane, on the core the lane leaves free."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    report = run_scenes([paper_scene("hole")], tmp_path, progress=pipeline.Progress(quiet=True),
+                        settings=Settings(simulate=False, figures=False, parallel=True))
+    assert any(st["stage"].startswith("hole: ROS 2") and st["stage"].endswith("[in a second process]")
+               for st in report["stages"])
+    assert (tmp_path / "hole.mcap").exists()

@@ -236,6 +236,75 @@ def test_tracking_a_slow_lift(robot, lift):
     assert r2["position_error_m"] == pytest.approx(report["position_errors_m"][0], abs=1e-12)
 
 
+def _tick_by_tick(robot, t, q, res, obstacles=()):
+    """The tracking loop of ``res`` again in a fresh model, each tick measured as it runs with the per-tick
+    functions (momenta_of_state, ground_contacts, center_of_pressure, gravity_torques): what the loop records."""
+    s = sim.build_model(robot, obstacles=obstacles)
+    m = s.model
+    m.actuator_biasprm[:, 1] = -np.asarray(res.settings["kp"])
+    m.actuator_biasprm[:, 2] = -np.asarray(res.settings["kd"])
+    kp, kd = np.asarray(res.settings["kp"]), np.asarray(res.settings["kd"])
+    d = mujoco.MjData(m)
+    s.set_state(d, q[0], res.base, lift=2e-4)
+    W0 = tracking.carried_weights(robot, robot.frames_many(q[:1], res.base))[0]
+    for _ in range(round(res.settings["settle"] / res.settings["control_dt"])):
+        mujoco.mj_step1(m, d)
+        d.ctrl[:] = kp * q[0] + tracking.gravity_torques(s, d, W0)
+        mujoco.mj_step2(m, d)
+        mujoco.mj_step(m, d)
+    qd_ref = np.column_stack([np.interp(res.t, t, col) for col in np.gradient(q, t, axis=0).T])
+    W = tracking.carried_weights(robot, robot.frames_many(res.q_ref, res.base))
+    head = s.body_ids[robot.body.link_index(robot.parts.head_tip)]
+    out = {key: [] for key in ("q", "head", "P", "L", "tau", "zmp", "points", "forces")}
+    for k in range(len(res.t)):
+        mujoco.mj_step1(m, d)
+        out["q"].append(d.qpos[s.qpos_adr].copy())
+        out["head"].append(np.r_[d.xpos[head], d.xmat[head]])
+        P, L = tracking.momenta_of_state(s, d)
+        out["P"].append(P)
+        out["L"].append(L)
+        d.ctrl[:] = kp * res.q_ref[k] + kd * qd_ref[k] + tracking.gravity_torques(s, d, W[k])
+        mujoco.mj_step2(m, d)
+        out["tau"].append(d.actuator_force.copy())
+        points, forces = tracking.ground_contacts(s, d)
+        out["points"].append(points)
+        out["forces"].append(forces)
+        out["zmp"].append(tracking.center_of_pressure(points, forces))
+        mujoco.mj_step(m, d)
+    return {key: np.array(v) if key not in ("points", "forces") else v for key, v in out.items()}
+
+
+def test_the_loop_records_what_each_tick_measures(robot, lift):
+    """The tracking loop records MuJoCo's arrays raw and computes momenta, contact forces and ZMP after it, all ticks
+    at once: the same numbers, to the bit, as measuring each tick as it runs (a shortened lift, floor contacts
+    throughout)."""
+    t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.3)
+    res = sim.simulate_trajectory(robot, t, q, torque_limit=10.0, settle=0.1)
+    ref = _tick_by_tick(robot, t, q, res)
+    np.testing.assert_array_equal(res.q, ref["q"])
+    np.testing.assert_array_equal(res.head_position, ref["head"][:, :3])
+    np.testing.assert_array_equal(res.head_pose[:, :3, :3].reshape(-1, 9), ref["head"][:, 3:])
+    for key in ("P", "L", "tau", "zmp"):
+        np.testing.assert_array_equal(getattr(res, key), ref[key], err_msg=key)
+    assert [len(p) for p in res.contact_points] == [len(p) for p in ref["points"]]
+    assert np.median([len(p) for p in ref["points"]]) > 3
+    np.testing.assert_array_equal(np.concatenate(res.contact_points), np.concatenate(ref["points"]))
+    np.testing.assert_array_equal(np.concatenate(res.contact_forces), np.concatenate(ref["forces"]))
+
+
+def test_contacts_measured_tick_by_tick_when_not_decodable(robot, monkeypatch):
+    """A model whose contacts the log cannot decode after the loop (another friction cone or contact dimension) has
+    them measured tick by tick with ground_contacts: the same result as the decoded ones here."""
+    t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.1)
+    decoded = sim.simulate_trajectory(robot, t, q, settle=0.05)
+    monkeypatch.setattr(tracking, "_contacts_decodable", lambda model: False)
+    live = sim.simulate_trajectory(robot, t, q, settle=0.05)
+    np.testing.assert_array_equal(live.zmp, decoded.zmp)
+    for a, b in zip(live.contact_forces, decoded.contact_forces):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+    assert sum(len(f) for f in live.contact_forces) > 3 * len(live.t)
+
+
 def test_weak_servos_cannot_lift_the_head_part(robot):
     """3 N m servos cannot raise the 1.3 kg head part from flat (joint 10 needs ~3.9 N m): the simulation
     shows it. This is why snake16.urdf declares 10 N m (our choice; the paper gives no effort)."""

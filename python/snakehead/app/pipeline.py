@@ -138,9 +138,11 @@ class PendingScene:
 
 
 def start_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress, *,
-                solution_figure: bool = False) -> PendingScene:
+                solution_figure: bool = False, beside: bool = True) -> PendingScene:
     """:func:`run_scene` up to its last figures (the momenta and the ZMP, drawn beside the caller once MuJoCo is
-    done), so that the next scene is planned while they are drawn."""
+    done), so that the next scene is planned while they are drawn. ``beside``: the figures (and the ROS outputs)
+    are made in processes beside this one when ``settings.parallel`` (False: here, in turn -- when every core
+    already runs a lane of scenes, more processes would only share the cores and copy the memory they touch)."""
     from ..motion.planner import plan
 
     s = FAST if settings.fast else NORMAL
@@ -157,9 +159,10 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
     files = [rep.write_trajectory_csv(result, out / f"{name}_trajectory.csv", robot.joint_names).name]
     # what needs only the plan (its figures, the ROS outputs) is made while MuJoCo simulates (forked first: see
     # _Beside), off the scene's critical path (plan -> MuJoCo -> the figures of the dynamics)
-    beside = _Beside(lambda p: _ros_outputs(name, out, p, result)
-                     + (_plan_outputs(scene, result, out, s, p, solution_figure, controller.map)
-                        if settings.figures else []), progress, parallel=settings.parallel)
+    parallel = settings.parallel and beside
+    plan_outputs = _Beside(lambda p: _ros_outputs(name, out, p, result)
+                           + (_plan_outputs(scene, result, out, s, p, solution_figure, controller.map)
+                              if settings.figures else []), progress, parallel=parallel)
 
     metrics, notes, sim_result = None, [], None
     if not settings.simulate:
@@ -186,10 +189,10 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
                          f"{metrics['max_angular_momentum_error']:.4f} kg m^2/s, "
                          f"{metrics['max_linear_momentum_error']:.4f} kg m/s; ZMP inside: {metrics['zmp_inside']}")
 
-    pending = [beside]
+    pending = [plan_outputs]
     if settings.figures:  # the two figures of the dynamics each in a process: they end the scene's work
         pending += [_Beside(functools.partial(_dynamics_figures, scene, result, sim_result, out, kinds=(kind,)),
-                            progress, parallel=settings.parallel) for kind in DYNAMICS_FIGURES]
+                            progress, parallel=parallel) for kind in DYNAMICS_FIGURES]
     entry = rep.scenario_entry(result, metrics, extra={"files": files})
     entry["notes"] = list(entry["notes"]) + notes
     return PendingScene(entry, files, pending)
@@ -536,7 +539,8 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     if on_controller is not None:
         on_controller(controller)
     try:
-        entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start)
+        entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start,
+                            figures_beside=len(lanes) < _cores())
         for lane in beside:
             entries.update(lane.result())
     except BaseException:  # interrupted or failed: the lanes beside stop too (they would run on, and be waited for)
@@ -562,11 +566,13 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
 def scene_lanes(scenes: Sequence[Scene], settings: Settings) -> list[list[Scene]]:
     """The scenes dealt round-robin into lanes that run side by side, one a core (at most one a scene); one lane
     (every scene in this process) without ``settings.parallel``, off Linux (no fork) or on one core."""
-    import os
-
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    n = min(cores, len(scenes)) if settings.parallel and sys.platform.startswith("linux") else 1
+    n = min(_cores(), len(scenes)) if settings.parallel and sys.platform.startswith("linux") else 1
     return [list(scenes[k::n]) for k in range(max(n, 1))]
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress: Progress) -> ReachabilityMap:
@@ -601,15 +607,17 @@ def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: Reachabili
         from ..control.controller import HeadController
 
         controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
-        return _run_lane(lane, controller, out, settings, p, solution_figure, None)
+        return _run_lane(lane, controller, out, settings, p, solution_figure, None, figures_beside=False)
 
     return _Beside(work, progress, parallel=True, suffix="", daemon=False, timeout_s=LANE_PROCESS_TIMEOUT_S)
 
 
 def _run_lane(scenes: Sequence[Scene], controller: HeadController, out: Path, settings: Settings,
-              progress: Progress, solution_figure: bool, start: BasePlacement | str | None) -> dict:
+              progress: Progress, solution_figure: bool, start: BasePlacement | str | None, *,
+              figures_beside: bool = True) -> dict:
     """The scenes one after the other with ``controller``, each planned while the previous one's last figures are
-    drawn; their report entries by name."""
+    drawn (``figures_beside``: in processes beside this lane, see :func:`start_scene`); their report entries by
+    name."""
     entries = {}
     drawing: PendingScene | None = None  # the previous scene, its last figures drawn while this one is planned
     for scene in scenes:
@@ -617,7 +625,8 @@ def _run_lane(scenes: Sequence[Scene], controller: HeadController, out: Path, se
             entries[scene.name] = run_loop_scene(scene, controller, out, settings, progress, start,
                                                  solution_figure=solution_figure)
             continue
-        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure)
+        pending = start_scene(scene, controller, out, settings, progress, solution_figure=solution_figure,
+                              beside=figures_beside)
         if drawing is not None:
             drawing.finish()
         entries[scene.name], drawing = pending.entry, pending

@@ -41,8 +41,10 @@ def momenta_of_state(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b of two 3-vectors (np.cross costs ~20 us a call; this runs at every control tick)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    """a x b of 3-vectors (..., 3) (np.cross costs ~20 us a call)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -275,6 +277,175 @@ def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray
     return GRAVITY * (a[:, 0] * moment[:, 1] - a[:, 1] * moment[:, 0])
 
 
+class _GravityTerm:
+    """:func:`gravity_torques` in the tracking loop, with what does not change from tick to tick prepared once: the
+    joints' and links' indices, and every tick's weighted masses and their totals (the same products and sums, so
+    the same torques to the bit)."""
+
+    def __init__(self, sim: SimModel, weights: np.ndarray) -> None:
+        m = sim.model
+        self.joints = _as_slice(m.dof_jntid[sim.dof_adr])
+        self.bodies = _as_slice(sim.body_ids)
+        self.wm = weights * m.body_mass[sim.body_ids][None, None, :]  # (N, n, L)
+        self.total = self.wm.sum(axis=2)[:, :, None]  # (N, n, 1)
+
+    def __call__(self, data: Any, k: int) -> np.ndarray:
+        """The torques (n,) N m of tick ``k`` in the state ``data``."""
+        a = data.xaxis[self.joints]
+        p = data.xanchor[self.joints]
+        moment = self.wm[k] @ data.xipos[self.bodies, :2] - self.total[k] * p[:, :2]
+        return GRAVITY * (a[:, 0] * moment[:, 1] - a[:, 1] * moment[:, 0])
+
+
+def _as_slice(index: np.ndarray) -> slice | np.ndarray:
+    """``index`` as a slice when it is a run of consecutive integers (a view, no copy, when indexing), else as it is."""
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
+def _contacts_decodable(model: Any) -> bool:
+    """Whether every contact of ``model`` is a 3-D one with a pyramidal friction cone (what :func:`_contact_forces`
+    decodes from the constraint forces alone): geoms of condim 3 only, no explicit pairs or flexes."""
+    mj = _mujoco()
+    return bool(model.opt.cone == mj.mjtCone.mjCONE_PYRAMIDAL and np.all(model.geom_condim == 3)
+                and model.npair == 0 and model.nflex == 0)
+
+
+def _centers_of_pressure(points: list, forces: list) -> np.ndarray:
+    """(N, 2) :func:`center_of_pressure` of each tick's contacts (views into one array each): the products for all
+    ticks at once, each tick's sums as that function sums them (so the same numbers to the bit)."""
+    zmp = np.full((len(points), 2), np.nan)
+    if not points:
+        return zmp
+    p, f = np.concatenate(points), np.concatenate(forces)
+    fz = f[:, 2]
+    terms = np.stack([fz, p[:, 0] * fz - p[:, 2] * f[:, 0], p[:, 1] * fz - p[:, 2] * f[:, 1]])  # (3, K): rows
+    end = np.cumsum([len(x) for x in points])  # summed along, pairwise as a 1-D sum is: the same bits
+    for k, (a, b) in enumerate(zip((end - [len(x) for x in points]).tolist(), end.tolist())):
+        total, mx, my = terms[:, a:b].sum(axis=1).tolist()
+        if b > a and total > 1e-9:
+            zmp[k] = mx / total, my / total
+    return zmp
+
+
+class _TickLog:
+    """What the tracking loop records at each control tick: MuJoCo's arrays copied as they are (the state into
+    arrays made for every tick, the contacts and their constraint forces into growing arrays), and after the loop the
+    :class:`SimResult`'s quantities computed from them, all ticks at once. They are the numbers
+    :func:`momenta_of_state`, :func:`ground_contacts` and :func:`center_of_pressure` give tick by tick, to the bit
+    (tested), for a fifth of the loop's Python, which cost more than MuJoCo's physics."""
+
+    def __init__(self, sim: SimModel, robot: SnakeRobot, N: int) -> None:
+        m = sim.model
+        self.sim, self.robot = sim, robot
+        self.xpos, self.xmat = np.empty((N, m.nbody, 3)), np.empty((N, m.nbody, 9))
+        self.qpos, self.qvel, self.tau = np.empty((N, m.nq)), np.empty((N, m.nv)), np.empty((N, m.nu))
+        self.linvel, self.angmom, self.com = np.empty((N, 3)), np.empty((N, 3)), np.empty((N, 3))
+        self.live = not _contacts_decodable(m)  # else the ground contacts are measured tick by tick
+        self.contacts: list = []  # (live) each tick's ground_contacts
+        # every contact of every tick, one row each, and every tick's constraint forces, in growing arrays
+        self.ncon, self.nefc = np.zeros(N, int), np.zeros(N, int)
+        self.geom, self.address = _Rows((2,), np.int32), _Rows((), np.int32)
+        self.pos, self.frame, self.friction = _Rows((3,), float), _Rows((9,), float), _Rows((2,), float)
+        self.efc = _Rows((), float)
+
+    def state(self, k: int, d: Any) -> None:
+        """Tick ``k``'s state, after ``mj_step1``."""
+        self.xpos[k] = d.xpos
+        self.xmat[k] = d.xmat
+        self.qpos[k] = d.qpos
+        self.qvel[k] = d.qvel
+        _mujoco().mj_subtreeVel(self.sim.model, d)
+        b = self.sim.root_body
+        self.linvel[k] = d.subtree_linvel[b]
+        self.angmom[k] = d.subtree_angmom[b]
+        self.com[k] = d.subtree_com[b]
+
+    def forces(self, k: int, d: Any) -> None:
+        """Tick ``k``'s torques and contact forces, after ``mj_step2``."""
+        self.tau[k] = d.actuator_force
+        if self.live:
+            self.contacts.append(ground_contacts(self.sim, d))
+            return
+        c = d.contact
+        self.ncon[k], self.nefc[k] = d.ncon, d.nefc
+        self.geom.add(c.geom)
+        self.pos.add(c.pos)
+        self.frame.add(c.frame)
+        self.address.add(c.efc_address)
+        self.friction.add(c.friction[:, :2])
+        self.efc.add(d.efc_force)
+
+    def result(self) -> dict:
+        """The SimResult's recorded fields (q, qdot, tau, head_pose, root_pose, base_positions, P, L, com, zmp,
+        contact_points, contact_forces)."""
+        sim, robot = self.sim, self.robot
+        out: dict[str, Any] = {"q": self.qpos[:, sim.qpos_adr], "qdot": self.qvel[:, sim.dof_adr],
+                               "tau": self.tau, "com": self.com}
+        out["head_pose"] = self._poses(sim.body_ids[robot.body.link_index(robot.parts.head_tip)])
+        out["root_pose"] = self._poses(sim.root_body)
+        out["base_positions"] = self.xpos[:, sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]]
+        out["P"] = sim.model.body_subtreemass[sim.root_body] * self.linvel
+        out["L"] = self.angmom + _cross3(self.com, out["P"])
+        points, forces = self._ground_contacts()
+        out["contact_points"], out["contact_forces"] = points, forces
+        out["zmp"] = _centers_of_pressure(points, forces)
+        return out
+
+    def _poses(self, body: int) -> np.ndarray:
+        """(N, 4, 4) world poses of ``body`` at every tick."""
+        T = np.zeros((len(self.xpos), 4, 4))
+        T[:, :3, :3] = self.xmat[:, body].reshape(-1, 3, 3)
+        T[:, :3, 3] = self.xpos[:, body]
+        T[:, 3, 3] = 1.0
+        return T
+
+    def _ground_contacts(self) -> tuple[list, list]:
+        """Every tick's :func:`ground_contacts`: the points and forces of the robot-floor contacts."""
+        if self.live:
+            return [p for p, _ in self.contacts], [f for _, f in self.contacts]
+        counts = self.ncon
+        efc_start = np.concatenate([[0], np.cumsum(self.nefc)])  # each tick's constraint forces in one array
+        tick = np.repeat(np.arange(len(counts)), counts)
+        geom = self.geom.array()
+        floor = self.sim.floor_geom
+        rows = np.flatnonzero((geom[:, 0] == floor) | (geom[:, 1] == floor))
+        adr = self.address.array()[rows]
+        efc = np.concatenate([self.efc.array(), np.zeros(4)])  # (padded: a row without constraints reads 0 below)
+        edges = np.where(adr[:, None] >= 0,
+                         efc[np.where(adr >= 0, efc_start[tick[rows]] + adr, 0)[:, None] + np.arange(4)], 0.0)
+        mu = self.friction.array()[rows]
+        local = np.column_stack([edges.sum(axis=1), (edges[:, 0] - edges[:, 1]) * mu[:, 0],
+                                 (edges[:, 2] - edges[:, 3]) * mu[:, 1]])
+        f = np.einsum("kij,ki->kj", self.frame.array()[rows].reshape(-1, 3, 3), local)
+        f[geom[rows, 0] != floor] *= -1.0  # on the robot
+        points = self.pos.array()[rows]
+        end = np.cumsum(np.bincount(tick[rows], minlength=len(counts))).tolist()
+        start = [0] + end[:-1]
+        return [points[a:b] for a, b in zip(start, end)], [f[a:b] for a, b in zip(start, end)]
+
+
+class _Rows:
+    """Rows of one shape added a few at a time into one array that grows (doubling): no array per addition to
+    join after."""
+
+    def __init__(self, shape: tuple, dtype: Any, capacity: int = 4096) -> None:
+        self.data = np.empty((capacity, *shape), dtype)
+        self.n = 0
+
+    def add(self, rows: np.ndarray) -> None:
+        end = self.n + len(rows)
+        if end > len(self.data):
+            self.data = np.concatenate([self.data[:self.n], np.empty((max(end, 2 * len(self.data)) - self.n,
+                                                                       *self.data.shape[1:]), self.data.dtype)])
+        self.data[self.n:end] = rows
+        self.n = end
+
+    def array(self) -> np.ndarray:
+        return self.data[:self.n]
+
+
 def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
                         kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None, *,
                         control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
@@ -344,7 +515,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                         f"{type(state).__name__}")
 
     qdot_plan = np.gradient(q, t, axis=0)
-    qa, da = sim.qpos_adr, sim.dof_adr
+    da = sim.dof_adr
 
     def control(qr: np.ndarray, qdr: np.ndarray, W: np.ndarray | None) -> None:
         tau_g: np.ndarray | float
@@ -377,40 +548,23 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     qd_ref[ts > t[-1]] = 0.0
     Wref = carried_weights(robot, robot.frames_many(q_ref, base)) if mode == "supported" else None
 
-    head_k = robot.body.link_index(robot.parts.head_tip)
-    base_frames = sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]  # the base's frames up to base_end (P0)
-    rec = {k: np.zeros((N, 3)) for k in ("P", "L", "com")}
-    qs, qds, taus = np.zeros((N, n)), np.zeros((N, n)), np.zeros((N, n))
-    head = np.zeros((N, 4, 4))
-    root = np.zeros((N, 4, 4))
-    basepos = np.zeros((N, len(base_frames), 3))
-    zmp = np.zeros((N, 2))
-    cpts, cfrc = [], []
-    hb = sim.body_ids[head_k]
+    log = _TickLog(sim, robot, N)
+    pd_ref = kp * q_ref + kd * qd_ref  # the servo's reference terms, as control() adds them, for every tick
+    gravity = _GravityTerm(sim, Wref) if Wref is not None else None
     for k in range(N):
         mj.mj_step1(m, d)  # positions, velocities, collisions, bias forces at this tick
-        qs[k] = d.qpos[qa]
-        qds[k] = d.qvel[da]
-        head[k, :3, :3] = d.xmat[hb].reshape(3, 3)
-        head[k, :3, 3] = d.xpos[hb]
-        head[k, 3, 3] = 1.0
-        root[k, :3, :3] = d.xmat[sim.root_body].reshape(3, 3)
-        root[k, :3, 3] = d.xpos[sim.root_body]
-        root[k, 3, 3] = 1.0
-        basepos[k] = d.xpos[base_frames]
-        rec["P"][k], rec["L"][k] = momenta_of_state(sim, d)
-        rec["com"][k] = d.subtree_com[sim.root_body]
-        control(q_ref[k], qd_ref[k], None if Wref is None else Wref[k])
+        log.state(k, d)
+        if gravity is not None:
+            d.ctrl[:] = pd_ref[k] + gravity(d, k)
+        else:
+            control(q_ref[k], qd_ref[k], None)
         mj.mj_step2(m, d)  # constraint (contact) forces of this tick's state, then integration
-        taus[k] = d.actuator_force
-        p, f = ground_contacts(sim, d)
-        cpts.append(p)
-        cfrc.append(f)
-        zmp[k] = center_of_pressure(p, f)
-        for _ in range(sub - 1):
-            mj.mj_step(m, d)
-        if not np.all(np.isfinite(d.qpos)):
+        log.forces(k, d)
+        if sub > 1:
+            mj.mj_step(m, d, sub - 1)
+        if not math.isfinite(d.qpos.sum()):  # NaN or inf anywhere (a sum of finite angles does not overflow)
             raise RuntimeError(f"the simulation diverged at t = {ts[k]:.3f} s; lower the gains or the timestep")
+    rec = log.result()
 
     settings = dict(kp=kp.tolist(), kd=kd.tolist(), control_dt=control_dt, timestep=timestep,
                     settle=float(settle), hold=float(hold), gravity_compensation=mode,
@@ -418,7 +572,5 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                     n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
     # the state's clock: the plan's without ``state``, else going on from the state's time
     t_end = (ts[-1] if state is None else float(state.time) + float(settle) + ts[-1] - t[0]) + control_dt
-    return SimResult(t=ts, q=qs, qdot=qds, q_ref=q_ref, tau=taus, head_pose=head, P=rec["P"], L=rec["L"],
-                     com=rec["com"], zmp=zmp, contact_points=cpts, contact_forces=cfrc, base_positions=basepos,
-                     base=base, torque_limit=sim.torque_limit, settings=settings, root_pose=root,
+    return SimResult(t=ts, q_ref=q_ref, **rec, base=base, torque_limit=sim.torque_limit, settings=settings,
                      end_state=SimState(d.qpos.copy(), d.qvel.copy(), t_end))

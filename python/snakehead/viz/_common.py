@@ -121,7 +121,7 @@ def crop_and_write_png(figure: Figure, drawn: np.ndarray, file: IO[bytes], dpi: 
     from matplotlib.colors import to_rgba
 
     background = np.round(255 * np.array(to_rgba(figure.get_facecolor()))).astype(np.uint8)
-    ink = (drawn != background).any(axis=2)
+    ink = ink_mask(drawn, background)
     rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
     height, width = ink.shape
     if not len(rows) or rows[0] == 0 or cols[0] == 0 or rows[-1] == height - 1 or cols[-1] == width - 1:
@@ -135,6 +135,14 @@ def crop_and_write_png(figure: Figure, drawn: np.ndarray, file: IO[bytes], dpi: 
     out[r0 - top:r1 - top, c0 - left:c1 - left] = drawn[r0:r1, c0:c1]
     _write_png(file, out, dpi)
     return True
+
+
+def ink_mask(pixels: np.ndarray, background: np.ndarray) -> np.ndarray:
+    """(h, w) bool: the pixels of ``pixels`` (h, w, 4) uint8 whose RGBA differs from ``background`` (4,) uint8 --
+    ``(pixels != background).any(axis=2)``, each pixel compared as one 32-bit word (~10x faster on a figure)."""
+    if pixels.dtype != np.uint8 or pixels.shape[-1] != 4 or not pixels.flags.c_contiguous:
+        return (pixels != background).any(axis=2)
+    return pixels.view(np.uint32)[..., 0] != np.ascontiguousarray(background, np.uint8).view(np.uint32)[0]
 
 
 def _write_png(file: IO[bytes], pixels: np.ndarray, dpi: float) -> None:

@@ -32,8 +32,8 @@ from ..geometry.shapes import shape_mesh
 from ..model.robot import BasePlacement, SnakeRobot
 from ..motion.cartesian import cartesian_interpolation
 from .._errors import InputError
-from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, literal, new_figure,
-                      setup_axes3d)
+from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, ink_mask, literal,
+                      new_figure, setup_axes3d)
 
 #: Colour of box obstacles in the figures.
 OBSTACLE_COLOR = "#8d6e63"
@@ -437,7 +437,7 @@ class _PanelPicture:
         self.left, self.top = max(int(np.floor(tight.x0)), 0), max(int(np.floor(height - tight.y1)), 0)
         right, bottom = int(np.ceil(tight.x1)), int(np.ceil(height - tight.y0))
         self.image = pixels[self.top:bottom, self.left:right].copy()
-        self.ink = (self.image != pixels[0, 0]).any(axis=2)  # the figure's corner: its background
+        self.ink = ink_mask(self.image, pixels[0, 0])  # the figure's corner: its background
 
     def paste(self, pixels: np.ndarray, dx: int, dy: int) -> None:
         """Lay the picture over ``pixels`` moved by (dx, dy) pixels (y up), clipped to the canvas."""
@@ -448,9 +448,11 @@ class _PanelPicture:
         if r1 <= r0 or c1 <= c0:
             return
         part = (slice(r0 - top, r1 - top), slice(c0 - left, c1 - left))
-        target = pixels[r0:r1, c0:c1]
-        ink = self.ink[part]
-        target[ink] = self.image[part][ink]
+        if pixels.dtype == np.uint8 and pixels.shape[2] == 4 and pixels.flags.c_contiguous:  # a pixel as one word
+            np.copyto(pixels.view(np.uint32)[r0:r1, c0:c1, 0], np.ascontiguousarray(self.image).view(np.uint32)[
+                part + (0,)], where=self.ink[part])
+        else:
+            np.copyto(pixels[r0:r1, c0:c1], self.image[part], where=self.ink[part][..., None])
 
 
 class _SnapshotLayout:
