@@ -269,15 +269,18 @@ def _tick_by_tick(robot, t, q, res, obstacles=()):
         points, forces = tracking.ground_contacts(s, d)
         out["points"].append(points)
         out["forces"].append(forces)
-        out["zmp"].append(tracking.center_of_pressure(points, forces))
-        mujoco.mj_step(m, d)
+        steps = [(points, forces)]  # the ZMP: the centre of pressure of the tick's physics steps' contacts together
+        for _ in range(round(res.settings["control_dt"] / res.settings["timestep"]) - 1):
+            mujoco.mj_step(m, d)
+            steps.append(tracking.ground_contacts(s, d))
+        out["zmp"].append(tracking.center_of_pressure(np.vstack([p for p, _ in steps]), np.vstack([f for _, f in steps])))
     return {key: np.array(v) if key not in ("points", "forces") else v for key, v in out.items()}
 
 
 def test_the_loop_records_what_each_tick_measures(robot, lift):
     """The tracking loop records MuJoCo's arrays raw and computes momenta, contact forces and ZMP after it, all ticks
     at once: the same numbers, to the bit, as measuring each tick as it runs (a shortened lift, floor contacts
-    throughout)."""
+    throughout); the ZMP over each tick's two physics steps, the contacts at its first."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.3)
     res = sim.simulate_trajectory(robot, t, q, torque_limit=10.0, settle=0.1)
     ref = _tick_by_tick(robot, t, q, res)

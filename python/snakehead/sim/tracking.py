@@ -158,8 +158,9 @@ class SimResult:
 
     t (N,) s, starting at the planned t[0]; q, qdot, q_ref (N, n) rad, rad/s; tau (N, n) N m applied joint
     torques; head_pose (N, 4, 4) world pose of ``head_tip``; P (N, 3) kg m/s and L (N, 3) kg m^2/s momenta about
-    the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground forces (NaN if airborne);
-    contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the robot-floor contacts;
+    the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground's impulse over each tick's physics
+    steps (NaN if airborne); contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the
+    robot-floor contacts at the tick's first physics step;
     base_positions (N, nb, 3) world origins of the base-part frames; base_slide_m / base_lift_m the largest
     horizontal / upward displacement of any of them from the first tick (m). root_pose (N, 4, 4): the root frame's
     world pose at every tick; end_state: the simulated state after the last tick (continue from it).
@@ -331,10 +332,16 @@ def _centers_of_pressure(points: list, forces: list) -> np.ndarray:
 
 class _TickLog:
     """What the tracking loop records at each control tick: MuJoCo's arrays copied as they are (the state into
-    arrays made for every tick, the contacts and their constraint forces into growing arrays), and after the loop the
-    :class:`SimResult`'s quantities computed from them, all ticks at once. They are the numbers
+    arrays made for every tick, the contacts and their constraint forces of every physics step into growing arrays),
+    and after the loop the :class:`SimResult`'s quantities computed from them, all ticks at once. They are the numbers
     :func:`momenta_of_state`, :func:`ground_contacts` and :func:`center_of_pressure` give tick by tick, to the bit
-    (tested), for a fifth of the loop's Python, which cost more than MuJoCo's physics."""
+    (tested), for a fifth of the loop's Python, which cost more than MuJoCo's physics.
+
+    A tick's ZMP is the centre of pressure of the ground's impulse over all of the tick's physics steps (every step's
+    contacts together: the steps are equal), which is what carries the momenta from one tick to the next; one step
+    alone aliases the contact solver's chatter (a corner barely touching drops out of the contact set for a step and
+    the centre of pressure jumps to the edge of the contacts left: 5 mm for 1 ms). The recorded contacts are the
+    tick's first step's."""
 
     def __init__(self, sim: SimModel, robot: SnakeRobot, N: int) -> None:
         m = sim.model
@@ -342,10 +349,11 @@ class _TickLog:
         self.xpos, self.xmat = np.empty((N, m.nbody, 3)), np.empty((N, m.nbody, 9))
         self.qpos, self.qvel, self.tau = np.empty((N, m.nq)), np.empty((N, m.nv)), np.empty((N, m.nu))
         self.linvel, self.angmom, self.com = np.empty((N, 3)), np.empty((N, 3)), np.empty((N, 3))
-        self.live = not _contacts_decodable(m)  # else the ground contacts are measured tick by tick
-        self.contacts: list = []  # (live) each tick's ground_contacts
-        # every contact of every tick, one row each, and every tick's constraint forces, in growing arrays
-        self.ncon, self.nefc = np.zeros(N, int), np.zeros(N, int)
+        self.live = not _contacts_decodable(m)  # else the ground contacts are measured step by step
+        self.contacts: list = []  # (live) each step's ground_contacts
+        # every contact of every physics step, one row each, and every step's constraint forces, in growing arrays;
+        # the tick of each step
+        self.ncon, self.nefc, self.tick = _Rows((), int), _Rows((), int), _Rows((), int)
         self.geom, self.address = _Rows((2,), np.int32), _Rows((), np.int32)
         self.pos, self.frame, self.friction = _Rows((3,), float), _Rows((9,), float), _Rows((2,), float)
         self.efc = _Rows((), float)
@@ -363,13 +371,19 @@ class _TickLog:
         self.com[k] = d.subtree_com[b]
 
     def forces(self, k: int, d: Any) -> None:
-        """Tick ``k``'s torques and contact forces, after ``mj_step2``."""
+        """Tick ``k``'s torques and its first physics step's contact forces, after ``mj_step2``."""
         self.tau[k] = d.actuator_force
+        self.step(k, d)
+
+    def step(self, k: int, d: Any) -> None:
+        """The contact forces of a physics step of tick ``k``, after it (``mj_step2`` or ``mj_step``)."""
+        self.tick.add(np.array([k]))
         if self.live:
             self.contacts.append(ground_contacts(self.sim, d))
             return
         c = d.contact
-        self.ncon[k], self.nefc[k] = d.ncon, d.nefc
+        self.ncon.add(np.array([d.ncon]))
+        self.nefc.add(np.array([d.nefc]))
         self.geom.add(c.geom)
         self.pos.add(c.pos)
         self.frame.add(c.frame)
@@ -388,9 +402,14 @@ class _TickLog:
         out["base_positions"] = self.xpos[:, sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]]
         out["P"] = sim.model.body_subtreemass[sim.root_body] * self.linvel
         out["L"] = self.angmom + _cross3(self.com, out["P"])
-        points, forces = self._ground_contacts()
-        out["contact_points"], out["contact_forces"] = points, forces
-        out["zmp"] = _centers_of_pressure(points, forces)
+        points, forces = self._ground_contacts()  # per step
+        tick = self.tick.array()
+        first = np.flatnonzero(np.diff(tick, prepend=-1) != 0)  # each tick's first step
+        out["contact_points"] = [points[i] for i in first]
+        out["contact_forces"] = [forces[i] for i in first]
+        end = first[1:].tolist() + [len(tick)]
+        out["zmp"] = _centers_of_pressure([np.concatenate(points[a:b]) for a, b in zip(first, end)],
+                                          [np.concatenate(forces[a:b]) for a, b in zip(first, end)])
         return out
 
     def _poses(self, body: int) -> np.ndarray:
@@ -402,11 +421,11 @@ class _TickLog:
         return T
 
     def _ground_contacts(self) -> tuple[list, list]:
-        """Every tick's :func:`ground_contacts`: the points and forces of the robot-floor contacts."""
+        """Every physics step's :func:`ground_contacts`: the points and forces of the robot-floor contacts."""
         if self.live:
             return [p for p, _ in self.contacts], [f for _, f in self.contacts]
-        counts = self.ncon
-        efc_start = np.concatenate([[0], np.cumsum(self.nefc)])  # each tick's constraint forces in one array
+        counts = self.ncon.array()
+        efc_start = np.concatenate([[0], np.cumsum(self.nefc.array())])  # each step's constraint forces in one array
         tick = np.repeat(np.arange(len(counts)), counts)
         geom = self.geom.array()
         floor = self.sim.floor_geom
@@ -560,8 +579,9 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
             control(q_ref[k], qd_ref[k], None)
         mj.mj_step2(m, d)  # constraint (contact) forces of this tick's state, then integration
         log.forces(k, d)
-        if sub > 1:
-            mj.mj_step(m, d, sub - 1)
+        for _ in range(sub - 1):  # the tick's other physics steps: their contacts count in its ZMP (_TickLog)
+            mj.mj_step(m, d)
+            log.step(k, d)
         if not math.isfinite(d.qpos.sum()):  # NaN or inf anywhere (a sum of finite angles does not overflow)
             raise RuntimeError(f"the simulation diverged at t = {ts[k]:.3f} s; lower the gains or the timestep")
     rec = log.result()
