@@ -156,8 +156,9 @@ class SimResult:
 
     t (N,) s, starting at the planned t[0]; q, qdot, q_ref (N, n) rad, rad/s; tau (N, n) N m applied joint
     torques; head_pose (N, 4, 4) world pose of ``head_tip``; P (N, 3) kg m/s and L (N, 3) kg m^2/s momenta about
-    the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground forces (NaN if airborne);
-    contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the robot-floor contacts;
+    the world origin; com (N, 3) m; zmp (N, 2) m centre of pressure of the ground's impulse over each tick's physics steps (NaN if
+    airborne); contact_points / contact_forces: per tick (k, 3) arrays (m, N, world) of the robot-floor contacts at
+    the tick's first physics step;
     base_positions (N, nb, 3) world origins of the base-part frames; base_slide_m / base_lift_m the largest
     horizontal / upward displacement of any of them from the first tick (m). root_pose (N, 4, 4): the root frame's
     world pose at every tick; end_state: the simulated state after the last tick (continue from it).
@@ -406,9 +407,17 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
         p, f = ground_contacts(sim, d)
         cpts.append(p)
         cfrc.append(f)
-        zmp[k] = center_of_pressure(p, f)
+        # the ZMP over the tick: the centre of pressure of the ground's impulse over all its physics steps (every
+        # step's contacts together, equal steps), which is what moves the momenta from this tick to the next. One
+        # step alone aliases the contact solver's chatter: a corner barely touching drops out of the contact set
+        # for a step and the centre of pressure jumps to the edge of the contacts left (5 mm for 1 ms).
+        ps, fs = [p], [f]
         for _ in range(sub - 1):
             mj.mj_step(m, d)
+            p, f = ground_contacts(sim, d)
+            ps.append(p)
+            fs.append(f)
+        zmp[k] = center_of_pressure(np.vstack(ps), np.vstack(fs))
         if not np.all(np.isfinite(d.qpos)):
             raise RuntimeError(f"the simulation diverged at t = {ts[k]:.3f} s; lower the gains or the timestep")
 
