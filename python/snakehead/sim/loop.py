@@ -648,7 +648,14 @@ class ClosedLoop:
         to the leg that reaches it, within WAYPOINT_TOLERANCE; an escape along the axis creeps), or towards
         ``straight_goal`` within ``tolerance`` when it is the last (or there is no route); None when there."""
         if route is None or k == len(route.waypoints) - 1:
-            return lc.next_step(self.robot, here, straight_goal, rates, tolerance=tolerance, frequency=self.frequency)
+            creep = route is not None and route.staging_creep
+            if creep and abs(math.degrees(math.remainder(straight_goal.yaw - here.yaw, 2 * math.pi))) \
+                    > tolerance.yaw_deg:  # from a staging point on the goal's axis: turn to its heading first
+                m = lc.compose(here, self._offset)
+                facing = lc.compose(BasePlacement(m.x, m.y, straight_goal.yaw), lc.inverse(self._offset))
+                return lc.next_step(self.robot, here, facing, rates, tolerance=tolerance, frequency=self.frequency)
+            return lc.next_step(self.robot, here, straight_goal, rates, tolerance=tolerance, frequency=self.frequency,
+                                creep=creep)
         w, h = route.waypoints[k], route.headings[k - 1]
         goal = lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(self._offset))
         return lc.next_step(self.robot, here, goal, rates, tolerance=WAYPOINT_TOLERANCE, frequency=self.frequency,
