@@ -240,9 +240,32 @@ def test_escape_along_the_axis_between_two_boxes(robot):
         gp.plan_route(robot, ring, start, goal)
 
 
+def _swept_distance(robot, box, a, yaw, scale, moves, b=None):
+    """The smallest exact distance to ``box`` of the corners of a sidewinding run's shapes at ``scale`` (both
+    directions, 24 phases, the ramps' half and full envelope) and of their edges' midpoints, the virtual chassis
+    at ``moves`` points from ``a`` to ``b`` at heading ``yaw``."""
+    from snakehead.motion.gaits import make_gait, virtual_chassis
+
+    b = a if b is None else b
+    qs = [np.zeros((1, robot.n_joints))]
+    for direction in (1, -1):
+        g = make_gait("sidewinding", direction)
+        q = g.joint_angles(robot, g.ramp_s + np.linspace(0.0, g.period_s, 24, endpoint=False), 1.0)
+        qs += [e * scale * q for e in (0.5, 1.0)]
+    F = robot.frames_many(np.vstack(qs))
+    local = []
+    for c, p in zip(robot.link_centres(F), robot.hull_points(F)):
+        T = virtual_chassis(c, forward=c[-1] - c[0])
+        pts = np.concatenate([p, 0.5 * (p[:, :, None] + p[:, None, :]).reshape(len(p), -1, 3)], axis=1)
+        local.append(((pts.reshape(-1, 3) - T[:3, 3]) @ T[:3, :2]))
+    local = np.concatenate(local)
+    R = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+    return min(_box_distance(box, (a + s * (b - a)) + local @ R.T).min() for s in np.linspace(0.0, 1.0, moves))
+
+
 def test_sweep_check_against_brute_force(robot):
-    """sweep_clear against the exact distance of densely sampled swept points to a box: turning (the disc of the
-    swept radius about both ends), sidewinding (the band of the wave's half width about the moving axis) and
+    """sweep_clear against the exact distance of densely sampled swept points to a box: turning by half a turn or
+    more (the disc of the swept radius about both ends; a smaller turn's sector: test_turn_slack_against_brute_force), sidewinding (its sweep profile, against the run's own shapes moved along) and
     linear progression (the straight body's band): sound (what it passes keeps the margin, or no less than its
     ends do) and not much stricter than the truth (a grid of two cell diagonals)."""
     box = BoxObstacle.from_yaw([0.0, 0.0, 0.125], [0.25, 0.25, 0.25], 0.3)
@@ -260,11 +283,24 @@ def test_sweep_check_against_brute_force(robot):
         b = a + (move if gait != "turning" else 0.0)
         scale = rng.uniform(0.1, 1.0)
         grid = gp.clearance_grid([box], [a, b], 1.5)
-        ok = gp.sweep_clear(grid, robot, gait, BasePlacement(*a, yaw), BasePlacement(*b, yaw), scale)
+        turn = 1.6 if gait == "turning" else 0.0  # a turn whose sector reaches half a turn: the disc alone
+        ok = gp.sweep_clear(grid, robot, gait, BasePlacement(*a, yaw), BasePlacement(*b, yaw + turn), scale)
         seen[ok] += 1
         if gait == "turning":
             true = min(_box_distance(box, a[None])[0], _box_distance(box, b[None])[0])
             need = radius + m
+        elif gait == "sidewinding":  # the run's shapes themselves, moved along: never touching, the margin where
+            # both ends keep it (the profile's bins and samples: up to a few centimetres stricter than the truth)
+            ends = [_swept_distance(robot, box, p, yaw, scale, 1) for p in (a, b)]
+            true = _swept_distance(robot, box, a, yaw, scale, 12, b)
+            if ok:
+                assert true > 0.0, (trial, true)
+                if min(ends) > m + 0.05:
+                    assert true >= m - 1e-3, (trial, true)
+            elif true > m + 0.06:
+                pytest.fail(f"trial {trial}: sidewinding refused at {true:.3f} m")
+            seen[ok] += 1
+            continue
         else:
             axis = np.array([math.cos(yaw), math.sin(yaw)])
             width = straight + (scale * (wave - straight) if gait == "sidewinding" else 0.0)
@@ -277,3 +313,69 @@ def test_sweep_check_against_brute_force(robot):
         elif true > need + slack + 0.01:
             pytest.fail(f"trial {trial}: {gait} refused at {true:.3f} m, {need:.3f} m needed")
     assert seen[True] > 5 and seen[False] > 5
+
+
+def test_turn_slack_against_brute_force(robot):
+    """turn_slack: a lower bound of the exact distance to a box of a turning run's own shapes (corners and edge
+    midpoints; both directions, 24 phases, the ramps' half and full envelope) turned about the middle through the
+    sector it bounds (TURN_OVERSHOOT times the predicted turn, TURN_SLACK_DEG either way), and not much below
+    it; -inf where the sector reaches half a turn."""
+    from snakehead.motion.gaits import make_gait, virtual_chassis
+
+    box = BoxObstacle.from_yaw([0.0, 0.0, 0.125], [0.25, 0.25, 0.25], 0.3)
+    rng = np.random.default_rng(5)
+    finite = 0
+    for trial in range(12):
+        a = rng.uniform(-1.2, 1.2, 2)
+        yaw, turn, scale = rng.uniform(-math.pi, math.pi), rng.uniform(-0.8, 0.8), rng.uniform(0.1, 1.0)
+        grid = gp.clearance_grid([box], [a], 1.5)
+        slack = gp.turn_slack(grid, robot, BasePlacement(*a, yaw), BasePlacement(*a, yaw + turn), scale)
+        lo = min(0.0, gp.TURN_OVERSHOOT * turn) - math.radians(gp.TURN_SLACK_DEG)
+        hi = max(0.0, gp.TURN_OVERSHOOT * turn) + math.radians(gp.TURN_SLACK_DEG)
+        if hi - lo >= math.pi:
+            assert slack == -math.inf
+            continue
+        finite += 1
+        qs = [np.zeros((1, robot.n_joints))]
+        for direction in (1, -1):
+            g = make_gait("turning", direction)
+            q = g.joint_angles(robot, g.ramp_s + np.linspace(0.0, g.period_s, 24, endpoint=False), 1.0)
+            qs += [e * scale * q for e in (0.5, 1.0)]
+        F = robot.frames_many(np.vstack(qs))
+        local = []
+        for c, p in zip(robot.link_centres(F), robot.hull_points(F)):
+            T = virtual_chassis(c, forward=c[-1] - c[0])
+            pts = np.concatenate([p, 0.5 * (p[:, :, None] + p[:, None, :]).reshape(len(p), -1, 3)], axis=1)
+            local.append((pts.reshape(-1, 3) - T[:3, 3]) @ T[:3, :2])
+        local = np.concatenate(local)
+        true = min(_box_distance(box, a + local @ np.array([[math.cos(h), -math.sin(h)], [math.sin(h), math.cos(h)]]).T
+                                 ).min() for h in yaw + np.linspace(lo, hi, 90))
+        assert true >= slack - 1e-3, (trial, true, slack)
+        if true > 0.0:  # (the exact distance stops at 0 inside the box)
+            assert slack > true - 2 * math.sqrt(2) * gp.RESOLUTION_M - 0.02, (trial, true, slack)  # grid, bins
+    assert finite >= 4
+
+
+def test_staging_on_the_goal_axis_when_none_across(robot):
+    """A goal whose across-axis runs beside a long wall (no point on it within MAX_STAGING_M lets the body turn
+    with the whole clearance budget): the last leg comes from a staging point on the goal's own axis, away from the
+    wall, where the turning disc keeps the budget; the body creeps from there at the goal's heading, its straight
+    band no nearer the wall than at the goal (exact geometry)."""
+    from snakehead.motion import locomotion as lc
+
+    wall = BoxObstacle([0.85, 0.0, 0.15], [0.05, 6.0, 0.3])
+    goal, start = BasePlacement(0.0, 0.0, 0.0), BasePlacement(-2.0, 1.0, 0.0)
+    route = gp.plan_route(robot, [wall], start, goal)
+    W = route.waypoints
+    assert route.staging and route.staging_creep and not route.escape
+    assert route.headings[-1] == goal.yaw
+    assert abs(W[-2, 1]) < 1e-9 and W[-2, 0] < 0.0  # on the goal's axis, away from the wall
+    assert _box_distance(wall, W[-2][None])[0] > route.clear_m
+    assert route.clear_m == pytest.approx(gp.swept_radius(robot) + gp.CLEARANCE_M)
+    _assert_straight_leg_keeps(robot, W[-2], W[-1], goal.yaw, [wall], gp.half_width(robot) + gp.EXECUTION_M)
+    # the loop's step for it once the body faces the goal's way: linear progression towards the head
+    rates = lc.GaitRates.first_guess(robot)
+    offset = lc.chassis_offset(robot)
+    here = lc.compose(BasePlacement(W[-2, 0], W[-2, 1], goal.yaw), lc.inverse(offset))
+    step = lc.next_step(robot, here, lc.compose(goal, lc.inverse(offset)), rates, creep=True)
+    assert (step.gait.name, step.gait.direction, step.leg) == ("linear_progression", 1, "along")

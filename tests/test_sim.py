@@ -212,6 +212,22 @@ def test_contact_zmp_matches_the_momentum_zmp(robot, lift):
     assert np.percentile(err, 99) < 5e-3
 
 
+def test_contact_zmp_is_the_ticks_momentum_change(robot, lift):
+    """The recorded ZMP of a tick is the centre of pressure of the ground's impulse over all its physics steps:
+    Eqs. 39-40 on the momenta's change from this tick to the next (forward differences, no smoothing) give it to
+    within numerical noise (measured 28 um at most; one physics step's contacts alone were up to 5 mm off, the
+    contact solver's chatter)."""
+    t, q, res = lift
+    dt = res.t[1] - res.t[0]
+    Pdot, Ldot = np.diff(res.P, axis=0) / dt, np.diff(res.L, axis=0) / dt
+    M, g = robot.total_mass, tracking.GRAVITY
+    den = M * g + Pdot[:, 2]
+    px = (M * g * res.com[:-1, 0] - Ldot[:, 1]) / den
+    py = (M * g * res.com[:-1, 1] + Ldot[:, 0]) / den
+    err = np.hypot(px - res.zmp[:-1, 0], py - res.zmp[:-1, 1])
+    assert err.max() < 2e-4, err.max()
+
+
 def test_tracking_a_slow_lift(robot, lift):
     t, q, res = lift
     report = sim.compare(robot, t, q, res, targets=[t[-1], t[-1] + 0.5])

@@ -18,7 +18,9 @@ waypoint tolerance) plus :data:`DRIFT_M` (how far the dead reckoning drifts over
 The goal itself usually lies nearer an obstacle than that (the bending state stands beside the wall whose hole
 the head goes through): the last leg comes from a *staging point* on the goal's own across-axis
 (:func:`plan_route`), where the body can turn, then sidewinds at the goal's heading to the goal, its swept band
-(the axis inflated by :func:`swept_half_width` plus EXECUTION_M) nowhere nearer an obstacle than the goal's own.
+(the axis inflated by :func:`swept_half_width` plus EXECUTION_M) nowhere nearer an obstacle than the goal's own;
+where no point across has room to turn with the whole budget (a goal between two boxes), from one on the goal's
+axis, the body creeping from there along it (linear progression: the straight body's band).
 Likewise a start too near an obstacle to turn is left first by an *escape* leg: sidewinding across its axis, or,
 when that is blocked too (the body lying between two boxes), creeping along its axis
 (:func:`~snakehead.motion.gaits.linear_progression`, whose sweep is the straight body's outline). Each gait run is
@@ -233,7 +235,8 @@ class Route:
     staging point; an escape leg's the start's), ``staging``: whether the last leg comes from a staging point;
     ``clear_m``: the turning disc's radius the path keeps from the obstacles (swept radius + clearance);
     ``escape``: whether the first leg is an escape (at the start's heading, nearer the obstacles than clear_m);
-    ``creep``: whether it is one along the body's axis (linear progression)."""
+    ``creep``: whether it is one along the body's axis (linear progression); ``staging_creep``: whether the staging
+    point lies on the goal's own axis (the body turns to the goal's heading there and creeps to the goal)."""
 
     waypoints: np.ndarray
     headings: np.ndarray
@@ -241,6 +244,7 @@ class Route:
     clear_m: float
     creep: bool = False
     escape: bool = False
+    staging_creep: bool = False
 
 
 def half_width(robot: SnakeRobot) -> float:
@@ -297,6 +301,106 @@ def swept_radius(robot: SnakeRobot) -> float:
 def swept_half_width(robot: SnakeRobot) -> float:
     """How far from its axis the body reaches in the gaits (m; :func:`swept_extents`)."""
     return swept_extents(robot)[1]
+
+
+#: Amplitude steps of the sweep profiles (:func:`sweep_profile`): a run at amplitude scale k is bounded by the shapes
+#: of every amplitude up to the step at or above k.
+PROFILE_STEPS = 8
+#: Amplitude envelope steps of a run's ramps within each profile step (the ramps scale the wave at any phase).
+PROFILE_RAMP_STEPS = 4
+
+#: sweep_profile's answers per robot, by (gait, amplitude step).
+_PROFILES: "weakref.WeakKeyDictionary[SnakeRobot, dict]" = weakref.WeakKeyDictionary()
+
+
+#: Samples along each segment between two hull points of a link (sweep_profile): the silhouette of a link's convex
+#: shape seen from above is made of such segments (its edges').
+PROFILE_SEGMENT_SAMPLES = 16
+
+
+@dataclass(frozen=True)
+class SweepProfile:
+    """The body's outline over a gait run, seen from above in its virtual chassis frame (:func:`sweep_profile`):
+    ``points`` (P, 2) m such that every point of the body lies within ``pad`` m of one of them."""
+
+    points: np.ndarray
+    pad: float
+
+
+def _slabs(robot: SnakeRobot, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """(lo (J,), hi (J,), pad): the body in the shapes ``q`` (T, n), seen from above in each shape's virtual
+    chassis frame, sampled along every segment between two hull points of a link (its silhouette's edges are
+    among them) PROFILE_SEGMENT_SAMPLES times, each sample counted in the slab of its nearest axis point u_j (half
+    a cell apart): the samples' y from lo_j to hi_j (lo_j > hi_j: none); every point of the body within ``pad``
+    of a sample (its edges') or between two on one line across the axis (its inside)."""
+    from .gaits import virtual_chassis
+
+    F = robot.frames_many(q)
+    pts, centres = robot.hull_points(F), robot.link_centres(F)  # (T, k, M, 3), (T, k, 3)
+    ia, ib = np.triu_indices(pts.shape[2], 1)
+    f = np.linspace(0.0, 1.0, PROFILE_SEGMENT_SAMPLES)
+    local_pts = robot.link_points[1]
+    pad = 0.5 * float(np.linalg.norm(local_pts[:, ia] - local_pts[:, ib], axis=-1).max()) / (
+        PROFILE_SEGMENT_SAMPLES - 1)
+    h = float(u[1] - u[0])
+    lo, hi = np.full(len(u), np.inf), np.full(len(u), -np.inf)
+    for c, p in zip(centres, pts):
+        T = virtual_chassis(c, forward=c[-1] - c[0])
+        local = (p - T[:3, 3]) @ T[:3, :2]  # (k, M, 2)
+        xy = (local[:, ia, None, :] + f[None, None, :, None] * (local[:, ib] - local[:, ia])[:, :, None, :]
+              ).reshape(-1, 2)
+        j = np.clip(np.round((xy[:, 0] - u[0]) / h).astype(int), 0, len(u) - 1)
+        np.minimum.at(lo, j, xy[:, 1])
+        np.maximum.at(hi, j, xy[:, 1])
+    return lo, hi, pad
+
+
+def sweep_profile(robot: SnakeRobot, gait: str, scale: float = 1.0) -> SweepProfile:
+    """The outline of a run of ``gait`` ("sidewinding" or "turning") at amplitude ``scale`` in its virtual
+    chassis frame: the straight body's shapes and a cycle's at every amplitude up to the PROFILE_STEPS step at or
+    above ``scale`` (the ramps' too: PROFILE_RAMP_STEPS envelopes a step), both directions, SWEEP_SAMPLES a
+    cycle; per slab across the axis (half a grid cell wide, out to the swept radius) the samples' extent across
+    it (:func:`_slabs`), filled with points half a cell apart. Every point of those shapes lies within ``pad`` of
+    one: the samples' spacing along the edges, and half a cell either way. Tighter than the band of
+    :func:`swept_half_width` over the whole length: near the ends the wave stays nearer the axis, and a slab
+    holds only the side the body reaches."""
+    from .gaits import make_gait
+
+    robot = as_robot(robot)
+    k = min(max(int(math.ceil(float(scale) * PROFILE_STEPS - 1e-9)), 1), PROFILE_STEPS)
+    cache = _PROFILES.setdefault(robot, {})
+    if (gait, k) in cache:
+        return cache[(gait, k)][0]
+    h = 0.5 * RESOLUTION_M
+    n = int(math.ceil(swept_radius(robot) / h)) + 1
+    u = h * np.arange(-n, n + 1)
+    if k == 1:
+        lo, hi, pad = _slabs(robot, np.zeros((1, robot.n_joints)), u)
+    else:
+        sweep_profile(robot, gait, (k - 1) / PROFILE_STEPS)
+        lo, hi, pad = cache[(gait, k - 1)][1]
+    shapes = []
+    for direction in (1, -1):
+        g = make_gait(gait, direction)
+        t = g.ramp_s + np.linspace(0.0, g.period_s, SWEEP_SAMPLES, endpoint=False)
+        q = g.joint_angles(robot, t, 1.0)  # full amplitude: each wave's offset is 0, so amplitude scales q
+        for e in np.arange(1, PROFILE_RAMP_STEPS + 1) / PROFILE_RAMP_STEPS:
+            shapes.append(q * ((k - 1 + e) / PROFILE_STEPS))
+    lo2, hi2, _ = _slabs(robot, np.vstack(shapes), u)
+    lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
+    points = [np.column_stack([np.full(m, x), np.linspace(a, b, m)])
+              for x, a, b in zip(u, lo, hi) if a <= b for m in [int(math.ceil((b - a) / h)) + 1]]
+    profile = SweepProfile(np.vstack(points), math.hypot(0.5 * h + pad, 0.5 * h + pad))
+    cache[(gait, k)] = (profile, (lo, hi, pad))
+    return profile
+
+
+def profile_slack(grid: ClearanceGrid, middle: np.ndarray, heading: float, profile: SweepProfile) -> float:
+    """A lower bound of the distance (m) to the obstacles of every point the ``profile`` (:func:`sweep_profile`)
+    bounds, its virtual chassis at ``middle`` (2,) m along ``heading`` rad."""
+    c, s = math.cos(heading), math.sin(heading)
+    xy = middle + profile.points @ np.array([[c, s], [-s, c]])
+    return float(grid.clearance_at(xy).min()) - profile.pad
 
 
 def band_clearance(grid: ClearanceGrid, middle: np.ndarray, heading: float, length: float) -> float:
@@ -383,6 +487,10 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
     # the last leg: from a staging point on the goal's across-axis, the body at the goal's heading; the first, when
     # the body cannot turn where it lies: sidewinding or creeping at its own heading to where it can
     staging = _sidestep(grid, goal_middle, L, R, side)
+    staging_creep = False
+    if staging is None:  # none across: one along the goal's axis, the body creeping from there at its heading
+        staging = _sidestep(grid, goal_middle, L, R, straight_side, along=True)
+        staging_creep = staging is not None
     escape = _escape(grid, start_middle, L, R, side, straight_side)
     if staging is None:
         raise Infeasible(f"no staging point within {MAX_STAGING_M} m of the goal's middle ({g[0]:.2f}, {g[1]:.2f}) "
@@ -421,27 +529,59 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
         prev = headings[-1] if headings else start_middle.yaw
         options = (square, square + math.pi)
         headings.append(min(options, key=lambda h: abs(math.remainder(h - prev, 2 * math.pi))))
-    return Route(waypoints, np.array(headings), staged, R, creep and escaped, escaped)
+    return Route(waypoints, np.array(headings), staged, R, creep and escaped, escaped, staging_creep and staged)
+
+
+#: A turning run is taken to turn by up to TURN_OVERSHOOT times what the rates predict (the default robot's runs turn
+#: within 15 % of it: bench/RESULTS.md, "Gaits"), and by TURN_SLACK_DEG more either way (a cycle's own sway).
+TURN_OVERSHOOT = 2.0
+TURN_SLACK_DEG = 5.0
+
+
+def turn_slack(grid: ClearanceGrid, robot: SnakeRobot, start_middle: BasePlacement, end_middle: BasePlacement,
+               scale: float = 1.0) -> float:
+    """A lower bound of the distance (m) to the obstacles of a turning run at amplitude ``scale`` whose middle
+    stays at ``start_middle`` and ``end_middle`` (predicted) and turns from the start's heading by up to
+    TURN_OVERSHOOT times the predicted turn (the end's heading less the start's) and TURN_SLACK_DEG either way:
+    the turning :func:`sweep_profile` at headings through that sector, so close that no point of the body moves
+    more than ``pad`` between two (which the bound takes off); -inf when the sector reaches half a turn (then
+    only the disc of :func:`swept_radius` bounds it)."""
+    turn = math.remainder(end_middle.yaw - start_middle.yaw, 2.0 * math.pi)
+    slack = math.radians(TURN_SLACK_DEG)
+    lo, hi = min(0.0, TURN_OVERSHOOT * turn) - slack, max(0.0, TURN_OVERSHOOT * turn) + slack
+    if hi - lo >= math.pi:
+        return -math.inf
+    reach = swept_radius(robot)
+    step = 0.25 * grid.resolution / reach
+    angles = start_middle.yaw + np.linspace(lo, hi, int(math.ceil((hi - lo) / step)) + 1)
+    pad = reach * 0.5 * float(angles[1] - angles[0]) if len(angles) > 1 else 0.0
+    profile = sweep_profile(robot, "turning", scale)
+    middles = [np.array([start_middle.x, start_middle.y]), np.array([end_middle.x, end_middle.y])]
+    return min(profile_slack(grid, m, float(h), profile) for m in middles for h in angles) - pad
 
 
 def sweep_clear(grid: ClearanceGrid, robot: SnakeRobot, gait: str, start_middle: BasePlacement,
                 end_middle: BasePlacement, scale: float = 1.0, margin: float = EXECUTION_M) -> bool:
     """Whether a gait run (``gait`` at amplitude ``scale``) that takes the body's middle from ``start_middle`` to
     ``end_middle`` (predicted) stays clear of the obstacles: turning, the disc of :func:`swept_radius` about the
-    middle at both ends, ``margin`` clear; sidewinding and linear progression, the band about the body's axis
-    (the straight body's half width, plus the sidewinding wave's reach beyond it times ``scale``) moved from
-    start to end at the start's heading, ``margin`` clear, or, where the run starts or ends nearer than that, no
-    nearer than the nearer of its two ends and never touching."""
+    middle at both ends, or the sector it may turn through (:func:`turn_slack`), ``margin`` clear; sidewinding, its :func:`sweep_profile` at ``scale`` moved from start
+    to end at the start's heading, and linear progression, the band of the straight body's half width about its
+    axis, likewise: ``margin`` clear, or, where the run starts or ends nearer than that, no nearer than the nearer
+    of its two ends and never touching."""
     robot = as_robot(robot)
-    reach, wave = swept_extents(robot)
+    reach = swept_radius(robot)
     a = np.array([start_middle.x, start_middle.y])
     b = np.array([end_middle.x, end_middle.y])
     if gait == "turning":
-        return bool(min(grid.clearance_at(a)[0], grid.clearance_at(b)[0]) > reach + margin)
-    straight = half_width(robot)
-    width = straight + (scale * (wave - straight) if gait == "sidewinding" else 0.0)
-    L = robot.body_length
+        disc = min(grid.clearance_at(a)[0], grid.clearance_at(b)[0]) > reach + margin
+        return bool(disc or turn_slack(grid, robot, start_middle, end_middle, scale) > margin)
     n = max(int(math.ceil(float(np.linalg.norm(b - a)) / (0.5 * grid.resolution))), 1)
-    along = [band_clearance(grid, a + s * (b - a), start_middle.yaw, L) for s in np.linspace(0.0, 1.0, n + 1)]
-    need = min(width + margin, max(min(along[0], along[-1]), width + 1e-9))
-    return bool(min(along) >= need)
+    middles = [a + s * (b - a) for s in np.linspace(0.0, 1.0, n + 1)]
+    if gait == "sidewinding":  # the slack beyond the profile's reach
+        profile = sweep_profile(robot, gait, scale)
+        slack = [profile_slack(grid, m, start_middle.yaw, profile) for m in middles]
+    else:
+        straight, L = half_width(robot), robot.body_length
+        slack = [band_clearance(grid, m, start_middle.yaw, L) - straight for m in middles]
+    need = min(margin, max(min(slack[0], slack[-1]), 1e-9))
+    return bool(min(slack) >= need)
