@@ -61,8 +61,8 @@ def main() -> int:
         for py, r in zip(args.python, rows):
             wall = [x["wall"] for x in r]
             ratio = statistics.median(a["wall"] / b["wall"] for a, b in zip(rows[0], r))
-            print(f"| {kind} | `{py}` | {sum(x['ok'] for x in r)}/{len(r)} | {statistics.median(wall):.2f} | "
-                  f"{max(wall):.2f} | {statistics.median(x['cpu'] for x in r):.2f} | "
+            print(f"| {kind} | `{py}` | {sum(x['ok'] for x in r)}/{len(r)} | {statistics.median(wall):.3f} | "
+                  f"{max(wall):.3f} | {statistics.median(x['cpu'] for x in r):.3f} | "
                   f"{statistics.median(x['motion'] for x in r):.1f} | {ratio:.2f} |", flush=True)
     return 0
 
