@@ -23,6 +23,24 @@ def pitch_first():
     return SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
 
 
+#: Two generated snakes unlike the default (their SnakeSpec and the robot file's three frames), shared by the tests
+#: that run on several robots: long20, 20 joints, 7 cm modules, 5 cm section, 0.15 kg/module, a 2-joint neck that
+#: begins with a yaw joint (its first link stays on the ground) and an 8-DOF head; pitchy, 13 joints starting with a
+#: pitch joint, 10 cm modules, 6 cm section, 0.3 kg/module, parts named by link frames, a 1-joint neck and a 6-DOF
+#: head (whose map has no voxel of index 100).
+def generated_specs() -> dict:
+    from snakehead.model.generate import SnakeSpec
+
+    return {
+        "long20": (SnakeSpec(n_joints=20, module_length=0.07, section=0.05, mass_per_module=0.15, first_axis="yaw",
+                             markers={"p0": 10, "b0": 12}, tip_name="tip", name="long20"),
+                   dict(base_end="p0", neck_end="b0", head_tip="tip")),
+        "pitchy": (SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
+                             link_prefix="seg", joint_prefix="j", tip_name="nose", name="pitchy"),
+                   dict(base_end="seg6", neck_end="seg7", head_tip="nose")),
+    }
+
+
 #: A coarse, quick reachability map of the default robot's head (a few seconds): the options the map tests share.
 SMALL_MAP = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, timeout=3e-4)
 

@@ -18,23 +18,14 @@ import snakehead
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
-from snakehead.model.generate import SnakeSpec, snake_urdf
+from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
+
+from conftest import generated_specs
 
 pytest.importorskip("mujoco")
 
-ROBOTS = {
-    # 20 joints, 7 cm modules, 5 cm section, 0.15 kg/module, markers; a 2-joint neck that begins with a yaw joint
-    # (its first link stays on the ground) and an 8-DOF head
-    "long20": (SnakeSpec(n_joints=20, module_length=0.07, section=0.05, mass_per_module=0.15, first_axis="yaw",
-                         markers={"p0": 10, "b0": 12}, tip_name="tip", name="long20"),
-               dict(base_end="p0", neck_end="b0", head_tip="tip")),
-    # 13 joints starting with a pitch joint, 10 cm modules, 6 cm section, 0.3 kg/module, parts named by link
-    # frames; a 1-joint neck and a 6-DOF head (whose map has no voxel of index 100)
-    "pitchy": (SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
-                         link_prefix="seg", joint_prefix="j", tip_name="nose", name="pitchy"),
-               dict(base_end="seg6", neck_end="seg7", head_tip="nose")),
-}
+ROBOTS = generated_specs()
 
 #: Coarse maps keep the suite fast (the defaults take minutes per robot on 2 cores).
 def map_options(robot) -> dict:

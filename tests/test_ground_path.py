@@ -240,16 +240,14 @@ def test_escape_along_the_axis_between_two_boxes(robot):
         gp.plan_route(robot, ring, start, goal)
 
 
-def _swept_distance(robot, box, a, yaw, scale, moves, b=None):
-    """The smallest exact distance to ``box`` of the corners of a sidewinding run's shapes at ``scale`` (both
-    directions, 24 phases, the ramps' half and full envelope) and of their edges' midpoints, the virtual chassis
-    at ``moves`` points from ``a`` to ``b`` at heading ``yaw``."""
+def _run_outline(robot, gait: str, scale: float) -> np.ndarray:
+    """(k, 2) m: the corners and edge midpoints of a ``gait`` run's shapes at ``scale`` (both directions, 24 phases,
+    the ramps' half and full envelope) in each shape's virtual chassis (x forward, y left)."""
     from snakehead.motion.gaits import make_gait, virtual_chassis
 
-    b = a if b is None else b
     qs = [np.zeros((1, robot.n_joints))]
     for direction in (1, -1):
-        g = make_gait("sidewinding", direction)
+        g = make_gait(gait, direction)
         q = g.joint_angles(robot, g.ramp_s + np.linspace(0.0, g.period_s, 24, endpoint=False), 1.0)
         qs += [e * scale * q for e in (0.5, 1.0)]
     F = robot.frames_many(np.vstack(qs))
@@ -257,8 +255,15 @@ def _swept_distance(robot, box, a, yaw, scale, moves, b=None):
     for c, p in zip(robot.link_centres(F), robot.hull_points(F)):
         T = virtual_chassis(c, forward=c[-1] - c[0])
         pts = np.concatenate([p, 0.5 * (p[:, :, None] + p[:, None, :]).reshape(len(p), -1, 3)], axis=1)
-        local.append(((pts.reshape(-1, 3) - T[:3, 3]) @ T[:3, :2]))
-    local = np.concatenate(local)
+        local.append((pts.reshape(-1, 3) - T[:3, 3]) @ T[:3, :2])
+    return np.concatenate(local)
+
+
+def _swept_distance(robot, box, a, yaw, scale, moves, b=None):
+    """The smallest exact distance to ``box`` of a sidewinding run's outline points (_run_outline) at ``scale``,
+    the virtual chassis at ``moves`` points from ``a`` to ``b`` at heading ``yaw``."""
+    b = a if b is None else b
+    local = _run_outline(robot, "sidewinding", scale)
     R = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
     return min(_box_distance(box, (a + s * (b - a)) + local @ R.T).min() for s in np.linspace(0.0, 1.0, moves))
 
@@ -320,8 +325,6 @@ def test_turn_slack_against_brute_force(robot):
     midpoints; both directions, 24 phases, the ramps' half and full envelope) turned about the middle through the
     sector it bounds (TURN_OVERSHOOT times the predicted turn, TURN_SLACK_DEG either way), and not much below
     it; -inf where the sector reaches half a turn."""
-    from snakehead.motion.gaits import make_gait, virtual_chassis
-
     box = BoxObstacle.from_yaw([0.0, 0.0, 0.125], [0.25, 0.25, 0.25], 0.3)
     rng = np.random.default_rng(5)
     finite = 0
@@ -336,18 +339,7 @@ def test_turn_slack_against_brute_force(robot):
             assert slack == -math.inf
             continue
         finite += 1
-        qs = [np.zeros((1, robot.n_joints))]
-        for direction in (1, -1):
-            g = make_gait("turning", direction)
-            q = g.joint_angles(robot, g.ramp_s + np.linspace(0.0, g.period_s, 24, endpoint=False), 1.0)
-            qs += [e * scale * q for e in (0.5, 1.0)]
-        F = robot.frames_many(np.vstack(qs))
-        local = []
-        for c, p in zip(robot.link_centres(F), robot.hull_points(F)):
-            T = virtual_chassis(c, forward=c[-1] - c[0])
-            pts = np.concatenate([p, 0.5 * (p[:, :, None] + p[:, None, :]).reshape(len(p), -1, 3)], axis=1)
-            local.append((pts.reshape(-1, 3) - T[:3, 3]) @ T[:3, :2])
-        local = np.concatenate(local)
+        local = _run_outline(robot, "turning", scale)
         true = min(_box_distance(box, a + local @ np.array([[math.cos(h), -math.sin(h)], [math.sin(h), math.cos(h)]]).T
                                  ).min() for h in yaw + np.linspace(lo, hi, 90))
         assert true >= slack - 1e-3, (trial, true, slack)

@@ -210,12 +210,9 @@ def test_check_motion_catches_a_thin_obstacle_between_coarse_samples() -> None:
     assert clear.clear and np.isinf(clear.obstacle_lower).all()
 
 
-def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
-    """A check that takes over the first samples' part of an earlier one (KeptSamples: a motion beginning with the
-    same samples) equals the check from scratch bit for bit; a motion whose first samples differ is computed from
-    scratch; at another placement on the ground the prefix is moved there (test below)."""
-    robot = SnakeRobot.default()
-    rng = np.random.default_rng(3)
+def _lift_then_other(robot: SnakeRobot, rng: np.random.Generator):
+    """A motion ``lift`` (301 samples over 2 s) and ``q``: its first m = 120 samples, then another motion's: t, lift,
+    its velocities, the other motion, q, its velocities, m."""
     t = np.linspace(0.0, 2.0, 301)
     lift = _smooth_motion(robot, rng, 301, 0.2)
     qd_lift = np.gradient(lift, t, axis=0)
@@ -223,6 +220,16 @@ def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
     m = 120
     q = np.concatenate([lift[:m], other[m:]])
     qd = np.concatenate([qd_lift[:m], np.gradient(other, t, axis=0)[m:]])
+    return t, lift, qd_lift, other, q, qd, m
+
+
+def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
+    """A check that takes over the first samples' part of an earlier one (KeptSamples: a motion beginning with the
+    same samples) equals the check from scratch bit for bit; a motion whose first samples differ is computed from
+    scratch; at another placement on the ground the prefix is moved there (test below)."""
+    robot = SnakeRobot.default()
+    rng = np.random.default_rng(3)
+    t, lift, qd_lift, other, q, qd, m = _lift_then_other(robot, rng)
     base = BasePlacement(0.1, 0.2, 0.3)
     kept = stability.KeptSamples(m)
     stability.dynamic_stability_with_clearance(robot, t, lift, base, qd_lift, kept=kept)
@@ -247,13 +254,7 @@ def test_zmp_check_moves_a_prefix_kept_at_another_placement(robots: dict[str, Sn
     height) is computed from scratch. (sea: a rotated root.)"""
     robot = robots[which]
     rng = np.random.default_rng(8)
-    t = np.linspace(0.0, 2.0, 301)
-    lift = _smooth_motion(robot, rng, 301, 0.2)
-    qd_lift = np.gradient(lift, t, axis=0)
-    other = _smooth_motion(robot, rng, 301, 0.2)
-    m = 120
-    q = np.concatenate([lift[:m], other[m:]])
-    qd = np.concatenate([qd_lift[:m], np.gradient(other, t, axis=0)[m:]])
+    t, lift, qd_lift, other, q, qd, m = _lift_then_other(robot, rng)
     kept = stability.KeptSamples(m)
     stability.dynamic_stability_with_clearance(robot, t, lift, BasePlacement(0.1, 0.2, 0.3), qd_lift, kept=kept)
     for where in (BasePlacement(-1.3, 0.7, -2.9), BasePlacement(0.1, 0.2, 0.31), BasePlacement(25.0, -40.0, 1.0)):

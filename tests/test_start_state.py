@@ -9,20 +9,13 @@ import pytest
 import snakehead
 from snakehead._errors import Infeasible
 from snakehead.dynamics import stability
-from snakehead.model.generate import SnakeSpec, snake_urdf
+from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
+
+from conftest import generated_specs
 from snakehead.motion import start_state as ss
 
-SPECS = {
-    # a yaw-first snake with a 2-joint neck (its first link stays on the ground: its yaw keeps the shape)
-    "long20": (SnakeSpec(n_joints=20, module_length=0.07, section=0.05, mass_per_module=0.15, first_axis="yaw",
-                         markers={"p0": 10, "b0": 12}, tip_name="tip", name="long20"),
-               dict(base_end="p0", neck_end="b0", head_tip="tip")),
-    # pitch first, heavy modules: fewer yaw joints to curl
-    "pitchy": (SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
-                         link_prefix="seg", joint_prefix="j", tip_name="nose", name="pitchy"),
-               dict(base_end="seg6", neck_end="seg7", head_tip="nose")),
-}
+SPECS = generated_specs()  # long20 (a 2-joint neck beginning with a yaw joint), pitchy (pitch first, heavy)
 
 
 @pytest.fixture(scope="module", params=["default", *sorted(SPECS)])
