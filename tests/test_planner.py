@@ -73,6 +73,11 @@ def test_spheres(spheres, controller):
 def test_hole(hole, controller):
     check(hole, controller.robot)
     assert hole.obstacle_distance is not None and hole.obstacle_distance.min() > 0  # no link touches the wall
+    # the reported least distance is the exact one at the samples (every sample's exact distance, independently),
+    # not the proof's lower bound between them (which stops tightening once positive)
+    truth = coll.collision_check(controller.robot, hole.q, hole.obstacles, hole.base, exact_within=np.inf).distance
+    assert hole.min_obstacle_distance_m == pytest.approx(truth.min(), abs=1e-12)
+    assert hole.min_obstacle_distance_m > 1e-3 > hole.obstacle_distance.min()  # the bound is far below it here
     # The head link is through: the head tip beyond the wall's far face, on the hole's axis.
     last = controller.robot.head_pose(hole.q[-1], hole.base)
     assert last[1, 3] > HOLE_CENTRE[1] + WALL_SIZE[2] / 2

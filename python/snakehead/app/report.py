@@ -107,8 +107,7 @@ def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict 
         "base": {"x_m": result.base.x, "y_m": result.base.y, "yaw_rad": result.base.yaw},
         "dynamically_stable": bool(result.stability.stable),
         "touches_obstacle": bool(result.touches_obstacle),
-        "min_obstacle_distance_m": (None if result.obstacle_distance is None
-                                    else float(np.min(result.obstacle_distance))),
+        "min_obstacle_distance_m": result.min_obstacle_distance_m,
         "segments": [{"segment": s, "interpolation": m} for s, m in result.segments],
         "relocation": None if result.relocation is None else result.relocation.as_dict(),
         "notes": list(result.notes),

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..dynamics import stability
 from ..geometry import collision as coll
-from ..margins import ZMP_MARGIN
+from ..margins import EXACT_DISTANCE_WITHIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene
 
@@ -114,6 +114,22 @@ class Plan:
     @property
     def duration_s(self) -> float:
         return float(self.t[-1] - self.t[0])
+
+    @property
+    def min_obstacle_distance_m(self) -> float | None:
+        """The smallest exact distance (m) of the robot to the obstacles at the motion's samples (None without
+        obstacles). ``obstacle_distance`` holds the proof's lower bound between samples, which stops tightening once
+        it is positive (micrometres where the head passes a hole): the samples whose bound is below
+        EXACT_DISTANCE_WITHIN get their exact distance here, the others' bound is above it already."""
+        if self.obstacle_distance is None:
+            return None
+        near = np.flatnonzero(self.obstacle_distance < EXACT_DISTANCE_WITHIN)
+        if len(near) == 0:
+            return float(self.obstacle_distance.min())
+        exact = coll.collision_check(self.robot, self.q[near], self.obstacles, self.base,
+                                     exact_within=EXACT_DISTANCE_WITHIN).distance
+        far = np.delete(self.obstacle_distance, near)
+        return float(min(exact.min(), far.min(initial=np.inf)))
 
     @property
     def touches_obstacle(self) -> bool:
