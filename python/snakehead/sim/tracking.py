@@ -493,104 +493,154 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     Returns a :class:`SimResult` sampled at every control tick from t[0] through the first tick at or after
     t[-1] + hold (so that any time of the motion, its end included, lies within the recorded span).
     """
-    mj = _mujoco()
     robot = as_robot(robot)
     base = as_base(base)
     t, q = check_trajectory(robot, t, q)
-    n = robot.n_joints
-    timestep = duration(timestep, "timestep", maximum=MAX_TIMESTEP)
-    armature = non_negative(armature, "armature")
-    if kp is None or kd is None:
-        kp_load, kd_load = default_gains(robot, armature=armature)
-        kp = kp_load if kp is None else kp
-        kd = kd_load if kd is None else kd
-    kp = _gains(kp, n, "kp", allow_zero=False)
-    kd = _gains(kd, n, "kd", allow_zero=True)
-    control_dt = duration(control_dt, "control_dt", maximum=MAX_CONTROL_DT)
-    sub = int(round(control_dt / timestep))
-    if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
-        raise InputError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
-    settle, hold = duration(settle, "settle", allow_zero=True), duration(hold, "hold", allow_zero=True)
-    drop = non_negative(drop, "drop", maximum=1.0)
-    # What the run will record and step, checked before anything is allocated or stepped.
-    sample_count(t[-1] - t[0] + hold, control_dt, "the simulated motion (t[-1] - t[0] + hold)")
-    sample_count(settle + t[-1] - t[0] + hold, timestep, "the physics steps (settle + motion + hold)",
-                 maximum=MAX_PHYSICS_STEPS)
-    mode = _compensated_mode(gravity_compensation)
-
-    sim = build_model(robot, timestep=timestep, friction=friction, joint_damping=joint_damping,
-                      armature=armature, torque_limit=torque_limit, obstacles=obstacles, hole_slices=hole_slices,
+    o = _TrackingOptions.checked(robot, t, kp, kd, control_dt, timestep, settle, hold, gravity_compensation, armature,
+                                 drop)
+    sim = build_model(robot, timestep=o.timestep, friction=friction, joint_damping=joint_damping,
+                      armature=o.armature, torque_limit=torque_limit, obstacles=obstacles, hole_slices=hole_slices,
                       self_collision=self_collision)
-    m = sim.model
-    m.actuator_biasprm[:, 1] = -kp
-    m.actuator_biasprm[:, 2] = -kd
-    d = mj.MjData(m)
+    sim.model.actuator_biasprm[:, 1] = -o.kp
+    sim.model.actuator_biasprm[:, 2] = -o.kd
+    d = _start_data(sim, q[0], base, o.drop, state)
+    _settle(sim, d, robot, q[0], base, o)
+    ts, q_ref, qd_ref = _reference(robot, t, q, o)
+    rec = _track(sim, d, robot, base, ts, q_ref, qd_ref, o)
+
+    settings = dict(kp=o.kp.tolist(), kd=o.kd.tolist(), control_dt=o.control_dt, timestep=o.timestep,
+                    settle=o.settle, hold=o.hold, gravity_compensation=o.mode,
+                    friction=float(friction), joint_damping=float(joint_damping), armature=o.armature,
+                    n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
+    # the state's clock: the plan's without ``state``, else going on from the state's time
+    t_end = (ts[-1] if state is None else float(state.time) + o.settle + ts[-1] - t[0]) + o.control_dt
+    return SimResult(t=ts, q_ref=q_ref, **rec, base=base, torque_limit=sim.torque_limit, settings=settings,
+                     end_state=SimState(d.qpos.copy(), d.qvel.copy(), t_end))
+
+
+@dataclass(frozen=True)
+class _TrackingOptions:
+    """:func:`simulate_trajectory`'s numbers, checked: the gains (n,), the control period and physics step (s), the
+    physics steps per control tick, the settling and holding times (s), the drop (m), the armature and the gravity
+    compensation's mode."""
+
+    kp: np.ndarray
+    kd: np.ndarray
+    control_dt: float
+    timestep: float
+    sub: int
+    settle: float
+    hold: float
+    drop: float
+    armature: float
+    mode: str
+
+    @staticmethod
+    def checked(robot: SnakeRobot, t: np.ndarray, kp: Any, kd: Any, control_dt: Any, timestep: Any, settle: Any,
+                hold: Any, gravity_compensation: Any, armature: Any, drop: Any) -> _TrackingOptions:
+        """InputError naming the first bad argument; also when the run would record or step more than its bounds
+        allow (checked before anything is allocated or stepped)."""
+        n = robot.n_joints
+        timestep = duration(timestep, "timestep", maximum=MAX_TIMESTEP)
+        armature = non_negative(armature, "armature")
+        if kp is None or kd is None:
+            kp_load, kd_load = default_gains(robot, armature=armature)
+            kp = kp_load if kp is None else kp
+            kd = kd_load if kd is None else kd
+        kp = _gains(kp, n, "kp", allow_zero=False)
+        kd = _gains(kd, n, "kd", allow_zero=True)
+        control_dt = duration(control_dt, "control_dt", maximum=MAX_CONTROL_DT)
+        sub = int(round(control_dt / timestep))
+        if sub < 1 or abs(sub * timestep - control_dt) > 1e-9 * control_dt:
+            raise InputError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
+        settle, hold = duration(settle, "settle", allow_zero=True), duration(hold, "hold", allow_zero=True)
+        drop = non_negative(drop, "drop", maximum=1.0)
+        sample_count(t[-1] - t[0] + hold, control_dt, "the simulated motion (t[-1] - t[0] + hold)")
+        sample_count(settle + t[-1] - t[0] + hold, timestep, "the physics steps (settle + motion + hold)",
+                     maximum=MAX_PHYSICS_STEPS)
+        return _TrackingOptions(kp, kd, float(control_dt), float(timestep), sub, float(settle), float(hold),
+                                float(drop), float(armature), _compensated_mode(gravity_compensation))
+
+
+def _start_data(sim: SimModel, q0: np.ndarray, base: BasePlacement, drop: float, state: Any) -> Any:
+    """MuJoCo's data at the start: the robot at q0, ``drop`` m above its resting height at ``base``, or ``state``."""
+    d = _mujoco().MjData(sim.model)
     if state is None:
-        sim.set_state(d, q[0], base, lift=float(drop))
+        sim.set_state(d, q0, base, lift=drop)
     elif isinstance(state, SimState):
         state.load(sim, d)
     else:
         raise InputTypeError(f"state must be a SimState (from GaitSimulator or a SimResult's end_state), got "
-                        f"{type(state).__name__}")
+                             f"{type(state).__name__}")
+    return d
 
-    qdot_plan = np.gradient(q, t, axis=0)
-    da = sim.dof_adr
 
-    def control(qr: np.ndarray, qdr: np.ndarray, W: np.ndarray | None) -> None:
-        tau_g: np.ndarray | float
-        if mode == "supported":
-            assert W is not None  # the supported mode computes the weights
-            tau_g = gravity_torques(sim, d, W)
-        elif mode == "bias":
-            tau_g = d.qfrc_bias[da]
-        else:
-            tau_g = 0.0
-        d.ctrl[:] = kp * qr + kd * qdr + tau_g
+def _control(sim: SimModel, d: Any, o: _TrackingOptions, qr: np.ndarray, qdr: np.ndarray,
+             W: np.ndarray | None) -> None:
+    """The servo's command at one tick: PD on (qr, qdr) plus the gravity compensation of ``o.mode`` (W: the
+    carried weights, for "supported")."""
+    tau_g: np.ndarray | float
+    if o.mode == "supported":
+        assert W is not None  # the supported mode computes the weights
+        tau_g = gravity_torques(sim, d, W)
+    elif o.mode == "bias":
+        tau_g = d.qfrc_bias[sim.dof_adr]
+    else:
+        tau_g = 0.0
+    d.ctrl[:] = o.kp * qr + o.kd * qdr + tau_g
 
-    # settle at q[0]
-    zero = np.zeros(n)
-    W0 = carried_weights(robot, robot.frames_many(q[:1], base))[0]
-    for _ in range(int(round(float(settle) / control_dt))):
+
+def _settle(sim: SimModel, d: Any, robot: SnakeRobot, q0: np.ndarray, base: BasePlacement,
+            o: _TrackingOptions) -> None:
+    """Hold q0 with the same controller for ``o.settle`` s (unrecorded)."""
+    mj, m = _mujoco(), sim.model
+    zero = np.zeros(robot.n_joints)
+    W0 = carried_weights(robot, robot.frames_many(q0[None], base))[0]
+    for _ in range(int(round(o.settle / o.control_dt))):
         mj.mj_step1(m, d)
-        control(q[0], zero, W0)
+        _control(sim, d, o, q0, zero, W0)
         mj.mj_step2(m, d)
-        for _ in range(sub - 1):
+        for _ in range(o.sub - 1):
             mj.mj_step(m, d)
 
-    # Ticks control_dt apart from t[0] through the first one at or after t[-1] + hold: the recorded span covers the
-    # whole motion (and hold) even when its length is not a whole number of periods (a plan's last sample is its
-    # exact end, at most one period after the previous one); past t[-1] the reference holds q[-1] at rest.
-    N = sample_count_covering(t[-1] - t[0] + float(hold), control_dt)
-    ts = t[0] + control_dt * np.arange(N)
+
+def _reference(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, o: _TrackingOptions
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ticks ts (N,) and the reference q_ref, qd_ref (N, n) at them. Ticks are control_dt apart from t[0] through
+    the first one at or after t[-1] + hold: the recorded span covers the whole motion (and hold) even when its length
+    is not a whole number of periods (a plan's last sample is its exact end, at most one period after the previous
+    one); past t[-1] the reference holds q[-1] at rest."""
+    n = robot.n_joints
+    qdot_plan = np.gradient(q, t, axis=0)
+    N = sample_count_covering(t[-1] - t[0] + o.hold, o.control_dt)
+    ts = t[0] + o.control_dt * np.arange(N)
     q_ref = np.column_stack([np.interp(ts, t, q[:, j]) for j in range(n)])
     qd_ref = np.column_stack([np.interp(ts, t, qdot_plan[:, j]) for j in range(n)])
     qd_ref[ts > t[-1]] = 0.0
-    Wref = carried_weights(robot, robot.frames_many(q_ref, base)) if mode == "supported" else None
+    return ts, q_ref, qd_ref
 
-    log = _TickLog(sim, robot, N)
-    pd_ref = kp * q_ref + kd * qd_ref  # the servo's reference terms, as control() adds them, for every tick
+
+def _track(sim: SimModel, d: Any, robot: SnakeRobot, base: BasePlacement, ts: np.ndarray, q_ref: np.ndarray,
+           qd_ref: np.ndarray, o: _TrackingOptions) -> dict:
+    """Run the servo along the reference, tick by tick, and return the recorded fields of the SimResult
+    (:class:`_TickLog`)."""
+    mj, m = _mujoco(), sim.model
+    Wref = carried_weights(robot, robot.frames_many(q_ref, base)) if o.mode == "supported" else None
+    log = _TickLog(sim, robot, len(ts))
+    pd_ref = o.kp * q_ref + o.kd * qd_ref  # the servo's reference terms, as _control adds them, for every tick
     gravity = _GravityTerm(sim, Wref) if Wref is not None else None
-    for k in range(N):
+    for k in range(len(ts)):
         mj.mj_step1(m, d)  # positions, velocities, collisions, bias forces at this tick
         log.state(k, d)
         if gravity is not None:
             d.ctrl[:] = pd_ref[k] + gravity(d, k)
         else:
-            control(q_ref[k], qd_ref[k], None)
+            _control(sim, d, o, q_ref[k], qd_ref[k], None)
         mj.mj_step2(m, d)  # constraint (contact) forces of this tick's state, then integration
         log.forces(k, d)
-        for _ in range(sub - 1):  # the tick's other physics steps: their contacts count in its ZMP (_TickLog)
+        for _ in range(o.sub - 1):  # the tick's other physics steps: their contacts count in its ZMP (_TickLog)
             mj.mj_step(m, d)
             log.step(k, d)
         if not math.isfinite(d.qpos.sum()):  # NaN or inf anywhere (a sum of finite angles does not overflow)
             raise RuntimeError(f"the simulation diverged at t = {ts[k]:.3f} s; lower the gains or the timestep")
-    rec = log.result()
-
-    settings = dict(kp=kp.tolist(), kd=kd.tolist(), control_dt=control_dt, timestep=timestep,
-                    settle=float(settle), hold=float(hold), gravity_compensation=mode,
-                    friction=float(friction), joint_damping=float(joint_damping), armature=float(armature),
-                    n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
-    # the state's clock: the plan's without ``state``, else going on from the state's time
-    t_end = (ts[-1] if state is None else float(state.time) + float(settle) + ts[-1] - t[0]) + control_dt
-    return SimResult(t=ts, q_ref=q_ref, **rec, base=base, torque_limit=sim.torque_limit, settings=settings,
-                     end_state=SimState(d.qpos.copy(), d.qvel.copy(), t_end))
+    return log.result()
