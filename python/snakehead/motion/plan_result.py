@@ -117,10 +117,10 @@ class Plan:
 
     @property
     def min_obstacle_distance_m(self) -> float | None:
-        """The smallest exact distance (m) of the robot to the obstacles at the motion's samples (None without
-        obstacles). ``obstacle_distance`` holds the proof's lower bound between samples, which stops tightening once
-        it is positive (micrometres where the head passes a hole): the samples whose bound is below
-        EXACT_DISTANCE_WITHIN get their exact distance here, the others' bound is above it already."""
+        """The smallest distance (m) of the robot to the obstacles at the motion's samples (None without obstacles):
+        exact when it is below EXACT_DISTANCE_WITHIN, else a lower bound of it that is at least that. The proof's
+        lower bounds in ``obstacle_distance`` stop tightening once positive (micrometres where the head passes a
+        hole), so the samples whose bound is below EXACT_DISTANCE_WITHIN get their exact distance here."""
         if self.obstacle_distance is None:
             return None
         near = np.flatnonzero(self.obstacle_distance < EXACT_DISTANCE_WITHIN)
