@@ -8,7 +8,7 @@ import pytest
 from scipy.sparse import lil_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from snakehead import BasePlacement, Infeasible, SnakeRobot
+from snakehead import BasePlacement, Infeasible, InputError, SnakeRobot
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.motion import ground_path as gp
 
@@ -371,3 +371,10 @@ def test_staging_on_the_goal_axis_when_none_across(robot):
     here = lc.compose(BasePlacement(W[-2, 0], W[-2, 1], goal.yaw), lc.inverse(offset))
     step = lc.next_step(robot, here, lc.compose(goal, lc.inverse(offset)), rates, creep=True)
     assert (step.gait.name, step.gait.direction, step.leg) == ("linear_progression", 1, "along")
+
+
+@pytest.mark.parametrize("gait, scale", [("rolling", 0.5), (None, 0.5), ("sidewinding", float("nan")),
+                                         ("turning", -0.2), ("sidewinding", float("inf")), ("sidewinding", "big")])
+def test_sweep_profile_refuses_bad_arguments(robot, gait, scale):
+    with pytest.raises(InputError, match="gait|scale"):
+        gp.sweep_profile(robot, gait, scale)

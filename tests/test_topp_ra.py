@@ -157,7 +157,7 @@ def test_canonical_solve_equals_the_stage_solve_to_the_bit(robot: snakehead.Snak
         if ours.sd is not None:
             np.testing.assert_array_equal(ours.sd, ref.sd)
         kinds.add(ours.sd is not None)
-    assert True in kinds
+    assert True in kinds, "no feasible path was drawn: the comparison covered only failures"
 
 
 def test_canonical_solve_refuses_malformed_rows() -> None:

@@ -37,7 +37,8 @@ from typing import Any, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from .._errors import Infeasible
+from .._errors import InputError, Infeasible
+from .._validate import non_negative
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 #: Grid resolution (m).
@@ -311,6 +312,8 @@ PROFILE_RAMP_STEPS = 4
 
 #: sweep_profile's answers per robot, by (gait, amplitude step).
 _PROFILES: "weakref.WeakKeyDictionary[SnakeRobot, dict]" = weakref.WeakKeyDictionary()
+#: The gaits whose runs sweep_profile outlines.
+SWEPT_GAITS = ("sidewinding", "turning")
 
 
 #: Samples along each segment between two hull points of a link (sweep_profile): the silhouette of a link's convex
@@ -367,7 +370,10 @@ def sweep_profile(robot: SnakeRobot, gait: str, scale: float = 1.0) -> SweepProf
     from .gaits import make_gait
 
     robot = as_robot(robot)
-    k = min(max(int(math.ceil(float(scale) * PROFILE_STEPS - 1e-9)), 1), PROFILE_STEPS)
+    if gait not in SWEPT_GAITS:
+        raise InputError(f"gait must be one of {', '.join(SWEPT_GAITS)}, got {gait!r}")
+    scale = non_negative(scale, "scale")  # 0: the straight body (the first step covers it)
+    k = min(max(int(math.ceil(scale * PROFILE_STEPS - 1e-9)), 1), PROFILE_STEPS)
     cache = _PROFILES.setdefault(robot, {})
     if (gait, k) in cache:
         return cache[(gait, k)][0]

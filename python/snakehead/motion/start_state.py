@@ -21,6 +21,9 @@ BENDING_CLEARANCE = 0.005  # m: least gap between non-neighbouring links of the 
 #: m: bound on the difference between ground_curl's fast margins and the exhaustive ones (both the same sums
 #: in double precision, ~1e-15 m apart on a robot of metres: a million times that)
 CURL_MARGIN_SLACK = 1e-9
+#: Curls spread over all of them whose composed centre of mass ground_curl checks against the robot's own (a chain
+#: the composition does not model then falls back to the exhaustive search).
+CURL_COM_SPREAD = 16
 
 
 def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
@@ -86,7 +89,7 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
         raise Infeasible(_NO_CURL)
     near = order[fast[order] >= fast[first] - 2.0 * CURL_MARGIN_SLACK]
     # the robot's own centres of mass of those, and of a spread of all the curls, which the fast ones must equal
-    rows = np.unique(np.concatenate([near, np.linspace(0, len(com) - 1, 16).astype(int)]))
+    rows = np.unique(np.concatenate([near, np.linspace(0, len(com) - 1, CURL_COM_SPREAD).astype(int)]))
     qs = _curl_configurations(q, yaw, values, rows)
     exact_com = stability.center_of_mass(robot, qs)[:, :2]
     if np.abs(exact_com - com[rows]).max() > CURL_MARGIN_SLACK / 4:  # a chain the composition does not model
@@ -197,5 +200,5 @@ def _line_margins(hull: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return (cross / np.hypot(edge[:, 0], edge[:, 1])).min(axis=1)
 
 
-__all__ = ["bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
+__all__ = ["bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
            "BENDING_CLEARANCE"]
