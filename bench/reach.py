@@ -1,6 +1,9 @@
 """The whole body's stable reachability map (snakehead reach) of the default robot: its time on one process and on
 a local Dask cluster of 1, 2 and 4 workers (one thread each), and the agreement of full plans with it.
 
+The one process's core uses every core in TRAC-IK's batches (snakehead.core_threads()); a Dask worker's core uses
+one thread (Dask's workers set OMP_NUM_THREADS=1, which snakehead.threads follows), so the workers share the cores.
+
     python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100] [--unpruned]
 
 --unpruned adds a one-process run that solves every pose (compute_reach(prune=False): the map before the prunes of
@@ -39,7 +42,7 @@ def main() -> None:
     if not args.no_serial:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions))
-        rows.append(("1 process", time.perf_counter() - t))
+        rows.append((f"1 process ({sh.core_threads()} core threads)", time.perf_counter() - t))
     if args.unpruned:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, prune=False))
@@ -49,9 +52,11 @@ def main() -> None:
     for w in args.workers:
         with LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
                 Client(cluster) as client:
+            threads = ",".join(map(str, sorted(set(client.run(sh.core_threads).values()))))  # imports snakehead there
             t = time.perf_counter()
             maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, executor=client))
-            rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''}", time.perf_counter() - t))
+            rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''} ({threads} core threads each)",
+                         time.perf_counter() - t))
         print(f"(done: {rows[-1][0]}, load {os.getloadavg()[0]:.1f})", flush=True)
     print("| run | time (s) | poses reached |")
     print("|---|---:|---:|")

@@ -14,4 +14,5 @@ void bind_path_check(pybind11::module_& m);
 void bind_topp_ra(pybind11::module_& m);
 void bind_tracking_fit(pybind11::module_& m);
 void bind_limits(pybind11::module_& m);
+void bind_core_threads(pybind11::module_& m);
 }  // namespace snakehead::bindings

@@ -37,6 +37,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_topp_ra(m);
   snakehead::bindings::bind_tracking_fit(m);
   snakehead::bindings::bind_limits(m);
+  snakehead::bindings::bind_core_threads(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");

@@ -1,5 +1,6 @@
 #include "snakehead/trac_ik.hpp"
 
+#include "snakehead/core_threads.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
 
@@ -788,8 +789,9 @@ void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allo
     }
   };
   // The calling thread works too, so one thread fewer from the pool: more threads than cores would let the
-  // scheduler park a thread, mid-target, for longer than a timeout.
-  std::vector<WorkerPool::JobPtr> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(impl_->pool.size() - 1, T)));
+  // scheduler park a thread, mid-target, for longer than a timeout. At most core_threads() in all.
+  const int helpers = std::min(impl_->pool.size(), core_threads()) - 1;
+  std::vector<WorkerPool::JobPtr> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(helpers, T)));
   for (auto& j : jobs) {
     j = std::make_shared<WorkerPool::Job>(work);
     impl_->pool.submit(j);

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "snakehead/alpha_shape.hpp"
+#include "snakehead/core_threads.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
@@ -389,7 +390,7 @@ VoxelEvaluation evaluate_tiles(const ChainModel& model, const WorkspaceOptions& 
   const int n_rolls = options.free_roll ? 1 : options.rolls;
   const ReachBound bound(model, options);
   const double radius = 0.5 * options.voxel_size;
-  int n_threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  int n_threads = options.threads > 0 ? options.threads : core_threads();
   n_threads = static_cast<int>(
       std::max<std::int64_t>(1, std::min<std::int64_t>(std::max(n_threads, 1), static_cast<std::int64_t>(tiles.size()))));
   out.threads_used = n_threads;

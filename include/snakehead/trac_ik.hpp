@@ -102,8 +102,8 @@ class TracIK {
   IKResult solve_ex(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
                     const TracIKOptions& options, IKAlgorithm algorithm = IKAlgorithm::TracIK) const;
 
-  // Solve many targets across all cores (the calling thread and pool workers, one thread per core). q_inits
-  // is n x T (one column per target). Each target gets the full timeout; its two solvers run interleaved in
+  // Solve many targets across core_threads() threads (core_threads.hpp: the calling thread and pool workers).
+  // q_inits is n x T (one column per target). Each target gets the full timeout; its two solvers run interleaved in
   // one thread (the seeded schedule above, on the clock when unseeded). With a seed, target k uses a generator derived from (seed, k), so results do not depend on
   // which thread solved it. q_out is resized to n x T; ok to T.
   void solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& targets,

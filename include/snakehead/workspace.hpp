@@ -68,7 +68,7 @@ struct WorkspaceOptions {
   HullKind hull = HullKind::Boundary;
   double shrink = 0.5;           // the boundary's shrink factor S in [0, 1] (MATLAB's default 0.5)
   std::uint64_t seed = 1;
-  int threads = 0;               // worker threads; 0 = hardware concurrency
+  int threads = 0;               // worker threads; 0 = core_threads() (core_threads.hpp)
   int shard_index = 0;           // this run processes the in-hull voxels k with k % shard_count == shard_index
   int shard_count = 1;
 

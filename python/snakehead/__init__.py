@@ -16,6 +16,7 @@ Start with ``SnakeRobot.default()``.
 """
 from ._errors import Infeasible, InputError, InputTypeError, InternalError, MotionTooLong
 from .control.controller import HeadController, HeadSolution
+from .threads import core_threads, set_core_threads
 from .geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .kinematics.ik import TracIK
 from .kinematics.workspace import ReachabilityMap
@@ -32,5 +33,5 @@ from .sim.plan import PlanSimulation, simulate
 __all__ = ["Infeasible", "InputError", "InputTypeError", "InternalError", "MotionTooLong", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
            "ReachabilityMap", "compute_map", "load_map", "plan", "plan_many", "PlanError", "Plan", "PlanProgress", "TargetResult", "simulate",
            "PlanSimulation", "Scene", "Target", "load_scene", "BoxObstacle", "MeshObstacle", "WallWithHole", "default_robot_file",
-           "default_urdf_path"]
+           "default_urdf_path", "core_threads", "set_core_threads"]
 __version__ = "0.2.0"

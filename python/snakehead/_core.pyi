@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -390,6 +390,10 @@ def convex_hulls(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]
     """
     Each sample's counter-clockwise convex hull of its active points: vertex indices (T, N), -1 after the count, and the counts (T,)
     """
+def core_threads() -> int:
+    """
+    The threads the core's batch work (TRAC-IK batches, a workspace sweep without a thread count) may use in this process: the value set, else SNAKEHEAD_NUM_THREADS, else OMP_NUM_THREADS, else every hardware thread.
+    """
 def evaluate_voxels(model: ChainModel, options: WorkspaceOptions, centers: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], stream_ids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], progress: typing.Any = None) -> dict:
     """
     Algorithm 1's lines 9-21 for spheres at the given centres; progress(done, total) -> bool
@@ -431,6 +435,10 @@ def sample_tip_positions(model: ChainModel, samples: typing.SupportsInt | typing
 def save_map(path: str, command: str, options: WorkspaceOptions, centers: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], solved: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], voxel_ids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], reached: typing.Annotated[numpy.typing.ArrayLike, numpy.uint8] | None, tried: typing.SupportsInt | typing.SupportsIndex, grid_origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], grid_voxel: typing.SupportsFloat | typing.SupportsIndex, grid_n: typing.SupportsInt | typing.SupportsIndex, hull_voxels: typing.SupportsInt | typing.SupportsIndex, hull_facets: typing.SupportsInt | typing.SupportsIndex, alpha: typing.SupportsFloat | typing.SupportsIndex, reach: typing.SupportsFloat | typing.SupportsIndex, chain_hash: str, base: str, tip: str, ik_calls: typing.SupportsInt | typing.SupportsIndex, cheap_exits: typing.SupportsInt | typing.SupportsIndex, seconds: typing.SupportsFloat | typing.SupportsIndex, threads: typing.SupportsInt | typing.SupportsIndex, kind: str = 'head', base_joints: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, base_placements: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> None:
     """
     The one map writer (save_npz, also workspace_gen's): a map's arrays to an .npz that numpy.load reads
+    """
+def set_core_threads(n: typing.SupportsInt | typing.SupportsIndex) -> None:
+    """
+    Sets core_threads() for this process (1..MAX_THREADS; 0 restores the default); InputError otherwise.
     """
 def shape_lowest_points(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], set: ShapeSet, shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], max_points: typing.SupportsInt | typing.SupportsIndex = 16) -> numpy.typing.NDArray[numpy.float64]:
     """

@@ -9,7 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "snakehead/core_threads.hpp"
 #include "snakehead/kinematics.hpp"
+#include "snakehead/limits.hpp"
 #include "snakehead/pose_error.hpp"
 #include "snakehead/trac_ik.hpp"
 
@@ -353,6 +355,18 @@ TEST(TracIK, BatchMatchesSingleCallsAndIsSeededPerTarget) {
     expect_solution(*model, targets[k], q1.col(k), o.epsilon);
   }
   EXPECT_GE(solved, T - 1);
+  // On one thread (core_threads.hpp), the same solutions: a seeded batch does not depend on its threads.
+  const int default_threads = core_threads();
+  EXPECT_GE(default_threads, 1);
+  set_core_threads(1);
+  EXPECT_EQ(core_threads(), 1);
+  ik.solve_many(targets, q0, q2, ok2);
+  set_core_threads(0);
+  EXPECT_EQ(core_threads(), default_threads);
+  EXPECT_EQ(ok1, ok2);
+  EXPECT_EQ(q1, q2);
+  EXPECT_THROW(set_core_threads(-1), InputError);
+  EXPECT_THROW(set_core_threads(limits::kMaxThreads + 1), InputError);
   // Unseeded too.
   TracIK fast(model);
   fast.solve_many(targets, q0, q1, ok1);

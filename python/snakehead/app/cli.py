@@ -381,8 +381,12 @@ def _reach_executor(args: argparse.Namespace) -> tuple[Any, Any]:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        # spawned workers: a forked child of a process whose C++ threads hold locks can hang
-        pool = ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn"))
+        from ..threads import set_core_threads, share_per_worker
+
+        # spawned workers: a forked child of a process whose C++ threads hold locks can hang; each worker's core
+        # uses its share of the cores, so that the pool uses them once
+        pool = ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=set_core_threads, initargs=(share_per_worker(args.workers),))
         return pool, pool.shutdown
     return None, None
 
@@ -586,7 +590,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=_bounded_int(0, ws.MAX_SEED), default=defaults.HEAD_SEED, metavar="N",
                    help="random seed, 0 to 2^64 - 1 (default %(default)s)")
     p.add_argument("--threads", type=_bounded_int(1, ws.MAX_THREADS), default=None, metavar="N",
-                   help=f"worker threads, 1 to {ws.MAX_THREADS} (default all cores)")
+                   help=f"worker threads, 1 to {ws.MAX_THREADS} (default: snakehead.core_threads(), all cores unless "
+                        "SNAKEHEAD_NUM_THREADS or OMP_NUM_THREADS says fewer)")
     p.add_argument("--shard", type=_shard, default=None, metavar="i/N",
                    help=f"compute only shard i of N (0 <= i < N <= {ws.MAX_SHARDS}); merge the N files afterwards "
                         "with --merge")

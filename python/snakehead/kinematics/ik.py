@@ -199,7 +199,7 @@ class TracIK:
         return self._solver.ik(T, q, b, t, algorithm)
 
     def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Solve many targets across all cores: poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
+        """Solve many targets across ``snakehead.core_threads()`` threads (all cores by default): poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
 
         Rows of ``q`` where ``ok`` is False hold the start configuration. With a seed, target k's search
         depends only on (seed, k), so results do not depend on which thread solved it.

@@ -71,7 +71,7 @@ MAX_FRAMES_PER_VOXEL = limits.MAX_FRAMES_PER_VOXEL
 MAX_VOXELS_PER_AXIS, MIN_VOXELS_PER_AXIS = limits.MAX_VOXELS_PER_AXIS, 4
 #: Random configurations sampled for the hull (``cloud_samples``).
 MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES = 100, limits.MAX_CLOUD_SAMPLES
-#: Worker threads (0 or None: all cores).
+#: Worker threads (0 or None: snakehead.core_threads(), all cores by default).
 MAX_THREADS = limits.MAX_THREADS
 #: The seed is an unsigned 64-bit integer.
 MAX_SEED = 2**64 - 1
@@ -476,7 +476,7 @@ def _options(voxel: float, directions: int, rolls: int, any_roll: bool, free_rol
     cloud_samples = _count("cloud_samples", cloud_samples, MIN_CLOUD_SAMPLES, MAX_CLOUD_SAMPLES,
                            " (the hull needs a cloud)")
     seed = _count("seed", seed, 0, MAX_SEED)
-    threads = 0 if threads is None else _count("threads", threads, 0, MAX_THREADS, " (0 = all cores)")
+    threads = 0 if threads is None else _count("threads", threads, 0, MAX_THREADS, " (0 = snakehead.core_threads())")
     voxel, timeout, epsilon = _real("voxel", voxel), _real("timeout", timeout), _real("epsilon", epsilon)
     if not (math.isfinite(voxel) and voxel > 0):
         raise InputError(f"voxel size must be a positive number of metres, got {voxel!r}")
@@ -638,8 +638,8 @@ def compute(chain_or_robot: Chain | SnakeRobot, *, voxel: float = defaults.HEAD_
     point; any_roll: a point counts when one of its rolls is solved (the paper) rather than each frame on its
     own; free_roll: one IK call per point with the roll free; approach_axis: 'x' (the head's direction) or
     'z'; timeout: TRAC-IK budget per call (s; seeded, so an evaluation budget: the map does not depend on
-    the machine's load); seed: the map is a function of it; threads: worker threads (None: all cores; the
-    map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th tile of voxels.
+    the machine's load); seed: the map is a function of it; threads: worker threads (None:
+    ``snakehead.core_threads()``; the map does not depend on it); shard: (i, N) or 'i/N' to compute only every N-th tile of voxels.
 
     executor: any ``concurrent.futures.Executor`` (a process pool, Dask's ``client.get_executor()``...) or a Dask
     ``distributed.Client`` (``snakehead._executors``, the one way work is spread):
