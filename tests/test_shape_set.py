@@ -174,3 +174,23 @@ def test_bad_input_is_value_error():
     nan[1, 0, 0, 3] = np.nan
     with pytest.raises(ValueError):
         _core.shape_pair_min_distances(nan, shapes, frames, shapes, np.array([[0, 0]]))
+
+
+def test_shapes_of_is_the_shapes_on_the_frames_and_remembered() -> None:
+    """ShapeSet.shapes_of against np.isin over the shapes' frames, for random frame lists, asked again and again
+    (the remembered answer) and past the number it keeps."""
+    from snakehead.geometry import shapes as sh_shapes
+    from snakehead.model.robot import SnakeRobot
+
+    g = SnakeRobot.default().geometry
+    rng = np.random.default_rng(5)
+    lists = [rng.choice(g.n_frames, size=rng.integers(0, g.n_frames + 1), replace=False)
+             for _ in range(sh_shapes.SHAPES_OF_KEPT + 20)]
+    for _ in range(2):
+        for frames in lists:
+            want = np.flatnonzero(np.isin([s.frame for s in g.shapes], frames))
+            got = g.shapes_of(frames)
+            np.testing.assert_array_equal(got, want)
+            assert not got.flags.writeable
+            assert len(g._shapes_on) <= sh_shapes.SHAPES_OF_KEPT
+    np.testing.assert_array_equal(g.shapes_of(list(lists[0])), g.shapes_of(lists[0]))  # a list as an array

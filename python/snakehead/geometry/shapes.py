@@ -34,6 +34,8 @@ CONTACT_POINTS = {"box": 4, "sphere": 1, "cylinder": 10, "convex": 10}
 
 #: Segments of a cylinder's or sphere's drawn mesh around its axis.
 DRAW_SEGMENTS = 24
+#: Frame lists whose shapes a ShapeSet remembers (:meth:`ShapeSet.shapes_of`; it forgets them all when full).
+SHAPES_OF_KEPT = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +79,8 @@ class ShapeSet:
     shapes: tuple[Shape, ...]
     n_frames: int
     _core_set: _core.ShapeSet = field(init=False, repr=False)
+    #: :meth:`shapes_of`'s answers by frame list (a plan asks for the same few lists hundreds of times)
+    _shapes_on: dict = field(init=False, repr=False, compare=False, default_factory=dict)
 
     def __post_init__(self) -> None:
         shapes = tuple(self.shapes)
@@ -105,8 +109,16 @@ class ShapeSet:
         return np.unique(self.shape_frames)
 
     def shapes_of(self, frames: Sequence[int] | np.ndarray) -> np.ndarray:
-        """Indices of the shapes on the given frames, in shape order."""
-        return np.flatnonzero(np.isin(self.shape_frames, np.asarray(frames, dtype=np.int64)))
+        """Indices of the shapes on the given frames, in shape order (read-only; remembered per frame list)."""
+        key = np.asarray(frames, dtype=np.int64).tobytes()
+        found = self._shapes_on.get(key)
+        if found is None:
+            found = np.flatnonzero(np.isin(self.shape_frames, np.frombuffer(key, dtype=np.int64)))
+            found.flags.writeable = False
+            if len(self._shapes_on) >= SHAPES_OF_KEPT:
+                self._shapes_on.clear()
+            self._shapes_on[key] = found
+        return found
 
     @cached_property
     def contact_points_per_shape(self) -> int:
