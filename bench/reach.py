@@ -3,6 +3,7 @@ a local Dask cluster of 1, 2 and 4 workers (one thread each), and the agreement 
 
 The one process's core uses every core in TRAC-IK's batches (snakehead.core_threads()); a Dask worker's core uses
 one thread (Dask's workers set OMP_NUM_THREADS=1, which snakehead.threads follows), so the workers share the cores.
+Dask's worker profiler is off (it costs ~7 % here).
 
     python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100] [--unpruned]
 
@@ -47,8 +48,11 @@ def main() -> None:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, prune=False))
         rows.append(("1 process, unpruned (every pose solved)", time.perf_counter() - t))
+    import dask
     from distributed import Client, LocalCluster
 
+    # Dask's statistical profiler samples each worker's stack every 10 ms under the GIL: ~7 % of these runs' time
+    dask.config.set({"distributed.worker.profile.enabled": False})
     for w in args.workers:
         with LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
                 Client(cluster) as client:
