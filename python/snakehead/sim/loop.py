@@ -687,301 +687,353 @@ class ClosedLoop:
         start = as_base(start)
         believed = start if believed_start is None else as_base(believed_start)
         q_now = lc.flat_shape(robot, np.zeros(robot.n_joints) if q_start is None else q_start, "q_start")
-        q_first = q_now.copy()
         if coll.self_clearance(robot, q_now[None])[0] <= 0.0:
             raise InputError("q_start folds the body onto itself (two links overlap)")
         if self.obstacles and coll.collision_check(robot, q_now[None], self.obstacles, start,
                                                    exact_within=EXACT_DISTANCE_WITHIN).distance[0] <= 0.0:
             raise InputError(f"the body lying at {_fmt(start)} is inside an obstacle of the scene")
         inputs_checked()  # the loop plans and simulates from here: an InputError inside would be a bug
-        say = progress or (lambda text: None)
-        sim = self.simulator
-        rng = np.random.default_rng(None if self.fix is None else self.fix.seed)
-        state = sim.lying(start, q_now)
-        sim.restore(state)
-        est = sim.estimator.reset(sim.measured_joints(), sim.measured_attitude(), (believed.x, believed.y),
-                                  believed.yaw)
-        phases: list[Phase] = []
-        fixes: list[dict] = []
-        notes: list[str] = []
-        rates = lc.GaitRates.first_guess(robot)
-        planning = 0.0
-        head_plan: Plan | None = None
-        head: SimResult | None = None
-        metrics, head_t0 = None, 0.0
-        failure = None
-        corrections = -1
-
-        def ground(run: GaitRun, name: str, kind: str) -> None:
-            nonlocal state, est
-            phases.append(Phase(name, kind, float(state.time), float(run.state.time), run.estimate_error, run))
-            state, est = run.state, run.estimate
-            e = run.estimate_error
-            say(f"{name}: estimated at {_fmt(est.base)}; estimate off by {1000 * e['position_error_m']:.1f} mm, "
-                f"{e['yaw_error_deg']:.2f} deg")
-
-        def curl(q_to: np.ndarray, name: str) -> None:
-            nonlocal q_now
-            duration = max(1.0, float(np.abs(q_to - q_now).max()) / self.curl_speed)
-            ground(sim.run_path(state, lc.curl_path(q_now, q_to), duration, start_estimate=est, name=name), name,
-                   "curl")
-            q_now = q_to.copy()
-
-        goal: BasePlacement | None = None  # where the base must lie: a placement whose plan succeeds
-        q_bend = bending_state(self.controller, self.controller.q_initial)
-        tolerance = self.tolerance
-
-        def head_plan_here(label: str, dynamics_check: bool, q_now: np.ndarray | None = None) -> Plan | None:
-            """The head phases from the current estimate, the base kept, starting from the joints as they are
-            (measured: they rest a few tenths of a degree from their commands, friction holding the links against
-            the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails.
-            A joint commanded to its limit rests a fraction of a milliradian past it (the servo's error): the
-            measured joints are clipped to the limits, which the retiming requires of every waypoint."""
-            nonlocal planning
-            t0 = time.perf_counter()
-            q_measured = np.clip(sim.measured_joints() if q_now is None else q_now, robot.lower, robot.upper)
-            p = plan(self.scene, controller=self.controller, base=est.base, allow_relocation=False,
-                     start_q=q_measured, timing=self.timing)
-            planning += time.perf_counter() - t0
-            why = p.failure if p.failure is not None else self._dynamics_check(p) if dynamics_check else None
-            if why is None:
-                return p
-            notes.append(f"{label}: the head phases from {_fmt(est.base)} fail ({why})")
-            say(notes[-1])
-            return None
-
-        extra: list[tuple[str, float, SimResult]] = []  # the head's runs outside its plan: lift and look, servo
-        servo_log: list[dict] = []
-        routes: list[np.ndarray] = []
-        head_sensor = None if self.sensors is None else self.sensors.head
-        encoders = None if self.sensors is None else self.sensors.encoders
-
-        def simulate_from(at: SimState, t: np.ndarray, q: np.ndarray, base: BasePlacement, label: str,
-                          kind: str, hold: float = 0.0) -> SimResult:
-            """A joint motion of the lifted body in MuJoCo from the state ``at`` (then ``hold`` s still), recorded
-            as a phase."""
-            t0 = float(at.time)
-            r = simulate_trajectory(robot, t, q, base, state=at, settle=0.0, hold=hold, obstacles=self.obstacles,
-                                    **self._ground_options)
-            extra.append((label, t0, r))
-            assert r.end_state is not None
-            if phases and abs(phases[-1].t1_s - t0) < 0.01:  # the last phase ends at the last tick simulated
-                phases[-1].t1_s = t0
-            phases.append(Phase(label, kind, t0, float(r.end_state.time)))
-            return r
-
-        def look(head_pose: np.ndarray, k: int) -> list:
-            assert head_sensor is not None
-            readings = [head_sensor.read(head_pose, k) for _ in range(sv.HEAD_FRAMES)]
-            return [r for r in readings if r is not None]
-
-        def look_first(p: Plan) -> tuple[Plan, SimState, float, int] | None:
-            """The head phases run up to the first waypoint from which the plan expects a marker in the head
-            camera's view (:func:`look_waypoint`), the head held still there; then the camera's fix from the nearest
-            marker in view and the head phases planned again from there and the fixed pose. Returns the plan, the
-            state its simulation starts from, the time its clock starts at and its first sample to simulate; with no
-            marker in view, the rest of the plan from dead reckoning. None (back to step 2, the body lowered again
-            along the plan) when the plan from the fixed pose fails."""
-            nonlocal est, state
-            assert head_sensor is not None and encoders is not None
-            k = look_waypoint(robot, p, head_sensor)
-            if k is None:
-                notes.append("the plan never turns the head camera towards a marker: the head phases from dead "
-                             "reckoning")
-                say(notes[-1])
-                return p, state, float(state.time), 0
-            start_t = float(state.time)
-            looked = simulate_from(state, p.t[:k + 1], p.q[:k + 1], p.base, "head up to look", "lift", LOOK_HOLD_S)
-            assert looked.end_state is not None and looked.root_pose is not None
-            head_pose = looked.head_pose[-1]
-            seen = head_sensor.visible(head_pose)
-            q_look = encoders.read(looked.q[-1])
-            if not seen:
-                notes.append("no marker in the head camera's view where the plan expected one: the head phases from "
-                             "dead reckoning")
-                say(notes[-1])
-                phases.pop()  # the plan's own phases say it
-                return p, looked.end_state, start_t + LOOK_HOLD_S, k
-            nearest = min(seen, key=lambda j: float(np.linalg.norm(head_sensor.markers[j][:3, 3] - head_pose[:3, 3])))
-            T_root = sv.root_from_head_reading(robot, look(head_pose, nearest), head_sensor.markers[nearest], q_look)
-            dead_reckoned, truth = est, _true_pose(robot, looked.root_pose[-1], looked.q[-1])
-            R_imu = T_root[:3, :3] @ robot.body.fk_all(q_look)[sim.estimator.imu_index][:3, :3]
-            body = T_root @ robot.body_in_root
-            est = sim.estimator.reset(q_look, R_imu, body[:2, 3], math.atan2(body[1, 0], body[0, 0]))
-            fixes.append({"t_s": float(looked.end_state.time), "source": "head camera", "target": nearest,
-                          "dead_reckoning": pose_error(dead_reckoned, truth), "fix": pose_error(est, truth)})
-            say(f"the head camera puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
-            again = head_plan_here("after the head camera's fix", self.dynamics_check, q_look)
-            if again is not None:
-                return again, looked.end_state, float(looked.end_state.time), 0
-            # lower the body again into the bending state, back along the plan, and go back to the locomotion
-            lowered = simulate_from(looked.end_state, p.t[:k + 1], p.q[k::-1], p.base, "lower again", "lift", 0.5)
-            assert lowered.end_state is not None
-            state = lowered.end_state
-            sim.restore(state)
-            sim.reset_attitude(R_imu)
-            return None
-
-        def final_approach(p: Plan, head: SimResult) -> dict:
-            """The head corrected on the camera's measurement of the last target (see :mod:`snakehead.sim.servo`);
-            the final errors against the truth."""
-            assert head_sensor is not None and encoders is not None and head.end_state is not None
-            last = max(k for k, tg in enumerate(self.scene.targets) if not tg.via)
-            target = sn.target_frame(self.scene.targets[last].position, self.scene.targets[last].direction)
-            q_cmd, at, now = p.q[-1].copy(), head.end_state, head
-            for it in range(sv.SERVO_ITERATIONS + 1):
-                readings = look(now.head_pose[-1], last)
-                true_error = sv.head_error(np.linalg.solve(now.head_pose[-1], target))
-                record = {"iteration": it, "true_position_error_m": true_error[0],
-                          "true_direction_error_deg": true_error[1], "in_view": bool(readings)}
-                servo_log.append(record)
-                if not readings:
-                    notes.append("the last target's marker is not in the head camera's view: no final approach")
-                    break
-                seen = sn.mean_pose([r.target_in_head for r in readings])
-                record["measured_position_error_m"], record["measured_direction_error_deg"] = sv.head_error(seen)
-                if record["measured_position_error_m"] > sv.SERVO_MAX_POSITION_M \
-                        or record["measured_direction_error_deg"] > sv.SERVO_MAX_DIRECTION_DEG:
-                    notes.append(f"the head camera sees the head {1000 * record['measured_position_error_m']:.0f} mm "
-                                 f"and {record['measured_direction_error_deg']:.1f} deg off: too far for the final "
-                                 "approach on the head chain alone")
-                    break
-                if (record["measured_position_error_m"] < sv.SERVO_POSITION_TOL_M
-                        and record["measured_direction_error_deg"] < sv.SERVO_DIRECTION_TOL_DEG) \
-                        or it == sv.SERVO_ITERATIONS:
-                    break
-                q_new = np.clip(q_cmd + sv.servo_step(robot, encoders.read(now.q[-1]), seen), robot.lower, robot.upper)
-                t = np.array([0.0, sv.SERVO_MOVE_S, sv.SERVO_MOVE_S + sv.SERVO_HOLD_S])
-                q = np.vstack([q_cmd, q_new, q_new])
-                moved = simulate_from(at, t, q, p.base, f"final approach {it + 1}", "servo")
-                check = compare(robot, t, q, moved, base=p.base)
-                record["base_lift_m"] = check["base_lift_m"]
-                assert moved.end_state is not None
-                q_cmd, at, now = q_new, moved.end_state, moved
-                if check["base_lift_m"] > CHECK_BASE_LIFT:
-                    notes.append(f"the final approach lifts the base {1000 * check['base_lift_m']:.1f} mm: stopped")
-                    break
-            final = servo_log[-1]
-            return {"final_position_error_m": final["true_position_error_m"],
-                    "final_direction_error_deg": final["true_direction_error_deg"],
-                    "final_approach_moves": sum(1 for r in servo_log if "base_lift_m" in r)}
-
+        ep = _Episode(self, start, believed, q_now, progress or (lambda text: None))
+        failure, corrections = None, -1
         while failure is None:
             corrections += 1
             if corrections > self.max_corrections:
                 failure = (f"the body was not brought where the head phases succeed after {self.max_corrections} "
                            "corrections")
                 break
-            if goal is None:
-                # 1. where must the base go? The plan from where the curl would leave it, relocated if need be,
-                # checked in dynamics at its own start (a relocated base's plan can pass its static checks and still
-                # tip the body in MuJoCo: then every attempt to reach that goal fails); when it fails, the scene's
-                # own placement (the default one for a scene without); then placements near each plan that tipped or
-                # whose straight pose or curl came too near an obstacle
-                after_curl = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-                tried, refused = [], []
-                t0 = time.perf_counter()
-                for candidate in (after_curl, as_base(self.scene.base)):
-                    first = plan(self.scene, controller=self.controller, base=candidate, allow_relocation=True,
-                                 timing=self.timing)
-                    why = self._goal_failure(first)
-                    if why is None and first.failure is None:
-                        why = self._straight_failure(first.base, first.states[0][2])
-                    if why is None:
-                        goal, q_bend = first.base, first.states[0][2].copy()
-                        break
-                    if first.failure is None:
-                        refused.append(first)
-                    tried.append(f"from {_fmt(candidate)}: {why}")
-                    notes.append(f"the plan from {_fmt(candidate)} fails ({why})")
-                    say(notes[-1])
-                for near in refused if goal is None else []:  # (two rings: an obstacle in the way needs a larger step)
-                    goal = self._nearby_goal(near.base, near.states[0][2], rings=2)
-                    if goal is not None:
-                        q_bend = near.states[0][2].copy()
-                        break
-                planning += time.perf_counter() - t0
-                if goal is None:
-                    failure = "no plan reaches the targets " + "; nor ".join(tried)
-                    break
-                if goal != after_curl:
-                    say(f"the base must go to {_fmt(goal)}")
-            else:  # a correction: closer to the goal than last time, or to another goal nearby
-                tolerance = tolerance.tighter()
-                straight_here = lc.compose(lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend)),
-                                           lc.inverse(lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)))
-                straight_goal = lc.compose(goal, lc.inverse(lc.curl_displacement(robot, np.zeros(robot.n_joints),
-                                                                                q_bend)))
-                if lc.next_step(robot, straight_here, straight_goal, rates, tolerance=tolerance) is None:
-                    # as close to the goal as the gaits get, and the head phases still fail: another goal nearby
-                    t0 = time.perf_counter()
-                    nearby = self._nearby_goal(goal, q_bend)
-                    planning += time.perf_counter() - t0
-                    if nearby is None:
-                        failure = f"no placement near {_fmt(goal)} gives head phases that succeed"
-                        break
-                    goal = nearby
-                    say(f"the base must go to {_fmt(goal)} instead")
-            # 2. locomotion, when the curl from here would not leave the base at the goal
-            D = lc.curl_displacement(robot, np.zeros(robot.n_joints), q_bend)
-            straight_goal = lc.compose(goal, lc.inverse(D))
-            landing = lc.compose(est.base, lc.curl_displacement(robot, q_now, q_bend))
-            if lc.next_step(robot, lc.compose(landing, lc.inverse(D)), straight_goal, rates,
-                            tolerance=tolerance) is not None:
-                if np.abs(q_now).max() > 0.0:
-                    curl(np.zeros(robot.n_joints), "uncurl")
-                blocked = self._locomotion(sim, est, straight_goal, tolerance, rates, routes, say, ground,
-                                           lambda: state)
-                if blocked is not None:
-                    failure = blocked
-                    break
-            # 3. the curl into the bending state
-            if np.abs(q_bend - q_now).max() > 1e-9:
-                curl(q_bend, "curl into the bending state")
-            # 4. re-plan from the estimate (dead reckoning)
-            head_plan = head_plan_here("after the curl", self.dynamics_check and self.fix is None)
-            if head_plan is None:
+            failure = ep.choose_goal() if ep.goal is None else ep.closer_goal()
+            if failure is None:
+                failure = ep.go_to_goal()
+            if failure is not None:
+                break
+            started = ep.plan_head_phases()
+            if started is None:
                 continue
-            head_state, plan_t0, first_sample = state, float(state.time), 0  # where and when the head phases start
-            # 5. the fix, and the plan from it
-            if self.fix is not None:
-                dead_reckoned, truth = est, sim.true_pose()
-                est = self.fix.measure(sim, rng)
-                fixes.append({"t_s": float(state.time), "dead_reckoning": pose_error(dead_reckoned, truth),
-                              "fix": pose_error(est, truth)})
-                say(f"the fix puts the base at {_fmt(est.base)} (dead reckoning said {_fmt(dead_reckoned.base)})")
-                head_plan = head_plan_here("after the fix", self.dynamics_check)
-                if head_plan is None:
-                    continue
-            elif self.sensors is not None and self.sensors.head is not None:
-                # 5'. onboard: lift, look at a marker, fix the pose from it, plan again from the lifted state
-                looked = look_first(head_plan)
-                if looked is None:
-                    continue
-                head_plan, head_state, plan_t0, first_sample = looked
-            # 6. the head phases, in MuJoCo from where the body is
-            say(f"head phases planned from {_fmt(est.base)}: {head_plan.duration_s:.1f} s; simulating")
-            head_t0 = float(head_state.time)
-            head = simulate_trajectory(robot, head_plan.t[first_sample:], head_plan.q[first_sample:], head_plan.base,
-                                       state=head_state, settle=0.0, obstacles=self.obstacles, **self._ground_options)
-            check_plan_span(head_plan.t, [tg.time_s for tg in head_plan.targets], head)
-            targets = [(tg.time_s, tg.position, tg.direction) for tg in head_plan.targets] or None
-            # against the plan placed where the body truly lies (MuJoCo's, at the head phases' first tick): the
-            # simulated ZMP is the true one, and the support polygon at the believed base would count the belief's
-            # error (the camera's fix: tenths of a millimetre, 0.1 deg) as the ZMP leaving it
-            lies = _true_pose(robot, head.root_pose[0], head.q[0]).base if head.root_pose is not None \
-                else head_plan.base
-            metrics = compare(robot, head_plan.t, head_plan.q, head, targets=targets, base=lies)
-            phases += head_phases(head_plan, plan_t0)
-            assert head.end_state is not None
-            phases[-1].t1_s = float(head.end_state.time)
-            if self.sensors is not None and self.sensors.head is not None:
-                metrics.update(final_approach(head_plan, head))
+            ep.run_head_phases(*started)
             break
-        return LoopRun(robot=robot, scene=self.scene, start=start, believed_start=believed, q_start=q_first,
-                       phases=phases, fixes=fixes, plan=head_plan, head=head, metrics=metrics, head_t0_s=head_t0,
-                       corrections=max(corrections, 0), planning_time_s=planning, notes=notes, failure=failure,
-                       fix=self.fix, sensing=self.sensing, head_extra=extra, servo=servo_log, routes=routes)
+        return LoopRun(robot=robot, scene=self.scene, start=start, believed_start=believed, q_start=q_now,
+                       phases=ep.phases, fixes=ep.fixes, plan=ep.head_plan, head=ep.head, metrics=ep.metrics,
+                       head_t0_s=ep.head_t0, corrections=max(corrections, 0), planning_time_s=ep.planning,
+                       notes=ep.notes, failure=failure, fix=self.fix, sensing=self.sensing, head_extra=ep.extra,
+                       servo=ep.servo_log, routes=ep.routes)
+
+
+class _Episode:
+    """One run of :meth:`ClosedLoop.run`: the simulation's state and the estimate of the body's pose as they go,
+    the joints commanded, the goal, and the record (phases, fixes, notes, the head's plan and its simulation); its
+    methods are the loop's steps (1. the goal, 2. the gaits and the curl, 3.-5. the head phases planned from the
+    estimate and a fix, 6. run in MuJoCo)."""
+
+    def __init__(self, loop: ClosedLoop, start: BasePlacement, believed: BasePlacement, q_now: np.ndarray,
+                 say: Callable[[str], None]) -> None:
+        self.loop, self.robot, self.sim, self.say = loop, loop.robot, loop.simulator, say
+        self.rng = np.random.default_rng(None if loop.fix is None else loop.fix.seed)
+        self.q_now = q_now.copy()
+        self.state = self.sim.lying(start, q_now)
+        self.sim.restore(self.state)
+        self.est = self.sim.estimator.reset(self.sim.measured_joints(), self.sim.measured_attitude(),
+                                            (believed.x, believed.y), believed.yaw)
+        self.phases: list[Phase] = []
+        self.fixes: list[dict] = []
+        self.notes: list[str] = []
+        self.extra: list[tuple[str, float, SimResult]] = []  # the head's runs outside its plan: lift and look, servo
+        self.servo_log: list[dict] = []
+        self.routes: list[np.ndarray] = []
+        self.rates = lc.GaitRates.first_guess(self.robot)
+        self.planning = 0.0  # seconds spent planning
+        self.goal: BasePlacement | None = None  # where the base must lie: a placement whose plan succeeds
+        self.q_bend = bending_state(loop.controller, loop.controller.q_initial)
+        self.tolerance = loop.tolerance
+        self.head_plan: Plan | None = None
+        self.head: SimResult | None = None
+        self.metrics: dict | None = None
+        self.head_t0 = 0.0
+        self.head_sensor = None if loop.sensors is None else loop.sensors.head
+        self.encoders = None if loop.sensors is None else loop.sensors.encoders
+
+    def note(self, text: str) -> None:
+        self.notes.append(text)
+        self.say(text)
+
+    # --- the record of the body's motion ---------------------------------------------------------------
+    def ground(self, run: GaitRun, name: str, kind: str) -> None:
+        """A run on the ground (a gait, a curl) recorded as a phase; the state and the estimate move on."""
+        self.phases.append(Phase(name, kind, float(self.state.time), float(run.state.time), run.estimate_error, run))
+        self.state, self.est = run.state, run.estimate
+        e = run.estimate_error
+        self.say(f"{name}: estimated at {_fmt(self.est.base)}; estimate off by {1000 * e['position_error_m']:.1f} "
+                 f"mm, {e['yaw_error_deg']:.2f} deg")
+
+    def curl(self, q_to: np.ndarray, name: str) -> None:
+        duration = max(1.0, float(np.abs(q_to - self.q_now).max()) / self.loop.curl_speed)
+        self.ground(self.sim.run_path(self.state, lc.curl_path(self.q_now, q_to), duration, start_estimate=self.est,
+                                      name=name), name, "curl")
+        self.q_now = q_to.copy()
+
+    def simulate_from(self, at: SimState, t: np.ndarray, q: np.ndarray, base: BasePlacement, label: str,
+                      kind: str, hold: float = 0.0) -> SimResult:
+        """A joint motion of the lifted body in MuJoCo from the state ``at`` (then ``hold`` s still), recorded
+        as a phase."""
+        t0 = float(at.time)
+        r = simulate_trajectory(self.robot, t, q, base, state=at, settle=0.0, hold=hold, obstacles=self.loop.obstacles,
+                                **self.loop._ground_options)
+        self.extra.append((label, t0, r))
+        assert r.end_state is not None
+        if self.phases and abs(self.phases[-1].t1_s - t0) < 0.01:  # the last phase ends at the last tick simulated
+            self.phases[-1].t1_s = t0
+        self.phases.append(Phase(label, kind, t0, float(r.end_state.time)))
+        return r
+
+    # --- 1. the goal -------------------------------------------------------------------------------------
+    def choose_goal(self) -> str | None:
+        """Where must the base go? The plan from where the curl would leave it, relocated if need be, checked in
+        dynamics at its own start (a relocated base's plan can pass its static checks and still tip the body in
+        MuJoCo: then every attempt to reach that goal fails); when it fails, the scene's own placement (the default
+        one for a scene without); then placements near each plan that tipped or whose straight pose or curl came
+        too near an obstacle. None when found, else why not."""
+        loop, robot = self.loop, self.robot
+        after_curl = lc.compose(self.est.base, lc.curl_displacement(robot, self.q_now, self.q_bend))
+        tried, refused = [], []
+        t0 = time.perf_counter()
+        for candidate in (after_curl, as_base(loop.scene.base)):
+            first = plan(loop.scene, controller=loop.controller, base=candidate, allow_relocation=True,
+                         timing=loop.timing)
+            why = loop._goal_failure(first)
+            if why is None and first.failure is None:
+                why = loop._straight_failure(first.base, first.states[0][2])
+            if why is None:
+                self.goal, self.q_bend = first.base, first.states[0][2].copy()
+                break
+            if first.failure is None:
+                refused.append(first)
+            tried.append(f"from {_fmt(candidate)}: {why}")
+            self.note(f"the plan from {_fmt(candidate)} fails ({why})")
+        for near in refused if self.goal is None else []:  # (two rings: an obstacle in the way needs a larger step)
+            self.goal = loop._nearby_goal(near.base, near.states[0][2], rings=2)
+            if self.goal is not None:
+                self.q_bend = near.states[0][2].copy()
+                break
+        self.planning += time.perf_counter() - t0
+        if self.goal is None:
+            return "no plan reaches the targets " + "; nor ".join(tried)
+        if self.goal != after_curl:
+            self.say(f"the base must go to {_fmt(self.goal)}")
+        return None
+
+    def closer_goal(self) -> str | None:
+        """A correction: closer to the goal than last time (a tighter tolerance), or another goal nearby when the
+        gaits get no closer. None, else why there is none."""
+        robot, goal = self.robot, self.goal
+        assert goal is not None
+        self.tolerance = self.tolerance.tighter()
+        straight = lc.curl_displacement(robot, np.zeros(robot.n_joints), self.q_bend)
+        straight_here = lc.compose(lc.compose(self.est.base, lc.curl_displacement(robot, self.q_now, self.q_bend)),
+                                   lc.inverse(straight))
+        straight_goal = lc.compose(goal, lc.inverse(straight))
+        if lc.next_step(robot, straight_here, straight_goal, self.rates, tolerance=self.tolerance) is None:
+            # as close to the goal as the gaits get, and the head phases still fail: another goal nearby
+            t0 = time.perf_counter()
+            nearby = self.loop._nearby_goal(goal, self.q_bend)
+            self.planning += time.perf_counter() - t0
+            if nearby is None:
+                return f"no placement near {_fmt(goal)} gives head phases that succeed"
+            self.goal = nearby
+            self.say(f"the base must go to {_fmt(nearby)} instead")
+        return None
+
+    # --- 2. locomotion and the curl --------------------------------------------------------------------------
+    def go_to_goal(self) -> str | None:
+        """Gaits when the curl from here would not leave the base at the goal, then the curl into the bending
+        state. None, else why the body cannot go on."""
+        robot, goal = self.robot, self.goal
+        assert goal is not None
+        D = lc.curl_displacement(robot, np.zeros(robot.n_joints), self.q_bend)
+        straight_goal = lc.compose(goal, lc.inverse(D))
+        landing = lc.compose(self.est.base, lc.curl_displacement(robot, self.q_now, self.q_bend))
+        if lc.next_step(robot, lc.compose(landing, lc.inverse(D)), straight_goal, self.rates,
+                        tolerance=self.tolerance) is not None:
+            if np.abs(self.q_now).max() > 0.0:
+                self.curl(np.zeros(robot.n_joints), "uncurl")
+            blocked = self.loop._locomotion(self.sim, self.est, straight_goal, self.tolerance, self.rates,
+                                            self.routes, self.say, self.ground, lambda: self.state)
+            if blocked is not None:
+                return blocked
+        if np.abs(self.q_bend - self.q_now).max() > 1e-9:
+            self.curl(self.q_bend, "curl into the bending state")
+        return None
+
+    # --- 3.-5. the head phases planned -----------------------------------------------------------------------
+    def plan_head_phases(self) -> tuple[SimState, float, int] | None:
+        """The head phases planned from the estimate (dead reckoning), then from a fix (outside, or onboard: the
+        head camera's, :meth:`look_first`): ``head_plan`` and where, when and from which sample its simulation
+        starts; None when the plan fails (the loop corrects the base)."""
+        loop = self.loop
+        self.head_plan = self.head_plan_here("after the curl", loop.dynamics_check and loop.fix is None)
+        if self.head_plan is None:
+            return None
+        if loop.fix is not None:
+            dead_reckoned, truth = self.est, self.sim.true_pose()
+            self.est = loop.fix.measure(self.sim, self.rng)
+            self.fixes.append({"t_s": float(self.state.time), "dead_reckoning": pose_error(dead_reckoned, truth),
+                               "fix": pose_error(self.est, truth)})
+            self.say(f"the fix puts the base at {_fmt(self.est.base)} (dead reckoning said "
+                     f"{_fmt(dead_reckoned.base)})")
+            self.head_plan = self.head_plan_here("after the fix", loop.dynamics_check)
+            if self.head_plan is None:
+                return None
+        elif self.head_sensor is not None:
+            looked = self.look_first(self.head_plan)
+            if looked is None:
+                return None
+            self.head_plan, head_state, plan_t0, first_sample = looked
+            return head_state, plan_t0, first_sample
+        return self.state, float(self.state.time), 0
+
+    def head_plan_here(self, label: str, dynamics_check: bool, q_now: np.ndarray | None = None) -> Plan | None:
+        """The head phases from the current estimate, the base kept, starting from the joints as they are
+        (measured: they rest a few tenths of a degree from their commands, friction holding the links against
+        the servos, which moves P0 by millimetres), checked in dynamics when asked. None when it fails.
+        A joint commanded to its limit rests a fraction of a milliradian past it (the servo's error): the
+        measured joints are clipped to the limits, which the retiming requires of every waypoint."""
+        loop, robot = self.loop, self.robot
+        t0 = time.perf_counter()
+        q_measured = np.clip(self.sim.measured_joints() if q_now is None else q_now, robot.lower, robot.upper)
+        p = plan(loop.scene, controller=loop.controller, base=self.est.base, allow_relocation=False,
+                 start_q=q_measured, timing=loop.timing)
+        self.planning += time.perf_counter() - t0
+        why = p.failure if p.failure is not None else loop._dynamics_check(p) if dynamics_check else None
+        if why is None:
+            return p
+        self.note(f"{label}: the head phases from {_fmt(self.est.base)} fail ({why})")
+        return None
+
+    def look(self, head_pose: np.ndarray, k: int) -> list:
+        assert self.head_sensor is not None
+        readings = [self.head_sensor.read(head_pose, k) for _ in range(sv.HEAD_FRAMES)]
+        return [r for r in readings if r is not None]
+
+    def look_first(self, p: Plan) -> tuple[Plan, SimState, float, int] | None:
+        """The head phases run up to the first waypoint from which the plan expects a marker in the head
+        camera's view (:func:`look_waypoint`), the head held still there; then the camera's fix from the nearest
+        marker in view and the head phases planned again from there and the fixed pose. Returns the plan, the
+        state its simulation starts from, the time its clock starts at and its first sample to simulate; with no
+        marker in view, the rest of the plan from dead reckoning. None (back to step 2, the body lowered again
+        along the plan) when the plan from the fixed pose fails."""
+        head_sensor, encoders, robot, sim = self.head_sensor, self.encoders, self.robot, self.sim
+        assert head_sensor is not None and encoders is not None
+        k = look_waypoint(robot, p, head_sensor)
+        if k is None:
+            self.note("the plan never turns the head camera towards a marker: the head phases from dead reckoning")
+            return p, self.state, float(self.state.time), 0
+        start_t = float(self.state.time)
+        looked = self.simulate_from(self.state, p.t[:k + 1], p.q[:k + 1], p.base, "head up to look", "lift",
+                                    LOOK_HOLD_S)
+        assert looked.end_state is not None and looked.root_pose is not None
+        head_pose = looked.head_pose[-1]
+        seen = head_sensor.visible(head_pose)
+        q_look = encoders.read(looked.q[-1])
+        if not seen:
+            self.note("no marker in the head camera's view where the plan expected one: the head phases from dead "
+                      "reckoning")
+            self.phases.pop()  # the plan's own phases say it
+            return p, looked.end_state, start_t + LOOK_HOLD_S, k
+        nearest = min(seen, key=lambda j: float(np.linalg.norm(head_sensor.markers[j][:3, 3] - head_pose[:3, 3])))
+        T_root = sv.root_from_head_reading(robot, self.look(head_pose, nearest), head_sensor.markers[nearest], q_look)
+        dead_reckoned, truth = self.est, _true_pose(robot, looked.root_pose[-1], looked.q[-1])
+        R_imu = T_root[:3, :3] @ robot.body.fk_all(q_look)[sim.estimator.imu_index][:3, :3]
+        body = T_root @ robot.body_in_root
+        self.est = sim.estimator.reset(q_look, R_imu, body[:2, 3], math.atan2(body[1, 0], body[0, 0]))
+        self.fixes.append({"t_s": float(looked.end_state.time), "source": "head camera", "target": nearest,
+                           "dead_reckoning": pose_error(dead_reckoned, truth), "fix": pose_error(self.est, truth)})
+        self.say(f"the head camera puts the base at {_fmt(self.est.base)} (dead reckoning said "
+                 f"{_fmt(dead_reckoned.base)})")
+        again = self.head_plan_here("after the head camera's fix", self.loop.dynamics_check, q_look)
+        if again is not None:
+            return again, looked.end_state, float(looked.end_state.time), 0
+        # lower the body again into the bending state, back along the plan, and go back to the locomotion
+        lowered = self.simulate_from(looked.end_state, p.t[:k + 1], p.q[k::-1], p.base, "lower again", "lift", 0.5)
+        assert lowered.end_state is not None
+        self.state = lowered.end_state
+        sim.restore(self.state)
+        sim.reset_attitude(R_imu)
+        return None
+
+    # --- 6. the head phases in MuJoCo -------------------------------------------------------------------------
+    def run_head_phases(self, head_state: SimState, plan_t0: float, first_sample: int) -> None:
+        """``head_plan`` in MuJoCo from where the body is, compared with the plan placed where the body truly lies,
+        then (onboard) the final approach on the head camera."""
+        p, robot, loop = self.head_plan, self.robot, self.loop
+        assert p is not None
+        self.say(f"head phases planned from {_fmt(self.est.base)}: {p.duration_s:.1f} s; simulating")
+        self.head_t0 = float(head_state.time)
+        head = simulate_trajectory(robot, p.t[first_sample:], p.q[first_sample:], p.base, state=head_state,
+                                   settle=0.0, obstacles=loop.obstacles, **loop._ground_options)
+        self.head = head
+        check_plan_span(p.t, [tg.time_s for tg in p.targets], head)
+        targets = [(tg.time_s, tg.position, tg.direction) for tg in p.targets] or None
+        # against the plan placed where the body truly lies (MuJoCo's, at the head phases' first tick): the
+        # simulated ZMP is the true one, and the support polygon at the believed base would count the belief's
+        # error (the camera's fix: tenths of a millimetre, 0.1 deg) as the ZMP leaving it
+        lies = _true_pose(robot, head.root_pose[0], head.q[0]).base if head.root_pose is not None else p.base
+        self.metrics = compare(robot, p.t, p.q, head, targets=targets, base=lies)
+        self.phases += head_phases(p, plan_t0)
+        assert head.end_state is not None
+        self.phases[-1].t1_s = float(head.end_state.time)
+        if self.head_sensor is not None:
+            self.metrics.update(self.final_approach(p, head))
+
+    def final_approach(self, p: Plan, head: SimResult) -> dict:
+        """The head corrected on the camera's measurement of the last target (see :mod:`snakehead.sim.servo`);
+        the final errors against the truth."""
+        assert self.encoders is not None and head.end_state is not None
+        scene, robot = self.loop.scene, self.robot
+        last = max(k for k, tg in enumerate(scene.targets) if not tg.via)
+        target = sn.target_frame(scene.targets[last].position, scene.targets[last].direction)
+        q_cmd, at, now = p.q[-1].copy(), head.end_state, head
+        for it in range(sv.SERVO_ITERATIONS + 1):
+            record, seen = self.servo_record(it, now, last, target)
+            if seen is None:
+                break
+            q_new = np.clip(q_cmd + sv.servo_step(robot, self.encoders.read(now.q[-1]), seen), robot.lower,
+                            robot.upper)
+            t = np.array([0.0, sv.SERVO_MOVE_S, sv.SERVO_MOVE_S + sv.SERVO_HOLD_S])
+            q = np.vstack([q_cmd, q_new, q_new])
+            moved = self.simulate_from(at, t, q, p.base, f"final approach {it + 1}", "servo")
+            check = compare(robot, t, q, moved, base=p.base)
+            record["base_lift_m"] = check["base_lift_m"]
+            assert moved.end_state is not None
+            q_cmd, at, now = q_new, moved.end_state, moved
+            if check["base_lift_m"] > CHECK_BASE_LIFT:
+                self.notes.append(f"the final approach lifts the base {1000 * check['base_lift_m']:.1f} mm: stopped")
+                break
+        final = self.servo_log[-1]
+        return {"final_position_error_m": final["true_position_error_m"],
+                "final_direction_error_deg": final["true_direction_error_deg"],
+                "final_approach_moves": sum(1 for r in self.servo_log if "base_lift_m" in r)}
+
+    def servo_record(self, it: int, now: SimResult, last: int, target: np.ndarray) -> tuple[dict, np.ndarray | None]:
+        """One look of the final approach, logged in ``servo_log`` (the true and measured errors), and the measured
+        pose of the target in the head (None: stop here: not in view, too far, near enough or the last look)."""
+        readings = self.look(now.head_pose[-1], last)
+        true_error = sv.head_error(np.linalg.solve(now.head_pose[-1], target))
+        record = {"iteration": it, "true_position_error_m": true_error[0], "true_direction_error_deg": true_error[1],
+                  "in_view": bool(readings)}
+        self.servo_log.append(record)
+        if not readings:
+            self.notes.append("the last target's marker is not in the head camera's view: no final approach")
+            return record, None
+        seen = sn.mean_pose([r.target_in_head for r in readings])
+        record["measured_position_error_m"], record["measured_direction_error_deg"] = sv.head_error(seen)
+        if record["measured_position_error_m"] > sv.SERVO_MAX_POSITION_M \
+                or record["measured_direction_error_deg"] > sv.SERVO_MAX_DIRECTION_DEG:
+            self.notes.append(f"the head camera sees the head {1000 * record['measured_position_error_m']:.0f} mm "
+                              f"and {record['measured_direction_error_deg']:.1f} deg off: too far for the final "
+                              "approach on the head chain alone")
+            return record, None
+        if (record["measured_position_error_m"] < sv.SERVO_POSITION_TOL_M
+                and record["measured_direction_error_deg"] < sv.SERVO_DIRECTION_TOL_DEG) or it == sv.SERVO_ITERATIONS:
+            return record, None
+        return record, seen
 
 
 def look_waypoint(robot: SnakeRobot, p: Plan, camera: sn.HeadSensor) -> int | None:
