@@ -519,11 +519,19 @@ def _planning_parser(sub: Any, name: str, func: Callable[..., Any], help_text: s
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The command line: one sub-command per helper below."""
     parser = _Parser(prog="snakehead", description=__doc__.split("\n\n")[0],
                      epilog=__doc__.split("\n\n", 1)[1],
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p: argparse.ArgumentParser = sub.add_parser(
+    for add in (_add_info, _add_demo, _add_plan, _add_workspace, _add_reach, _add_view):
+        add(sub)
+    return parser
+
+
+def _add_info(sub: Any) -> None:
+    """snakehead info: check a robot."""
+    p = sub.add_parser(
         "info", help="check a robot: its parts, whether its design can work, a split of the parts that does",
         description="Check a robot: each part's frames (where they sit along the body), length, mass and joints; "
                     "its collision shapes; whether the base can hold the lifted neck and head (an initial state and a "
@@ -533,6 +541,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="do not search for a split of the parts that works")
     p.set_defaults(func=_info)
 
+
+def _add_demo(sub: Any) -> None:
+    """snakehead demo: the paper's two scenarios."""
     demo = _planning_parser(sub, "demo", _demo, "the paper's two scenarios (Section 4) with figures, animations and a report",
                      "Plan the paper's two scenarios (catching two spheres, Section 4.1; getting the head through a "
                      "hole in a wall, Section 4.2; on the default robot unless --robot), check them in MuJoCo (the "
@@ -545,6 +556,10 @@ def build_parser() -> argparse.ArgumentParser:
                            "--start X Y YAW puts the tail at (X, Y) m with the body along YAW rad. Adds "
                            "NAME_path.png and NAME_loop.gif, and phases to the report")
     _add_sensing_option(demo)
+
+
+def _add_plan(sub: Any) -> None:
+    """snakehead plan: head targets or a scene file."""
     p = _planning_parser(sub, "plan", _plan, "head targets: --position/--direction, or a scene file",
                          "Plan the head from the bending state on the ground to POSITION pointing along DIRECTION "
                          "(world frame, z up, ground at z = 0), or through the targets of a scene file (--scene; "
@@ -564,6 +579,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "NAME_loop.gif, and phases to the report")
     _add_sensing_option(p)
 
+
+def _add_workspace(sub: Any) -> None:
+    """snakehead workspace: a head's reachability map (Algorithm 1)."""
+    from .. import sweep_defaults as defaults
+    from ..kinematics import workspace as ws
+
     p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
                        description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "
                                    "robot: its 7-DOF head; the 6-DOF variant is the robot file snake16_head6.toml "
@@ -572,8 +593,6 @@ def build_parser() -> argparse.ArgumentParser:
                                    "executable installed with the package (workspace_gen --help).")
     p.add_argument("--out", required=True, metavar="MAP.npz", help="output file (.npz)")
     _add_robot_option(p)
-    from .. import sweep_defaults as defaults
-    from ..kinematics import workspace as ws
 
     p.add_argument("--voxel", type=_positive_float, default=None, metavar="M",
                    help="voxel edge (m; default: a twelfth of the head's reach rounded to 5 mm, 0.045 on the default "
@@ -601,7 +620,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_workspace)
 
+
+def _add_reach(sub: Any) -> None:
+    """snakehead reach: the whole body's stable reachability map."""
+    from .. import sweep_defaults as defaults
     from ..motion import reach as rc
+
 
     p = sub.add_parser("reach", help="compute the whole body's stable reachability map",
                        description="For voxels around the robot (a cube of side 2 x the body's length, from the "
@@ -628,6 +652,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=_reach)
 
+
+def _add_view(sub: Any) -> None:
+    """snakehead view: the 3-D viewer."""
     p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo, or (--live) of "
                                     "plans made as you drag targets (a web page)",
                        description="Serve the scenes that 'snakehead plan' or 'snakehead demo' wrote into DIR "
@@ -655,8 +682,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--port", type=_port, default=8080, metavar="N",
                    help="port (default 8080; the next free one if taken)")
     p.set_defaults(func=_view)
-    return parser
-
 
 def _traceback_wanted() -> bool:
     return os.environ.get("SNAKEHEAD_TRACEBACK", "") not in ("", "0")
