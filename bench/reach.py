@@ -43,7 +43,8 @@ def main() -> None:
     if not args.no_serial:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions))
-        rows.append((f"1 process ({sh.core_threads()} core threads)", time.perf_counter() - t))
+        rows.append((f"1 process ({sh.core_threads()} core thread{'' if sh.core_threads() == 1 else 's'})",
+                     time.perf_counter() - t))
     if args.unpruned:
         t = time.perf_counter()
         maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, prune=False))
@@ -59,7 +60,7 @@ def main() -> None:
             threads = ",".join(map(str, sorted(set(client.run(sh.core_threads).values()))))  # imports snakehead there
             t = time.perf_counter()
             maps.append(reach.compute_reach(robot, voxel=args.voxel, directions=args.directions, executor=client))
-            rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''} ({threads} core threads each)",
+            rows.append((f"Dask LocalCluster, {w} worker{'s' if w > 1 else ''} ({threads} core thread{'' if threads == '1' else 's'} each)",
                          time.perf_counter() - t))
         print(f"(done: {rows[-1][0]}, load {os.getloadavg()[0]:.1f})", flush=True)
     print("| run | time (s) | poses reached |")

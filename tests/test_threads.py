@@ -80,7 +80,7 @@ def test_bad_environment_names_the_variable() -> None:
 
 
 def test_share_per_worker() -> None:
-    cores = os.cpu_count() or 1
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     assert ct.share_per_worker(1) == cores
     assert ct.share_per_worker(cores) == 1
     assert ct.share_per_worker(4 * cores) == 1

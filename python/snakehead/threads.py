@@ -33,5 +33,7 @@ def set_core_threads(n: Any) -> None:
 
 
 def share_per_worker(workers: int) -> int:
-    """The threads each of ``workers`` worker processes on this machine should use: its share of the cores (>= 1)."""
-    return max(1, (os.cpu_count() or 1) // max(1, int(workers)))
+    """The threads each of ``workers`` worker processes on this machine should use: its share of the cores this
+    process may run on (>= 1)."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return max(1, cores // max(1, int(workers)))
