@@ -811,9 +811,21 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
     outside [0, 100] or not 100 * solved / tried, solved counts outside [0, tried], NaN or non-positive sizes,
     voxel ids duplicated, out of order or outside the grid, voxel centres that are not their voxels' centres,
     per-direction results of the wrong shape, and parameters beyond the sweep's limits. Either format (1 or 2)."""
-    def fail(field: str, what: str) -> InputError:
-        return InputError(f"{where}: {field} {what}")
+    scalars = _check_map_fields(arrays, where)
+    value = {k: arrays[k][()] for k in scalars}
+    M = len(arrays["voxel_ids"])
+    n, tried, directions = _check_map_parameters(arrays, value, M, where)
+    _check_map_voxels(arrays, float(value["voxel_size"]), n, M, where)
+    _check_map_results(arrays, tried, directions, M, where)
 
+
+def _map_error(where: str, field: str, what: str) -> InputError:
+    return InputError(f"{where}: {field} {what}")
+
+
+def _check_map_fields(arrays: dict[str, np.ndarray], where: str) -> dict:
+    """The format, every scalar's and array's presence and type, and the arrays' shapes; returns the scalars'
+    kinds."""
     if "format" not in arrays or arrays["format"].dtype.kind != "U" or str(arrays["format"][()]) not in FORMATS:
         raise InputError(f"{where} is not a snakehead reachability map (its format is not one of "
                          f"{', '.join(FORMATS)})")
@@ -823,95 +835,115 @@ def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -
             scalars[key] = kind
     for key, kind in scalars.items():
         if key not in arrays:
-            raise fail(key, "is missing")
+            raise _map_error(where, key, "is missing")
         a = arrays[key]
         if a.shape != () or a.dtype.kind not in _KINDS[kind]:
-            raise fail(key, f"must be one {kind} value, got {a.dtype} of shape {a.shape}")
+            raise _map_error(where, key, f"must be one {kind} value, got {a.dtype} of shape {a.shape}")
     for key, (kind, shape) in _MAP_ARRAYS.items():
         if key not in arrays:
-            raise fail(key, "is missing")
+            raise _map_error(where, key, "is missing")
         a = arrays[key]
         if a.dtype.kind not in ("fiu" if kind == "f" else "iu") or a.ndim != len(shape):
-            raise fail(key, f"must be an array of {'numbers' if kind == 'f' else 'integers'} of shape "
-                            f"{tuple(shape)}, got {a.dtype} of shape {a.shape}")
-    value = {k: arrays[k][()] for k in scalars}
+            raise _map_error(where, key, f"must be an array of {'numbers' if kind == 'f' else 'integers'} of "
+                                         f"shape {tuple(shape)}, got {a.dtype} of shape {a.shape}")
     M = len(arrays["voxel_ids"])
     for key, (kind, shape) in _MAP_ARRAYS.items():
         want = tuple(M if d == "M" else d for d in shape)
         if arrays[key].shape != want:
-            raise fail(key, f"has shape {arrays[key].shape}; the map's {M} voxels need {want}")
+            raise _map_error(where, key, f"has shape {arrays[key].shape}; the map's {M} voxels need {want}")
+    return scalars
+
+
+def _check_map_parameters(arrays: dict[str, np.ndarray], value: dict, M: int, where: str) -> tuple[int, int, int]:
+    """The sweep's parameters and the grid's: within their limits and consistent; returns the voxels per axis, the
+    frames tried per voxel and the directions."""
     for key in ("grid_size", "voxel_size", "timeout", "epsilon"):
         if not (math.isfinite(float(value[key])) and float(value[key]) > 0):
-            raise fail(key, f"must be a positive finite number, got {value[key]}")
+            raise _map_error(where, key, f"must be a positive finite number, got {value[key]}")
     for key in ("centers", "indices", "grid_origin"):
         if not np.all(np.isfinite(arrays[key])):
-            raise fail(key, "holds NaN or inf")
+            raise _map_error(where, key, "holds NaN or inf")
     if str(value["approach_axis"]) not in ("x", "z"):
-        raise fail("approach_axis", f"must be 'x' or 'z', got {str(value['approach_axis'])!r}")
+        raise _map_error(where, "approach_axis", f"must be 'x' or 'z', got {str(value['approach_axis'])!r}")
     if "map_kind" in value and str(value["map_kind"]) not in MAP_KINDS:
-        raise fail("map_kind", f"must be one of {', '.join(MAP_KINDS)}, got {str(value['map_kind'])!r}")
+        raise _map_error(where, "map_kind", f"must be one of {', '.join(MAP_KINDS)}, got {str(value['map_kind'])!r}")
     if "hull" in value and str(value["hull"]) not in ("convex", "boundary"):
-        raise fail("hull", f"must be 'convex' or 'boundary', got {str(value['hull'])!r}")
+        raise _map_error(where, "hull", f"must be 'convex' or 'boundary', got {str(value['hull'])!r}")
     if "shrink" in value and not 0.0 <= float(value["shrink"]) <= 1.0:  # NaN too
-        raise fail("shrink", f"must be within [0, 1], got {value['shrink']}")
+        raise _map_error(where, "shrink", f"must be within [0, 1], got {value['shrink']}")
     directions, rolls, tried = int(value["directions"]), int(value["rolls"]), int(value["tried"])
     if not 1 <= directions <= MAX_DIRECTIONS or not 0 <= rolls <= MAX_ROLLS:
-        raise fail("directions/rolls", f"must be within [1, {MAX_DIRECTIONS}] / [0, {MAX_ROLLS}], got {directions} "
-                                       f"/ {rolls}")
+        raise _map_error(where, "directions/rolls", f"must be within [1, {MAX_DIRECTIONS}] / [0, {MAX_ROLLS}], "
+                                                    f"got {directions} / {rolls}")
     if tried not in (directions, directions * max(rolls, 1)):
-        raise fail("tried", f"must be the directions ({directions}) or directions x rolls, got {tried}")
+        raise _map_error(where, "tried", f"must be the directions ({directions}) or directions x rolls, got {tried}")
     grid_shape = arrays["grid_shape"]
     if not (grid_shape[0] == grid_shape[1] == grid_shape[2] and 1 <= int(grid_shape[0]) <= MAX_VOXELS_PER_AXIS):
-        raise fail("grid_shape", f"must be (n, n, n) with 1 <= n <= {MAX_VOXELS_PER_AXIS}, got {grid_shape.tolist()}")
+        raise _map_error(where, "grid_shape",
+                         f"must be (n, n, n) with 1 <= n <= {MAX_VOXELS_PER_AXIS}, got {grid_shape.tolist()}")
     n = int(grid_shape[0])
     voxel = float(value["voxel_size"])
     if not math.isclose(float(value["grid_size"]), n * voxel, rel_tol=1e-9):
-        raise fail("grid_size", f"must be grid_shape x voxel_size ({n} x {voxel}), got {value['grid_size']}")
+        raise _map_error(where, "grid_size",
+                         f"must be grid_shape x voxel_size ({n} x {voxel}), got {value['grid_size']}")
     i, count = (int(x) for x in arrays["shard"])
     if not 0 <= i < count:
-        raise fail("shard", f"must be (i, N) with 0 <= i < N, got {(i, count)}")
+        raise _map_error(where, "shard", f"must be (i, N) with 0 <= i < N, got {(i, count)}")
     if not M <= int(value["hull_voxels"]) <= n ** 3:
-        raise fail("hull_voxels", f"must be within [{M} (the map's voxels), {n ** 3} (the grid's)], got "
-                                  f"{value['hull_voxels']}")
+        raise _map_error(where, "hull_voxels", f"must be within [{M} (the map's voxels), {n ** 3} (the grid's)], "
+                                               f"got {value['hull_voxels']}")
+    return n, tried, directions
+
+
+def _check_map_voxels(arrays: dict[str, np.ndarray], voxel: float, n: int, M: int, where: str) -> None:
+    """The voxel ids: strictly increasing within the grid; the centres: those voxels' centres."""
     ids = arrays["voxel_ids"]
     if M and (ids[0] < 0 or ids[-1] >= n ** 3 or np.any(np.diff(ids) <= 0)):
         if M and np.any(np.diff(ids) == 0):
-            raise fail("voxel_ids", f"holds duplicates (voxel {int(ids[np.flatnonzero(np.diff(ids) == 0)[0]])})")
-        raise fail("voxel_ids", f"must increase strictly within [0, {n ** 3}) (the grid's {n}^3 voxels)")
+            raise _map_error(where, "voxel_ids",
+                             f"holds duplicates (voxel {int(ids[np.flatnonzero(np.diff(ids) == 0)[0]])})")
+        raise _map_error(where, "voxel_ids", f"must increase strictly within [0, {n ** 3}) (the grid's {n}^3 voxels)")
     ijk = np.stack([ids // (n * n), (ids // n) % n, ids % n], axis=1)
     expected = np.asarray(arrays["grid_origin"], float) + (ijk + 0.5) * voxel
     if M and not np.allclose(arrays["centers"], expected, rtol=0.0, atol=1e-6 * max(voxel, 1.0)):
-        raise fail("centers", "are not the centres of the voxels voxel_ids names (grid_origin + (ijk + 1/2) voxel)")
+        raise _map_error(where, "centers",
+                         "are not the centres of the voxels voxel_ids names (grid_origin + (ijk + 1/2) voxel)")
+
+
+def _check_map_results(arrays: dict[str, np.ndarray], tried: int, directions: int, M: int, where: str) -> None:
+    """The solved counts, the indices, the per-direction results and the bases: within range and consistent."""
     solved = arrays["solved"]
     if M and (solved.min() < 0 or solved.max() > tried):
-        raise fail("solved", f"must be within [0, tried = {tried}]")
+        raise _map_error(where, "solved", f"must be within [0, tried = {tried}]")
     indices = np.asarray(arrays["indices"], float)
     if M and (indices.min() < 0 or indices.max() > 100):
-        raise fail("indices", f"must be within [0, 100], got [{indices.min():g}, {indices.max():g}]")
+        raise _map_error(where, "indices", f"must be within [0, 100], got [{indices.min():g}, {indices.max():g}]")
     if not np.allclose(indices, 100.0 * solved / tried, rtol=0.0, atol=1e-9):
-        raise fail("indices", "disagree with 100 * solved / tried")
+        raise _map_error(where, "indices", "disagree with 100 * solved / tried")
     if "reached" in arrays:
         r = arrays["reached"]
         if r.dtype != np.uint8 or r.shape != (M, (tried + 7) // 8):
-            raise fail("reached", f"must be uint8 of shape ({M}, {(tried + 7) // 8}), got {r.dtype} {r.shape}")
+            raise _map_error(where, "reached",
+                             f"must be uint8 of shape ({M}, {(tried + 7) // 8}), got {r.dtype} {r.shape}")
         bits = np.unpackbits(r, axis=1, count=tried, bitorder="little") if M else np.zeros((0, tried), np.uint8)
         if not np.array_equal(bits.sum(axis=1), solved):
-            raise fail("reached", "(the per-direction results) disagree with the solved counts")
+            raise _map_error(where, "reached", "(the per-direction results) disagree with the solved counts")
     for key, width in (("base_joints", None), ("base_placements", 3)):
         if key in arrays:
             a = arrays[key]
             if (a.dtype.kind != "f" or a.ndim != 3 or a.shape[:2] != (M, tried) or a.shape[2] < 1
                     or (width is not None and a.shape[2] != width)):
-                raise fail(key, f"must be numbers of shape ({M}, {tried}, {width or 'k'}), got {a.dtype} {a.shape}")
+                raise _map_error(where, key,
+                                 f"must be numbers of shape ({M}, {tried}, {width or 'k'}), got {a.dtype} {a.shape}")
             if M and not np.array_equal(np.isfinite(a).all(axis=2), np.unpackbits(
                     arrays["reached"], axis=1, count=tried, bitorder="little").astype(bool)
                     if "reached" in arrays else np.isfinite(a).all(axis=2)):
-                raise fail(key, "must be finite exactly where a pose is reached (NaN elsewhere)")
+                raise _map_error(where, key, "must be finite exactly where a pose is reached (NaN elsewhere)")
     if "sphere_directions" in arrays:
         d = arrays["sphere_directions"]
         if d.dtype.kind != "f" or d.shape != (directions, 3) or not np.all(np.isfinite(d)):
-            raise fail("sphere_directions", f"must be ({directions}, 3) finite numbers, got {d.dtype} {d.shape}")
-
+            raise _map_error(where, "sphere_directions",
+                             f"must be ({directions}, 3) finite numbers, got {d.dtype} {d.shape}")
 
 def load(path: str | os.PathLike) -> ReachabilityMap:
     """Read a map written by ``save`` or ``workspace_gen`` (numpy alone reads the file; this only checks it).
