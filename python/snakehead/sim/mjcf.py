@@ -273,16 +273,20 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     boxes = obstacle_boxes(obstacles, hole_slices)
     lim = _torque_limits(robot, torque_limit)
     _check_names(robot)
-    n = robot.n_joints
-    model = robot.body.model
-    names = robot.link_names
-    F0 = robot.body.fk_all(np.zeros(n))  # frames at q = 0 in the root frame
-    child_of = {int(c): j for j, c in enumerate(model.joint_child_links)}
-    axes = np.asarray(model.joint_axes, float)
-    jnames = robot.body.joint_names
-    lower, upper = robot.lower, robot.upper
     surface = dict(solref=solref, friction=[friction, 0.005, 0.0001])  # sliding, torsional, rolling
+    spec = _empty_spec(mj, timestep)
+    _add_ground_and_obstacles(mj, spec, boxes, [o for o in obstacles if isinstance(o, MeshObstacle)], surface)
+    _add_bodies(mj, spec, robot, joint_damping, armature, self_collision, surface)
+    for j, joint in enumerate(robot.body.joint_names):
+        act = spec.add_actuator(name=f"act_{joint}", target=joint, trntype=mj.mjtTrn.mjTRN_JOINT)
+        act.gainprm[0] = 1.0
+        act.biastype = mj.mjtBias.mjBIAS_AFFINE
+        act.forcerange = [-lim[j], lim[j]]
+    return spec
 
+
+def _empty_spec(mj: Any, timestep: float) -> Any:
+    """An MjSpec with the compiler's and the simulation's options and nothing in its world."""
     spec = mj.MjSpec()
     spec.modelname = "snakehead"
     spec.compiler.degree = False
@@ -291,6 +295,12 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     spec.option.timestep = timestep
     spec.option.gravity = [0.0, 0.0, -GRAVITY]
     spec.option.integrator = mj.mjtIntegrator.mjINT_IMPLICITFAST
+    return spec
+
+
+def _add_ground_and_obstacles(mj: Any, spec: Any, boxes: Sequence, meshes: Sequence[MeshObstacle],
+                              surface: dict) -> None:
+    """The floor, the obstacles' boxes (``obstacle_<k>``) and their meshes' hulls (after the boxes)."""
     world = spec.worldbody
     world.add_geom(name=FLOOR, type=mj.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], contype=0, conaffinity=1,
                    **surface)
@@ -298,17 +308,29 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
         world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
                        quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
                        conaffinity=1, **surface)
-    meshes: list[MeshObstacle] = [o for o in obstacles if isinstance(o, MeshObstacle)]
     for k, rock in enumerate(meshes):
         mesh = spec.add_mesh(name=f"obstacle_hull_{k}", uservert=np.asarray(rock.vertices, dtype=float).reshape(-1).tolist())
         mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
         world.add_geom(name=f"obstacle_{len(boxes) + k}", type=mj.mjtGeom.mjGEOM_MESH, meshname=mesh.name,
                        pos=rock.pose[:3, 3], quat=_quat_array(rock.pose[:3, :3]), contype=0, conaffinity=1, **surface)
+
+
+def _add_bodies(mj: Any, spec: Any, robot: SnakeRobot, joint_damping: float, armature: float, self_collision: bool,
+                surface: dict) -> None:
+    """The robot's links as a chain of bodies from a free joint (at q = 0), each with its hinge, inertia, collision
+    shapes (colliding with the world, and with each other when ``self_collision``) and a site at its origin."""
+    n = robot.n_joints
+    model = robot.body.model
+    F0 = robot.body.fk_all(np.zeros(n))  # frames at q = 0 in the root frame
+    child_of = {int(c): j for j, c in enumerate(model.joint_child_links)}
+    axes = np.asarray(model.joint_axes, float)
+    jnames = robot.body.joint_names
+    lower, upper = robot.lower, robot.upper
     shapes_on: dict[int, list[int]] = {}
     for k, shape in enumerate(robot.geometry.shapes):
         shapes_on.setdefault(int(shape.frame), []).append(k)
-    parent = world
-    for i, name in enumerate(names):
+    parent = spec.worldbody
+    for i, name in enumerate(robot.link_names):
         if i == 0:
             body = parent.add_body(name=name)
             body.add_freejoint(name=FREE_JOINT)
@@ -335,12 +357,6 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
             add_shape_geom(spec, body, robot, k, contype=1, conaffinity=1 if self_collision else 0, **surface)
         body.add_site(name=f"site_{name}")
         parent = body
-    for j in range(n):
-        act = spec.add_actuator(name=f"act_{jnames[j]}", target=jnames[j], trntype=mj.mjtTrn.mjTRN_JOINT)
-        act.gainprm[0] = 1.0
-        act.biastype = mj.mjtBias.mjBIAS_AFFINE
-        act.forcerange = [-lim[j], lim[j]]
-    return spec
 
 
 @dataclass
