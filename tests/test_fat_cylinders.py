@@ -18,8 +18,6 @@ from snakehead.kinematics import workspace as ws
 from snakehead.model import published
 from snakehead.motion import start_state, waypoints
 
-from known_bugs import BLAS_DEPENDENT_RSNAKE_LIFT
-
 mujoco = pytest.importorskip("mujoco")
 
 
@@ -33,7 +31,6 @@ def fat_rsnake(tmp_path_factory):
     return robot, controller, snakehead.plan([(H[:3, 3], H[:3, 0])], controller=controller)
 
 
-@BLAS_DEPENDENT_RSNAKE_LIFT
 def test_lift_keeps_the_ground_links_and_the_body_clear(fat_rsnake):
     robot, _, plan = fat_rsnake
     assert plan.success, plan.failure
@@ -57,7 +54,6 @@ def test_detour_moves_only_the_lifting_joints(fat_rsnake):
     assert np.abs(path[:, :robot.lift_joints.start] - qa[:robot.lift_joints.start]).max() < 1e-12
 
 
-@BLAS_DEPENDENT_RSNAKE_LIFT
 def test_fat_plan_tracks_in_mujoco(fat_rsnake):
     _, _, plan = fat_rsnake
     sim = snakehead.simulate(plan)

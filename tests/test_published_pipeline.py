@@ -17,7 +17,6 @@ import snakehead
 from snakehead.kinematics import workspace as ws
 from snakehead.model import published
 
-from known_bugs import BLAS_DEPENDENT_RSNAKE_LIFT
 from snakehead.motion.targets import reachable_targets
 
 pytest.importorskip("mujoco")
@@ -29,8 +28,7 @@ def run(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
     return subprocess.run(CLI + list(args), capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.mark.parametrize("style", [pytest.param(s, marks=BLAS_DEPENDENT_RSNAKE_LIFT) if s == "rsnake" else s
-                                   for s in published.STYLES])
+@pytest.mark.parametrize("style", published.STYLES)
 def test_published_style_through_the_command_line(style: str, tmp_path: Path) -> None:
     robot_file = published.write_robot(style, tmp_path / style)
     info = run("info", "--robot", str(robot_file), "--quick")

@@ -208,8 +208,11 @@ TRACKING_CONTINUITY = 0.03
 #: apart (m), with the ground's weight: thick links (e.g. cylinders wider than a module is long) folded by the
 #: interpolated points would otherwise overlap, and the planner would fall back to a detour for the whole move.
 TRACKING_SELF_CLEARANCE = 0.005
-#: Step (rad) of the finite differences of the self-clearance term's distances.
-TRACKING_SELF_STEP = 1e-6
+#: Step (rad) of the finite differences of the self-clearance term's distances. GJK's distances carry noise of
+#: ~1e-7 m: at 1e-6 rad the differences were mostly that noise, and the fit of a folding fat-cylinder neck
+#: (RSNAKE-style) ended anywhere from -2 to +3.6 mm apart as ulps changed (numpy's BLAS kernel, the sample count);
+#: at 1e-5 to 1e-3 rad it ends 3.0-3.7 mm apart, the same on every kernel.
+TRACKING_SELF_STEP = 1e-4
 #: A sample's fit stops after a step (rad, largest joint change) smaller than this.
 TRACKING_STEP_TOLERANCE = 1e-7
 

@@ -32,6 +32,10 @@ DENSIFY = 3  # configurations checked between consecutive waypoints of a move, a
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
 MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
 DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
+#: A tracked move whose path fails its check is fitted once more with this many times the samples: between two
+#: samples the path is a straight joint segment, and where thick links fold past each other (RSNAKE-style cylinders)
+#: a coarse fit can dip into itself between samples that are 3 mm apart.
+TRACKING_RETRY_FACTOR = 2
 MARGIN_TIE = 1e-12  # m: smallest margins this close are equal (their round-off differs with the batch)
 
 
@@ -138,7 +142,8 @@ class Waypoints:
 
         First the tracking Cartesian interpolation (Eq. 41 with every joint point fitted:
         ``motion.cartesian.tracking_interpolation``), kept when every configuration is safe (above the ground, clear
-        of itself and the obstacles, statically stable with DETOUR_MARGIN); else the straight joint-space path;
+        of itself and the obstacles, statically stable with DETOUR_MARGIN), with n samples or else
+        TRACKING_RETRY_FACTOR times as many; else the straight joint-space path;
         else a joint-space path through a safe detour waypoint (see ``_joint_path``). Steps longer than
         MAX_WAYPOINT_STEP are split (:func:`split_steps`) and every path is checked at least every
         MOVE_CHECK_STEP (:func:`check_points`): the timed motion passes near the straight segments between the
@@ -148,9 +153,11 @@ class Waypoints:
         if np.abs(q - self.qs[-1]).max() <= 1e-12:
             self._append(label, q)
             return "none"
-        path = split_steps(tracking_interpolation(self.robot, self.qs[-1], q, n, self.base).q)
-        if self.path_feasible(path):
-            qs, method = path, "cartesian (Eq. 41, tracked)"
+        for samples in (n, TRACKING_RETRY_FACTOR * n):
+            path = split_steps(tracking_interpolation(self.robot, self.qs[-1], q, samples, self.base).q)
+            if self.path_feasible(path):
+                qs, method = path, "cartesian (Eq. 41, tracked)"
+                break
         else:
             qs, method = self._joint_path(self.qs[-1], q, n)
         self.append_path(label, qs, method)
