@@ -16,7 +16,7 @@ import snakehead
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
 from snakehead.model import published
-from snakehead.motion import start_state, waypoints
+from snakehead.motion import cartesian, start_state, waypoints
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -40,6 +40,27 @@ def test_lift_keeps_the_ground_links_and_the_body_clear(fat_rsnake):
     # the lift is the tracked Cartesian interpolation, not a detour: the fit keeps the thick links apart
     assert dict(plan.segments)["initial state (head lifted)"].startswith("cartesian")
     assert coll.self_clearance(robot, plan.q[::10], plan.base).min() > 0.0
+
+
+def test_lift_fit_does_not_amplify_rounding(fat_rsnake):
+    """Regression: the fit's self-clearance gradient (finite differences of GJK distances) was noise at a 1e-6 rad
+    step, and the fit of this lift ended anywhere from -1.6 to +4.0 mm apart when the end pose moved by 1e-10 rad
+    (as numpy's BLAS kernels round it differently): the plan failed on some CPUs."""
+    robot, controller, _ = fat_rsnake
+    qa = start_state.bending_state(controller)
+    qb = qa.copy()
+    lift = slice(robot.lift_joints.start, None)
+    qb[lift] = controller.q_initial[lift]
+    rng = np.random.default_rng(0)
+    closest = []
+    for k in range(8):
+        q_end = qb.copy()
+        if k:
+            q_end[lift] += rng.uniform(-1e-10, 1e-10, len(q_end[lift]))
+        fit = cartesian.tracking_interpolation(robot, qa, q_end, 12)
+        closest.append(coll.self_clearance(robot, fit.q).min())
+    assert np.ptp(closest) < 2e-4, closest
+    assert min(closest) > 0.5 * cartesian.TRACKING_SELF_CLEARANCE, closest
 
 
 def test_detour_moves_only_the_lifting_joints(fat_rsnake):
