@@ -2,10 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "snakehead/core_threads.hpp"
 #include "snakehead/dynamics.hpp"
 #include "snakehead/model.hpp"
+#include "snakehead/parallel_for.hpp"
+#include "snakehead/path_check.hpp"
 
 namespace {
 
@@ -83,3 +89,54 @@ TEST(NewtonEuler, InconsistentChainsAreRejected) {
 }
 
 }  // namespace
+
+namespace {
+
+// newton_euler_along over T random samples of the sample robot's whole chain on `threads` threads: tau, force,
+// moment and com, one after the other.
+std::vector<double> along(const snakehead::ChainModel& model, long T, int threads) {
+  const snakehead::RigidBodyChain chain = snakehead::chain_dynamics(model);
+  const long n = model.n_joints();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> q(static_cast<std::size_t>(T * n)), qd(q.size()), qdd(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) q[i] = u(rng), qd[i] = u(rng), qdd[i] = u(rng);
+  std::vector<double> out(static_cast<std::size_t>(T * (n + 9)));
+  snakehead::set_core_threads(threads);
+  snakehead::newton_euler_along(model, Eigen::Matrix4d::Identity(), chain, nullptr, q.data(), qd.data(), qdd.data(),
+                                Eigen::Vector3d(0.0, 0.0, -9.81), T, out.data(), out.data() + T * n,
+                                out.data() + T * (n + 3), out.data() + T * (n + 6));
+  snakehead::set_core_threads(0);
+  return out;
+}
+
+}  // namespace
+
+TEST(NewtonEuler, ThreadsGiveTheSerialResultBitForBit) {
+  const auto model = snakehead::ChainModel::from_urdf(std::string(SNAKEHEAD_URDF_DIR) + "/snake16.urdf", "link_0",
+                                                      "head_tip");
+  const std::vector<double> serial = along(model, 1001, 1);
+  EXPECT_EQ(along(model, 1001, 2), serial);
+  EXPECT_EQ(along(model, 1001, 7), serial);
+}
+
+TEST(ParallelFor, EverySampleOnceAndTheEarliestErrorRethrown) {
+  snakehead::set_core_threads(4);
+  std::vector<int> seen(1000, 0);
+  snakehead::parallel_for(1000, 10, [&](long begin, long end) {
+    for (long k = begin; k < end; ++k) ++seen[static_cast<std::size_t>(k)];
+  });
+  EXPECT_EQ(std::vector<int>(1000, 1), seen);
+  try {
+    snakehead::parallel_for(1000, 10, [](long begin, long) {
+      if (begin > 0) throw std::runtime_error("range at " + std::to_string(begin));
+    });
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "range at 250");  // the second of four ranges, the earliest that failed
+  }
+  int calls = 0;
+  snakehead::parallel_for(15, 10, [&](long begin, long end) { calls += static_cast<int>(end - begin) + 100 * (begin != 0); });
+  EXPECT_EQ(calls, 15);  // fewer than two ranges' worth: one range, on the calling thread
+  snakehead::set_core_threads(0);
+}

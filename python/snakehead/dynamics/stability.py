@@ -116,6 +116,23 @@ def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.Ar
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
+#: Multiply-adds of one matrix product above which OpenBLAS runs it on several threads (its m n k threshold). The
+#: threads then spin idle for ~0.1 s: one such product per plan (the CoM of a grid of thousands of configurations)
+#: kept the second core busy for most of the plan, away from the core's own threads (TRAC-IK's batches,
+#: Newton-Euler): perf showed a quarter of a plan's samples in OpenBLAS's spinning thread.
+BLAS_THREADED_PRODUCT = 1 << 18
+
+
+def _product_in_blocks(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """A @ B (m, k) x (k, p) in blocks of rows small enough that OpenBLAS keeps each on the calling thread
+    (BLAS_THREADED_PRODUCT): the same numbers, bit for bit (each row's dot products do not depend on the rows
+    around it)."""
+    rows = max(1, BLAS_THREADED_PRODUCT // max(1, A.shape[1] * B.shape[1]) - 1)
+    if len(A) <= rows:
+        return A @ B
+    return np.concatenate([A[i:i + rows] @ B for i in range(0, len(A), rows)])
+
+
 def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
                    frames: np.ndarray | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
@@ -137,7 +154,7 @@ def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None 
     for i in range(3):
         W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
         W[:, i, 3, i] = m  # coefficient of p_l[i]
-    c = (np.asarray(frames).reshape(len(frames), -1) @ W.reshape(-1, 3)) / m.sum()
+    c = _product_in_blocks(np.asarray(frames).reshape(len(frames), -1), W.reshape(-1, 3)) / m.sum()
     if not world:
         W = robot.root_pose(base)
         c = c @ W[:3, :3].T + W[:3, 3]
