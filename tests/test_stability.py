@@ -463,7 +463,7 @@ def test_static_margins_of_a_batch_match_qhull(robot, contact):
         assert st.static_margin(robot, qs[k], base, contact=contact) == pytest.approx(ref, abs=1e-9)
 
 
-@pytest.mark.parametrize("rows", [1, 272, 273, 5000])
+@pytest.mark.parametrize("rows", [1, 2, 272, 273, 545, 1001, 5000])
 def test_product_in_blocks_is_the_product_bit_for_bit(rows):
     """center_of_mass's products in blocks of rows (kept off OpenBLAS's threads) give A @ B to the bit."""
     rng = np.random.default_rng(rows)

@@ -127,10 +127,11 @@ def _product_in_blocks(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """A @ B (m, k) x (k, p) in blocks of rows small enough that OpenBLAS keeps each on the calling thread
     (BLAS_THREADED_PRODUCT): the same numbers, bit for bit (each row's dot products do not depend on the rows
     around it)."""
-    rows = max(1, BLAS_THREADED_PRODUCT // max(1, A.shape[1] * B.shape[1]) - 1)
+    rows = max(2, BLAS_THREADED_PRODUCT // max(1, A.shape[1] * B.shape[1]) - 1)
     if len(A) <= rows:
         return A @ B
-    return np.concatenate([A[i:i + rows] @ B for i in range(0, len(A), rows)])
+    # blocks of equal size: no block of one row, which numpy would hand to another kernel (gemv)
+    return np.concatenate([block @ B for block in np.array_split(A, -(-len(A) // rows))])
 
 
 def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
