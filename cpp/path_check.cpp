@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "snakehead/kinematics.hpp"
+#include "snakehead/parallel_for.hpp"
 #include "snakehead/support.hpp"
 
 namespace snakehead {
@@ -14,6 +15,9 @@ namespace snakehead {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Samples of zmp_check below which another thread costs more than it saves (a thread starts in ~20-50 us; a
+// sample's frames, momenta and lowest points take ~1 us).
+constexpr long kZmpSamplesPerThread = 256;
 using Row4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 
 using ItemKind = PathChecker::ItemKind;
@@ -779,21 +783,23 @@ void zmp_and_margins(const RigidBodyChain& chain, const ZmpCheckSpec& spec, cons
   const double Mg = M * spec.gravity;
   out.zmp.resize(static_cast<std::size_t>(2 * T));
   out.margin.resize(static_cast<std::size_t>(T));
-  for (long k = 0; k < T; ++k) {
-    const double den = Mg + Pdot[3 * k + 2];
-    const double* c = &out.com[3 * k];
-    if (!(den > 0.0)) {  // the ground cannot pull: no ZMP, the body would leave the ground
-      out.zmp[2 * k] = out.zmp[2 * k + 1] = std::numeric_limits<double>::quiet_NaN();
-      out.margin[k] = -kInf;
-      continue;
+  parallel_for(T, kZmpSamplesPerThread, [&](long begin, long end) {
+    for (long k = begin; k < end; ++k) {
+      const double den = Mg + Pdot[3 * k + 2];
+      const double* c = &out.com[3 * k];
+      if (!(den > 0.0)) {  // the ground cannot pull: no ZMP, the body would leave the ground
+        out.zmp[2 * k] = out.zmp[2 * k + 1] = std::numeric_limits<double>::quiet_NaN();
+        out.margin[k] = -kInf;
+        continue;
+      }
+      const Eigen::Vector2d p((Mg * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
+                              (Mg * c[1] + Ldot[3 * k]) / den);      // Eq. 40
+      out.zmp[2 * k] = p.x();
+      out.zmp[2 * k + 1] = p.y();
+      if (!p.allFinite()) throw InputError("zmp_check: the ZMP is not finite (qd or t out of range)");
+      out.margin[k] = polygons.margin(run[k], p);
     }
-    const Eigen::Vector2d p((Mg * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
-                            (Mg * c[1] + Ldot[3 * k]) / den);      // Eq. 40
-    out.zmp[2 * k] = p.x();
-    out.zmp[2 * k + 1] = p.y();
-    if (!p.allFinite()) throw InputError("zmp_check: the ZMP is not finite (qd or t out of range)");
-    out.margin[k] = polygons.margin(run[k], p);
-  }
+  });
 }
 
 }  // namespace
@@ -817,7 +823,7 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   out.clearance.assign(static_cast<std::size_t>(T), kInf);
   SupportRuns polygons(spec, shapes, L);
   std::vector<long> run(static_cast<std::size_t>(T));
-  std::vector<double> frames(static_cast<std::size_t>(16 * L)), key, previous;
+  std::vector<double> previous;  // the contact key of the last run
   std::vector<std::vector<double>> run_key;  // each run's contact key (a kept prefix ends with its last)
   long k0 = 0;
   const Takeover how = resume != nullptr ? takeover(*resume, checker, spec, q, qd, T) : Takeover{};
@@ -842,14 +848,40 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
   std::vector<long> lowest_of;
   const std::vector<long> slot = clearance_slots(spec, lowest_of);
   const long U = static_cast<long>(lowest_of.size());
-  std::vector<double> low(static_cast<std::size_t>(U));
+  const long K = spec.ground_key ? static_cast<long>(chain.joint_child.size()) + 1
+                                 : static_cast<long>(spec.key_joints.size());  // contact_key's length
   const std::vector<int>& child = chain.joint_child;
-  Frames work;  // every buffer of the loop is allocated before it (key and previous on their first samples)
   const auto nbytes = static_cast<std::size_t>(n) * sizeof(double);
+  // the sample repeats the one before (a hold: ~500 samples a target): its values are that one's, to the bit
+  const auto repeats = [&](long k) {
+    return k > 0 && k % spec.chunk != 0 && std::memcmp(q + k * n, q + (k - 1) * n, nbytes) == 0 &&
+           std::memcmp(qd + k * n, qd + (k - 1) * n, nbytes) == 0;
+  };
+  // 1. each sample on its own (split over the core's threads): frames, momenta, CoM, lowest points, clearance and
+  // contact key
+  const long S = T - k0;
+  std::vector<double> lows(static_cast<std::size_t>(S * U)), keys(static_cast<std::size_t>(S * K));
+  parallel_for(S, kZmpSamplesPerThread, [&](long begin, long end) {
+    std::vector<double> frames(static_cast<std::size_t>(16 * L)), key;
+    Frames work;
+    for (long k = k0 + begin; k < k0 + end; ++k) {
+      if (repeats(k)) continue;
+      const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
+      model.check_configuration(qk);
+      checker.world_frames(qk, frames.data(), work);
+      momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
+      double* low = &lows[static_cast<std::size_t>((k - k0) * U)];
+      lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), U, low);
+      for (long c : slot) out.clearance[k] = std::min(out.clearance[k], low[static_cast<std::size_t>(c)]);
+      contact_key(spec, child, shapes, low, q + k * n, key);
+      std::copy(key.begin(), key.end(), keys.begin() + (k - k0) * K);
+    }
+  });
+  // 2. in order: the repeats, and the contact runs (a new polygon where the key changes; its frames again)
+  std::vector<double> frames(static_cast<std::size_t>(16 * L));
+  Frames work;
   for (long k = k0; k < T; ++k) {
-    if (k > 0 && k % spec.chunk != 0 && std::memcmp(q + k * n, q + (k - 1) * n, nbytes) == 0 &&
-        std::memcmp(qd + k * n, qd + (k - 1) * n, nbytes) == 0) {
-      // the sample repeats the one before (a hold: ~500 samples a target): its values are that one's, to the bit
+    if (repeats(k)) {
       for (int c = 0; c < 3; ++c) {
         out.linear[3 * k + c] = out.linear[3 * (k - 1) + c];
         out.angular[3 * k + c] = out.angular[3 * (k - 1) + c];
@@ -859,16 +891,12 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
       run[k] = run[k - 1];
       continue;
     }
-    const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
-    model.check_configuration(qk);
-    checker.world_frames(qk, frames.data(), work);
-    momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
-    lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), U, low.data());
-    for (long c : slot) out.clearance[k] = std::min(out.clearance[k], low[static_cast<std::size_t>(c)]);
-    contact_key(spec, child, shapes, low.data(), q + k * n, key);
-    if (k % spec.chunk == 0 || key != previous) {
-      polygons.add(frames.data(), L, low.data());
-      previous.swap(key);
+    const auto key = keys.begin() + (k - k0) * K;
+    if (k % spec.chunk == 0 || previous.size() != static_cast<std::size_t>(K) ||
+        !std::equal(key, key + K, previous.begin())) {
+      checker.world_frames(Eigen::Map<const Eigen::VectorXd>(q + k * n, n), frames.data(), work);
+      polygons.add(frames.data(), L, &lows[static_cast<std::size_t>((k - k0) * U)]);
+      previous.assign(key, key + K);
       if (keep > 0 && k < keep) run_key.push_back(previous);
     }
     run[k] = polygons.runs() - 1;

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
+from snakehead import set_core_threads
 from snakehead.dynamics import stability
 from snakehead.geometry import BoxObstacle, collision as coll, path_check
 from snakehead.margins import EXACT_DISTANCE_WITHIN
@@ -390,3 +391,32 @@ def test_zmp_check_takes_gravity_from_the_caller() -> None:
     for bad in (np.nan, 0.0, -1.0, np.inf):
         with pytest.raises(InputError, match="gravity"):
             _core.zmp_check(*args, bad)
+
+
+def test_zmp_check_on_several_threads_equals_one_thread_to_the_bit() -> None:
+    """zmp_check splits its samples over the core's threads (then builds the contact runs in order): the same
+    momenta, CoM, ZMP, margins and clearances as on one thread, from scratch and taking over a kept prefix."""
+    robot = SnakeRobot.default()
+    rng = np.random.default_rng(4)
+    t, m = np.linspace(0.0, 6.0, 1501), 700
+    lift, other = _smooth_motion(robot, rng, len(t), 0.2), _smooth_motion(robot, rng, len(t), 0.2)
+    qd_lift = np.gradient(lift, t, axis=0)
+    q = np.concatenate([lift[:m], other[m:]])
+    qd = np.concatenate([qd_lift[:m], np.gradient(other, t, axis=0)[m:]])
+    base = BasePlacement(0.1, 0.2, 0.3)
+    results = []
+    try:
+        for threads in (1, 3):
+            set_core_threads(threads)
+            kept = stability.KeptSamples(m)
+            stability.dynamic_stability_with_clearance(robot, t, lift, base, qd_lift, kept=kept)
+            results.append([stability.dynamic_stability_with_clearance(robot, t, q, base, qd),
+                            stability.dynamic_stability_with_clearance(robot, t, q, base, qd, kept=kept)])
+            assert kept.resumed == m
+    finally:
+        set_core_threads(None)
+    for one, several in zip(*results):
+        for name in ("zmp", "margin", "P", "L", "com"):
+            np.testing.assert_array_equal(getattr(several[0], name), getattr(one[0], name), err_msg=name)
+        np.testing.assert_array_equal(several[1], one[1])
+    assert len(t) - m > 2 * 256, "enough samples after the prefix to be split"
