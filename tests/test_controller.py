@@ -88,6 +88,16 @@ def test_unreachable_target_fails_with_a_reason(robot):
     assert "no planar base move" in sol.message and "no solution" in sol.message
 
 
+@pytest.mark.parametrize("seed, calls", [(0, 1), (None, 3)])
+def test_free_roll_calls_the_ik_again_only_when_unseeded(robot, seed, calls):
+    """A seeded head IK would run the same seeded restarts again (one call, the whole budget, is enough); an
+    unseeded one searches anew from each start (FREE_ROLL_ATTEMPTS calls for a target it does not reach)."""
+    controller = HeadController(robot, method="free_roll", timeout=0.002, seed=seed)
+    sol = controller.solve([0.0, 0.4, 3.0], [0, 1, 0], allow_base_move=False)  # beyond the whole body
+    assert not sol.success and sol.head is not None
+    assert sol.head.tried == calls
+
+
 def test_accept_hook_filters_solutions(robot):
     controller = HeadController(robot, method="rotated", n_frames=6, seed=0)
     sol = controller.solve(SPHERE_2, SPHERE_DIRECTION, accept=lambda q, base: False)
