@@ -15,4 +15,5 @@ void bind_topp_ra(pybind11::module_& m);
 void bind_tracking_fit(pybind11::module_& m);
 void bind_limits(pybind11::module_& m);
 void bind_core_threads(pybind11::module_& m);
+void bind_neck_fit(pybind11::module_& m);
 }  // namespace snakehead::bindings

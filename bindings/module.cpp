@@ -25,7 +25,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() =
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
       "convex-shape distances (FCL), "
-      "inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, "
+      "inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, "
       "and the limits on what callers may ask for";
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
@@ -38,6 +38,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_tracking_fit(m);
   snakehead::bindings::bind_limits(m);
   snakehead::bindings::bind_core_threads(m);
+  snakehead::bindings::bind_neck_fit(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from snakehead import BasePlacement, SnakeRobot
+from snakehead import BasePlacement, InputError, SnakeRobot
 from snakehead.control import neck as nk
 
 
@@ -131,3 +131,23 @@ def test_base_move_impossible_when_too_high(robot):
 def test_bad_input(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_core_neck_fit_rejects_bad_settings(robot):
+    """The core's Eq. 22 fit says which of its inputs is wrong (InputError naming it)."""
+    from snakehead import _core
+
+    neck, P0 = robot.lift_chain, np.eye(4)
+    good = dict(h=0.01, grid_points=5, grid_fraction=0.9, iterations=60, tolerance=1e-9, continuity_tolerance=1e-4)
+    q, cost = _core.fit_neck(neck.model, P0, [0.3, 0.0, 0.1], [1.0, 0.0, 0.0], None, **good)
+    assert q.shape == (neck.n_joints,) and cost >= 0.0
+    for change, word in ((dict(h=0.0), "h"), (dict(grid_points=0), "grid_points"), (dict(iterations=-1), "iterations"),
+                         (dict(grid_fraction=1.5), "grid_fraction"), (dict(tolerance=np.nan), "tolerances")):
+        with pytest.raises(InputError, match=word):
+            _core.fit_neck(neck.model, P0, [0.3, 0.0, 0.1], [1.0, 0.0, 0.0], None, **{**good, **change})
+    with pytest.raises(InputError, match="q_init"):
+        _core.fit_neck(neck.model, P0, [0.3, 0.0, 0.1], [1.0, 0.0, 0.0], np.zeros(neck.n_joints + 1), **good)
+    with pytest.raises(InputError, match="finite"):
+        _core.fit_neck(neck.model, P0, [np.nan, 0.0, 0.1], [1.0, 0.0, 0.0], None, **good)
+    with pytest.raises(InputError, match="rigid"):
+        _core.fit_neck(neck.model, np.diag([1.0, 1.0, 1.0, 2.0]), [0.3, 0.0, 0.1], [1.0, 0.0, 0.0], None, **good)

@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, and the limits on what callers may ask for
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, and the limits on what callers may ask for
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_voxels', 'fibonacci_directions', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -401,6 +401,10 @@ def evaluate_voxels(model: ChainModel, options: WorkspaceOptions, centers: typin
 def fibonacci_directions(n: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     n unit vectors spread evenly on the sphere (Fibonacci lattice), (n, 3)
+    """
+def fit_neck(neck: ChainModel, P0_frame: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], P_d: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], r_d: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], q_init: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None, *, h: typing.SupportsFloat | typing.SupportsIndex, grid_points: typing.SupportsInt | typing.SupportsIndex, grid_fraction: typing.SupportsFloat | typing.SupportsIndex, iterations: typing.SupportsInt | typing.SupportsIndex, tolerance: typing.SupportsFloat | typing.SupportsIndex, continuity_tolerance: typing.SupportsFloat | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], float]:
+    """
+    Eq. 22 (neck_fit.hpp): the neck joints minimising |P_a - P_d|^2 + h |r_d x r_a|^2 within their limits, by a bounded Levenberg-Marquardt from q_init (None: none) and from the best point of a grid; (q, cost)
     """
 def hull_margins(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], active: typing.Annotated[numpy.typing.ArrayLike, numpy.bool], xy: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
     """

@@ -10,19 +10,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _core
 from .._validate import finite_array, finite_float, pose, positive, vector3
 from ..model.chain import Chain
 from .head import angle_between_deg
 from ..model.robot import BasePlacement
 
 import numpy.typing as npt
-from typing import Any, Callable
 from .._errors import InputError, InputTypeError
 
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
 #: How much lower (m^2) Eq. 22's cost from another start must be to leave the minimum reached from q_init.
 CONTINUITY_TOLERANCE = 1e-4
+#: The coarse grid that gives Eq. 22's second start (it is not convex): this many values per neck joint, evenly over
+#: this fraction of its limits.
+GRID_POINTS = 5
+GRID_FRACTION = 0.9
+#: Levenberg-Marquardt steps per start, at most; a step lowering the cost by less than this fraction of it ends the
+#: start (the neck needs no more than ~1e-9 rad: the head's IK absorbs what the neck leaves).
+FIT_ITERATIONS = 60
+FIT_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -101,9 +109,10 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
 
     ``neck`` is the chain from the base's end frame (P0) to the neck end frame (B0); ``P0_frame`` (4, 4) is
     the world pose of P0. Eq. 22 is a sum of squares of six residuals, so it is solved by a bounded
-    Levenberg-Marquardt with the analytic Jacobian (a general-purpose scipy minimiser costs ~10x more here),
-    started from ``q_init`` and from the best point of a coarse grid (Eq. 22 is not convex); the minimum
-    reached from ``q_init`` is kept unless the grid's is lower by more than ``CONTINUITY_TOLERANCE``.
+    Levenberg-Marquardt with the analytic Jacobian in the C++ core (``_core.fit_neck``, neck_fit.hpp; a
+    general-purpose scipy minimiser costs ~10x more), started from ``q_init`` and from the best point of a coarse
+    grid (GRID_POINTS per joint; Eq. 22 is not convex); the minimum reached from ``q_init`` is kept unless the grid's
+    is lower by more than ``CONTINUITY_TOLERANCE``.
     """
     if not isinstance(neck, Chain):
         raise InputTypeError(f"neck must be a snakehead Chain, got {type(neck).__name__}")
@@ -117,78 +126,15 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
         cost = float(np.sum((T[:3, 3] - goal.P_d) ** 2) + h * np.sum(np.cross(goal.r_d, ra) ** 2))
         return NeckSolution(q=np.zeros(0), frame=T, cost=cost, position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
                             direction_error_deg=angle_between_deg(ra, goal.r_d))
-    R0, p0 = P0_frame[:3, :3], P0_frame[:3, 3]
-    lo, hi = neck.lower, neck.upper
-    sqrt_h = np.sqrt(h)
-
-    S_rd = _skew(goal.r_d)  # r_d x (.) as a matrix: np.cross is slow on tiny arrays
-
-    model = neck.model  # the C++ model checks q itself; skipping the Python checks halves this loop's cost
-
-    def residual(q: np.ndarray, with_jacobian: bool = True) -> Any:
-        T = model.fk(q)
-        ra = R0 @ T[:3, 0]
-        r = np.concatenate([R0 @ T[:3, 3] + p0 - goal.P_d, sqrt_h * (S_rd @ ra)])
-        if not with_jacobian:
-            return r, None
-        J = model.jacobian(q)
-        # d(P_a)/dq = R0 Jv;  d(r_a)/dq = (R0 Jw) x r_a = -[r_a]x R0 Jw;  d(r_d x r_a) = [r_d]x d(r_a)
-        dra = -_skew(ra) @ (R0 @ J[3:])
-        return r, np.vstack([R0 @ J[:3], sqrt_h * (S_rd @ dra)])
-
-    grid = np.stack(np.meshgrid(*[np.linspace(0.9 * l, 0.9 * u, 5) for l, u in zip(lo, hi)]), -1)
-    grid = grid.reshape(-1, neck.n_joints)
-    grid_costs = [float(np.sum(residual(g, False)[0] ** 2)) for g in grid]
-    ranked = grid[np.argsort(grid_costs)[:1]]
-    starts = ranked if q_init is None else np.vstack([finite_array(q_init, "q_init", (neck.n_joints,)), ranked])
-    best_q, best_cost = None, np.inf
-    for k, q0 in enumerate(starts):
-        q, cost = _bounded_least_squares(residual, np.clip(q0, lo, hi), lo, hi)
-        # Continuity: the solution reached from q_init (tried first) is kept unless another start is
-        # clearly better, so that nearby targets give nearby necks instead of jumping between minima.
-        if k == 0 or cost < best_cost - CONTINUITY_TOLERANCE:
-            best_q, best_cost = q, cost
-    assert best_q is not None  # starts holds at least one start
+    q_init = None if q_init is None else finite_array(q_init, "q_init", (neck.n_joints,))
+    best_q, best_cost = _core.fit_neck(neck.model, P0_frame, goal.P_d, goal.r_d, q_init, h=h,
+                                       grid_points=GRID_POINTS, grid_fraction=GRID_FRACTION,
+                                       iterations=FIT_ITERATIONS, tolerance=FIT_TOLERANCE,
+                                       continuity_tolerance=CONTINUITY_TOLERANCE)
     T = P0_frame @ neck.fk(best_q)
     return NeckSolution(q=best_q, frame=T, cost=float(best_cost),
                         position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
                         direction_error_deg=angle_between_deg(T[:3, 0], goal.r_d))
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _bounded_least_squares(residual: Callable[..., Any], q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int = 60,
-                           tol: float = 1e-9) -> Any:
-    """Levenberg-Marquardt on 0.5|r(q)|^2 with steps projected onto the box [lo, hi]."""
-    r, J = residual(q)
-    cost = float(r @ r)
-    lam = 1e-3
-    for _ in range(iterations):
-        g = J.T @ r
-        # Variables held at a bound by the gradient stay there (the active set); step in the others.
-        free = ~(((q <= lo) & (g > 0)) | ((q >= hi) & (g < 0)))
-        if not free.any():
-            break
-        Jf = J[:, free]
-        step = np.zeros_like(q)
-        step[free] = -np.linalg.solve(Jf.T @ Jf + lam * np.eye(int(free.sum())), g[free])
-        q_new = np.clip(q + step, lo, hi)
-        r_new, J_new = residual(q_new)
-        cost_new = float(r_new @ r_new)
-        if cost_new < cost:
-            # The neck needs no more than ~1e-9 rad: the head's IK absorbs what the neck leaves.
-            done = cost - cost_new < tol * max(cost, 1e-30) or np.abs(q_new - q).max() < 1e-9
-            q, r, J, cost = q_new, r_new, J_new, cost_new
-            lam = max(lam / 10, 1e-12)
-            if done:
-                break
-        else:
-            lam *= 10
-            if lam > 1e8:
-                break
-    return q, cost
 
 
 def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: BasePlacement, Lc: float, length: float,
