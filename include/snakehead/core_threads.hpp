@@ -1,5 +1,6 @@
-// How many threads the core's batch work may use at once in this process: TRAC-IK's batches (TracIK::solve_many)
-// and a workspace sweep without an explicit thread count.
+// How many threads the core's batch work may use at once in this process: TRAC-IK's batches (TracIK::solve_many),
+// a workspace sweep without an explicit thread count, and the sample loops of parallel_for.hpp (Newton-Euler along
+// a path, the ZMP check of a motion).
 //
 // A process that is one of several workers on a machine (a process pool, a Dask worker) should use its share, so
 // that the workers together use the cores once instead of each of them using all of them. The default follows the

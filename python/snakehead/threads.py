@@ -1,5 +1,5 @@
 """How many threads the C++ core's batch work uses in this process (TRAC-IK's batches, a workspace sweep without a
-thread count): all hardware threads by default.
+thread count, Newton-Euler along a path and a motion's ZMP check): all hardware threads by default.
 
 A process that is one of several workers on a machine should use its share, so that the workers together use the
 cores once instead of each using all of them (as joblib caps BLAS threads in its workers). The default follows the
