@@ -392,9 +392,13 @@ def reu_xacro(spec: StyleSpec) -> str:
     """The ReU-style snake as a xacro file: a ``module`` macro unrolled by a recursive ``modules`` macro over
     ``$(arg n_modules)`` modules. Expanded with ``n_modules = spec.n_joints`` it is :func:`reu_urdf` of ``spec``
     (same links, joints, numbers). ``spec.n_joints`` only sets the servo effort; the arg sets the length."""
+    return _xacro_properties(spec) + _XACRO_LINK_MACROS + _xacro_module_macros() + _XACRO_CHAIN
+
+
+def _xacro_properties(spec: StyleSpec) -> str:
+    """The xacro file's head: its comment, the ``n_modules`` arg and the properties of ``spec``."""
     L = spec.module_length
     effort = spec.servo_effort(L / 2 + spec.n_joints * L)
-    (inp, in_share), (body, body_share), (out, out_share) = REU_THIRDS
     return f'''<?xml version="1.0"?>
 <!-- {spec.name}: the ReU-style sample snake as a xacro macro, written by snakehead.model.published;
      {_parts_comment(spec)}. Expand with the PyPI xacro package (no ROS needed: no $(find ...) here). -->
@@ -411,37 +415,48 @@ def reu_xacro(spec: StyleSpec) -> str:
   <xacro:property name="effort" value="{_num(effort)}"/>
   <xacro:property name="velocity" value="{_num(spec.velocity)}"/>
 
-  <!-- A solid cylinder along x from 0 to length, of the module's section and mass per length. -->
+'''
+
+
+#: The xacro file's macros of one cylinder link and of a fixed joint (no number of the spec in them).
+_XACRO_LINK_MACROS = '''  <!-- A solid cylinder along x from 0 to length, of the module's section and mass per length. -->
   <xacro:macro name="cylinder_link" params="name length">
-    <xacro:property name="mass" value="${{module_mass * length / module_length}}"/>
-    <link name="${{name}}">
+    <xacro:property name="mass" value="${module_mass * length / module_length}"/>
+    <link name="${name}">
       <inertial>
-        <origin xyz="${{length / 2}} 0 0" rpy="0 0 0"/>
-        <mass value="${{mass}}"/>
-        <inertia ixx="${{mass * radius * radius / 2}}" ixy="0" ixz="0"
-                 iyy="${{mass * (3 * radius * radius + length * length) / 12}}" iyz="0"
-                 izz="${{mass * (3 * radius * radius + length * length) / 12}}"/>
+        <origin xyz="${length / 2} 0 0" rpy="0 0 0"/>
+        <mass value="${mass}"/>
+        <inertia ixx="${mass * radius * radius / 2}" ixy="0" ixz="0"
+                 iyy="${mass * (3 * radius * radius + length * length) / 12}" iyz="0"
+                 izz="${mass * (3 * radius * radius + length * length) / 12}"/>
       </inertial>
       <visual>
-        <origin xyz="${{length / 2}} 0 0" rpy="0 ${{pi/2}} 0"/>
-        <geometry><cylinder radius="${{radius}}" length="${{length}}"/></geometry>
+        <origin xyz="${length / 2} 0 0" rpy="0 ${pi/2} 0"/>
+        <geometry><cylinder radius="${radius}" length="${length}"/></geometry>
       </visual>
       <collision>
-        <origin xyz="${{length / 2}} 0 0" rpy="0 ${{pi/2}} 0"/>
-        <geometry><cylinder radius="${{radius}}" length="${{length}}"/></geometry>
+        <origin xyz="${length / 2} 0 0" rpy="0 ${pi/2} 0"/>
+        <geometry><cylinder radius="${radius}" length="${length}"/></geometry>
       </collision>
     </link>
   </xacro:macro>
 
   <xacro:macro name="fixed" params="name parent child x">
-    <joint name="${{name}}" type="fixed">
-      <parent link="${{parent}}"/>
-      <child link="${{child}}"/>
-      <origin xyz="${{x}} 0 0" rpy="0 0 0"/>
+    <joint name="${name}" type="fixed">
+      <parent link="${parent}"/>
+      <child link="${child}"/>
+      <origin xyz="${x} 0 0" rpy="0 0 0"/>
     </joint>
   </xacro:macro>
 
-  <!-- Module i hangs from parent by its joint, x m along parent's x; odd joints yaw (z), even joints pitch (y). -->
+'''
+
+
+def _xacro_module_macros() -> str:
+    """The xacro macros of a module (its joint and its three links, REU_THIRDS), of a marker frame and of the
+    recursion over the modules."""
+    (inp, in_share), (body, body_share), (out, out_share) = REU_THIRDS
+    return f'''  <!-- Module i hangs from parent by its joint, x m along parent's x; odd joints yaw (z), even joints pitch (y). -->
   <xacro:macro name="module" params="i parent x">
     <joint name="reu_joint_${{i}}" type="revolute">
       <parent link="${{parent}}"/>
@@ -491,8 +506,12 @@ def reu_xacro(spec: StyleSpec) -> str:
     </xacro:if>
   </xacro:macro>
 
-  <xacro:cylinder_link name="reu_tail" length="${{module_length / 2}}"/>
-  <xacro:modules i="1" parent="reu_tail" x="${{module_length / 2}}"/>
+'''
+
+
+#: The xacro file's chain: the tail, then the modules from the first.
+_XACRO_CHAIN = '''  <xacro:cylinder_link name="reu_tail" length="${module_length / 2}"/>
+  <xacro:modules i="1" parent="reu_tail" x="${module_length / 2}"/>
 </robot>
 '''
 
