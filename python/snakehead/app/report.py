@@ -231,6 +231,15 @@ def summary_markdown(report: dict) -> str:
     report -- scene and target names, phases, notes, stages, settings -- is shown literally (:func:`markdown_text`;
     file names as code, :func:`markdown_code`): a name is never read as markup, and a table row always has its
     columns."""
+    lines = _header_lines(report)
+    for name, sc in report.get("scenarios", {}).items():
+        lines += _scenario_lines(name, sc)
+    lines += _closing_lines(report)
+    return "\n".join(lines)
+
+
+def _header_lines(report: dict) -> list[str]:
+    """The title, the machine and versions the run was on, and its settings."""
     md = markdown_text
     lines = [f"# snakehead {md(report.get('command', ''))}", ""]
     m, v = report.get("machine") or {}, report.get("versions") or {}
@@ -239,77 +248,92 @@ def summary_markdown(report: dict) -> str:
                   f"{md(v.get('snakehead'))}, Python {md(v.get('python'))}, "
                   f"MuJoCo {md(v.get('mujoco') or 'not installed')}. "
                   f"Total run time {_fmt(report.get('run_time_s'), 1, 1)} s.", ""]
-    for key in ("settings",):
-        if report.get(key):
-            lines += ["Settings: " + ", ".join(f"{md(k)} = {md(val)}" for k, val in report[key].items()), ""]
-    for name, sc in report.get("scenarios", {}).items():
-        paper = sc.get("paper") or {}
-        sim = sc.get("sim")
-        lines += [f"## {md(name)}: {'success' if sc['success'] else 'NOT successful'}", ""]
-        # escaped as a whole: an unknown duration made it "- s of motion", a list item
-        lines += [md(f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
-                     f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, "
-                     f"planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
-                     f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
-                     f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad."), ""]
-        lines += ["| target | planned position error (mm) | planned direction error (deg) | solved |",
+    if report.get("settings"):
+        lines += ["Settings: " + ", ".join(f"{md(k)} = {md(val)}" for k, val in report["settings"].items()), ""]
+    return lines
+
+
+def _scenario_lines(name: str, sc: dict) -> list[str]:
+    """One scenario: its verdict and motion, its targets, the checks against the paper, the phases of a closed
+    loop, its notes and files."""
+    md = markdown_text
+    lines = [f"## {md(name)}: {'success' if sc['success'] else 'NOT successful'}", ""]
+    # escaped as a whole: an unknown duration made it "- s of motion", a list item
+    lines += [md(f"{_fmt(sc.get('duration_s'), 1, 1)} s of motion, {sc.get('samples')} samples at "
+                 f"{_fmt(sc.get('control_period_s'), 1000, 0)} ms, "
+                 f"planned in {_fmt(sc['planning_time_s'], 1, 1)} s. "
+                 f"Base at x = {_fmt(sc['base']['x_m'], 1, 3)} m, y = {_fmt(sc['base']['y_m'], 1, 3)} m, "
+                 f"yaw = {_fmt(sc['base']['yaw_rad'], 1, 3)} rad."), ""]
+    lines += ["| target | planned position error (mm) | planned direction error (deg) | solved |",
+              "|---|---|---|---|"]
+    for tg in sc["targets"]:
+        lines.append(f"| {md(tg['name'])} | {_fmt(tg['position_error_m'], 1000, 4)} | "
+                     f"{_fmt(tg['direction_error_deg'], 1, 4)} | {_fmt(tg.get('solved'))} |")
+    lines += ["", "| check | ours (plan) | ours (MuJoCo) | paper |", "|---|---|---|---|"]
+    for label, ours, simv, pap, scale, digits in _check_rows(sc):
+        if ours is None and simv is None and pap is None:
+            continue
+        lines.append(f"| {label} | {_fmt(ours, scale, digits)} | {_fmt(simv, scale, digits)} | "
+                     f"{_fmt(pap, scale, digits)} |")
+    if sc.get("sim") is None:
+        lines += ["", "No dynamics check (MuJoCo not installed, --no-sim, or the simulation failed)."]
+    if sc.get("phases"):
+        lines += ["", f"From lying straight (closed loop): {_fmt(sc.get('total_time_s'), 1, 1)} s in all, "
+                  f"{sc.get('corrections', 0)} correction(s).", "", "| phase | kind | from (s) | to (s) |",
                   "|---|---|---|---|"]
-        for tg in sc["targets"]:
-            lines.append(f"| {md(tg['name'])} | {_fmt(tg['position_error_m'], 1000, 4)} | "
-                         f"{_fmt(tg['direction_error_deg'], 1, 4)} | {_fmt(tg.get('solved'))} |")
-        lines += ["", "| check | ours (plan) | ours (MuJoCo) | paper |", "|---|---|---|---|"]
-        s = sim or {}
-        rows = [
-            ("head position error (mm, worst target)", max((t["position_error_m"] for t in sc["targets"]),
-                                                           default=None), s.get("position_error_m"),
-             paper.get("position_error_m"), 1000, 3),
-            ("head direction error (deg, worst target)", max((t["direction_error_deg"] for t in sc["targets"]),
-                                                             default=None), s.get("direction_error_deg"),
-             paper.get("direction_error_deg"), 1, 3),
-            ("max angular momentum error ‖L_sim − L_plan‖ (kg m²/s)", None, s.get("max_angular_momentum_error"),
-             None, 1, 4),
-            ("max angular momentum magnitude error (kg m²/s)", None,
-             s.get("max_angular_momentum_magnitude_error"), paper.get("max_angular_momentum_magnitude_error"), 1, 4),
-            ("max linear momentum error ‖P_sim − P_plan‖ (kg m/s)", None, s.get("max_linear_momentum_error"),
-             None, 1, 4),
-            ("max linear momentum magnitude error (kg m/s)", None, s.get("max_linear_momentum_magnitude_error"),
-             paper.get("max_linear_momentum_magnitude_error"), 1, 4),
-            ("ZMP inside the support polygon", sc.get("dynamically_stable"), s.get("zmp_inside"),
-             paper.get("zmp_inside"), 1, 0),
-            ("min ZMP margin (mm)", sc["min_zmp_margin_m"], s.get("zmp_min_margin_m"), None, 1000, 1),
-            ("min ground clearance of neck and head (mm)", sc["min_ground_clearance_m"], None, None, 1000, 1),
-            ("min distance to the obstacles (mm)", sc.get("min_obstacle_distance_m"), None, None, 1000, 1),
-            ("base slide in simulation (mm)", None, s.get("base_slide_m"), None, 1000, 2),
-            ("the tail's travel over the ground, whole sequence (m)", None, s.get("base_travel_m"), None, 1, 2),
-            ("max joint torque in simulation (N m)", None, s.get("max_torque_nm"), None, 1, 2),
-            ("motion duration (s)", sc.get("duration_s"), None, paper.get("duration_s"), 1, 1),
-        ]
-        for label, ours, simv, pap, scale, digits in rows:
-            if ours is None and simv is None and pap is None:
-                continue
-            lines.append(f"| {label} | {_fmt(ours, scale, digits)} | {_fmt(simv, scale, digits)} | "
-                         f"{_fmt(pap, scale, digits)} |")
-        if sim is None:
-            lines += ["", "No dynamics check (MuJoCo not installed, --no-sim, or the simulation failed)."]
-        if sc.get("phases"):
-            lines += ["", f"From lying straight (closed loop): {_fmt(sc.get('total_time_s'), 1, 1)} s in all, "
-                      f"{sc.get('corrections', 0)} correction(s).", "", "| phase | kind | from (s) | to (s) |",
-                      "|---|---|---|---|"]
-            lines += [f"| {md(ph['name'])} | {md(ph['kind'])} | {_fmt(ph['t0_s'], 1, 1)} | {_fmt(ph['t1_s'], 1, 1)} |"
-                      for ph in sc["phases"]]
-        notes = list(sc.get("notes") or [])
-        if notes:
-            lines += ["", "Notes:", ""] + [f"- {md(n)}" for n in notes]
-        files = sc.get("files") or []
-        if files:
-            lines += ["", "Files: " + ", ".join(markdown_code(f) for f in files)]
-        lines.append("")
+        lines += [f"| {md(ph['name'])} | {md(ph['kind'])} | {_fmt(ph['t0_s'], 1, 1)} | {_fmt(ph['t1_s'], 1, 1)} |"
+                  for ph in sc["phases"]]
+    notes = list(sc.get("notes") or [])
+    if notes:
+        lines += ["", "Notes:", ""] + [f"- {md(n)}" for n in notes]
+    files = sc.get("files") or []
+    if files:
+        lines += ["", "Files: " + ", ".join(markdown_code(f) for f in files)]
+    lines.append("")
+    return lines
+
+
+def _check_rows(sc: dict) -> list[tuple[str, Any, Any, Any, float, int]]:
+    """The rows of a scenario's check table: (label, the plan's value, MuJoCo's, the paper's, scale, digits)."""
+    paper = sc.get("paper") or {}
+    s = sc.get("sim") or {}
+    return [
+        ("head position error (mm, worst target)", max((t["position_error_m"] for t in sc["targets"]),
+                                                       default=None), s.get("position_error_m"),
+         paper.get("position_error_m"), 1000, 3),
+        ("head direction error (deg, worst target)", max((t["direction_error_deg"] for t in sc["targets"]),
+                                                         default=None), s.get("direction_error_deg"),
+         paper.get("direction_error_deg"), 1, 3),
+        ("max angular momentum error ‖L_sim − L_plan‖ (kg m²/s)", None, s.get("max_angular_momentum_error"),
+         None, 1, 4),
+        ("max angular momentum magnitude error (kg m²/s)", None,
+         s.get("max_angular_momentum_magnitude_error"), paper.get("max_angular_momentum_magnitude_error"), 1, 4),
+        ("max linear momentum error ‖P_sim − P_plan‖ (kg m/s)", None, s.get("max_linear_momentum_error"),
+         None, 1, 4),
+        ("max linear momentum magnitude error (kg m/s)", None, s.get("max_linear_momentum_magnitude_error"),
+         paper.get("max_linear_momentum_magnitude_error"), 1, 4),
+        ("ZMP inside the support polygon", sc.get("dynamically_stable"), s.get("zmp_inside"),
+         paper.get("zmp_inside"), 1, 0),
+        ("min ZMP margin (mm)", sc["min_zmp_margin_m"], s.get("zmp_min_margin_m"), None, 1000, 1),
+        ("min ground clearance of neck and head (mm)", sc["min_ground_clearance_m"], None, None, 1000, 1),
+        ("min distance to the obstacles (mm)", sc.get("min_obstacle_distance_m"), None, None, 1000, 1),
+        ("base slide in simulation (mm)", None, s.get("base_slide_m"), None, 1000, 2),
+        ("the tail's travel over the ground, whole sequence (m)", None, s.get("base_travel_m"), None, 1, 2),
+        ("max joint torque in simulation (N m)", None, s.get("max_torque_nm"), None, 1, 2),
+        ("motion duration (s)", sc.get("duration_s"), None, paper.get("duration_s"), 1, 1),
+    ]
+
+
+def _closing_lines(report: dict) -> list[str]:
+    """The run's own notes and where its time went."""
+    md = markdown_text
+    lines: list[str] = []
     if report.get("notes"):
         lines += ["## Notes", ""] + [f"- {md(n)}" for n in report["notes"]] + [""]
     if report.get("stages"):
         lines += ["## Where the time went", "", "| stage | s |", "|---|---|"]
         lines += [f"| {md(st['stage'])} | {st['seconds']:.1f} |" for st in report["stages"]] + [""]
-    return "\n".join(lines)
+    return lines
 
 
 def write_summary(report: dict, path: str | os.PathLike) -> Path:
