@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -18,6 +19,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Samples of zmp_check below which another thread costs more than it saves (a thread starts in ~20-50 us; a
 // sample's frames, momenta and lowest points take ~1 us).
 constexpr long kZmpSamplesPerThread = 256;
+// Samples zmp_check takes at a time (its per-sample buffers: lowest points and contact keys, ~0.5 MB).
+constexpr long kZmpBlock = 8192;
 using Row4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 
 using ItemKind = PathChecker::ItemKind;
@@ -857,49 +860,52 @@ ZmpCheck zmp_check(const PathChecker& checker, const RigidBodyChain& chain, cons
     return k > 0 && k % spec.chunk != 0 && std::memcmp(q + k * n, q + (k - 1) * n, nbytes) == 0 &&
            std::memcmp(qd + k * n, qd + (k - 1) * n, nbytes) == 0;
   };
-  // 1. each sample on its own (split over the core's threads): frames, momenta, CoM, lowest points, clearance and
-  // contact key
-  const long S = T - k0;
-  std::vector<double> lows(static_cast<std::size_t>(S * U)), keys(static_cast<std::size_t>(S * K));
-  parallel_for(S, kZmpSamplesPerThread, [&](long begin, long end) {
-    std::vector<double> frames(static_cast<std::size_t>(16 * L)), key;
-    Frames work;
-    for (long k = k0 + begin; k < k0 + end; ++k) {
-      if (repeats(k)) continue;
-      const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
-      model.check_configuration(qk);
-      checker.world_frames(qk, frames.data(), work);
-      momenta(chain, frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
-      double* low = &lows[static_cast<std::size_t>((k - k0) * U)];
-      lowest_z(frames.data(), 1, L, shapes, lowest_of.data(), U, low);
-      for (long c : slot) out.clearance[k] = std::min(out.clearance[k], low[static_cast<std::size_t>(c)]);
-      contact_key(spec, child, shapes, low, q + k * n, key);
-      std::copy(key.begin(), key.end(), keys.begin() + (k - k0) * K);
-    }
-  });
-  // 2. in order: the repeats, and the contact runs (a new polygon where the key changes; its frames again)
+  // In blocks of kZmpBlock samples (bounded buffers): 1. each sample on its own, split over the core's threads
+  // (frames, momenta, CoM, lowest points, clearance, contact key); 2. in order, the repeats and the contact runs (a
+  // new polygon where the key changes, from the sample's frames again).
+  std::vector<double> lows(static_cast<std::size_t>(kZmpBlock * U)), keys(static_cast<std::size_t>(kZmpBlock * K));
   std::vector<double> frames(static_cast<std::size_t>(16 * L));
   Frames work;
-  for (long k = k0; k < T; ++k) {
-    if (repeats(k)) {
-      for (int c = 0; c < 3; ++c) {
-        out.linear[3 * k + c] = out.linear[3 * (k - 1) + c];
-        out.angular[3 * k + c] = out.angular[3 * (k - 1) + c];
-        out.com[3 * k + c] = out.com[3 * (k - 1) + c];
+  for (long b0 = k0; b0 < T; b0 += kZmpBlock) {
+    const long b1 = std::min(T, b0 + kZmpBlock);
+    parallel_for(b1 - b0, kZmpSamplesPerThread, [&](long begin, long end) {
+      std::vector<double> own_frames(static_cast<std::size_t>(16 * L)), key;
+      Frames own_work;
+      for (long k = b0 + begin; k < b0 + end; ++k) {
+        if (repeats(k)) continue;
+        const Eigen::Map<const Eigen::VectorXd> qk(q + k * n, n);
+        model.check_configuration(qk);
+        checker.world_frames(qk, own_frames.data(), own_work);
+        momenta(chain, own_frames.data(), qd + k * n, 1, L, &out.linear[3 * k], &out.angular[3 * k], &out.com[3 * k]);
+        double* low = &lows[static_cast<std::size_t>((k - b0) * U)];
+        lowest_z(own_frames.data(), 1, L, shapes, lowest_of.data(), U, low);
+        for (long c : slot) out.clearance[k] = std::min(out.clearance[k], low[static_cast<std::size_t>(c)]);
+        contact_key(spec, child, shapes, low, q + k * n, key);
+        if (static_cast<long>(key.size()) != K) throw std::logic_error("zmp_check: a contact key of another length");
+        std::copy(key.begin(), key.end(), keys.begin() + (k - b0) * K);
       }
-      out.clearance[k] = out.clearance[k - 1];
-      run[k] = run[k - 1];
-      continue;
+    });
+    for (long k = b0; k < b1; ++k) {
+      if (repeats(k)) {
+        for (int c = 0; c < 3; ++c) {
+          out.linear[3 * k + c] = out.linear[3 * (k - 1) + c];
+          out.angular[3 * k + c] = out.angular[3 * (k - 1) + c];
+          out.com[3 * k + c] = out.com[3 * (k - 1) + c];
+        }
+        out.clearance[k] = out.clearance[k - 1];
+        run[k] = run[k - 1];
+        continue;
+      }
+      const auto key = keys.begin() + (k - b0) * K;
+      if (k % spec.chunk == 0 || previous.size() != static_cast<std::size_t>(K) ||
+          !std::equal(key, key + K, previous.begin())) {
+        checker.world_frames(Eigen::Map<const Eigen::VectorXd>(q + k * n, n), frames.data(), work);
+        polygons.add(frames.data(), L, &lows[static_cast<std::size_t>((k - b0) * U)]);
+        previous.assign(key, key + K);
+        if (keep > 0 && k < keep) run_key.push_back(previous);
+      }
+      run[k] = polygons.runs() - 1;
     }
-    const auto key = keys.begin() + (k - k0) * K;
-    if (k % spec.chunk == 0 || previous.size() != static_cast<std::size_t>(K) ||
-        !std::equal(key, key + K, previous.begin())) {
-      checker.world_frames(Eigen::Map<const Eigen::VectorXd>(q + k * n, n), frames.data(), work);
-      polygons.add(frames.data(), L, &lows[static_cast<std::size_t>((k - k0) * U)]);
-      previous.assign(key, key + K);
-      if (keep > 0 && k < keep) run_key.push_back(previous);
-    }
-    run[k] = polygons.runs() - 1;
   }
   if (keep > 0 && kept != nullptr) {
     const long m = std::min(keep, T);

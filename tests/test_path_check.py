@@ -394,11 +394,11 @@ def test_zmp_check_takes_gravity_from_the_caller() -> None:
 
 
 def test_zmp_check_on_several_threads_equals_one_thread_to_the_bit() -> None:
-    """zmp_check splits its samples over the core's threads (then builds the contact runs in order): the same
-    momenta, CoM, ZMP, margins and clearances as on one thread, from scratch and taking over a kept prefix."""
+    """zmp_check splits its samples over the core's threads (then builds the contact runs in order), in blocks: the
+    same momenta, CoM, ZMP, margins and clearances as on one thread, from scratch and taking over a kept prefix."""
     robot = SnakeRobot.default()
     rng = np.random.default_rng(4)
-    t, m = np.linspace(0.0, 6.0, 1501), 700
+    t, m = np.linspace(0.0, 18.0, 9001), 700  # past one block of the core's (8192 samples)
     lift, other = _smooth_motion(robot, rng, len(t), 0.2), _smooth_motion(robot, rng, len(t), 0.2)
     qd_lift = np.gradient(lift, t, axis=0)
     q = np.concatenate([lift[:m], other[m:]])
