@@ -12,7 +12,8 @@
 namespace snakehead {
 
 // Runs body(begin, end) over [0, n) split into at most core_threads() contiguous ranges of at least `grain` samples
-// (fewer samples than 2 * grain: one range, on the calling thread). The first range runs on the calling thread.
+// (fewer samples than 2 * grain: one range, on the calling thread). The first range runs on the calling thread, and
+// so do the ranges whose thread could not be started.
 // An exception of any range is rethrown, that of the earliest range first, after every range has ended.
 template <class Body>
 void parallel_for(long n, long grain, Body&& body) {
@@ -30,9 +31,14 @@ void parallel_for(long n, long grain, Body&& body) {
     }
   };
   std::vector<std::thread> threads;
-  threads.reserve(static_cast<std::size_t>(parts - 1));
-  for (long p = 1; p < parts; ++p) threads.emplace_back(range, p);
+  long started = 1;  // ranges 1 .. started-1 have their threads
+  try {
+    threads.reserve(static_cast<std::size_t>(parts - 1));
+    for (long p = 1; p < parts; ++p, ++started) threads.emplace_back(range, p);
+  } catch (...) {  // no thread to be had (a process at its limit): the calling thread runs the rest
+  }
   range(0);
+  for (long p = started; p < parts; ++p) range(p);
   for (auto& t : threads) t.join();
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);

@@ -416,4 +416,4 @@ def concatenate_motions(a: Any, b: Any) -> Any:
 
 __all__ = ["Waypoints", "split_steps", "check_points", "densify", "concatenate_motions", "PLAN_CONTACT",
            "DETOUR_TRIALS", "DETOUR_SPREAD", "DETOUR_SEED", "JOINT_STEP_CHECK", "FALLBACK_SPEED", "DENSIFY", "MOVE_CHECK_STEP",
-           "MAX_WAYPOINT_STEP", "DETOUR_BATCH", "MARGIN_TIE"]
+           "MAX_WAYPOINT_STEP", "DETOUR_BATCH", "MARGIN_TIE", "TRACKING_RETRY_FACTOR", "TRACKED", "NO_DETOUR"]
