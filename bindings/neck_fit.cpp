@@ -16,7 +16,7 @@ void bind_neck_fit(py::module_& m) {
       [](const ChainModel& neck, const Eigen::Matrix4d& P0_frame, const Eigen::Vector3d& P_d,
          const Eigen::Vector3d& r_d, std::optional<Eigen::VectorXd> q_init, double h, int grid_points,
          double grid_fraction, int iterations, double tolerance, double continuity_tolerance) {
-        if (!P0_frame.allFinite() || !P0_frame.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 0.0))
+        if (!P0_frame.allFinite() || P0_frame.row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0))
           throw InputError("fit_neck: P0_frame must be a finite rigid frame (last row 0 0 0 1)");
         NeckFitSettings s;
         s.h = h;

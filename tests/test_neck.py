@@ -151,3 +151,13 @@ def test_core_neck_fit_rejects_bad_settings(robot):
         _core.fit_neck(neck.model, P0, [np.nan, 0.0, 0.1], [1.0, 0.0, 0.0], None, **good)
     with pytest.raises(InputError, match="rigid"):
         _core.fit_neck(neck.model, np.diag([1.0, 1.0, 1.0, 2.0]), [0.3, 0.0, 0.1], [1.0, 0.0, 0.0], None, **good)
+
+
+def test_solve_neck_refuses_a_neck_without_limits(mixed_urdf):
+    """Eq. 22's grid spans the neck's joint limits: a continuous joint (no limits; a robot file must give it some)
+    is refused with an InputError that says so, not a NaN grid."""
+    from snakehead.model.chain import Chain
+
+    neck = Chain.from_urdf(mixed_urdf, "base", "b")  # j1 revolute, j2 continuous
+    with pytest.raises(InputError, match="finite limits"):
+        nk.solve_neck(neck, np.eye(4), nk.neck_goal([0.0, 0.0, 0.0], [0.3, 0.0, 0.1], 0.2))
