@@ -79,7 +79,7 @@ void bind_trac_ik(py::module_& m) {
       .def(
           "ik_many",
           [](const TracIK& s, py::array_t<double, py::array::c_style | py::array::forcecast> poses,
-             const Eigen::Ref<const RowMat>& q_inits) {
+             const Eigen::Ref<const RowMat>& q_inits, std::optional<std::vector<std::uint64_t>> streams) {
             if (poses.ndim() != 3 || poses.shape(1) != 4 || poses.shape(2) != 4)
               throw InputError("poses must have shape (T, 4, 4)");
             const auto T = static_cast<std::size_t>(poses.shape(0));
@@ -96,7 +96,7 @@ void bind_trac_ik(py::module_& m) {
             std::vector<bool> ok;
             {
               py::gil_scoped_release release;
-              s.solve_many(targets, qi, q_out, ok);
+              s.solve_many(targets, qi, q_out, ok, streams ? &*streams : nullptr);
             }
             RowMat q = q_out.transpose();
             py::array_t<bool> okv(static_cast<py::ssize_t>(T));
@@ -104,7 +104,7 @@ void bind_trac_ik(py::module_& m) {
             for (std::size_t k = 0; k < T; ++k) o(k) = ok[k];
             return py::make_tuple(q, okv);
           },
-          py::arg("poses"), py::arg("q_inits"))
+          py::arg("poses"), py::arg("q_inits"), py::arg("streams") = py::none())
       .def(
           "fk",
           [](const TracIK& s, const ConstVec& q) {

@@ -757,9 +757,12 @@ IKResult TracIK::solve_ex(const Eigen::Isometry3d& target, const Eigen::Ref<cons
 
 void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& targets,
                         const Eigen::Ref<const Eigen::MatrixXd>& q_inits, Eigen::MatrixXd& q_out,
-                        std::vector<bool>& ok) const {
+                        std::vector<bool>& ok, const std::vector<std::uint64_t>* streams) const {
   const int n = n_joints();
   const auto T = static_cast<Eigen::Index>(targets.size());
+  if (streams != nullptr && static_cast<Eigen::Index>(streams->size()) != T)
+    throw InputError("streams must hold one value per target (" + std::to_string(T) + "), got " +
+                     std::to_string(streams->size()));
   if (q_inits.rows() != n || q_inits.cols() != T)
     throw InputError("q_inits must be " + std::to_string(n) + " x " + std::to_string(T) + " (one column per target), got " +
                      std::to_string(q_inits.rows()) + " x " + std::to_string(q_inits.cols()));
@@ -777,8 +780,10 @@ void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allo
     try {
       for (Eigen::Index k; !failed.load() && (k = next.fetch_add(1)) < T;) {
         Eigen::VectorXd q0 = q_inits.col(k).cwiseMax(impl_->model->lower()).cwiseMin(impl_->model->upper());
+        const std::uint64_t stream = streams != nullptr ? (*streams)[static_cast<std::size_t>(k)]
+                                                        : static_cast<std::uint64_t>(k);
         IKResult r = impl_->run(targets[k], q0, impl_->options, IKAlgorithm::TracIK, Impl::Schedule::Interleaved,
-                                static_cast<std::uint64_t>(k));
+                                stream);
         q_out.col(k) = r.q;
         found[k] = r.found;
       }

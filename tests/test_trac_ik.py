@@ -238,6 +238,24 @@ def test_ik_many(head7):
     assert ik.ik_many(np.zeros((0, 4, 4)))[0].shape == (0, 7)
 
 
+def test_ik_many_streams_solve_part_of_a_batch(head7):
+    """A subset of a seeded batch, each target with its index in the batch as its stream, gives that batch's
+    answers bit for bit; without the streams the subset's targets get other searches."""
+    rng = np.random.default_rng(3)
+    poses = np.array([head7.fk(head7.random_configuration(rng)) for _ in range(12)])
+    q0 = np.array([head7.random_configuration(rng) for _ in range(12)])
+    ik = TracIK.from_chain(head7, seed=2)
+    q, ok = ik.ik_many(poses, q0)
+    part = np.array([1, 6, 7, 11])
+    q_part, ok_part = ik.ik_many(poses[part], q0[part], streams=part)
+    np.testing.assert_array_equal(q_part, q[part])
+    np.testing.assert_array_equal(ok_part, ok[part])
+    assert not np.array_equal(ik.ik_many(poses[part], q0[part])[0], q[part])
+    for bad in ([1, 2], [0, 1, 2, -1], [0.0, 1.0, 2.0, 3.0], [[0, 1, 2, 3]]):
+        with pytest.raises(ValueError, match="streams"):
+            ik.ik_many(poses[part], q0[part], streams=bad)
+
+
 def test_unreachable_target_returns_none_in_about_the_timeout(head7):
     far = np.eye(4)
     far[0, 3] = 3.0  # beyond reach

@@ -105,10 +105,12 @@ class TracIK {
   // Solve many targets across core_threads() threads (core_threads.hpp: the calling thread and pool workers).
   // q_inits is n x T (one column per target). Each target gets the full timeout; its two solvers run interleaved in
   // one thread (the seeded schedule above, on the clock when unseeded). With a seed, target k uses a generator derived from (seed, k), so results do not depend on
-  // which thread solved it. q_out is resized to n x T; ok to T.
+  // which thread solved it. q_out is resized to n x T; ok to T. `streams` (T values, or nullptr for 0..T-1): the
+  // stream of each target in place of its index, so that a subset of a batch solved on its own gives, target for
+  // target, what the whole batch gives.
   void solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& targets,
                   const Eigen::Ref<const Eigen::MatrixXd>& q_inits, Eigen::MatrixXd& q_out,
-                  std::vector<bool>& ok) const;
+                  std::vector<bool>& ok, const std::vector<std::uint64_t>* streams = nullptr) const;
 
   // Number of worker threads in the pool.
   int n_workers() const;

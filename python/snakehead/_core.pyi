@@ -118,7 +118,7 @@ class TracIK:
         """
         Returns (found, q, seconds); q is q_init when nothing was found.
         """
-    def ik_many(self, poses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_inits: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], numpy.typing.NDArray[numpy.bool]]:
+    def ik_many(self, poses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_inits: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], streams: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] | None = None) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], numpy.typing.NDArray[numpy.bool]]:
         ...
     @property
     def bounds(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:

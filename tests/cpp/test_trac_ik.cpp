@@ -393,6 +393,42 @@ TEST(TracIK, BatchMatchesSingleCallsAndIsSeededPerTarget) {
     if (ok1[k]) expect_solution(*model, targets[k], q1.col(k), o.epsilon);
 }
 
+TEST(TracIK, SubsetWithItsStreamsMatchesTheWholeBatch) {
+  const auto model = head7();
+  TracIKOptions o;
+  o.seed = 4;
+  TracIK ik(model, o);
+  std::mt19937 rng(4);
+  const int T = 12;
+  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets, subset;
+  Eigen::MatrixXd q0(model->n_joints(), T);
+  for (int k = 0; k < T; ++k) {
+    targets.push_back(forward_kinematics(*model, random_q(*model, rng)));
+    q0.col(k) = random_q(*model, rng);
+  }
+  Eigen::MatrixXd q_all, q_sub, q_plain;
+  std::vector<bool> ok_all, ok_sub, ok_plain;
+  ik.solve_many(targets, q0, q_all, ok_all);
+  const std::vector<std::uint64_t> streams{2, 5, 11};
+  Eigen::MatrixXd q0_sub(model->n_joints(), 3);
+  for (int i = 0; i < 3; ++i) {
+    subset.push_back(targets[streams[i]]);
+    q0_sub.col(i) = q0.col(static_cast<Eigen::Index>(streams[i]));
+  }
+  ik.solve_many(subset, q0_sub, q_sub, ok_sub, &streams);
+  ik.solve_many(subset, q0_sub, q_plain, ok_plain);  // streams 0, 1, 2: other searches
+  bool all_same = true;
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<Eigen::Index>(streams[i]);
+    EXPECT_EQ(ok_sub[i], ok_all[k]) << "target " << k;
+    EXPECT_EQ(q_sub.col(i), q_all.col(k)) << "target " << k;  // bit for bit
+    all_same = all_same && q_plain.col(i) == q_all.col(k);
+  }
+  EXPECT_FALSE(all_same);  // (the streams are what made the subset's answers the batch's)
+  const std::vector<std::uint64_t> two{0, 1};
+  EXPECT_THROW(ik.solve_many(subset, q0_sub, q_sub, ok_sub, &two), InputError);
+}
+
 // Targets of random configurations (reachable) and random starts; how many a batch solves.
 int solve_batch(const TracIK& ik, std::uint32_t seed) {
   const ChainModel& m = ik.model();

@@ -652,13 +652,27 @@ def lifted_candidates(prob: BodyProblem, q_now: np.ndarray, base: BasePlacement,
     inits = np.vstack([np.tile(q_now[start:], (CANDIDATE_ROLLS, 1))]
                       + [rng.uniform(ik.lower, ik.upper, (CANDIDATE_ROLLS, ik.n_joints))
                          for _ in range(CANDIDATE_SEEDS - 1)])
-    qs, ok = ik.ik_many(poses, inits)
+    qs, ok = _rolls_reached(ik, poses, inits)
     out = []
     for qk in qs[ok]:
         q = q_now.copy()
         q[start:] = qk
         out.append(q)
     return out
+
+
+def _rolls_reached(ik: Any, poses: np.ndarray, inits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`lifted_candidates`' IK: first every roll from the current joints, then the random starts of the rolls
+    that the current joints' start reached (a roll it missed within its budget is out of the chain's reach with
+    its limits nearly always, and a failing target costs the IK's whole budget): (q (T, m), ok (T,)), the targets
+    left out not found. Each target keeps its index in the batch as its stream (the same answers as one batch)."""
+    first = np.arange(CANDIDATE_ROLLS)
+    qs, ok = inits.copy(), np.zeros(len(poses), bool)
+    qs[first], ok[first] = ik.ik_many(poses[first], inits[first], streams=first)
+    rest = np.flatnonzero(np.tile(ok[first], CANDIDATE_SEEDS - 1)) + CANDIDATE_ROLLS
+    if len(rest):
+        qs[rest], ok[rest] = ik.ik_many(poses[rest], inits[rest], streams=rest)
+    return qs, ok
 
 
 def _rolled(T: np.ndarray, angles: np.ndarray) -> np.ndarray:

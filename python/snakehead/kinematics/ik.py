@@ -198,11 +198,14 @@ class TracIK:
             raise InputError(f"unknown algorithm {algorithm!r}; expected TRAC-IK, KDL-RR or SQP")
         return self._solver.ik(T, q, b, t, algorithm)
 
-    def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_many(self, poses: npt.ArrayLike, q_inits: npt.ArrayLike | None = None,
+                streams: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Solve many targets across ``snakehead.core_threads()`` threads (all cores by default): poses (T, 4, 4) -> (q (T, n), ok (T,) bool).
 
         Rows of ``q`` where ``ok`` is False hold the start configuration. With a seed, target k's search
-        depends only on (seed, k), so results do not depend on which thread solved it.
+        depends only on (seed, k), so results do not depend on which thread solved it. ``streams`` (T,) non-negative
+        integers stand for the k's: the targets of a batch solved in parts, each with its index in the batch, give
+        what the whole batch gives.
         """
         P = finite_array(poses, "poses", (None, 4, 4))
         for k in range(P.shape[0]):
@@ -215,11 +218,23 @@ class TracIK:
             Q = finite_array(q_inits, "q_inits", (P.shape[0], self.n_joints))
             for k in range(Q.shape[0]):
                 self._q_init(Q[k], f"q_inits[{k}]")
-        return self._solver.ik_many(np.ascontiguousarray(P), np.ascontiguousarray(Q))
+        return self._solver.ik_many(np.ascontiguousarray(P), np.ascontiguousarray(Q), _streams(streams, P.shape[0]))
 
     def __repr__(self) -> str:
         return (f"TracIK({self._chain.base!r} -> {self._chain.tip!r}, {self.n_joints} joints, "
                 f"{self.solve_type}, timeout={self.timeout:g} s, epsilon={self.epsilon:g})")
+
+
+def _streams(streams: npt.ArrayLike | None, count: int) -> list[int] | None:
+    """:meth:`TracIK.ik_many`'s ``streams``, checked: ``count`` integers in [0, 2**63)."""
+    if streams is None:
+        return None
+    values = np.asarray(streams)
+    if values.shape != (count,) or (count and values.dtype.kind not in "iu"):
+        raise InputError(f"streams must be {count} integers (one per pose), got {values.dtype} of shape {values.shape}")
+    if count and (values.min() < 0 or values.max() >= 2 ** 63):
+        raise InputError(f"streams must be in [0, 2**63), got values from {values.min()} to {values.max()}")
+    return [int(v) for v in values]
 
 
 def pose_error(target: Any, current: Any) -> np.ndarray:
