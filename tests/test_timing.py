@@ -347,3 +347,45 @@ def test_required_zmp_margin_closed_form():
     static = np.array([0.02, 0.0084, 0.006, 0.004, 0.0])
     expected = [m, m, max(0.003, 0.006 - room), max(0.002, 0.004 - room), 0.0]
     np.testing.assert_allclose(timing.required_margins(static, m), expected, atol=1e-15)
+
+
+def test_limit_ratios_are_the_numpy_formulas_to_the_bit():
+    """``_ratios`` (the core's ``limit_ratios``) against the formulas written in numpy here: each sample's largest
+    |qd| / limit, |qdd| / limit, |tau| / limit, the friction used and the ZMP's signed distance inside its polygon
+    (Eqs. 39-40), equal bit for bit, with samples where the ground would have to pull (no ZMP: -inf, friction inf).
+    Bad shapes are refused."""
+    from snakehead import _core
+    from snakehead.dynamics.inverse_dynamics import InverseDynamics
+    from snakehead.model.physics import GRAVITY
+
+    robot = snakehead.SnakeRobot.default()
+    rng = np.random.default_rng(21)
+    N, n, E = 400, robot.n_joints, 6
+    qd, qdd, tau = (rng.normal(size=(N, n)) for _ in range(3))
+    Pdot, Ldot, com = rng.normal(size=(N, 3)), rng.normal(size=(N, 3)), rng.normal(size=(N, 3)) * 0.1
+    Mg = robot.total_mass * GRAVITY
+    Pdot[::7, 2] = -2 * Mg  # the ground would have to pull
+    angle = rng.uniform(0, 2 * np.pi, (N, E))
+    normal = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+    offset = rng.normal(size=(N, E)) * 0.1
+    support = timing.Support(normal, offset, com, rng.uniform(0.01, 0.05, N), rng.uniform(0.005, 0.01, N))
+    limits = timing.resolve_limits(robot)
+    got = timing._ratios(robot, snakehead.BasePlacement(), limits, support, np.zeros((N, n)), qd, qdd,
+                         dyn=InverseDynamics(tau, Pdot, Ldot))
+    force = Mg + Pdot[:, 2]
+    up = force > 0
+    safe = np.where(up, force, 1.0)
+    zmp = np.column_stack([(Mg * com[:, 0] - Ldot[:, 1]) / safe, (Mg * com[:, 1] + Ldot[:, 0]) / safe])
+    margin = np.where(up, ((normal * zmp[:, None, :]).sum(-1) - offset).min(axis=1), -np.inf)
+    want = {"velocity": (np.abs(qd) / limits.velocity).max(axis=1),
+            "acceleration": (np.abs(qdd) / limits.acceleration).max(axis=1),
+            "torque": (np.abs(tau) / limits.torque).max(axis=1),
+            "friction": np.where(up, np.hypot(Pdot[:, 0], Pdot[:, 1]) / (limits.friction * safe), np.inf),
+            "zmp_margin": margin, "zmp_slack": margin - support.required}
+    assert set(got) == set(want) and not up.all()
+    for key in want:
+        np.testing.assert_array_equal(got[key], want[key], err_msg=key)
+    args = [qd, qdd, tau, Pdot, Ldot, com, normal, offset, limits.velocity, limits.acceleration, limits.torque]
+    for k, bad in [(1, qdd[:, :3]), (3, Pdot[:, :2]), (7, offset[:-1]), (8, limits.velocity[:3])]:
+        with pytest.raises(ValueError, match="limit_ratios"):
+            _core.limit_ratios(*(bad if i == k else a for i, a in enumerate(args)), Mg, limits.friction)

@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, piecewise polynomials, and the limits on what callers may ask for
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, piecewise polynomials, a timed motion's use of its limits, and the limits on what callers may ask for
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'limit_ratios', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -417,6 +417,10 @@ def hull_margins(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]
 def kdl_nr_jl_ik(model: ChainModel, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], q_init: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], timeout: typing.SupportsFloat | typing.SupportsIndex = 0.005, epsilon: typing.SupportsFloat | typing.SupportsIndex = 1e-05) -> tuple[bool, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
     """
     KDL's ChainIkSolverPos_NR_JL from q_init until converged or timeout: (found, q).
+    """
+def limit_ratios(qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], tau: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], Pdot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], Ldot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], normal: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], velocity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], acceleration: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], torque: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], Mg: typing.SupportsFloat | typing.SupportsIndex, friction: typing.SupportsFloat | typing.SupportsIndex) -> dict:
+    """
+    Per sample (N,): the largest |value| / limit of qd, qdd and tau (N, n), the friction used (|dP_xy/dt| / (friction (Mg + dP_z/dt)), inf where the ground would pull) and the ZMP's signed distance inside its polygon (normal (N, E, 2) inward, offset (N, E); -inf where the ground would pull): a dict of arrays.
     """
 def momenta(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], joint_child: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], axes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], inertias: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """

@@ -44,6 +44,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.interpolate import CubicSpline
 
+from .. import _core
 from .._validate import MAX_SAMPLES, finite_array, finite_float, positive, sample_count
 from ..dynamics import stability
 from ..dynamics.inverse_dynamics import InverseDynamics, inverse_dynamics, newton_euler
@@ -325,20 +326,13 @@ def _ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, supp
     ``dyn``: the samples' Newton-Euler pass when the caller has it."""
     if dyn is None:
         dyn = newton_euler(robot, q, qd, qdd, base, frames=frames)  # torques and exact momentum rates
-    tau, Pdot, Ldot = dyn.tau, dyn.Pdot, dyn.Ldot
-    Mg = robot.total_mass * GRAVITY
-    normal_force = Mg + Pdot[:, 2]
-    lifting = normal_force > 0  # else the ground would have to pull: no ZMP
-    safe = np.where(lifting, normal_force, 1.0)
-    com = support.com
-    zmp = np.column_stack([(Mg * com[:, 0] - Ldot[:, 1]) / safe,  # Eqs. 39-40 with p_z = 0
-                           (Mg * com[:, 1] + Ldot[:, 0]) / safe])
-    margin = np.where(lifting, support.margins(zmp), -np.inf)
-    return {"velocity": (np.abs(qd) / limits.velocity).max(axis=1),
-            "acceleration": (np.abs(qdd) / limits.acceleration).max(axis=1),
-            "torque": (np.abs(tau) / limits.torque).max(axis=1),
-            "friction": np.where(lifting, np.hypot(Pdot[:, 0], Pdot[:, 1]) / (limits.friction * safe), np.inf),
-            "zmp_margin": margin, "zmp_slack": margin - support.required}
+    # in the core (the numpy it replaces, to the bit: Mg + dP_z/dt <= 0 means the ground would have to pull, no ZMP)
+    c = np.ascontiguousarray
+    ratios = _core.limit_ratios(c(qd), c(qdd), c(dyn.tau), c(dyn.Pdot), c(dyn.Ldot), c(support.com), c(support.normal),
+                                c(support.offset), c(limits.velocity, float), c(limits.acceleration, float),
+                                c(limits.torque, float), robot.total_mass * GRAVITY, float(limits.friction))
+    ratios["zmp_slack"] = ratios["zmp_margin"] - support.required
+    return ratios
 
 
 def check_limits(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: npt.ArrayLike, base: BasePlacement | None,
