@@ -69,8 +69,8 @@ def _contact_points_many(robot: SnakeRobot, frames: np.ndarray, contact: str,
     if contact not in CONTACT_MODELS:
         raise InputError(f"contact must be one of {CONTACT_MODELS}, got {contact!r}")
     # the base part's links (the robot's own: those before base_end), or with "ground" every link
-    links = np.asarray(robot.base_links, int) if contact != "ground" else np.arange(len(robot.link_names))
-    links = links[np.isin(links, robot.shaped_links)]
+    # (every shaped link is ascending and unique: with "ground", they are the links)
+    links = robot.shaped_base_links if contact != "ground" else robot.shaped_links
     if links.size == 0:
         raise InputError("the base part has no links with collision shapes; no support polygon")
     if contact == "endpoints":

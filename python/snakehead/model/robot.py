@@ -501,6 +501,12 @@ class SnakeRobot:
         return self.geometry.frames_with_shapes
 
     @cached_property
+    def shaped_base_links(self) -> np.ndarray:
+        """Indices (link_names) of the base part's links that have collision shapes, ascending."""
+        links = np.asarray(self.base_links, int)
+        return links[np.isin(links, self.shaped_links)]
+
+    @cached_property
     def distal_points(self) -> tuple[np.ndarray, np.ndarray]:
         """The shaped links (k,) and, in each link's frame, the points (k, M, 3) of its shapes farthest along the
         body at q = 0 (a box's distal face, a cylinder's distal rim; padded by repetition): where a link pitched up
