@@ -62,6 +62,19 @@ def _pose(T: npt.ArrayLike, name: str = "pose") -> np.ndarray:
     return check_pose(T, name)
 
 
+def _poses(poses: npt.ArrayLike) -> np.ndarray:
+    """``poses`` as valid 4x4 poses (T, 4, 4): all at once in numpy where every one is clearly valid (half
+    :func:`_pose`'s tolerance); else pose by pose, so that a bad one is named (``poses[k]``) as :func:`_pose` names it."""
+    P = finite_array(poses, "poses", (None, 4, 4))
+    R = P[:, :3, :3]
+    err = np.abs(np.einsum("kji,kjl->kil", R, R) - np.eye(3)).max(initial=0.0)
+    if err <= 0.5 * ORTHONORMAL_TOLERANCE and np.all(P[:, 3] == (0.0, 0.0, 0.0, 1.0)) and np.all(np.linalg.det(R) > 0):
+        return P
+    for k in range(P.shape[0]):
+        _pose(P[k], f"poses[{k}]")
+    return P
+
+
 def _seed(seed: int | None) -> int | None:
     return None if seed is None else integer(seed, "seed", least=0, most=2**64 - 1)
 
@@ -207,17 +220,16 @@ class TracIK:
         integers stand for the k's: the targets of a batch solved in parts, each with its index in the batch, give
         what the whole batch gives.
         """
-        P = finite_array(poses, "poses", (None, 4, 4))
-        for k in range(P.shape[0]):
-            _pose(P[k], f"poses[{k}]")
+        P = _poses(poses)
         if q_inits is None:
             rng = self._start_generator()
             Q = np.array([self._chain.random_configuration(rng) for _ in range(P.shape[0])]).reshape(
                 P.shape[0], self.n_joints)
         else:
             Q = finite_array(q_inits, "q_inits", (P.shape[0], self.n_joints))
-            for k in range(Q.shape[0]):
-                self._q_init(Q[k], f"q_inits[{k}]")
+            if not (np.all(Q >= self.lower - 1e-9) and np.all(Q <= self.upper + 1e-9)):
+                for k in range(Q.shape[0]):  # (the first out of its limits is named)
+                    self._q_init(Q[k], f"q_inits[{k}]")
         return self._solver.ik_many(np.ascontiguousarray(P), np.ascontiguousarray(Q), _streams(streams, P.shape[0]))
 
     def __repr__(self) -> str:
