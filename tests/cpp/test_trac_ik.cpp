@@ -63,6 +63,17 @@ void expect_solution(const ChainModel& m, const Eigen::Isometry3d& target, const
   EXPECT_LE(std::acos(c), std::sqrt(3.0) * eps * (1 + 1e-6) + 1e-7);
 }
 
+using Poses = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
+
+// T reachable targets (the poses of random configurations) and T random starts (columns of q0), drawn in turn.
+void random_batch(const ChainModel& m, std::mt19937& rng, int T, Poses& targets, Eigen::MatrixXd& q0) {
+  q0.resize(m.n_joints(), T);
+  for (int k = 0; k < T; ++k) {
+    targets.push_back(forward_kinematics(m, random_q(m, rng)));
+    q0.col(k) = random_q(m, rng);
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------------
@@ -355,12 +366,9 @@ TEST(TracIK, BatchMatchesSingleCallsAndIsSeededPerTarget) {
   TracIK ik(model, o);
   std::mt19937 rng(9);
   const int T = 40;
-  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets;
-  Eigen::MatrixXd q0(model->n_joints(), T);
-  for (int k = 0; k < T; ++k) {
-    targets.push_back(forward_kinematics(*model, random_q(*model, rng)));
-    q0.col(k) = random_q(*model, rng);
-  }
+  Poses targets;
+  Eigen::MatrixXd q0;
+  random_batch(*model, rng, T, targets, q0);
   Eigen::MatrixXd q1, q2;
   std::vector<bool> ok1, ok2;
   ik.solve_many(targets, q0, q1, ok1);
@@ -400,12 +408,9 @@ TEST(TracIK, SubsetWithItsStreamsMatchesTheWholeBatch) {
   TracIK ik(model, o);
   std::mt19937 rng(4);
   const int T = 12;
-  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets, subset;
-  Eigen::MatrixXd q0(model->n_joints(), T);
-  for (int k = 0; k < T; ++k) {
-    targets.push_back(forward_kinematics(*model, random_q(*model, rng)));
-    q0.col(k) = random_q(*model, rng);
-  }
+  Poses targets, subset;
+  Eigen::MatrixXd q0;
+  random_batch(*model, rng, T, targets, q0);
   Eigen::MatrixXd q_all, q_sub, q_plain;
   std::vector<bool> ok_all, ok_sub, ok_plain;
   ik.solve_many(targets, q0, q_all, ok_all);
@@ -434,12 +439,9 @@ int solve_batch(const TracIK& ik, std::uint32_t seed) {
   const ChainModel& m = ik.model();
   std::mt19937 rng(seed);
   const int T = 24;
-  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> targets;
-  Eigen::MatrixXd q0(m.n_joints(), T), q;
-  for (int k = 0; k < T; ++k) {
-    targets.push_back(forward_kinematics(m, random_q(m, rng)));
-    q0.col(k) = random_q(m, rng);
-  }
+  Poses targets;
+  Eigen::MatrixXd q0, q;
+  random_batch(m, rng, T, targets, q0);
   std::vector<bool> ok;
   ik.solve_many(targets, q0, q, ok);
   int solved = 0;
