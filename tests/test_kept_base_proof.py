@@ -60,17 +60,25 @@ def test_never_refuses_a_reachable_target(controller):
         assert not _search(controller, t.position, t.direction, q_prev=t.q).beyond_reach()
 
 
-def _ik_batch(controller, q, position, direction) -> np.ndarray:
-    """The lifted chain's IK from q at the controller's base towards the rolled frames, as lifted_candidates asks
-    for them but with no proof asked first: which succeeded."""
-    robot, prob = controller.robot, controller.body_problem
-    ik = prob.lifted_ik(0)
+def _batch(controller, q, position, direction, rng) -> tuple[np.ndarray, np.ndarray]:
+    """lifted_candidates' batch from q at the controller's base: the rolled frames, first from q, then from random
+    joints (poses (16, 4, 4) in the lift frame, starts (16, m))."""
+    robot, ik = controller.robot, controller.body_problem.lifted_ik(0)
     T0 = robot.frame(q, robot.lift_frame, controller.base)
     target = np.linalg.inv(T0) @ frame_along(position, direction)
     angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
-    poses = wb._rolled(target, angles)
-    inits = np.tile(q[robot.lift_joints.start:], (len(poses), 1))
-    return ik.ik_many(poses, inits)[1]
+    poses = np.concatenate([wb._rolled(target, angles)] * wb.CANDIDATE_SEEDS)
+    inits = np.vstack([np.tile(q[robot.lift_joints.start:], (wb.CANDIDATE_ROLLS, 1)),
+                       rng.uniform(ik.lower, ik.upper, (wb.CANDIDATE_ROLLS * (wb.CANDIDATE_SEEDS - 1), ik.n_joints))])
+    return poses, inits
+
+
+def _ik_batch(controller, q, position, direction) -> np.ndarray:
+    """The lifted chain's IK from q at the controller's base towards the rolled frames, as lifted_candidates asks
+    for them but with no proof asked first: which succeeded."""
+    poses, inits = _batch(controller, q, position, direction, np.random.default_rng(0))
+    first = slice(0, wb.CANDIDATE_ROLLS)
+    return controller.body_problem.lifted_ik(0).ik_many(poses[first], inits[first])[1]
 
 
 def test_what_it_refuses_is_not_reached(controller, request):
@@ -115,3 +123,28 @@ def test_choice_of_base_past_the_proof_is_deterministic(controller):
     sol = wb.solve_target(controller, refused.position, refused.direction, q_prev=first[1], base=first[0],
                           allow_base_move=False, problem=controller.body_problem, min_margin=DETOUR_MARGIN)
     assert sol.success
+
+
+def test_candidates_skip_the_random_starts_of_rolls_the_current_joints_miss(controller):
+    """lifted_candidates' IK (``_rolls_reached``) solves every roll from the current joints, then from random
+    starts only the rolls reached from there: each target it solves gives, bit for bit, what one batch of all of
+    them gives (its index in the batch is its stream), and the others are reported not found at their start. On
+    the default robot and on others; targets of other base shapes asked from the initial one, where some rolls are
+    out of the chain's reach."""
+    ik = controller.body_problem.lifted_ik(0)
+    rng = np.random.default_rng(5)
+    missed = 0
+    for t in reachable_targets(controller, "shape", 8, np.random.default_rng(6)):
+        if missed >= 3:
+            break
+        poses, inits = _batch(controller, controller.q_initial, t.position, t.direction, rng)
+        q_all, ok_all = ik.ik_many(poses, inits)
+        q, ok = wb._rolls_reached(ik, poses, inits)
+        first = ok_all[:wb.CANDIDATE_ROLLS]
+        solved = np.concatenate([np.ones(wb.CANDIDATE_ROLLS, bool), first])
+        np.testing.assert_array_equal(q[solved], q_all[solved])
+        np.testing.assert_array_equal(ok[solved], ok_all[solved])
+        assert not ok[~solved].any()
+        np.testing.assert_array_equal(q[~solved], inits[~solved])
+        missed += int((~first).sum())
+    assert missed > 0  # (the skipped branch was taken)

@@ -8,7 +8,6 @@ import pytest
 import snakehead
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.control import whole_body as wb
-from snakehead.control.head import frame_along
 from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
@@ -429,32 +428,3 @@ def test_rolled_frames_are_roll_about_x():
         assert got[k][:3, 1] @ T[:3, 1] == pytest.approx(np.cos(a), abs=1e-12)
         assert got[k][:3, 1] @ T[:3, 2] == pytest.approx(np.sin(a), abs=1e-12)
 
-
-def test_candidates_skip_the_random_starts_of_rolls_the_current_joints_miss(default):
-    """lifted_candidates' IK (``_rolls_reached``) solves every roll from the current joints, then from random
-    starts only the rolls reached from there: each target it solves gives, bit for bit, what one batch of all of
-    them gives (its index in the batch is its stream), and the others are reported not found at their start."""
-    robot, controller, prob = default
-    ik = prob.lifted_ik(0)
-    rng = np.random.default_rng(5)
-    start = robot.lift_joints.start
-    angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
-    missed = 0
-    for _ in range(3):
-        # targets made on another base shape, asked from the initial one: some rolls are out of the chain's reach
-        position, direction = reachable(robot, controller, prob, rng, "shape")
-        T0 = robot.frame(controller.q_initial, robot.lift_frame, controller.base)
-        target = np.linalg.inv(T0) @ frame_along(position, direction)
-        poses = np.concatenate([wb._rolled(target, angles)] * wb.CANDIDATE_SEEDS)
-        inits = np.vstack([np.tile(controller.q_initial[start:], (wb.CANDIDATE_ROLLS, 1)),
-                           rng.uniform(ik.lower, ik.upper, (wb.CANDIDATE_ROLLS, ik.n_joints))])
-        q_all, ok_all = ik.ik_many(poses, inits)
-        q, ok = wb._rolls_reached(ik, poses, inits)
-        first = ok_all[:wb.CANDIDATE_ROLLS]
-        solved = np.concatenate([np.ones(wb.CANDIDATE_ROLLS, bool), first])
-        np.testing.assert_array_equal(q[solved], q_all[solved])
-        np.testing.assert_array_equal(ok[solved], ok_all[solved])
-        assert not ok[~solved].any()
-        np.testing.assert_array_equal(q[~solved], inits[~solved])
-        missed += int((~first).sum())
-    assert missed > 0  # (the skipped branch was taken)
