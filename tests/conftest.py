@@ -1,8 +1,72 @@
+import os
+import re
 from pathlib import Path
 
 import pytest
 
 DATA = Path(__file__).resolve().parent / "data"
+
+
+# --- a missing test dependency fails the run in CI --------------------------------------------------------------
+#: The pip name of a test dependency whose import name differs (pyproject.toml's test, docs and lint extras).
+PIP_NAMES = {"pinocchio": "pin", "sklearn": "scikit-learn", "dask": "dask[distributed]",
+             "distributed": "dask[distributed]", "bs4": "beautifulsoup4", "markdown_it": "markdown-it-py",
+             "yaml": "pyyaml"}
+#: What pytest.importorskip says when it skips (pytest's own wording, either cause).
+_IMPORTORSKIP = re.compile(r"could not import '(?P<a>[^']+)'|module '(?P<b>[^']+)' has __version__")
+
+
+def in_ci() -> bool:
+    """Whether the environment variable CI is set to a true value (.ci/run sets CI=true; CI runners set it too)."""
+    return os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no", "off")
+
+
+def missing_import(report: pytest.CollectReport | pytest.TestReport) -> str | None:
+    """The module a skip was for, when ``report`` is a skip by pytest.importorskip (else None)."""
+    if not report.skipped or not isinstance(report.longrepr, tuple):
+        return None
+    found = _IMPORTORSKIP.search(str(report.longrepr[2]))
+    return None if found is None else found["a"] or found["b"]
+
+
+def _fail_in_ci(report: pytest.CollectReport | pytest.TestReport) -> None:
+    """Under CI, a skip for a missing import becomes a failure that names the package: in CI every test dependency is
+    installed (bash .ci/setup), so a skip there would drop a feature's tests silently."""
+    module = missing_import(report) if in_ci() else None
+    if module is None:
+        return
+    top = module.split(".")[0]
+    package = PIP_NAMES.get(module, PIP_NAMES.get(top, top))
+    reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else ""
+    report.outcome = "failed"
+    report.longrepr = (f"missing test dependency {package!r} (import {module!r}): CI is set, so a test that needs it "
+                       f"fails instead of skipping; install the test extras (bash .ci/setup, or pip install "
+                       f"'.[test,docs,lint]'). pytest said: {reason}")
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    _fail_in_ci(outcome.get_result())
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_make_collect_report(collector):
+    outcome = yield
+    _fail_in_ci(outcome.get_result())
+
+
+@pytest.fixture(scope="session")
+def mujoco():
+    """The mujoco module, for the tests that simulate (skipped without it, a failure in CI)."""
+    return pytest.importorskip("mujoco")
+
+
+@pytest.fixture(scope="session")
+def toppra():
+    """The toppra module, for the tests that compare the core's TOPP-RA with it (skipped without it, a failure in
+    CI)."""
+    return pytest.importorskip("toppra")
 
 
 def head6_robot():
