@@ -9,7 +9,6 @@ from snakehead.dynamics.inverse_dynamics import (carried_weights, inverse_dynami
                                                  newton_euler)
 from snakehead.model.generate import SnakeSpec, snake_urdf
 
-pin = pytest.importorskip("pinocchio")
 
 GENERATED = SnakeSpec(n_joints=11, module_length=0.11, section=0.05, mass_per_module=0.3, first_axis="pitch",
                       markers={"p0": 5, "b0": 6}, tip_name="tip", name="gen11")
@@ -22,7 +21,13 @@ def robot(request):
     return snakehead.SnakeRobot.from_urdf(snake_urdf(GENERATED), base_end="p0", neck_end="b0", head_tip="tip")
 
 
-def pin_model(robot):
+@pytest.fixture(scope="module")
+def pin():
+    """pinocchio, the independent Newton-Euler reference: the one test that compares with it needs it."""
+    return pytest.importorskip("pinocchio")
+
+
+def pin_model(pin, robot):
     src = robot.urdf
     model = pin.buildModelFromXML(src) if src.lstrip().startswith("<") else pin.buildModelFromUrdf(src)
     assert [model.names[i] for i in range(1, model.njoints)] == robot.joint_names
@@ -35,8 +40,8 @@ def random_states(robot, T, seed):
     return q, rng.normal(0, 1.5, q.shape), rng.normal(0, 3.0, q.shape)
 
 
-def test_full_gravity_and_inertia_equal_pinocchio_rnea(robot):
-    model = pin_model(robot)
+def test_full_gravity_and_inertia_equal_pinocchio_rnea(pin, robot):
+    model = pin_model(pin, robot)
     data = model.createData()
     q, qd, qdd = random_states(robot, 40, 1)
     base = snakehead.BasePlacement(0.3, -0.7, 1.1)  # a yaw of the root does not change gravity's direction in it

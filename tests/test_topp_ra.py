@@ -12,6 +12,7 @@ import concurrent.futures
 import dataclasses
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -24,8 +25,6 @@ from snakehead.model import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.motion import _topp, timing
 
-pytest.importorskip("toppra")
-from topp_reference import toppra_solve_grid, toppra_solver  # noqa: E402  (tests/topp_reference.py; needs toppra)
 
 #: Controllable sets and path speeds: this share of their largest value (toppra's float32 velocity bound: ~1e-7).
 REL_TOL = 1e-6
@@ -49,6 +48,15 @@ def _robot(name: str) -> snakehead.SnakeRobot:
 @pytest.fixture(scope="module", params=["default", "gen14", "published:head6"])
 def robot(request: pytest.FixtureRequest) -> snakehead.SnakeRobot:
     return _robot(request.param)
+
+
+@pytest.fixture(scope="module")
+def reference(toppra: Any) -> Any:
+    """tests/topp_reference.py (toppra's TOPPRA over the same constraints), for the tests that compare with it: they
+    alone need toppra."""
+    import topp_reference
+
+    return topp_reference
 
 
 def random_waypoints(robot: snakehead.SnakeRobot, rng: np.random.Generator) -> np.ndarray:
@@ -102,7 +110,7 @@ def test_lp2d_against_highs() -> None:
 # ------------------------------------------------------------------------------------------------
 # the solver against toppra
 # ------------------------------------------------------------------------------------------------
-def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRobot) -> None:
+def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRobot, reference: Any) -> None:
     """Same controllable sets and path speeds, or infeasible at the same gridpoint, over the real constraint set."""
     rng = np.random.default_rng(11)
     kinds = {"feasible": 0, "infeasible": 0}
@@ -114,7 +122,7 @@ def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRo
             continue
         ours = timing._solve_grid(robot, points, limits)
         try:
-            ref = toppra_solve_grid(robot, points, limits)
+            ref = reference.toppra_solve_grid(robot, points, limits)
         except ZeroDivisionError:
             # toppra's seidel LP divides by zero on a row 0 u + 0 x <= g < 0 (the path stands still at its ends,
             # q' = q'' = 0, where the CoM is outside the polygon): the core reports that stage infeasible
@@ -190,7 +198,7 @@ def _canonical(robot: snakehead.SnakeRobot, points: timing.GridPoints, limits: t
                            np.einsum("nkj,nj->nk", F, points.w_b), g)
 
 
-def test_core_reports_infeasible_where_toppra_does() -> None:
+def test_core_reports_infeasible_where_toppra_does(reference: Any) -> None:
     """The default robot lifting its head over its CoM margin: both solvers fail at the same gridpoint."""
     robot = snakehead.SnakeRobot.default()
     rng = np.random.default_rng(5)
@@ -205,7 +213,7 @@ def test_core_reports_infeasible_where_toppra_does() -> None:
             continue  # stable all along: feasible
         ours = timing._solve_grid(robot, points, limits)
         try:
-            ref = toppra_solve_grid(robot, points, limits)
+            ref = reference.toppra_solve_grid(robot, points, limits)
         except ZeroDivisionError:
             continue  # see above
         assert ours.sd is None and ref.sd is None
@@ -239,7 +247,7 @@ def test_closed_form_bang_bang_profile_and_duration() -> None:
 # retime on both solvers
 # ------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name,seed", [("default", 2), ("gen14", 4)])
-def test_retime_matches_toppra_retime(name: str, seed: int) -> None:
+def test_retime_matches_toppra_retime(name: str, seed: int, reference: Any) -> None:
     robot = _robot(name)
     rng = np.random.default_rng(seed)
     for _ in range(20):  # the first random lift whose start and path stand
@@ -251,7 +259,7 @@ def test_retime_matches_toppra_retime(name: str, seed: int) -> None:
             continue
     else:
         pytest.fail("no stable random lift")
-    with toppra_solver():
+    with reference.toppra_solver():
         ref = timing.retime(robot, W)
     assert ours.duration == pytest.approx(ref.duration, rel=DURATION_TOL)
     assert np.allclose(ours.waypoint_times, ref.waypoint_times, rtol=DURATION_TOL, atol=1e-6)
