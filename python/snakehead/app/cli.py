@@ -154,7 +154,7 @@ def _robot(args: argparse.Namespace) -> SnakeRobot:
 
     if getattr(args, "robot", None) is None:
         return SnakeRobot.default()
-    return SnakeRobot.from_file(args.robot)
+    return SnakeRobot.from_file(args.robot, trust_xacro=bool(getattr(args, "trust_xacro", False)))
 
 
 def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
@@ -472,6 +472,10 @@ def _add_robot_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--robot", default=None, metavar="ROBOT.toml",
                    help="a robot file (TOML: urdf, base_end, neck_end, head_tip, optional root and map); "
                         "default: the shipped 16-joint robot")
+    p.add_argument("--trust-xacro", action="store_true",
+                   help="expand the robot's xacro with xacro's own Python evaluator, the environment and any file "
+                        "(only for a description you trust; by default a xacro runs no code and reads only the "
+                        "robot's folders: SECURITY.md)")
 
 
 def _add_planning_options(p: argparse.ArgumentParser) -> None:

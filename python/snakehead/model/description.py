@@ -2,11 +2,13 @@
 limits, mesh paths resolved and collision meshes loaded as their convex hulls.
 
 * :func:`read_description` -- the URDF text of a ``.urdf`` file, a ``.xacro`` file (expanded without ROS by the
-  ``xacro`` package, with arguments) or the XML itself, and the folder its relative paths start from.
+  ``xacro`` package, with arguments, without running the file's code: :mod:`.xacro_expansion`) or the XML itself,
+  the folder its relative paths start from and the folders it may read (:mod:`.robot_folders`).
 * :func:`with_joint_limits` -- ``continuous`` joints turned into revolute ones with the limits a robot file gives
   (a snake's planner needs bounded joints; a continuous joint without limits is an error naming it).
-* :class:`MeshResolver` -- ``package://NAME/...``, ``file://...`` and relative mesh paths to files: the robot file's
-  ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`convex_hull_vertices` loads one with trimesh.
+* :class:`MeshResolver` -- ``package://NAME/...``, ``file://...`` and relative mesh paths to files inside the
+  robot's folders: the robot file's ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`convex_hull_vertices`
+  loads one with trimesh.
 
 Errors are :class:`snakehead.InputError` naming the file and the element.
 """
@@ -22,6 +24,8 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError
 from .._validate import MAX_COORDINATE_M, input_file
+from .robot_folders import RobotFolders
+from .xacro_expansion import expand_xacro
 
 from typing import Any, Mapping
 
@@ -39,50 +43,52 @@ class Description:
     text: str
     folder: Path | None
     source: str
+    folders: RobotFolders = field(default_factory=RobotFolders)
 
 
 def _is_xml(urdf: str) -> bool:
     return urdf.lstrip().startswith("<")
 
 
-def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, object] | None = None) -> Description:
-    """The URDF text of ``urdf``: a path to a ``.urdf`` or ``.xacro`` file, or the XML itself."""
+def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, object] | None = None, *,
+                     packages: Mapping[str, str | os.PathLike[str]] | None = None,
+                     robot_file: str | os.PathLike[str] | None = None, trust_xacro: bool = False) -> Description:
+    """The URDF text of ``urdf``: a path to a ``.urdf`` or ``.xacro`` file, or the XML itself. ``packages`` and
+    ``robot_file`` (the robot file it came from) add to the folders the description may read
+    (:class:`.robot_folders.RobotFolders`). A xacro is expanded without running code unless ``trust_xacro``
+    (:mod:`.xacro_expansion`)."""
     if isinstance(urdf, os.PathLike):
         urdf = os.fspath(urdf)
     if not isinstance(urdf, str):
         raise InputTypeError(f"urdf must be a path or an XML string, got {type(urdf).__name__}")
+    if not isinstance(trust_xacro, bool):
+        raise InputTypeError(f"trust_xacro must be True or False, got {trust_xacro!r}")
+    package_folders = {str(k): Path(v) for k, v in (packages or {}).items()}
+    extra = () if robot_file is None else (Path(robot_file).resolve().parent,)
     if _is_xml(urdf):
         if xacro_args:
             raise InputError("xacro_args are given but the description is URDF text, not a .xacro file")
-        return Description(urdf, None, "<URDF text>")
+        return Description(urdf, None, "<URDF text>", RobotFolders(extra, package_folders))
     path = input_file(urdf, "the robot's description", MAX_DESCRIPTION_BYTES)
+    folder = path.resolve().parent
+    folders = RobotFolders((folder, *extra), package_folders)
     if path.suffix == ".xacro":
-        return Description(expand_xacro(path, xacro_args or {}), path.resolve().parent, os.fspath(path))
+        text = expand_xacro(path, _xacro_mappings(xacro_args or {}), folders, trusted=trust_xacro)
+        return Description(text, folder, os.fspath(path), folders)
     if xacro_args:
         raise InputError(f"xacro_args are given but {os.fspath(path)!r} is not a .xacro file")
     # the core reads URDF files itself (with its own checks); only the folder is needed here
-    return Description(os.fspath(path), path.resolve().parent, os.fspath(path))
+    return Description(os.fspath(path), folder, os.fspath(path), folders)
 
 
-def expand_xacro(path: Path, args: Mapping[str, object]) -> str:
-    """Expand a xacro file with the ``xacro`` package (no ROS needed; ``$(find ...)`` is not available)."""
-    try:
-        import xacro
-    except ImportError:  # pragma: no cover - a dependency of the package
-        raise InputError(f"{os.fspath(path)!r} is a xacro file and the 'xacro' package is not installed") from None
-    if not path.is_file():
-        raise InputError(f"xacro file {os.fspath(path)!r} does not exist")
+def _xacro_mappings(args: Mapping[str, object]) -> dict[str, str]:
+    """xacro's arguments as the strings it takes (booleans as ``true``/``false``)."""
     mappings = {}
     for key, value in args.items():
         if not isinstance(value, (str, int, float, bool)):
             raise InputError(f"xacro argument {key!r} must be a string or a number, got {value!r}")
         mappings[str(key)] = str(value).lower() if isinstance(value, bool) else str(value)
-    try:
-        doc = xacro.process_file(os.fspath(path), mappings=mappings)
-        return str(doc.toxml())
-    except Exception as exc:  # xacro raises its own and the XML parser's exceptions; all mean a bad file
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        raise InputError(f"xacro file {os.fspath(path)!r}: {message}") from None
+    return mappings
 
 
 def _xml_root(text: str, where: str) -> ET.Element:
@@ -169,23 +175,22 @@ def add_fixed_frames(text: str, frames: list[tuple[str, str, np.ndarray]]) -> st
 
 @dataclass(frozen=True)
 class MeshResolver:
-    """Where mesh files are: ``package://NAME/rest`` in ``packages[NAME]`` (a robot file's ``[packages]``), then in
-    ``ROS_PACKAGE_PATH`` (``DIR/NAME/rest``); ``file://`` paths as they are; relative paths from ``folder`` (the
-    URDF's)."""
+    """Where mesh files are: ``package://NAME/rest`` in the package's folder (:meth:`.RobotFolders.package_folder`),
+    ``file://`` and absolute paths as they are, relative paths from ``folder`` (the URDF's); each must be inside
+    the robot's folders (:meth:`.RobotFolders.inside`)."""
 
     folder: Path | None = None
-    packages: Mapping[str, Path] = field(default_factory=dict)
+    folders: RobotFolders = field(default_factory=RobotFolders)
 
     def resolve(self, filename: str, where: str) -> Path:
+        return self.folders.inside(self._path(filename, where), f"{where}: mesh file", MAX_MESH_BYTES)
+
+    def _path(self, filename: str, where: str) -> Path:
         if filename.startswith("package://"):
-            rest = filename[len("package://"):]
-            name, _, inside = rest.partition("/")
+            name, _, inside = filename[len("package://"):].partition("/")
             if not name or not inside:
                 raise InputError(f"{where}: mesh {filename!r} is not package://NAME/path")
-            for folder in self._package_folders(name):
-                return folder / inside
-            raise InputError(f"{where}: mesh {filename!r}: package {name!r} is not known; add {name} = \"folder\" to "
-                             "the robot file's [packages] table (or put it on ROS_PACKAGE_PATH)")
+            return self.folders.package_folder(name, f"{where}: mesh {filename!r}") / inside
         if filename.startswith("file://"):
             return Path(filename[len("file://"):])
         path = Path(filename)
@@ -195,14 +200,6 @@ class MeshResolver:
                                  "(no folder to resolve it from)")
             path = self.folder / path
         return path
-
-    def _package_folders(self, name: str) -> list[Path]:
-        if name in self.packages:
-            return [Path(self.packages[name])]
-        for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
-            if entry and (Path(entry) / name).is_dir():
-                return [Path(entry) / name]
-        return []
 
 
 def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarray:

@@ -132,10 +132,13 @@ class SnakeRobot:
                  root: str | None = None, map_path: str | os.PathLike | None = None, source: str | None = None,
                  head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
                  limits: Mapping[str, tuple[float, float]] | None = None,
-                 xacro_args: Mapping[str, object] | None = None) -> None:
+                 xacro_args: Mapping[str, object] | None = None, robot_file: str | os.PathLike | None = None,
+                 trust_xacro: bool = False) -> None:
         self._arguments = {"urdf": urdf, "root": root, "head_axis": head_axis, "packages": packages, "limits": limits,
-                           "xacro_args": xacro_args, "source": source}
-        description = read_description(_urdf_source(urdf), xacro_args)
+                           "xacro_args": xacro_args, "source": source, "robot_file": robot_file,
+                           "trust_xacro": trust_xacro}
+        description = read_description(_urdf_source(urdf), xacro_args, packages=packages, robot_file=robot_file,
+                                        trust_xacro=trust_xacro)
         names = {"base_end": _frame_name(base_end, "base_end"), "neck_end": _frame_name(neck_end, "neck_end"),
                  "head_tip": _frame_name(head_tip, "head_tip")}
         if head_axis not in HEAD_AXES:
@@ -148,7 +151,7 @@ class SnakeRobot:
         self.map_path = None if map_path is None else Path(map_path)
         #: Where the robot came from (a robot file's path), for messages and reports.
         self.source = source or description.source
-        self._meshes = MeshResolver(description.folder, {k: Path(v) for k, v in (packages or {}).items()})
+        self._meshes = MeshResolver(description.folder, description.folders)
         text = description.text
         _check_utf8(text, "urdf")
         root = _core.urdf_root_link(text) if root is None else _frame_name(root, "root")  # the core checks the text
@@ -171,29 +174,33 @@ class SnakeRobot:
     def from_urdf(cls, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
                   root: str | None = None, head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
                   limits: Mapping[str, tuple[float, float]] | None = None,
-                  xacro_args: Mapping[str, object] | None = None) -> "SnakeRobot":
+                  xacro_args: Mapping[str, object] | None = None, trust_xacro: bool = False) -> "SnakeRobot":
         """A robot from a description (a URDF or ``.xacro`` path, or the URDF XML itself starting with ``<``) and
         the frames that bound its parts.
 
         ``root`` defaults to the URDF's root link. Any link or fixed marker frame may be named. ``head_axis``: the
         head_tip frame's axis that points where the head looks. ``packages``: NAME -> folder for
         ``package://NAME/...`` meshes. ``limits``: joint -> (lower, upper) rad, needed for ``continuous`` joints.
-        ``xacro_args``: the arguments of a xacro file. Raises :class:`~snakehead.InputError` for frames that are
+        ``xacro_args``: the arguments of a xacro file. ``trust_xacro``: expand a xacro with xacro's own Python
+        evaluator, the environment and any file (only for a description you trust; by default its expressions are
+        evaluated without running code and it reads only its own folders: SECURITY.md). Raises :class:`~snakehead.InputError` for frames that are
         missing or out of order, a part without joints, or a body that is not a snake (straight at q = 0,
         revolute joints about two perpendicular axes across it, collision shapes on the base).
         """
         return cls(urdf, base_end=base_end, neck_end=neck_end, head_tip=head_tip, root=root, head_axis=head_axis,
-                   packages=packages, limits=limits, xacro_args=xacro_args)
+                   packages=packages, limits=limits, xacro_args=xacro_args, trust_xacro=trust_xacro)
 
     @classmethod
-    def from_file(cls, path: str | os.PathLike) -> "SnakeRobot":
-        """A robot from a robot file (TOML; :mod:`snakehead.model.robot_file`)."""
+    def from_file(cls, path: str | os.PathLike, *, trust_xacro: bool = False) -> "SnakeRobot":
+        """A robot from a robot file (TOML; :mod:`snakehead.model.robot_file`). ``trust_xacro``: as in
+        :meth:`from_urdf` (a robot file reached through a scene file is never trusted unless the caller says so)."""
         from .robot_file import read_robot_file
 
         spec = read_robot_file(path)
         return cls(spec.urdf, base_end=spec.base_end, neck_end=spec.neck_end, head_tip=spec.head_tip,
                    root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
-                   packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args)
+                   packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args, robot_file=path,
+                   trust_xacro=trust_xacro)
 
     @property
     def description_arguments(self) -> dict[str, Any]:
