@@ -28,7 +28,7 @@ def check(a, b, closed):
     assert found.upper - found.lower <= 1.001e-7
     # the direction it reports has the gap it reports
     gap = -(support(a, found.direction[None])[0] + support(b, -found.direction[None])[0])[0]
-    assert gap == pytest.approx(found.lower, abs=1e-15)
+    assert gap == pytest.approx(found.lower, abs=1e-12)
     return closed
 
 
