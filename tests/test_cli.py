@@ -100,10 +100,15 @@ def test_report_keys_and_types(demo, name):
         for key, typ in SIM_KEYS.items():
             assert isinstance(sc["sim"][key], typ), key
         assert sc["sim"]["position_error_m"] >= 0 and sc["sim"]["max_linear_momentum_error"] >= 0
-        # The dynamics check tracks the plan: measured 0.5 mm / 0.065 deg and 0.043 kg m/s / 0.0075 kg m^2/s
-        # with --fast; bounded here at the paper's own figures (1.39 mm / 0.76 deg, 0.195 kg m/s, 0.0383 kg m^2/s).
-        assert sc["sim"]["position_error_m"] < 1.39e-3 and sc["sim"]["direction_error_deg"] < 0.76
-        assert sc["sim"]["max_linear_momentum_error"] < 0.195 and sc["sim"]["max_angular_momentum_error"] < 0.0383
+        # The dynamics check tracks the plan as the README says the demo does: "0.18-0.33 mm and 0.04-0.05 deg",
+        # bounded at those figures as printed (0.335 mm, 0.055 deg). Measured with --fast --seed 1: spheres 0.181 mm
+        # / 0.036 deg, hole 0.331 mm / 0.052 deg, the same to 1e-9 with OPENBLAS_CORETYPE Prescott, Haswell, Zen and
+        # SkylakeX. The momentum errors have no documented figure for --fast (bench/RESULTS.md's 0.014-0.016 kg m/s
+        # and 0.0044-0.0076 kg m^2/s are the slower demo's; they grow with the motion's speed): measured 0.0152 /
+        # 0.0168 kg m/s and 0.0050 / 0.0083 kg m^2/s, bounded at 1.5x the larger (the paper's figures, 0.195 and
+        # 0.0383, were 12x and 4.6x that).
+        assert sc["sim"]["position_error_m"] < 0.335e-3 and sc["sim"]["direction_error_deg"] < 0.055
+        assert sc["sim"]["max_linear_momentum_error"] < 0.025 and sc["sim"]["max_angular_momentum_error"] < 0.0125
         assert sc["sim"]["zmp_inside"] is True
     else:
         assert sc["sim"] is None

@@ -223,7 +223,8 @@ def test_the_mujoco_check_shows_its_errors_beside_the_plans(live):
     number = live.check_dynamics()
     check = live.wait_for_check(600)
     assert check.number == number and check.error is None
-    assert check.simulation.position_error_m < 0.02
+    # README: the plans run in MuJoCo land within 2 mm and 1 deg (measured here: 0.22 mm, 0.041 deg)
+    assert check.simulation.position_error_m < 2e-3 and check.simulation.direction_error_deg < 1.0
     table = live._errors.content
     assert "| position error |" in table and "MuJoCo" in table and "| - |" not in table
 

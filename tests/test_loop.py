@@ -436,7 +436,10 @@ def test_closed_loop_corrects_a_disturbed_start(disturbed):
     assert run.success, run.failure
     assert run.sensing == "onboard"
     m = run.metrics
-    assert m["position_error_m"] < 0.005 and m["direction_error_deg"] < 1.0  # the head phases, before the servo
+    # the head phases, before the servo, on the head camera's fix (the docs promise nothing for them): measured
+    # 2.57 mm and 0.19 deg (the sensors' noise is seeded: the same every run); bounds ~1.4x that, for a plan that
+    # differs a little on another machine
+    assert m["position_error_m"] < 0.0035 and m["direction_error_deg"] < 0.3
     assert m["final_position_error_m"] < 0.002 and m["final_direction_error_deg"] < 1.0
     assert m["zmp_inside"]
     # the loop did not know: its dead reckoning was off by the disturbance until the head camera's fix

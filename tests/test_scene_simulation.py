@@ -132,7 +132,8 @@ def test_a_target_held_zero_seconds_is_simulated(tmp_path, hold_s):
     assert plan.targets[-1].time_s == pytest.approx(plan.t[-1], abs=2e-9)  # the target is the motion's end
     checked = snakehead.simulate(plan)
     check_simulation(plan, checked)
-    assert checked.position_error_m < 5e-3
+    # README: the plans run in MuJoCo land within 2 mm and 1 deg (measured: 0.18 mm, 0.036 deg at either hold)
+    assert checked.position_error_m < 2e-3 and checked.direction_error_deg < 1.0
 
 
 def test_cli_plans_and_simulates_a_scene_with_default_hold(tmp_path):
@@ -145,7 +146,8 @@ def test_cli_plans_and_simulates_a_scene_with_default_hold(tmp_path):
     entry = report["scenarios"]["one"]
     assert entry["success"] is True
     assert entry["sim"] is not None and len(entry["sim"]["position_errors_m"]) == 1
-    assert entry["sim"]["position_error_m"] < 5e-3
+    # README: the plans run in MuJoCo land within 2 mm and 1 deg (measured with --fast: 0.18 mm, 0.036 deg)
+    assert entry["sim"]["position_error_m"] < 2e-3 and entry["sim"]["direction_error_deg"] < 1.0
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -192,7 +194,9 @@ def test_valid_scene_variants_plan_and_simulate(tmp_path, variant):
     assert plan.success, plan.failure
     checked = snakehead.simulate(plan)
     check_simulation(plan, checked)
-    assert checked.position_error_m < 5e-3
+    # README: the plans run in MuJoCo land within 2 mm and 1 deg (measured: 0.05-0.33 mm and 0.02-0.05 deg, but
+    # "where the head lies", whose target is the lying head's own pose: 1.27 mm, 0.74 deg)
+    assert checked.position_error_m < 2e-3 and checked.direction_error_deg < 1.0
 
 
 # ------------------------------------------------------------------------------------------------------------

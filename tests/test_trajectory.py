@@ -439,7 +439,18 @@ def test_collision_check_on_the_robot(robot):
     assert rep.collides.all()  # the base lies on the ground box
     assert not rep.link_collides[..., 0].any()
     d_box = rep.link_distance[..., 0].min(1)
-    assert d_box[-1] == pytest.approx(0.1 - 0.025 - 0.0, abs=0.05) and d_box.min() > 0
+    # the final pose's distance against coal's (another GJK than the core's FCL) over every link box: measured
+    # 0.0470755 m, 5e-12 from coal's (it was checked as 0.075 +- 0.05: the box's bottom 7.5 cm above the tip, but the
+    # nearest link corner is not under it)
+    coal = pytest.importorskip("coal")
+    final = robot.frames_many(qs[-1:])[0]
+    to_coal = lambda M: coal.Transform3s(M[:3, :3].copy(), M[:3, 3].copy())  # noqa: E731
+    request = coal.DistanceRequest()
+    request.gjk_tolerance = 1e-10
+    expected = min(coal.distance(coal.Box(*s.size), to_coal(final[s.frame] @ s.origin), coal.Box(0.1, 0.1, 0.05),
+                                 coal.Transform3s(np.eye(3), tip + [0.0, 0.0, 0.1]), request, coal.DistanceResult())
+                   for s in robot.geometry.shapes if s.kind == "box")
+    assert d_box[-1] == pytest.approx(expected, abs=1e-9) and d_box.min() > 0
     # consistent with ground_clearance for the ground box (distance = clearance for boxes above it)
     clear = coll.ground_clearance(robot, qs)[:, rep.links]
     np.testing.assert_allclose(np.maximum(rep.link_distance[..., 1], 0), np.maximum(clear, 0), atol=1e-12)
