@@ -1,7 +1,9 @@
-"""The core's tracking fit (snakehead._core.TrackingFit, include/snakehead/tracking_fit.hpp) against the numpy code it
-replaced (tests/tracking_reference.py): one step's stacked residual, Jacobian and step, and whole interpolations, on
-the default robot and on published-style snakes (cylinders along z, meshes, fat cylinders, spheres), from random
-start/end pairs with the ground and self terms active and not.
+"""The core's tracking fit (snakehead._core.TrackingFit, include/snakehead/tracking_fit.hpp): one step's stacked
+residual, Jacobian and step against the numpy code it replaced (tests/tracking_reference.py), and whole
+interpolations against the fit's definition stated independently (tests/fit_reference.py: pinocchio's forward
+kinematics, closed-form lowest points, coal's distances; scipy's least_squares on the same objective), on the default
+robot and on published-style snakes (cylinders along z, meshes, fat cylinders, spheres), from random start/end pairs
+with the ground and self terms active and not.
 """
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import least_squares
 
 import snakehead
 from snakehead import InputError, _core
@@ -19,12 +22,7 @@ from snakehead.model import published
 from snakehead.motion import cartesian
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from tracking_reference import tracking_interpolation_numpy, tracking_system  # noqa: E402
-
-#: rad: the interpolations' q agree this well where the numpy code is well-conditioned. Both run the same arithmetic
-#: but for round-off (numpy's and Eigen's matrix products, LU against Cholesky, FCL's distances at poses a few ulp
-#: apart, divided by the self term's 1e-6 rad forward-difference step).
-Q_TOLERANCE = 1e-6
+from tracking_reference import tracking_system  # noqa: E402
 
 STYLES = ["default", "sea", "mesh", "rsnake", "head6"]
 
@@ -108,7 +106,7 @@ def planner_like_pairs(robot: snakehead.SnakeRobot, count: int, seed: int) -> li
 
 
 def contact_rows(robot: snakehead.SnakeRobot, ref: cartesian.TrackingInterpolation) -> tuple[int, int]:
-    """The ground and self rows of the numpy fit's systems at each interior sample's result, summed."""
+    """The ground and self rows of the fit's systems (the numpy code's) at each interior sample's result, summed."""
     base = snakehead.BasePlacement()
     lift, pts, pairs = fit_inputs(robot)
     ground = selfc = 0
@@ -133,32 +131,166 @@ def short_moves_near_contact(robot: snakehead.SnakeRobot, seed: int) -> list[tup
     return out
 
 
+def fit_objective(robot: snakehead.SnakeRobot, base: snakehead.BasePlacement):
+    """The fit's objective stated independently (tests/fit_reference.py: pinocchio, closed-form lowest points, coal)
+    with the TRACKING_* weights and clearances."""
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("coal")
+    from fit_reference import FitObjective
+
+    c = cartesian
+    return FitObjective(robot, base, *fit_inputs(robot), dict(
+        clearance=c.TRACKING_CLEARANCE, ground_weight=c.TRACKING_GROUND_WEIGHT, continuity=c.TRACKING_CONTINUITY,
+        self_clearance=c.TRACKING_SELF_CLEARANCE))
+
+
+def moves(robot: snakehead.SnakeRobot) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Plan-like moves and short moves near self contact, "chaotic" ones included (those whose fit a 1e-13 m nudge
+    of the base moves by radians: the numpy fit it replaced skipped them)."""
+    return planner_like_pairs(robot, 8, seed=7) + short_moves_near_contact(robot, seed=2)
+
+
+def sample_problem(obj, res: cartesian.TrackingInterpolation, qa: np.ndarray, qb: np.ndarray, j: int):
+    """Interior sample j's problem: the joints before the lift (their linear interpolation), the previous sample's
+    fitted lifted joints (the warm start and the continuity term's reference), the self pairs that can matter near
+    the samples (closer than 5 cm at j or j - 1: those farther add nothing within a step of 1e-6 rad)."""
+    q_lin = (1 - res.s[j]) * qa + res.s[j] * qb
+    return q_lin, res.q[j - 1, obj.lift], obj.near_pairs([res.q[j], res.q[j - 1]], 0.05)
+
+
+def one_sided_gradients(obj, x, q_lin, target, current, pairs, h=1e-7) -> tuple[np.ndarray, np.ndarray]:
+    """The smaller and larger one-sided difference quotients of the reference objective along each lifted joint: a
+    gradient of it lies between them (where a lifted link's lowest point is a tie of corners, e.g. an edge parallel
+    to the ground, the objective has a kink and the core differentiates one of the corners)."""
+    v = obj.value(x, q_lin, target, current, pairs)
+    up = np.array([(obj.value(x + h * e, q_lin, target, current, pairs) - v) / h for e in np.eye(len(x))])
+    down = np.array([(v - obj.value(x - h * e, q_lin, target, current, pairs)) / h for e in np.eye(len(x))])
+    return np.minimum(up, down), np.maximum(up, down)
+
+
+def distance_accuracy(obj, pair) -> float:
+    """m: how close the core's signed distance of a pair is to the exact one (tests/test_shape_set.py's bounds: ~1e-6
+    on polytopes and spheres; libccd's GJK and EPA on a cylinder stop up to 5e-6 and 3e-5 short)."""
+    return 3e-5 if "cylinder" in (obj.shapes[pair[0]].kind, obj.shapes[pair[1]].kind) else 1e-6
+
+
+#: The core's gradient of the points, ground and continuity rows (exact derivatives) against the reference's
+#: one-sided differences (h = 1e-7 rad, their truncation ~1e-7 x the objective's curvature), relative to the largest
+#: entry when above 1: measured at most 2.1e-8 (gradients below 1), 2.4e-6 on gradients of ~20 (sea).
+GRADIENT_TOLERANCE = 1e-6
+
+
 @pytest.mark.parametrize("styled", [pytest.param(s, marks=[pytest.mark.slow] if s in ("sea", "mesh") else [])
                                     for s in STYLES], indirect=True)
-def test_interpolation_is_the_numpy_one(styled):
-    """The same q (Q_TOLERANCE), points and deviations as the numpy code on plan-like moves and short moves near self
-    contact, where the numpy code is well-conditioned: moving the base by 1e-13 m moves its q by less than 1e-9 rad.
-    On the others the fit is chaotic (measured: the numpy code then ends up to radians from itself under that
-    perturbation, and the core about as far from it) and they are skipped. The moves compared have ground rows and,
-    on the default and head6 robots, self rows (on the others every move with self rows found was chaotic)."""
+def test_interpolation_meets_its_definition(styled):
+    """Every move, none skipped, against the fit's definition stated independently (tests/fit_reference.py): the
+    ends are the given configurations; the joints before the lift interpolate linearly; the lifted ones stay within
+    their limits; the points are Eq. 41's between the ends' frame origins (pinocchio's FK), and ``actual`` and
+    ``deviation`` are where pinocchio puts the fitted joints. At every interior sample the system the core iterates
+    is the reference objective: its sum of squares equal (within what the core's distances are known to be off), its
+    self rows the reference's active pairs, the gradient of its other rows (exact derivatives) the reference's.
+    Where the fit has converged (its step below 1e-6 rad, no joint on a limit) it is a local minimum: scipy's
+    least_squares started there finds nothing lower. (Not every sample converges, and the fit is not always as good
+    as scipy's: test_each_sample_is_as_good_as_scipy_from_the_same_start.) The self rows' Jacobian, forward
+    differences of the core's own distances, is compared with the numpy code's only (test_one_step_is_the_numpy_step):
+    on cylinders libccd's distances are too rough for a difference of 1e-4 rad to match a reference's derivative."""
     style, robot = styled
-    base, nudged = snakehead.BasePlacement(), snakehead.BasePlacement(1e-13, 0.0, 0.0)
-    compared, ground, selfc = 0, 0, 0
-    for qa, qb in planner_like_pairs(robot, 8, seed=7) + short_moves_near_contact(robot, seed=2):
-        ref = tracking_interpolation_numpy(robot, qa, qb, 12, base)
-        if np.abs(tracking_interpolation_numpy(robot, qa, qb, 12, nudged).q - ref.q).max() > 1e-9:
-            continue
-        new = cartesian.tracking_interpolation(robot, qa, qb, 12, base)
-        assert isinstance(new, cartesian.TrackingInterpolation)
-        np.testing.assert_allclose(new.q, ref.q, rtol=0, atol=Q_TOLERANCE)
-        np.testing.assert_array_equal(new.s, ref.s)
-        np.testing.assert_allclose(new.points, ref.points, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(new.deviation, ref.deviation, rtol=0, atol=1e-5)
-        assert np.array_equal(new.q[0], qa) and np.array_equal(new.q[-1], qb)
-        g, c = contact_rows(robot, ref)
-        compared, ground, selfc = compared + 1, ground + g, selfc + c
-    assert compared >= 3 and ground > 0
+    base = snakehead.BasePlacement()
+    obj = fit_objective(robot, base)
+    fit = cartesian.tracking_fit(robot, base, obj.lift, obj.points)
+    lift, m, w = obj.lift, len(obj.points), cartesian.TRACKING_GROUND_WEIGHT
+    other = np.setdiff1d(np.arange(robot.n_joints), lift)
+    none = np.zeros((0, 2), np.int64)
+    converged = samples = ground = selfc = 0
+    worst = {"value": 0.0, "value / bound": 0.0, "gradient": 0.0, "above scipy": 0.0}
+    for qa, qb in moves(robot):
+        res = cartesian.tracking_interpolation(robot, qa, qb, 12, base)
+        assert np.array_equal(res.q[0], qa) and np.array_equal(res.q[-1], qb)
+        lin = (1 - res.s)[:, None] * qa + res.s[:, None] * qb
+        np.testing.assert_allclose(res.q[:, other], lin[:, other], rtol=0, atol=1e-15)
+        assert (res.q[:, lift] >= obj.lower).all() and (res.q[:, lift] <= obj.upper).all()
+        ends = np.array([obj.tracked(qa), obj.tracked(qb)])
+        np.testing.assert_allclose(res.points, (1 - res.s)[:, None, None] * ends[0] + res.s[:, None, None] * ends[1],
+                                   rtol=0, atol=1e-12)
+        actual = np.array([obj.tracked(q) for q in res.q])
+        np.testing.assert_allclose(res.actual, actual, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(res.deviation, np.linalg.norm(actual - res.points, axis=2).max(axis=1), rtol=0,
+                                   atol=1e-12)
+        g, c = contact_rows(robot, res)
+        ground, selfc = ground + g, selfc + c
+        for j in range(1, len(res.q) - 1):
+            q_lin, current, pairs = sample_problem(obj, res, qa, qb, j)
+            x, target = res.q[j, lift], res.points[j]
+            r, J, step = fit.step(res.q[j], current, target)
+            ref = obj.residual(x, q_lin, target, current, pairs)
+            value = float(ref @ ref)
+            assert obj.value(x, q_lin, target, current) == pytest.approx(value, rel=1e-14)  # the far pairs add 0
+            # the sum of squares, within what the core's distances may be off by (delta per pair): each active self
+            # row w (d - c) moves by w delta, its square by w^2 (2 |d - c| delta + delta^2)
+            gaps = ref[3 * m + len(obj.ground):len(ref) - len(lift)] / w
+            delta = np.array([distance_accuracy(obj, p) for p in pairs])
+            near = gaps < delta  # active in the reference, or within delta of it
+            bound = 1e-12 + (w ** 2 * (2 * np.abs(gaps[near]) * delta[near] + delta[near] ** 2)).sum()
+            worst["value"] = max(worst["value"], abs(r @ r - value))
+            worst["value / bound"] = max(worst["value / bound"], abs(r @ r - value) / bound)
+            assert abs(r @ r - value) <= bound, (j, r @ r, value, bound)
+            # the rows: points, ground (the reference's active links), self (its active pairs), continuity
+            nb = int((ref[3 * m:3 * m + len(obj.ground)] < 0.0).sum())
+            core_self = r[3 * m + nb:len(r) - len(lift)] / w
+            assert len(core_self) >= (gaps < -delta).sum() and len(core_self) <= near.sum()
+            np.testing.assert_allclose(np.sort(core_self), np.sort(gaps[gaps < 0])[:len(core_self)], rtol=0,
+                                       atol=delta.max(initial=0.0))
+            exact = np.r_[0:3 * m + nb, len(r) - len(lift):len(r)]
+            low, high = one_sided_gradients(obj, x, q_lin, target, current, none)
+            core_gradient = 2 * J[exact].T @ r[exact]
+            excess = np.maximum(low - core_gradient, core_gradient - high).max()
+            worst["gradient"] = max(worst["gradient"], excess)
+            assert excess <= GRADIENT_TOLERANCE * max(1.0, np.abs(core_gradient).max()), (j, core_gradient, low, high)
+            samples += 1
+            if np.abs(step).max() < 1e-6 and ((x > obj.lower) & (x < obj.upper)).all():
+                converged += 1
+                polished = least_squares(lambda y: obj.residual(y, q_lin, target, current, pairs), x,
+                                         bounds=(obj.lower, obj.upper), xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                         max_nfev=200)
+                # a step below 1e-6 rad leaves ~|J dq|^2 ~ 1e-12 to gain; the core minimises with its own distances,
+                # whose objective is within `bound` of the reference's (measured: at most 5e-13 on boxes and spheres,
+                # 1.7e-10 with cylinders)
+                worst["above scipy"] = max(worst["above scipy"], value - 2 * polished.cost)
+                assert value <= 2 * polished.cost * (1 + 1e-9) + 2 * bound, (j, value, 2 * polished.cost)
+    print(f"{style}: {samples} samples, {converged} converged, {ground} ground rows, {selfc} self rows; largest "
+          f"differences: {worst}")
+    # the systems compared had ground rows and, on the default and head6 robots, self rows
+    assert converged > 0 and ground > 0
     assert selfc > 0 or style not in ("default", "head6")
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "open: the fit's Levenberg-Marquardt steps keep a fixed damping (0.01 m), take every step (no acceptance "
+    "test) and clip it at the joint limits, 12 steps at most: measured on the default robot's 11 moves, 87 of 110 "
+    "samples end above scipy's minimum from the same start (up to 27.3 against 0.31, move 4), 34 of them above "
+    "their own start, and samples with a joint on a limit stall where the projected gradient is not zero. "
+    "cartesian.tracking_interpolation's 'the fit is the closest in the least-squares sense' holds only where the "
+    "fit converged (test_interpolation_meets_its_definition); the fit is in C++, not changed here."))
+def test_each_sample_is_as_good_as_scipy_from_the_same_start():
+    """At every interior sample of every move (default robot), the fit's objective is no higher than what scipy's
+    least_squares (trust-region reflective, within the limits) reaches on the same objective (tests/fit_reference.py)
+    from the same start: the previous sample's fitted lifted joints."""
+    robot = snakehead.SnakeRobot.default()
+    base = snakehead.BasePlacement()
+    obj = fit_objective(robot, base)
+    worse = []
+    for m, (qa, qb) in enumerate(moves(robot)):
+        res = cartesian.tracking_interpolation(robot, qa, qb, 12, base)
+        for j in range(1, len(res.q) - 1):
+            q_lin, current, pairs = sample_problem(obj, res, qa, qb, j)
+            target = res.points[j]
+            best = least_squares(lambda y: obj.residual(y, q_lin, target, current, pairs), current,
+                                 bounds=(obj.lower, obj.upper), xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=200)
+            value = obj.value(res.q[j, obj.lift], q_lin, target, current, pairs)
+            if value > 2 * best.cost * (1 + 1e-6) + 1e-12:
+                rose = value > obj.value(current, q_lin, target, current, pairs)
+                worse.append((m, j, round(value, 6), round(2 * best.cost, 6), "above its start" if rose else ""))
+    assert not worse, f"{len(worse)} samples above scipy's minimum (move, sample, fit, scipy): {worse}"
 
 
 def test_one_fit_serves_many_threads():
