@@ -23,7 +23,6 @@ from snakehead.model.robot_file import write_robot_file
 
 from conftest import generated_specs
 
-pytest.importorskip("mujoco")
 
 ROBOTS = generated_specs()
 
@@ -77,7 +76,7 @@ def test_map_and_dexterous_band(setup):
     assert np.linalg.norm(G0) < robot.head_chain.reach
 
 
-def test_plan_and_simulate(setup):
+def test_plan_and_simulate(mujoco, setup):
     name, robot, _, _, controller, _ = setup
     position, direction = reachable_target(robot, controller, seed={"long20": 3, "pitchy": 0}[name])
     plan = snakehead.plan([(position, direction)], controller=controller)

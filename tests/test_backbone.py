@@ -15,6 +15,7 @@ from scipy.spatial import ConvexHull
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability
 from snakehead import backbone as bb
+from snakehead._errors import InputError
 
 L_BASE = 0.646  # tail end to P0 on the default robot (m)
 
@@ -364,11 +365,13 @@ def test_bad_central_angle(robot, theta):
         bb.arc_segment_area(L_BASE, theta if theta is not None else float("nan"))
 
 
-@pytest.mark.parametrize("kwargs", [dict(radius=0.0, central_angle=1.0), dict(radius=0.2, central_angle=7.0),
-                                    dict(radius=0.2, central_angle=1.0, turn=2),
-                                    dict(radius=0.2, central_angle=1.0, start=[0.0, float("nan")])])
-def test_bad_plane_arc(kwargs):
-    with pytest.raises(ValueError):
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(radius=0.0, central_angle=1.0), "radius must be a positive finite number"),
+    (dict(radius=0.2, central_angle=7.0), r"central_angle must be in \(0, 2\*pi\]"),
+    (dict(radius=0.2, central_angle=1.0, turn=2), r"turn must be \+1"),
+    (dict(radius=0.2, central_angle=1.0, start=[0.0, float("nan")]), "start contains NaN or inf")])
+def test_bad_plane_arc(kwargs, match):
+    with pytest.raises(InputError, match=match):
         bb.PlaneArc(**kwargs)
 
 

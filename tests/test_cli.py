@@ -125,10 +125,8 @@ def test_report_targets_are_the_papers(demo):
     assert rep["run_time_s"] > 0 and rep["stages"]
 
 
-def test_hole_simulated_with_the_wall(demo):
+def test_hole_simulated_with_the_wall(mujoco, demo):
     _, _, rep = demo
-    if not HAVE_MUJOCO:
-        pytest.skip("MuJoCo not installed")
     assert any("MuJoCo" in s["stage"] and "(1 obstacle)" in s["stage"] and s["stage"].startswith("hole")
                for s in rep["stages"])
 
@@ -194,8 +192,7 @@ def test_plan_writes_the_same_kinds_of_files(plan):
     assert data.shape == (sc["samples"], 17)
 
 
-@pytest.mark.skipif(not HAVE_MUJOCO, reason="--start runs the closed loop in MuJoCo")
-def test_plan_from_lying_straight_end_to_end(tmp_path):
+def test_plan_from_lying_straight_end_to_end(mujoco, tmp_path):  # --start runs the closed loop in MuJoCo
     """``snakehead plan --start X Y YAW`` from the shell: the closed loop in MuJoCo (gaits, the curl, the head
     phases) from the body lying straight 0.3 m behind the default placement, its files, its phases in order, and
     the simulated head at the target within 2 mm and 1 deg with the ZMP inside (about a minute of simulated

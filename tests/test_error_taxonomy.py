@@ -39,14 +39,14 @@ def test_the_types_say_whose_fault_it_is():
 def test_the_core_raises_input_error_for_bad_input():
     with pytest.raises(InputError, match="malformed URDF"):
         _core.urdf_root_link("<robot")
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="unknown tip link 'nope' in URDF robot 'r'"):
         snakehead.Chain.from_urdf("<robot name='r'><link name='a'/></robot>", "a", "nope")
 
 
 def test_validators_raise_input_errors():
     from snakehead import _validate
 
-    with pytest.raises(InputTypeError):
+    with pytest.raises(InputTypeError, match="x must be numbers, got str '1'"):
         _validate.finite_array("1", "x")
     with pytest.raises(InputError, match="NaN"):
         _validate.vector3([np.nan, 0, 0], "x")

@@ -18,7 +18,6 @@ from snakehead.kinematics import workspace as ws
 from snakehead.model import published
 from snakehead.motion import cartesian, start_state, waypoints
 
-mujoco = pytest.importorskip("mujoco")
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +74,7 @@ def test_detour_moves_only_the_lifting_joints(fat_rsnake):
     assert np.abs(path[:, :robot.lift_joints.start] - qa[:robot.lift_joints.start]).max() < 1e-12
 
 
-def test_fat_plan_tracks_in_mujoco(fat_rsnake):
+def test_fat_plan_tracks_in_mujoco(mujoco, fat_rsnake):
     _, _, plan = fat_rsnake
     sim = snakehead.simulate(plan)
     m = sim.metrics

@@ -187,7 +187,6 @@ def test_bad_estimator_input(robot):
 # ------------------------------------------------------------------------------------------------
 # in MuJoCo
 # ------------------------------------------------------------------------------------------------
-mujoco = pytest.importorskip("mujoco")
 
 #: Short runs for the suite: one cycle at 1 Hz with half-second ramps (bench/gaits.py runs longer ones).
 QUICK = dict(frequency=1.0, ramp_s=0.5)
@@ -195,7 +194,7 @@ START = BasePlacement(0.3, -0.2, 0.7)
 
 
 @pytest.fixture(scope="module")
-def simulators(robot):
+def simulators(mujoco, robot):
     from snakehead.sim import GaitSimulator
 
     return {"default": GaitSimulator(robot), "pitch_first": GaitSimulator(pitch_first())}
@@ -265,7 +264,7 @@ def test_runs_chain_from_state_to_state(simulators):
     assert isinstance(base, BasePlacement) and np.isfinite([base.x, base.y, base.yaw]).all()
 
 
-def test_imu_heading_drift_shows_in_the_estimate(robot):
+def test_imu_heading_drift_shows_in_the_estimate(mujoco, robot):
     from snakehead.sim import GaitSimulator
 
     sim = GaitSimulator(robot, imu_yaw_drift_deg_per_s=2.0)

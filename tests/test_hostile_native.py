@@ -270,7 +270,7 @@ def test_no_runtime_error_from_the_core(head):
 
     with pytest.raises(KeyError, match="from the callback"):
         _core.compute_reachability(head.model, options, raises)
-    with pytest.raises(_core.Cancelled):
+    with pytest.raises(_core.Cancelled, match="workspace sweep cancelled"):
         _core.compute_reachability(head.model, options, returns(False))
     assert not issubclass(_core.Cancelled, RuntimeError)
 

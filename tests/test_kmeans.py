@@ -70,7 +70,7 @@ def test_grid_points_with_ties_agree_with_scikit_learn() -> None:
 
 
 def test_bad_input() -> None:
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=r"points must be \(n, d\) with n >= k = 3, got shape \(2, 3\)"):
         kmeans(np.zeros((2, 3)), 3)
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=r"points must be \(n, d\) with n >= k = 1, got shape \(5,\)"):
         kmeans(np.zeros(5), 1)

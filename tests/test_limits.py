@@ -166,7 +166,7 @@ def test_the_cli_defaults_and_help_come_from_the_shared_definitions(monkeypatch)
         assert option(sub, flag).default == value, flag
         assert said in sub.format_help().replace("\n", " ").replace("  ", " "), flag
     assert reach.parse_args(["--workers", "17"]).workers == 17
-    with pytest.raises(SystemExit):
+    with pytest.raises(SystemExit, match="^2$"):  # argparse's usage error
         reach.parse_args(["--workers", "18"])
 
 

@@ -222,11 +222,10 @@ def test_bad_locomotion_input(call, error, match):
 # ------------------------------------------------------------------------------------------------
 # in MuJoCo
 # ------------------------------------------------------------------------------------------------
-mujoco = pytest.importorskip("mujoco")
 
 
 @pytest.mark.parametrize("which", ["default", "pitch_first"])
-def test_curl_prediction_against_mujoco(which):
+def test_curl_prediction_against_mujoco(mujoco, which):
     """The friction model predicts where a curl on the ground leaves the body, on two robots: within 5 cm and 5 deg
     of MuJoCo (measured 2026-12-01: default robot 3.4 cm and 3.4 deg of an 82 deg turn, pitch-first 2.6 cm and
     2.9 deg of 57 deg; not rate-dependent: the same in 6 s as in 2 s). The estimate follows the curl too."""
@@ -249,7 +248,7 @@ def test_curl_prediction_against_mujoco(which):
     np.testing.assert_allclose(run.q[-1], q, atol=math.radians(2.0))
 
 
-def test_gaits_bring_the_body_to_a_goal(robot):
+def test_gaits_bring_the_body_to_a_goal(mujoco, robot):
     """next_step and the pose estimate, run after run: the body reaches a goal 0.5 m away and turned by 60 deg within
     the tolerance by its estimate, and within 10 cm and 6 deg in truth (the estimate drifts)."""
     from snakehead.sim import GaitSimulator
@@ -272,7 +271,7 @@ def test_gaits_bring_the_body_to_a_goal(robot):
     assert math.hypot(truth.x, truth.y) < 0.10 and abs(math.degrees(truth.yaw)) < 6.0
 
 
-def test_simulate_trajectory_continues_from_a_state(robot):
+def test_simulate_trajectory_continues_from_a_state(mujoco, robot):
     """A trajectory run from a SimState starts where the state is (not where ``base`` says) and goes on from its
     time; run in two halves chained by end_state, it ends where the whole run ends."""
     from snakehead.sim import GaitSimulator, simulate_trajectory
@@ -320,7 +319,7 @@ def _straight_distance(robot, obstacles, base):
     return coll.collision_check(robot, np.zeros((1, robot.n_joints)), obstacles, base, exact_within=10.0).distance[0]
 
 
-def test_locomotion_leaves_two_boxes_and_goes_round_them(robot):
+def test_locomotion_leaves_two_boxes_and_goes_round_them(mujoco, robot):
     """The loop's locomotion (routes planned again from the estimate, escape, sweep checks) on bench/loop.py's
     pose 11 (the body's head between two boxes), its gait runs going exactly where predicted: it reaches the
     straight goal, its first runs creep back along the body's axis, and the straight body, at every run's ends
@@ -363,7 +362,7 @@ def test_locomotion_leaves_two_boxes_and_goes_round_them(robot):
             assert _straight_distance(robot, boxes, lc.compose(m, lc.inverse(offset))) > 0.0, (name, s)
 
 
-def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(robot):
+def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(mujoco, robot):
     """The goal check puts the body at every CURL_CHECKS-th step of its predicted curl against the obstacles: a
     wall that the straight body before the curl clears by 0.2 m but the curling body (at the sliding model's
     placements, every step, exact geometry) comes within GOAL_CLEARANCE_M of is refused, naming the curl; the same
@@ -414,7 +413,7 @@ def controller(robot):
 
 
 @pytest.fixture(scope="module")
-def disturbed(controller):
+def disturbed(mujoco, controller):
     """The paper's sphere 1 from the straight pose whose curl alone reaches it, disturbed by 10 cm and 20 deg
     without the loop knowing: it believes it lies at the undisturbed pose."""
     from snakehead.scenes import Scene
@@ -683,5 +682,5 @@ def test_sensing_option_of_the_command_line():
         args = parser.parse_args([command, *extra, "--sensing", "outside-fix"])
         assert _settings(args).sensing == "outside fix" and _settings(args).as_dict()["sensing"] == "outside fix"
         assert _settings(parser.parse_args([command, *extra])).sensing == "onboard"
-        with pytest.raises(SystemExit):
+        with pytest.raises(SystemExit, match="^2$"):  # argparse's usage error
             parser.parse_args([command, *extra, "--sensing", "gps"])

@@ -242,7 +242,7 @@ def test_workspace_numbers_beyond_their_limits_are_refused_before_any_work(optio
 
 
 def test_workspace_help_documents_the_limits(capsys):
-    with pytest.raises(SystemExit):
+    with pytest.raises(SystemExit, match="^0$"):  # --help exits 0
         cli.main(["workspace", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     for limit in ("1 to 4096", "1 to 360", "1 to 256", "0 <= i < N <= 4096", "at most 86400", "0 to 2^64 - 1",

@@ -15,6 +15,7 @@ from snakehead.geometry import collision as coll
 from snakehead.geometry.obstacles import BoxObstacle, MeshObstacle
 from snakehead.model import published
 from snakehead.scenes import load_scene
+from snakehead._errors import InputError
 
 
 def scene_with_a_mesh(folder: Path, mesh: str, position: str) -> Path:
@@ -93,7 +94,7 @@ def test_shapes_and_mesh_obstacles_reject_bad_input(tmp_path: Path) -> None:
         Shape("cone", 0, np.eye(4), np.ones(3))
     with pytest.raises(ValueError, match="frame"):
         ShapeSet((Shape("box", 3, np.eye(4), np.ones(3)),), 2)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"shape 0: size \(box extents.*must be > 0"):
         ShapeSet((Shape("box", 0, np.eye(4), -np.ones(3)),), 1)  # the core checks sizes
     trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(tmp_path / "rock.stl")
     with pytest.raises(ValueError, match="scale"):

@@ -62,9 +62,9 @@ def test_bad_arguments_before_any_work(robot: sh.SnakeRobot) -> None:
         plan_many(SETS, speed=2)
     with pytest.raises(sh.InputError, match="method"):
         plan_many(SETS, method="fast")
-    with pytest.raises(sh.InputTypeError):
+    with pytest.raises(sh.InputTypeError, match="executor must be a concurrent.futures.Executor .*got object"):
         plan_many(SETS, executor=object())
-    with pytest.raises(sh.InputTypeError):
+    with pytest.raises(sh.InputTypeError, match="target_sets must be a sequence .*got str"):
         plan_many("scene.toml")
     with ThreadPoolExecutor(1) as pool, pytest.raises(sh.InputError, match="controller"):
         plan_many(SETS, executor=pool, controller=sh.HeadController(robot))

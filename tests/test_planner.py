@@ -13,6 +13,7 @@ from snakehead.geometry import collision as coll
 from snakehead.margins import DETOUR_MARGIN
 from snakehead.motion import start_state
 from snakehead.scenes import paper_scene
+from snakehead._errors import InputError
 
 HOLE = paper_scene("hole")
 WALL = HOLE.obstacles[0]
@@ -144,9 +145,11 @@ def test_self_clearance_detects_overlap(controller):
     assert coll.self_clearance(robot, q)[0] < 0
 
 
-@pytest.mark.parametrize("qs", [np.zeros(15), np.zeros((3, 4)), np.full(16, np.nan)])
-def test_self_clearance_bad_input(controller, qs):
-    with pytest.raises(ValueError):
+@pytest.mark.parametrize("qs, match", [(np.zeros(15), r"qs has shape \(15,\); expected \(T, 16\)"),
+                                       (np.zeros((3, 4)), r"qs has shape \(3, 4\); expected \(T, 16\)"),
+                                       (np.full(16, np.nan), "qs contains NaN or inf")])
+def test_self_clearance_bad_input(controller, qs, match):
+    with pytest.raises(InputError, match=match):
         coll.self_clearance(controller.robot, qs)
 
 

@@ -19,7 +19,6 @@ from snakehead.model import published
 
 from snakehead.motion.targets import reachable_targets
 
-pytest.importorskip("mujoco")
 
 CLI = [sys.executable, "-m", "snakehead"]
 

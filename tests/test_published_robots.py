@@ -11,6 +11,7 @@ import pytest
 from snakehead import _core
 from snakehead.model.chain import Chain
 from snakehead.model.published import STYLES, StyleSpec, style_spec, write_robot
+from snakehead._errors import InputError, InputTypeError
 
 #: (base, neck, head) joints of each style, written out here rather than read from the module under test.
 PARTS = {"sea": (7, 2, 7), "reu": (7, 2, 7), "rsnake": (6, 2, 6), "mesh": (6, 2, 7), "xacro": (5, 2, 7),
@@ -242,13 +243,16 @@ def test_overrides_change_the_numbers(tmp_path):
     assert np.linalg.norm(frames[-1][:3, 3]) == pytest.approx(0.07 / 2 + 14 * 0.07)
 
 
-@pytest.mark.parametrize("style, overrides, error", [
-    ("snake16", {}, ValueError), ("sea", {"joints": 3}, TypeError), ("sea", {"n_joints": 9}, ValueError),
-    ("reu", {"module_length": float("nan")}, ValueError), ("mesh", {"n_joints": True}, ValueError),
-    ("rsnake", {"joint_limit_deg": 270}, ValueError), ("head6", {"effort": -1.0}, ValueError),
+@pytest.mark.parametrize("style, overrides, error, match", [
+    ("snake16", {}, InputError, "unknown style 'snake16'"), ("sea", {"joints": 3}, InputTypeError, "unknown override 'joints'"),
+    ("sea", {"n_joints": 9}, InputError, r"n_joints \(9\) must exceed neck_joints \+ head_joints"),
+    ("reu", {"module_length": float("nan")}, InputError, "module_length must be finite, got nan"),
+    ("mesh", {"n_joints": True}, InputError, "n_joints must be a positive integer, got True"),
+    ("rsnake", {"joint_limit_deg": 270}, InputError, "joint_limit_deg must be at most 180, got 270"),
+    ("head6", {"effort": -1.0}, InputError, "effort must be positive, got -1.0"),
 ])
-def test_bad_styles_and_overrides_are_refused(tmp_path, style, overrides, error):
-    with pytest.raises(error):
+def test_bad_styles_and_overrides_are_refused(tmp_path, style, overrides, error, match):
+    with pytest.raises(error, match=match):
         write_robot(style, tmp_path, **overrides)
     assert not any(tmp_path.iterdir())
 

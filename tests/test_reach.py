@@ -81,24 +81,27 @@ def test_head_and_body_maps_refuse_each_other(robot: sh.SnakeRobot, body_map: ws
         ws.require_map(body_map, robot, what="workspace_map")
     with pytest.raises(sh.InputError, match="head map"):
         ws.require_map(head_map, robot, kind=ws.KIND_WHOLE_BODY)
-    with pytest.raises(sh.InputError):
+    with pytest.raises(sh.InputError, match="workspace_map .* is a whole-body stable reachability map"):
         sh.HeadController(robot, workspace_map=body_map)
-    with pytest.raises(sh.InputError):
+    with pytest.raises(sh.InputError, match="the reach map .* is a head map"):
         reach.check_reach(head_map, robot, 2)
     assert ws.require_map(body_map, robot, kind=ws.KIND_WHOLE_BODY) is body_map
 
 
 def test_options_checked_before_work(robot: sh.SnakeRobot) -> None:
-    for voxel, directions in ((0.001, 12), (5.0, 12), (float("nan"), 12), (0.1, 0), (0.1, 1000)):
-        with pytest.raises(sh.InputError):
+    for voxel, directions, match in ((0.001, 12, "voxel must be within"), (5.0, 12, "voxel must be within"),
+                                     (float("nan"), 12, "voxel must be within"),
+                                     (0.1, 0, "directions must be between 1 and 64, got 0"),
+                                     (0.1, 1000, "directions must be between 1 and 64, got 1000")):
+        with pytest.raises(sh.InputError, match=match):
             reach.check_options(robot, voxel, directions)
-    with pytest.raises(sh.InputTypeError):
+    with pytest.raises(sh.InputTypeError, match="directions must be an integer, got float 2.5"):
         reach.check_options(robot, 0.1, 2.5)
 
 
 def test_cli_exit_codes(tmp_path: object, monkeypatch: pytest.MonkeyPatch, body_map: ws.ReachabilityMap) -> None:
     assert cli.main(["reach", "--voxel", "0.001", "--out", str(tmp_path)]) == 2
-    with pytest.raises(SystemExit) as exc:  # argparse's usage error
+    with pytest.raises(SystemExit, match="^2$") as exc:  # argparse's usage error
         cli.main(["reach", "--workers", "2", "--scheduler", "tcp://x:1", "--out", str(tmp_path)])
     assert exc.value.code == 2
 

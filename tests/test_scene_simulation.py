@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("mujoco")
 
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
@@ -87,7 +86,7 @@ def test_sample_count_covering(span, period, count):
 
 @pytest.mark.parametrize("end, hold", [(0.1003, 0.0), (0.1003, 1e-9), (0.1, 0.0), (0.1, 1e-9), (0.1001, 0.0011),
                                        (0.0999999999, 0.0)])
-def test_simulated_span_covers_the_motion_and_hold(robot, end, hold):
+def test_simulated_span_covers_the_motion_and_hold(mujoco, robot, end, hold):
     """The recorded ticks, control_dt apart from t[0], run through the first one at or after t[-1] + hold; a target
     at the motion's end (as a plan's last target with hold_s = 0 is) is compared."""
     t = np.array([0.0, end])
@@ -102,7 +101,7 @@ def test_simulated_span_covers_the_motion_and_hold(robot, end, hold):
     assert max(metrics["position_errors_m"]) < 1e-3
 
 
-def test_compare_rejects_a_target_time_outside_the_simulation_as_input(robot):
+def test_compare_rejects_a_target_time_outside_the_simulation_as_input(mujoco, robot):
     t = np.array([0.0, 0.01])
     q = np.zeros((2, robot.n_joints))
     res = simulate_trajectory(robot, t, q, settle=0.0)
@@ -110,7 +109,7 @@ def test_compare_rejects_a_target_time_outside_the_simulation_as_input(robot):
         compare(robot, t, q, res, targets=[0.5])
 
 
-def test_a_plan_not_covered_by_its_simulation_is_an_internal_error(robot):
+def test_a_plan_not_covered_by_its_simulation_is_an_internal_error(mujoco, robot):
     t = np.array([0.0, 0.01])
     q = np.zeros((2, robot.n_joints))
     res = simulate_trajectory(robot, t, q, settle=0.0)
@@ -125,7 +124,7 @@ def test_a_plan_not_covered_by_its_simulation_is_an_internal_error(robot):
 # finding 1 end to end: a target with hold_s at its default (fast: one plan and one simulation each)
 # ------------------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("hold_s", [None, 1e-9])
-def test_a_target_held_zero_seconds_is_simulated(tmp_path, hold_s):
+def test_a_target_held_zero_seconds_is_simulated(mujoco, tmp_path, hold_s):
     path = write_scene(tmp_path, target_toml("a", *SPHERE_1, hold_s))
     plan = snakehead.plan(snakehead.load_scene(path))
     assert plan.success, plan.failure
@@ -136,7 +135,7 @@ def test_a_target_held_zero_seconds_is_simulated(tmp_path, hold_s):
     assert checked.position_error_m < 2e-3 and checked.direction_error_deg < 1.0
 
 
-def test_cli_plans_and_simulates_a_scene_with_default_hold(tmp_path):
+def test_cli_plans_and_simulates_a_scene_with_default_hold(mujoco, tmp_path):
     from snakehead.app.cli import main
 
     path = write_scene(tmp_path, target_toml("a", *SPHERE_1), stem="one")
@@ -246,7 +245,7 @@ def scene_files(draw) -> str:
 @settings(max_examples=4, derandomize=True, deadline=None, database=None, print_blob=False,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(text=scene_files())
-def test_valid_scene_files_plan_and_simulate(tmp_path, text):
+def test_valid_scene_files_plan_and_simulate(mujoco, tmp_path, text):
     """The property: a valid scene file loads, plans (the plan may fail, saying why) and simulates without raising."""
     path = write_scene(tmp_path, text)
     scene = snakehead.load_scene(path)

@@ -4,11 +4,11 @@ import sys
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
 
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
 from snakehead.sim import tracking  # noqa: E402
 from snakehead.dynamics import stability  # noqa: E402
+from snakehead._errors import InputTypeError
 
 #: A curled base (yaw joints 0.879 rad) with the neck turned inwards and the head part raised 0.42 m:
 #: statically stable with a ~3 cm margin (endpoints polygon) all along the joint-space path from flat.
@@ -38,7 +38,7 @@ def quintic(q0, q1, duration, dt=0.002):
 # ------------------------------------------------------------------------------------------------
 # the model against the robot
 # ------------------------------------------------------------------------------------------------
-def test_masses_and_inertias_match_the_robot(robot):
+def test_masses_and_inertias_match_the_robot(mujoco, robot):
     s = sim.build_model(robot)
     m = s.model
     assert m.body_mass.sum() == pytest.approx(robot.total_mass, abs=1e-9)
@@ -60,7 +60,7 @@ def test_masses_and_inertias_match_the_robot(robot):
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_kinematics_match_robot_frames(robot, seed):
+def test_kinematics_match_robot_frames(mujoco, robot, seed):
     rng = np.random.default_rng(seed)
     s = sim.build_model(robot)
     d = mujoco.MjData(s.model)
@@ -73,7 +73,7 @@ def test_kinematics_match_robot_frames(robot, seed):
     np.testing.assert_allclose(d.site_xmat[s.site_ids].reshape(-1, 3, 3), expected[:, :3, :3], atol=1e-9)
 
 
-def test_momenta_of_a_state_three_ways(robot):
+def test_momenta_of_a_state_three_ways(mujoco, robot):
     """Subtree momenta == per-body sum == the planner's Eqs. 25-31 (root held still), and P == M dc/dt."""
     rng = np.random.default_rng(3)
     s = sim.build_model(robot)
@@ -96,7 +96,7 @@ def test_momenta_of_a_state_three_ways(robot):
     np.testing.assert_allclose(P, robot.total_mass * (c[0] - c[1]) / (2 * h), atol=1e-7)
 
 
-def test_gravity_torques_of_any_weights_equal_the_cross_products(robot):
+def test_gravity_torques_of_any_weights_equal_the_cross_products(mujoco, robot):
     """tau_j = -a_j . sum_i W_ji (c_i - p_j) x (m_i g), term by term with np.cross, for random weights W."""
     rng = np.random.default_rng(14)
     s = sim.build_model(robot)
@@ -112,7 +112,7 @@ def test_gravity_torques_of_any_weights_equal_the_cross_products(robot):
     np.testing.assert_allclose(tracking.gravity_torques(s, d, W), expected, atol=1e-12)
 
 
-def test_ground_contacts_are_mujocos_contacts_on_the_robot(robot):
+def test_ground_contacts_are_mujocos_contacts_on_the_robot(mujoco, robot):
     """Contact by contact against mj_contactForce rotated by the contact frame; at rest on the floor the forces carry
     the robot's weight."""
     s = sim.build_model(robot)
@@ -139,7 +139,7 @@ def test_ground_contacts_are_mujocos_contacts_on_the_robot(robot):
     assert np.abs(forces[:, :2]).sum() > 0.1 * weight
 
 
-def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(robot):
+def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(mujoco, robot):
     rng = np.random.default_rng(4)
     s = sim.build_model(robot)
     d = mujoco.MjData(s.model)
@@ -163,7 +163,7 @@ def test_gravity_torques_equal_mujoco_bias_when_everything_is_carried(robot):
 # physics sanity
 # ------------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def held(robot):
+def held(mujoco, robot):
     """Hold the raised, statically stable configuration for 1 s."""
     t = np.array([0.0, 1.0])
     q = np.array([Q_LIFTED, Q_LIFTED])
@@ -190,7 +190,7 @@ def test_holding_a_stable_configuration_stays_put(robot, held):
 
 
 @pytest.fixture(scope="module")
-def lift(robot):
+def lift(mujoco, robot):
     """A slow 3 s lift of the head part from the flat curled pose, then 0.5 s of holding."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 3.0)
     res = sim.simulate_trajectory(robot, t, q, torque_limit=10.0, hold=0.5)
@@ -255,6 +255,8 @@ def test_tracking_a_slow_lift(robot, lift):
 def _tick_by_tick(robot, t, q, res, obstacles=()):
     """The tracking loop of ``res`` again in a fresh model, each tick measured as it runs with the per-tick
     functions (momenta_of_state, ground_contacts, center_of_pressure, gravity_torques): what the loop records."""
+    import mujoco  # its callers' fixtures (lift) need it: skipped without it
+
     s = sim.build_model(robot, obstacles=obstacles)
     m = s.model
     m.actuator_biasprm[:, 1] = -np.asarray(res.settings["kp"])
@@ -311,7 +313,7 @@ def test_the_loop_records_what_each_tick_measures(robot, lift):
     np.testing.assert_array_equal(np.concatenate(res.contact_forces), np.concatenate(ref["forces"]))
 
 
-def test_contacts_measured_tick_by_tick_when_not_decodable(robot, monkeypatch):
+def test_contacts_measured_tick_by_tick_when_not_decodable(mujoco, robot, monkeypatch):
     """A model whose contacts the log cannot decode after the loop (another friction cone or contact dimension) has
     them measured tick by tick with ground_contacts: the same result as the decoded ones here."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.1)
@@ -324,7 +326,7 @@ def test_contacts_measured_tick_by_tick_when_not_decodable(robot, monkeypatch):
     assert sum(len(f) for f in live.contact_forces) > 3 * len(live.t)
 
 
-def test_weak_servos_cannot_lift_the_head_part(robot):
+def test_weak_servos_cannot_lift_the_head_part(mujoco, robot):
     """3 N m servos cannot raise the 1.3 kg head part from flat (joint 10 needs ~3.9 N m): the simulation
     shows it. This is why snake16.urdf declares 10 N m (our choice; the paper gives no effort)."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 1.5)
@@ -341,7 +343,7 @@ def _inside_box(p, ob):
     return np.all(np.abs(local) <= ob.size / 2 + 1e-12)
 
 
-def test_wall_with_hole_as_boxes(robot):
+def test_wall_with_hole_as_boxes(mujoco, robot):
     from snakehead.geometry.obstacles import WallWithHole
 
     centre = np.array([0.2, 0.5, 0.4])
@@ -395,7 +397,7 @@ def test_bad_trajectories(robot, mutate, match):
     (dict(torque_limit=0.0), "torque"), (dict(gravity_compensation="lifted"), "gravity_compensation"),
     (dict(timestep=0.0), "timestep"), (dict(friction=-0.1), "friction"),
 ])
-def test_bad_parameters(robot, kwargs, match):
+def test_bad_parameters(mujoco, robot, kwargs, match):
     t = np.array([0.0, 0.1])
     q = np.zeros((2, robot.n_joints))
     with pytest.raises(ValueError, match=match):
@@ -410,7 +412,7 @@ def test_bad_compare_input(robot, held):
         sim.compare(robot, t, q, res, targets=[(1.0, np.zeros(3), np.zeros(3))])
     with pytest.raises(ValueError, match="targets"):
         sim.compare(robot, t, q, res, targets=[(1.0, np.zeros(3))])
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="result must be a SimResult, got str"):
         sim.compare(robot, t, q, "not a result")
 
 

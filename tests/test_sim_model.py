@@ -6,7 +6,6 @@ import math
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
 
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
 from snakehead.backbone import initial_configuration  # noqa: E402
@@ -40,7 +39,7 @@ def robot(request):
 # ------------------------------------------------------------------------------------------------
 # the model against the robot
 # ------------------------------------------------------------------------------------------------
-def test_model_matches_the_robot(robot):
+def test_model_matches_the_robot(mujoco, robot):
     s = sim.build_model(robot)
     m = s.model
     assert m.nbody == 1 + len(robot.link_names) and m.njnt == 1 + robot.n_joints and m.nu == robot.n_joints
@@ -63,7 +62,7 @@ def test_model_matches_the_robot(robot):
 HOSTILE = '"/><include file="/etc/passwd"/><body name="x&amp;<'
 
 
-def test_hostile_names_are_data():
+def test_hostile_names_are_data(mujoco):
     """Link, joint and frame names with XML metacharacters and an <include> build and simulate; the model holds
     exactly the robot's elements, under exactly those names."""
     spec = SnakeSpec(n_joints=8, link_prefix="l" + HOSTILE, joint_prefix="j" + HOSTILE + "&<",
@@ -87,7 +86,7 @@ def test_hostile_names_are_data():
     assert res.base_slide_m < 1e-4 and np.all(np.isfinite(res.q))
 
 
-def test_a_joint_named_like_the_free_joint_is_refused():
+def test_a_joint_named_like_the_free_joint_is_refused(mujoco):
     spec = SnakeSpec(n_joints=8, markers={"p0": 3, "b0": 4})
     urdf = snake_urdf(spec).replace('name="joint_2"', 'name="root"')
     robot = SnakeRobot.from_urdf(urdf, base_end="p0", neck_end="b0", head_tip="head_tip")
@@ -98,7 +97,7 @@ def test_a_joint_named_like_the_free_joint_is_refused():
 # ------------------------------------------------------------------------------------------------
 # loads and gains
 # ------------------------------------------------------------------------------------------------
-def test_gravity_torques_against_mujoco_and_a_closed_form(robot):
+def test_gravity_torques_against_mujoco_and_a_closed_form(mujoco, robot):
     """tau_j == MuJoCo's gravity torque on joint j with the tail clamped, the body straight and horizontal, the
     joint's axis horizontal (pitch joints as the body lies, yaw joints with the body rolled 90 deg); and for a
     body of uniform density (masses proportional to length, centres of mass mid-link) tau_j = w g l_j^2 / 2."""
@@ -140,7 +139,7 @@ def test_default_gains_follow_the_rule():
                             armature=0.0)
 
 
-def test_default_torque_limits():
+def test_default_torque_limits(mujoco):
     robot = SnakeRobot.default()
     np.testing.assert_allclose(gains.default_torque_limits(robot), robot.effort)  # the URDF's servos
     urdf = snake_urdf(SnakeSpec(n_joints=8, markers={"p0": 3, "b0": 4}, effort=1.0)).replace('effort="1"', 'effort="0"')
@@ -158,7 +157,7 @@ def raised(robot):
     return initial_configuration(robot)
 
 
-def test_a_raised_configuration_held_still_stays_put(robot):
+def test_a_raised_configuration_held_still_stays_put(mujoco, robot):
     q1 = raised(robot)
     res = sim.simulate_trajectory(robot, np.array([0.0, 0.6]), np.array([q1, q1]), settle=0.2)
     assert res.base_slide_m < 1e-3
@@ -167,7 +166,7 @@ def test_a_raised_configuration_held_still_stays_put(robot):
     assert np.linalg.norm(res.head_position[-1] - H[:3, 3]) < 1e-3
 
 
-def test_a_smooth_trajectory_is_tracked(robot):
+def test_a_smooth_trajectory_is_tracked(mujoco, robot):
     """The head sways about the raised configuration (sin^2, 2 s, +-0.12 rad on every head joint, statically
     stable all along), then holds 0.3 s. Measured on the three robots: joints within 0.09 deg, the head within
     1.03 mm / 0.19 deg while moving and 0.55 mm / 0.07 deg held, the base sliding 0.02 mm; bounds with margin."""

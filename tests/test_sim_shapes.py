@@ -8,8 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
-trimesh = pytest.importorskip("trimesh")
+import trimesh  # noqa: E402
 
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
 from snakehead.sim.estimate import BodyPoseEstimator  # noqa: E402
@@ -84,7 +83,7 @@ def test_the_robot_has_every_kind_of_shape(robot):
     assert robot.body_axis_height == pytest.approx(R, abs=1e-9)
 
 
-def test_the_geoms_are_the_shapes(robot):
+def test_the_geoms_are_the_shapes(mujoco, robot):
     """One geom per shape on its link's body: same type, MuJoCo's size (half length of a box or cylinder), same
     pose in the world; a mesh geom's vertices are the hull's."""
     s = sim.build_model(robot)
@@ -121,7 +120,7 @@ def test_the_geoms_are_the_shapes(robot):
             assert gaps.max() < 1e-6
 
 
-def test_floor_contacts_at_rest_are_the_lowest_points(robot):
+def test_floor_contacts_at_rest_are_the_lowest_points(mujoco, robot):
     """Lying straight on the ground at the body-axis height (0.1 mm into it, so that every touching shape makes
     contact), MuJoCo's floor contacts lie where robot.lowest_points says, within 1 mm, and every shape that touches
     the ground has one."""

@@ -9,6 +9,7 @@ import snakehead
 from shape_reference import box_corners, lowest_z_by_sampling
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability as st
+from snakehead._errors import InputError, InputTypeError
 
 #: The default robot's body axis lies half its 0.043 m section above the ground.
 AXIS_HEIGHT = 0.0215
@@ -224,11 +225,11 @@ def test_stability_bad_input(robot):
         st.static_margin(robot, np.full(16, np.nan))
     with pytest.raises(ValueError, match="contact"):
         st.support_polygon(robot, np.zeros(16), contact="feet")
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="base must be a BasePlacement or None, got tuple"):
         st.center_of_mass(robot, np.zeros(16), base=(0, 0, 0))
     q = np.zeros(16)
     q[0] = np.nan
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="q contains NaN or inf"):
         st.support_polygon(robot, q)
 
 

@@ -348,16 +348,20 @@ def _straight(N: int = 30) -> tuple:
 
 def test_bad_input_is_input_error() -> None:
     grid, A, B, C, ub, xb = _straight()
-    bad = [(grid[::-1], A, B, C, ub, xb), (grid, A[:-1], B, C, ub, xb), (grid, A, B, C, ub, xb[:-1]),
-           (grid, A, B, C, ub[:, :1], xb), (grid[:, None], A, B, C, ub, xb),
-           (grid, np.where(A > 0, np.nan, A), B, C, ub, xb), (grid, A, B, C, ub, np.full_like(xb, np.nan)),
-           (grid[:1], A[:0], B[:0], C[:0], ub[:0], xb[:1])]
-    for args in bad:
-        with pytest.raises(InputError):
+    bad = [((grid[::-1], A, B, C, ub, xb), "grid must be strictly increasing"),
+           ((grid, A[:-1], B, C, ub, xb), r"A must have shape \(N, m\) = \(30, 2\)"),
+           ((grid, A, B, C, ub, xb[:-1]), r"x_bounds must have shape \(N \+ 1, 2\)"),
+           ((grid, A, B, C, ub[:, :1], xb), "u_bounds .* has the wrong shape"),
+           ((grid[:, None], A, B, C, ub, xb), "grid must be one-dimensional"),
+           ((grid, np.where(A > 0, np.nan, A), B, C, ub, xb), "A must be finite"),
+           ((grid, A, B, C, ub, np.full_like(xb, np.nan)), "x_bounds must not be NaN"),
+           ((grid[:1], A[:0], B[:0], C[:0], ub[:0], xb[:1]), "grid needs at least two gridpoints, got 1")]
+    for args, match in bad:
+        with pytest.raises(InputError, match=match):
             _core.topp_ra(*args)
     with pytest.raises(InputError, match="x_start"):
         _core.topp_ra(grid, A, B, C, ub, xb, -1.0, 0.0)
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="rows .* has the wrong shape"):
         _core.solve_lp2d(1.0, 1.0, np.zeros((3, 2)), np.zeros(2), np.ones(2))
 
 

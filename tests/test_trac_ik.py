@@ -11,6 +11,7 @@ import pytest
 import snakehead
 from snakehead import TracIK
 from snakehead.kinematics.ik import FREE_ROLL, pose_error
+from snakehead._errors import InputTypeError
 from conftest import head6_robot
 
 EPS = 1e-5
@@ -400,7 +401,7 @@ def test_bad_algorithm_and_fk(solver7, head7):
         solver7.ik_ex(good_pose(head7), algorithm="CCD")
     with pytest.raises(ValueError, match="shape"):
         solver7.fk(np.zeros(3))
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="chain must be a snakehead.Chain, got str"):
         TracIK.from_chain("not a chain")
 
 

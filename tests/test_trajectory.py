@@ -13,6 +13,7 @@ from snakehead.geometry import obstacles as obs
 from snakehead.geometry.shapes import Shape, ShapeSet, pair_distances
 from snakehead.motion import cartesian as cart
 from snakehead.motion import interpolation as interp
+from snakehead._errors import InputTypeError
 
 
 @pytest.fixture(scope="module")
@@ -312,7 +313,7 @@ def test_ground_clearance_bad_input(robot):
         coll.ground_clearance(robot, np.zeros((3, 15)))
     with pytest.raises(ValueError, match="NaN"):
         coll.ground_clearance(robot, np.full((3, 16), np.nan))
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="base must be a BasePlacement or None, got str"):
         coll.ground_clearance(robot, np.zeros(16), base="origin")
 
 
@@ -484,7 +485,7 @@ def test_obstacle_bad_input(robot):
         obs.WallWithHole([0, 0, 0], [1, 0, 0], (1, 1, 0.01), -0.1)
     with pytest.raises(ValueError, match="no obstacles"):
         coll.collision_check(robot, np.zeros((2, 16)), [])
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="obstacles must be BoxObstacle, WallWithHole, MeshObstacle, got str"):
         coll.collision_check(robot, np.zeros((2, 16)), ["a wall"])
     with pytest.raises(ValueError, match="shape"):
         coll.collision_check(robot, np.zeros((2, 17)), obs.BoxObstacle([0, 0, 1], [1, 1, 1]))

@@ -12,6 +12,7 @@ from snakehead.dynamics import stability
 from snakehead.geometry import collision as coll
 from snakehead.kinematics import workspace as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
+from snakehead._errors import InputTypeError
 
 
 @pytest.fixture(scope="module")
@@ -196,7 +197,7 @@ def test_bad_input(default):
         wb.solve_target(controller, [0.1, 0.5, 0.3], [0, 0, 0], problem=prob)
     with pytest.raises(ValueError, match="start"):
         wb.solve_whole_body(robot, [0.1, 0.5, 0.3], [0, 1, 0], [])
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="robot must be a SnakeRobot, got str"):
         wb.BodyProblem("robot")
 
 

@@ -14,6 +14,7 @@ import pytest
 from snakehead import Chain, SnakeRobot, default_robot_file
 from snakehead import sweep_defaults
 from snakehead.kinematics import workspace as ws
+from snakehead._errors import InputError, InputTypeError
 from conftest import SMALL_MAP, head6_robot
 
 SMALL = SMALL_MAP
@@ -65,7 +66,7 @@ def test_fibonacci_directions_unit_and_well_spread():
     probes = np.random.default_rng(0).normal(size=(2000, 3))
     probes /= np.linalg.norm(probes, axis=1, keepdims=True)
     assert np.max(np.min(np.linalg.norm(probes[:, None] - d[None], axis=2), axis=1)) < 1.2 * spacing
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"n \(directions\) must be between 1 and 4096, got 0"):
         ws.fibonacci_directions(0)
 
 
@@ -81,9 +82,9 @@ def test_approach_frame_axis_is_the_direction(axis, col):
         np.testing.assert_allclose(R[:, col], d / np.linalg.norm(d), atol=1e-12)
         np.testing.assert_allclose(T[:3, 3], p)
         np.testing.assert_allclose(T[3], [0, 0, 0, 1])
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="approach direction must be a finite non-zero vector"):
         ws.approach_frame([0, 0, 0], [0, 0, 0])
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="approach axis must be 'x' or 'z', got 'y'"):
         ws.approach_frame([0, 0, 0], [1, 0, 0], axis="y")
 
 
@@ -368,7 +369,7 @@ def test_histogram_uses_table2_bins():
     counts, pct = m.histogram()
     np.testing.assert_array_equal(counts, [2, 2, 2, 2, 4])  # [80, 100] is closed
     np.testing.assert_allclose(pct, 100 * np.array([2, 2, 2, 2, 4]) / 12)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="bins must be an increasing sequence of at least two edges"):
         m.histogram([0, 50, 20])
 
 
@@ -390,9 +391,9 @@ def test_clusters_and_center_on_known_blobs():
     assert m.clusters(k=3, random_state=7).chosen == 0
     with pytest.raises(ValueError, match="at least"):
         synthetic([100, 100]).clusters(k=3)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="k must be a positive integer, got 0"):
         m.clusters(k=0)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"threshold must be within \[0, 100\], got 101"):
         m.dexterous(threshold=101)
 
 
@@ -450,7 +451,7 @@ def test_figures(small, tmp_path):
     h = small.voxel_size
     layer_y = small.grid_origin[1] + (np.floor((0.01 - small.grid_origin[1]) / h) + 0.5) * h  # the layer holding y
     assert len(ax.collections[0].get_array()) == np.sum(np.isclose(small.centers[:, 1], layer_y)) > 0
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="axis must be 'x', 'y' or 'z', got 'w'"):
         wp.plot_section(small, axis="w")
     with pytest.raises(ValueError, match="outside"):
         wp.plot_section(small, axis="z", value=5.0)
@@ -502,11 +503,11 @@ def test_bad_inputs_of_the_helpers(robot, small, tmp_path):
         ws.evaluate(robot, [[np.nan, 0.0, 0.0]])
     with pytest.raises(ValueError, match="centers"):
         ws.evaluate(robot, [1.0, 2.0])
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="voxel size must be a positive number of metres, got -1.0"):
         ws.evaluate(robot, [[0.1, 0.0, 0.0]], voxel=-1.0)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"points must be finite, shape \(3,\) or \(k, 3\)"):
         small.index_at([[np.inf, 0.0, 0.0]])
-    with pytest.raises(TypeError):
+    with pytest.raises(InputTypeError, match="robot must be a SnakeRobot, got str"):
         ws.map_for("snake16")
     with pytest.raises(ValueError, match="at least one"):
         ws.merge([])
