@@ -10,6 +10,7 @@ import pytest
 
 from minkowski_reference import Shape, signed_distance
 from snakehead import _core
+from snakehead._errors import InputError
 
 KINDS = ["box", "cylinder", "sphere", "convex"]
 BLOB = np.random.default_rng(0).uniform(-0.04, 0.04, size=(12, 3))
@@ -195,41 +196,43 @@ def test_bad_input_is_value_error():
     ok = dict(kinds=["box"], frames=np.array([0]), origins=eye, sizes=np.array([[0.1, 0.1, 0.1]]), vertices=[None])
     _core.ShapeSet(**ok)
     bad = [
-        dict(kinds=["cone"]),
-        dict(sizes=np.array([[0.1, -0.1, 0.1]])),
-        dict(sizes=np.array([[0.1, np.nan, 0.1]])),
-        dict(sizes=np.array([0.1, 0.1, 0.1])),
-        dict(origins=np.eye(4)),
-        dict(origins=np.array([[[1, 0.5, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]])),
-        dict(frames=np.array([-1])),
-        dict(frames=np.array([0, 1])),
-        dict(vertices=[np.zeros((4, 3))]),
-        dict(kinds=["convex"], vertices=[np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])]),
-        dict(kinds=["convex"], vertices=[None]),
-        dict(kinds=["convex"], vertices=[np.zeros((4, 2))]),
+        (dict(kinds=["cone"]), "unknown kind 'cone'"),
+        (dict(sizes=np.array([[0.1, -0.1, 0.1]])), r"shape 0: size \(box extents.*must be > 0"),
+        (dict(sizes=np.array([[0.1, np.nan, 0.1]])), "shape 0: size must be finite"),
+        (dict(sizes=np.array([0.1, 0.1, 0.1])), r"sizes must have shape \(S, 3\)"),
+        (dict(origins=np.eye(4)), r"origins must have shape \(S, 4, 4\)"),
+        (dict(origins=np.array([[[1, 0.5, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]])),
+         "shape 0: origin's rotation must be orthonormal and right-handed"),
+        (dict(frames=np.array([-1])), "frames must be >= 0"),
+        (dict(frames=np.array([0, 1])), r"frames must have shape \(S,\) like kinds"),
+        (dict(vertices=[np.zeros((4, 3))]), "shape 0 is not convex: its vertices must be None"),
+        (dict(kinds=["convex"], vertices=[np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])]),
+         "shape 0: its vertices span no volume"),
+        (dict(kinds=["convex"], vertices=[None]), r"shape 0 is convex: its vertices must have shape \(V, 3\)"),
+        (dict(kinds=["convex"], vertices=[np.zeros((4, 2))]), r"shape 0 is convex: its vertices must have shape \(V, 3\)"),
     ]
-    for change in bad:
-        with pytest.raises(ValueError):
+    for change, match in bad:
+        with pytest.raises(InputError, match="ShapeSet: " + match):
             _core.ShapeSet(**{**ok, **change})
     shapes = _core.ShapeSet(**ok)
     frames = np.tile(np.eye(4), (3, 1, 1, 1))
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"shape_lowest_z: frames must have shape \(T, L, 4, 4\)"):
         _core.shape_lowest_z(frames[:, :, :3], shapes, np.array([0]))
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="lowest_z: shape index 1 is outside the set of 1 shapes"):
         _core.shape_lowest_z(frames, shapes, np.array([1]))
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match="incompatible function arguments"):  # pybind11's own: owners must be ints
         _core.shape_lowest_z(frames, shapes, np.array([0.0]))
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="shape_lowest_points: max_points must be >= 1"):
         _core.shape_lowest_points(frames, shapes, np.array([0]), max_points=0)
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="pair_distances: sample counts 3 and 2 do not broadcast"):
         _core.shape_pair_distances(frames, shapes, frames[:2], shapes, np.array([[0, 0]]))
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match=r"shape_pair_distances: pairs must have shape \(P, 2\)"):
         _core.shape_pair_distances(frames, shapes, frames, shapes, np.array([0, 0]))
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="pair_min_distances: cutoff must not be NaN"):
         _core.shape_pair_min_distances(frames, shapes, frames, shapes, np.array([[0, 0]]), cutoff=np.nan)
     nan = frames.copy()
     nan[1, 0, 0, 3] = np.nan
-    with pytest.raises(ValueError):
+    with pytest.raises(InputError, match="pair_min_distances: frames must be finite"):
         _core.shape_pair_min_distances(nan, shapes, frames, shapes, np.array([[0, 0]]))
 
 
