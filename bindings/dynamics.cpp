@@ -124,6 +124,25 @@ void bind_dynamics(py::module_& m) {
       "in the core: torques (T, n), the inertial wrench across the first joint (force, moment (T, 3)) and the "
       "centre of mass (T, 3)");
   m.def(
+      "center_of_mass",
+      [](Array frames, Array masses, Array coms) {
+        expect_shape(frames, {-1, -1, 4, 4}, "frames (T, L, 4, 4)");
+        const long T = static_cast<long>(frames.shape(0)), L = static_cast<long>(frames.shape(1));
+        expect_shape(masses, {L}, "masses (L,)");
+        expect_shape(coms, {L, 3}, "coms (L, 3)");
+        Array c({static_cast<py::ssize_t>(T), py::ssize_t{3}});
+        double* cp = c.mutable_data();
+        {
+          py::gil_scoped_release release;
+          center_of_mass(frames.data(), masses.data(), coms.data(), T, L, cp);
+        }
+        return c;
+      },
+      py::arg("frames"), py::arg("masses"), py::arg("coms"),
+      "The centre of mass (Eq. 23) of each sample (T, 3) from the links' frames (T, L, 4, 4), masses (L,) and centres "
+      "of mass in the links' frames (L, 3): summed link by link in a fixed order, without BLAS, so that a sample's "
+      "numbers do not depend on the samples around it, the machine or the thread count");
+  m.def(
       "momenta",
       [](Array frames, Array qd, std::vector<int> joint_child, Array axes, Array masses, Array coms, Array inertias) {
         expect_shape(frames, {-1, -1, 4, 4}, "frames (T, L, 4, 4)");

@@ -1,6 +1,7 @@
 #include "snakehead/dynamics.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -129,18 +130,28 @@ void lifted_shares(const LiftPoints& lift, const double* F, long L, double* shar
   }
 }
 
-// Eq. 23 for one sample: sum_k m_k (p_k + R_k c_k) / M.
-Eigen::Vector3d centre_of_mass(const RigidBodyChain& chain, const double* F, long L) {
-  Eigen::Vector3d mc = Eigen::Vector3d::Zero();
+// Eq. 23 for one sample: sum_k m_k (p_k + R_k c_k) / M, link by link in chain order, in scalars (an Eigen product may
+// use fused multiply-adds of its own where the target has them): the same numbers on any machine.
+// coms: L x 3 (row-major). Massless links (marker frames) are left out.
+void centre_of_mass_of(const double* F, const double* masses, const double* coms, long L, double* out) {
+  double mc[3] = {0.0, 0.0, 0.0};
   double total = 0.0;
   for (long k = 0; k < L; ++k) {
-    const double m = chain.mass[k];
+    const double m = masses[k];
     if (m <= 0.0) continue;
-    const Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(F + k * 16);
-    mc += m * (M.topRightCorner<3, 1>() + M.topLeftCorner<3, 3>() * chain.com[k]);
+    const double* M = F + k * 16;
+    const double* c = coms + 3 * k;
+    for (int i = 0; i < 3; ++i) {
+      const double* row = M + 4 * i;
+      double Rc = row[0] * c[0];
+      Rc += row[1] * c[1];
+      Rc += row[2] * c[2];
+      const double x = row[3] + Rc;
+      mc[i] += m * x;
+    }
     total += m;
   }
-  return mc / total;
+  for (int i = 0; i < 3; ++i) out[i] = mc[i] / total;
 }
 
 }  // namespace
@@ -181,6 +192,9 @@ void newton_euler_along(const ChainModel& model, const Eigen::Matrix4d& origin, 
   if (lift != nullptr) lift->validate(L);
   if (chain.mass.size() > 0 && !(std::accumulate(chain.mass.begin(), chain.mass.end(), 0.0) > 0.0))
     throw InputError("newton_euler_along: the body has no mass");
+  std::vector<double> coms(3 * chain.com.size());
+  for (std::size_t k = 0; k < chain.com.size(); ++k)
+    for (int i = 0; i < 3; ++i) coms[3 * k + i] = chain.com[k][i];
   // the samples are independent: split over the core's threads, each with its own pass and buffers
   parallel_for(T, kSamplesPerThread, [&](long begin, long end) {
     NewtonEulerPass own(pass);
@@ -191,9 +205,20 @@ void newton_euler_along(const ChainModel& model, const Eigen::Matrix4d& origin, 
       if (lift != nullptr) lifted_shares(*lift, F.data(), L, share.data());
       own.run(chain, F.data(), qd + t * n, qdd + t * n, lift != nullptr ? share.data() : nullptr, gravity,
               tau + t * n, force + 3 * t, moment + 3 * t);
-      Eigen::Map<Eigen::Vector3d>(com + 3 * t) = centre_of_mass(chain, F.data(), L);
+      centre_of_mass_of(F.data(), chain.mass.data(), coms.data(), L, com + 3 * t);
     }
   });
+}
+
+void center_of_mass(const double* frames, const double* masses, const double* coms, long T, long L, double* com) {
+  if (T < 0 || L < 0) throw InputError("center_of_mass: negative sample or link count");
+  double total = 0.0;
+  for (long k = 0; k < L; ++k) {
+    if (!std::isfinite(masses[k]) || masses[k] < 0.0) throw InputError("center_of_mass: masses must be finite and >= 0");
+    if (masses[k] > 0.0) total += masses[k];
+  }
+  if (!(total > 0.0)) throw InputError("center_of_mass: the body has no mass");
+  for (long t = 0; t < T; ++t) centre_of_mass_of(frames + t * L * 16, masses, coms, L, com + 3 * t);
 }
 
 void momenta(const RigidBodyChain& chain, const double* frames, const double* qd, long T, long L, double* linear,

@@ -3,7 +3,6 @@ seeds, threads, timeouts and bad input."""
 from __future__ import annotations
 
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -85,7 +84,7 @@ def test_pose_error_is_in_the_target_frame():
 
 
 def test_solutions_reach_the_pose_within_the_limits(chain):
-    ik = TracIK.from_chain(chain, timeout=0.02)
+    ik = TracIK.from_chain(chain, timeout=0.02, seed=1)  # seeded: an evaluation budget, the same count under load
     rng = np.random.default_rng(1)
     solved = 0
     for _ in range(40):
@@ -100,7 +99,7 @@ def test_solutions_reach_the_pose_within_the_limits(chain):
 
 @pytest.mark.parametrize("solve_type", ["Speed", "Distance", "Manip1", "Manip2"])
 def test_every_solve_type_solves_reachable_targets(head7, solve_type):
-    ik = TracIK.from_chain(head7, timeout=0.02, solve_type=solve_type)
+    ik = TracIK.from_chain(head7, timeout=0.02, solve_type=solve_type, seed=2)  # seeded: not cut by the clock
     rng = np.random.default_rng(2)
     for _ in range(5):
         T = head7.fk(head7.random_configuration(rng))
@@ -141,7 +140,7 @@ def test_manipulability_types_do_no_worse_than_speed(head7):
 
 
 def test_free_roll(chain):
-    ik = TracIK.from_chain(chain, timeout=0.03)
+    ik = TracIK.from_chain(chain, timeout=0.03, seed=5)  # seeded: an evaluation budget, the same count under load
     rng = np.random.default_rng(5)
     solved = rolled = 0
     for _ in range(30):
@@ -159,7 +158,7 @@ def test_free_roll(chain):
     assert solved >= 29
     assert rolled >= 10, "the roll about x does not look free"
     # The same targets with the roll enforced are often out of reach: the bound matters.
-    strict = TracIK.from_chain(chain, timeout=0.002)
+    strict = TracIK.from_chain(chain, timeout=0.002, seed=5)
     rng = np.random.default_rng(5)
     misses = 0
     for _ in range(10):
@@ -192,9 +191,12 @@ def test_seeded_calls_are_identical(chain):
     np.testing.assert_array_equal(a.ik_many(poses)[0], b.ik_many(poses)[0])
 
 
-def test_eight_threads_share_one_solver(head7):
-    # A generous timeout: 8 threads on a small, busy machine must not turn scheduling delays into failures.
-    solver7 = TracIK.from_chain(head7, timeout=0.05)
+@pytest.mark.parametrize("seed", [7, None], ids=["seeded", "unseeded"])
+def test_eight_threads_share_one_solver(head7, seed):
+    # Seeded, each call is bounded by evaluations, not the clock: 8 threads give what one thread gives, bit for bit,
+    # however the machine schedules them. Unseeded (the race, with the pool's workers), what is found is checked, not
+    # how much: that depends on the clock.
+    solver7 = TracIK.from_chain(head7, timeout=0.05, seed=seed)
     rng = np.random.default_rng(7)
     jobs = [[(head7.fk(head7.random_configuration(rng)), head7.random_configuration(rng)) for _ in range(20)]
             for _ in range(8)]
@@ -215,9 +217,15 @@ def test_eight_threads_share_one_solver(head7):
     assert not errors
     for t in range(8):
         found = [(T, q) for (T, _), q in zip(jobs[t], results[t]) if q is not None]
-        assert len(found) >= 19
         for T, q in found:
             assert_solution(head7, T, q)
+        if seed is not None:
+            assert len(found) >= 19
+            for (T, q0), q in zip(jobs[t], results[t]):
+                serial = solver7.ik(T, q0)
+                assert (q is None) == (serial is None)
+                if q is not None:
+                    np.testing.assert_array_equal(q, serial)
 
 
 def test_ik_many(head7):
@@ -257,14 +265,13 @@ def test_ik_many_streams_solve_part_of_a_batch(head7):
             ik.ik_many(poses[part], q0[part], streams=bad)
 
 
-def test_unreachable_target_returns_none_in_about_the_timeout(head7):
+def test_unreachable_target_returns_none(head7):
+    # (how long it takes is measured in bench/; a seeded call ends on its evaluation budget, tests/cpp/test_trac_ik.cpp)
     far = np.eye(4)
     far[0, 3] = 3.0  # beyond reach
     for seed in (None, 1):
         ik = TracIK.from_chain(head7, timeout=0.01, seed=seed)
-        t0 = time.perf_counter()
         assert ik.ik(far, np.zeros(7)) is None
-        assert time.perf_counter() - t0 < 20 * 0.01 + 0.05
 
 
 def test_kdl_reference_binding(head7):

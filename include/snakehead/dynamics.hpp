@@ -49,6 +49,13 @@ void newton_euler_along(const ChainModel& model, const Eigen::Matrix4d& origin, 
                         const Eigen::Vector3d& gravity, long T, double* tau, double* force, double* moment,
                         double* com);
 
+// The centre of mass (Eq. 23) of T samples, com (T x 3) = sum_k m_k (p_k + R_k c_k) / sum_k m_k, from the links'
+// frames (T x L x 4 x 4, row-major), masses (L) and centres of mass in the links' frames (L x 3). Summed link by link
+// in chain order, each product and sum rounded on its own (the core is built with -ffp-contract=off; no BLAS, no
+// vector intrinsics): a sample's centre of mass is the same numbers whatever the samples around it, the machine or
+// the number of threads. newton_euler_along's centre of mass is this one.
+void center_of_mass(const double* frames, const double* masses, const double* coms, long T, long L, double* com);
+
 // The paper's momenta (Eqs. 25-31) for T samples: linear momentum P, angular momentum L about the frames' origin,
 // and the centre of mass (Eq. 23), each T x 3, from the links' frames (T x L x 4 x 4, an inertial frame in which
 // the root link is still) and the joint velocities qd (T x n). Each massive link's CoM velocity is the sum over

@@ -28,10 +28,10 @@
 // run interleaved in the calling thread (KDL-RR alone first, as in a raced call; then whichever solver has
 // made fewer kinematics evaluations runs its next local search) from random generators derived from the
 // seed alone (no call counter), and the search is bounded by a budget of kinematics evaluations derived
-// from the timeout (kEvaluationsPerSecond in trac_ik.cpp) instead of the clock. A hard wall-clock guard of
-// max(10 x timeout, timeout + 50 ms) still applies so that no call can hang; it can only cut a seeded search
-// on a machine ten times slower than the nominal rate, and then results may differ. (A sanitizer build,
-// tens of times slower, has a guard of 1000 x timeout.)
+// from the timeout (kEvaluationsPerSecond in trac_ik.cpp) instead of the clock. A seeded call reads no clock: every
+// local search is bounded and counts its evaluations, so the budget always ends the call, and the answer is the same
+// on a loaded, slow or sanitized machine (where the call takes longer than its timeout: about timeout x the nominal
+// rate / the machine's rate).
 #pragma once
 
 #include "snakehead/model.hpp"
@@ -52,7 +52,7 @@ SolveType solve_type_from_string(const std::string& name);
 const char* to_string(SolveType type);
 
 struct TracIKOptions {
-  double timeout = 0.005;  // s, > 0: wall-clock budget of one solve
+  double timeout = 0.005;  // s, > 0: wall-clock budget of one solve (seeded: an evaluation budget, see above)
   double epsilon = 1e-5;   // > 0: allowed residual per axis (m, rad)
   SolveType solve_type = SolveType::Speed;
   // Per-axis tolerances of the pose error (vx vy vz wx wy wz, target frame), each >= 0 or +inf.

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'limit_ratios', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'center_of_mass', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'limit_ratios', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -373,6 +373,10 @@ def boundary(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 
 def boundary_voxels(points: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]", "flags.c_contiguous"], shrink: typing.SupportsFloat | typing.SupportsIndex, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], voxel: typing.SupportsFloat | typing.SupportsIndex, n: typing.SupportsInt | typing.SupportsIndex) -> numpy.typing.NDArray[numpy.int64]:
     """
     Linear ids of the grid voxels whose centre lies inside the boundary of the points
+    """
+def center_of_mass(frames: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], masses: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], coms: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The centre of mass (Eq. 23) of each sample (T, 3) from the links' frames (T, L, 4, 4), masses (L,) and centres of mass in the links' frames (L, 3): summed link by link in a fixed order, without BLAS, so that a sample's numbers do not depend on the samples around it, the machine or the thread count
     """
 def compute_reachability(model: ChainModel, options: WorkspaceOptions, progress: typing.Any = None) -> dict:
     """

@@ -520,25 +520,27 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     out.mkdir(parents=True, exist_ok=True)
     lanes = [list(scenes)]
     beside: list[_Beside] = []
-    if controller is None:
-        if robot is None:
-            first = scenes[0].robot_file
-            robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
-        if on_controller is None and start is None:
-            lanes = scene_lanes(scenes, settings)
-        with progress.stage("the head's reachability map and its dexterous centre G0"):
-            workspace_map = _head_map(robot, workspace_map, progress)
-            if len(lanes) > 1:  # forked before this process makes its controller (a TracIK: not fork-safe)
-                if settings.figures:
-                    _preload_figures(progress)
-                beside = [_lane_beside(lane, robot, workspace_map, out, settings, progress, solution_figure)
-                          for lane in lanes[1:]]
-            controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
-        if controller.dexterous_threshold < 100.0:
-            progress.say(controller.dexterous_note)
-    if on_controller is not None:
-        on_controller(controller)
+    # (from the first lane's fork on: a Ctrl-C while this process still makes its controller stops them too)
     try:
+        if controller is None:
+            if robot is None:
+                first = scenes[0].robot_file
+                robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
+            if on_controller is None and start is None:
+                lanes = scene_lanes(scenes, settings)
+            with progress.stage("the head's reachability map and its dexterous centre G0"):
+                workspace_map = _head_map(robot, workspace_map, progress)
+                if len(lanes) > 1:  # forked before this process makes its controller (a TracIK: not fork-safe)
+                    if settings.figures:
+                        _preload_figures(progress)
+                    for other in lanes[1:]:
+                        beside.append(_lane_beside(other, robot, workspace_map, out, settings, progress,
+                                                   solution_figure))
+                controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
+            if controller.dexterous_threshold < 100.0:
+                progress.say(controller.dexterous_note)
+        if on_controller is not None:
+            on_controller(controller)
         entries = _run_lane(lanes[0], controller, out, settings, progress, solution_figure, start,
                             figures_beside=len(lanes) < _cores())
         for lane in beside:

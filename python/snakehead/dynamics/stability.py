@@ -116,24 +116,6 @@ def polygon_margin_many(points: npt.ArrayLike, active: npt.ArrayLike, xy: npt.Ar
 # ------------------------------------------------------------------------------------------------
 # Eq. 23: centre of mass
 # ------------------------------------------------------------------------------------------------
-#: Multiply-adds of one matrix product above which OpenBLAS runs it on several threads (its m n k threshold). The
-#: threads then spin idle for ~0.1 s: one such product per plan (the CoM of a grid of thousands of configurations)
-#: kept the second core busy for most of the plan, away from the core's own threads (TRAC-IK's batches,
-#: Newton-Euler): perf showed a quarter of a plan's samples in OpenBLAS's spinning thread.
-BLAS_THREADED_PRODUCT = 1 << 18
-
-
-def _product_in_blocks(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """A @ B (m, k) x (k, p) in blocks of rows small enough that OpenBLAS keeps each on the calling thread
-    (BLAS_THREADED_PRODUCT): the same numbers, bit for bit (each row's dot products do not depend on the rows
-    around it)."""
-    rows = max(2, BLAS_THREADED_PRODUCT // max(1, A.shape[1] * B.shape[1]) - 1)
-    if len(A) <= rows:
-        return A @ B
-    # blocks of equal size: no block of one row, which numpy would hand to another kernel (gemv)
-    return np.concatenate([block @ B for block in np.array_split(A, -(-len(A) // rows))])
-
-
 def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
                    frames: np.ndarray | None = None) -> np.ndarray:
     """Centre of mass of the whole robot in the world frame (m), Eq. 23: c = sum m_i P_i / sum m_i.
@@ -148,17 +130,14 @@ def center_of_mass(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None 
     if not world:
         frames = robot.body.fk_all_many(qs)  # root frame; only the CoM is moved to the world
     assert frames is not None
-    m = robot.masses
-    # sum_i m_i P_i with P_i = p_i + R_i cbar_i is linear in the frames' top three rows: one matrix product (over
-    # the whole frames, the bottom rows' coefficients zero: no copy of the top rows)
-    W = np.zeros((len(m), 4, 4, 3))
-    for i in range(3):
-        W[:, i, :3, i] = m[:, None] * robot.coms  # coefficient of R_l[i, k]
-        W[:, i, 3, i] = m  # coefficient of p_l[i]
-    c = _product_in_blocks(np.asarray(frames).reshape(len(frames), -1), W.reshape(-1, 3)) / m.sum()
+    # sum_i m_i P_i / M with P_i = p_i + R_i cbar_i, in the core: link by link in a fixed order, no BLAS (whose
+    # kernels and blocking round a matrix product differently from machine to machine and from one batch size to
+    # another), so that a configuration's centre of mass is the same numbers in any batch, on any machine
+    c = _core.center_of_mass(np.ascontiguousarray(frames, dtype=float), robot.masses, robot.coms)
     if not world:
         W = robot.root_pose(base)
-        c = c @ W[:3, :3].T + W[:3, 3]
+        # c @ W[:3, :3].T + W[:3, 3], written out (a BLAS product of (T, 3) by (3, 3) rounds as its kernel does)
+        c = c[:, :1] * W[:3, 0] + c[:, 1:2] * W[:3, 1] + c[:, 2:] * W[:3, 2] + W[:3, 3]
     return c[0] if single else c
 
 

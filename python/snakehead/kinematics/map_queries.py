@@ -107,7 +107,10 @@ def _direction_candidates(m: ReachabilityMap) -> np.ndarray:
         centres = np.concatenate(faces)
         centres /= np.linalg.norm(centres, axis=1, keepdims=True)
         keep = min(_CANDIDATES, len(dirs))
-        m._cache["candidates"] = np.argsort(-(centres @ dirs.T), axis=1)[:, :keep]
+        # the cosines written out, not a BLAS product (whose kernel rounds them), and ties kept in direction order
+        # (the default sort orders them by the CPU's vector extensions): the same candidates on any machine
+        cos = centres[:, :1] * dirs[:, 0] + centres[:, 1:2] * dirs[:, 1] + centres[:, 2:] * dirs[:, 2]
+        m._cache["candidates"] = np.argsort(-cos, axis=1, kind="stable")[:, :keep]
     return m._cache["candidates"]
 
 
@@ -156,7 +159,7 @@ def _reachability(m: ReachabilityMap, p: np.ndarray, d: np.ndarray) -> np.ndarra
     # direction's cell on a cube map (the nearest ones of the cell's centre, and then some).
     candidates = _direction_candidates(m)[_cube_cell(d)]  # (K, C)
     cos = np.einsum("kcj,kj->kc", dirs[candidates], d)
-    order = np.argsort(-cos, axis=1)[:, :BLENDED_DIRECTIONS + 1]
+    order = np.argsort(-cos, axis=1, kind="stable")[:, :BLENDED_DIRECTIONS + 1]  # ties in candidate order
     nearest = np.take_along_axis(candidates, order, axis=1)
     near_cos = np.take_along_axis(cos, order, axis=1)
     angles = np.arccos(np.clip(near_cos, -1.0, 1.0))

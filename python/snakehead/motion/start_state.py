@@ -98,8 +98,8 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
     qs, exact_com = qs[keep], exact_com[keep]
     margin = stability.polygon_margin_many(np.broadcast_to(poly, (len(qs),) + poly.shape),
                                            np.ones((len(qs), len(poly)), bool), exact_com)
-    ranked = np.argsort(-margin)
-    ranked = ranked[margin[ranked] > 0]
+    ranked = np.argsort(-margin, kind="stable")  # ties in curl order, as the exhaustive search ranks them (the
+    ranked = ranked[margin[ranked] > 0]  # default sort orders ties by the CPU's vector width: AVX-512, AVX2)
     ok = coll.self_clearance(robot, qs[ranked]) > BENDING_CLEARANCE if ranked.size else np.zeros(0, bool)
     if not ok.any():
         raise Infeasible(_NO_CURL)
@@ -117,7 +117,7 @@ def ground_curl_exhaustive(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
     com = stability.center_of_mass(robot, qs)
     pts = np.broadcast_to(poly, (len(qs),) + poly.shape)
     margin = stability.polygon_margin_many(pts, np.ones(pts.shape[:2], bool), com[:, :2])
-    order = np.argsort(-margin)
+    order = np.argsort(-margin, kind="stable")  # ties in curl order, on any machine
     stable = order[margin[order] > 0]
     for chunk in np.array_split(stable, max(1, stable.size // 500 + 1)) if stable.size else []:
         ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
