@@ -470,7 +470,7 @@ def test_center_of_mass_is_the_same_in_any_batch(robot, rows):
     round a product of many rows otherwise than the same rows in blocks: OpenBLAS's AVX-512 kernel did from 273 rows
     of 320), so a configuration's centre of mass is the same numbers, bit for bit, in a batch of any size, alone, in
     any thread, on any machine. Against numpy's matrix products link by link (whose rounding is the BLAS kernel's),
-    equal to round-off: at most 4.5e-16 m measured on each of OpenBLAS's x86-64 kernels, 1e-14 m allowed."""
+    equal to round-off: at most 3.3e-16 m measured on each of OpenBLAS's x86-64 kernels, 1e-14 m allowed."""
     from hull_reference import com_reference
 
     rng = np.random.default_rng(rows)

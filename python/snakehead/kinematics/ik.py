@@ -103,7 +103,9 @@ class TracIK:
     ``timeout`` (s) bounds each call; ``epsilon`` is the per-axis tolerance (m, rad); ``solve_type`` is one of
     Speed, Distance, Manip1, Manip2; ``bounds`` the default per-axis tolerances; ``seed`` an integer makes
     every call reproducible (a seeded call is a pure function of its inputs: both solvers run interleaved in
-    the calling thread, bounded by an evaluation budget derived from the timeout rather than the clock).
+    the calling thread, bounded by an evaluation budget derived from the timeout rather than the clock: such a call
+    never reads the clock, so a slow or loaded machine takes longer than ``timeout`` and gives the same answer).
+    Without a seed, ``timeout`` is wall-clock time, and what a call finds depends on the machine's load.
     """
 
     def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = 0.005,
