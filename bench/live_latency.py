@@ -117,7 +117,7 @@ def main() -> int:
     driver = browser()
     try:
         live.wait_for_plan(300)
-        driver.get(f"http://127.0.0.1:{live.port}")
+        driver.get(live.url)  # with the session's token
         time.sleep(20)  # the page loads, the scene arrives and fades in (slow in SwiftShader)
         driver.execute_script(MOTION_WATCH_JS)
         print(f"python {platform.python_version()}, {platform.machine()}; headless Chromium (SwiftShader) 1000x720")

@@ -99,9 +99,9 @@ def test_what_a_scene_file_cannot_say_is_an_input_error(tmp_path):
 # the Python API
 # ----------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def live():
+def live(tmp_path_factory):
     scene = Scene(name="live_test", targets=(Target("target", NEAR[0], FORWARD, hold_s=1.0),))
-    viewer = LiveViewer(scene, port=0)
+    viewer = LiveViewer(scene, port=0, save_dir=tmp_path_factory.mktemp("live_saves"))
     try:
         viewer.wait_for_plan(TIMEOUT_S)
         yield viewer
@@ -183,7 +183,7 @@ def test_targets_are_added_and_removed(live):
     live.wait_for_plan(TIMEOUT_S)
     assert [t.name for t in live.targets] == ["target", "target 1"]
     assert [tg.name for tg in live.latest.targets] == ["target", "target 1"]
-    assert len(live._gizmos.handles) == 2 and live._chosen.options == ("target", "target 1")
+    assert len(live._gizmos.handles) == 2
     live.remove_target(1)
     live.wait_for_plan(TIMEOUT_S)
     assert [tg.name for tg in live.latest.targets] == ["target"] and len(live._gizmos.handles) == 1
@@ -213,9 +213,11 @@ def test_the_scene_is_saved_as_a_scene_file(live, tmp_path):
     path = live.save_scene(tmp_path / "live.toml")
     again = load_scene(path)
     assert_same_scene(again, live.scene())
-    live._file.value = str(tmp_path / "from the panel.toml")  # the panel's button
-    live._save()
-    assert (tmp_path / "from the panel.toml").is_file() and "from the panel.toml" in live._saved.content
+    assert live.save_named("from the panel") == "from the panel.toml"  # what the panel's button does
+    assert_same_scene(load_scene(live.saves.folder / "from the panel.toml"), live.scene())
+    with pytest.raises(InputError, match="bare name"):
+        live.save_named(str(tmp_path / "elsewhere.toml"))  # the page saves nowhere else
+    assert not (tmp_path / "elsewhere.toml").exists()
 
 
 def test_the_mujoco_check_shows_its_errors_beside_the_plans(live):
@@ -290,7 +292,7 @@ def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
 
     driver = _chromium()
     try:
-        driver.get(f"http://127.0.0.1:{live.port}")
+        driver.get(live.url)  # with the session's token
         from selenium.webdriver.common.by import By
         from selenium.webdriver.support import expected_conditions as EC
         from selenium.webdriver.support.ui import WebDriverWait

@@ -303,8 +303,8 @@ def _pixels_served(browser, args: list, rgb, enough: int, tolerance_deg: float =
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         line = proc.stdout.readline()
-        assert f"http://127.0.0.1:{port}" in line, line
-        browser.get(f"http://127.0.0.1:{port}")
+        assert f"http://127.0.0.1:{port}/?token=" in line, line
+        browser.get(line.split()[2])  # the URL as printed, with its token
         from selenium.webdriver.common.by import By
         from selenium.webdriver.support import expected_conditions as EC
         from selenium.webdriver.support.ui import WebDriverWait

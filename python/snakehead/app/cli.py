@@ -429,16 +429,18 @@ def _view(args: argparse.Namespace) -> int:
         raise UsageError("--scene goes with --live (DIR's scenes hold their robot and targets)")
     if args.robot is not None and args.map is None:
         raise UsageError("--robot goes with --live or --map (DIR's scenes hold their robot)")
+    if args.save_dir is not None:
+        raise UsageError("--save-dir goes with --live (only the live viewer's page saves scene files)")
     directory = None if args.dir is None else Path(args.dir)
     if directory is not None and not directory.is_dir():
         raise UsageError(f"{args.dir!r} is not a directory (give the --out folder of 'snakehead plan' or 'demo')")
     extra = [] if args.map is None else [viewer.reach_scene(workspace.load(args.map), _robot(args))]
-    shown = viewer.serve(directory, host=args.host, port=args.port, extra=extra)
+    shown = viewer.serve(directory, host=args.host, port=args.port, extra=extra, allow_hosts=args.allow_host)
     try:  # from here on Ctrl-C is how the viewer ends (the line below tells the user so, and may be interrupted)
         where = " and ".join(([str(directory.resolve())] if directory is not None else []) + ([args.map] if args.map
                                                                                              else []))
-        print(f"snakehead view: http://{args.host}:{shown.port} shows {', '.join(shown.scenes)} from {where}; "
-              "Ctrl-C stops", flush=True)
+        print(f"snakehead view: {shown.url} shows {', '.join(shown.scenes)} from {where}; Ctrl-C stops", flush=True)
+        _warn_if_exposed(args.host)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
@@ -452,17 +454,27 @@ def _view_live(args: argparse.Namespace) -> int:
     from ..viz.live import LiveViewer
 
     scene = load_scene(args.scene) if args.scene is not None else None
-    live = LiveViewer(scene, robot_file=args.robot, host=args.host, port=args.port)
+    live = LiveViewer(scene, robot_file=args.robot, host=args.host, port=args.port, save_dir=args.save_dir,
+                      allow_hosts=args.allow_host)
     try:  # from here on Ctrl-C is how the viewer ends
         what = f"scene {scene.name!r}" if scene is not None else "a target where the head starts"
-        print(f"snakehead view --live: http://{args.host}:{live.port} plans {what} again whenever a target's gizmo is "
-              "let go; Ctrl-C stops", flush=True)
+        print(f"snakehead view --live: {live.url} plans {what} again whenever a target's gizmo is let go; the page "
+              f"saves scene files into {live.saves.folder}; Ctrl-C stops", flush=True)
+        _warn_if_exposed(args.host)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
         return 0
     finally:
         live.close()
+
+
+def _warn_if_exposed(host: str) -> None:
+    """A line on stderr when the viewer listens beyond this machine: plain HTTP, its token readable on the way."""
+    if host not in ("127.0.0.1", "localhost", "::1"):
+        print(f"snakehead view: listening on {host}: other machines can reach this server over plain HTTP (the "
+              "token in the URL is all that keeps them out, and anyone on the network path can read it)",
+              file=sys.stderr, flush=True)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -659,6 +671,8 @@ def _add_reach(sub: Any) -> None:
 
 def _add_view(sub: Any) -> None:
     """snakehead view: the 3-D viewer."""
+    from ..viz.save_folder import DEFAULT_SAVE_DIR
+
     p = sub.add_parser("view", help="the interactive 3-D viewer of the output of plan or demo, or (--live) of "
                                     "plans made as you drag targets (a web page)",
                        description="Serve the scenes that 'snakehead plan' or 'snakehead demo' wrote into DIR "
@@ -669,7 +683,9 @@ def _add_view(sub: Any) -> None:
                                    "--live (no DIR): the robot in its initial state and the targets as gizmos to "
                                    "drag, turn, add and remove; the plan is made again and played whenever one is "
                                    "let go, its failure shown with its reason; buttons check the motion in MuJoCo "
-                                   "and save the targets and obstacles as a scene file.")
+                                   "and save the targets and obstacles as a scene file (a bare name, into "
+                                   "--save-dir). The URL printed carries a token: open it as printed (the server "
+                                   "answers only to this machine's names and to pages of its own origin).")
     p.add_argument("dir", metavar="DIR", nargs="?", default=None,
                    help="the --out folder of snakehead plan or demo (not with --live)")
     p.add_argument("--live", action="store_true",
@@ -681,10 +697,19 @@ def _add_view(sub: Any) -> None:
     p.add_argument("--scene", default=None, metavar="SCENE.toml",
                    help="with --live: start from a scene file's targets, obstacles and base (its robot file unless "
                         "--robot is given)")
+    p.add_argument("--save-dir", default=None, metavar="DIR",
+                   help=f"with --live: the one folder the page saves scene files into (default ./{DEFAULT_SAVE_DIR}, "
+                        "made at the first save); the page gives a bare file name and never replaces a file this "
+                        "session did not write")
     p.add_argument("--host", default="127.0.0.1",
-                   help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for every interface)")
+                   help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for every interface, "
+                        "over plain HTTP)")
     p.add_argument("--port", type=_port, default=8080, metavar="N",
                    help="port (default 8080; the next free one if taken)")
+    p.add_argument("--allow-host", action="append", default=[], metavar="NAME",
+                   help="a host name the server also answers to (repeatable; e.g. this machine's name when serving "
+                        "other machines with --host 0.0.0.0). Always: localhost, 127.0.0.1, [::1] and the address "
+                        "a request came in on; any other Host header is refused (DNS rebinding)")
     p.set_defaults(func=_view)
 
 def _traceback_wanted() -> bool:

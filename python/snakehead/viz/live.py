@@ -6,7 +6,15 @@ rings to turn it: its x-axis, the red arrow, is the head's direction) with its n
 current plan's support polygon at its start, the ZMP's trace and the ZMP now, and the head tip's path. The panel:
 the plan's state (planning, its errors, or why it failed), play/pause, time and speed; adding and removing targets;
 the MuJoCo check of the current plan (its errors beside the plan's); saving the targets and obstacles as a scene
-file (TOML, :func:`snakehead.scenes.save_scene`).
+file (TOML) in the viewer's save folder. What one browser chooses (the target to remove, the file name) and what it
+is told about its own actions are its own (:class:`.live_panel.ClientPanel`); the rest is shared.
+
+Safe to serve: the server sits behind :mod:`.server_guard` (Host and Origin allow-lists, a token in the printed
+URL, no framing, only the messages the page sends; :attr:`LiveViewer.url`). The page saves only bare file names
+into one folder fixed at start, never over a file this session did not write (:mod:`.save_folder`). Every value a
+browser sends is checked here: a speed not offered, a time that is not a number of the motion, a gizmo's pose that
+is not finite are refused (the panel says so to that browser) and playback goes on. At most :data:`MAX_TARGETS`
+targets; a motion longer than :data:`MAX_MOTION_S` is not played.
 
 How: one :class:`~snakehead.control.HeadController` (one robot, its map and its TRAC-IK threads) plans every
 target set in one worker thread. Each change (a gizmo released, a target added or removed) is a request; a request
@@ -18,19 +26,18 @@ a :class:`Replan` record of when it was released, planned and shown.
 
 The Python API (what tests and benchmarks drive, without a mouse): :class:`LiveViewer` with ``move_target``,
 ``add_target``, ``remove_target``, ``wait_for_plan``, ``check_dynamics``, ``wait_for_check``, ``save_scene``,
-``latest`` and ``records``.
+``latest``, ``records`` and ``url``; ``save_named`` saves as the page's button does (into the save folder),
+``save_scene`` anywhere (the caller's own code is trusted).
 """
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import io
+import logging
 import os
 import sys
 import threading
 import time
 import traceback
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
@@ -41,14 +48,19 @@ from .._errors import InputError, InputTypeError
 from .._validate import unit_vector3, world_position
 from ..scenes.scene import Scene, Target
 from . import viewer as vw
-from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, live_motion, x_axis
+from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, gizmo_pose, live_motion
+from .live_panel import MOTION_WATCH_JS, ClientPanel, ClientPanels, DynamicsCheck, Replan, errors_text, shown_text
+from .save_folder import SaveFolder
+from .server_guard import ServerGuard, guarded_server
+
+__all__ = ["LiveViewer", "Replan", "DynamicsCheck", "MOTION_WATCH_JS", "MAX_TARGETS", "MAX_MOTION_S", "SPEEDS"]
+
+LOG = logging.getLogger("snakehead.viz.server")
 
 if TYPE_CHECKING:
-
     from ..control.controller import HeadController
     from ..model.robot import SnakeRobot
     from ..motion.plan_result import Plan
-    from ..sim.plan import PlanSimulation
 
 #: s between two steps of the player (30 per second).
 TICK_S = 1.0 / 30.0
@@ -71,68 +83,16 @@ NEW_TARGET_HOLD_S = 1.0
 FILL_LIGHT = 1.5
 #: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
 GROUND_MARGIN_M = 0.2
-
-
-@dataclass
-class Replan:
-    """One request (a target moved, added or removed) and what became of it. Times are epoch seconds
-    (``time.time()``; a browser's ``Date.now() / 1000`` on the same machine compares with them): ``released``
-    (the request), ``plan_started`` and ``planned`` (around ``snakehead.plan``), ``drawn`` (its motion's frames
-    computed) and ``playing`` (its first frame sent to the browsers). ``superseded``: a newer request came while it
-    was planned, so it was never shown. ``failure``: the plan's, if it failed; ``error``: what went wrong if
-    planning raised (then nothing plays)."""
-
-    number: int
-    what: str
-    released: float
-    plan_started: float | None = None
-    planned: float | None = None
-    drawn: float | None = None
-    playing: float | None = None
-    superseded: bool = False
-    failure: str | None = None
-    error: str | None = None
-
-    @property
-    def settled(self) -> bool:
-        """Done with: playing, dropped for a newer request, or failed with an error."""
-        return self.playing is not None or self.superseded or self.error is not None
-
-    @property
-    def planning_s(self) -> float:
-        """s spent in ``snakehead.plan``."""
-        return _span(self.plan_started, self.planned)
-
-    @property
-    def latency_s(self) -> float:
-        """s from the request to its motion playing (NaN if it never played)."""
-        return _span(self.released, self.playing)
-
-    @property
-    def overhead_s(self) -> float:
-        """The viewer's share of :attr:`latency_s`: everything but planning (waiting for the worker, drawing,
-        sending)."""
-        return self.latency_s - self.planning_s
-
-
-def _span(start: float | None, end: float | None) -> float:
-    return float("nan") if start is None or end is None else end - start
-
+#: Targets at most in the live viewer (a scene with more is refused at start; "add target" stops there): each adds
+#: a few seconds to the motion and to every plan (203 targets took 8-15 s a plan, a 613 s motion and 200 MB).
+MAX_TARGETS = 16
+#: s: the longest motion the live viewer plays (a longer plan is reported, not drawn).
+MAX_MOTION_S = 300.0
 
 
 # ----------------------------------------------------------------------------------------------
 # the viewer
 # ----------------------------------------------------------------------------------------------
-@dataclass
-class DynamicsCheck:
-    """The MuJoCo check of motion ``number``: its :class:`~snakehead.sim.plan.PlanSimulation`, or ``error``."""
-
-    number: int
-    simulation: PlanSimulation | None = None
-    error: str | None = None
-    seconds: float = float("nan")
-
-
 class LiveViewer:
     """A viser server where the user drags the head's targets and the plan follows (``snakehead view --live``).
 
@@ -140,17 +100,26 @@ class LiveViewer:
     is in its initial state, no obstacles). robot: the robot (default: ``robot_file``'s, else the scene's robot
     file's, else the shipped one); robot_file: the robot file the saved scene names (default: the scene's).
     controller: the :class:`~snakehead.control.HeadController` that plans every request (default: one for the
-    robot with seed 1, as ``snakehead plan``). Served at http://HOST:PORT (the next free port if PORT is taken);
-    :meth:`close` stops it. The first plan (of the scene's targets) is requested at once.
+    robot with seed 1, as ``snakehead plan``). save_dir: the one folder the page saves into (default
+    ``./snakehead-scenes``, :mod:`.save_folder`); allow_hosts: host names the server answers to besides this
+    machine's (:mod:`.server_guard`). Served at :attr:`url` (http://HOST:PORT/?token=..., the next free port if
+    PORT is taken); :meth:`close` stops it. The first plan (of the scene's targets) is requested at once.
     """
 
     def __init__(self, scene: Scene | None = None, *, robot: SnakeRobot | None = None,
                  robot_file: str | os.PathLike | None = None, controller: HeadController | None = None,
-                 host: str = "127.0.0.1", port: int = 8080, frame_step_s: float = vw.FRAME_STEP_S) -> None:
+                 host: str = "127.0.0.1", port: int = 8080, frame_step_s: float = vw.FRAME_STEP_S,
+                 save_dir: str | os.PathLike | None = None, allow_hosts: tuple[str, ...] | list[str] = ()) -> None:
         if scene is not None and not isinstance(scene, Scene):
             raise InputTypeError(f"scene must be a Scene (snakehead.load_scene), got {type(scene).__name__}")
         if not (np.isfinite(frame_step_s) and frame_step_s > 0):
             raise InputError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
+        if scene is not None and len(scene.targets) > MAX_TARGETS:
+            raise InputError(f"scene {scene.name!r} has {len(scene.targets)} targets: the live viewer takes at most "
+                             f"{MAX_TARGETS} ('snakehead plan --scene' plans any number)")
+        self.saves = SaveFolder(save_dir)
+        self.guard = ServerGuard(allow_hosts)
+        self._host = host
         self.controller = _controller(scene, robot, robot_file, controller)
         self.robot = self.controller.robot
         self.frame_step_s = float(frame_step_s)
@@ -167,6 +136,9 @@ class LiveViewer:
         self._paths_due: float | None = None  # perf_counter time to draw the motion's paths
         self._check: DynamicsCheck | None = None
         self._checking = False
+        self._panels = ClientPanels(self._say)  # each browser's own part of the panel
+        self._speed_factor = float(DEFAULT_SPEED.rstrip("x"))  # the last speed a browser chose that is offered
+        self.player_errors = 0  # what the player's loop survived (it logs the first)
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._serve(host, port)
@@ -181,6 +153,11 @@ class LiveViewer:
     @property
     def port(self) -> int:
         return int(self.server.get_port())
+
+    @property
+    def url(self) -> str:
+        """The page's address with this session's token (what ``snakehead view --live`` prints)."""
+        return self.guard.url(self._host, self.port)
 
     @property
     def targets(self) -> list[Target]:
@@ -226,8 +203,11 @@ class LiveViewer:
     def add_target(self, position: npt.ArrayLike | None = None, direction: npt.ArrayLike | None = None,
                    name: str | None = None) -> int:
         """Add a target after the last one, at ``position`` (default: beside the last one) pointing along
-        ``direction`` (default: as the last one), held 1 s; returns the number of the replan requested."""
+        ``direction`` (default: as the last one), held 1 s; returns the number of the replan requested. InputError
+        beyond :data:`MAX_TARGETS`."""
         with self._changed:
+            if len(self._targets) >= MAX_TARGETS:
+                raise InputError(f"at most {MAX_TARGETS} targets in the live viewer: remove one first")
             last = self._targets[-1]
             side = np.cross([0.0, 0.0, 1.0], last.direction)
             side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-6 else np.array([1.0, 0.0, 0.0])
@@ -285,10 +265,19 @@ class LiveViewer:
             return self._check
 
     def save_scene(self, path: str | os.PathLike) -> Path:
-        """Write the current targets and the scene's obstacles as a scene file (TOML) at ``path``; the path."""
+        """Write the current targets and the scene's obstacles as a scene file (TOML) at ``path``; the path. (The
+        caller's own path, trusted: the page saves through :meth:`save_named`.)"""
         from ..scenes.scene import save_scene
 
         return save_scene(self.scene(), path)
+
+    def save_named(self, name: str) -> str:
+        """Save the scene as the page's "save scene" does: as the bare file ``name`` (``.toml`` added) in the save
+        folder, never over a file this session did not write (:class:`.save_folder.SaveFolder`); the bare name.
+        InputError, in words a browser may be shown, if not saved."""
+        from ..scenes.scene import scene_to_toml
+
+        return self.saves.write(name, scene_to_toml(self.scene(), self.saves.folder))
 
     def close(self) -> None:
         """Stop the threads and the server (a plan running is left to finish in its daemon thread)."""
@@ -331,7 +320,7 @@ class LiveViewer:
         except ValueError as exc:  # the scene's own checks (a line approach first, names alike...): the user's
             raise InputError(str(exc)) from None
         self._targets = targets
-        self._chosen.options = tuple(t.name for t in targets)
+        self._panels.set_targets(tuple(t.name for t in targets))
         return self._request(what)
 
     def _request(self, what: str) -> int:
@@ -344,12 +333,17 @@ class LiveViewer:
         self._changed.notify_all()
         return record.number
 
-    def _released(self, handle: Any) -> None:
-        """A gizmo let go (viser's thread): its pose is the target's."""
+    def _released(self, handle: Any, client: Any = None) -> None:
+        """A gizmo let go (viser's thread): its pose is the target's. A pose that is no target's (not finite, a
+        direction of length 0) puts the gizmo back where its target is."""
         with self._changed:
             k = self._gizmos.index(handle)
-        if k >= 0:
-            self._reported(self._say, lambda: self.move_target(k, handle.position, x_axis(handle.wxyz)))
+        if k < 0:
+            return
+        if not self._panels.reported(client, lambda: self.move_target(k, *gizmo_pose(handle))):
+            with self._changed:
+                if k < len(self._targets):
+                    self._gizmos.place(k, self._targets[k])
 
     # --- planning and playing -------------------------------------------------------------------------------------
     def _run_worker(self) -> None:
@@ -373,10 +367,15 @@ class LiveViewer:
             record.failure = result.failure
             if self._superseded(record):
                 return
+            duration = float(result.t[-1] - result.t[0])
+            if not duration <= MAX_MOTION_S:
+                raise InputError(f"its motion lasts {duration:.0f} s, longer than the {MAX_MOTION_S:.0f} s the live "
+                                 "viewer plays: remove targets or shorten their holds")
             motion = live_motion(record.number, result, self._nodes.origins, self.frame_step_s)
             record.drawn = time.time()
         except Exception as exc:  # noqa: BLE001 -- the viewer shows it and keeps serving; the traceback to stderr
-            traceback.print_exc(file=sys.stderr)
+            if not isinstance(exc, InputError):
+                traceback.print_exc(file=sys.stderr)
             record.error = f"{type(exc).__name__}: {exc}"
             self._say(f"**Request {record.number} ({record.what}) raised** {record.error}")
             with self._changed:
@@ -403,8 +402,8 @@ class LiveViewer:
                 self._paths_due = time.perf_counter() + PATHS_DELAY_S
                 self._time.max = max(round(motion.duration_s, 1), 0.1)
                 self._time.value = 0.0  # type: ignore[misc]  # viser's handles are assignable (typed read-only)
-                self._shown.content = _shown_text(record, motion)
-                self._errors.content = _errors_text(motion, self._check)
+                self._shown.content = shown_text(record, motion)
+                self._errors.content = errors_text(motion, self._check)
                 self._status.content = "Ready: drag a target's gizmo, or add one."
             self.server.flush()
             record.playing = time.time()
@@ -412,37 +411,68 @@ class LiveViewer:
             self._changed.notify_all()
 
     def _run_player(self) -> None:
+        """Step the motion shown along, :data:`TICK_S` apart, until :meth:`close`. Nothing a browser sends stops it:
+        it reads only values checked when they came (:meth:`_speed_changed`, :meth:`_seek`), and whatever else goes
+        wrong in a step is logged (the first time) and counted in ``player_errors``, and the next step comes."""
         last = slider_moved = time.perf_counter()
         while not self._stop.wait(TICK_S):
             now = time.perf_counter()
             dt, last = now - last, now
-            with self._draw:
-                m = self._motion
-                if m is not None and self._paths_due is not None and now >= self._paths_due:
-                    self._paths_due = None
-                    self._nodes.draw_paths(m)
-                if m is None or not self._playing.value:
-                    continue
-                self._t += float(self._speed.value.rstrip("x")) * dt
-                if self._t > m.duration_s + HOLD_S:
-                    self._t = 0.0
-                self._nodes.show(m, m.frame_at(self._t))
-                if now - slider_moved >= SLIDER_STEP_S:
+            try:
+                if self._step(now, dt, now - slider_moved >= SLIDER_STEP_S):
                     slider_moved = now
-                    self._time.value = round(min(self._t, m.duration_s), 1)  # type: ignore[misc]
+            except Exception:  # noqa: BLE001 -- the player outlives any one step
+                self.player_errors += 1
+                if self.player_errors == 1:
+                    LOG.exception("the live viewer's player failed a step (it goes on)")
+
+    def _step(self, now: float, dt: float, move_slider: bool) -> bool:
+        """One step of the player; whether it moved the time slider."""
+        with self._draw:
+            m = self._motion
+            if m is not None and self._paths_due is not None and now >= self._paths_due:
+                self._paths_due = None
+                self._nodes.draw_paths(m)
+            if m is None or not self._playing.value:
+                return False
+            self._t = self._t + self._speed_factor * dt
+            if not 0.0 <= self._t <= m.duration_s + HOLD_S:
+                self._t = 0.0
+            self._nodes.show(m, m.frame_at(self._t))
+            if move_slider:
+                self._time.value = round(min(self._t, m.duration_s), 1)  # type: ignore[misc]
+            return move_slider
+
+    def _speed_changed(self, event: Any) -> None:
+        """A speed chosen: one of :data:`SPEEDS` is taken; anything else is refused and the menu set back."""
+        value = self._speed.value
+        if value in SPEEDS:
+            self._speed_factor = float(value.rstrip("x"))
+            return
+        shown = f"{self._speed_factor:g}x"
+        self._speed.value = shown if shown in SPEEDS else DEFAULT_SPEED  # type: ignore[misc]
+        self._panels.tell(event.client, f"**Not done:** speed must be one of {', '.join(SPEEDS)}")
 
     def _seek(self, event: Any) -> None:
+        """The time slider moved by a browser: a time of the motion shown is taken (its frame shown); anything
+        else (not a number, NaN, inf, before 0 or after the end) is refused and the slider set back."""
         if event.client is None:  # the player moved the slider
             return
         with self._draw:
-            if self._motion is not None:
-                self._t = float(self._time.value)
-                self._nodes.show(self._motion, self._motion.frame_at(self._t))
+            if self._motion is None:
+                return
+            t = self._time.value
+            if not (isinstance(t, (int, float)) and np.isfinite(t) and 0.0 <= t <= self._time.max):
+                self._time.value = round(min(self._t, self._motion.duration_s), 1)  # type: ignore[misc]
+                self._panels.tell(event.client, f"**Not done:** the time must be between 0 and {self._time.max:g} s")
+                return
+            self._t = float(t)
+            self._nodes.show(self._motion, self._motion.frame_at(self._t))
 
     def _run_check(self, motion: LiveMotion) -> None:
         import importlib.util
 
-        self._errors.content = _errors_text(motion, None) + "\n\nMuJoCo: simulating ..."
+        self._errors.content = errors_text(motion, None) + "\n\nMuJoCo: simulating ..."
         started = time.perf_counter()
         check = DynamicsCheck(motion.number)
         try:
@@ -461,14 +491,11 @@ class LiveViewer:
             self._changed.notify_all()
         shown = self.motion
         if shown is not None:
-            self._errors.content = _errors_text(shown, check)
+            self._errors.content = errors_text(shown, check)
 
     # --- the server and its panel ---------------------------------------------------------------------------------
     def _serve(self, host: str, port: int) -> None:
-        import viser
-
-        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        self.server = guarded_server(self.guard, host, port)
         try:
             self._draw_scene()
             self._panel()
@@ -498,6 +525,7 @@ class LiveViewer:
         vw.camera_to(self.server.initial_camera, *vw.camera_for(lo - 0.05, hi + 0.05))
 
     def _panel(self) -> None:
+        """The shared panel; each browser's own part is added when it connects (:meth:`_client_panel`)."""
         gui = self.server.gui
         gui.configure_theme(control_width="medium")
         self._status = gui.add_markdown("Planning the first motion ...")
@@ -507,39 +535,46 @@ class LiveViewer:
             self._playing = gui.add_checkbox("play", initial_value=True)
             self._time = gui.add_slider("time (s)", min=0.0, max=1.0, step=0.1, initial_value=0.0)
             self._speed = gui.add_dropdown("speed", SPEEDS, initial_value=DEFAULT_SPEED)
-        with gui.add_folder("Targets"):
-            self._chosen = gui.add_dropdown("target", tuple(t.name for t in self._targets))
-            add, remove = gui.add_button("add target"), gui.add_button("remove target")
+        self._targets_folder = gui.add_folder("Targets")
+        with self._targets_folder:
+            self._add, self._remove = gui.add_button("add target"), gui.add_button("remove target")
         with gui.add_folder("MuJoCo"):
             check = gui.add_button("check the motion in MuJoCo")
-        with gui.add_folder("Scene file"):
-            self._file = gui.add_text("file", initial_value=f"{self._scene.name}_live.toml")
-            save = gui.add_button("save scene")
-            self._saved = gui.add_markdown("")
+        self._file_folder = gui.add_folder("Scene file")
+        with self._file_folder:
+            self._save_button = gui.add_button("save scene")
         self._time.on_update(self._seek)
-        add.on_click(lambda _: self._reported(self._say, self.add_target))
-        remove.on_click(lambda _: self._reported(self._say, lambda: self.remove_target(self._chosen_index())))
-        check.on_click(lambda _: self._reported(self._say, self.check_dynamics))
-        save.on_click(lambda _: self._reported(lambda text: setattr(self._saved, "content", text), self._save))
+        self._speed.on_update(self._speed_changed)
+        self._add.on_click(lambda event: self._with_panel(event, lambda _: self.add_target()))
+        self._remove.on_click(lambda event: self._with_panel(
+            event, lambda panel: self.remove_target(self._chosen_index(panel))))
+        check.on_click(lambda event: self._with_panel(event, lambda _: self.check_dynamics()))
+        self._save_button.on_click(lambda event: self._with_panel(event, self._save))
+        self._panels.bind(self.server, self._status, (self._targets_folder, self._add),
+                          (self._file_folder, self._save_button), lambda: (tuple(t.name for t in self.targets),
+                                                                           f"{self._scene.name}_live.toml"))
 
-    def _chosen_index(self) -> int:
+    def _with_panel(self, event: Any, action: Callable[[ClientPanel], Any]) -> None:
+        """Run a button's ``action`` with the panel of the browser that clicked (none yet: nothing is done)."""
+        panel = self._panels.of(event.client)
+        if panel is not None:
+            self._panels.reported(event.client, lambda: action(panel))
+
+    def _chosen_index(self, panel: ClientPanel) -> int:
         names = [t.name for t in self.targets]
-        return names.index(self._chosen.value) if self._chosen.value in names else -1
+        if panel.chosen.value not in names:
+            raise InputError("choose a target in the menu first")
+        return names.index(panel.chosen.value)
 
-    def _save(self) -> None:
-        path = self.save_scene(self._file.value)
-        self._saved.content = f"Saved to `{path.resolve()}`"
+    def _save(self, panel: ClientPanel) -> None:
+        """The browser's "save scene": its file box's name in the save folder; it is told the bare name only."""
+        try:
+            panel.saved.content = f"Saved as `{self.save_named(panel.file.value)}` in the viewer's save folder."
+        except InputError as exc:
+            panel.saved.content = f"**Not saved:** {exc}"
 
     def _say(self, text: str) -> None:
         self._status.content = text
-
-    @staticmethod
-    def _reported(say: Callable[[str], None], action: Callable[[], Any]) -> None:
-        """Run a panel's or a gizmo's action; a mistake of the user's (InputError) is said in the panel."""
-        try:
-            action()
-        except InputError as exc:
-            say(f"**Not done:** {exc}")
 
 
 def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str | os.PathLike | None,
@@ -558,56 +593,3 @@ def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str |
     elif not isinstance(robot, SnakeRobot):
         raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
     return HeadController(robot, base_pose=scene.base if scene is not None else None, seed=1)
-
-
-def _shown_text(record: Replan, motion: LiveMotion) -> str:
-    """The panel's line on the motion shown (the browser test reads "motion N playing" in it)."""
-    plan = motion.plan
-    text = (f"**Plan {record.number}** ({record.what}): planned in {record.planning_s:.2f} s; motion "
-            f"{record.number} playing ({motion.duration_s:.1f} s).")
-    if plan.relocation is not None:
-        r = plan.relocation.base
-        text += f" The base lies elsewhere first (x {r.x:.3f} m, y {r.y:.3f} m, yaw {r.yaw:.2f} rad)."
-    if record.failure is not None:
-        text += f"\n\n**Failed:** {record.failure}"
-    return text
-
-
-def _errors_text(motion: LiveMotion, check: DynamicsCheck | None) -> str:
-    """The plan's errors, and beside them MuJoCo's when the last check was of this motion."""
-    plan = motion.plan
-    pos = max((tg.position_error_m for tg in plan.targets), default=float("nan"))
-    ang = max((tg.direction_error_deg for tg in plan.targets), default=float("nan"))
-    rows = [("position error", f"{1000 * pos:.2f} mm"), ("direction error", f"{ang:.2f}°"),
-            ("ZMP", f"{1000 * plan.min_zmp_margin_m:.1f} mm inside at least")]
-    sim = None if check is None or check.number != motion.number else check
-    if sim is not None and sim.simulation is not None:
-        m = sim.simulation
-        cells = [f"{1000 * m.position_error_m:.2f} mm", f"{m.direction_error_deg:.2f}°",
-                 "inside" if m.zmp_inside else "**leaves the polygon**"]
-    else:
-        cells = ["-"] * 3
-    lines = ["| | planned | MuJoCo |", "|---|---|---|"]
-    lines += [f"| {name} | {value} | {cell} |" for (name, value), cell in zip(rows, cells)]
-    if sim is not None and sim.error is not None:
-        lines.append(f"\nMuJoCo: {sim.error}")
-    elif check is not None and sim is None:
-        lines.append(f"\n(the last MuJoCo check was of motion {check.number})")
-    return "\n".join(lines)
-
-
-#: JavaScript for measuring the viewer in a browser (tests/test_live_viewer.py, bench/live_latency.py): the time
-#: (Date.now(), ms) each "motion N playing" first appears in the panel, and the second frame painted after it.
-MOTION_WATCH_JS = """
-window.__motions = {};
-const seen = () => {
-  const m = document.body.textContent.match(/motion (\\d+) playing/);
-  if (m && !(m[1] in window.__motions)) {
-    const entry = {text: Date.now()};
-    window.__motions[m[1]] = entry;
-    requestAnimationFrame(() => requestAnimationFrame(() => { entry.painted = Date.now(); }));
-  }
-};
-new MutationObserver(seen).observe(document.body, {subtree: true, childList: true, characterData: true});
-seen();
-"""

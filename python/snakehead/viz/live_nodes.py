@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import InputError
 from ..scenes.scene import Target
 from . import viewer as vw
 
@@ -114,11 +115,26 @@ def x_axis(wxyz: npt.ArrayLike) -> np.ndarray:
     return np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)])
 
 
+def gizmo_pose(handle: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The position (3,) and x-axis (3,) of a gizmo as a browser left it (viser takes the pose a browser sends as it
+    is); InputError for a pose that is not 3 and 4 finite numbers with a quaternion of non-zero length."""
+    try:
+        p = np.asarray(handle.position, dtype=float).reshape(3)
+        q = np.asarray(handle.wxyz, dtype=float).reshape(4)
+    except (TypeError, ValueError):
+        raise InputError("a gizmo's pose must be a position of 3 numbers and a quaternion of 4") from None
+    if not (np.isfinite(p).all() and np.isfinite(q).all() and np.linalg.norm(q) > 1e-9):
+        raise InputError("a gizmo's pose must be finite numbers and its quaternion not of length 0")
+    return p, x_axis(q)
+
+
 class TargetGizmos:
     """The targets in the scene: one transform gizmo each (its x-axis the target's direction) carrying an arrow and
-    the target's name. ``on_release(name)`` is called (on viser's thread) when the user lets go of a gizmo."""
+    the target's name. ``on_release(handle, client)`` is called (on viser's thread) when a user lets go of a gizmo
+    (``client``: viser's handle of the browser that did, None if unknown); its pose is the browser's word, to be
+    checked."""
 
-    def __init__(self, scene_api: viser.SceneApi, size: float, on_release: Callable[[Any], None]) -> None:
+    def __init__(self, scene_api: viser.SceneApi, size: float, on_release: Callable[[Any, Any], None]) -> None:
         self.scene, self.size, self.on_release = scene_api, size, on_release
         self.handles: list[Any] = []
         self._made = 0
@@ -146,7 +162,7 @@ class TargetGizmos:
 
     def _released(self, event: Any) -> None:
         if event.phase == "end":
-            self.on_release(event.target)
+            self.on_release(event.target, getattr(event, "client", None))
 
 
 # ----------------------------------------------------------------------------------------------

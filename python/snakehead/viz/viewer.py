@@ -652,11 +652,11 @@ def _camera_to(target: Any, data: ViewerScene) -> None:
 
 @contextlib.contextmanager
 def _quiet_server(port: int = 0) -> Iterator[viser.ViserServer]:
-    """A viser server on the loopback interface (a free port by default) that prints nothing; stopped after."""
-    import viser
+    """A viser server on the loopback interface (a free port by default) that prints nothing; stopped after. It is
+    behind a guard whose token nobody is told (:mod:`.server_guard`): while a page is recorded, no browser gets in."""
+    from .server_guard import ServerGuard, guarded_server
 
-    with contextlib.redirect_stdout(io.StringIO()):
-        server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    server = guarded_server(ServerGuard(), "127.0.0.1", port)
     try:
         yield server
     finally:
@@ -702,19 +702,24 @@ def write_html(data: ViewerScene, path: str | Path) -> Path:
 # ----------------------------------------------------------------------------------------------
 class Viewer:
     """A live viser server over viewer scenes (``snakehead view``): the GUI picks the scenario, plays and pauses,
-    scrubs time, sets the speed and toggles the layers. :meth:`close` stops it."""
+    scrubs time, sets the speed and toggles the layers (one scene, shared by every browser). Served at :attr:`url`
+    behind :mod:`.server_guard` (Host, Origin, the token in the URL; ``allow_hosts``: names besides this
+    machine's). What a browser sends is checked: a scenario or a speed not offered, a time that is not one of the
+    motion are set back, and playback goes on. :meth:`close` stops it."""
 
     SPEEDS = ("0.5x", "1x", "2x", "4x", "8x", "16x")
 
-    def __init__(self, scenes: Sequence[ViewerScene], *, host: str = "127.0.0.1", port: int = 8080) -> None:
-        import viser
+    def __init__(self, scenes: Sequence[ViewerScene], *, host: str = "127.0.0.1", port: int = 8080,
+                 allow_hosts: Sequence[str] = ()) -> None:
+        from .server_guard import ServerGuard, guarded_server
 
         if not scenes:
             raise InputError("no viewer scenes to show")
         self.scenes = {s.name: s for s in scenes}
-        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller says where to look
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        self.lock = threading.Lock()
+        self.guard = ServerGuard(allow_hosts)
+        self._host = host
+        self.server = guarded_server(self.guard, host, port)
+        self.lock = threading.RLock()  # re-entered: a value set here calls its callback on this thread
         gui = self.server.gui
         gui.configure_theme(control_width="medium")
         self.scenario = gui.add_dropdown("scenario", tuple(self.scenes), initial_value=scenes[0].name)
@@ -725,9 +730,12 @@ class Viewer:
                        for name in SceneNodes.LAYERS}
         self.nodes: SceneNodes | None = None
         self._stop = threading.Event()
+        self._t, self._factor, self._shown = 0.0, 4.0, scenes[0].name  # the checked time, speed and scenario
+        self.player_errors = 0  # what the player's loop survived (it logs the first)
         self._load(scenes[0].name)
         self.scenario.on_update(lambda _: self._load(self.scenario.value))
-        self.time.on_update(lambda _: self._seek(self.time.value))
+        self.time.on_update(lambda event: self._seek(self.time.value, event.client is not None))
+        self.speed.on_update(lambda _: self._speed_changed())
         for layer in self.layers.values():
             layer.on_update(lambda _: self._apply_layers())
         self._thread = threading.Thread(target=self._play, name="snakehead-viewer", daemon=True)
@@ -737,8 +745,17 @@ class Viewer:
     def port(self) -> int:
         return int(self.server.get_port())
 
+    @property
+    def url(self) -> str:
+        """The page's address with this session's token (what ``snakehead view`` prints)."""
+        return self.guard.url(self._host, self.port)
+
     def _load(self, name: str) -> None:
         with self.lock:
+            if name not in self.scenes:  # not a scenario offered: the menu set back
+                self.scenario.value = self._shown  # type: ignore[misc]  # (viser: assignable, typed read-only)
+                return
+            self._shown, self._t = name, 0.0
             data = self.scenes[name]
             self.server.scene.reset()
             self.nodes = SceneNodes(self.server.scene, data)
@@ -759,10 +776,25 @@ class Viewer:
         times = self.nodes.data.times
         return int(np.searchsorted(times - times[0], t_rel + 1e-9, side="right") - 1)
 
-    def _seek(self, t_rel: float) -> None:
+    def _seek(self, t_rel: float, by_client: bool = True) -> None:
+        """Show the frame at ``t_rel`` s; a browser's time that is not a number of the motion (NaN, inf, before 0,
+        after the end) is refused and the slider set back."""
         with self.lock:
-            if self.nodes is not None:
-                self.nodes.show_frame(self._frame_at(float(t_rel)))
+            if self.nodes is None:
+                return
+            if not (isinstance(t_rel, (int, float)) and np.isfinite(t_rel) and 0.0 <= t_rel <= self.time.max):
+                self.time.value = self._t  # type: ignore[misc]  # (viser: assignable, typed read-only)
+                return
+            if by_client:
+                self._t = float(t_rel)
+            self.nodes.show_frame(self._frame_at(float(t_rel)))
+
+    def _speed_changed(self) -> None:
+        """A speed of :attr:`SPEEDS` is taken; anything else is refused and the menu set back."""
+        if self.speed.value in self.SPEEDS:
+            self._factor = float(self.speed.value.rstrip("x"))
+        else:
+            self.speed.value = f"{self._factor:g}x"  # type: ignore[misc]  # (viser: assignable, typed read-only)
 
     def _apply_layers(self) -> None:
         if self.nodes is None:
@@ -774,17 +806,24 @@ class Viewer:
             group.visible = self.layers[layer].value
 
     def _play(self, tick_s: float = 0.05) -> None:
+        """Step the time along until :meth:`close`, from the checked time and speed only; a step that fails is
+        logged (the first time) and counted in ``player_errors``, and the next step comes."""
+        import logging
+
         last = time.perf_counter()
         while not self._stop.wait(tick_s):
             now = time.perf_counter()
             dt, last = now - last, now
-            if not self.playing.value or self.nodes is None:
-                continue
-            factor = float(self.speed.value.rstrip("x"))
-            t_next = self.time.value + factor * dt
-            if t_next > self.time.max:
-                t_next = 0.0
-            self.time.value = t_next  # type: ignore[misc]  # (viser: assignable, typed read-only); moves the scene
+            try:
+                if not self.playing.value or self.nodes is None:
+                    continue
+                t_next = self._t + self._factor * dt
+                self._t = t_next if 0.0 <= t_next <= self.time.max else 0.0
+                self.time.value = self._t  # type: ignore[misc]  # (viser: assignable, typed read-only); moves the scene
+            except Exception:  # noqa: BLE001 -- the player outlives any one step
+                self.player_errors += 1
+                if self.player_errors == 1:
+                    logging.getLogger("snakehead.viz.server").exception("the viewer's player failed a step")
 
     def close(self) -> None:
         self._stop.set()
@@ -793,12 +832,12 @@ class Viewer:
 
 
 def serve(directory: str | Path | None, *, host: str = "127.0.0.1", port: int = 8080,
-          extra: Sequence[ViewerScene] = ()) -> Viewer:
+          extra: Sequence[ViewerScene] = (), allow_hosts: Sequence[str] = ()) -> Viewer:
     """Serve the viewer scenes of ``directory`` (the output of ``snakehead plan`` or ``demo``; None: none) and
-    ``extra`` scenes (e.g. :func:`reach_scene`'s) at http://HOST:PORT (the next free port if PORT is taken);
-    returns the running :class:`Viewer`."""
+    ``extra`` scenes (e.g. :func:`reach_scene`'s) at http://HOST:PORT (the next free port if PORT is taken; the
+    page at the returned viewer's ``url``, with its token); returns the running :class:`Viewer`."""
     paths = scenes_in(directory) if directory is not None else []
     if not paths and not extra:
         raise InputError(f"{directory} holds no viewer scenes (*{SCENE_SUFFIX}); 'snakehead plan' and "
                          "'snakehead demo' write them")
-    return Viewer([load_viewer_scene(p) for p in paths] + list(extra), host=host, port=port)
+    return Viewer([load_viewer_scene(p) for p in paths] + list(extra), host=host, port=port, allow_hosts=allow_hosts)
