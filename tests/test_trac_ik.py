@@ -33,7 +33,7 @@ def head7(robot):
 
 @pytest.fixture(scope="module")
 def solver7(head7):
-    return TracIK.from_chain(head7)
+    return TracIK.from_chain(head7, seed=0)  # seeded: what it finds does not depend on the clock
 
 
 def roll_about_x(angle):
@@ -430,7 +430,7 @@ def test_mixed_chain_with_continuous_and_prismatic_joints():
     from pathlib import Path
     chain = snakehead.Chain.from_urdf(Path(__file__).parent / "data" / "mixed_chain.urdf", "world", "tool")
     assert "continuous" in chain.joint_types and "prismatic" in chain.joint_types
-    ik = TracIK.from_chain(chain, timeout=0.02, bounds=[0, 0, 0, np.inf, np.inf, np.inf])
+    ik = TracIK.from_chain(chain, timeout=0.02, bounds=[0, 0, 0, np.inf, np.inf, np.inf], seed=10)  # not the clock
     rng = np.random.default_rng(10)
     for _ in range(10):
         T = chain.fk(chain.random_configuration(rng))
