@@ -11,7 +11,9 @@ to a file, atomically. By topic:
 * :mod:`.animation` -- a plan's motion as a GIF (:func:`~.animation.animate`);
 * :mod:`.viewer` -- the interactive 3-D viewer (viser): a standalone HTML page per plan and ``snakehead view``;
 * :mod:`.live` -- the live viewer (``snakehead view --live``): drag the head's targets, the plan follows
-  (:mod:`.live_nodes`: what it draws).
+  (:mod:`.live_nodes`: what it draws; :mod:`.live_panel`: its records, texts and each browser's own panel);
+* :mod:`.server_guard` -- what both servers check before viser sees a request (Host, Origin, the token, the
+  messages a browser may send); :mod:`.save_folder` -- the one folder the live page saves into, bare names only.
 
 >>> from snakehead.viz import save, body
 >>> save(body.plot_snapshots(plan), "snapshots.png")                    # doctest: +SKIP
