@@ -441,8 +441,13 @@ def test_each_tab_saves_to_its_own_file_box(live, tab, folders):
 def test_the_save_folder_takes_bare_names_only(tmp_path, monkeypatch):
     assert bare_name("scene") == "scene.toml" and bare_name("My scene-2.TOML") == "My scene-2.toml"
     assert bare_name("v1.2") == "v1.2.toml"
-    for name in ("/etc/passwd", "../x", "a/b", ".hidden", "a..b", "x.", " x", "CON", "lpt1.toml", "é", 3, None):
-        with pytest.raises(InputError):
+    refused = {"/etc/passwd": "without a folder", "../x": "without a folder", "a/b": "without a folder",
+               ".hidden": "must not start with a dot", "a..b": "must not hold '..'", "x.": "dots \\(not first or last\\)",
+               " x": "dots \\(not first or last\\)", "CON": "device name on Windows",
+               "lpt1.toml": "device name on Windows", "é": "dots \\(not first or last\\)", 3: "must be text, got int",
+               None: "must be text, got NoneType"}
+    for name, message in refused.items():
+        with pytest.raises(InputError, match=message):
             bare_name(name)
     folder = SaveFolder(tmp_path / "saves")
     assert not folder.folder.exists()  # made at the first save
