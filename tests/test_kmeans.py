@@ -9,7 +9,9 @@ import pytest
 from snakehead import InputError
 from snakehead.kinematics.kmeans import kmeans
 
-sklearn_cluster = pytest.importorskip("sklearn.cluster")
+def _sklearn_cluster():
+    """scikit-learn's clustering, for the comparisons only (skipped without it, a failure in CI)."""
+    return pytest.importorskip("sklearn.cluster")
 
 
 def _same_partition(a: np.ndarray, b: np.ndarray) -> bool:
@@ -19,7 +21,7 @@ def _same_partition(a: np.ndarray, b: np.ndarray) -> bool:
 
 def _check_against_sklearn(points: np.ndarray, k: int, seed: int) -> None:
     ours = kmeans(points, k, n_init=10, random_state=seed)
-    ref = sklearn_cluster.KMeans(n_clusters=k, init="k-means++", n_init=10, random_state=seed).fit(points)
+    ref = _sklearn_cluster().KMeans(n_clusters=k, init="k-means++", n_init=10, random_state=seed).fit(points)
     assert _same_partition(ours.labels, ref.labels_)
     # the same clusters; which number each gets is not compared (it follows the seeding's draws, whose near-ties
     # scikit-learn's BLAS and ours may round apart, and scikit-learn is not pinned): the centres of the same clusters
@@ -38,7 +40,7 @@ def test_the_default_maps_g0_is_scikit_learns() -> None:
     m = workspace.map_for(SnakeRobot.default(), progress=False)
     pts = m.dexterous(m.dexterous_threshold())
     _check_against_sklearn(pts, 3, 0)
-    ref = sklearn_cluster.KMeans(n_clusters=3, init="k-means++", n_init=10, random_state=0).fit(pts)
+    ref = _sklearn_cluster().KMeans(n_clusters=3, init="k-means++", n_init=10, random_state=0).fit(pts)
     sizes = np.bincount(ref.labels_, minlength=3)
     largest = ref.cluster_centers_[int(np.argmax(sizes))]
     np.testing.assert_allclose(m.center(), largest, rtol=0, atol=1e-12)
@@ -65,7 +67,7 @@ def test_grid_points_with_ties_agree_with_scikit_learn() -> None:
     rng = np.random.default_rng(0)
     for seed in range(3):
         ours = kmeans(points, 3, random_state=seed)
-        ref = sklearn_cluster.KMeans(n_clusters=3, init="k-means++", n_init=10, random_state=seed).fit(points)
+        ref = _sklearn_cluster().KMeans(n_clusters=3, init="k-means++", n_init=10, random_state=seed).fit(points)
         assert ours.inertia == pytest.approx(ref.inertia_, rel=1e-12)
         assert sorted(np.bincount(ours.labels)) == sorted(np.bincount(ref.labels_))
         _check_against_sklearn(points + 1e-9 * rng.standard_normal(points.shape), 3, seed)
