@@ -205,7 +205,7 @@ class SnakeRobot:
     @property
     def description_arguments(self) -> dict[str, Any]:
         """The arguments this robot's description was read with (``urdf``, ``root``, ``head_axis``, ``packages``,
-        ``limits``, ``xacro_args``, ``source``; a copy): with :attr:`user_frames` and :attr:`map_path`, what builds
+        ``limits``, ``xacro_args``, ``source``, ``robot_file``, ``trust_xacro``; a copy): with :attr:`user_frames` and :attr:`map_path`, what builds
         the same robot again, e.g. in another process."""
         return dict(self._arguments)
 
