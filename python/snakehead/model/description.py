@@ -24,13 +24,11 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError
 from .._validate import MAX_COORDINATE_M, input_file
-from .robot_folders import RobotFolders
+from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .xacro_expansion import expand_xacro
 
 from typing import Any, Mapping
 
-#: A URDF or xacro file larger than this is not a snake's description.
-MAX_DESCRIPTION_BYTES = 16 * 1024 * 1024
 
 #: A collision mesh larger than this is not a snake module's (and would stall the hull).
 MAX_MESH_BYTES = 64 * 1024 * 1024

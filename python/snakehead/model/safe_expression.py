@@ -113,7 +113,7 @@ def evaluate(text: str, lookup: Callable[[str], Any], functions: Mapping[str, An
     except (SyntaxError, ValueError, RecursionError) as exc:
         raise ExpressionError(f"not an expression: {text.strip()!r} ({type(exc).__name__})") from None
     extra = dict(functions or {})
-    callables = {id(f) for f in _callables(SAFE_NAMES)} | {id(f) for f in _callables(extra)}
+    callables = _SAFE_CALLABLES | {id(f) for f in _callables(extra)}
 
     def names(name: str) -> Any:
         try:
@@ -126,7 +126,7 @@ def evaluate(text: str, lookup: Callable[[str], Any], functions: Mapping[str, An
             return SAFE_NAMES[name]
         raise ExpressionError(f"name {name!r} is not defined") from None
 
-    run = _Run(names, frozenset(callables))
+    run = _Run(names, callables)
     try:
         return _value(_eval(tree.body, run))
     except ExpressionError:
@@ -145,6 +145,10 @@ def _callables(names: Mapping[str, Any]) -> list[Any]:
         elif callable(value):
             out.append(value)
     return out
+
+
+#: The functions of SAFE_NAMES, by identity: what an expression may call besides a caller's own.
+_SAFE_CALLABLES = frozenset(id(f) for f in _callables(SAFE_NAMES))
 
 
 def _value(v: Any) -> Any:

@@ -21,11 +21,8 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from .._errors import InputError
-from .robot_folders import RobotFolders
+from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .safe_expression import ExpressionError, Namespace, evaluate
-
-#: An included xacro or a YAML file larger than this is not part of a snake's description.
-MAX_INCLUDED_BYTES = 16 * 1024 * 1024
 
 #: What the error says when a description asks for what only a trusted one may do.
 TRUST_HINT = ("if you trust this description, load it with trust_xacro=True (snakehead --trust-xacro); "
@@ -75,14 +72,15 @@ class _Hooks:
         self.functions = Namespace(arg=self.arg, load_yaml=self.load_yaml, abs_filename=xacro.abs_filename_spec,
                                    dotify=xacro.YamlDictWrapper, tokenize=xacro.tokenize,
                                    **{k: names[k] for k in ("message", "warning", "error", "fatal")})
+        # the names ${...} reads besides the properties: the xacro namespace, and its older names used directly
+        self.names = {"xacro": self.functions, "load_yaml": self.load_yaml, "abs_filename": xacro.abs_filename_spec,
+                      "dotify": xacro.YamlDictWrapper}
 
     # --- ${...} -------------------------------------------------------------------------------------
     def evaluate(self, expr: str, globals: Any, locals: Any = None) -> Any:
         symbols = globals if locals is None else locals
-        extra = {"xacro": self.functions, "load_yaml": self.load_yaml, "abs_filename": self.functions["abs_filename"],
-                 "dotify": self.functions["dotify"]}
         try:
-            return evaluate(expr, lambda name: _property(self.xacro, symbols, name), extra)
+            return evaluate(expr, lambda name: _property(self.xacro, symbols, name), self.names)
         except ExpressionError as exc:
             raise self.xacro.XacroException(f"{exc} ({TRUST_HINT})") from None
 
@@ -91,7 +89,7 @@ class _Hooks:
 
     def load_yaml(self, filename: str) -> Any:
         path = self.folders.inside(self.xacro.abs_filename_spec(str(filename)), "xacro.load_yaml's file",
-                                   MAX_INCLUDED_BYTES)
+                                   MAX_DESCRIPTION_BYTES)
         return self.xacro.load_yaml(os.fspath(path))
 
     # --- includes -------------------------------------------------------------------------------------
@@ -99,7 +97,7 @@ class _Hooks:
         if inp is None and filename is not None:
             where = "the included file" if len(self.xacro.filestack) > 1 else "the xacro file"
             try:
-                path = self.folders.inside(os.path.join(self.xacro.root_dir, filename), where, MAX_INCLUDED_BYTES)
+                path = self.folders.inside(os.path.join(self.xacro.root_dir, filename), where, MAX_DESCRIPTION_BYTES)
             except InputError as exc:
                 raise self.xacro.XacroException(str(exc)) from None
             return self.original["parse"](None, os.fspath(path))
