@@ -233,3 +233,10 @@ def test_allowed_expressions_agree_with_python(expression: str) -> None:
     reference = eval(expression, names)  # the reference: Python itself, on expressions that are safe
     value = evaluate(expression, lambda name: {}[name])
     assert value == (list(reference) if isinstance(reference, (zip, map, filter)) else reference)
+
+
+def test_trust_must_be_said_with_a_boolean(tmp_path: Path) -> None:
+    from snakehead import InputTypeError
+
+    with pytest.raises(InputTypeError, match="trust_xacro must be True or False, got 'yes'"):
+        read_description(_xacro(tmp_path, "m0"), trust_xacro="yes")  # type: ignore[arg-type]
