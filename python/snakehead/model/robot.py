@@ -33,8 +33,11 @@ from .. import _core
 from .._errors import InputError, InputTypeError
 from .._validate import finite_array, joint_vector
 from .chain import Chain, _check_utf8
-from .body_frame import ALIGNED_SUFFIX, HEAD_AXES, STRAIGHT_TOLERANCE, aligned_frames, body_frame
+from .body_frame import (ALIGNED_SUFFIX, AXIS_TOLERANCE_DEG, HEAD_AXES, STRAIGHT_TOLERANCE, NotStraight,
+                         Straightness, aligned_frames, body_frame, straightness)
 from .description import MeshResolver, convex_hull_vertices, read_description, with_joint_limits
+from .mass_properties import with_inertia
+from .description_tree import JointOffsets, TreeChanges, body_description
 
 import numpy.typing as npt
 from typing import TYPE_CHECKING, Any, Mapping
@@ -133,12 +136,14 @@ class SnakeRobot:
                  head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
                  limits: Mapping[str, tuple[float, float]] | None = None,
                  xacro_args: Mapping[str, object] | None = None, robot_file: str | os.PathLike | None = None,
-                 trust_xacro: bool = False) -> None:
+                 trust_xacro: bool = False, home: Mapping[str, float] | None = None,
+                 inertia: str = "urdf", density: float | None = None) -> None:
         self._arguments = {"urdf": urdf, "root": root, "head_axis": head_axis, "packages": packages, "limits": limits,
                            "xacro_args": xacro_args, "source": source, "robot_file": robot_file,
-                           "trust_xacro": trust_xacro}
+                           "trust_xacro": trust_xacro, "home": home, "inertia": inertia, "density": density}
         description = read_description(_urdf_source(urdf), xacro_args, packages=packages, robot_file=robot_file,
                                         trust_xacro=trust_xacro)
+        description = with_inertia(description, inertia, density)  # <inertial> from the shapes, if asked
         names = {"base_end": _frame_name(base_end, "base_end"), "neck_end": _frame_name(neck_end, "neck_end"),
                  "head_tip": _frame_name(head_tip, "head_tip")}
         if head_axis not in HEAD_AXES:
@@ -155,12 +160,17 @@ class SnakeRobot:
         text = description.text
         _check_utf8(text, "urdf")
         root = _core.urdf_root_link(text) if root is None else _frame_name(root, "root")  # the core checks the text
-        raw = _body_chain(text, root, names["head_tip"])
-        text, raw = _bounded(text, raw, root, names["head_tip"], limits or {}, description.source)
+        #: The description's URDF as read (a xacro expanded): what ROS tools take as ``robot_description``.
+        self.description_text = text if _is_xml_text(text) else _core.read_urdf_file(text)
+        text, self.tree_changes, raw = _body_text(text, self.description_text, root, names["head_tip"],
+                                                  limits or {}, _home_table(home), description.source)
+        self.joint_offsets = JointOffsets(np.array([dict(self.tree_changes.home).get(j, 0.0)
+                                                    for j in raw.joint_names]))
         parts = _part_slices(raw, root, names)
         body_in_root = body_frame(raw)
         aligned, text = aligned_frames(text, raw, body_in_root, parts, names, head_axis)
-        #: The URDF text the core reads: the description with limits and aligned frames (a path when unchanged).
+        #: The URDF text the core reads: the description re-rooted, straightened at its home pose, its branches
+        #: lumped, with limits and aligned frames (:mod:`.description_tree`; a path when unchanged).
         self.urdf = text
         self.body = raw if aligned == names else _body_chain(text, root, aligned["head_tip"])
         self._body_in_root = body_in_root
@@ -174,7 +184,9 @@ class SnakeRobot:
     def from_urdf(cls, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
                   root: str | None = None, head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
                   limits: Mapping[str, tuple[float, float]] | None = None,
-                  xacro_args: Mapping[str, object] | None = None, trust_xacro: bool = False) -> "SnakeRobot":
+                  xacro_args: Mapping[str, object] | None = None, trust_xacro: bool = False,
+                  home: Mapping[str, float] | None = None, inertia: str = "urdf",
+                  density: float | None = None) -> "SnakeRobot":
         """A robot from a description (a URDF or ``.xacro`` path, or the URDF XML itself starting with ``<``) and
         the frames that bound its parts.
 
@@ -183,12 +195,19 @@ class SnakeRobot:
         ``package://NAME/...`` meshes. ``limits``: joint -> (lower, upper) rad, needed for ``continuous`` joints.
         ``xacro_args``: the arguments of a xacro file. ``trust_xacro``: expand a xacro with xacro's own Python
         evaluator, the environment and any file (only for a description you trust; by default its expressions are
-        evaluated without running code and it reads only its own folders: SECURITY.md). Raises :class:`~snakehead.InputError` for frames that are
+        evaluated without running code and it reads only its own folders: SECURITY.md). ``home``: joint -> angle
+        (rad) at which the body lies straight (default 0; the planner's angles are the description's minus these,
+        :meth:`description_angles`). ``root`` may lie anywhere on the tree: the body runs from it to ``head_tip``
+        against the tree where it must (:mod:`.description_tree`). Raises :class:`~snakehead.InputError` for frames that are
         missing or out of order, a part without joints, or a body that is not a snake (straight at q = 0,
-        revolute joints about two perpendicular axes across it, collision shapes on the base).
+        revolute joints about two perpendicular axes across it, collision shapes on the base). ``inertia``:
+        ``"urdf"`` (the description's ``<inertial>``) or ``"from_shapes"`` (each link's inertia recomputed from its
+        collision shapes at uniform density, with its URDF mass or, given ``density`` in kg/m^3, the mass that
+        density gives: :mod:`.mass_properties`).
         """
         return cls(urdf, base_end=base_end, neck_end=neck_end, head_tip=head_tip, root=root, head_axis=head_axis,
-                   packages=packages, limits=limits, xacro_args=xacro_args, trust_xacro=trust_xacro)
+                   packages=packages, limits=limits, xacro_args=xacro_args, trust_xacro=trust_xacro, home=home,
+                   inertia=inertia, density=density)
 
     @classmethod
     def from_file(cls, path: str | os.PathLike, *, trust_xacro: bool = False) -> "SnakeRobot":
@@ -200,12 +219,12 @@ class SnakeRobot:
         return cls(spec.urdf, base_end=spec.base_end, neck_end=spec.neck_end, head_tip=spec.head_tip,
                    root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
                    packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args, robot_file=path,
-                   trust_xacro=trust_xacro)
+                   trust_xacro=trust_xacro, home=spec.home, inertia=spec.inertia, density=spec.density)
 
     @property
     def description_arguments(self) -> dict[str, Any]:
         """The arguments this robot's description was read with (``urdf``, ``root``, ``head_axis``, ``packages``,
-        ``limits``, ``xacro_args``, ``source``, ``robot_file``, ``trust_xacro``; a copy): with :attr:`user_frames` and :attr:`map_path`, what builds
+        ``limits``, ``xacro_args``, ``source``, ``robot_file``, ``trust_xacro``, ``home``, ``inertia``, ``density``; a copy): with :attr:`user_frames` and :attr:`map_path`, what builds
         the same robot again, e.g. in another process."""
         return dict(self._arguments)
 
@@ -231,12 +250,16 @@ class SnakeRobot:
         return _joints_before(self.body, link_index)
 
     def _check_snake(self) -> None:
-        for j, a in enumerate(self.joint_axes):
-            if not (np.allclose(np.abs(a), (0, 0, 1), atol=STRAIGHT_TOLERANCE)
-                    or np.allclose(np.abs(a), (0, 1, 0), atol=STRAIGHT_TOLERANCE)):
-                raise InputError(f"joint {self.joint_names[j]!r} turns about {np.round(a, 4).tolist()} in the body "
-                                 "frame (x along the body, z up); a snake's joints turn about its z-axis (yaw) or "
-                                 "y-axis (pitch)")
+        self._check_straight()  # first: a curled body's axes are off its line too
+        off_deg = np.degrees(self.axis_deviations)
+        for j in np.flatnonzero(off_deg > AXIS_TOLERANCE_DEG):
+            a = self.joint_axes[j]
+            error = NotStraight if self.straightness.offset > STRAIGHT_TOLERANCE else InputError
+            raise error(f"joint {self.joint_names[j]!r} turns about {np.round(a, 4).tolist()} in the body "
+                             f"frame (x along the body, z up), {off_deg[j]:.2f} deg off its y- or z-axis (at most "
+                             f"{AXIS_TOLERANCE_DEG:g} deg): a snake's joints turn about its z-axis (yaw) or y-axis "
+                             "(pitch); if the body is not straight at zero, give the robot file a [home] table",
+                             *((self.body,) if error is NotStraight else ()))
         shaped = set(self.shaped_links.tolist())
         segments: dict[int, list[int]] = {}  # the base's rigid segments: links between the same two joints
         for i in self.base_links.tolist():
@@ -405,6 +428,47 @@ class SnakeRobot:
         """(n,) +1 where the axis is +z (yaw) or +y (pitch), -1 where it is -z or -y."""
         a = self.joint_axes
         return np.where(np.where(np.abs(a[:, 2]) > 0.5, a[:, 2], a[:, 1]) > 0, 1.0, -1.0)
+
+    @cached_property
+    def axis_deviations(self) -> np.ndarray:
+        """(n,) each joint axis's angle (rad) from the nearest of the body frame's y- and z-axes at q = 0 (the
+        description's true axes; the yaw/pitch split reads them within :data:`.body_frame.AXIS_TOLERANCE_DEG`)."""
+        a = self.joint_axes / np.linalg.norm(self.joint_axes, axis=1, keepdims=True)
+        out = np.arccos(np.clip(np.maximum(np.abs(a[:, 1]), np.abs(a[:, 2])), -1.0, 1.0))
+        out.setflags(write=False)
+        return out
+
+    @cached_property
+    def straightness(self) -> Straightness:
+        """How far the body at q = 0 (the description's home pose) is from its line: the largest side offset of a
+        frame (m) and which frame. Offsets within the body's half-section are accepted (CAD exports place joint
+        frames a few mm to the side)."""
+        return straightness(self.body)[2]
+
+    @cached_property
+    def half_section(self) -> float:
+        """The base's narrowest half-width across the body (m): the thinnest module's radius."""
+        radii = self.link_capsules[1][self.shaped_base_links]
+        return float(radii.min()) if len(radii) else 0.0
+
+    def _check_straight(self) -> None:
+        st = self.straightness
+        if st.out_of_order or st.offset > self.half_section:
+            where = (f"frame {st.out_of_order[0]!r} lies behind the one before it" if st.out_of_order else
+                     f"frame {st.frame!r} is {1000 * st.offset:.2f} mm off the body's line (at most the body's "
+                     f"half-section, {1000 * self.half_section:.1f} mm)")
+            raise NotStraight(f"the body does not lie straight at its zero: {where}; give the robot file a [home] table "
+                              "of the joint angles at which it lies straight (`snakehead info` suggests one)",
+                              self.body)
+
+    def description_angles(self, q: npt.ArrayLike) -> np.ndarray:
+        """Joint angles (..., n) as the description writes them: the planner's ``q`` plus the home pose (the planner
+        reads the body straight at zero; files written for the robot hold the description's angles)."""
+        return self.joint_offsets.to_description(np.asarray(q, float))
+
+    def body_angles(self, q_description: npt.ArrayLike) -> np.ndarray:
+        """The planner's joint angles (..., n) for the description's (the inverse of :meth:`description_angles`)."""
+        return self.joint_offsets.from_description(np.asarray(q_description, float))
 
     @cached_property
     def joint_arc_lengths(self) -> np.ndarray:
@@ -732,11 +796,22 @@ class SnakeRobot:
 # ------------------------------------------------------------------------------------------------
 # construction steps
 # ------------------------------------------------------------------------------------------------
-def _bounded(text: str, raw: Chain, root: str, head_tip: str, limits: Mapping[str, tuple[float, float]],
-             where: str) -> tuple[str, Chain]:
-    """The description (a path or URDF text) and its body chain with the body's ``continuous`` joints made
-    revolute within ``limits`` (InputError for one without); unchanged when there are none and none are given.
-    Continuous joints off the body (a camera's pan, a wheel) need no limits."""
+def _home_table(home: Mapping[str, float] | None) -> dict[str, float]:
+    """The ``[home]`` table checked: joint name -> finite angle (rad, or m for a prismatic branch joint)."""
+    if home is None:
+        return {}
+    if not isinstance(home, Mapping):
+        raise InputTypeError(f"home must be a mapping of joint name -> angle (rad), got {type(home).__name__}")
+    out = {}
+    for name, value in home.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                or not np.isfinite(value):
+            raise InputError(f"home.{name} must be a finite angle in rad, got {value!r}")
+        out[str(name)] = float(value)
+    return out
+
+
+def _checked_limits(limits: Mapping[str, tuple[float, float]]) -> dict[str, tuple[float, float]]:
     checked = {}
     for name, pair in limits.items():
         try:
@@ -746,12 +821,40 @@ def _bounded(text: str, raw: Chain, root: str, head_tip: str, limits: Mapping[st
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise InputError(f"limits of {name!r} must be finite with lower < upper, got [{lo}, {hi}]")
         checked[str(name)] = (lo, hi)
+    return checked
+
+
+def _body_text(text: str, xml: str, root: str, head_tip: str, limits: Mapping[str, tuple[float, float]],
+               home: Mapping[str, float], where: str) -> tuple[str, TreeChanges, Chain]:
+    """The text the core reads for the body ``root`` -> ``head_tip`` (``text``: a path or URDF text; ``xml``: its
+    XML), what the tree rewrite changed and the body chain: the robot file's limits first (they are the
+    description's angles), then :func:`.description_tree.body_description` (re-rooted, straight at zero, branches
+    lumped). The body's ``continuous`` joints need limits (InputError naming them); those off the body do not."""
+    checked = _checked_limits(limits)
+    if checked:
+        xml = with_joint_limits(xml, checked, where)
+        text = xml
+    rewritten, changes = body_description(xml, root, head_tip, home, where)
+    if rewritten is not None:
+        text = xml = rewritten
+    _check_home_limits(xml, changes, root, head_tip, where)
+    raw = _body_chain(text, root, head_tip)
     needed = [n for n, t in zip(raw.joint_names, raw.joint_types) if t == "continuous"]
-    if not checked and not needed:
-        return text, raw
-    xml = text if _is_xml_text(text) else Path(text).read_text(encoding="utf-8")
-    bounded = with_joint_limits(xml, checked, where, needed=needed)
-    return bounded, _body_chain(bounded, root, head_tip)
+    if needed:
+        with_joint_limits(xml, {}, where, needed=needed)  # raises, naming them
+    return text, changes, raw
+
+
+def _check_home_limits(xml: str, changes: TreeChanges, root: str, head_tip: str, where: str) -> None:
+    """InputError for a home angle outside its joint's limits (the straight body must be a pose the robot takes)."""
+    if not changes.home:
+        return
+    chain = _body_chain(xml, root, head_tip)
+    for name, value in changes.home:
+        j = chain.joint_names.index(name)
+        if not chain.lower[j] <= 0.0 <= chain.upper[j]:
+            raise InputError(f"{where}: home.{name} = {value:.6g} rad lies outside the joint's limits "
+                             f"[{chain.lower[j] + value:.6g}, {chain.upper[j] + value:.6g}]")
 
 
 def _is_xml_text(text: str) -> bool:

@@ -11,12 +11,17 @@
     head_tip = "head_tip"         # the head link frame
     head_axis = "x"               # optional: head_tip's axis that points where the head looks ("x", "y", "z", "-z"...)
     map = "my_snake_head.npz"     # optional: the head's reachability map (relative to this file)
+    inertia = "from_shapes"       # optional: recompute <inertial> from the collision shapes (default "urdf")
+    density = 1200.0              # optional, with from_shapes: kg/m^3 (default: each link's URDF mass)
 
     [packages]                    # optional: package://NAME/... mesh paths (relative to this file); then
     my_snake_description = "."    # ROS_PACKAGE_PATH
 
     [limits]                      # optional; needed for continuous joints: [lower, upper] rad
     joint_3 = [-1.57, 1.57]
+
+    [home]                        # optional: joint angles (rad) at which the body lies straight (default 0);
+    joint_2 = 0.035               # a branch joint (a passive wheel) named here is held at this value
 
 Any link or fixed marker frame of the URDF may be named. The parts are the joints between the frames: base =
 root -> base_end, neck = base_end -> neck_end, head = neck_end -> head_tip (a frame named by a link's name sits at
@@ -38,7 +43,7 @@ from .._validate import file_problem, input_file
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
-OPTIONAL_KEYS = ("root", "map", "head_axis", "xacro_args", "packages", "limits")
+OPTIONAL_KEYS = ("root", "map", "head_axis", "xacro_args", "packages", "limits", "home", "inertia", "density")
 
 #: A robot file is a few lines; anything larger is not one.
 MAX_FILE_BYTES = 64 * 1024
@@ -59,6 +64,9 @@ class RobotFile:
     xacro_args: dict | None = None
     packages: dict | None = None
     limits: dict | None = None
+    home: dict | None = None
+    inertia: str = "urdf"
+    density: float | None = None
 
 
 def read_toml(path: str | os.PathLike, what: str, max_bytes: int = MAX_FILE_BYTES) -> dict:
@@ -121,7 +129,15 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
                      root=_string(data, "root", where) if "root" in data else None, map=map_path,
                      head_axis=_string(data, "head_axis", where) if "head_axis" in data else "x",
                      xacro_args=_xacro_args(data, where), packages=_packages(data, folder, where),
-                     limits=_limits(data, where))
+                     limits=_limits(data, where), home=_home(data, where), **_inertia(data, where))
+
+
+def _inertia(data: dict, where: str) -> dict:
+    """``inertia`` ("urdf" or "from_shapes") and ``density`` (kg/m^3, only with "from_shapes"), checked."""
+    from .mass_properties import check_inertia_source
+
+    inertia, density = check_inertia_source(data.get("inertia", "urdf"), data.get("density"), where)
+    return {"inertia": inertia, "density": density}
 
 
 def _table(data: dict, key: str, where: str) -> dict:
@@ -159,6 +175,15 @@ def _limits(data: dict, where: str) -> dict | None:
         if not ok or not (math.isfinite(value[0]) and math.isfinite(value[1]) and value[0] < value[1]):
             raise InputError(f"{where}: limits.{joint} must be [lower, upper] in rad with lower < upper, got {value!r}")
         out[joint] = (float(value[0]), float(value[1]))
+    return out or None
+
+
+def _home(data: dict, where: str) -> dict | None:
+    out = {}
+    for joint, value in _table(data, "home", where).items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise InputError(f"{where}: home.{joint} must be an angle in rad (a finite number), got {value!r}")
+        out[joint] = float(value)
     return out or None
 
 
