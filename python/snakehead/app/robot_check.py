@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.mass_properties import inertia_source, mass_findings
 from ..model.robot import ALIGNED_SUFFIX, SnakeRobot
 
 #: How far (joints) a suggested split moves base_end and neck_end from the robot file's.
@@ -186,6 +187,10 @@ def check_lines(robot: SnakeRobot, check: RobotCheck) -> list[str]:
                      f"{part.length_m:.4f} m, {part.mass_kg:.3f} kg, {len(part.joints)} joints "
                      f"({' '.join(f'{j}:{k[0]}' for j, k in zip(part.joints, part.kinds))})")
     lines.append(f"head's map: {check.map_line}")
+    lines.append(f"inertia: {inertia_source(robot)}")
+    findings = mass_findings(robot)  # the masses and inertias the core, the stability checks and MuJoCo use
+    lines.append("masses and inertias: " + (f"{len(findings)} implausible" if findings else "plausible"))
+    lines += [f"  MASS: {finding}" for finding in findings]
     if not check.problems:
         lines.append("design: the base holds the lifted neck and head (an initial state and a bending state exist)")
     for note in check.notes:
