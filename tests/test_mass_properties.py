@@ -172,10 +172,15 @@ def test_odd_description_gets_each_finding(tmp_path):
     found = mp.mass_findings(robot)
     kinds = {f.kind for f in found}
     assert {"gyration", "shapeless"} <= kinds, found
-    shell = [f for f in found if f.kind == "gyration" and f.links == ("s3",)]
-    assert len(shell) == 1 and "5.35 m" in shell[0].text and "2.948 kg m^2" in shell[0].text, shell
-    joint = [f for f in found if f.kind == "gyration" and f.links == ("m3",)]
-    assert len(joint) == 1 and "no collision shapes" in joint[0].text and "1 m " in joint[0].text, joint
+    # the 17 modules' identical findings come as one line each, naming the links
+    shell = [f for f in found if f.kind == "gyration" and "s3" in f.links]
+    assert len(shell) == 1 and shell[0].links == tuple(f"s{k}" for k in range(17)), shell
+    assert shell[0].text.startswith("17 links ('s0', 's1', 's2', 's3', 's4', 's5' and 11 more) each: radius of "
+                                    "gyration 5.35 m (inertia 2.948 kg m^2, mass 0.103 kg) is 151 times"), shell
+    joint = [f for f in found if f.kind == "gyration" and "m3" in f.links]
+    assert len(joint) == 1 and len(joint[0].links) == 17, joint
+    assert "(no collision shapes): radius of gyration 1 m (inertia 1 kg m^2, mass 1 kg) is 28 times" in joint[0].text
+    assert len(found) == 3, found
     (shapeless,) = [f for f in found if f.kind == "shapeless"]
     assert set(shapeless.links) == {f"m{k}" for k in range(17)}
     assert "17 kg of the robot's 18.75 kg (90.7 %)" in shapeless.text and "'m0' 1 kg" in shapeless.text, shapeless
@@ -199,6 +204,7 @@ def test_mass_share_and_density(tmp_path):
     dense = {f.links[0]: f.text for f in found if f.kind == "density"}
     assert set(dense) == {"s5", "s9"}, found
     assert "denser than any metal" in dense["s5"] and "lighter than foam" in dense["s9"]
+    assert dense["s5"].startswith("link 's5': 10 kg in") and dense["s9"].startswith("link 's9': 0.0005 kg in")
     assert "98.17 cm^3" in dense["s5"], dense
     assert not [f for f in found if f.kind in ("gyration", "shapeless")], found
     good = SnakeRobot.from_file(write_odd(tmp_path, joint_mass=0, shell_moments=tuple(np.diag(shell_by_hand(0.2))),
@@ -242,9 +248,10 @@ def test_from_shapes_core_and_mujoco(tmp_path, mujoco):
     assert not np.allclose(I, link_inertia(urdf_robot, "s4")[2])
     # the joint links have no shapes: they keep the URDF's numbers (and the findings say so)
     np.testing.assert_array_equal(link_inertia(robot, "m4")[2], np.eye(3))
-    kinds = {(f.kind, f.links[0]) for f in mp.mass_findings(robot)}
-    assert ("gyration", "s4") not in kinds and ("gyration", "m4") in kinds
-    assert "links without shapes keep the URDF's: 'm0'" in mp.inertia_source(robot)
+    kinds = {(f.kind, link) for f in mp.mass_findings(robot) for link in f.links}
+    assert ("gyration", "s4") not in kinds and ("gyration", "m4") in kinds and ("shapeless", "m4") in kinds
+    assert "links without shapes keep the URDF's: 'm0', 'm1', 'm2', 'm3', 'm4', 'm5' and 11 more" in \
+        mp.inertia_source(robot)
     # the core's chain and MuJoCo's bodies hold the same numbers
     chain = robot.body.model
     k = robot.link_index("s4")

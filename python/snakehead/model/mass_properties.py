@@ -341,7 +341,7 @@ def findings_of(names: list[str], masses: np.ndarray, inertias: np.ndarray,
     inertias = np.asarray(inertias, float)
     total = float(masses.sum())
     largest = max((e for e, _ in extents.values()), default=0.0)
-    out: list[Finding] = []
+    per_link: list[tuple[str, str, str]] = []  # (kind, link, text with _WHO for the link)
     for k, name in enumerate(names):
         m = float(masses[k])
         if m <= 0:
@@ -349,32 +349,33 @@ def findings_of(names: list[str], masses: np.ndarray, inertias: np.ndarray,
         moments = np.linalg.eigvalsh(0.5 * (inertias[k] + inertias[k].T))
         a, b, c = moments
         if a + b < c - TRIANGLE_TOLERANCE * max(abs(a), abs(c)):
-            out.append(Finding("triangle", (name,), f"link {name!r}: principal moments {a:.4g}, {b:.4g}, {c:.4g} "
+            per_link.append(("triangle", name, f"{_WHO}: principal moments {a:.4g}, {b:.4g}, {c:.4g} "
                                                     f"kg m^2 violate the triangle inequality ({a:.4g} + {b:.4g} < "
                                                     f"{c:.4g}): no body has them"))
         gyration = math.sqrt(max(c, 0.0) / m)
         extent, volume = extents.get(k, (None, 0.0))
         if extent is not None and gyration > GYRATION_FACTOR * extent:
-            out.append(Finding("gyration", (name,), f"link {name!r}: radius of gyration {gyration:.3g} m "
+            per_link.append(("gyration", name, f"{_WHO}: radius of gyration {gyration:.3g} m "
                                                     f"(inertia {c:.4g} kg m^2, mass {_kg(m)}) is "
                                                     f"{gyration / extent:.0f} times its collision shapes' extent "
                                                     f"({extent:.3g} m from its centre of mass); more than "
                                                     f"{GYRATION_FACTOR:g} times cannot be the part"))
         elif extent is None and largest > 0 and gyration > GYRATION_FACTOR * largest:
-            out.append(Finding("gyration", (name,), f"link {name!r} (no collision shapes): radius of gyration "
+            per_link.append(("gyration", name, f"{_WHO} (no collision shapes): radius of gyration "
                                                     f"{gyration:.3g} m (inertia {c:.4g} kg m^2, mass {_kg(m)}) is "
                                                     f"{gyration / largest:.0f} times the largest link's extent "
                                                     f"({largest:.3g} m); more than {GYRATION_FACTOR:g} times cannot "
                                                     "be a module's part"))
         if volume > 0 and not MIN_DENSITY <= m / volume <= MAX_DENSITY:
             what = "denser than any metal" if m / volume > MAX_DENSITY else "lighter than foam"
-            out.append(Finding("density", (name,), f"link {name!r}: {_kg(m)} in {1e6 * volume:.4g} cm^3 of collision "
+            per_link.append(("density", name, f"{_WHO}: {_kg(m)} in {1e6 * volume:.4g} cm^3 of collision "
                                                    f"shapes is {m / volume:.4g} kg/m^3, {what}"))
+    out = _grouped(per_link)
     shapeless = [k for k in range(len(names)) if masses[k] > 0 and k not in extents]
     if shapeless and total > 0:
         held = float(masses[shapeless].sum())
-        listed = ", ".join(f"{names[k]!r} {_kg(masses[k])}" for k in shapeless[:6])
-        more = f" and {len(shapeless) - 6} more" if len(shapeless) > 6 else ""
+        listed = ", ".join(f"{names[k]!r} {_kg(masses[k])}" for k in shapeless[:_LISTED])
+        more = f" and {len(shapeless) - _LISTED} more" if len(shapeless) > _LISTED else ""
         out.append(Finding("shapeless", tuple(names[k] for k in shapeless),
                            f"{_kg(held)} of the robot's {_kg(total)} ({100 * held / total:.1f} %) sits on "
                            f"{len(shapeless)} link{'s' if len(shapeless) > 1 else ''} without collision shapes: "
@@ -390,6 +391,27 @@ def findings_of(names: list[str], masses: np.ndarray, inertias: np.ndarray,
     return out
 
 
+_WHO = "\x00"  # where a per-link finding's text names its link(s)
+_LISTED = 6  # names listed in one finding before "and N more"
+
+
+def _names(links: list[str]) -> str:
+    more = f" and {len(links) - _LISTED} more" if len(links) > _LISTED else ""
+    return ", ".join(map(repr, links[:_LISTED])) + more
+
+
+def _grouped(per_link: list[tuple[str, str, str]]) -> list[Finding]:
+    """Per-link findings, those of the same kind and numbers on several links (a module repeated) as one."""
+    groups: dict[tuple[str, str], list[str]] = {}
+    for kind, link, text in per_link:
+        groups.setdefault((kind, text), []).append(link)
+    out = []
+    for (kind, text), links in groups.items():
+        who = f"link {links[0]!r}" if len(links) == 1 else f"{len(links)} links ({_names(links)}) each"
+        out.append(Finding(kind, tuple(links), text.replace(_WHO, who)))
+    return out
+
+
 def inertia_source(robot: SnakeRobot) -> str:
     """Which inertial data the robot uses, as a line for ``snakehead info``."""
     args = robot.description_arguments
@@ -401,5 +423,5 @@ def inertia_source(robot: SnakeRobot) -> str:
     kept = [n for k, n in enumerate(robot.link_names) if robot.masses[k] > 0 and k not in shaped]
     line = f"recomputed from the collision shapes (uniform density, {how})"
     if kept:
-        line += f"; links without shapes keep the URDF's: {', '.join(map(repr, kept))}"
+        line += f"; links without shapes keep the URDF's: {_names(kept)}"
     return line
