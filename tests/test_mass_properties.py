@@ -353,3 +353,20 @@ def test_robot_file_reads_the_keys(tmp_path):
     assert (spec.inertia, spec.density) == ("urdf", None)
     with pytest.raises(InputError, match="'inertia' must be one of"):
         SnakeRobot.from_urdf(odd_urdf(), base_end="m10", neck_end="m12", head_tip="head_tip", inertia="shapes")
+
+
+@pytest.mark.parametrize("geometry, match", [
+    ('<cylinder radius="0" length="0.05"/>', r"link 's2' <collision> 1 <cylinder> radius must be positive"),
+    ('<box size="0.1 0.02"/>', r"link 's2' <collision> 1 <box> size must be 3 finite numbers"),
+    ('<mesh filename="missing.stl"/>', r"link 's2' <collision> 1: mesh file .*missing\.stl"),
+    ('<capsule radius="0.02" length="0.05"/>', r"link 's2' <collision> 1 has an unknown shape <capsule>")])
+def test_from_shapes_bad_shapes_name_the_link(tmp_path, geometry, match):
+    path = write_odd(tmp_path, 'inertia = "from_shapes"\n')
+    urdf = tmp_path / "odd.urdf"
+    text = urdf.read_text()
+    start = text.index('<link name="s2">')
+    a = text.index("<geometry>", start) + len("<geometry>")
+    urdf.write_text(text[:a] + geometry + text[text.index("</geometry>", a):])
+    with pytest.raises(InputError, match=match) as err:
+        SnakeRobot.from_file(path)
+    assert "\n" not in str(err.value)
