@@ -34,6 +34,9 @@ ROBOTS = {
                     lambda: generated(13, 0.10, 0.06, 0.3, "pitch", head=6, neck=1)),
     "heavy": ("30 joints, 15 cm, 8 cm, 0.5 kg", lambda: generated(30, 0.15, 0.08, 0.5)),
     "light": ("8 joints, 5 cm, 3 cm, 0.1 kg", lambda: generated(8, 0.05, 0.03, 0.1, head=6, neck=1)),
+    # issue 34 item 9: the neck has no pitch joint (its lifting part is empty)
+    "yaw_neck": ("13 joints, a one-joint yaw neck before a pitch-first 6-DOF head, 10 cm, 6 cm, 0.3 kg",
+                 lambda: generated(13, 0.10, 0.06, 0.3, "yaw", head=6, neck=1)),
 }
 ROBOTS.update({f"published:{style}": (f"published style {style!r}", lambda style=style: published_style(style))
                for style in published.STYLES})

@@ -202,6 +202,19 @@ class HeadController:
         return nk.RangeCheck(False, float("nan"), 0.0, 0.0, "the neck has no pitch joint: it cannot lift the head's "
                              "base (name a base_end before a pitch joint to give the neck one)")
 
+    def _solve_lift(self, P0_frame: np.ndarray, goal: nk.NeckGoal, q_init: np.ndarray) -> nk.NeckSolution:
+        """Eqs. 18-22 over the neck's lifting joints from the lift frame P0_frame. A neck without a pitch joint
+        (a one-joint yaw neck before a pitch-first head) has none: its lift frame is the neck's end, the chain
+        between them would have no link, and B0 is P0_frame itself."""
+        if self.robot.lift_joints.start < self.robot.lift_joints.stop:
+            return nk.solve_neck(self.robot.lift_chain, P0_frame, goal, q_init=q_init)
+        ra = P0_frame[:3, 0]
+        error = P0_frame[:3, 3] - goal.P_d
+        cost = float(error @ error + nk.DEFAULT_H * np.sum(np.cross(goal.r_d, ra) ** 2))
+        return nk.NeckSolution(q=np.zeros(0), frame=P0_frame.copy(), cost=cost,
+                               position_error_m=float(np.linalg.norm(error)),
+                               direction_error_deg=head_ik.angle_between_deg(ra, goal.r_d))
+
     def _solve_from(self, base: BasePlacement, q: np.ndarray, desired: np.ndarray, keep_close: bool,
                     accept: Callable[..., bool] | None = None) -> HeadSolution:
         """Steps 3-5 with the base where it is: the neck by Eqs. 18-22, the head by TRAC-IK, the static check."""
@@ -217,7 +230,7 @@ class HeadController:
         q[parts.neck.start:lift.start] = self.q_initial[parts.neck.start:lift.start]
         P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
         goal = nk.neck_goal(P0_frame[:3, 3], position, self.Lc)
-        neck = nk.solve_neck(self.robot.lift_chain, P0_frame, goal, q_init=q[lift])
+        neck = self._solve_lift(P0_frame, goal, q[lift])
         q[lift] = neck.q
         timings["neck"] = time.perf_counter() - t0
 
