@@ -45,6 +45,9 @@ from .generate import SnakeSpec, holding_effort, snake_urdf
 from .._errors import InputError, InputTypeError
 
 STYLES = ("sea", "reu", "rsnake", "mesh", "xacro", "one_joint_neck", "head6")
+#: Styles with the quirks of descriptions found in public repositories (model/published_quirks.py).
+QUIRK_STYLES = ("cad", "reu_reversed", "wheeled", "cmu_masses", "backwards_head")
+ALL_STYLES = STYLES + QUIRK_STYLES
 
 HALF_PI = math.pi / 2
 
@@ -124,13 +127,20 @@ DEFAULT_SPECS = {
     "one_joint_neck": StyleSpec(n_joints=14, module_length=0.0865, thickness=0.043, neck_joints=1,
                                 name="snake_one_joint_neck"),
     "head6": StyleSpec(n_joints=16, module_length=0.0865, thickness=0.043, head_joints=6, name="snake_head6"),
+    # the quirk styles: a student snake's 72.4 mm modules; the SEA module; the default's; the ReU's 1.103 kg
+    "cad": StyleSpec(n_joints=16, module_length=0.0724, thickness=0.045, name="cad_snake_sw"),
+    "reu_reversed": StyleSpec(n_joints=16, module_length=0.0639, thickness=0.052, name="reu_reversed"),
+    "wheeled": StyleSpec(n_joints=16, module_length=0.0865, thickness=0.043, name="wheeled_snake"),
+    "cmu_masses": StyleSpec(n_joints=16, module_length=0.066, thickness=0.0508, mass_per_module=1.103,
+                            name="cmu_masses"),
+    "backwards_head": StyleSpec(n_joints=16, module_length=0.0865, thickness=0.043, name="backwards_head"),
 }
 
 
 def style_spec(style: str, **overrides: Any) -> StyleSpec:
     """The numbers ``write_robot(style, ...)`` uses: the style's defaults with ``overrides`` (StyleSpec fields)."""
     if style not in DEFAULT_SPECS:
-        raise InputError(f"unknown style {style!r} (known: {', '.join(STYLES)})")
+        raise InputError(f"unknown style {style!r} (known: {', '.join(ALL_STYLES)})")
     fields = {f.name for f in dataclasses.fields(StyleSpec)}
     unknown = sorted(set(overrides) - fields)
     if unknown:
@@ -140,12 +150,16 @@ def style_spec(style: str, **overrides: Any) -> StyleSpec:
 
 
 def write_robot(style: str, folder: str | os.PathLike, **overrides: Any) -> Path:
-    """Write the sample robot ``style`` (one of :data:`STYLES`) into ``folder`` (created if needed): its description,
+    """Write the sample robot ``style`` (one of :data:`ALL_STYLES`) into ``folder`` (created if needed): its description,
     its meshes and its robot file. ``overrides`` replace the style's numbers (:class:`StyleSpec` fields, e.g.
     ``n_joints=14``). Returns the robot file's path."""
     spec = style_spec(style, **overrides)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
+    if style in QUIRK_STYLES:
+        from .published_quirks import QUIRK_WRITERS  # it builds on this module's pieces
+
+        return QUIRK_WRITERS[style](spec, out)
     return _WRITERS[style](spec, out)
 
 
