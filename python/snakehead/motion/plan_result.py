@@ -13,6 +13,7 @@ from ..geometry import collision as coll
 from ..margins import EXACT_DISTANCE_WITHIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene
+from .fallbacks import tried_message
 
 if TYPE_CHECKING:
     from .base_choice import Relocation
@@ -102,6 +103,7 @@ class Plan:
     timing_failure: str | None = None  # why the path could not be timed within the limits, when it could not
     out_of_range: str | None = None  # why no relocation was tried: a target beyond MAX_RELOCATION_M of the start
     motion_proof: Any = None  # geometry.path_check.MotionReport of the motion (None: not checked)
+    attempts: list = field(default_factory=list)  # what was tried before the plan failed (motion.fallbacks)
 
     @property
     def min_zmp_margin_m(self) -> float:
@@ -138,7 +140,12 @@ class Plan:
     @property
     def failure(self) -> str | None:
         """None when the plan succeeds, else the first reason it does not (a target not solved, the ZMP leaving the
-        support polygon, a link in the ground, a link touching an obstacle)."""
+        support polygon, a link in the ground, a link touching an obstacle), and what the planner tried before it
+        gave up (``attempts``: ``motion.fallbacks``)."""
+        reason = self._first_failure()
+        return None if reason is None else tried_message(reason, self.attempts)
+
+    def _first_failure(self) -> str | None:
         for tg in self.targets:
             if not tg.solved:
                 why = self.out_of_range if self.out_of_range is not None else tg.solution.message

@@ -41,6 +41,7 @@ from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene, Target
 from . import plan_bounds
 from .base_choice import choose_base, out_of_range, shape_of
+from .fallbacks import retime_slower
 from .plan_bounds import check_size, check_timing
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
 from .start_state import LIFT_STEPS, bending_state
@@ -153,9 +154,17 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     q = _lift(way, controller, q_shape)
     run = _Run(controller, scene, lines, chosen, obstacles, way, notes, solved, report)
     run.reach_targets(q)
+    reached_at = [tg.time_s for tg in run.results]  # waypoint indices: _finish turns them into times
+
+    def finish(options: dict[str, Any] | None) -> Plan:
+        for tg, k in zip(run.results, reached_at):
+            tg.time_s = k
+        way.timing_failure = None
+        return _finish(scene.name, way, run.results, t_start, obstacles=obstacles, notes=notes, scene=scene,
+                       timing=options, stage=report.stage)
+
     try:
-        plan = _finish(scene.name, way, run.results, t_start, obstacles=obstacles, notes=notes, scene=scene,
-                       timing=timing, stage=report.stage)
+        plan = retime_slower(finish, timing, finish(timing))
     except MotionTooLong as exc:
         raise MotionTooLong(f"scene {scene.name!r}: {exc}: split the scene into scenes planned one after the other"
                             ) from None

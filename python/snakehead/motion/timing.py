@@ -847,7 +847,8 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
                  sd: np.ndarray, support: Support, only: np.ndarray | None = None) -> np.ndarray:
     """(N-1,) bool: the stages of a solution that break a limit between their gridpoints (TOPP-RA keeps the limits
     at the gridpoints only). Probed at PROBES points inside each stage, with its constant path acceleration; the
-    ZMP against the support polygon of the nearer gridpoint. ``only``: (N-1,) bool, the stages to probe (the others
+    ZMP against the support polygon of the nearer gridpoint, or the probe's own where the stage's two gridpoints
+    stand on different polygons (:func:`_probe_support`). ``only``: (N-1,) bool, the stages to probe (the others
     are reported within the limits)."""
     x = sd ** 2
     ds = np.diff(grid)
@@ -863,8 +864,7 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     nearer = np.where(fr < 0.5, stage, stage + 1)
     dyn = newton_euler(robot, q, qd, qdd, base)  # in the core along q: no frames array, the CoM with it
     assert dyn.com is not None
-    sub = Support(support.normal[nearer], support.offset[nearer], dyn.com, support.static[nearer],
-                  support.required[nearer])
+    sub = _probe_support(robot, base, limits, support, q, stage, nearer, dyn.com)
     r = _ratios(robot, base, limits, sub, q, qd, qdd, dyn=dyn)
     over = np.zeros(len(s), bool)
     for key in ("velocity", "acceleration", "torque", "friction"):
@@ -873,3 +873,22 @@ def _stages_over(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     bad = np.zeros(len(ds), bool)
     bad[stage[over]] = True
     return bad
+
+
+def _probe_support(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits, support: Support, q: np.ndarray,
+                   stage: np.ndarray, nearer: np.ndarray, com: np.ndarray) -> Support:
+    """The support the probes q (M, n) of stages ``stage`` (M,) are checked against: the nearer gridpoint's
+    (``nearer`` (M,)), except in a stage whose two gridpoints stand on different polygons (a link touches down or
+    lifts off between them), where each probe's own polygon is computed: the plan's check takes every 2 ms sample's
+    own, and a link lifting between gridpoints narrows it there (a heavy ReU-like snake's lift passed the retiming
+    with its ZMP 3.3 mm from an edge the gridpoints did not have)."""
+    a, b = stage, stage + 1
+    changed = (np.any(support.offset[a] != support.offset[b], axis=1)
+               | np.any(support.normal[a] != support.normal[b], axis=(1, 2)))
+    near = Support(support.normal[nearer], support.offset[nearer], com, support.static[nearer],
+                   support.required[nearer])
+    if not changed.any():
+        return near
+    own = Support.of(robot, q[changed], base, limits.zmp_margin)
+    order = np.argsort(np.concatenate([np.flatnonzero(~changed), np.flatnonzero(changed)]), kind="stable")
+    return near.take(np.flatnonzero(~changed)).joined(own).take(order)

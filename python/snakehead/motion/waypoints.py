@@ -311,6 +311,7 @@ class Waypoints:
         # the plan checks its 2 ms samples itself (_finish: the ZMP by the paper's momenta, the ground, obstacles);
         # the retiming keeps the joint limits between its gridpoints by refining them
         timing = dict(timing, check_samples=False)
+        self._lift_rows = None  # set again below when this timing uses a kept lift (a plan may be timed again)
         hold_s = np.zeros(len(self.qs) - 1)
         for k, seconds in self.holds.items():
             hold_s[k] = seconds
