@@ -150,8 +150,9 @@ def test_bad_robots(tmp_path):
     about_x = URDF.replace('<axis xyz="0 1 0"/>', '<axis xyz="1 0 0"/>', 1)
     with pytest.raises(ValueError, match="turns about"):
         SnakeRobot.from_urdf(about_x, base_end="p0", neck_end="b0", head_tip="head_tip")
-    bent = URDF.replace('<origin xyz="0.0865 0 0" rpy="0 0 0"/>\n    <axis', '<origin xyz="0.0865 0.01 0" rpy="0 0 0"/>\n    <axis', 1)
-    with pytest.raises(ValueError, match="straight"):
+    # a joint 8 cm to the side: beyond the body's half-section (21.5 mm), so not a CAD offset but a bent body
+    bent = URDF.replace('<origin xyz="0.0865 0 0" rpy="0 0 0"/>\n    <axis', '<origin xyz="0.0865 0.08 0" rpy="0 0 0"/>\n    <axis', 1)
+    with pytest.raises(ValueError, match=r"does not lie straight at its zero: frame '\w+' is \d+\.\d+ mm off the body's line .*\[home\]"):
         SnakeRobot.from_urdf(bent, base_end="p0", neck_end="b0", head_tip="head_tip")
     no_boxes = URDF.replace("<collision>", "<!--").replace("</collision>", "-->")
     with pytest.raises(ValueError, match="collision> shape"):

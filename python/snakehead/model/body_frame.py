@@ -9,6 +9,8 @@ the planner can read their axes as the paper does.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .._errors import InputError
@@ -17,10 +19,14 @@ from .description import add_fixed_frames
 
 from pathlib import Path
 
-#: How far (rad) a joint axis may be from the body frame's y- or z-axis, and how far (m) a frame may be from the
-#: body axis at q = 0, for the body to count as a straight snake with yaw and pitch joints (URDFs write pi/2 as
-#: 1.5708: 4e-6 rad off).
+#: Below this (rad, m) two frames turn and sit alike: a frame within it of the body frame's orientation needs no
+#: aligned twin (URDFs write pi/2 as 1.5708: 4e-6 rad off).
 STRAIGHT_TOLERANCE = 1e-4
+
+#: How far (deg) a joint axis may be from the body frame's y- or z-axis to count as a pitch or yaw joint. Published
+#: descriptions write right angles as 1.57 (0.05 deg off) or drift by a few tenths of a degree in CAD exports;
+#: the kinematics keeps the true axes, the planner's yaw/pitch split reads them within this.
+AXIS_TOLERANCE_DEG = 1.0
 
 #: The suffix of the aligned twin of a frame.
 ALIGNED_SUFFIX = "__aligned"
@@ -29,11 +35,78 @@ ALIGNED_SUFFIX = "__aligned"
 HEAD_AXES = {"x": 0, "y": 1, "z": 2, "-x": 0, "-y": 1, "-z": 2}
 
 
+@dataclass(frozen=True)
+class Straightness:
+    """How far the body at q = 0 is from a straight line: the largest side offset of a frame from the fitted line
+    (m) and that frame, and the frames out of order along it."""
+
+    offset: float
+    frame: str
+    out_of_order: tuple[str, ...] = ()
+
+
+class NotStraight(InputError):
+    """The body does not lie straight at the robot's zero (its home pose): the message says where; ``chain`` is
+    the body, for :func:`suggest_home`."""
+
+    def __init__(self, message: str, chain: Chain) -> None:
+        super().__init__(message)
+        self.chain = chain
+
+
+def _body_line(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The line fitted to points p (k, 3) by least squares: a point on it and its unit direction, pointing from
+    the first point towards the last."""
+    centre = p.mean(axis=0)
+    d = np.linalg.svd(p - centre)[2][0] if len(p) > 2 else p[-1] - p[0]
+    d = d / np.linalg.norm(d)
+    return centre, d if (p[-1] - p[0]) @ d >= 0 else -d
+
+
+def straightness(body: Chain, q: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, Straightness]:
+    """The body's line at ``q`` (default 0): a point on it, its direction (first joint -> head tip) and how far the
+    frames are from it. Frames before the first joint (a dummy root, a base link placed elsewhere) are left out."""
+    F = body.fk_all(np.zeros(body.n_joints) if q is None else q)
+    p = F[:, :3, 3]
+    child = np.asarray(body.model.joint_child_links)
+    first = int(child[0]) if len(child) else 0
+    if not np.linalg.norm(p[-1] - p[first]) > STRAIGHT_TOLERANCE:
+        raise InputError("the head tip lies on the first joint at q = 0: the body has no length")
+    centre, d = _body_line(p[first:])
+    rel = p[first:] - centre
+    s = rel @ d
+    off = np.linalg.norm(rel - np.outer(s, d), axis=1)
+    k = int(np.argmax(off))
+    back = tuple(body.link_names[first + i + 1] for i in np.flatnonzero(np.diff(s) < -STRAIGHT_TOLERANCE))
+    return centre, d, Straightness(float(off[k]), body.link_names[first + k], back)
+
+
+def suggest_home(body: Chain) -> np.ndarray:
+    """Joint angles (n,) at which the body lies straight, by least squares from q = 0 within the limits: the side
+    offsets of the frames from the line through the first joint and the head tip, with a small pull towards 0."""
+    from scipy.optimize import least_squares
+
+    child = np.asarray(body.model.joint_child_links)
+    first = int(child[0]) if len(child) else 0
+    reach = max(body.reach, STRAIGHT_TOLERANCE)
+
+    def residuals(q: np.ndarray) -> np.ndarray:
+        p = body.fk_all(q)[first:, :3, 3]
+        d = p[-1] - p[0]
+        d = d / max(np.linalg.norm(d), STRAIGHT_TOLERANCE)
+        rel = p - p[0]
+        return np.concatenate([(rel - np.outer(rel @ d, d)).ravel() / reach, 1e-3 * q])
+
+    lo = np.where(np.isfinite(body.lower), body.lower, -np.pi)
+    hi = np.where(np.isfinite(body.upper), body.upper, np.pi)
+    return least_squares(residuals, np.clip(np.zeros(body.n_joints), lo, hi), bounds=(lo, hi), x_scale=1.0).x
+
+
 def body_frame(body: Chain) -> np.ndarray:
-    """The body frame (4, 4) in the root frame: x along the straight body's line (from the first joint to the head
-    tip) towards the head, z the joint-axis direction nearest the root frame's z (then x, then y), origin the
-    root's projection on the line.
-    InputError when the body is not straight at q = 0 or a joint axis is not across it."""
+    """The body frame (4, 4) in the root frame: x along the line fitted to the frames at q = 0 (from the first joint
+    towards the head tip), z the joint-axis direction nearest the root frame's z (then x, then y), origin the
+    root's projection on the line. How straight the body is: :func:`straightness` (SnakeRobot checks it against
+    the body's section). InputError for joints that are not revolute."""
     if set(body.joint_types) - {"revolute"}:
         raise InputError(f"a snake robot's joints are revolute with limits; this body has "
                          f"{sorted(set(body.joint_types))} joints (give continuous joints limits in the robot file's "
@@ -41,20 +114,7 @@ def body_frame(body: Chain) -> np.ndarray:
     F = body.fk_all(np.zeros(body.n_joints))
     p = F[:, :3, 3]
     child = np.asarray(body.model.joint_child_links)
-    # the line runs from the first joint (its link's origin) to the head tip; frames before the first joint (a
-    # dummy root, a base link placed elsewhere) may lie off it
-    first = int(child[0]) if len(child) else 0
-    d = p[-1] - p[first]
-    if not np.linalg.norm(d) > STRAIGHT_TOLERANCE:
-        raise InputError("the head tip lies on the first joint at q = 0: the body has no length")
-    d /= np.linalg.norm(d)
-    s = (p[first:] - p[first]) @ d
-    off = np.linalg.norm((p[first:] - p[first]) - np.outer(s, d), axis=1)
-    if off.max() > STRAIGHT_TOLERANCE or np.any(np.diff(s) < -STRAIGHT_TOLERANCE):
-        k = int(np.argmax(off)) if off.max() > STRAIGHT_TOLERANCE else int(np.argmin(np.diff(s))) + 1
-        raise InputError(f"the body does not lie straight at q = 0: frame {body.link_names[first + k]!r} is "
-                         f"{1000 * off[k]:.2f} mm off the line from the first joint to the head tip (or out of "
-                         "order); a snake's frames lie on one line, in order, when its joints are at zero")
+    centre, d, _ = straightness(body)
     axes = np.einsum("jik,jk->ji", F[child, :3, :3], np.asarray(body.model.joint_axes, float))
     across = axes - np.outer(axes @ d, d)
     up = None
@@ -71,7 +131,7 @@ def body_frame(body: Chain) -> np.ndarray:
         up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0.5 else np.cross(d, np.eye(3)[1])
     T = np.eye(4)
     T[:3, 0], T[:3, 1], T[:3, 2] = d, np.cross(up, d), up
-    T[:3, 3] = p[first] - ((p[first] - p[0]) @ d) * d  # the root's projection on the line
+    T[:3, 3] = centre + ((p[0] - centre) @ d) * d  # the root's projection on the line
     return T
 
 

@@ -125,18 +125,31 @@ def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], wher
     return ET.tostring(root, encoding="unicode")
 
 
-def _origin_matrix(joint: ET.Element) -> np.ndarray:
+def origin_matrix(element: ET.Element, where: str = "origin") -> np.ndarray:
+    """The pose (4, 4) an element's ``<origin xyz rpy>`` gives (identity without one); InputError naming ``where``
+    and the attribute for one that is not three finite numbers."""
     from scipy.spatial.transform import Rotation
 
     T = np.eye(4)
-    origin = joint.find("origin")
-    if origin is not None:
-        T[:3, 3] = [float(v) for v in origin.get("xyz", "0 0 0").split()]
-        T[:3, :3] = Rotation.from_euler("xyz", [float(v) for v in origin.get("rpy", "0 0 0").split()]).as_matrix()
+    origin = element.find("origin")
+    if origin is None:
+        return T
+    values = {}
+    for key in ("xyz", "rpy"):
+        text = origin.get(key, "0 0 0")
+        try:
+            values[key] = np.array([float(v) for v in text.split()])
+        except ValueError:
+            values[key] = np.zeros(0)
+        if values[key].shape != (3,) or not np.all(np.isfinite(values[key])):
+            raise InputError(f"{where}: <origin {key}> must be three finite numbers, got {text!r}")
+    T[:3, 3] = values["xyz"]
+    T[:3, :3] = Rotation.from_euler("xyz", values["rpy"]).as_matrix()
     return T
 
 
-def _set_origin(joint: ET.Element, T: np.ndarray) -> None:
+def set_origin(joint: ET.Element, T: np.ndarray) -> None:
+    """Write T (4, 4) as the element's ``<origin xyz rpy>``."""
     from scipy.spatial.transform import Rotation
 
     origin = joint.find("origin")
@@ -162,12 +175,12 @@ def add_fixed_frames(text: str, frames: list[tuple[str, str, np.ndarray]]) -> st
             p = joint.find("parent")
             if p is not None and p.get("link") == parent:
                 p.set("link", name)
-                _set_origin(joint, inv @ _origin_matrix(joint))
+                set_origin(joint, inv @ origin_matrix(joint, f"joint {joint.get('name')!r}"))
         ET.SubElement(root, "link", {"name": name})
         joint = ET.SubElement(root, "joint", {"name": name + "_joint", "type": "fixed"})
         ET.SubElement(joint, "parent", {"link": parent})
         ET.SubElement(joint, "child", {"link": name})
-        _set_origin(joint, T)
+        set_origin(joint, T)
     return ET.tostring(root, encoding="unicode")
 
 

@@ -250,16 +250,6 @@ class SnakeRobot:
         return _joints_before(self.body, link_index)
 
     def _check_snake(self) -> None:
-        self._check_straight()  # first: a curled body's axes are off its line too
-        off_deg = np.degrees(self.axis_deviations)
-        for j in np.flatnonzero(off_deg > AXIS_TOLERANCE_DEG):
-            a = self.joint_axes[j]
-            error = NotStraight if self.straightness.offset > STRAIGHT_TOLERANCE else InputError
-            raise error(f"joint {self.joint_names[j]!r} turns about {np.round(a, 4).tolist()} in the body "
-                             f"frame (x along the body, z up), {off_deg[j]:.2f} deg off its y- or z-axis (at most "
-                             f"{AXIS_TOLERANCE_DEG:g} deg): a snake's joints turn about its z-axis (yaw) or y-axis "
-                             "(pitch); if the body is not straight at zero, give the robot file a [home] table",
-                             *((self.body,) if error is NotStraight else ()))
         shaped = set(self.shaped_links.tolist())
         segments: dict[int, list[int]] = {}  # the base's rigid segments: links between the same two joints
         for i in self.base_links.tolist():
@@ -268,6 +258,17 @@ class SnakeRobot:
         if not segments or bare:
             raise InputError("every rigid segment of the base needs a <collision> shape (the base lies on the ground "
                              f"on them); none on {bare or 'the base'}")
+        self._check_straight()  # first: a curled body's axes are off its line too
+        off_deg = np.degrees(self.axis_deviations)
+        for j in np.flatnonzero(off_deg > AXIS_TOLERANCE_DEG):
+            a = self.joint_axes[j]
+            message = (f"joint {self.joint_names[j]!r} turns about {np.round(a, 4).tolist()} in the body frame (x "
+                       f"along the body, z up), {off_deg[j]:.2f} deg off its y- or z-axis (at most "
+                       f"{AXIS_TOLERANCE_DEG:g} deg): a snake's joints turn about its z-axis (yaw) or y-axis (pitch)")
+            if self.straightness.offset > STRAIGHT_TOLERANCE:  # a body bent at zero: a home pose may straighten it
+                raise NotStraight(message + "; if the body is not straight at zero, give the robot file a [home] table",
+                                  self.body)
+            raise InputError(message)
         if not self.total_mass > 0:
             raise InputError("the robot has no mass (no <inertial> on its links): stability needs the masses")
 
