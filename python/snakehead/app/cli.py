@@ -171,9 +171,15 @@ def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
 # info
 # ----------------------------------------------------------------------------------------------
 def _info(args: argparse.Namespace) -> int:
-    from .robot_check import check_lines, check_robot
+    from ..model.body_frame import NotStraight
+    from .robot_check import check_lines, check_robot, home_suggestion
 
-    robot = _robot(args)
+    try:
+        robot = _robot(args)
+    except NotStraight as exc:  # refused (exit 2), with the home pose that would straighten it when one does
+        for line in home_suggestion(exc):
+            print(line)
+        raise
     check = check_robot(robot, suggest=not args.quick)
     for line in check_lines(robot, check):
         print(line)

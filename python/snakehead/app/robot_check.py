@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mass_properties import inertia_source, mass_findings
+from ..model.body_frame import AXIS_TOLERANCE_DEG, NotStraight, straightness, suggest_home
 from ..model.robot import ALIGNED_SUFFIX, SnakeRobot
+from ..model.robot_file import toml_string
 
 #: How far (joints) a suggested split moves base_end and neck_end from the robot file's.
 SPLIT_SEARCH = (1, -1, 2, -2, 3, -3)
@@ -174,6 +176,58 @@ def check_robot(robot: SnakeRobot, suggest: bool = True) -> RobotCheck:
     return check
 
 
+def description_lines(robot: SnakeRobot) -> list[str]:
+    """What the description needed to be read as a snake (:mod:`snakehead.model.description_tree`): the largest
+    joint-axis deviation, the side offsets at the straight pose, the joints turned around, the home pose, the side
+    branches and the joints held."""
+    j = int(np.argmax(robot.axis_deviations))
+    st = robot.straightness
+    lines = [f"description: joint axes within {np.degrees(robot.axis_deviations[j]):.3f} deg of the body's y or z "
+             f"(largest: {robot.joint_names[j]}; at most {AXIS_TOLERANCE_DEG:g} deg); frames within "
+             f"{1000 * st.offset:.2f} mm of the body's line (largest: {st.frame}; at most the half-section, "
+             f"{1000 * robot.half_section:.1f} mm)"]
+    changes = robot.tree_changes
+    if changes.reversed_joints:
+        lines.append(f"  the body runs against the URDF's tree: {len(changes.reversed_joints)} joints turned around "
+                     f"({', '.join(changes.reversed_joints[:4])}{' ...' if len(changes.reversed_joints) > 4 else ''});"
+                     " angles keep the description's signs")
+    if changes.home:
+        lines.append("  home (the body lies straight; planner angles = description's - home): "
+                     + ", ".join(f"{name} = {value:.4f}" for name, value in changes.home))
+    if changes.branch_links:
+        mass = sum(b.mass for b in changes.branch_links)
+        lines.append(f"  side branches: {len(changes.branch_links)} links ({mass:.3f} kg, "
+                     f"{sum(b.shapes for b in changes.branch_links)} collision shapes) added to the body links they "
+                     "hang from: " + ", ".join(f"{b.name} -> {b.onto}" for b in changes.branch_links[:6])
+                     + (" ..." if len(changes.branch_links) > 6 else ""))
+    if changes.held_joints:
+        held = changes.held_joints
+        zero_axis = [joint for joint, _, note in held if note == "axis 0 0 0"]
+        lines.append(f"  held: {len(held)} moving joints off the body, at their [home] value or 0: "
+                     + ", ".join(f"{joint} = {value:g}" for joint, value, _ in held[:4]) + (" ..." if len(held) > 4 else "")
+                     + (f"; with axis 0 0 0: {', '.join(zero_axis)}" if zero_axis else ""))
+    return lines
+
+
+def home_suggestion(exc: NotStraight) -> list[str]:
+    """The ``[home]`` table at which the body of a robot refused as not straight lies straight (least squares:
+    :func:`snakehead.model.body_frame.suggest_home`), as robot-file lines; [] when none straightens it."""
+    chain = exc.chain
+    q = suggest_home(chain)
+    _, d, st = straightness(chain, q)
+    F = chain.fk_all(q)
+    child = np.asarray(chain.model.joint_child_links)
+    axes = np.einsum("jik,jk->ji", F[child, :3, :3], np.asarray(chain.model.joint_axes, float))
+    across = np.abs(axes @ d) / np.linalg.norm(axes, axis=1)
+    if st.out_of_order or st.offset > exc.max_offset or across.max() > np.sin(np.radians(AXIS_TOLERANCE_DEG)):
+        return []
+    home = q + exc.home
+    rows = [f"{toml_string(name)} = {value:.6f}" for name, value in zip(chain.joint_names, home)
+            if abs(value) > 1e-5]
+    return [f"SUGGESTION: the body lies straight (frames within {1000 * st.offset:.2f} mm of one line) at these joint "
+            "angles; add them to the robot file:", "[home]", *rows]
+
+
 def check_lines(robot: SnakeRobot, check: RobotCheck) -> list[str]:
     """The check as the lines ``snakehead info`` prints."""
     lines = [f"robot: {robot.source}",
@@ -181,6 +235,7 @@ def check_lines(robot: SnakeRobot, check: RobotCheck) -> list[str]:
              f"mass {robot.total_mass:.3f} kg, length {robot.body_length:.4f} m, body axis "
              f"{1000 * robot.body_axis_height:.1f} mm above the ground",
              "collision shapes: " + ", ".join(f"{n} {k}" for k, n in sorted(check.shapes.items()))]
+    lines += description_lines(robot)
     for part in check.parts:
         lines.append(f"{part.name}: {part.start_frame} ({frame_position(robot, _frame(robot, part.start_frame))}) -> "
                      f"{part.end_frame} ({frame_position(robot, _frame(robot, part.end_frame))}); "

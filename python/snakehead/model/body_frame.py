@@ -49,9 +49,13 @@ class NotStraight(InputError):
     """The body does not lie straight at the robot's zero (its home pose): the message says where; ``chain`` is
     the body, for :func:`suggest_home`."""
 
-    def __init__(self, message: str, chain: Chain) -> None:
+    def __init__(self, message: str, chain: Chain, home: np.ndarray | None = None, max_offset: float = 0.0) -> None:
         super().__init__(message)
         self.chain = chain
+        #: How far (m) a frame may lie to the side of the body's line (the base's half-section).
+        self.max_offset = max_offset
+        #: The home angles (n,) the chain was already turned by (the description's angles = chain's + these).
+        self.home = np.zeros(chain.n_joints) if home is None else np.asarray(home, float)
 
 
 def _body_line(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -83,19 +87,26 @@ def straightness(body: Chain, q: np.ndarray | None = None) -> tuple[np.ndarray, 
 
 def suggest_home(body: Chain) -> np.ndarray:
     """Joint angles (n,) at which the body lies straight, by least squares from q = 0 within the limits: the side
-    offsets of the frames from the line through the first joint and the head tip, with a small pull towards 0."""
+    offsets of the frames from the line through the root (or the first joint) and the head tip, the joint axes
+    across it, with a small pull towards 0."""
     from scipy.optimize import least_squares
 
     child = np.asarray(body.model.joint_child_links)
     first = int(child[0]) if len(child) else 0
     reach = max(body.reach, STRAIGHT_TOLERANCE)
 
+    local = np.asarray(body.model.joint_axes, float)
+    # the root link's origin joins the line when it is not on the first joint (a module, not a dummy root)
+    start = 0 if np.linalg.norm(body.fk_all(np.zeros(body.n_joints))[first, :3, 3]) > STRAIGHT_TOLERANCE else first
+
     def residuals(q: np.ndarray) -> np.ndarray:
-        p = body.fk_all(q)[first:, :3, 3]
+        F = body.fk_all(q)
+        p = F[start:, :3, 3]
         d = p[-1] - p[0]
         d = d / max(np.linalg.norm(d), STRAIGHT_TOLERANCE)
         rel = p - p[0]
-        return np.concatenate([(rel - np.outer(rel @ d, d)).ravel() / reach, 1e-3 * q])
+        across = np.einsum("jik,jk->ji", F[child, :3, :3], local) @ d  # each joint axis across the line
+        return np.concatenate([(rel - np.outer(rel @ d, d)).ravel() / reach, across, 1e-3 * q])
 
     lo = np.where(np.isfinite(body.lower), body.lower, -np.pi)
     hi = np.where(np.isfinite(body.upper), body.upper, np.pi)

@@ -267,7 +267,7 @@ class SnakeRobot:
                        f"{AXIS_TOLERANCE_DEG:g} deg): a snake's joints turn about its z-axis (yaw) or y-axis (pitch)")
             if self.straightness.offset > STRAIGHT_TOLERANCE:  # a body bent at zero: a home pose may straighten it
                 raise NotStraight(message + "; if the body is not straight at zero, give the robot file a [home] table",
-                                  self.body)
+                                  self.body, self.joint_offsets.home, self.half_section)
             raise InputError(message)
         if not self.total_mass > 0:
             raise InputError("the robot has no mass (no <inertial> on its links): stability needs the masses")
@@ -460,7 +460,7 @@ class SnakeRobot:
                      f"half-section, {1000 * self.half_section:.1f} mm)")
             raise NotStraight(f"the body does not lie straight at its zero: {where}; give the robot file a [home] table "
                               "of the joint angles at which it lies straight (`snakehead info` suggests one)",
-                              self.body)
+                              self.body, self.joint_offsets.home, self.half_section)
 
     def description_angles(self, q: npt.ArrayLike) -> np.ndarray:
         """Joint angles (..., n) as the description writes them: the planner's ``q`` plus the home pose (the planner
