@@ -185,8 +185,8 @@ def test_schemas_are_the_ros2_definitions():
 def test_robot_description_is_the_urdf(plan, written):
     (log_time, msg), = written.topics["/robot_description"]
     assert log_time == 0
-    assert msg.data == plan.robot.urdf_text
-    assert msg.data == Path(plan.robot.urdf).read_text()  # the default robot: its file as it is
+    assert msg.data == plan.robot.description_text == plan.robot.urdf_text  # the default robot: nothing rewritten
+    assert msg.data == Path(plan.robot.urdf).read_text()  # its file as it is
 
 
 def test_tf_places_the_root_and_the_targets(plan, written):
@@ -221,15 +221,18 @@ def pinocchio_head(urdf: str, frame: str, names, positions) -> np.ndarray:
 
 def check_head_through_the_bag(topics, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, samples) -> None:
     """world -> URDF root (/tf) composed with pinocchio's FK of /robot_description at /joint_states is the plan's
-    head pose (snakehead's FK of the same joints)."""
+    head pose (snakehead's FK of the same joints): the head tip frame as the description names it (the one the
+    planner reads may be its aligned twin, which only snakehead's internal URDF has)."""
     urdf = topics["/robot_description"][0][1].data
     root = tf_frames(topics["/tf"])[robot.description_root]
     states = topics["/joint_states"]
+    tip = robot.user_frames["head_tip"]
     for k in samples:
         stamp, js = states[k]
         T = root[int(np.searchsorted([s for s, _ in root], stamp, side="right")) - 1][1]  # the base does not move
-        head = T @ pinocchio_head(urdf, robot.parts.head_tip, js.name, js.position)
-        np.testing.assert_allclose(head, robot.head_pose(q[k], base), atol=1e-9)
+        head = T @ pinocchio_head(urdf, tip, js.name, js.position)
+        np.testing.assert_allclose(head, robot.frame(q[k], tip, base), atol=1e-9)
+        np.testing.assert_allclose(head[:3, 3], robot.head_pose(q[k], base)[:3, 3], atol=1e-9)
 
 
 def test_the_bag_puts_the_head_where_the_plan_does(plan, written):

@@ -154,10 +154,17 @@ def write_json(report: dict, path: str | os.PathLike) -> Path:
 
 def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list[str] | None = None) -> Path:
     """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
-    time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns."""
+    time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns.
+
+    The angles are the description's: for a result with a ``robot`` (a :class:`~snakehead.motion.plan_result.Plan`),
+    ``robot.description_angles(result.q)`` (the planner's ``q`` plus the robot file's ``[home]``); without one,
+    ``result.q`` as it is."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)
     if q.ndim != 2 or q.shape[0] != t.shape[0]:
         raise InputError(f"t {t.shape} and q {q.shape} do not match")
+    robot = getattr(result, "robot", None)
+    if robot is not None:
+        q = robot.description_angles(q)
     names = joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])]
     if len(names) != q.shape[1]:
         raise InputError(f"{len(names)} joint names for {q.shape[1]} joints")

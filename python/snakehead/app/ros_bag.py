@@ -7,12 +7,15 @@ or RViz"):
   CDR messages) that ``ros2 bag play``, RViz and Foxglove read:
 
   - :data:`JOINT_STATES` (``sensor_msgs/msg/JointState``): every sample of the plan (the control period, 2 ms): the
-    robot's joints in the CSV's order (then any other movable joint of the URDF, held at 0), positions (rad),
-    velocities (rad/s);
-  - :data:`TF` (``tf2_msgs/msg/TFMessage``) every :data:`TF_PERIOD`: ``world`` -> the URDF's root link, placed
-    where the plan puts the base, and ``world`` -> ``target/NAME`` (:func:`frame_name`; x-axis along the target's
-    direction); the links themselves are robot_state_publisher's, from the URDF and the joint states;
-  - :data:`ROBOT_DESCRIPTION` (``std_msgs/msg/String``), once at 0: the URDF (:attr:`SnakeRobot.urdf_text`);
+    robot's joints in the CSV's order (then any other movable joint of the description, a passive wheel at the
+    value the planner held it at, else 0), positions (rad) as the description writes them
+    (:meth:`SnakeRobot.description_angles`: the planner's plus the robot file's ``[home]``), velocities (rad/s);
+  - :data:`TF` (``tf2_msgs/msg/TFMessage``) every :data:`TF_PERIOD`: ``world`` -> the description's root link
+    (:attr:`SnakeRobot.description_root`), placed where the plan puts the body (with the joints when the
+    description's tree starts from the head), and ``world`` -> ``target/NAME`` (:func:`frame_name`; x-axis along
+    the target's direction); the links themselves are robot_state_publisher's, from the URDF and the joint states;
+  - :data:`ROBOT_DESCRIPTION` (``std_msgs/msg/String``), once at 0: the description's own URDF as the user wrote it
+    (a xacro expanded; :attr:`SnakeRobot.description_text`), not the tree snakehead rewrites for its core;
   - :data:`MARKERS` (``visualization_msgs/msg/MarkerArray``, frame ``world``): the targets and the obstacles every
     :data:`STATIC_MARKER_PERIOD` (stamped 0), the support polygon and the ZMP on the ground every
     :data:`MARKER_PERIOD`.
@@ -27,6 +30,9 @@ or RViz"):
   ZMP.
 * ``NAME_joint_trajectory.yaml`` (:func:`write_joint_trajectory`): ``trajectory_msgs/msg/JointTrajectory`` as YAML
   message fields, a point per sample of the plan.
+
+Every joint angle written is the description's (its names, its signs, its zero); the plans' arrays
+(``Plan.q``) hold the planner's, which are the description's minus the robot file's ``[home]``.
 """
 from __future__ import annotations
 
@@ -159,22 +165,32 @@ def _every(t: np.ndarray, period: float) -> np.ndarray:
 # --- joints and frames --------------------------------------------------------------------------------------------
 def joint_names(robot: SnakeRobot) -> list[str]:
     """The joints :data:`JOINT_STATES` names: the robot's (its body's, the CSV's columns, in order), then every other
-    movable joint of the URDF that mimics none (a camera's pan, a wheel: held at 0), so that robot_state_publisher
-    places every link."""
+    movable joint of the description (:attr:`SnakeRobot.description_text`) that mimics none (a camera's pan, a
+    passive wheel: :func:`held_values`), so that robot_state_publisher places every link."""
     body = list(robot.joint_names)
-    root = ET.fromstring(robot.urdf_text)
+    root = ET.fromstring(robot.description_text)
     extra = [j.get("name", "") for j in root.findall("joint")
              if j.get("type") in _MOVABLE and j.find("mimic") is None and j.get("name") not in body]
     return body + extra
 
 
+def held_values(robot: SnakeRobot) -> np.ndarray:
+    """The positions of :func:`joint_names` past the body's: a joint the planner held (a passive wheel,
+    ``robot.tree_changes.held_joints``) at its value, any other at 0."""
+    held = {name: value for name, value, _ in robot.tree_changes.held_joints}
+    return np.array([held.get(name, 0.0) for name in joint_names(robot)[robot.n_joints:]], float)
+
+
 def _joint_rows(robot: SnakeRobot, q: np.ndarray, qd: np.ndarray | None) -> tuple[list[str], np.ndarray,
                                                                                  np.ndarray | None]:
-    """The names and the position and velocity rows of :data:`JOINT_STATES` (the other joints at 0)."""
+    """The names and the position and velocity rows of :data:`JOINT_STATES` for the planner's joints ``q`` (T, n):
+    the description's angles (:meth:`SnakeRobot.description_angles`), the other joints at :func:`held_values`
+    (velocities 0)."""
     names = joint_names(robot)
+    q = robot.description_angles(q)
     pad = len(names) - q.shape[1]
     if pad:
-        q = np.pad(q, ((0, 0), (0, pad)))
+        q = np.concatenate([q, np.broadcast_to(held_values(robot), (len(q), pad))], axis=1)
         qd = None if qd is None else np.pad(qd, ((0, 0), (0, pad)))
     return names, q, qd
 
@@ -329,18 +345,22 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
 # --- the bags -----------------------------------------------------------------------------------------------------
 def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
     """Write ``plan`` (a :class:`~snakehead.motion.plan_result.Plan`) as a ROS 2 bag at ``path`` (see the module);
-    returns the path. Every :data:`JOINT_STATES` sample is the plan's (``t``, ``q``, ``qd``)."""
+    returns the path. Every :data:`JOINT_STATES` sample is the plan's (``t``, ``q`` as the description's angles,
+    ``qd``)."""
     robot = plan.robot
     t = np.asarray(plan.t, float)
     invariant(len(t) > 0 and plan.q.shape == (len(t), robot.n_joints), "a plan without samples")
     stamps = _stamps(t - t[0])
     bag = _Bag()
     bag.add_joint_states(JOINT_STATES, stamps, *_joint_rows(robot, np.asarray(plan.q), np.asarray(plan.qd)))
-    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.urdf_text}))
+    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.description_text}))
     goals = target_frames(plan.targets)
     children = [robot.description_root] + [f for f, _ in goals]
-    poses = np.array([robot.description_root_pose(robot.root_pose(plan.base))] + [T for _, T in goals])
-    tf_stamps = stamps[_every(t, TF_PERIOD)]
+    idx = _every(t, TF_PERIOD)
+    roots = robot.description_root_pose(robot.root_pose(plan.base), np.asarray(plan.q, float)[idx])
+    fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
+    poses = np.concatenate([roots[:, None], fixed], axis=1)
+    tf_stamps = stamps[idx]
     bag.add_many(TF, tf_stamps, _tf_messages(tf_stamps, children, poses))
     _add_static_markers(bag, plan.targets, plan.obstacles, plan.scene, float(t[-1] - t[0]))
     _add_plan_markers(bag, plan, 0.0)
@@ -368,12 +388,12 @@ def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
     stamps = _stamps(t)
     bag = _Bag()
     bag.add_joint_states(JOINT_STATES, stamps, *_joint_rows(robot, q, qd))
-    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.urdf_text}))
+    bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.description_text}))
     targets = run.plan.targets if run.plan is not None else list(run.scene.targets)
     goals = target_frames(targets)
     idx = _every(t, TF_PERIOD)
     body = robot.body_in_root
-    moving = np.stack([roots[idx] @ robot.description_root_pose(np.eye(4)), roots[idx] @ body], axis=1)
+    moving = np.stack([robot.description_root_pose(roots[idx], q[idx]), roots[idx] @ body], axis=1)
     fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
     bag.add_many(TF, stamps[idx], _tf_messages(stamps[idx], [robot.description_root, TRUE_BASE_FRAME]
                                                 + [f for f, _ in goals], np.concatenate([moving, fixed], axis=1)))
@@ -415,11 +435,12 @@ def write_joint_trajectory(plan: Plan, path: str | os.PathLike) -> Path:
     """Write ``plan`` as a ``trajectory_msgs/msg/JointTrajectory`` in YAML (the message's fields, as ``ros2 topic
     echo`` prints them and ``rosidl_runtime_py.set_message_fields`` reads them) at ``path``; returns the path.
 
-    A point per sample of the plan, at the control period (2 ms): ``positions`` (rad), ``velocities`` (rad/s),
-    ``time_from_start`` from the first sample (0); no accelerations or efforts; ``header.stamp`` 0 (a controller
-    starts it on arrival); ``joint_names`` the robot's, in the CSV's order."""
+    A point per sample of the plan, at the control period (2 ms): ``positions`` (rad, the description's angles:
+    :meth:`SnakeRobot.description_angles` of the plan's), ``velocities`` (rad/s), ``time_from_start`` from the
+    first sample (0); no accelerations or efforts; ``header.stamp`` 0 (a controller starts it on arrival);
+    ``joint_names`` the robot's, in the CSV's order."""
     t = np.asarray(plan.t, float)
-    q, qd = np.asarray(plan.q, float), np.asarray(plan.qd, float)
+    q, qd = plan.robot.description_angles(np.asarray(plan.q, float)), np.asarray(plan.qd, float)
     invariant(len(t) > 0 and bool(np.isfinite(q).all() and np.isfinite(qd).all()), "a plan without finite samples")
     period = float(np.median(np.diff(t))) if len(t) > 1 else CONTROL_PERIOD
     title = " ".join(str(plan.name).split())

@@ -745,18 +745,52 @@ class SnakeRobot:
 
     @cached_property
     def description_root(self) -> str:
-        """The URDF's root link: ``parts.root`` or a frame above it (a link-less dummy root)."""
-        return _core.urdf_root_link(self.urdf_text)
+        """The root link of the description's own URDF (:attr:`description_text`), where ROS tools start its tree
+        (/tf places it): ``parts.root``, a frame above it (a link-less dummy root), or, for a tree written from the
+        head (re-rooted, :mod:`.description_tree`), a link at the far end of the body."""
+        return _core.urdf_root_link(self.description_text)
 
-    def description_root_pose(self, root_pose: npt.ArrayLike) -> np.ndarray:
+    @cached_property
+    def _description_root_on_body(self) -> tuple[int, np.ndarray]:
+        """(k, F): :attr:`description_root` is F (4, 4) in the body frame ``link_names[k]``, the nearest body frame
+        above it in :attr:`urdf_text` (every link of the description keeps its frame there; the joints off the
+        body are fixed there, moving branch joints at the value they are held at)."""
+        import xml.etree.ElementTree as ET
+
+        from .._errors import invariant
+        from .description import origin_matrix
+
+        up: dict[str, tuple[ET.Element, str]] = {}
+        for joint in ET.fromstring(self.urdf_text).findall("joint"):
+            parent, child = joint.find("parent"), joint.find("child")
+            if parent is not None and child is not None:
+                up[child.get("link", "")] = (joint, parent.get("link", ""))
+        on_body = set(self.link_names)
+        link, F = self.description_root, np.eye(4)
+        while link not in on_body:
+            invariant(link in up, f"the description's root {self.description_root!r} is not below the body's root "
+                                  f"{self.parts.root!r} in the internal URDF")
+            joint, link = up[link]
+            invariant(joint.get("type") == "fixed", f"joint {joint.get('name')!r} off the body is not fixed in the "
+                                                    "internal URDF")
+            F = origin_matrix(joint, f"joint {joint.get('name')!r}") @ F
+        F.setflags(write=False)
+        return self.link_index(link), F
+
+    def description_root_pose(self, root_pose: npt.ArrayLike, q: npt.ArrayLike | None = None) -> np.ndarray:
         """World pose (4, 4) of :attr:`description_root` when the root frame (``parts.root``) has the world pose
-        ``root_pose`` (4, 4) (e.g. :meth:`root_pose`); joints between the two, if any, at 0."""
-        T = finite_array(root_pose, "root_pose", (4, 4))
-        if self.description_root == self.parts.root:
-            return T.copy()
-        # the core takes chains with a moving joint: the one to the head tip, read where it passes the root frame
-        whole = Chain.from_urdf(self.urdf_text, self.description_root, self.parts.head_tip)
-        return T @ np.linalg.inv(whole.fk_all(np.zeros(whole.n_joints))[whole.link_index(self.parts.root)])
+        ``root_pose`` (4, 4) (e.g. :meth:`root_pose`) and the body's joints are at ``q`` (the planner's angles
+        (n,); default 0, the home pose): it moves with the joints when the description's tree starts from the head.
+        Along a motion, ``q`` (T, n) with ``root_pose`` (T, 4, 4) or (4, 4) gives (T, 4, 4)."""
+        T = np.asarray(root_pose, dtype=float)
+        if T.shape[-2:] != (4, 4) or T.ndim > 3 or not np.isfinite(T).all():
+            raise InputError(f"root_pose must be finite (4, 4) or (T, 4, 4), got shape {T.shape}")
+        k, F = self._description_root_on_body
+        if q is None or np.ndim(q) <= 1:
+            q = np.zeros(self.n_joints) if q is None else joint_vector(q, self.n_joints)
+            return T @ (self.body.fk_all(q)[k] @ F)
+        qs = finite_array(q, "q", (None, self.n_joints))
+        return T @ (self.body.fk_all_many(qs)[:, k] @ F)
 
     def frames(self, q: npt.ArrayLike, base: BasePlacement | None = None) -> np.ndarray:
         """World poses of every frame in ``link_names`` at joint vector ``q`` (n,): (n_links, 4, 4)."""

@@ -374,7 +374,8 @@ class LoopRun:
 
     def report(self) -> dict:
         """The loop's part of a report entry: ``phases``, ``sim`` (``base_travel_m`` and the head's metrics),
-        ``estimate``, ``start``, ``total_time_s``, ``corrections``."""
+        ``estimate``, ``start`` (its ``q_rad`` the description's angles, :meth:`SnakeRobot.description_angles` of
+        ``q_start``, which like every array of the run holds the planner's), ``total_time_s``, ``corrections``."""
         sim = dict(self.metrics) if self.metrics is not None else {}
         sim.update(base_travel_m=self.base_travel_m, base_displacement_m=self.base_displacement_m,
                    total_time_s=self.total_time_s, sensing=self.sensing,
@@ -384,7 +385,7 @@ class LoopRun:
                 "sim": sim,
                 "estimate": self.estimate_summary(),
                 "start": {"x_m": self.start.x, "y_m": self.start.y, "yaw_rad": self.start.yaw,
-                          "q_rad": self.q_start.tolist()},
+                          "q_rad": self.robot.description_angles(self.q_start).tolist()},  # the description's
                 "believed_start": {"x_m": self.believed_start.x, "y_m": self.believed_start.y,
                                    "yaw_rad": self.believed_start.yaw},
                 "total_time_s": self.total_time_s, "corrections": self.corrections,
