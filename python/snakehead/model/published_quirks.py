@@ -192,6 +192,8 @@ def _write_reu_reversed(spec: StyleSpec, folder: Path) -> Path:
 # --- "wheeled": passive wheels off every module ------------------------------------------------------------------
 WHEEL_WIDTH = 0.008
 WHEEL_MASS = 0.01
+#: "wheeled": how far (m) the wheels' bottoms reach below the body's (the wheels carry the snake).
+WHEEL_DROP = 0.001
 #: "wheeled": the wheel whose joint has the zero axis "0 0 0" (link index, side).
 ZERO_AXIS_WHEEL = (2, "right")
 
@@ -210,7 +212,7 @@ def _write_wheeled(spec: StyleSpec, folder: Path) -> Path:
     for i in range(spec.n_joints):
         for side, sign in (("left", 1.0), ("right", -1.0)):
             name = f"wheel_{i}_{side}"
-            xyz = (snake.link_length(i) / 2, sign * (s / 2 + WHEEL_WIDTH / 2 + 0.002), -s / 2 + rw - 0.001)
+            xyz = (snake.link_length(i) / 2, sign * (s / 2 + WHEEL_WIDTH / 2 + 0.002), -s / 2 + rw - WHEEL_DROP)
             continuous = (2 * i + (side == "right")) % 3 != 0
             joint = _moving_joint(f"{name}_joint", f"link_{i}", name, xyz, (0, 0, 0), "0 0 1", spec, 1.0,
                                   continuous=continuous)
