@@ -398,7 +398,9 @@ def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
     bag.add_many(TF, stamps[idx], _tf_messages(stamps[idx], [robot.description_root, TRUE_BASE_FRAME]
                                                 + [f for f, _ in goals], np.concatenate([moving, fixed], axis=1)))
     known = idx[np.isfinite(estimates[idx]).all(axis=(1, 2))]
-    bag.add_many(TF, stamps[known], _tf_messages(stamps[known], [ESTIMATED_BASE_FRAME], estimates[known, None] @ body))
+    if len(known):  # (a run whose ground phases kept no estimate has none)
+        bag.add_many(TF, stamps[known], _tf_messages(stamps[known], [ESTIMATED_BASE_FRAME],
+                                                     estimates[known, None] @ body))
     _add_static_markers(bag, targets, list(run.scene.obstacles), run.scene, float(t[-1]))
     if run.plan is not None:
         p = run.plan
