@@ -319,3 +319,29 @@ def test_cmu_masses_are_reported(tmp_path):
     kinds = {f.kind for f in findings}
     assert {"gyration", "shapeless"} <= kinds, [str(f) for f in findings]
     assert any("reu_module_body_1" in f.links for f in findings if f.kind == "gyration")
+
+
+#: What ``snakehead info --quick`` must say of each quirk style (lines of its output, in part).
+INFO_SAYS = {
+    "cad": ("home (the body lies straight; planner angles = description's - home): joint1 = -0.0349",
+            "side branches: 8 links (0.072 kg, 8 collision shapes)", "collar2 -> link2",
+            "joint axes within 0.015 deg of the body's y or z", "frames within 4."),
+    "reu_reversed": ("the body runs against the URDF's tree", "-> kdl_dummy_root (1.0544 m",
+                     "7 joints (mod_16_joint:y", "joint axes within 0.040 deg"),
+    "wheeled": ("held: 32 moving joints off the body", "with axis 0 0 0: wheel_2_right_joint",
+                "side branches: 32 links (0.320 kg, 32 collision shapes)"),
+    "cmu_masses": ("inertia: recomputed from the collision shapes", "masses and inertias: 2 implausible",
+                   "sits on 16 links without collision shapes"),
+    "backwards_head": ("head: neck_end", "design: the base holds the lifted neck and head"),
+}
+
+
+def test_info_reports_each_quirk(written):
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "snakehead", "info", "--quick", "--robot", str(written.path)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    for text in INFO_SAYS[written.style]:
+        assert text in proc.stdout, (text, proc.stdout)
