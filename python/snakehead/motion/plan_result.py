@@ -73,7 +73,9 @@ class TargetResult:
 class Plan:
     """A planned motion: the 2 ms joint trajectory, its states and targets, and its checks.
 
-    name: the scene's. robot, base: the robot and where its base lies. t (T,) s, q (T, n) rad, qd (T, n) rad/s.
+    name: the scene's. robot, base: the robot and where its base lies. t (T,) s, q (T, n) rad, qd (T, n) rad/s:
+    the planner's joint angles, zero with the body straight (the description's are ``robot.description_angles(q)``,
+    the same when the robot file has no ``[home]``; the files written for the plan hold the description's).
     states: (label, time s, q (n,)) of every waypoint. targets: :class:`TargetResult` per reported target.
     stability: ``dynamics.DynamicStability`` (ZMP and its margin at every sample). ground_clearance (T,) m: the
     lowest neck or head box corner above the ground. obstacles and obstacle_distance (T,) m (None without
