@@ -87,7 +87,10 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
                prob.margin_and_gradient(prob.frames(q, base), base)[0]) <= min_margin:
             continue
         clear = coll.ground_clearance(robot, q, base)[0]
-        if clear[lifted].min() < 0.0 or clear[lifted[lifted > pivot]].min(initial=np.inf) < TARGET_GROUND_CLEARANCE:
+        # the pivot link rests on its edge: within the ground tolerance (a description's 1.57 tilts a yaw joint's
+        # axis 0.05 deg, enough to press a bent base's links some micrometres into the ground)
+        if clear[lifted].min() < -coll.GROUND_TOLERANCE \
+                or clear[lifted[lifted > pivot]].min(initial=np.inf) < TARGET_GROUND_CLEARANCE:
             continue
         if coll.self_clearance(robot, q, base)[0] <= 0.0:
             continue
