@@ -88,10 +88,14 @@ class ShapeSet:
         for s in shapes:
             if not 0 <= s.frame < self.n_frames:
                 raise InputError(f"shape on frame {s.frame}, outside [0, {self.n_frames})")
-        core = _core.ShapeSet([s.kind for s in shapes], np.array([s.frame for s in shapes], dtype=np.int64).reshape(-1),
-                              np.array([s.origin for s in shapes], float).reshape(-1, 4, 4),
-                              np.array([s.size for s in shapes], float).reshape(-1, 3),
-                              [s.vertices for s in shapes])
+        try:
+            core = _core.ShapeSet([s.kind for s in shapes],
+                                  np.array([s.frame for s in shapes], dtype=np.int64).reshape(-1),
+                                  np.array([s.origin for s in shapes], float).reshape(-1, 4, 4),
+                                  np.array([s.size for s in shapes], float).reshape(-1, 3),
+                                  [s.vertices for s in shapes])
+        except InputError as exc:  # the core names a shape by its index: say which shape that is
+            raise InputError(_named_shape(str(exc), shapes)) from None
         object.__setattr__(self, "_core_set", core)
 
     @property
@@ -149,6 +153,18 @@ class ShapeSet:
             return np.zeros((T, 0, 3)), np.zeros(0, dtype=np.int64)
         pts = _core.shape_lowest_points(np.ascontiguousarray(frames, float), self.core, idx, per_shape)
         return pts.reshape(T, -1, 3), np.repeat(self.shape_frames[idx], per_shape)
+
+
+def _named_shape(message: str, shapes: tuple[Shape, ...]) -> str:
+    """The core's message about "shape i" with what that shape is: its kind, frame and mesh file."""
+    import re
+
+    found = re.search(r"\bshape (\d+)\b", message)
+    if found is None or int(found.group(1)) >= len(shapes):
+        return message
+    s = shapes[int(found.group(1))]
+    source = f", mesh file {s.source!r}" if s.source else ""
+    return f"{message} ({s.kind} shape on frame {s.frame}{source})"
 
 
 def _reduce_to_frames(values: np.ndarray, owner_frames: np.ndarray, on: np.ndarray, out: np.ndarray) -> None:

@@ -14,7 +14,9 @@ Errors are :class:`snakehead.InputError` naming the file and the element.
 """
 from __future__ import annotations
 
+import math
 import os
+import re
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -32,6 +34,8 @@ from typing import Any, Mapping
 
 #: A collision mesh larger than this is not a snake module's (and would stall the hull).
 MAX_MESH_BYTES = 64 * 1024 * 1024
+#: A collision mesh thinner than this (m) once scaled is flat: a scale that is wrong (mm read as m twice, a 0).
+MIN_MESH_THICKNESS_M = 1e-6
 
 
 @dataclass(frozen=True)
@@ -66,16 +70,23 @@ def read_description(urdf: str | os.PathLike[str], xacro_args: Mapping[str, obje
     if _is_xml(urdf):
         if xacro_args:
             raise InputError("xacro_args are given but the description is URDF text, not a .xacro file")
+        check_description(urdf, "<URDF text>")
         return Description(urdf, None, "<URDF text>", RobotFolders(extra, package_folders))
     path = input_file(urdf, "the robot's description", MAX_DESCRIPTION_BYTES)
     folder = path.resolve().parent
     folders = RobotFolders((folder, *extra), package_folders)
     if path.suffix == ".xacro":
         text = expand_xacro(path, _xacro_mappings(xacro_args or {}), folders, trusted=trust_xacro)
+        check_description(text, os.fspath(path))
         return Description(text, folder, os.fspath(path), folders)
     if xacro_args:
         raise InputError(f"xacro_args are given but {os.fspath(path)!r} is not a .xacro file")
-    # the core reads URDF files itself (with its own checks); only the folder is needed here
+    # the core reads URDF files itself (with its own checks: the size, the encoding, the nesting); the content is
+    # checked here first, for messages that name the element (a file that is not UTF-8 is left to the core)
+    try:
+        check_description(path.read_text(encoding="utf-8"), os.fspath(path))
+    except UnicodeDecodeError:
+        pass
     return Description(os.fspath(path), folder, os.fspath(path), folders)
 
 
@@ -94,6 +105,164 @@ def _xml_root(text: str, where: str) -> ET.Element:
         return ET.fromstring(text)
     except ET.ParseError as exc:
         raise InputError(f"malformed URDF ({where}): {exc}") from None
+
+
+# --- the description's content, each problem named by its element ----------------------------------------------
+#: The joint types a URDF may give (urdfdom's).
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+#: The geometry elements a URDF shape may be (urdfdom's).
+GEOMETRY_KINDS = ("box", "cylinder", "sphere", "mesh")
+#: A number as urdfdom reads one (a C++ stream in the classic locale): no nan, inf, hex or digit separators.
+_NUMBER = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _scalar(text: str | None) -> float | None:
+    """The finite number urdfdom reads from an attribute's text, else None (nan, inf, words, trailing spaces)."""
+    if text is None or not _NUMBER.fullmatch(text):
+        return None
+    value = float(text)
+    return value if math.isfinite(value) else None
+
+
+def _vector(text: str | None) -> list[float] | None:
+    """The three finite numbers of a vector attribute as urdfdom reads it (separated by spaces), else None."""
+    if text is None:
+        return None
+    pieces = [piece for piece in text.split(" ") if piece]
+    values = [_scalar(piece) for piece in pieces]
+    return [v for v in values if v is not None] if len(values) == 3 and None not in values else None
+
+
+def _check_origin(parent: ET.Element, what: str) -> None:
+    origin = parent.find("origin")  # urdfdom reads the first <origin> only
+    if origin is None:
+        return
+    for key in ("xyz", "rpy"):
+        text = origin.get(key)
+        if text is not None and _vector(text) is None:
+            raise InputError(f"{what} <origin> {key} must be 3 finite numbers separated by spaces, got {text!r}")
+
+
+def _check_geometry(shape: ET.Element, what: str) -> None:
+    """A <visual> or <collision> element's <origin> and <geometry>: one shape of a known kind, its numbers readable;
+    a collision mesh's scale positive (the core takes no mirrored or flattened collision mesh)."""
+    _check_origin(shape, what)
+    geometry = shape.find("geometry")
+    if geometry is None:
+        raise InputError(f"{what} has no <geometry> shape (no <geometry> element)")
+    kinds = list(geometry)
+    if not kinds:
+        raise InputError(f"{what} has no <geometry> shape (an empty <geometry>: give it a <box>, <cylinder>, "
+                         "<sphere> or <mesh>)")
+    element = kinds[0]  # urdfdom reads the first
+    kind = element.tag
+    if kind not in GEOMETRY_KINDS:
+        raise InputError(f"{what} has an unknown shape <{kind}> (box, cylinder, sphere or mesh)")
+    if kind == "box":
+        size = element.get("size")
+        if size is None:
+            raise InputError(f"{what} <box> has no size attribute (three numbers of metres)")
+        if _vector(size) is None:
+            raise InputError(f"{what} <box> size must be 3 finite numbers separated by spaces, got {size!r}")
+    elif kind in ("cylinder", "sphere"):
+        for key in ("radius", "length") if kind == "cylinder" else ("radius",):
+            text = element.get(key)
+            if text is None:
+                raise InputError(f"{what} <{kind}> has no {key} attribute")
+            if _scalar(text) is None:
+                raise InputError(f"{what} <{kind}> {key} must be a finite number of metres, got {text!r}")
+    else:
+        filename = element.get("filename")
+        if filename is None or not filename.strip():
+            raise InputError(f"{what} <mesh> has no filename")
+        scale_text = element.get("scale")
+        if scale_text is None:
+            return
+        scale = _vector(scale_text)
+        if scale is None:
+            raise InputError(f"{what} <mesh filename={filename!r}> scale must be 3 finite numbers separated by "
+                             f"spaces, got {scale_text!r}")
+        if shape.tag == "collision" and min(scale) <= 0:
+            raise InputError(f"{what} <mesh filename={filename!r}> scale must be 3 positive numbers, got "
+                             f"{scale_text!r} (a collision mesh is not mirrored or flattened: mirror the file itself)")
+
+
+def _check_link(link: ET.Element, what: str) -> None:
+    for kind in ("visual", "collision"):
+        for k, shape in enumerate(link.findall(kind)):
+            _check_geometry(shape, f"{what} <{kind}> {k + 1}")  # numbered from 1, as mass_properties does
+
+
+def _check_joint(joint: ET.Element, what: str, links: set[str]) -> tuple[str, str]:
+    """A <joint>'s type, parent, child, origin and axis; (parent, child). urdfdom reads an axis only on a joint that
+    moves about one; <limit>, <dynamics> and the rest are left to it (its messages name the joint and the value)."""
+    kind = joint.get("type")
+    if kind is None:
+        raise InputError(f"{what} has no type (one of {', '.join(JOINT_TYPES)})")
+    if kind not in JOINT_TYPES:
+        raise InputError(f"{what} has type {kind!r}, not one of {', '.join(JOINT_TYPES)}")
+    ends = []
+    for end in ("parent", "child"):
+        element = joint.find(end)
+        name = None if element is None else element.get("link")
+        if name is None:
+            raise InputError(f"{what} has no <{end} link=\"...\"> element")
+        if name not in links:
+            raise InputError(f"{what} names {end} link {name!r}, which the URDF does not have")
+        ends.append(name)
+    _check_origin(joint, what)
+    axis = joint.find("axis")
+    if axis is not None and kind not in ("fixed", "floating") and axis.get("xyz") is not None \
+            and _vector(axis.get("xyz")) is None:
+        raise InputError(f"{what} <axis> xyz must be 3 finite numbers separated by spaces, got {axis.get('xyz')!r}")
+    return ends[0], ends[1]
+
+
+def _names(elements: list[ET.Element], kind: str, where: str) -> list[str]:
+    names: list[str] = []
+    for element in elements:
+        name = element.get("name")
+        if name is None:
+            before = f" (after {kind} {names[-1]!r})" if names else " (the first)"
+            raise InputError(f"{where}: a <{kind}> has no name{before}")
+        if name in names:
+            raise InputError(f"{where}: two <{kind}> elements are named {name!r}: names must be unique")
+        names.append(name)
+    return names
+
+
+def check_description(text: str, where: str) -> None:
+    """Check a URDF's content before the core reads it, so that each problem is one line naming ``where`` (the
+    file) and the element: links and joints named and unique, joint types, parents and children that exist (one
+    parent per link, one root), readable origins, axes and shapes (a shape's kind, its sizes; a collision mesh's
+    filename and a positive scale). Numbers are read as urdfdom reads them; what this does not check is left to
+    the core, whose messages name the element too."""
+    root = _xml_root(text, where)
+    if root.tag.startswith("{"):  # a namespaced document: urdfdom ignores namespaces, ElementTree does not
+        return
+    if root.tag != "robot":
+        raise InputError(f"{where}: the document's root element is <{root.tag}>, not <robot>")
+    if root.get("name") is None:
+        raise InputError(f"{where}: the <robot> element has no name attribute")
+    link_elements = root.findall("link")
+    links = _names(link_elements, "link", where)
+    if not links:
+        raise InputError(f"{where}: the URDF has no <link>")
+    for name, link in zip(links, link_elements):
+        _check_link(link, f"{where}: link {name!r}")
+    joint_elements = root.findall("joint")
+    parent_joint: dict[str, str] = {}
+    for name, joint in zip(_names(joint_elements, "joint", where), joint_elements):
+        _, child = _check_joint(joint, f"{where}: joint {name!r}", set(links))
+        if child in parent_joint:
+            raise InputError(f"{where}: link {child!r} is the child of two joints, {parent_joint[child]!r} and "
+                             f"{name!r}: a URDF is a tree (one parent per link)")
+        parent_joint[child] = name
+    roots = [name for name in links if name not in parent_joint]
+    if len(roots) > 1:
+        shown = ", ".join(map(repr, roots[:6])) + (f" and {len(roots) - 6} more" if len(roots) > 6 else "")
+        raise InputError(f"{where}: the links {shown} hang from no joint: a URDF is one tree with one root link "
+                         f"(join the others to it with joints, or remove them)")
 
 
 def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], where: str,
@@ -215,23 +384,38 @@ class MeshResolver:
 
 def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarray:
     """The vertices (V, 3) of the convex hull of the mesh file ``path`` (STL, OBJ, DAE, PLY... through trimesh),
-    scaled. A missing, unreadable, empty or flat mesh is an InputError naming ``where`` and the path."""
+    scaled. A missing, unreadable, empty or flat mesh (flat as written or once scaled: thinner than
+    :data:`MIN_MESH_THICKNESS_M`) is an InputError naming ``where`` and the path."""
     import trimesh
 
+    shown = repr(os.fspath(path))
     input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
+    if os.path.getsize(path) == 0:
+        raise InputError(f"{where}: mesh file {shown} is empty (0 bytes)")
     try:
         loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
         vertices = np.asarray(loaded.vertices, dtype=float)
     except Exception as exc:  # trimesh raises many kinds for a bad file
-        raise InputError(f"{where}: cannot read mesh file {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None
+        raise InputError(f"{where}: cannot read mesh file {shown}: {' '.join(str(exc).split())}") from None
     if vertices.ndim != 2 or vertices.shape[1] != 3:  # e.g. an OBJ "v" line with two coordinates
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has vertices of shape {vertices.shape}, not (V, 3)")
-    vertices = vertices[np.all(np.isfinite(vertices), axis=1)] * np.asarray(scale, float)
-    if len(vertices) < 4 or np.linalg.matrix_rank(vertices - vertices.mean(axis=0), tol=1e-9) < 3:
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has no volume (empty or flat: "
-                         f"{len(vertices)} vertices)")
+        raise InputError(f"{where}: mesh file {shown} has vertices of shape {vertices.shape}, not (V, 3)")
+    vertices = vertices[np.all(np.isfinite(vertices), axis=1)]
+    if len(vertices) == 0:
+        raise InputError(f"{where}: mesh file {shown} has no vertices (not a mesh trimesh reads: STL, OBJ, PLY, "
+                         "DAE, ...)")
+    if _thickness(vertices) <= 0:
+        raise InputError(f"{where}: mesh file {shown} is flat ({len(vertices)} vertices on a plane, a line or a "
+                         "point): a collision mesh must enclose a volume")
+    scale = np.asarray(scale, float).reshape(3)
+    vertices = vertices * scale
+    thickness = _thickness(vertices)
+    if thickness < MIN_MESH_THICKNESS_M:
+        extent = vertices.max(axis=0) - vertices.min(axis=0)
+        raise InputError(f"{where}: mesh file {shown} scaled by {' '.join(f'{s:g}' for s in scale)} is "
+                         f"{thickness:.3g} m thin (extent {' x '.join(f'{e:.3g}' for e in extent)} m): no volume "
+                         f"(at least {MIN_MESH_THICKNESS_M:g} m; is the scale right?)")
     if np.abs(vertices).max() > MAX_COORDINATE_M:
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has a vertex {np.abs(vertices).max():.3g} m from its "
+        raise InputError(f"{where}: mesh file {shown} has a vertex {np.abs(vertices).max():.3g} m from its "
                          f"origin (at most {MAX_COORDINATE_M:g} m; is the scale right?)")
     from scipy.spatial import ConvexHull, QhullError
 
@@ -239,5 +423,20 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
         hull = ConvexHull(vertices)
     except QhullError as exc:  # nearly flat, or coordinates whose round-off swamps the shape
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else "qhull failed"
-        raise InputError(f"{where}: mesh file {os.fspath(path)!r} has no convex hull ({first})") from None
+        raise InputError(f"{where}: mesh file {shown} has no convex hull ({first})") from None
     return np.ascontiguousarray(vertices[hull.vertices])
+
+
+def _thickness(vertices: np.ndarray) -> float:
+    """The width (m) of points (V, 3) across their thinnest principal direction (0 for fewer than 4 points)."""
+    if len(vertices) < 4:
+        return 0.0
+    centred = vertices - vertices.mean(axis=0)
+    scale = float(np.abs(centred).max())
+    if scale == 0:
+        return 0.0
+    _, s, vt = np.linalg.svd(centred / scale, full_matrices=False)
+    if s[-1] <= 1e-12 * s[0]:
+        return 0.0
+    across = centred @ vt[-1]
+    return float(across.max() - across.min())
