@@ -217,6 +217,26 @@ def test_general_discretisation_of_a_plane_arc_equals_eq9(robot):
                                bb.arc_joint_angles(L_BASE, theta, robot, turn=-1), atol=1e-8)
 
 
+def test_initial_phase_takes_a_frame_tilted_within_the_axis_tolerance():
+    """A body frame whose x is tilted off the start tangent by less than AXIS_TOLERANCE_DEG (a bent base whose
+    yaw axes a description writes 0.6 deg off) gives the phase of its projection; beyond it, an error."""
+    from scipy.spatial.transform import Rotation
+    from snakehead.model.body_frame import AXIS_TOLERANCE_DEG
+
+    r, ders = helix(0.8, 0.25, True)
+    c = bb.SpaceCurve(r, 0.0, 2.0, derivatives=ders)
+    T, N, B = c.frenet(0.0).T
+    y = math.cos(0.7) * N - math.sin(0.7) * B
+    R0 = np.column_stack([T, y, np.cross(T, y)])
+    for tilt_deg, ok in ((0.6 * AXIS_TOLERANCE_DEG, True), (1.5 * AXIS_TOLERANCE_DEG, False)):
+        tilted = Rotation.from_rotvec(np.radians(tilt_deg) * R0[:, 2]).as_matrix() @ R0  # x turned about z
+        if ok:
+            assert c.initial_phase(tilted) == pytest.approx(0.7, abs=np.radians(tilt_deg))
+        else:
+            with pytest.raises(ValueError, match="not the curve's start tangent"):
+                c.initial_phase(tilted)
+
+
 def test_helix_gives_yaw_and_pitch_and_fk_follows_it(robot):
     """A helix discretised onto the whole body: both yaw and pitch joints bend, with the closed-form angles
     of Eqs. 5-6, and the robot's joints (FK) stay near the helix (a gentle one: 8.65 cm links)."""

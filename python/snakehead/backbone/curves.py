@@ -24,6 +24,7 @@ import numpy as np
 from scipy import integrate, optimize
 
 from .._validate import finite_array, finite_float, positive
+from ..model.body_frame import AXIS_TOLERANCE_DEG
 
 import numpy.typing as npt
 from .._errors import InputError
@@ -275,12 +276,13 @@ class SpaceCurve:
     def initial_phase(self, frame0: npt.ArrayLike) -> float:
         """phi0 for a body whose frame at the curve's start has rotation ``frame0`` (3, 3) (columns x, y, z).
 
-        Its x-axis must be the curve's start tangent (to 1e-6); phi0 = atan2(N.z, N.y) with N the Frenet
-        normal at t0 (0 for a straight curve).
+        Its x-axis must be the curve's start tangent, within :data:`~snakehead.model.body_frame.AXIS_TOLERANCE_DEG`
+        (a description's joint axes may be that far off its body's y or z, which tilts a bent base's end by as
+        much); phi0 = atan2(N.z, N.y) with N the Frenet normal at t0 (0 for a straight curve).
         """
         R = finite_array(frame0, "frame0", (3, 3))
         F = self.frenet(self.t0)
-        if abs(float(R[:, 0] @ F[:, 0]) - 1.0) > 1e-6:
+        if float(R[:, 0] @ F[:, 0]) < math.cos(math.radians(AXIS_TOLERANCE_DEG)):
             raise InputError("the body frame's x-axis is not the curve's start tangent: "
                              f"x = {R[:, 0].round(6).tolist()}, T(t0) = {F[:, 0].round(6).tolist()}")
         if self._straight:
