@@ -330,8 +330,9 @@ INFO_SAYS = {
                      "7 joints (mod_16_joint:y", "joint axes within 0.040 deg"),
     "wheeled": ("held: 32 moving joints off the body", "with axis 0 0 0: wheel_2_right_joint",
                 "side branches: 32 links (0.320 kg, 32 collision shapes)"),
-    "cmu_masses": ("inertia: recomputed from the collision shapes", "masses and inertias: 2 implausible",
-                   "sits on 16 links without collision shapes"),
+    "cmu_masses": ("inertia: recomputed from the collision shapes (uniform density over each rigid segment",
+                   "16 kg on 16 links without shapes moved onto the shapes fixed to them (now 0 kg): "
+                   "'reu_module_in_1' 1 kg -> 'reu_module_body_1'", "masses and inertias: plausible"),
     "backwards_head": ("head: neck_end", "design: the base holds the lifted neck and head"),
 }
 

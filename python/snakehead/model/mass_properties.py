@@ -21,13 +21,17 @@ inertia of 1 kg m^2 and no geometry, a 0.103 kg shell with ixx = 2.948 kg m^2 (a
     core refuses a description with them unless ``inertia = "from_shapes"`` replaces them).
 
 * :func:`with_inertia` -- the description with its ``<inertial>`` elements recomputed from the links' collision
-  shapes (``inertia = "from_shapes"`` in the robot file): a uniform density over each link's shapes, the link's
-  own URDF mass (or, with ``density`` in kg/m^3, the mass that density gives). Boxes, cylinders and spheres in
-  closed form, meshes as their convex hulls (as everywhere in snakehead) through trimesh; several shapes of a link
-  are combined about their common centre of mass (parallel-axis theorem), each at its ``<origin>``. Overlapping
-  shapes count twice where they overlap. Links without collision shapes keep their ``<inertial>``; so do links
-  with shapes but no mass when no density is given. It rewrites the URDF text (everything but the ``<inertial>``
-  elements is kept), so the core, the stability checks and MuJoCo all see the same numbers.
+  shapes (``inertia = "from_shapes"`` in the robot file), one *rigid segment* at a time (:func:`rigid_segments`:
+  links joined by fixed joints between two moving joints): a uniform density over all the segment's shapes, the
+  segment's total URDF mass (or, with ``density`` in kg/m^3, the mass that density gives), so each link with shapes
+  holds its shapes' share. Boxes, cylinders and spheres in closed form, meshes as their convex hulls (as everywhere
+  in snakehead) through trimesh; several shapes of a link are combined about their common centre of mass
+  (parallel-axis theorem), each at its ``<origin>``. Overlapping shapes count twice where they overlap. Links without
+  collision shapes in a segment with shapes lose their ``<inertial>`` (their mass moves to the segment's shapes:
+  a 1 kg joint link fixed to its shell; :class:`InertiaRewrite` says what moved); segments without shapes keep
+  theirs, and so do segments with shapes but no mass when no density is given. It rewrites the URDF text
+  (everything but the ``<inertial>`` elements is kept), so the core, the stability checks and MuJoCo all see the
+  same numbers.
 """
 from __future__ import annotations
 
@@ -170,11 +174,19 @@ def check_inertia_source(inertia: object, density: object, where: str = "") -> t
 def with_inertia(description: Description, inertia: str = "urdf", density: float | None = None,
                  where: str = "") -> Description:
     """The description whose URDF text the core will read: unchanged for ``inertia = "urdf"``; for "from_shapes"
-    every link's ``<inertial>`` recomputed from its collision shapes (:func:`inertia_from_shapes`; mesh paths
-    resolved as the robot's shapes are). InputError for a bad ``inertia`` or ``density``."""
+    the ``<inertial>`` elements recomputed from the collision shapes (:func:`rewrite_inertia`)."""
+    return rewrite_inertia(description, inertia, density, where)[0]
+
+
+def rewrite_inertia(description: Description, inertia: str = "urdf", density: float | None = None,
+                    where: str = "") -> tuple[Description, InertiaRewrite | None]:
+    """:func:`with_inertia` and what it moved: for "from_shapes" the ``<inertial>`` elements recomputed one rigid
+    segment at a time (:func:`rewrite_inertia_text`; mesh paths resolved as the robot's shapes are) and the
+    :class:`InertiaRewrite`; for "urdf" the description unchanged and None. InputError for a bad ``inertia`` or
+    ``density``."""
     inertia, density = check_inertia_source(inertia, density, where)
     if inertia == "urdf":
-        return description
+        return description, None
     from .description import MeshResolver, convex_hull_vertices
 
     resolver = MeshResolver(description.folder, description.folders)
@@ -185,7 +197,8 @@ def with_inertia(description: Description, inertia: str = "urdf", density: float
     def hull(filename: str, scale: np.ndarray, at: str) -> np.ndarray:
         return convex_hull_vertices(resolver.resolve(filename, at), scale, at)
 
-    return dataclasses.replace(description, text=inertia_from_shapes(text, hull, density, description.source))
+    text, rewrite = rewrite_inertia_text(text, hull, density, description.source)
+    return dataclasses.replace(description, text=text), rewrite
 
 
 def _numbers(text: str | None, count: int, what: str, default: str | None = None) -> np.ndarray:
@@ -282,28 +295,117 @@ def _write_inertial(link: ET.Element, props: MassProperties) -> None:
     new[-1].tail = closing
 
 
+@dataclass(frozen=True)
+class InertiaRewrite:
+    """What ``inertia = "from_shapes"`` did beyond recomputing inertias (:func:`rewrite_inertia_text`).
+
+    ``moved``: (link, URDF mass in kg, the links with shapes of its rigid segment) for each link without shapes
+    whose mass went to its segment's shapes (its ``<inertial>`` removed); ``dropped``: links without shapes and
+    without mass in such a segment whose ``<inertial>`` was removed (a 0 kg link with 1 kg m^2); ``kept``: links
+    with mass in segments without any collision shape (their ``<inertial>`` kept); ``unmassed``: links of
+    segments with shapes but no URDF mass (without ``density``: kept as written)."""
+
+    moved: tuple[tuple[str, float, tuple[str, ...]], ...] = ()
+    dropped: tuple[str, ...] = ()
+    kept: tuple[str, ...] = ()
+    unmassed: tuple[str, ...] = ()
+
+    @property
+    def moved_mass(self) -> float:
+        return float(sum(m for _, m, _ in self.moved))
+
+
 def inertia_from_shapes(text: str, hull: Callable[[str, np.ndarray, str], np.ndarray], density: float | None = None,
                         where: str = "the URDF") -> str:
-    """The URDF text with each link's ``<inertial>`` recomputed from its collision shapes (see the module's
-    docstring); links without shapes, and links with shapes but no mass when ``density`` is None, keep theirs.
-    ``hull(filename, scale, where)``: a mesh's convex hull vertices."""
+    """The URDF text with the ``<inertial>`` elements recomputed from the collision shapes, one rigid segment at a
+    time (:func:`rewrite_inertia_text`). ``hull(filename, scale, where)``: a mesh's convex hull vertices."""
+    return rewrite_inertia_text(text, hull, density, where)[0]
+
+
+def rigid_segments(root: ET.Element) -> list[list[ET.Element]]:
+    """The URDF's links grouped into rigid segments: links joined by ``fixed`` joints, in either direction (the
+    body's tree may be rooted anywhere), each segment bounded by moving joints. Segments and their links in the
+    order of the links in the URDF."""
+    links = root.findall("link")
+    index = {link.get("name", ""): k for k, link in enumerate(links)}
+    up = list(range(len(links)))
+
+    def find(k: int) -> int:
+        while up[k] != k:
+            up[k] = up[up[k]]
+            k = up[k]
+        return k
+
+    for joint in root.findall("joint"):
+        if joint.get("type") != "fixed":
+            continue
+        parent, child = joint.find("parent"), joint.find("child")
+        a = None if parent is None else index.get(parent.get("link", ""))
+        b = None if child is None else index.get(child.get("link", ""))
+        if a is not None and b is not None:
+            up[find(a)] = find(b)
+    groups: dict[int, list[ET.Element]] = {}
+    for k, link in enumerate(links):
+        groups.setdefault(find(k), []).append(link)
+    return list(groups.values())
+
+
+def _urdf_mass(link: ET.Element) -> float:
+    node = link.find("inertial/mass")
+    if node is None:
+        return 0.0
+    return float(_numbers(node.get("value"), 1, f"link {link.get('name', '')!r} <inertial> <mass> value")[0])
+
+
+def rewrite_inertia_text(text: str, hull: Callable[[str, np.ndarray, str], np.ndarray],
+                         density: float | None = None, where: str = "the URDF") -> tuple[str, InertiaRewrite]:
+    """The URDF text with its ``<inertial>`` elements recomputed from the collision shapes, and what was moved.
+
+    Each rigid segment (:func:`rigid_segments`) is one body of uniform density over all its links' collision
+    shapes: its total URDF mass spread over their volume (or ``density`` kg/m^3), so each link with shapes gets
+    its shapes' share of the mass and their inertia (about their centre of mass, in the link's frame), and the
+    segment's mass is kept. Links without shapes in a segment with shapes get no ``<inertial>`` (mass 0): a joint
+    link of 1 kg and 1 kg m^2 fixed to a shell gives its mass to the shell. Segments without shapes, and segments
+    with shapes but no mass when ``density`` is None, keep their ``<inertial>`` elements. Only the fixed joints'
+    topology matters: each link's share is computed in its own frame, and the core and MuJoCo join the links
+    through the fixed joints' transforms as they would any others."""
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise InputError(f"malformed URDF ({where}): {exc}") from None
-    for link in root.iter("link"):
-        shapes = link_shapes(link, hull)
-        if not shapes:
+    moved: list[tuple[str, float, tuple[str, ...]]] = []
+    dropped: list[str] = []
+    kept: list[str] = []
+    unmassed: list[str] = []
+    for segment in rigid_segments(root):
+        shapes = [link_shapes(link, hull) for link in segment]
+        masses = [_urdf_mass(link) for link in segment]
+        shaped = [k for k, s in enumerate(shapes) if s]
+        if not shaped:
+            kept += [link.get("name", "") for link, m in zip(segment, masses) if m > 0]
             continue
-        mass = None
-        if density is None:
-            node = link.find("inertial/mass")
-            mass = 0.0 if node is None else float(_numbers(node.get("value"), 1,
-                                                           f"link {link.get('name', '')!r} <inertial> <mass> value")[0])
-            if not mass > 0:
+        total = float(sum(masses))
+        if density is None and not total > 0:
+            unmassed += [link.get("name", "") for link in segment]
+            continue
+        volumes = [float(sum(v for _, v, _, _ in shapes[k])) for k in range(len(segment))]
+        volume = float(sum(volumes))
+        onto = tuple(segment[k].get("name", "") for k in shaped)
+        for k, link in enumerate(segment):
+            if shapes[k]:
+                share = (density * volumes[k] if density is not None
+                         else total if len(shaped) == 1 else total * volumes[k] / volume)
+                _write_inertial(link, shapes_mass_properties(shapes[k], mass=share))
                 continue
-        _write_inertial(link, shapes_mass_properties(shapes, mass=mass, density=density))
-    return ET.tostring(root, encoding="unicode")
+            inertials = link.findall("inertial")
+            for inertial in inertials:
+                link.remove(inertial)
+            if masses[k] > 0:
+                moved.append((link.get("name", ""), masses[k], onto))
+            elif inertials:
+                dropped.append(link.get("name", ""))
+    rewrite = InertiaRewrite(tuple(moved), tuple(dropped), tuple(kept), tuple(unmassed))
+    return ET.tostring(root, encoding="unicode"), rewrite
 
 
 # ------------------------------------------------------------------------------------------------
@@ -413,15 +515,25 @@ def _grouped(per_link: list[tuple[str, str, str]]) -> list[Finding]:
 
 
 def inertia_source(robot: SnakeRobot) -> str:
-    """Which inertial data the robot uses, as a line for ``snakehead info``."""
+    """Which inertial data the robot uses, as a line for ``snakehead info``: with "from_shapes", the mass moved from
+    links without shapes onto the shapes of their rigid segment (naming them) and the links that keep the URDF's."""
     args = robot.description_arguments
     if args.get("inertia", "urdf") != "from_shapes":
         return "the URDF's <inertial> elements"
     density = args.get("density")
     how = "the URDF's masses" if density is None else f"{float(density):g} kg/m^3"
+    line = f"recomputed from the collision shapes (uniform density over each rigid segment, {how})"
+    rewrite: InertiaRewrite | None = getattr(robot, "inertia_rewrite", None)
+    if rewrite is not None and rewrite.moved:
+        listed = ", ".join(f"{name!r} {_kg(m)} -> {_names(list(onto))}" for name, m, onto in rewrite.moved[:_LISTED])
+        more = f" and {len(rewrite.moved) - _LISTED} more" if len(rewrite.moved) > _LISTED else ""
+        n = len(rewrite.moved)
+        line += (f"; {_kg(rewrite.moved_mass)} on {n} link{'s' if n > 1 else ''} without shapes moved onto the "
+                 f"shapes fixed to {'them' if n > 1 else 'it'} (now 0 kg): {listed}{more}")
+    if rewrite is not None and rewrite.dropped:
+        line += f"; <inertial> of massless links without shapes removed: {_names(list(rewrite.dropped))}"
     shaped = set(int(k) for k in robot.shaped_links)
     kept = [n for k, n in enumerate(robot.link_names) if robot.masses[k] > 0 and k not in shaped]
-    line = f"recomputed from the collision shapes (uniform density, {how})"
     if kept:
-        line += f"; links without shapes keep the URDF's: {_names(kept)}"
+        line += f"; links without shapes in their rigid segment keep the URDF's: {_names(kept)}"
     return line

@@ -36,7 +36,7 @@ from .chain import Chain, _check_utf8
 from .body_frame import (ALIGNED_SUFFIX, AXIS_TOLERANCE_DEG, HEAD_AXES, STRAIGHT_TOLERANCE, NotStraight,
                          Straightness, aligned_frames, body_frame, straightness)
 from .description import MeshResolver, convex_hull_vertices, read_description, with_joint_limits
-from .mass_properties import with_inertia
+from .mass_properties import rewrite_inertia
 from .description_tree import JointOffsets, TreeChanges, body_description
 
 import numpy.typing as npt
@@ -143,7 +143,9 @@ class SnakeRobot:
                            "trust_xacro": trust_xacro, "home": home, "inertia": inertia, "density": density}
         description = read_description(_urdf_source(urdf), xacro_args, packages=packages, robot_file=robot_file,
                                         trust_xacro=trust_xacro)
-        description = with_inertia(description, inertia, density)  # <inertial> from the shapes, if asked
+        description, rewrite = rewrite_inertia(description, inertia, density)  # <inertial> from the shapes, if asked
+        #: What ``inertia = "from_shapes"`` moved (:class:`.mass_properties.InertiaRewrite`; None for "urdf").
+        self.inertia_rewrite = rewrite
         names = {"base_end": _frame_name(base_end, "base_end"), "neck_end": _frame_name(neck_end, "neck_end"),
                  "head_tip": _frame_name(head_tip, "head_tip")}
         if head_axis not in HEAD_AXES:
@@ -201,9 +203,9 @@ class SnakeRobot:
         against the tree where it must (:mod:`.description_tree`). Raises :class:`~snakehead.InputError` for frames that are
         missing or out of order, a part without joints, or a body that is not a snake (straight at q = 0,
         revolute joints about two perpendicular axes across it, collision shapes on the base). ``inertia``:
-        ``"urdf"`` (the description's ``<inertial>``) or ``"from_shapes"`` (each link's inertia recomputed from its
-        collision shapes at uniform density, with its URDF mass or, given ``density`` in kg/m^3, the mass that
-        density gives: :mod:`.mass_properties`).
+        ``"urdf"`` (the description's ``<inertial>``) or ``"from_shapes"`` (the inertias recomputed from the
+        collision shapes at uniform density over each rigid segment of links fixed together, with the segment's
+        URDF mass or, given ``density`` in kg/m^3, the mass that density gives: :mod:`.mass_properties`).
         """
         return cls(urdf, base_end=base_end, neck_end=neck_end, head_tip=head_tip, root=root, head_axis=head_axis,
                    packages=packages, limits=limits, xacro_args=xacro_args, trust_xacro=trust_xacro, home=home,
