@@ -1,7 +1,8 @@
 """`HeadController`: the control process of Section 3.3 for one target (steps 1, 3, 4 and the static check of 5).
 
 Given where the head must be and where it must point, find all the joint angles:
-1. the base lies on the optimised plane arc (``backbone.initial_configuration``);
+1. the base lies on the optimised plane arc (``backbone.initial_configuration``; on the body's actual ground
+   contacts when the paper's arc does not stand on them: ``initial_state``);
 3. P0, the accepted-range test, and, if the target is out of range, the planar move of the base that brings
    it in (reported, as the rolling gait or turning in place would have to carry it out);
    then the neck end frame by Eqs. 18-22 with the dexterous centre G0 of the head's reachability map;
@@ -20,6 +21,7 @@ import numpy as np
 
 from . import head as head_ik
 from . import neck as nk
+from .initial_state import stable_initial_configuration
 from ..dynamics import stability
 from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
 from ..kinematics.ik import TracIK
@@ -79,8 +81,6 @@ class HeadController:
                  base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
                  timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
                  base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
-        from .. import backbone  # late: heavier imports, only needed here
-
         from ..kinematics import workspace
         from ..motion.plan_cache import PlanCache
 
@@ -109,8 +109,8 @@ class HeadController:
         self.neck_length = self.robot.lift_length  # the part of the neck that can lift (all of it, usually)
         self.slack = positive(slack, "slack") if slack is not None else self.neck_length / 2
         self.allow_base_move = bool(allow_base_move)
-        if base_configuration is None:
-            base_configuration = backbone.initial_configuration(self.robot)
+        if base_configuration is None:  # the paper's, unless it does not stand on the body's actual contacts
+            base_configuration = stable_initial_configuration(self.robot)
         self.q_initial = within_limits(joint_vector(base_configuration, self.robot.n_joints, "base_configuration"),
                                        self.robot.lower, self.robot.upper, "base_configuration")
         self._polygons: dict = {}  # (base placement, base joints) -> support polygon
