@@ -74,4 +74,4 @@ ROBOTS = {
                  lambda: generated(13, 0.10, 0.06, 0.3, "yaw", head=6, neck=1)),
 }
 ROBOTS.update({f"published:{style}": (f"published style {style!r}", lambda style=style: published_style(style))
-               for style in published.STYLES})
+               for style in published.ALL_STYLES})

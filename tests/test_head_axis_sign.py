@@ -134,7 +134,7 @@ def test_info_reads_the_signed_axis(files, capsys):
 
 @pytest.mark.parametrize("value", ["w", "+x", "X", "-", "--x", "x "])
 def test_a_bad_head_axis_lists_the_choices(files, capsys, value):
-    """Exit 2 with one line that names head_axis, the value and every choice."""
+    """Exit 2 with one line that names the robot file, head_axis, the value and every choice."""
     path = files["turned"]
     bad = path.with_name("bad_axis.toml")
     bad.write_text(path.read_text(encoding="utf-8").replace('head_axis = "-x"', f'head_axis = "{value}"'),
@@ -142,4 +142,5 @@ def test_a_bad_head_axis_lists_the_choices(files, capsys, value):
     assert cli.main(["info", "--robot", str(bad)]) == 2
     line = capsys.readouterr().err.strip()
     assert "\n" not in line
-    assert re.search(r"head_axis must be one of x, y, z, -x, -y, -z, got " + re.escape(repr(value)), line), line
+    assert re.search(r"robot file '.*bad_axis\.toml': 'head_axis' must be one of x, y, z, -x, -y, -z \(.*\), got "
+                     + re.escape(repr(value)), line), line

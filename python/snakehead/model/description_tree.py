@@ -98,9 +98,6 @@ class _Tree:
                 raise InputError(f"{where}: link {child!r} is the child of two joints, {self.parent_joint[child]!r} "
                                  f"and {name!r}")
             self.parent_joint[child] = name
-            origin_matrix(self.joints[name], f"{where}: joint {name!r}")  # the core would misread a short list
-            if self.joints[name].get("type") in _MOVING:
-                _axis(self.joints[name], name, where)
 
     def ends(self, joint: str) -> tuple[str, str]:
         element = self.joints[joint]

@@ -260,6 +260,9 @@ class SnakeRobot:
         if not segments or bare:
             raise InputError("every rigid segment of the base needs a <collision> shape (the base lies on the ground "
                              f"on them); none on {bare or 'the base'}")
+        if not self.base_length > STRAIGHT_TOLERANCE:  # the base arc's radius would be 0
+            raise InputError(f"the base part (root {self.parts.root!r} -> base_end {self.user_frames['base_end']!r}) is "
+                             f"{1000 * self.base_length:.3g} mm long along the body: put base_end further along it")
         self._check_straight()  # first: a curled body's axes are off its line too
         off_deg = np.degrees(self.axis_deviations)
         for j in np.flatnonzero(off_deg > AXIS_TOLERANCE_DEG):

@@ -127,7 +127,7 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
     return RobotFile(path=Path(path), urdf=os.fspath(urdf), base_end=_string(data, "base_end", where),
                      neck_end=_string(data, "neck_end", where), head_tip=_string(data, "head_tip", where),
                      root=_string(data, "root", where) if "root" in data else None, map=map_path,
-                     head_axis=_string(data, "head_axis", where) if "head_axis" in data else "x",
+                     head_axis=_head_axis(data, where),
                      xacro_args=_xacro_args(data, where), packages=_packages(data, folder, where),
                      limits=_limits(data, where), home=_home(data, where), **_inertia(data, where))
 
@@ -176,6 +176,16 @@ def _limits(data: dict, where: str) -> dict | None:
             raise InputError(f"{where}: limits.{joint} must be [lower, upper] in rad with lower < upper, got {value!r}")
         out[joint] = (float(value[0]), float(value[1]))
     return out or None
+
+
+def _head_axis(data: dict, where: str) -> str:
+    from .body_frame import HEAD_AXES
+
+    value = data.get("head_axis", "x")
+    if value not in HEAD_AXES:
+        raise InputError(f"{where}: 'head_axis' must be one of {', '.join(HEAD_AXES)} (the head_tip frame's axis that "
+                         f"points where the head looks), got {value!r}")
+    return value
 
 
 def _home(data: dict, where: str) -> dict | None:
