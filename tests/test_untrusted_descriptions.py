@@ -160,9 +160,11 @@ def test_what_real_descriptions_use_still_expands(tmp_path: Path) -> None:
           </xacro:parts.module>
           <xacro:if value="${n == 2}">
             <link name="tip_${'_'.join([str(k) for k in python.range(n)])}_$(eval n * 3)"/>
+            <joint name="tip_joint" type="fixed"><parent link="m1"/><child link="tip_0_1_6"/></joint>
           </xacro:if>
           <xacro:unless value="${n == 2}"><link name="never"/></xacro:unless>
           <link name="here_${len('$(dirname)') > 0}"/>
+          <joint name="here_joint" type="fixed"><parent link="m1"/><child link="here_True"/></joint>
         </robot>
         """))
     text = read_description(path, {"n": 2}, packages={"snake_description": package}).text
