@@ -367,9 +367,3 @@ def body_description(text: str, root: str, head_tip: str, home: Mapping[str, flo
                           tuple((j, v) for j, v in body_home.items() if v != 0.0))
     return (tree.text() if changes.any else None), changes
 
-
-def body_joint_names(text: str, root: str, head_tip: str, where: str) -> list[str]:
-    """The moving joints on the body's chain, root -> head_tip, of a text :func:`body_description` wrote."""
-    tree = _Tree(text, where)
-    links = tree.path_links(root, head_tip)
-    return [j for j in (tree.parent_joint[link] for link in links[1:]) if tree.joints[j].get("type") in _MOVING]
