@@ -136,3 +136,20 @@ def plan_agrees(robot, m, pairs) -> list:
         p = m.centers[v] + 0.5 * m.voxel_size * d
         out.append(snakehead.plan([(p, d)], robot=robot).success == bits[v, k])
     return out
+
+
+def reachable_plan_in_mujoco(robot):
+    """One reachable target ("same" kind, seed 0) of ``robot`` planned and run in MuJoCo: the simulation (asserts the
+    plan succeeded and the head arrived within 2 mm and 1 deg)."""
+    import numpy as np
+    import snakehead
+    from snakehead.motion.targets import reachable_targets
+
+    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
+    (t,) = reachable_targets(controller, "same", 1, np.random.default_rng(0))
+    plan = snakehead.plan([(t.position, t.direction)], controller=controller)
+    assert plan.success, plan.failure
+    sim = snakehead.simulate(plan)
+    assert sim.position_error_m <= 2e-3 and sim.direction_error_deg <= 1.0, (sim.position_error_m,
+                                                                            sim.direction_error_deg)
+    return sim

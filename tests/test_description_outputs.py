@@ -23,6 +23,7 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead.app import ros_bag
 from snakehead.app.report import write_trajectory_csv
 from snakehead.model.published import write_robot
+from test_ros_bag import read_bag
 
 pin = pytest.importorskip("pinocchio")
 pytest.importorskip("rosbags")
@@ -46,17 +47,6 @@ def synthetic_plan(robot: SnakeRobot, n: int = 200, seed: int = 0) -> SimpleName
     q = rng.uniform(robot.lower, robot.upper, (n, robot.n_joints))
     return SimpleNamespace(name="synthetic", robot=robot, base=BASE, t=t, q=q, qd=np.gradient(q, t, axis=0),
                            targets=[], obstacles=[], scene=None, stability=SimpleNamespace(zmp=np.zeros((n, 2))))
-
-
-def read_bag(path: Path) -> dict[str, list]:
-    """topic -> [(log time ns, message)] with rosbags (the bag's own schemas)."""
-    from rosbags.highlevel import AnyReader
-
-    out: dict[str, list] = {}
-    with AnyReader([path]) as reader:
-        for conn, log_time, raw in reader.messages():
-            out.setdefault(conn.topic, []).append((log_time, reader.deserialize(raw, conn.msgtype)))
-    return out
 
 
 def tf_matrix(transform) -> np.ndarray:

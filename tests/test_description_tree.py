@@ -347,17 +347,10 @@ def test_quirk_plans_track_in_mujoco(tmp_path, mujoco, style):
     """A body straightened by [home] (cad: curled at zero, side offsets, near-right rolls, side branches) and a
     body running against its tree (reu_reversed): a reachable target planned on the rewritten model is followed in
     MuJoCo (built from the same rewritten model) within 2 mm and 1 deg, the base in place."""
-    import snakehead
+    from conftest import reachable_plan_in_mujoco
     from snakehead.model.published import write_robot
-    from snakehead.motion.targets import reachable_targets
 
     robot = SnakeRobot.from_file(write_robot(style, tmp_path))
     assert robot.tree_changes.home if style == "cad" else robot.tree_changes.reversed_joints
-    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
-    (t,) = reachable_targets(controller, "same", 1, np.random.default_rng(0))
-    plan = snakehead.plan([(t.position, t.direction)], controller=controller)
-    assert plan.success, plan.failure
-    sim = snakehead.simulate(plan)
-    assert sim.position_error_m <= 2e-3 and sim.direction_error_deg <= 1.0, (sim.position_error_m,
-                                                                            sim.direction_error_deg)
+    sim = reachable_plan_in_mujoco(robot)
     assert sim.metrics["base_slide_m"] < 2e-3, sim.metrics

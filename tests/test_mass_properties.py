@@ -519,15 +519,7 @@ def test_cmu_masses_plan_tracks_in_mujoco(tmp_path, mujoco):
     """One reachable target of the cmu_masses robot planned and run in MuJoCo: with the joint links' 1 kg m^2 the
     head missed by up to 397 mm and the base slid 0.56 m (bench/targets.py); now within the README's 2 mm and
     1 deg, the base in place."""
-    import snakehead
-    from snakehead.motion.targets import reachable_targets
+    from conftest import reachable_plan_in_mujoco
 
-    robot = SnakeRobot.from_file(write_robot("cmu_masses", tmp_path))
-    controller = snakehead.HeadController(robot, method="free_roll", seed=1)
-    (t,) = reachable_targets(controller, "same", 1, np.random.default_rng(0))
-    plan = snakehead.plan([(t.position, t.direction)], controller=controller)
-    assert plan.success, plan.failure
-    sim = snakehead.simulate(plan)
-    assert sim.position_error_m <= 2e-3 and sim.direction_error_deg <= 1.0, (sim.position_error_m,
-                                                                            sim.direction_error_deg)
+    sim = reachable_plan_in_mujoco(SnakeRobot.from_file(write_robot("cmu_masses", tmp_path)))
     assert sim.metrics["base_slide_m"] < 2e-3 and sim.metrics["zmp_min_margin_m"] > -1e-3, sim.metrics
