@@ -1,6 +1,6 @@
 """The robots the benchmarks run (bench/targets.py, bench/sim_gains.py, bench/gaits.py): the default one, generated
 snakes from light and short to heavy and long (their parts marked by fixed frames p0 (base end) and b0 (neck end)),
-and snakes written the way published ones are (snakehead.model.published: cylinders, meshes, xacro, modules along
+and snakes written the way published ones are (snakehead.samples.published: cylinders, meshes, xacro, modules along
 z behind a rotated root, several links per module, a one-joint neck, a 6-DOF head)."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import tempfile
 from pathlib import Path
 
 from snakehead import SnakeRobot
-from snakehead.model import published
+from snakehead.samples import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
 
 _FOLDER = Path(tempfile.mkdtemp(prefix="snakehead-bench-robots-"))

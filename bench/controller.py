@@ -17,7 +17,7 @@ import numpy as np
 
 from snakehead import SnakeRobot
 from snakehead.app.report import cpu_name
-from snakehead.control.controller import HeadController
+from snakehead.solve.head_controller import HeadController
 from snakehead.scenes import paper_scene
 
 

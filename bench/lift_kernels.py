@@ -3,7 +3,7 @@
 
 Each interpreter given runs a worker that plans the reachable-by-construction targets of a set (as bench/plan_speed.py:
 default robot, ``HeadController(method="free_roll", seed=1)`` warmed up by one plan), keeping the path each plan
-retimes (``motion.timing.retime``'s waypoints and options) and the motion it checks (``path_check.finish_checks``'s
+retimes (``retiming.timing.retime``'s waypoints and options) and the motion it checks (``path_check.finish_checks``'s
 t, q, qd, placement). Then, path by path and alternately between the workers, each times its own retiming of the path
 and its own ZMP pass over the motion from scratch (``stability.dynamic_stability_with_clearance``, contact "ground",
 nothing kept), and the pass again with the samples its motion shares with the first plan's (the lift) kept from a
@@ -29,9 +29,9 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
 
     import snakehead
     from snakehead.dynamics import stability
-    from snakehead.geometry import path_check
-    from snakehead.motion import timing
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.collision import path_proof as path_check
+    from snakehead.retiming import timing
+    from snakehead.samples.targets import reachable_targets
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)

@@ -86,7 +86,7 @@ def cached_planner(live):
     """snakehead.plan replaced by a lookup of plans of POSES made now (each target set's plan, ready at once)."""
     import dataclasses
 
-    import snakehead.motion.planner as planner
+    import snakehead.planning.planner as planner
 
     real = planner.plan
     made = {}

@@ -1,4 +1,4 @@
-"""The closed loop from lying straight (``snakehead.sim.loop.ClosedLoop``): gaits, the curl, the head phases, all in
+"""The closed loop from lying straight (``snakehead.closed_loop.loop.ClosedLoop``): gaits, the curl, the head phases, all in
 MuJoCo, from random poses, on the robot's own sensors (``--sensing onboard``, the default) or with the outside fix.
 
 ``--poses`` poses (20), drawn with ``--seed``: the tail 0.5-2.5 m from the target's foot (uniform in distance and
@@ -27,11 +27,11 @@ import numpy as np
 
 from _robots import ROBOTS  # bench/_robots.py
 from snakehead import BasePlacement, HeadController
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle
-from snakehead.motion import locomotion as lc
+from snakehead.locomotion import goals as lc
 from snakehead.scenes import Scene
-from snakehead.sim.loop import ClosedLoop
+from snakehead.closed_loop.loop import ClosedLoop
 
 SPHERE_1 = (-0.0405, 0.5443, 0.3)
 #: Starts with obstacles in the way are at least this far (m) from the target's foot (nearer, none fits between).
@@ -87,7 +87,7 @@ def main() -> None:
     nominal = ClosedLoop(free, controller=controller, sensing=sensing)
     goal = nominal.scene.base if nominal.scene.base is not None else BasePlacement()
     straight_goal = nominal.straight_start()
-    from snakehead.motion.planner import bending_state
+    from snakehead.planning.planner import bending_state
 
     q_bend = bending_state(controller, controller.q_initial)
     rng = np.random.default_rng(args.seed)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Many targets in one scene: wall time and peak memory of ``snakehead plan --scene S --no-sim`` per target count.
 
-The scenes hold targets reachable by construction (``snakehead.motion.targets.reachable_targets``, kind "same":
+The scenes hold targets reachable by construction (``snakehead.samples.targets.reachable_targets``, kind "same":
 head poses of stable, collision-free whole-body configurations from the planner's own base), each held
 ``--hold`` s, visited in the order drawn. Each count runs the command line in a fresh process
 (``python -m snakehead plan --scene S --no-sim --out D``) under ``/usr/bin/time -v`` (peak RSS of the process and
@@ -29,7 +29,7 @@ import numpy as np
 def write_scene(path: Path, count: int, hold_s: float = 0.2, seed: int = 0) -> Path:
     """A scene file of ``count`` targets reachable by construction on the default robot (see the module)."""
     import snakehead
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.samples.targets import reachable_targets
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot)

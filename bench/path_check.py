@@ -1,18 +1,18 @@
 #!/usr/bin/env python3
 """The planner's path checks, the Python ones of the last release against the C++ batches, side by side in one run.
 
-Plans reachable-by-construction targets (``snakehead.motion.targets.reachable_targets``, default robot,
+Plans reachable-by-construction targets (``snakehead.samples.targets.reachable_targets``, default robot,
 ``HeadController(method="free_roll", seed=1)``), records what the plans check (the paths of waypoints the moves check
 and the timed motions the plan's end checks), then times on the same inputs, alternately:
 
-* the end checks (``motion.planner._finish``): the Python ``dynamic_stability`` with the lowest points of the neck
-  and head (as released) against ``geometry.path_check.finish_checks`` (one C++ pass), from scratch and with the
+* the end checks (``planning.planner._finish``): the Python ``dynamic_stability`` with the lowest points of the neck
+  and head (as released) against ``planning.motion_checks.finish_checks`` (one C++ pass), from scratch and with the
   lift's part kept from an earlier plan (``stability.KeptSamples``, as ``Waypoints.finish_checks`` does);
 * the clearances of the timed motions between their samples: every 2 ms sample (``sample_clearances``, as the end
   checks did) against ``check_motion`` (coarse samples, the total-variation bound) at several first steps, with an
   obstacle box beside each motion's head path;
 * the path checks (``Waypoints.move``): the released ``_feasible`` at the ``_checked`` configurations (every
-  MOVE_CHECK_STEP) against ``geometry.path_check.path_feasible`` (clearances proven between samples, static margin at
+  MOVE_CHECK_STEP) against ``planning.motion_checks.path_feasible`` (clearances proven between samples, static margin at
   the same configurations), and ``check_path`` alone at several first steps (configurations evaluated, time).
 
     python3 bench/path_check.py [--count 8] [--sets same,shape] [--repeat 3]
@@ -29,7 +29,7 @@ import numpy as np
 
 def old_feasible(way: Any, qs: np.ndarray) -> np.ndarray:
     """The released ``_Waypoints._feasible`` (now ``Waypoints.feasible``) (Python over the core's per-call kernels), for comparison."""
-    from snakehead.geometry import collision as coll
+    from snakehead.collision import body_collisions as coll
     from snakehead.margins import DETOUR_MARGIN
 
     clearance = coll.ground_clearance(way.robot, qs, way.base)[:, way.robot.lifted_links].min(axis=1)
@@ -71,8 +71,8 @@ def best_of(f: Callable[[], Any], repeat: int) -> float:
 def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
     """Plans the targets; returns the paths checked by moves (way, path, checked) and the timed motions."""
     import snakehead
-    from snakehead.geometry import path_check
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.planning import motion_checks
+    from snakehead.samples.targets import reachable_targets
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)
@@ -80,7 +80,7 @@ def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
     snakehead.plan([(H[:3, 3], H[:3, 0])], controller=controller)  # warm-up
     paths: list = []
     motions: list = []
-    real_path, real_finish = path_check.path_feasible, path_check.finish_checks
+    real_path, real_finish = motion_checks.path_feasible, motion_checks.finish_checks
 
     def spy_path(way: Any, path: np.ndarray, checked: np.ndarray, margin: float) -> bool:
         paths.append((way, np.array(path), np.array(checked)))
@@ -92,21 +92,22 @@ def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
         motions.append((robot, base, t, q, qd, kept.samples if kept is not None else 0))
         return real_finish(robot, base, t, q, qd, obstacles, contact, **kwargs)
 
-    path_check.path_feasible, path_check.finish_checks = spy_path, spy_finish
+    motion_checks.path_feasible, motion_checks.finish_checks = spy_path, spy_finish
     plans = []
     try:
         for kind in sets:
             for tg in reachable_targets(controller, kind, count, np.random.default_rng(seed)):
                 plans.append(snakehead.plan([(tg.position, tg.direction)], controller=controller))
     finally:
-        path_check.path_feasible, path_check.finish_checks = real_path, real_finish
+        motion_checks.path_feasible, motion_checks.finish_checks = real_path, real_finish
     return paths, motions, plans
 
 
 def end_checks(motions: list, repeat: int) -> None:
     """The end checks of the recorded motions: released Python, the C++ pass from scratch and resumed."""
     from snakehead.dynamics import stability
-    from snakehead.geometry import path_check
+    from snakehead.collision import path_proof as path_check
+    from snakehead.planning import motion_checks
 
     rows: dict[str, list[float]] = {"old": [], "scratch": [], "kept": [], "zmp": [], "zmp kept": [], "proof": []}
     samples, taken = [], 0
@@ -116,9 +117,9 @@ def end_checks(motions: list, repeat: int) -> None:
         if kept is not None:  # as an earlier plan from this base leaves it
             stability.dynamic_stability_with_clearance(robot, t, q, base, qd, made=made, kept=kept)
         rows["old"].append(best_of(lambda: old_finish_checks(robot, base, t, q, qd), repeat))
-        rows["scratch"].append(best_of(lambda: path_check.finish_checks(robot, base, t, q, qd, [], "ground", made=made),
+        rows["scratch"].append(best_of(lambda: motion_checks.finish_checks(robot, base, t, q, qd, [], "ground", made=made),
                                        repeat))
-        rows["kept"].append(best_of(lambda: path_check.finish_checks(robot, base, t, q, qd, [], "ground", made=made,
+        rows["kept"].append(best_of(lambda: motion_checks.finish_checks(robot, base, t, q, qd, [], "ground", made=made,
                                                                      kept=kept), repeat))
         rows["zmp"].append(best_of(lambda: stability.dynamic_stability_with_clearance(robot, t, q, base, qd, made=made),
                                    repeat))
@@ -141,7 +142,8 @@ def end_checks(motions: list, repeat: int) -> None:
 
 def between_samples(motions: list, repeat: int) -> None:
     """Ground, self and an obstacle beside the head's path: every 2 ms sample against check_motion's proof."""
-    from snakehead.geometry import BoxObstacle, path_check
+    from snakehead.geometry import BoxObstacle
+    from snakehead.collision import path_proof as path_check
 
     print("| clearances of the timed motions, an obstacle beside the head | configurations evaluated | proven clear "
           "| total (ms) |")
@@ -172,7 +174,8 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    from snakehead.geometry import path_check
+    from snakehead.collision import path_proof as path_check
+    from snakehead.planning import motion_checks
     from snakehead.margins import DETOUR_MARGIN
 
     paths, motions, plans = record(args.count, args.sets.split(","), args.seed)
@@ -183,8 +186,8 @@ def main() -> int:
     old_p, new_p, agree, old_n = [], [], 0, 0
     for way, path, checked in paths:
         old_p.append(best_of(lambda: old_feasible(way, checked).all(), args.repeat))
-        new_p.append(best_of(lambda: path_check.path_feasible(way, path, checked, DETOUR_MARGIN), args.repeat))
-        agree += bool(old_feasible(way, checked).all()) == path_check.path_feasible(way, path, checked, DETOUR_MARGIN)
+        new_p.append(best_of(lambda: motion_checks.path_feasible(way, path, checked, DETOUR_MARGIN), args.repeat))
+        agree += bool(old_feasible(way, checked).all()) == motion_checks.path_feasible(way, path, checked, DETOUR_MARGIN)
         old_n += len(checked)
     print("| move path checks | paths | configurations (released: all sampled) | total (ms) | verdicts equal |")
     print("|---|---|---|---|---|")

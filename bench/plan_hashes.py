@@ -37,7 +37,7 @@ def _targets_module():
     try:
         from snakehead.samples import targets
     except ImportError:  # before the layout of issue 36
-        from snakehead.motion import targets  # type: ignore[no-redef]
+        from snakehead.samples import targets  # type: ignore[no-redef]
     return targets
 
 

@@ -2,7 +2,7 @@
 """Plan time of two installed revisions of snakehead, side by side in one run.
 
 Each Python interpreter given (e.g. two virtual environments with different revisions installed) runs a worker
-process that plans the same reachable-by-construction targets (``snakehead.motion.targets.reachable_targets``,
+process that plans the same reachable-by-construction targets (``snakehead.samples.targets.reachable_targets``,
 default robot, ``HeadController(method="free_roll", seed=1)`` warmed up by one plan, as bench/targets.py); the
 targets are handed to the workers one at a time, alternately, so that both see the same load. Prints per set: the
 plans that succeeded, median and worst wall time, median CPU time of the process, the median motion duration, and
@@ -25,7 +25,7 @@ def worker(kind: str, count: int, seed: int) -> None:
     import numpy as np
 
     import snakehead
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.samples.targets import reachable_targets
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)

@@ -8,7 +8,7 @@ Dask's worker profiler is off (it costs ~7 % here).
     python bench/reach.py [--voxel 0.1] [--directions 12] [--workers 1 2 4] [--check 100] [--unpruned]
 
 --unpruned adds a one-process run that solves every pose (compute_reach(prune=False): the map before the prunes of
-motion.reach_bounds), side by side; every map must be equal to the first.
+solve.pose_bounds), side by side; every map must be equal to the first.
 
 Prints a Markdown table. More workers than cores shows the overhead, not a speed-up (say how many cores there are).
 """
@@ -22,7 +22,7 @@ import numpy as np
 
 import snakehead as sh
 from snakehead import sweep_defaults as defaults
-from snakehead.motion import reach
+from snakehead.planning import whole_body_reach as reach
 
 
 def main() -> None:

@@ -12,7 +12,7 @@ import numpy as np
 
 import snakehead
 from snakehead.geometry.shapes import pair_distances, pair_min_distances
-from snakehead.model import published
+from snakehead.samples import published
 
 
 def best_of(fn, repeats=5):

@@ -4,7 +4,7 @@ Plan (joint space, on the default robot, base at BasePlacement()): from a flat c
 joints at 0.879 rad, neck turned inwards, all pitch joints 0) the head part rises to a pose 0.42 m high (target A,
 hold), then moves its head to a second pose (target B, hold). Both lifted poses and the joint-space path between
 them keep the CoM inside the base's support polygon. The plan is interpolated by
-``snakehead.motion.interpolation.joint_interpolation`` at 2 ms (quintic segments if that module is absent), then tracked by
+``snakehead.trajectory.interpolation.joint_interpolation`` at 2 ms (quintic segments if that module is absent), then tracked by
 ``snakehead.sim.simulate_trajectory`` (PD + support-aware gravity compensation, 2 ms control, 1 ms physics), and compared
 with ``snakehead.sim.compare``. Prints the table; writes the three figures with ``--out``.
 
@@ -43,9 +43,9 @@ def plan(dt: float = 0.002):
     times = [0.0, 4.0, 5.0, 8.0, 9.0]
     waypoints = np.array([q0, Q_A, Q_A, Q_B, Q_B])
     try:
-        from snakehead.motion.interpolation import joint_interpolation
+        from snakehead.trajectory.interpolation import joint_interpolation
         t, q = joint_interpolation(times, waypoints, dt=dt)
-        how = "snakehead.motion.interpolation.joint_interpolation"
+        how = "snakehead.trajectory.interpolation.joint_interpolation"
     except (ImportError, AttributeError):
         ts, qs = [np.zeros(1)], [waypoints[:1]]
         for k in range(len(times) - 1):

@@ -14,10 +14,10 @@ import numpy as np
 
 from snakehead import SnakeRobot
 from snakehead.dynamics import stability as st
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle
-from snakehead.motion import cartesian as cart
-from snakehead.motion import interpolation as interp
+from snakehead.trajectory import cartesian as cart
+from snakehead.trajectory import interpolation as interp
 
 
 def stable_lift_motion(robot: SnakeRobot) -> tuple[np.ndarray, np.ndarray]:

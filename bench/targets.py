@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How often ``snakehead.plan`` reaches a head target, why it fails, and how long it takes.
 
-Target sets (``snakehead.motion.targets``): reachable by construction with the planner's base shape ("same"),
+Target sets (``snakehead.samples.targets``): reachable by construction with the planner's base shape ("same"),
 with other flat base shapes ("shape"), with other placements ("place"), and random targets around the robot
 ("random"). For each target: ``snakehead.plan([(position, direction)])`` from the default placement; success,
 the failure's reason (the whole-body solve's: out of reach / no stable pose / no clear pose, or the motion's
@@ -29,7 +29,7 @@ import numpy as np
 
 import snakehead
 from snakehead.app.report import cpu_name
-from snakehead.motion.targets import KINDS, random_targets, reachable_targets
+from snakehead.samples.targets import KINDS, random_targets, reachable_targets
 
 
 def failure_cause(plan) -> str:
@@ -92,7 +92,7 @@ def main() -> int:
     if args.generated is not None:
         from _robots import ROBOTS  # bench/_robots.py
 
-        from snakehead.kinematics import workspace as ws
+        from snakehead.kinematics.reachability import reachability_map as ws
 
         if args.generated not in ROBOTS:
             ap.error(f"--generated must be one of {', '.join(ROBOTS)}")

@@ -1,4 +1,4 @@
-"""Time-optimal retiming of the paper's two scenarios (snakehead.motion.timing.retime) against the fixed speed.
+"""Time-optimal retiming of the paper's two scenarios (snakehead.retiming.timing.retime) against the fixed speed.
 
 For each scenario (snakehead.scenes.paper_scene: "spheres", "hole") the planner's states (today timed at a fixed
 0.12 rad/s) are retimed under a sweep of limits; each retimed motion is simulated in MuJoCo
@@ -28,7 +28,7 @@ import numpy as np
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.motion import timing
+from snakehead.retiming import timing
 from snakehead.scenes import paper_scene
 
 #: The paper's Section 4: durations (s) and simulated head errors (mm, deg).

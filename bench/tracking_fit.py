@@ -4,7 +4,7 @@
 
 Two worker processes (one fitting with numpy, one with the core; default robot, ``HeadController(method="free_roll",
 seed=1)`` warmed up by one plan, as bench/plan_speed.py) plan the same reachable-by-construction targets
-(``snakehead.motion.targets.reachable_targets``), handed to them one at a time, alternately, so that both see the
+(``snakehead.samples.targets.reachable_targets``), handed to them one at a time, alternately, so that both see the
 same load. Each worker records every ``tracking_interpolation`` call its plans make. Prints per set: the plans that
 succeeded, median and worst wall time, the median motion duration, the worst relative difference of the motion
 durations and of the plans' sum |q| (inf where the sample counts differ), the calls and the median time per call;
@@ -35,8 +35,8 @@ def worker(mode: str, kind: str, count: int, seed: int) -> None:
     import numpy as np
 
     import snakehead
-    from snakehead.motion import waypoints
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.planning import waypoints
+    from snakehead.samples.targets import reachable_targets
     from tracking_reference import numpy_tracking
 
     robot = snakehead.SnakeRobot.default()
@@ -75,7 +75,7 @@ def per_call(recorded: list[list]) -> list[str]:
     import numpy as np
 
     import snakehead
-    from snakehead.motion.cartesian import tracking_interpolation
+    from snakehead.trajectory.cartesian import tracking_interpolation
     from tracking_reference import tracking_interpolation_numpy
 
     robot = snakehead.SnakeRobot.default()

@@ -42,7 +42,7 @@ def shared_numbers() -> str:
     """Substitutions for the numbers the pages quote, from where each is defined (``|reach_voxel|`` ...), so that
     the pages cannot drift from the code: the sweeps' defaults (snakehead.sweep_defaults) and limits."""
     from snakehead import sweep_defaults as defaults
-    from snakehead.motion import reach as rc
+    from snakehead.planning import whole_body_reach as rc
 
     numbers = {"reach_voxel": f"{defaults.REACH_VOXEL_M:g}", "reach_directions": defaults.REACH_DIRECTIONS,
                "reach_min_voxel": f"{rc.MIN_VOXEL_M:g}", "reach_max_directions": rc.MAX_DIRECTIONS}

@@ -113,7 +113,7 @@ SMALL_MAP = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, 
 def small_map():
     """The default robot's head map with SMALL_MAP's options, computed once per session."""
     from snakehead import SnakeRobot
-    from snakehead.kinematics import workspace
+    from snakehead.kinematics.reachability import reachability_map as workspace
 
     return workspace.compute(SnakeRobot.default(), progress=False, **SMALL_MAP)
 
@@ -143,7 +143,7 @@ def reachable_plan_in_mujoco(robot):
     plan succeeded and the head arrived within 2 mm and 1 deg)."""
     import numpy as np
     import snakehead
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.samples.targets import reachable_targets
 
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)
     (t,) = reachable_targets(controller, "same", 1, np.random.default_rng(0))

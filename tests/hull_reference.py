@@ -1,4 +1,4 @@
-"""Brute-force references for the support polygon's margins (tests of dynamics.stability and control.whole_body):
+"""Brute-force references for the support polygon's margins (tests of dynamics.stability and solve.whole_body):
 SciPy's Qhull for the hull, each edge's distance in plain numpy, the centre of mass summed link by link."""
 from __future__ import annotations
 

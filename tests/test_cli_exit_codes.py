@@ -168,10 +168,10 @@ def _interrupted(argv: list[str], work: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.parametrize("argv, work", [
-    (["workspace", "--voxel", "0.01", "--quiet"], "snakehead.kinematics.workspace.compute"),
+    (["workspace", "--voxel", "0.01", "--quiet"], "snakehead.kinematics.reachability.reachability_map.compute"),
     (["plan", "--position", "0.1", "0.5", "0.35", "--direction", "0", "1", "0", "--fast"],
-     "snakehead.motion.planner.plan"),
-    (["demo", "--fast"], "snakehead.motion.planner.plan"),
+     "snakehead.planning.planner.plan"),
+    (["demo", "--fast"], "snakehead.planning.planner.plan"),
 ], ids=["workspace", "plan", "demo"])
 def test_interrupted_is_130(argv, work, tmp_path):
     out = str(tmp_path / ("m.npz" if argv[0] == "workspace" else "out"))

@@ -5,7 +5,7 @@ import pytest
 from snakehead import SnakeRobot
 from snakehead.dynamics import stability
 from snakehead.scenes import paper_scene
-from snakehead.control.controller import HeadController
+from snakehead.solve.head_controller import HeadController
 from conftest import head6_robot
 
 
@@ -120,7 +120,7 @@ def test_bad_construction(robot, kwargs, message):
 
 
 def test_map_of_another_chain_is_rejected(robot):
-    from snakehead.kinematics import workspace
+    from snakehead.kinematics.reachability import reachability_map as workspace
 
     with pytest.raises(ValueError, match="another head chain"):
         HeadController(robot, workspace_map=workspace.map_for(head6_robot()))

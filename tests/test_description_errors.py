@@ -27,8 +27,9 @@ from hypothesis import strategies as st
 
 from snakehead import InputError, SnakeRobot
 from snakehead.app import cli
-from snakehead.model.description import check_description, convex_hull_vertices
-from snakehead.model.published import write_robot
+from snakehead.geometry.meshes import convex_hull_vertices
+from snakehead.model.description import check_description
+from snakehead.samples.published import write_robot
 
 EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 3
 

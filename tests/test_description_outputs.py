@@ -2,7 +2,7 @@
 ROS bag shows the description's own tree (item 2): /robot_description is the user's URDF as written, /joint_states
 names every movable joint of it, /tf places its own root link.
 
-Robots from ``snakehead.model.published.write_robot``: "cad" (a [home] table: the planner's zero is not the
+Robots from ``snakehead.samples.published.write_robot``: "cad" (a [home] table: the planner's zero is not the
 description's), "reu_reversed" (the URDF's tree starts at the head: its root link moves with the joints), "wheeled"
 (passive wheels held by the planner) and the default robot (nothing rewritten). The plans are synthetic (random
 joints within the limits every 2 ms): the writers are called directly. The bag is read back with rosbags and its
@@ -22,7 +22,7 @@ import yaml
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.app import ros_bag
 from snakehead.app.report import write_trajectory_csv
-from snakehead.model.published import write_robot
+from snakehead.samples.published import write_robot
 from test_ros_bag import read_bag
 
 pin = pytest.importorskip("pinocchio")
@@ -160,7 +160,7 @@ def test_the_bag_of_a_robot_with_a_home_pose(robots, tmp_path):
 
 
 def test_the_loop_report_gives_its_start_in_description_angles(robots):
-    from snakehead.sim.loop import LoopRun
+    from snakehead.closed_loop.loop import LoopRun
 
     robot = robots["cad"]
     q_start = np.zeros(robot.n_joints)  # the body straight: the description's home
@@ -205,7 +205,7 @@ def test_description_root_pose_along_a_motion(robots):
 def test_a_loop_bag_of_a_tree_written_from_the_head(robots, tmp_path):
     """A closed loop's bag (a ground phase only, the root frame moving): /tf places the description's root where
     the simulated root frame and joints put it, /joint_states the description's joints."""
-    from snakehead.sim.loop import LoopRun, Phase
+    from snakehead.closed_loop.loop import LoopRun, Phase
 
     robot = robots["reu_reversed"]
     plan = synthetic_plan(robot, n=120, seed=6)

@@ -1,4 +1,4 @@
-"""The detours of a move whose straight path is not safe (``motion.waypoints.Waypoints._joint_path``): the staged
+"""The detours of a move whose straight path is not safe (``planning.waypoints.Waypoints._joint_path``): the staged
 screen and the bounded search of the fallback give the very path of the plain search (every configuration of
 every detour checked, every detour's margins computed), on moves that take a detour and on moves that have none."""
 from __future__ import annotations
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead.control.controller import HeadController
-from snakehead.motion import start_state
-from snakehead.motion import waypoints as wp
+from snakehead.solve.head_controller import HeadController
+from snakehead.planning import start_state
+from snakehead.planning import waypoints as wp
 
 
 def plain_joint_path(way, qa, qb, n):

@@ -158,7 +158,7 @@ def test_an_output_that_cannot_be_written_names_the_file(tmp_path):
 def test_a_target_beyond_the_relocation_range_fails_as_out_of_range():
     """A target 12 m away is valid input: the plan fails at once, saying why, instead of relocating the base
     across the world (a target 1e6 m away, once "planned" with a kilometre's relocation, is now bad input)."""
-    from snakehead.motion.base_choice import MAX_RELOCATION_M
+    from snakehead.planning.base_choice import MAX_RELOCATION_M
 
     robot = snakehead.SnakeRobot.default()
     far = MAX_RELOCATION_M + robot.body_length + 0.5
@@ -171,7 +171,7 @@ def test_a_target_beyond_the_relocation_range_fails_as_out_of_range():
 
 # --- validate once: after plan() has checked its input, an InputError inside is a bug -------------------------
 def test_an_input_error_inside_plan_is_an_internal_error(monkeypatch):
-    from snakehead.motion import planner
+    from snakehead.planning import planner
 
     robot = snakehead.SnakeRobot.default()
     with pytest.raises(InputError, match="method"):  # the caller's input, found where it entered
@@ -187,7 +187,7 @@ def test_an_input_error_inside_plan_is_an_internal_error(monkeypatch):
 
 
 def test_a_too_long_line_approach_is_refused_before_any_work(monkeypatch):
-    from snakehead.motion import planner
+    from snakehead.planning import planner
     from snakehead.scenes import Scene, Target
 
     def never(*args, **kwargs):

@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead.geometry import collision as coll
-from snakehead.kinematics import workspace as ws
-from snakehead.model import published
-from snakehead.motion import cartesian, start_state, waypoints
+from snakehead.collision import body_collisions as coll
+from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.samples import published
+from snakehead.trajectory import cartesian
+from snakehead.planning import start_state, waypoints
 
 
 

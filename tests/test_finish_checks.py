@@ -10,8 +10,8 @@ import pytest
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.motion import interpolation as interp
-from snakehead.motion import waypoints
+from snakehead.trajectory import interpolation as interp
+from snakehead.planning import waypoints
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""Gaits (snakehead.motion.gaits) and where the body is (snakehead.sim.estimate): the joint-angle generators
+"""Gaits (snakehead.locomotion.gaits) and where the body is (snakehead.closed_loop.estimate): the joint-angle generators
 against their formula, each gait in MuJoCo going where it is commanded on two robots, the pose estimate against
 closed forms and MuJoCo's ground truth, and bad input."""
 import math
@@ -9,7 +9,7 @@ import pytest
 from snakehead import BasePlacement, InputError, SnakeRobot
 from snakehead.backbone import initial_configuration
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion.gaits import GAITS, Gait, Wave, make_gait, virtual_chassis
+from snakehead.locomotion.gaits import GAITS, Gait, Wave, make_gait, virtual_chassis
 
 from conftest import pitch_first
 
@@ -132,7 +132,7 @@ def _rot_x(a):
 def test_estimate_of_a_body_rolling_over_its_edge(robot):
     """The straight body rolled 90 deg about its axis, pivoting on its bottom edge: its axis moves sideways by the
     section's width (0.043 m) and stays at half of it above the ground."""
-    from snakehead.sim.estimate import BodyPoseEstimator
+    from snakehead.closed_loop.estimate import BodyPoseEstimator
 
     est = BodyPoseEstimator(robot, imu_link="link_8")
     q = np.zeros(robot.n_joints)
@@ -148,7 +148,7 @@ def test_estimate_of_a_body_rolling_over_its_edge(robot):
 
 def test_estimate_stays_put_while_only_lifted_joints_move(robot):
     """The base lies still and only the raised head sways: the contacts do not move, nor does the estimate."""
-    from snakehead.sim.estimate import BodyPoseEstimator
+    from snakehead.closed_loop.estimate import BodyPoseEstimator
 
     base = BasePlacement(0.5, -0.3, 1.0)
     q1 = initial_configuration(robot, base=base)
@@ -167,7 +167,7 @@ def test_estimate_stays_put_while_only_lifted_joints_move(robot):
 
 
 def test_bad_estimator_input(robot):
-    from snakehead.sim.estimate import BodyPoseEstimator
+    from snakehead.closed_loop.estimate import BodyPoseEstimator
 
     with pytest.raises(ValueError, match="nowhere"):
         BodyPoseEstimator(robot, imu_link="nowhere")

@@ -1,4 +1,4 @@
-"""The body's route around obstacles (snakehead.motion.ground_path): A* against Dijkstra on the same graph
+"""The body's route around obstacles (snakehead.locomotion.ground_path): A* against Dijkstra on the same graph
 (scipy), the footprints' grid against the polygons, routes clear of the inflated obstacles (checked densely and
 against the exact geometry of the straight body), and the shortcut never worse than the grid path."""
 import math
@@ -10,7 +10,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from snakehead import BasePlacement, Infeasible, InputError, SnakeRobot
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
-from snakehead.motion import ground_path as gp
+from snakehead.locomotion import ground_path as gp
 
 
 def _dijkstra_cost(free, start, goal, weight=None):
@@ -82,8 +82,8 @@ def robot():
 def _straight_body_distance(robot, middle, heading, obstacles):
     """The exact distance of the straight body lying with its middle at ``middle`` along ``heading`` to the
     obstacles (the geometry layer)."""
-    from snakehead.geometry import collision as coll
-    from snakehead.motion import locomotion as lc
+    from snakehead.collision import body_collisions as coll
+    from snakehead.locomotion import goals as lc
 
     root = lc.compose(BasePlacement(middle[0], middle[1], heading), lc.inverse(lc.chassis_offset(robot)))
     return coll.collision_check(robot, np.zeros((1, robot.n_joints)), obstacles, root, exact_within=10.0).distance[0]
@@ -180,7 +180,7 @@ def test_swept_extents_against_dense_sampling(robot):
     """The gaits' swept radius and half width: against the body's hull points sampled 4 times as densely over a
     cycle of each gait, in the frame of the link centres' principal axes found by an eigen-decomposition (not
     the SVD of virtual_chassis); the straight body's own reach is the smallest the radius can be."""
-    from snakehead.motion.gaits import make_gait
+    from snakehead.locomotion.gaits import make_gait
 
     radius, half = gp.swept_extents(robot)
     ref_r = ref_w = 0.0
@@ -215,7 +215,7 @@ def test_escape_along_the_axis_between_two_boxes(robot):
     """The body lying with its head between two boxes can neither turn nor sidewind: the route's first leg
     creeps back along its own axis (linear progression), its straight body no nearer the boxes than at the start
     (exact geometry), to where the turning disc is clear of their outlines."""
-    from snakehead.motion import locomotion as lc
+    from snakehead.locomotion import goals as lc
 
     boxes = [BoxObstacle([0.45, 0.3, 0.125], [0.25, 0.25, 0.25]), BoxObstacle([0.45, -0.3, 0.125], [0.25, 0.25, 0.25])]
     start = BasePlacement(0.0, 0.0, 0.0)  # the middle at the origin, the head towards +x between the boxes
@@ -243,7 +243,7 @@ def test_escape_along_the_axis_between_two_boxes(robot):
 def _run_outline(robot, gait: str, scale: float) -> np.ndarray:
     """(k, 2) m: the corners and edge midpoints of a ``gait`` run's shapes at ``scale`` (both directions, 24 phases,
     the ramps' half and full envelope) in each shape's virtual chassis (x forward, y left)."""
-    from snakehead.motion.gaits import make_gait, virtual_chassis
+    from snakehead.locomotion.gaits import make_gait, virtual_chassis
 
     qs = [np.zeros((1, robot.n_joints))]
     for direction in (1, -1):
@@ -353,7 +353,7 @@ def test_staging_on_the_goal_axis_when_none_across(robot):
     with the whole clearance budget): the last leg comes from a staging point on the goal's own axis, away from the
     wall, where the turning disc keeps the budget; the body creeps from there at the goal's heading, its straight
     band no nearer the wall than at the goal (exact geometry)."""
-    from snakehead.motion import locomotion as lc
+    from snakehead.locomotion import goals as lc
 
     wall = BoxObstacle([0.85, 0.0, 0.15], [0.05, 6.0, 0.3])
     goal, start = BasePlacement(0.0, 0.0, 0.0), BasePlacement(-2.0, 1.0, 0.0)

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from snakehead import SnakeRobot, TracIK
-from snakehead.control import head
+from snakehead.solve import head
 
 
 @pytest.fixture(scope="module")

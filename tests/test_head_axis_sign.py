@@ -15,7 +15,7 @@ import pytest
 import snakehead
 from snakehead.app import cli
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion.targets import reachable_targets
+from snakehead.samples.targets import reachable_targets
 from test_reachable_plans import verify_plan
 
 #: The default robot's numbers and frames (snake16.urdf is written from them)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from snakehead import Chain, TracIK, _core, default_urdf_path, limits
-from snakehead.kinematics import workspace as ws
+from snakehead.kinematics.reachability import reachability_map as ws
 
 URDF = default_urdf_path()
 MAX_TIMEOUT_S = limits.MAX_TIMEOUT_S  # the core's (include/snakehead/limits.hpp)

@@ -27,8 +27,8 @@ from snakehead import InputError
 import snakehead
 from snakehead import SnakeRobot, default_urdf_path, sim
 from snakehead._files import atomic_open, write_text_atomic
-from snakehead.control import neck as nk
-from snakehead.kinematics import workspace as ws
+from snakehead.solve import neck as nk
+from snakehead.kinematics.reachability import reachability_map as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import read_robot_file, write_robot_file
 from snakehead.scenes import Scene, Target, load_scene

@@ -180,8 +180,8 @@ def test_core_passes_from_many_threads_and_bad_shapes():
 @pytest.fixture(scope="module")
 def sea_robot(tmp_path_factory):
     """A snake written as published ones are: a rotated dummy root, modules along z of two links each, cylinders and
-    a mesh tail (``snakehead.model.published``, style "sea")."""
-    from snakehead.model import published
+    a mesh tail (``snakehead.samples.published``, style "sea")."""
+    from snakehead.samples import published
 
     return snakehead.SnakeRobot.from_file(published.write_robot("sea", tmp_path_factory.mktemp("sea")))
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import snakehead as sh
-from snakehead.control import whole_body as wb
-from snakehead.control.head import frame_along
+from snakehead.solve import whole_body as wb
+from snakehead.solve.head import frame_along
 from snakehead.margins import DETOUR_MARGIN
-from snakehead.model import published
-from snakehead.motion.targets import reachable_targets
+from snakehead.samples import published
+from snakehead.samples.targets import reachable_targets
 
 from conftest import pitch_first
 
@@ -110,7 +110,7 @@ def test_choice_of_base_past_the_proof_is_deterministic(controller):
     """A target the proof refuses from the start: the base's choice (its relocation search) gives the same base,
     shape and solution twice, each with its own plan's solves, and that base reaches the target with the base kept
     (the solve's own check)."""
-    from snakehead.motion import base_choice
+    from snakehead.planning import base_choice
     from snakehead.scenes import Target
 
     refused = next(t for t in reachable_targets(controller, "shape", 30, np.random.default_rng(4))

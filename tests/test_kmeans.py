@@ -1,4 +1,4 @@
-"""The numpy k-means++ of the dexterous workspace's clusters (snakehead.kinematics.kmeans) against scikit-learn's
+"""The numpy k-means++ of the dexterous workspace's clusters (snakehead.kinematics.reachability.kmeans) against scikit-learn's
 KMeans (the test-only reference it replaces): the same partition and centres on the default map's dexterous voxels
 and on random clustered and unclustered point sets."""
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from snakehead import InputError
-from snakehead.kinematics.kmeans import kmeans
+from snakehead.kinematics.reachability.kmeans import kmeans
 
 def _sklearn_cluster():
     """scikit-learn's clustering, for the comparisons only (skipped without it, a failure in CI)."""
@@ -34,7 +34,7 @@ def _check_against_sklearn(points: np.ndarray, k: int, seed: int) -> None:
 
 
 def test_the_default_maps_g0_is_scikit_learns() -> None:
-    from snakehead.kinematics import workspace
+    from snakehead.kinematics.reachability import reachability_map as workspace
     from snakehead.model.robot import SnakeRobot
 
     m = workspace.map_for(SnakeRobot.default(), progress=False)

@@ -15,8 +15,8 @@ import snakehead
 from snakehead import _core, _validate, limits
 from snakehead import sweep_defaults as defaults
 from snakehead.app import cli
-from snakehead.kinematics import workspace as ws
-from snakehead.motion import reach as rc
+from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.planning import whole_body_reach as rc
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = Path(snakehead.__file__).parent

@@ -1,6 +1,6 @@
-"""The closed loop from lying anywhere (snakehead.sim.loop) and what it stands on: the quasi-static sliding model
+"""The closed loop from lying anywhere (snakehead.closed_loop.loop) and what it stands on: the quasi-static sliding model
 (snakehead.dynamics.sliding) against SciPy's minimiser and closed forms, the locomotion's poses and legs
-(snakehead.motion.locomotion), the curl's prediction against MuJoCo on two robots, gait runs reaching a goal,
+(snakehead.locomotion.goals), the curl's prediction against MuJoCo on two robots, gait runs reaching a goal,
 simulate_trajectory continuing from a state, the loop correcting a disturbed start, and bad input."""
 import json
 import math
@@ -11,8 +11,8 @@ from scipy import optimize
 
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics.sliding import balance_motion, balance_translation, predict_slide
-from snakehead.motion import locomotion as lc
-from snakehead.motion.gaits import make_gait
+from snakehead.locomotion import goals as lc
+from snakehead.locomotion.gaits import make_gait
 
 from conftest import pitch_first
 
@@ -314,7 +314,7 @@ class _ExactGaits:
 
 
 def _straight_distance(robot, obstacles, base):
-    from snakehead.geometry import collision as coll
+    from snakehead.collision import body_collisions as coll
 
     return coll.collision_check(robot, np.zeros((1, robot.n_joints)), obstacles, base, exact_within=10.0).distance[0]
 
@@ -330,7 +330,7 @@ def test_locomotion_leaves_two_boxes_and_goes_round_them(mujoco, robot):
 
     from snakehead.geometry.obstacles import BoxObstacle
     from snakehead.scenes import Scene
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop.loop import ClosedLoop
 
     boxes = [BoxObstacle.from_yaw([0.5925, 1.1913, 0.125], [0.25, 0.25, 0.25], -0.3018),
              BoxObstacle.from_yaw([0.0189, 1.3699, 0.125], [0.25, 0.25, 0.25], -0.3018)]
@@ -368,12 +368,12 @@ def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(mujoco, robot):
     placements, every step, exact geometry) comes within GOAL_CLEARANCE_M of is refused, naming the curl; the same
     wall moved 1 m away is not."""
     from snakehead.dynamics.sliding import predict_slide
-    from snakehead.geometry import collision as coll
+    from snakehead.collision import body_collisions as coll
     from snakehead.geometry.obstacles import BoxObstacle
-    from snakehead.motion import ground_path as gp
-    from snakehead.motion.planner import bending_state
+    from snakehead.locomotion import ground_path as gp
+    from snakehead.planning.planner import bending_state
     from snakehead.scenes import Scene
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop.loop import ClosedLoop
 
     goal = BasePlacement(0.0, 0.0, 0.0)
     probe = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))]), robot=robot)
@@ -417,7 +417,7 @@ def disturbed(mujoco, controller):
     """The paper's sphere 1 from the straight pose whose curl alone reaches it, disturbed by 10 cm and 20 deg
     without the loop knowing: it believes it lies at the undisturbed pose."""
     from snakehead.scenes import Scene
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop.loop import ClosedLoop
 
     scene = Scene.from_targets([(np.array([-0.0405, 0.5443, 0.3]), np.array([0.0, 1.0, 0.0]))], name="sphere",
                                hold_s=0.5)
@@ -454,7 +454,7 @@ def test_closed_loop_corrects_a_disturbed_start(disturbed):
 
 
 def test_loop_report_and_phases(disturbed):
-    from snakehead.sim.loop import PHASE_KINDS
+    from snakehead.closed_loop.loop import PHASE_KINDS
 
     _, run = disturbed
     report = json.loads(json.dumps(run.report()))
@@ -515,7 +515,7 @@ def test_loop_figures(disturbed, tmp_path):
 
 
 def test_bad_loop_input(disturbed, controller):
-    from snakehead.sim.loop import ClosedLoop, PoseFix
+    from snakehead.closed_loop.loop import ClosedLoop, PoseFix
 
     loop, _ = disturbed
     n = loop.robot.n_joints
@@ -549,7 +549,7 @@ def test_the_hole_from_behind_its_wall(controller):
     body goes around the wall on a planned route, never touching it, and the head gets through the hole on its own
     senses."""
     from snakehead.scenes import paper_scene
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop.loop import ClosedLoop
 
     loop = ClosedLoop(paper_scene("hole"), controller=controller)
     run = loop.run(BasePlacement(0.2, 1.4, 3.1416))
@@ -582,7 +582,7 @@ def test_outside_fix_keeps_the_old_behaviour_ci_sized(mujoco, controller):
 
 
 def check_outside_fix(controller, scene, **options):
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop.loop import ClosedLoop
 
     old = ClosedLoop(scene, controller=controller, sensing="outside fix", **options)
     nominal = old.straight_start()
@@ -616,9 +616,9 @@ def check_replay(robot, scene, monkeypatch, **options):
     import dataclasses
 
     from snakehead import HeadController
-    from snakehead.sim import loop as loop_mod
-    from snakehead.sim.gaits import replay_estimate
-    from snakehead.sim.loop import ClosedLoop
+    from snakehead.closed_loop import loop as loop_mod
+    from snakehead.closed_loop.gait_runner import replay_estimate
+    from snakehead.closed_loop.loop import ClosedLoop
 
     real = loop_mod.simulate_trajectory
     world: list = []

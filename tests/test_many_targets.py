@@ -12,12 +12,13 @@ import pytest
 import snakehead
 from snakehead import InputError, PlanProgress
 from snakehead._errors import Infeasible, MotionTooLong
-from snakehead.control import whole_body
-from snakehead.control.controller import HeadController
+from snakehead.solve import whole_body
+from snakehead.solve.head_controller import HeadController
 from snakehead.dynamics import stability
 from snakehead.model.robot import SnakeRobot
-from snakehead.motion import plan_bounds, timing
-from snakehead.motion.targets import reachable_targets
+from snakehead.planning import plan_bounds
+from snakehead.retiming import timing
+from snakehead.samples.targets import reachable_targets
 from snakehead.scenes import MAX_TARGETS, Scene, Target, load_scene, scene_from_dict
 
 
@@ -245,7 +246,7 @@ def test_the_plan_keeps_its_checks(planned):
 
 
 def test_snapshots_stay_one_page_with_many_targets(planned):
-    from snakehead.motion.plan_result import TargetResult
+    from snakehead.planning.plan_result import TargetResult
     from snakehead.viz import body
 
     result = planned[0]

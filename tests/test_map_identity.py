@@ -19,8 +19,8 @@ from snakehead._errors import InputError, InputTypeError
 from snakehead.app import cli
 from snakehead.app.robot_check import map_summary
 from snakehead.kinematics import base_placement as bp
-from snakehead.kinematics import map_queries as mq
-from snakehead.kinematics import workspace as ws
+from snakehead.kinematics.reachability import map_queries as mq
+from snakehead.kinematics.reachability import reachability_map as ws
 from snakehead.model.robot_file import write_robot_file
 from conftest import SMALL_MAP, head6_robot
 

@@ -40,10 +40,10 @@ from snakehead._errors import InputError
 from snakehead._validate import MAX_NAME_BYTES, MAX_NAME_CHARS, file_name_part
 from snakehead.app import report as rep
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion.plan_result import Plan, TargetResult
+from snakehead.planning.plan_result import Plan, TargetResult
 from snakehead.scenes.scene import Scene, Target, load_scene, scene_from_dict
 
 _EXAMPLES = int(os.environ.get("SNAKEHEAD_FUZZ_EXAMPLES", "0"))
@@ -149,8 +149,8 @@ def make_plan(robot: SnakeRobot, motion: dict, scene: Scene) -> Plan:
 
 def make_loop_run(robot: SnakeRobot, motion: dict, scene: Scene) -> Any:
     """A made-up closed loop of ``scene``: a gait (a ground phase), then the target's move and hold, named as
-    snakehead.sim.loop names them."""
-    from snakehead.sim.loop import LoopRun, Phase
+    snakehead.closed_loop.loop names them."""
+    from snakehead.closed_loop.loop import LoopRun, Phase
 
     t, q = motion["t"], motion["q"]
     roots = np.repeat(np.eye(4)[None], len(t), axis=0)
@@ -168,7 +168,7 @@ def make_loop_run(robot: SnakeRobot, motion: dict, scene: Scene) -> Any:
 
 def make_map(base: str, tip: str) -> Any:
     """A 2 x 2 x 2 reachability map between frames named ``base`` and ``tip``."""
-    from snakehead.kinematics.workspace import ReachabilityMap
+    from snakehead.kinematics.reachability.reachability_map import ReachabilityMap
 
     ids = np.arange(8)
     i, j, k = np.unravel_index(ids, (2, 2, 2))

@@ -4,7 +4,7 @@ import pytest
 from scipy.optimize import minimize
 
 from snakehead import BasePlacement, InputError, SnakeRobot
-from snakehead.control import neck as nk
+from snakehead.solve import neck as nk
 
 
 @pytest.fixture(scope="module")

@@ -11,9 +11,9 @@ from scipy.spatial import ConvexHull
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle, MeshObstacle
-from snakehead.model import published
+from snakehead.samples import published
 from snakehead.scenes import load_scene
 from snakehead._errors import InputError
 

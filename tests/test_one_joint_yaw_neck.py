@@ -12,7 +12,7 @@ import snakehead
 from snakehead.app import cli
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import write_robot_file
-from snakehead.motion.targets import reachable_targets
+from snakehead.samples.targets import reachable_targets
 from test_reachable_plans import verify_plan
 
 #: 13 joints, yaw first: base joints 1-6, the neck joint 7 (yaw), the head joints 8-13 (pitch first)

@@ -1,4 +1,4 @@
-"""The path checks in C++ batches (geometry.path_check, _core.PathChecker, _core.zmp_check) against brute force and
+"""The path checks in C++ batches (collision.path_proof, _core.PathChecker, _core.zmp_check) against brute force and
 the Python reference: per-sample minima equal the collision module's, the motion bound is never exceeded (100x finer
 sampling), a proven-clear path is clear at every fine sample, and the ZMP check equals an independent computation
 (tests/zmp_reference.py: pinocchio's momenta, each shape's contact candidates in numpy, scipy's hull) and the Python
@@ -14,10 +14,11 @@ from hypothesis import strategies as st
 
 from snakehead import set_core_threads
 from snakehead.dynamics import stability
-from snakehead.geometry import BoxObstacle, collision as coll, path_check
+from snakehead.geometry import BoxObstacle
+from snakehead.collision import body_collisions as coll, path_proof as path_check
 from snakehead.margins import EXACT_DISTANCE_WITHIN
 from snakehead.geometry.shapes import shape_points
-from snakehead.model.published import write_robot
+from snakehead.samples.published import write_robot
 from snakehead.model.robot import BasePlacement, SnakeRobot
 
 FINE = 100  # brute force: points per interval
@@ -273,7 +274,7 @@ def test_zmp_check_moves_a_prefix_kept_at_another_placement(robots: dict[str, Sn
         assert np.abs(again.margin[:m] - again.margin[:m].mean()).max() > 1e-4  # the prefix's margins vary: compared
     # an origin 1 cm higher (not a placement on the ground: the heights differ): computed from scratch
     from snakehead import _core
-    from snakehead.geometry.collision import GROUND_TOLERANCE
+    from snakehead.collision.body_collisions import GROUND_TOLERANCE
     from snakehead.margins import EXACT_DISTANCE_WITHIN
 
     origin = robot.root_pose(BasePlacement(0.1, 0.2, 0.3))

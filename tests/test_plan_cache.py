@@ -1,14 +1,17 @@
-"""The plans' caches a HeadController owns (``controller.plan_cache``): bounded maps, entries equal to what they
+"""The plans' caches a HeadController owns (``plan_cache_of(controller)``): bounded maps, entries equal to what they
 cache (recomputed without the cache), and plans that do not depend on what is kept."""
 import threading
+
+import gc
+import weakref
 
 import numpy as np
 import pytest
 
 import snakehead
-from snakehead.control.controller import HeadController
-from snakehead.motion import start_state
-from snakehead.motion.plan_cache import KEPT_LIFTS, KeptMap, PlanCache, shape_key
+from snakehead.solve.head_controller import HeadController
+from snakehead.planning import start_state
+from snakehead.planning.plan_cache import KEPT_LIFTS, KeptMap, PlanCache, plan_cache_of, shape_key
 
 
 @pytest.fixture(scope="module")
@@ -53,27 +56,32 @@ def test_shape_key_is_the_base_joints_rounded():
     assert shape_key(q, 3) != shape_key(np.array([0.1, 0.2, 0.3, 9.0]), 3)
 
 
-def test_a_controller_owns_one_plan_cache(controller):
-    assert isinstance(controller.plan_cache, PlanCache)
+def test_each_controller_has_one_plan_cache_gone_with_it(controller):
+    assert isinstance(plan_cache_of(controller), PlanCache)
+    assert plan_cache_of(controller) is plan_cache_of(controller)
     other = HeadController(controller.robot, method="free_roll", seed=1)
-    assert other.plan_cache is not controller.plan_cache
+    kept = weakref.ref(plan_cache_of(other))
+    assert kept() is not plan_cache_of(controller)
+    del other
+    gc.collect()
+    assert kept() is None  # the planner's cache does not keep a controller (or itself) alive
 
 
 def test_bending_states_are_kept_per_base_shape_and_equal_the_uncached_curl(controller):
     robot = controller.robot
-    controller.plan_cache.clear()
+    plan_cache_of(controller).clear()
     q = start_state.bending_state(controller)
     np.testing.assert_array_equal(q, start_state.ground_curl(robot, controller.q_initial))  # independent: uncached
-    assert len(controller.plan_cache.bending_states) == 1
+    assert len(plan_cache_of(controller).bending_states) == 1
     q[:] = 99.0  # a copy: the kept state is not changed through it
     np.testing.assert_array_equal(start_state.bending_state(controller),
                                   start_state.ground_curl(robot, controller.q_initial))
-    assert len(controller.plan_cache.bending_states) == 1
+    assert len(plan_cache_of(controller).bending_states) == 1
     # the same base shape with the neck and head moved is the same entry
     moved = controller.q_initial.copy()
     moved[robot.lift_joints.start:] += 0.1
     start_state.bending_state(controller, moved)
-    assert len(controller.plan_cache.bending_states) == 1
+    assert len(plan_cache_of(controller).bending_states) == 1
 
 
 def test_a_plan_fills_the_lift_caches_and_plans_the_same_from_them(controller):
@@ -81,9 +89,9 @@ def test_a_plan_fills_the_lift_caches_and_plans_the_same_from_them(controller):
     robot = controller.robot
     H = robot.head_pose(controller.q_initial)
     target = [(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])]
-    controller.plan_cache.clear()
+    plan_cache_of(controller).clear()
     first = snakehead.plan(target, controller=controller)
-    cache = controller.plan_cache
+    cache = plan_cache_of(controller)
     assert len(cache.lift_paths) == 1 and len(cache.timed_lifts) == 1 and len(cache.bending_states) == 1
     assert len(cache.lift_paths) <= KEPT_LIFTS
     again = snakehead.plan(target, controller=controller)  # from the kept lift
@@ -98,6 +106,6 @@ def test_a_scene_with_obstacles_keeps_no_lift_path(controller):
     robot = controller.robot
     H = robot.head_pose(controller.q_initial)
     far = snakehead.geometry.BoxObstacle(centre=[H[0, 3], H[1, 3] + 1.5, 0.2], size=[0.1, 0.1, 0.4])
-    controller.plan_cache.clear()
+    plan_cache_of(controller).clear()
     snakehead.plan([(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])], controller=controller, obstacles=[far])
-    assert len(controller.plan_cache.lift_paths) == 0
+    assert len(plan_cache_of(controller).lift_paths) == 0

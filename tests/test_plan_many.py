@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import snakehead as sh
-from snakehead.motion.plan_many import PlanError, RobotRecipe, plan_many
+from snakehead.planning.plan_many import PlanError, RobotRecipe, plan_many
 
 # two targets the base reaches as it lies, and one whose scene is refused by the planner (a plan error, a result)
 SETS = [[((0.3, 0.5, 0.6), (0.4, 0.0, 0.92))], [((0.3, 0.45, 0.55), (0.5, 0.1, 0.8))]]
@@ -71,7 +71,7 @@ def test_bad_arguments_before_any_work(robot: sh.SnakeRobot) -> None:
 
 
 def test_plan_errors_are_results(robot: sh.SnakeRobot, monkeypatch: pytest.MonkeyPatch) -> None:
-    from snakehead.motion import plan_many as pm
+    from snakehead.planning import plan_many as pm
 
     def refuse(*args: object, **kwargs: object) -> None:
         raise sh.Infeasible("no curl")

@@ -1,20 +1,21 @@
-"""The named steps of plan() (motion.planner), of the base's choice (motion.base_choice) and of the whole-body solve
-(control.whole_body._TargetSearch), each on its own, against independent computations (distances by hand, the
+"""The named steps of plan() (planning.planner), of the base's choice (planning.base_choice) and of the whole-body solve
+(solve.whole_body._TargetSearch), each on its own, against independent computations (distances by hand, the
 uncached bending state, the solves of the public entry points)."""
 import numpy as np
 import pytest
 
 import snakehead
 from snakehead._errors import InputError, InputTypeError, MotionTooLong
-from snakehead.control import whole_body as wb
-from snakehead.control.controller import HeadController
+from snakehead.solve import whole_body as wb
+from snakehead.solve.head_controller import HeadController
 from snakehead.geometry import BoxObstacle
 from snakehead.margins import DETOUR_MARGIN
-from snakehead.motion import base_choice, plan_bounds, planner, start_state
-from snakehead.motion.plan_result import PlanProgress
-from snakehead.motion.targets import reachable_targets
-from snakehead.motion.waypoints import Waypoints
+from snakehead.planning import base_choice, plan_bounds, planner, start_state
+from snakehead.planning.plan_result import PlanProgress
+from snakehead.samples.targets import reachable_targets
+from snakehead.planning.waypoints import Waypoints
 from snakehead.scenes import Scene, Target
+from snakehead.planning.plan_cache import plan_cache_of
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +117,7 @@ def test_progress_without_a_callback_reports_nothing(controller):
 # --- plan(): the lift and the targets ---------------------------------------------------------------------------
 def test_lift_ends_at_the_initial_state_and_keeps_its_path(controller):
     robot = controller.robot
-    controller.plan_cache.clear()
+    plan_cache_of(controller).clear()
     q_shape = controller.q_initial
     first = Waypoints(robot, controller.base)
     first.start("bending state", start_state.bending_state(controller, q_shape))
@@ -124,7 +125,7 @@ def test_lift_ends_at_the_initial_state_and_keeps_its_path(controller):
     np.testing.assert_array_equal(q, base_choice.shape_of(robot, q_shape, controller.q_initial))
     np.testing.assert_allclose(first.qs[-1], q, atol=1e-12)  # the path ends there (to round-off)
     assert first.lift_index == len(first.qs) - 1 and first.stops == [first.lift_index]
-    assert first.lift_cache is controller.plan_cache.timed_lifts and len(controller.plan_cache.lift_paths) == 1
+    assert first.lift_cache is plan_cache_of(controller).timed_lifts and len(plan_cache_of(controller).lift_paths) == 1
     # every waypoint of the lift passes the path's own checks
     assert first.feasible(np.array(first.qs)).all()
     again = Waypoints(robot, controller.base)
@@ -212,10 +213,10 @@ def test_first_failure(controller, reachable):
 
 def test_has_curl_is_the_bending_state_existing(controller):
     straight = np.zeros(controller.robot.n_joints)
-    controller.plan_cache.clear()
+    plan_cache_of(controller).clear()
     assert base_choice.has_curl(controller, controller.q_initial)
     assert not base_choice.has_curl(controller, straight)
-    assert len(controller.plan_cache.shapes_without_curl) == 1
+    assert len(plan_cache_of(controller).shapes_without_curl) == 1
     assert not base_choice.has_curl(controller, straight)  # from the cache
 
 

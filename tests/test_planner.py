@@ -7,13 +7,14 @@ from snakehead._errors import Infeasible
 
 import snakehead
 from snakehead import SnakeRobot
-from snakehead.control.controller import HeadController
+from snakehead.solve.head_controller import HeadController
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.margins import DETOUR_MARGIN
-from snakehead.motion import start_state
+from snakehead.planning import start_state
 from snakehead.scenes import paper_scene
 from snakehead._errors import InputError
+from snakehead.planning.plan_cache import plan_cache_of
 
 HOLE = paper_scene("hole")
 WALL = HOLE.obstacles[0]
@@ -163,7 +164,7 @@ def test_lift_kept_per_base_shape_gives_the_plan_a_fresh_controller_gives(contro
     target = [(H[:3, 3] + [0.0, 0.0, -0.05], H[:3, 0])]
     snakehead.plan([(robot.head_pose(controller.q_initial)[:3, 3], robot.head_pose(controller.q_initial)[:3, 0])],
                    controller=controller)  # the default placement: fills the caches
-    assert len(controller.plan_cache.lift_paths) and len(controller.plan_cache.timed_lifts)
+    assert len(plan_cache_of(controller).lift_paths) and len(plan_cache_of(controller).timed_lifts)
     reused = snakehead.plan(target, controller=controller, base=moved, allow_relocation=False)
     fresh = snakehead.plan(target, controller=HeadController(robot, method="free_roll", seed=0), base=moved,
                            allow_relocation=False)

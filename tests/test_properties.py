@@ -210,7 +210,7 @@ def _robot_from_file(toml: str, urdf: str) -> tuple:
 def _robot_from_xacro(text: str) -> tuple:
     """The xacro style's robot file with its .xacro text replaced by ``text``."""
     from snakehead import SnakeRobot
-    from snakehead.model.published import write_robot
+    from snakehead.samples.published import write_robot
 
     folder = Path(_cache["folder"]) / "case"
     shutil.rmtree(folder, ignore_errors=True)
@@ -451,7 +451,7 @@ def test_robots_from_damaged_urdfs(text, frames):
 
 
 def _xacro_text() -> str:
-    from snakehead.model.published import write_robot
+    from snakehead.samples.published import write_robot
 
     with tempfile.TemporaryDirectory() as folder:
         write_robot("xacro", folder)
@@ -472,7 +472,7 @@ def test_damaged_xacro_files(text):
 
 
 def _mesh_bytes() -> dict[str, bytes]:
-    from snakehead.model.published import write_robot
+    from snakehead.samples.published import write_robot
 
     with tempfile.TemporaryDirectory() as folder:
         write_robot("mesh", folder)

@@ -1,4 +1,4 @@
-"""plan_many and snakehead reach on a published-style snake (snakehead.model.published's "sea": a CMU SEA snake's
+"""plan_many and snakehead reach on a published-style snake (snakehead.samples.published's "sea": a CMU SEA snake's
 convention -- a link-less dummy root and a fixed joint rotated by -90 deg about y, modules along their own z of two
 links each, cylinders and an STL tail mesh, the head looking along its z), not only on the default robot:
 
@@ -17,10 +17,10 @@ import pytest
 
 import snakehead as sh
 from snakehead.app import cli
-from snakehead.kinematics import workspace as ws
-from snakehead.model import published
-from snakehead.motion.plan_many import plan_many
-from snakehead.motion.targets import reachable_targets
+from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.samples import published
+from snakehead.planning.plan_many import plan_many
+from snakehead.samples.targets import reachable_targets
 
 from conftest import plan_agrees
 

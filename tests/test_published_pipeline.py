@@ -1,7 +1,7 @@
-"""Each published-style snake (snakehead.model.published) through the command line from its robot file, as a user
+"""Each published-style snake (snakehead.samples.published) through the command line from its robot file, as a user
 would: ``info`` (exit 0, the parts), ``workspace`` (a coarse map of its head), ``plan`` with the MuJoCo check of a
 target reachable by construction (the head pose of a stable, collision-free configuration on the robot's initial
-base, snakehead.motion.targets): success, the head within 2 mm and 1 deg in MuJoCo, the body in place,
+base, snakehead.samples.targets): success, the head within 2 mm and 1 deg in MuJoCo, the body in place,
 the simulated ZMP in the planned support polygon (to 1 mm)."""
 from __future__ import annotations
 
@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead.kinematics import workspace as ws
-from snakehead.model import published
+from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.samples import published
 
-from snakehead.motion.targets import reachable_targets
+from snakehead.samples.targets import reachable_targets
 
 
 CLI = [sys.executable, "-m", "snakehead"]

@@ -1,4 +1,4 @@
-"""The quirk styles of snakehead.model.published (written by model/published_quirks.py, issue 34): each description
+"""The quirk styles of snakehead.samples.published (written by model/published_quirks.py, issue 34): each description
 does what the published one it stands for does, checked against pinocchio (an independent URDF parser and FK), and
 each loads as it is into a SnakeRobot whose kinematics are the description's.
 
@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead.model.published import QUIRK_STYLES, STYLES, style_spec, write_robot
+from snakehead.samples.published import QUIRK_STYLES, STYLES, style_spec, write_robot
 
 pin = pytest.importorskip("pinocchio")
 

@@ -1,4 +1,4 @@
-"""The sample robots written as published descriptions are (snakehead.model.published): each style's files are
+"""The sample robots written as published descriptions are (snakehead.samples.published): each style's files are
 well-formed and describe the snake they claim to, checked with what exists before the new loader (the core's URDF
 parser, Chain, trimesh, the PyPI xacro package)."""
 import tomllib
@@ -10,7 +10,7 @@ import pytest
 
 from snakehead import _core
 from snakehead.model.chain import Chain
-from snakehead.model.published import STYLES, StyleSpec, style_spec, write_robot
+from snakehead.samples.published import STYLES, StyleSpec, style_spec, write_robot
 from snakehead._errors import InputError, InputTypeError
 
 #: (base, neck, head) joints of each style, written out here rather than read from the module under test.

@@ -6,8 +6,8 @@ import pytest
 
 import snakehead as sh
 from snakehead.app import cli
-from snakehead.kinematics import workspace as ws
-from snakehead.motion import reach
+from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.planning import whole_body_reach as reach
 
 from conftest import plan_agrees
 
@@ -45,8 +45,8 @@ def test_every_reached_pose_is_planned(robot: sh.SnakeRobot, body_map: ws.Reacha
 
 def test_witnesses_reach_the_pose(robot: sh.SnakeRobot, body_map: ws.ReachabilityMap) -> None:
     """The base of a reached pose is a real witness: the whole-body solve with that base kept reaches the pose."""
-    from snakehead.control.controller import HeadController
-    from snakehead.control.whole_body import solve_checked_target
+    from snakehead.solve.head_controller import HeadController
+    from snakehead.solve.whole_body import solve_checked_target
 
     bits = body_map.reached_units()
     v, k = np.argwhere(bits)[-1]

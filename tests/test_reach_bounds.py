@@ -1,4 +1,4 @@
-"""The reach map's prunes (motion.reach_bounds): necessary conditions of a whole-body pose.
+"""The reach map's prunes (solve.pose_bounds): necessary conditions of a whole-body pose.
 
 Two independent checks: (1) brute force -- random configurations are real poses, and a test that would exclude
 the pose of one that passes the exact checks (its ground clearance, its static margin) is unsound; (2) full
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import snakehead as sh
-from snakehead.control.whole_body import BodyProblem
-from snakehead.geometry import collision as coll
+from snakehead.solve.whole_body import BodyProblem
+from snakehead.collision import body_collisions as coll
 from snakehead.margins import DETOUR_MARGIN
-from snakehead.motion import reach
-from snakehead.motion.reach_bounds import PoseBounds
+from snakehead.planning import whole_body_reach as reach
+from snakehead.solve.pose_bounds import PoseBounds
 
 
 @pytest.fixture(scope="module")

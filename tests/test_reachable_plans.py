@@ -1,4 +1,4 @@
-"""Plans of head targets reachable by construction (``motion.targets``) that the planner once failed, each now
+"""Plans of head targets reachable by construction (``samples.targets``) that the planner once failed, each now
 planned and its motion checked by independent computations (FK, support polygons, ground and self clearance at
 every 2 ms sample); and the pieces of the planner that fixed them: a relocated base holds a stable curl of the
 neck and head (``choose_base``), long steps of a move are split and every move is checked densely, and after the
@@ -12,12 +12,12 @@ from snakehead._errors import Infeasible
 
 import snakehead
 from shape_reference import box_corners
-from snakehead.control import whole_body as wb
+from snakehead.solve import whole_body as wb
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead import margins
-from snakehead.motion import start_state, waypoints
-from snakehead.motion.targets import reachable_targets
+from snakehead.planning import start_state, waypoints
+from snakehead.samples.targets import reachable_targets
 
 
 @pytest.fixture(scope="module")
@@ -171,7 +171,7 @@ def base_only_margin(robot, q, base):
 def generated():
     """A generated snake unlike the default: 13 joints starting with a pitch joint, 10 cm modules, 6 cm section,
     parts named by link frames (the base ends at a real link, not a marker), a 1-joint neck, a 6-DOF head."""
-    from snakehead.kinematics import workspace as ws
+    from snakehead.kinematics.reachability import reachability_map as ws
     from snakehead.model.generate import SnakeSpec, snake_urdf
 
     spec = SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",
@@ -228,7 +228,7 @@ def test_margins_after_the_lift_on_a_generated_snake(generated):
 def test_targets_keep_the_lifted_links_off_the_ground():
     """A target's pose keeps every link after the first one the neck lifts (which pivots on its edge) at least
     TARGET_GROUND_CLEARANCE above the ground: a head resting on the ground is a contact no plan counts on."""
-    from snakehead.motion.targets import KINDS, TARGET_GROUND_CLEARANCE
+    from snakehead.samples.targets import KINDS, TARGET_GROUND_CLEARANCE
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)

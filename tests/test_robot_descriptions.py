@@ -10,7 +10,7 @@ import pytest
 
 import snakehead
 from snakehead import InputError, SnakeRobot
-from snakehead.model import published
+from snakehead.samples import published
 from snakehead.model.robot import ALIGNED_SUFFIX
 
 

@@ -261,7 +261,7 @@ def test_a_robot_whose_urdf_root_is_above_its_root_frame(tmp_path):
 
 def test_a_robot_whose_body_frame_is_not_its_root_frame(tmp_path):
     """The SEA-snake style: a link-less dummy root turned by -90 deg, modules along z, its own joint names."""
-    from snakehead.model.published import write_robot
+    from snakehead.samples.published import write_robot
 
     robot = SnakeRobot.from_file(write_robot("sea", tmp_path))
     assert not np.allclose(robot.body_in_root, np.eye(4))
@@ -380,7 +380,7 @@ def loop_run(plan):
     """A LoopRun as ClosedLoop.run returns it, made from the plan: one ground phase of 1 s recorded every 10 ms
     (the tail sliding 0.2 m along x into the plan's placement, dead reckoning 1 cm off), then the head phases
     'simulated' as the plan offset by 1 mrad and the ZMP by 1 mm."""
-    from snakehead.sim.loop import LoopRun, Phase, head_phases
+    from snakehead.closed_loop.loop import LoopRun, Phase, head_phases
 
     robot = plan.robot
     t = 0.01 * np.arange(101)

@@ -207,7 +207,7 @@ PAPER_POSES = [SPHERE_1, SPHERE_2, RELEASE_1, HOLE_FRONT]
 def _reachable_pose(seed: int) -> tuple[list, list]:
     """A head pose reachable by construction (the head's FK at a random stable configuration from the planner's
     initial one, at its default placement)."""
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.samples.targets import reachable_targets
 
     ctrl = _controller()
     (rt,) = reachable_targets(ctrl, "same", 1, np.random.default_rng(seed))

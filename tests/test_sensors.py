@@ -7,7 +7,7 @@ import pytest
 
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.sim import sensors as sn
-from snakehead.sim.estimate import AttitudeFilter
+from snakehead.closed_loop.estimate import AttitudeFilter
 
 
 def _chi2_bounds(n):
@@ -178,9 +178,9 @@ def test_ground_run_estimate_replays_from_its_sensor_stream_alone():
     the locomotion would command from it."""
     pytest.importorskip("mujoco")
     from snakehead import BasePlacement, SnakeRobot
-    from snakehead.motion import locomotion as lc
-    from snakehead.motion.gaits import make_gait
-    from snakehead.sim.gaits import GaitSimulator, replay_estimate
+    from snakehead.locomotion import goals as lc
+    from snakehead.locomotion.gaits import make_gait
+    from snakehead.closed_loop.gait_runner import GaitSimulator, replay_estimate
 
     robot = SnakeRobot.default()
     sim = GaitSimulator(robot, sensors=sn.OnboardSensors.realistic(seed=3))
@@ -208,7 +208,7 @@ def test_servo_step_is_a_newton_step_on_the_head_chain():
     little is reached by the correction to second order (the error after one step is the square of the first,
     scaled), the base's joints never move, and the fix from a marker reading gives back the root pose exactly."""
     from snakehead import SnakeRobot
-    from snakehead.sim import servo as sv
+    from snakehead.closed_loop import servo as sv
 
     robot = SnakeRobot.default()
     k = robot.link_index(robot.parts.head_tip)

@@ -38,8 +38,8 @@ def test_gravity_and_the_margins_are_defined_once():
 
 
 def test_the_users_read_the_one_definition():
-    from snakehead.control import whole_body
-    from snakehead.motion import timing
+    from snakehead.solve import whole_body
+    from snakehead.retiming import timing
     from snakehead.sim import mjcf, tracking
 
     for name in ("dynamics.stability", "dynamics.inverse_dynamics", "model.generate", "sim.gains", "sim.mjcf",

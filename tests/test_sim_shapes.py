@@ -11,7 +11,7 @@ import pytest
 import trimesh  # noqa: E402
 
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
-from snakehead.sim.estimate import BodyPoseEstimator  # noqa: E402
+from snakehead.closed_loop.estimate import BodyPoseEstimator  # noqa: E402
 
 L = 0.08  # module length (m)
 R = 0.02  # cylinder and sphere radius (m): the body axis lies R above the ground

@@ -139,7 +139,7 @@ def test_lowest_points_against_sampled_surfaces(robot, which, tmp_path):
     """The core's lowest z and lowest candidate points (the ground contacts) of every shape kind against densely
     sampled surfaces in numpy, on random configurations at a random placement: boxes (the default robot, a generated
     snake), cylinders and a mesh tail (sea), spheres (head6), STL/OBJ hulls (mesh), offset cylinders (rsnake)."""
-    from snakehead.model import published
+    from snakehead.samples import published
     from snakehead.model.generate import SnakeSpec, snake_urdf
 
     if which == "generated":

@@ -1,4 +1,4 @@
-"""The bending state's search (``motion.start_state.ground_curl``): the fast search finds the very curl of the
+"""The bending state's search (``planning.start_state.ground_curl``): the fast search finds the very curl of the
 exhaustive one (every curl's margin from the robot's kinematics) on many base shapes of several robots, and its
 parts equal independent computations (the centre of mass of every curl, the margins inside the base's polygon)."""
 from __future__ import annotations
@@ -13,7 +13,7 @@ from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
 
 from conftest import generated_specs
-from snakehead.motion import start_state as ss
+from snakehead.planning import start_state as ss
 
 SPECS = generated_specs()  # long20 (a 2-joint neck beginning with a yaw joint), pitchy (pitch first, heavy)
 
@@ -101,8 +101,8 @@ def test_a_straight_base_has_no_curl_by_either_search():
 
 @pytest.fixture(scope="module")
 def reu(tmp_path_factory):
-    from snakehead.control.controller import HeadController
-    from snakehead.model import published
+    from snakehead.solve.head_controller import HeadController
+    from snakehead.samples import published
 
     robot = snakehead.SnakeRobot.from_file(published.write_robot("reu", tmp_path_factory.mktemp("reu") / "reu"))
     return HeadController(robot, method="free_roll", seed=1)
@@ -113,10 +113,10 @@ def test_a_shape_whose_lift_ends_unsafe_is_no_base_to_choose(reu):
     statically stable by less than DETOUR_MARGIN: the curl is stable, but the plan could not lift from it (it went
     straight from the curl on the ground to the target, 45 mm into the ground: bench/targets.py --generated
     published:reu, place 12). The base's choice skips such shapes; the initial shape is fine."""
-    from snakehead.geometry import path_check
+    from snakehead.collision import path_proof as path_check
     from snakehead.margins import DETOUR_MARGIN
-    from snakehead.motion import base_choice
-    from snakehead.motion.waypoints import Waypoints
+    from snakehead.planning import base_choice
+    from snakehead.planning.waypoints import Waypoints
 
     start = reu.robot.lift_joints.start
     flat = reu.q_initial.copy()

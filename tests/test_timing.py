@@ -1,4 +1,4 @@
-"""Time-optimal retiming (motion.timing): a lift of the head retimed on two robots keeps every limit and the ZMP
+"""Time-optimal retiming (retiming.timing): a lift of the head retimed on two robots keeps every limit and the ZMP
 inside at every 2 ms sample (checked independently by stability.dynamic_stability), is faster than the fixed
 speed and cannot be sped up by 5 %, tracks in MuJoCo; the linear ZMP rows and the momentum-rate coefficients
 against direct computations; holds, stops and bad input."""
@@ -10,11 +10,12 @@ from snakehead._errors import Infeasible
 import snakehead
 from snakehead.dynamics import stability
 from snakehead.dynamics.inverse_dynamics import inverse_dynamics
-from snakehead.geometry import collision as coll
-from snakehead.kinematics import workspace as ws
+from snakehead.collision import body_collisions as coll
+from snakehead.kinematics.reachability import reachability_map as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion import start_state, timing
-from snakehead.motion.interpolation import MonotoneQuintic
+from snakehead.planning import start_state
+from snakehead.retiming import timing
+from snakehead.trajectory.interpolation import MonotoneQuintic
 
 GENERATED = SnakeSpec(n_joints=14, module_length=0.08, section=0.045, mass_per_module=0.22, first_axis="yaw",
                       markers={"p0": 7, "b0": 9}, tip_name="tip", name="gen14")

@@ -1,4 +1,4 @@
-"""TOPP-RA in the core (snakehead._core.topp_ra, motion._topp) against toppra itself (tests/topp_reference.py: toppra's
+"""TOPP-RA in the core (snakehead._core.topp_ra, retiming._topp) against toppra itself (tests/topp_reference.py: toppra's
 TOPPRA with its seidel solver over the same constraints, built by toppra's own constraint classes) on random paths,
 random limits and random robots; its 2-D LP against scipy's HiGHS; a closed-form bang-bang profile; retime's motions
 on both solvers; the steps retime is made of; bad input.
@@ -21,9 +21,9 @@ from scipy.optimize import linprog
 import snakehead
 from snakehead import _core
 from snakehead._errors import Infeasible, InputError
-from snakehead.model import published
+from snakehead.samples import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion import _topp, timing
+from snakehead.retiming import _topp, timing
 
 
 #: Controllable sets and path speeds: this share of their largest value (toppra's float32 velocity bound: ~1e-7).

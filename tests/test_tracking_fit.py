@@ -18,8 +18,8 @@ from scipy.optimize import least_squares
 import snakehead
 from snakehead import InputError, _core
 from snakehead.geometry.shapes import pair_distances
-from snakehead.model import published
-from snakehead.motion import cartesian
+from snakehead.samples import published
+from snakehead.trajectory import cartesian
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from tracking_reference import tracking_system  # noqa: E402

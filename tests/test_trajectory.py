@@ -8,11 +8,11 @@ from scipy.optimize import lsq_linear
 from scipy.spatial.transform import Rotation
 
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry import obstacles as obs
 from snakehead.geometry.shapes import Shape, ShapeSet, pair_distances
-from snakehead.motion import cartesian as cart
-from snakehead.motion import interpolation as interp
+from snakehead.trajectory import cartesian as cart
+from snakehead.trajectory import interpolation as interp
 from snakehead._errors import InputTypeError
 
 
@@ -543,7 +543,7 @@ def test_figures_are_written(robot, tmp_path):
 # the monotone multi-segment quintic
 # ------------------------------------------------------------------------------------------------
 def test_monotone_quintic_passes_waypoints_without_overshoot():
-    from snakehead.motion.interpolation import MonotoneQuintic
+    from snakehead.trajectory.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(11)
     times = np.cumsum(rng.uniform(0.2, 2.0, 12))
@@ -561,7 +561,7 @@ def test_monotone_quintic_passes_waypoints_without_overshoot():
 
 
 def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
-    from snakehead.motion.interpolation import MonotoneQuintic
+    from snakehead.trajectory.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(12)
     times = np.cumsum(rng.uniform(0.5, 1.5, 8))
@@ -581,7 +581,7 @@ def test_monotone_quintic_derivatives_are_continuous_and_match_differences():
 def test_monotone_quintic_piecewise_polynomial_equals_the_hermite_basis():
     """The per-segment coefficients (scipy's PPoly) give the quintic Hermite basis's values and derivatives (written out
     here, as the class documents them), and ``derivatives`` gives what three calls give."""
-    from snakehead.motion.interpolation import MonotoneQuintic
+    from snakehead.trajectory.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(13)
     times = np.cumsum(rng.uniform(0.05, 2.0, 15))
@@ -615,7 +615,7 @@ def test_monotone_quintic_values_are_scipys_ppoly_to_the_bit():
     from scipy.interpolate import PPoly
 
     from snakehead import _core
-    from snakehead.motion.interpolation import MonotoneQuintic
+    from snakehead.trajectory.interpolation import MonotoneQuintic
 
     rng = np.random.default_rng(14)
     times = np.cumsum(rng.uniform(0.01, 2.0, 30))

@@ -16,7 +16,7 @@ import pytest
 
 from snakehead import InputError, SnakeRobot
 from snakehead.model.description import MeshResolver, read_description
-from snakehead.model.published import write_robot
+from snakehead.samples.published import write_robot
 from snakehead.model.robot_folders import RobotFolders
 
 LAMBDA_PAYLOAD = ("${(lambda: [c for c in ().__class__.__base__.__subclasses__() if c.__name__ == '_wrap_close'][0]"

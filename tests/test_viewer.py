@@ -336,7 +336,7 @@ def reach_file(tmp_path_factory) -> Path:
     """A whole-body map of a tiny grid written by the one map writer, its bits chosen (not computed): every voxel of
     the lower layer reaches one direction of two (a share of 50 %), one voxel both; the upper layer none."""
     from snakehead import SnakeRobot
-    from snakehead.motion import reach
+    from snakehead.planning import whole_body_reach as reach
 
     robot = SnakeRobot.default()
     grid = reach.reach_grid(robot, 0.6, 2)
@@ -356,7 +356,7 @@ def reach_file(tmp_path_factory) -> Path:
 
 def test_reach_scene_shows_the_reached_voxels_around_the_start(reach_file, tmp_path):
     from snakehead import BasePlacement, SnakeRobot, load_map
-    from snakehead.motion import reach
+    from snakehead.planning import whole_body_reach as reach
 
     robot = SnakeRobot.default()
     m = load_map(reach_file)
@@ -383,7 +383,7 @@ def test_reach_scene_shows_the_reached_voxels_around_the_start(reach_file, tmp_p
 def test_snakehead_view_map_shows_the_reach_map(browser, reach_file):
     """``snakehead view --map reach.npz`` serves the still scene with its voxels shown at once: the page holds the
     50 % voxels' colour (the index bar's)."""
-    from snakehead.viz.workspace import index_colors
+    from snakehead.viz.reachability_figures import index_colors
 
     half = np.round(255 * index_colors([50.0])[0]).astype(int)
     seen, line = _pixels_served(browser, ["--map", str(reach_file)], half, 300, tolerance_deg=15.0)

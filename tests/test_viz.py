@@ -14,11 +14,11 @@ from matplotlib.figure import Figure
 
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
+from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.geometry.shapes import shape_mesh
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.motion.plan_result import Plan
+from snakehead.planning.plan_result import Plan
 from snakehead.viz import animation, body, dynamics, save, viewer
 
 
@@ -139,7 +139,7 @@ def test_snapshots_draw_box_obstacles_and_target_arrows(plan):
 
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from snakehead.motion.plan_result import TargetResult
+    from snakehead.planning.plan_result import TargetResult
 
     tip = plan.robot.head_pose(plan.q[-1], plan.base)
     targets = [TargetResult("reached", tip[:3, 3], tip[:3, 0], 4.0, None)]

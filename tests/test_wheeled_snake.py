@@ -2,7 +2,7 @@
 modules', so that the body stands on its wheels. The paper's initial state (the base arc optimised on the links' end
 points) stood 2 cm inside the end points' support polygon but 1.6 cm outside the wheels'; the planner could not lift
 the head into it and moved from the neck and head curled on the ground straight to each target, through the ground
-(bench/targets.py: 11/20, 16/20, 18/20 of the reachable sets). ``control.initial_state`` now chooses the initial
+(bench/targets.py: 11/20, 16/20, 18/20 of the reachable sets). ``solve.initial_state`` now chooses the initial
 state on the actual contacts when the paper's does not stand on them."""
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import pytest
 
 import snakehead
 from snakehead import backbone, margins
-from snakehead.control.initial_state import INITIAL_MARGIN, initial_margins, stable_initial_configuration
-from snakehead.model.published import write_robot
-from snakehead.motion.targets import reachable_targets
+from snakehead.solve.initial_state import INITIAL_MARGIN, initial_margins, stable_initial_configuration
+from snakehead.samples.published import write_robot
+from snakehead.samples.targets import reachable_targets
 from test_reachable_plans import verify_plan
 
 

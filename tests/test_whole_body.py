@@ -1,4 +1,4 @@
-"""The stability-aware whole-body solve (control.whole_body): gradients against finite differences, and solutions
+"""The stability-aware whole-body solve (solve.whole_body): gradients against finite differences, and solutions
 for targets reachable by construction checked by independent computations (FK, support polygon, clearances)."""
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import pytest
 
 import snakehead
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.control import whole_body as wb
+from snakehead.solve import whole_body as wb
 from snakehead.dynamics import stability
-from snakehead.geometry import collision as coll
-from snakehead.kinematics import workspace as ws
+from snakehead.collision import body_collisions as coll
+from snakehead.kinematics.reachability import reachability_map as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead._errors import InputTypeError
 
@@ -367,8 +367,8 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
     no batch of the lifted chain's IK and no solve with the base kept is made twice with the same arguments (the
     relocation's search takes the failed solve with the base kept from the first failure), and the plan's own
     solve of the target is a hit."""
-    from snakehead.motion import base_choice, target_solves
-    from snakehead.motion.targets import reachable_targets
+    from snakehead.planning import base_choice, target_solves
+    from snakehead.samples.targets import reachable_targets
 
     robot, controller, prob = default
     calls: list[tuple] = []
@@ -417,7 +417,7 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
 def test_rolled_frames_are_roll_about_x():
     """The candidates' rolled frames (one call for every angle) are head.roll_about_x's, bit for bit (the IK's
     seeded results, and so the plans, depend on them)."""
-    from snakehead.control.head import frame_from_direction, roll_about_x
+    from snakehead.solve.head import frame_from_direction, roll_about_x
 
     T = frame_from_direction([0.3, -0.2, 0.4], [0.2, 0.5, 0.8])
     angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS

@@ -13,7 +13,7 @@ import pytest
 
 from snakehead import Chain, SnakeRobot, default_robot_file
 from snakehead import sweep_defaults
-from snakehead.kinematics import workspace as ws
+from snakehead.kinematics.reachability import reachability_map as ws
 from snakehead._errors import InputError, InputTypeError
 from conftest import SMALL_MAP, head6_robot
 

@@ -1,5 +1,5 @@
-"""The reference for snakehead's TOPP-RA (snakehead._core.topp_ra via snakehead.motion._topp): toppra's own TOPPRA
-with its seidel solver over the same constraints, built with toppra's constraint classes as snakehead.motion.timing
+"""The reference for snakehead's TOPP-RA (snakehead._core.topp_ra via snakehead.retiming._topp): toppra's own TOPPRA
+with its seidel solver over the same constraints, built with toppra's constraint classes as snakehead.retiming.timing
 did before the core solved them (toppra's joint velocity constraint with the x cap, its joint acceleration
 constraint, and the torque and stability rows as canonical linear constraints, all with toppra's interpolation
 discretization).
@@ -20,7 +20,7 @@ from toppra.constraint import (DiscretizationType, JointAccelerationConstraint, 
 from toppra.constraint.linear_constraint import canlinear_colloc_to_interpolate
 from toppra.interpolator import AbstractGeometricPath
 
-from snakehead.motion import _topp, timing
+from snakehead.retiming import _topp, timing
 
 #: toppra needs finite limits: "none" is a limit no motion here comes near.
 BIG = 1e6

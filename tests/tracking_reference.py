@@ -1,10 +1,10 @@
 """The reference for the core's tracking fit (snakehead._core.TrackingFit, include/snakehead/tracking_fit.hpp): the
-numpy code of ``motion.cartesian.tracking_interpolation``'s fit before the core took it over, unchanged but for the
+numpy code of ``trajectory.cartesian.tracking_interpolation``'s fit before the core took it over, unchanged but for the
 split of one step's stacked system into :func:`tracking_system` (the setup before the fit and the result after it
 are cartesian's own, shared).
 
 ``tracking_interpolation_numpy`` has the signature and result of ``cartesian.tracking_interpolation``;
-``numpy_tracking()`` swaps it into the planner (``motion.waypoints``) for a block (tests/test_tracking_fit.py,
+``numpy_tracking()`` swaps it into the planner (``planning.waypoints``) for a block (tests/test_tracking_fit.py,
 bench/tracking_fit.py).
 """
 from __future__ import annotations
@@ -17,11 +17,8 @@ import numpy.typing as npt
 
 from snakehead.geometry.shapes import pair_distances
 from snakehead.model.robot import BasePlacement, SnakeRobot
-from snakehead.motion import waypoints
-from snakehead.motion.cartesian import (TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING,
-                                        TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE,
-                                        TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation,
-                                        _self_pairs, _tracking_interpolation)
+from snakehead.planning import waypoints
+from snakehead.trajectory.cartesian import TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING, TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE, TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation, _self_pairs, _tracking_interpolation
 
 
 def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,

@@ -482,7 +482,7 @@ def topp_ra(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], A: ty
     """
 def topp_ra_canonical(grid: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], P: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], Q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], R: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_max: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], x_start: typing.SupportsFloat | typing.SupportsIndex = 0.0, x_end: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> ToppRaResult:
     """
-    TOPP-RA over grid (N+1,) with the gridpoints' rows P u + Q x <= R (N+1, m each) and x <= x_max (N+1,), discretized as toppra's interpolation discretization in the core: topp_ra's result for the stage rows motion._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)
+    TOPP-RA over grid (N+1,) with the gridpoints' rows P u + Q x <= R (N+1, m each) and x <= x_max (N+1,), discretized as toppra's interpolation discretization in the core: topp_ra's result for the stage rows retiming._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)
     """
 def urdf_root_link(urdf: str) -> str:
     """

@@ -1,5 +1,5 @@
-"""The one way work is spread over an executor: maps (``kinematics.workspace.compute``), many plans
-(``motion.plan_many``) and the whole body's reach (``motion.reach``).
+"""The one way work is spread over an executor: maps (``kinematics.reachability.reachability_map.compute``), many plans
+(``planning.plan_many``) and the whole body's reach (``planning.whole_body_reach``).
 
 An executor is any ``concurrent.futures.Executor`` (a thread or process pool, Dask's ``client.get_executor()``) or a
 Dask ``distributed.Client`` itself (its executor is used). Tasks are module-level functions of picklable arguments,

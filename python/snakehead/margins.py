@@ -1,8 +1,8 @@
 """The margins every plan keeps, each defined once: how far the ZMP stays inside the support polygon, the static
 margin of every planned configuration, and how far a solved configuration stays from the obstacles.
 
-The planner (:mod:`snakehead.motion.planner`), the whole-body solve (:mod:`snakehead.control.whole_body`) and the
-retiming (:mod:`snakehead.motion.timing`) read them from here.
+The planner (:mod:`snakehead.planning.planner`), the whole-body solve (:mod:`snakehead.solve.whole_body`) and the
+retiming (:mod:`snakehead.retiming.timing`) read them from here.
 """
 from __future__ import annotations
 

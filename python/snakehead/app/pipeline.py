@@ -24,12 +24,12 @@ from .._errors import Infeasible, InputError, InputTypeError, InternalError
 
 
 if TYPE_CHECKING:
-    from ..control.controller import HeadController
-    from ..kinematics.workspace import ReachabilityMap
+    from ..solve.head_controller import HeadController
+    from ..kinematics.reachability.reachability_map import ReachabilityMap
     from ..model.robot import BasePlacement, SnakeRobot
-    from ..motion.plan_result import PlanProgress
+    from ..planning.plan_result import PlanProgress
     from ..scenes.scene import Scene
-    from ..sim.loop import LoopRun
+    from ..closed_loop.loop import LoopRun
 
 #: What ``fast`` changes: joints planned twice as fast with shorter segments (so half the 2 ms samples to check
 #: and simulate), and animations with fewer frames.
@@ -72,7 +72,7 @@ class Settings:
     """How the pipeline runs. method/seed: the head IK's; fast: see FAST; simulate: run the MuJoCo check;
     figures: write figures, the animation and the 3-D viewer's page; parallel: draw what needs only the plan in a
     second process while MuJoCo simulates (Linux); relocation: let the plan move the base (by locomotion, first)
-    when the targets need it; sensing: the closed loop's (:data:`snakehead.sim.loop.SENSING`, with ``--start``)."""
+    when the targets need it; sensing: the closed loop's (:data:`snakehead.closed_loop.loop.SENSING`, with ``--start``)."""
 
     method: str = "rotated"
     seed: int | None = 1
@@ -143,7 +143,7 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
     done), so that the next scene is planned while they are drawn. ``beside``: the figures (and the ROS outputs)
     are made in processes beside this one when ``settings.parallel`` (False: here, in turn -- when every core
     already runs a lane of scenes, more processes would only share the cores and copy the memory they touch)."""
-    from ..motion.planner import plan
+    from ..planning.planner import plan
 
     s = FAST if settings.fast else NORMAL
     robot = controller.robot
@@ -202,7 +202,7 @@ def start_scene(scene: Scene, controller: HeadController, out: Path, settings: S
 #: state alone brings the base to the scene's placement (Fig. 17a before 17b).
 PAPER_START = "paper"
 
-#: What every report of a closed loop says about how it closes (snakehead.sim.loop, step 5), by its sensing.
+#: What every report of a closed loop says about how it closes (snakehead.closed_loop.loop, step 5), by its sensing.
 LOOP_ASSUMPTION = ("closed loop on the robot's own sensors (snakehead.sim.sensors): gaits and curls are steered by dead "
                    "reckoning from 12-bit joint encoders, one MEMS IMU (gyro noise and bias random walk, "
                    "accelerometer noise; an attitude filter) and friction-balance contact odometry; a head camera "
@@ -219,11 +219,11 @@ LOOP_ASSUMPTION_OUTSIDE_FIX = (
 def run_loop_scene(scene: Scene, controller: HeadController, out: Path, settings: Settings, progress: Progress,
                    start: BasePlacement | str, *, solution_figure: bool = False) -> dict:
     """One scene from the body lying straight at ``start`` (a placement of its tail, or :data:`PAPER_START`) by the
-    closed loop (:class:`snakehead.sim.loop.ClosedLoop`): gaits, the curl, the head phases, all in MuJoCo. Its report
+    closed loop (:class:`snakehead.closed_loop.loop.ClosedLoop`): gaits, the curl, the head phases, all in MuJoCo. Its report
     entry has what :func:`run_scene`'s has for the head phases, and ``phases``, ``sim.base_travel_m``,
     ``estimate``, ``start``, ``total_time_s``; the files add ``NAME_path.png`` (the path from above) and
     ``NAME_loop.gif`` (the whole sequence)."""
-    from ..sim.loop import ClosedLoop
+    from ..closed_loop.loop import ClosedLoop
 
     s = FAST if settings.fast else NORMAL
     name = scene.name
@@ -510,7 +510,7 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     ``start`` given) the scenes run in lanes, one a core (:func:`scene_lanes`): the first in this process, the
     others each in a forked process with a controller of its own, made alike (the same map, method and seed: the
     same plans as one controller planning every scene in turn)."""
-    from ..control.controller import HeadController
+    from ..solve.head_controller import HeadController
     from ..model.robot import SnakeRobot
 
     scenes = _distinct_names(scenes)
@@ -579,7 +579,7 @@ def _cores() -> int:
 
 def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress: Progress) -> ReachabilityMap:
     """``workspace_map``, else the robot's head map (cached, or computed and cached)."""
-    from ..kinematics import workspace
+    from ..kinematics.reachability import reachability_map as workspace
 
     if workspace_map is not None:
         return workspace_map
@@ -606,7 +606,7 @@ def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: Reachabili
     """A lane of scenes run in a forked process with a controller of its own; its result: their report entries."""
 
     def work(p: Progress) -> dict:
-        from ..control.controller import HeadController
+        from ..solve.head_controller import HeadController
 
         controller = HeadController(robot, workspace_map, method=settings.method, seed=settings.seed)
         return _run_lane(lane, controller, out, settings, p, solution_figure, None, figures_beside=False)

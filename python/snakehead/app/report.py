@@ -156,7 +156,7 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     """The planned trajectory as CSV: a header ``time_s,<joint 1>_rad,...`` then one row per 2 ms sample,
     time in s (to 1 us) and the joint angles in rad (to 1e-7 rad): T rows of 1 + n columns.
 
-    The angles are the description's: for a result with a ``robot`` (a :class:`~snakehead.motion.plan_result.Plan`),
+    The angles are the description's: for a result with a ``robot`` (a :class:`~snakehead.planning.plan_result.Plan`),
     ``robot.description_angles(result.q)`` (the planner's ``q`` plus the robot file's ``[home]``); without one,
     ``result.q`` as it is."""
     t, q = np.asarray(result.t, float), np.asarray(result.q, float)

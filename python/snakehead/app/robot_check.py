@@ -89,7 +89,7 @@ def describe_parts(robot: SnakeRobot) -> list[PartReport]:
 def design_problems(robot: SnakeRobot) -> list[str]:
     """What keeps the planner from starting on this robot (empty when nothing does)."""
     from ..backbone.initial import initial_configuration
-    from ..motion.start_state import ground_curl
+    from ..planning.start_state import ground_curl
 
     problems = []
     try:
@@ -142,7 +142,7 @@ def suggest_split(robot: SnakeRobot) -> tuple[str, SnakeRobot] | None:
 
 def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
     """A line about the head's map (the robot file's, if any) and a problem with it (None when there is none)."""
-    from ..kinematics import workspace
+    from ..kinematics.reachability import reachability_map as workspace
 
     if robot.map_path is None:
         return "none (plan computes one and caches it)", None

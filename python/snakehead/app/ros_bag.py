@@ -48,13 +48,13 @@ import numpy.typing as npt
 
 from .._errors import invariant
 from .._files import atomic_open, write_text_atomic
-from ..motion.interpolation import CONTROL_PERIOD
+from ..trajectory.interpolation import CONTROL_PERIOD
 from . import ros_messages as msgs
 
 if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
-    from ..motion.plan_result import Plan
-    from ..sim.loop import LoopRun
+    from ..planning.plan_result import Plan
+    from ..closed_loop.loop import LoopRun
 
 #: The fixed frame everything is placed in (world coordinates: z up, the ground at z = 0).
 WORLD_FRAME = "world"
@@ -204,7 +204,7 @@ def frame_name(name: str) -> str:
 def target_frames(targets: Sequence[Any]) -> list[tuple[str, np.ndarray]]:
     """(frame id, world pose (4, 4)) of each target (``name``, ``position``, ``direction``): the x-axis along its
     direction, z as near world z as can be; names made frame ids and unique (a "_2" for the second of a name)."""
-    from ..control.head import frame_along
+    from ..solve.head import frame_along
 
     out: list[tuple[str, np.ndarray]] = []
     for tg in targets:
@@ -324,7 +324,7 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
     """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``;
     with ``simulated`` (a SimResult of the plan), its ZMP beside (namespace "zmp_simulated")."""
     from ..dynamics import stability
-    from ..motion.waypoints import PLAN_CONTACT
+    from ..planning.waypoints import PLAN_CONTACT
 
     t = np.asarray(plan.t, float)
     idx = _every(t, MARKER_PERIOD)
@@ -344,7 +344,7 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
 
 # --- the bags -----------------------------------------------------------------------------------------------------
 def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
-    """Write ``plan`` (a :class:`~snakehead.motion.plan_result.Plan`) as a ROS 2 bag at ``path`` (see the module);
+    """Write ``plan`` (a :class:`~snakehead.planning.plan_result.Plan`) as a ROS 2 bag at ``path`` (see the module);
     returns the path. Every :data:`JOINT_STATES` sample is the plan's (``t``, ``q`` as the description's angles,
     ``qd``)."""
     robot = plan.robot
@@ -379,7 +379,7 @@ def _loop_tracks(run: LoopRun) -> tuple[np.ndarray, np.ndarray]:
 
 
 def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
-    """Write a closed loop's run (:class:`~snakehead.sim.loop.LoopRun`) as a ROS 2 bag at ``path`` (see the
+    """Write a closed loop's run (:class:`~snakehead.closed_loop.loop.LoopRun`) as a ROS 2 bag at ``path`` (see the
     module); returns the path."""
     robot = run.robot
     t, roots, q = run.timeline()

@@ -21,7 +21,7 @@ sliding workpiece", IEEE J. Robotics and Automation 4(6), 1988). Two uses:
 
 :func:`predict_slide` runs the second over a joint path of a body lying flat, giving where the root frame goes:
 the planner of a closed loop uses it to know where a curl on the ground will leave the body
-(:mod:`snakehead.motion.locomotion`), and the pose estimate (:mod:`snakehead.sim.estimate`) uses the first.
+(:mod:`snakehead.locomotion.goals`), and the pose estimate (:mod:`snakehead.closed_loop.estimate`) uses the first.
 Loads are the links' weights (uniform friction, the body flat on the ground); the model ignores inertia and the
 pressure's spread under each link.
 """

@@ -422,8 +422,8 @@ def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt
                                      ) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` (contact "ground" or "footprint") and, from the same frames in the same C++ pass,
     the lowest point of the neck and head links above the ground at each sample (T,) m (as
-    ``geometry.collision.ground_clearance`` over ``robot.lifted_links``). ``made``: the
-    ``geometry.path_check.checker`` of the robot at ``base``, when the caller keeps one. ``kept``: the first samples'
+    ``collision.body_collisions.ground_clearance`` over ``robot.lifted_links``). ``made``: the
+    ``collision.path_proof.checker`` of the robot at ``base``, when the caller keeps one. ``kept``: the first samples'
     part of an earlier check to take over (filled by this check when empty; see :class:`KeptSamples`): the result is
     the same, to the bit."""
     robot = as_robot(robot)
@@ -442,7 +442,7 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
     """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
     differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
     and the neck and head's lowest point per sample; ``kept`` as :func:`dynamic_stability_with_clearance`'s."""
-    from ..geometry.path_check import checker
+    from ..collision.path_proof import checker
 
     g = robot.geometry
     if contact == "ground":

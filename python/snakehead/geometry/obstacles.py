@@ -1,4 +1,4 @@
-"""The obstacles of a scene, one model for planning (:mod:`snakehead.geometry.collision`) and simulation
+"""The obstacles of a scene, one model for planning (:mod:`snakehead.collision.body_collisions`) and simulation
 (:mod:`snakehead.sim`): boxes, a wall with a round hole and meshes (their convex hulls). Scene files
 (:mod:`snakehead.scenes`) describe them. Each obstacle gives its convex :meth:`shapes` in the world (the wall as
 convex pieces around a polygon inscribed in its hole, so that collisions with it err on the safe side).
@@ -190,7 +190,7 @@ class MeshObstacle:
     def load(cls, path: str | os.PathLike, position: npt.ArrayLike, yaw: float = 0.0,
              scale: npt.ArrayLike = (1.0, 1.0, 1.0), where: str = "mesh obstacle") -> "MeshObstacle":
         """A mesh obstacle from a file, standing at ``position`` (m), turned by ``yaw`` rad about the world z."""
-        from ..model.description import convex_hull_vertices
+        from .meshes import convex_hull_vertices
 
         scale_v = vector3(scale, "mesh scale")
         if np.any(scale_v <= 0):

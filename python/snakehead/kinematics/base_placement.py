@@ -26,11 +26,11 @@ import numpy.typing as npt
 
 from .._errors import InputError
 from .._validate import joint_vector, position_direction_pairs
-from .map_queries import direction_bits
+from .reachability.map_queries import direction_bits
 
 if TYPE_CHECKING:
     from ..model.robot import BasePlacement, SnakeRobot
-    from .workspace import ReachabilityMap
+    from .reachability.reachability_map import ReachabilityMap
 
 
 @dataclass
@@ -91,7 +91,7 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     k, and the map voxels whose sphere point in direction k lies within half a voxel of the height plane of the
     target; the target position seen from B0 is that point moved onto the plane, which fixes x, y. Kept: the
     best voxel per (frame, yaw) when its index is at least ``min_index``; returned: the ``limit`` best."""
-    from .workspace import require_map
+    from .reachability.reachability_map import require_map
 
     m = require_map(workspace_map, needs=("poses",), what="workspace_map")  # whole, with per-direction results
     p, d, single = position_direction_pairs(position, direction)
@@ -159,7 +159,7 @@ def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position:
     The base keeps the base joints of ``base_configuration`` (default: the initial configuration); the neck
     joints take ``neck_samples`` values each; yaws are sampled every 360 / ``yaw_samples`` degrees. See the
     module's doc. The result says, for each placement, the neck joints and the target as seen from B0."""
-    from .workspace import require_map
+    from .reachability.reachability_map import require_map
 
     require_map(workspace_map, robot, needs=("poses",), what="workspace_map")  # also: a map of this robot's head
     frames, neck_q = neck_frames(robot, base_configuration, neck_samples)

@@ -7,7 +7,7 @@ limits, mesh paths resolved and collision meshes loaded as their convex hulls.
 * :func:`with_joint_limits` -- ``continuous`` joints turned into revolute ones with the limits a robot file gives
   (a snake's planner needs bounded joints; a continuous joint without limits is an error naming it).
 * :class:`MeshResolver` -- ``package://NAME/...``, ``file://...`` and relative mesh paths to files inside the
-  robot's folders: the robot file's ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`convex_hull_vertices`
+  robot's folders: the robot file's ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`~snakehead.geometry.meshes.convex_hull_vertices`
   loads one with trimesh.
 
 Errors are :class:`snakehead.InputError` naming the file and the element.
@@ -25,17 +25,14 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InputError, InputTypeError
-from .._validate import MAX_COORDINATE_M, input_file
+from .._validate import input_file
 from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .xacro_expansion import expand_xacro
+from ..geometry.meshes import MAX_MESH_BYTES
 
-from typing import Any, Mapping
+from typing import Mapping
 
 
-#: A collision mesh larger than this is not a snake module's (and would stall the hull).
-MAX_MESH_BYTES = 64 * 1024 * 1024
-#: A collision mesh thinner than this (m) once scaled is flat: a scale that is wrong (mm read as m twice, a 0).
-MIN_MESH_THICKNESS_M = 1e-6
 
 
 @dataclass(frozen=True)
@@ -380,63 +377,3 @@ class MeshResolver:
                                  "(no folder to resolve it from)")
             path = self.folder / path
         return path
-
-
-def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarray:
-    """The vertices (V, 3) of the convex hull of the mesh file ``path`` (STL, OBJ, DAE, PLY... through trimesh),
-    scaled. A missing, unreadable, empty or flat mesh (flat as written or once scaled: thinner than
-    :data:`MIN_MESH_THICKNESS_M`) is an InputError naming ``where`` and the path."""
-    import trimesh
-
-    shown = repr(os.fspath(path))
-    input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
-    if os.path.getsize(path) == 0:
-        raise InputError(f"{where}: mesh file {shown} is empty (0 bytes)")
-    try:
-        loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
-        vertices = np.asarray(loaded.vertices, dtype=float)
-    except Exception as exc:  # trimesh raises many kinds for a bad file
-        raise InputError(f"{where}: cannot read mesh file {shown}: {' '.join(str(exc).split())}") from None
-    if vertices.ndim != 2 or vertices.shape[1] != 3:  # e.g. an OBJ "v" line with two coordinates
-        raise InputError(f"{where}: mesh file {shown} has vertices of shape {vertices.shape}, not (V, 3)")
-    vertices = vertices[np.all(np.isfinite(vertices), axis=1)]
-    if len(vertices) == 0:
-        raise InputError(f"{where}: mesh file {shown} has no vertices (not a mesh trimesh reads: STL, OBJ, PLY, "
-                         "DAE, ...)")
-    if _thickness(vertices) <= 0:
-        raise InputError(f"{where}: mesh file {shown} is flat ({len(vertices)} vertices on a plane, a line or a "
-                         "point): a collision mesh must enclose a volume")
-    scale = np.asarray(scale, float).reshape(3)
-    vertices = vertices * scale
-    thickness = _thickness(vertices)
-    if thickness < MIN_MESH_THICKNESS_M:
-        extent = vertices.max(axis=0) - vertices.min(axis=0)
-        raise InputError(f"{where}: mesh file {shown} scaled by {' '.join(f'{s:g}' for s in scale)} is "
-                         f"{thickness:.3g} m thin (extent {' x '.join(f'{e:.3g}' for e in extent)} m): no volume "
-                         f"(at least {MIN_MESH_THICKNESS_M:g} m; is the scale right?)")
-    if np.abs(vertices).max() > MAX_COORDINATE_M:
-        raise InputError(f"{where}: mesh file {shown} has a vertex {np.abs(vertices).max():.3g} m from its "
-                         f"origin (at most {MAX_COORDINATE_M:g} m; is the scale right?)")
-    from scipy.spatial import ConvexHull, QhullError
-
-    try:
-        hull = ConvexHull(vertices)
-    except QhullError as exc:  # nearly flat, or coordinates whose round-off swamps the shape
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "qhull failed"
-        raise InputError(f"{where}: mesh file {shown} has no convex hull ({first})") from None
-    return np.ascontiguousarray(vertices[hull.vertices])
-
-
-def _thickness(vertices: np.ndarray) -> float:
-    """The width (m) of points (V, 3) across their thinnest principal direction (0 for fewer than 4 points)."""
-    if len(vertices) < 4:
-        return 0.0
-    centred = vertices - vertices.mean(axis=0)
-    scale = float(np.abs(centred).max())
-    if scale == 0:
-        return 0.0
-    _, s, vt = np.linalg.svd(centred / scale, full_matrices=False)
-    if s[-1] <= 1e-12 * s[0]:
-        return 0.0
-    across = centred @ vt[-1]
-    return float(across.max() - across.min())

@@ -30,7 +30,7 @@ from .._errors import InputError, InputTypeError
 def holding_effort(mass_per_metre: float, body_length: float) -> float:
     """A servo effort (N m) that can hold half of a uniform body (``mass_per_metre`` kg/m, ``body_length`` m)
     straight out as a cantilever, with 50 % to spare, and at least 10 N m: lifting a neck and head needs about
-    that at the neck's first joint. Every generated snake (here and in :mod:`snakehead.model.published`) uses it."""
+    that at the neck's first joint. Every generated snake (here and in :mod:`snakehead.samples.published`) uses it."""
     weight_per_metre = mass_per_metre * GRAVITY
     half = body_length / 2
     return max(10.0, round(1.5 * weight_per_metre * half * half / 2, 1))

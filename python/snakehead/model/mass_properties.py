@@ -187,7 +187,8 @@ def rewrite_inertia(description: Description, inertia: str = "urdf", density: fl
     inertia, density = check_inertia_source(inertia, density, where)
     if inertia == "urdf":
         return description, None
-    from .description import MeshResolver, convex_hull_vertices
+    from ..geometry.meshes import convex_hull_vertices
+    from .description import MeshResolver
 
     resolver = MeshResolver(description.folder, description.folders)
     text = description.text

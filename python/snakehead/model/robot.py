@@ -35,7 +35,8 @@ from .._validate import finite_array, joint_vector
 from .chain import Chain, _check_utf8
 from .body_frame import (ALIGNED_SUFFIX, AXIS_TOLERANCE_DEG, HEAD_AXES, STRAIGHT_TOLERANCE, NotStraight,
                          Straightness, aligned_frames, body_frame, straightness)
-from .description import MeshResolver, convex_hull_vertices, read_description, with_joint_limits
+from ..geometry.meshes import convex_hull_vertices
+from .description import MeshResolver, read_description, with_joint_limits
 from .mass_properties import rewrite_inertia
 from .description_tree import JointOffsets, TreeChanges, body_description
 

@@ -52,7 +52,7 @@ same scene.
 
 Sizes are bounded: a scene holds at most :data:`MAX_TARGETS` targets (via poses included) and a scene file is at
 most :data:`MAX_SCENE_FILE_BYTES` bytes, refused before anything is planned (``snakehead.InputError``); a plan also
-bounds the motion's length (``snakehead.motion.plan_bounds.MAX_MOTION_S``).
+bounds the motion's length (``snakehead.planning.plan_bounds.MAX_MOTION_S``).
 """
 from __future__ import annotations
 
@@ -76,7 +76,7 @@ APPROACHES = ("free", "line")
 #: The most targets (entries of ``[[targets]]``, via poses included) a scene may hold. Each is a whole-body solve
 #: and a rest-to-rest move: ~0.4-0.8 s of planning and ~5 s of motion each on the default robot (bench/RESULTS.md,
 #: "Many targets"), so 1000 take minutes to plan; and a plan's motion is at most MAX_SAMPLES 2 ms samples (2000 s,
-#: ``motion.plan_bounds.MAX_MOTION_S``), 2 s per target at 1000 targets, about the shortest a move with a hold takes.
+#: ``planning.plan_bounds.MAX_MOTION_S``), 2 s per target at 1000 targets, about the shortest a move with a hold takes.
 #: A longer task is several scenes, planned one after the other.
 MAX_TARGETS = 1000
 #: The largest scene file (bytes): MAX_TARGETS targets written out in full (~200 bytes each), comments and obstacles.

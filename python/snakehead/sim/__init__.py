@@ -1,21 +1,17 @@
-"""The dynamics check in MuJoCo (an optional extra: ``pip install snakehead[sim]``): the robot's model, PD control
-with gravity compensation at the 2 ms control period, and the comparison with the plan (paper Section 4).
-
-* :func:`simulate` -- a :class:`~snakehead.motion.plan_result.Plan` end to end (``snakehead.simulate``);
-* :func:`simulate_trajectory` -- any joint trajectory; :func:`compare` -- a simulation against its plan;
-* :func:`build_model` / :func:`build_spec` -- the MuJoCo model (built with MjSpec) of a robot and the scene's obstacles;
-  :mod:`.gains` -- the servos' gains and torque limits, derived from each joint's load;
-* :class:`GaitSimulator` -- gaits (:mod:`snakehead.motion.gaits`) run on the ground from any simulated state, with
-  the body's pose estimated as the robot would (:mod:`.estimate`: joint angles + one link's IMU) and measured.
+"""The MuJoCo plant (an optional extra: ``pip install snakehead[sim]``): the robot's model built with MjSpec
+(:mod:`.mjcf`), PD control with gravity compensation at the 2 ms control period (:mod:`.tracking`), the servos' gains
+and torque limits (:mod:`.gains`), the robot's own senses (:mod:`.sensors`), and a plan simulated and compared with
+itself as the paper does in Section 4 (:mod:`.simulate_plan`, :mod:`.compare`).
 """
+from .. import _moved
 from . import gains
 from .compare import compare, zmp_margins
-from .estimate import BodyPose, BodyPoseEstimator, pose_error
-from .gaits import GaitRun, GaitSimulator, SimState
 from .mjcf import SimModel, build_model, build_spec, obstacle_boxes
-from .plan import PlanSimulation, simulate
-from .tracking import SimResult, simulate_trajectory
+from .simulate_plan import PlanSimulation, simulate
+from .tracking import SimResult, SimState, simulate_trajectory
 
-__all__ = ["simulate", "PlanSimulation", "simulate_trajectory", "SimResult", "compare", "zmp_margins", "SimModel",
-           "build_spec", "build_model", "obstacle_boxes", "gains", "GaitSimulator", "GaitRun", "SimState", "BodyPose",
-           "BodyPoseEstimator", "pose_error"]
+__all__ = ["simulate", "PlanSimulation", "simulate_trajectory", "SimResult", "SimState", "compare", "zmp_margins",
+           "SimModel", "build_spec", "build_model", "obstacle_boxes", "gains"]
+
+__getattr__ = _moved.moved_names(__name__, {
+    name: "snakehead.closed_loop" for name in ("GaitSimulator", "GaitRun", "BodyPose", "BodyPoseEstimator", "pose_error")})

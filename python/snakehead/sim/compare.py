@@ -5,7 +5,7 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError, invariant
 from .._validate import finite_array
-from ..control.head import angle_between_deg
+from ..solve.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .tracking import SimResult, check_trajectory
 

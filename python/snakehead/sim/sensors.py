@@ -1,6 +1,6 @@
 """The robot's own senses in the simulation: what a real snake robot measures about itself and its target, with
-stated, realistic figures. The closed loop (:mod:`snakehead.sim.loop`, ``sensing="onboard"``) reads the simulator
-only through these models (:class:`OnboardSensors`); the estimator (:mod:`snakehead.sim.estimate`) turns their
+stated, realistic figures. The closed loop (:mod:`snakehead.closed_loop.loop`, ``sensing="onboard"``) reads the simulator
+only through these models (:class:`OnboardSensors`); the estimator (:mod:`snakehead.closed_loop.estimate`) turns their
 streams into a pose.
 
 * :class:`Encoders` -- every joint's absolute angle, quantised to ``counts_per_rev`` counts per revolution
@@ -16,7 +16,7 @@ streams into a pose.
   head tip frame: position with HEAD_POSITION_NOISE_M per axis and orientation with HEAD_DIRECTION_NOISE_DEG per
   axis, only within HEAD_HALF_FOV_DEG of the head's axis, between
   HEAD_RANGE_M, and when the line of sight does not pass through an obstacle (a ray test against the obstacles'
-  convex shapes, :mod:`snakehead.geometry.collision`).
+  convex shapes, :mod:`snakehead.collision.body_collisions`).
 
 Every noise comes from one seeded :class:`numpy.random.Generator` per sensor (``seed``), so a run is reproducible.
 What is not modelled: encoder backlash and calibration offsets, the IMU's scale factors and misalignment, the
@@ -250,7 +250,7 @@ def occluded(a: npt.ArrayLike, b: npt.ArrayLike, obstacles: Sequence[Any]) -> bo
     of SIGHT_RADIUS_M along it, against their convex shapes)."""
     if not obstacles:
         return False
-    from ..geometry.collision import obstacle_shapes
+    from ..collision.body_collisions import obstacle_shapes
     from ..geometry.shapes import Shape, ShapeSet, pair_min_distances
 
     a, b = np.asarray(a, float), np.asarray(b, float)

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.art3d import Line3D, Poly3DCollection
     from PIL import Image
 
-    from ..motion.plan_result import Plan
+    from ..planning.plan_result import Plan
 
 
 @dataclass

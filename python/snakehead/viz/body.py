@@ -26,11 +26,11 @@ import numpy as np
 import numpy.typing as npt
 from matplotlib.figure import Figure
 
-from ..geometry import collision as coll
+from ..collision import body_collisions as coll
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..geometry.shapes import shape_mesh
 from ..model.robot import BasePlacement, SnakeRobot
-from ..motion.cartesian import cartesian_interpolation
+from ..trajectory.cartesian import cartesian_interpolation
 from .._errors import InputError
 from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, ink_mask, literal,
                       new_figure, setup_axes3d)
@@ -46,8 +46,8 @@ if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
-    from ..control.controller import HeadSolution
-    from ..motion.plan_result import Plan
+    from ..solve.head_controller import HeadSolution
+    from ..planning.plan_result import Plan
 
 #: A sphere drawn at a target: (centre (3,) m, diameter m).
 Sphere = tuple[npt.ArrayLike, float]

@@ -58,9 +58,9 @@ __all__ = ["LiveViewer", "Replan", "DynamicsCheck", "MOTION_WATCH_JS", "MAX_TARG
 LOG = logging.getLogger("snakehead.viz.server")
 
 if TYPE_CHECKING:
-    from ..control.controller import HeadController
+    from ..solve.head_controller import HeadController
     from ..model.robot import SnakeRobot
-    from ..motion.plan_result import Plan
+    from ..planning.plan_result import Plan
 
 #: s between two steps of the player (30 per second).
 TICK_S = 1.0 / 30.0
@@ -357,7 +357,7 @@ class LiveViewer:
             self._replan(record, scene)
 
     def _replan(self, record: Replan, scene: Scene) -> None:
-        from ..motion.planner import plan
+        from ..planning.planner import plan
 
         self._say(f"Planning request {record.number} ({record.what}) ...")
         record.plan_started = time.time()
@@ -478,7 +478,7 @@ class LiveViewer:
         try:
             if importlib.util.find_spec("mujoco") is None:
                 raise InputError("MuJoCo is not installed (pip install snakehead[sim])")
-            from ..sim.plan import simulate
+            from ..sim.simulate_plan import simulate
 
             check.simulation = simulate(motion.plan)
         except Exception as exc:  # noqa: BLE001 -- shown in the panel; the viewer keeps serving
@@ -580,7 +580,7 @@ class LiveViewer:
 def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str | os.PathLike | None,
                 controller: HeadController | None) -> HeadController:
     """The controller the viewer plans with (see :class:`LiveViewer`)."""
-    from ..control.controller import HeadController
+    from ..solve.head_controller import HeadController
     from ..model.robot import SnakeRobot
 
     if controller is not None:

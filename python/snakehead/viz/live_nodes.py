@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     import viser
 
     from ..model.robot import BasePlacement, SnakeRobot
-    from ..motion.plan_result import Plan
+    from ..planning.plan_result import Plan
 
 #: Segments of the head tip's path and of the ZMP's trace: fixed, so that a new plan moves their points only.
 PATH_SEGMENTS = 200
@@ -102,8 +102,8 @@ def _closed_edges(polygon: np.ndarray, n: int) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 def wxyz_along(direction: npt.ArrayLike) -> np.ndarray:
     """A quaternion (w, x, y, z) of the head's frame for ``direction`` (3,): x along it, z as near the world's up as
-    can be (:func:`snakehead.control.head.frame_along`, the frame the planner aims the head at)."""
-    from ..control.head import frame_along
+    can be (:func:`snakehead.solve.head.frame_along`, the frame the planner aims the head at)."""
+    from ..solve.head import frame_along
 
     x = np.asarray(direction, float) / np.linalg.norm(direction)
     return vw._wxyz(frame_along(np.zeros(3), x)[:3, :3][None])[0]

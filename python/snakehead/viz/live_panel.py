@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, Callable
 from .._errors import InputError
 
 if TYPE_CHECKING:
-    from ..sim.plan import PlanSimulation
+    from ..sim.simulate_plan import PlanSimulation
     from .live_nodes import LiveMotion
 
 
@@ -68,7 +68,7 @@ def _span(start: float | None, end: float | None) -> float:
 
 @dataclass
 class DynamicsCheck:
-    """The MuJoCo check of motion ``number``: its :class:`~snakehead.sim.plan.PlanSimulation`, or ``error``."""
+    """The MuJoCo check of motion ``number``: its :class:`~snakehead.sim.simulate_plan.PlanSimulation`, or ``error``."""
 
     number: int
     simulation: PlanSimulation | None = None

@@ -9,7 +9,7 @@ paper's 20-step bar, Figs. 4-5), attached to the head's base frame and hidden un
 
 Three ways to it:
 
-* :func:`viewer_scene` turns a :class:`~snakehead.motion.plan_result.Plan` into a :class:`ViewerScene` (plain arrays),
+* :func:`viewer_scene` turns a :class:`~snakehead.planning.plan_result.Plan` into a :class:`ViewerScene` (plain arrays),
   which :func:`save_viewer_scene` writes as ``NAME_viewer.npz`` (``numpy.load`` reads it) and
   :func:`load_viewer_scene` reads back -- ``snakehead plan`` and ``snakehead demo`` write one per scenario;
 * :func:`write_html`: a single HTML file that opens from disk in a browser, with no server and no network (viser's
@@ -46,8 +46,8 @@ from .._errors import InputError
 if TYPE_CHECKING:
     import viser
 
-    from ..kinematics.workspace import ReachabilityMap
-    from ..motion.plan_result import Plan
+    from ..kinematics.reachability.reachability_map import ReachabilityMap
+    from ..planning.plan_result import Plan
 
 #: What :func:`save_viewer_scene` appends to a scenario's name.
 SCENE_SUFFIX = "_viewer.npz"
@@ -235,7 +235,7 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
         raise InputError(f"max_frames must be an integer >= 2, got {max_frames!r}")
     robot = plan.robot
     if workspace_map is not None:  # a whole map (a shard shows part of it) of this robot's head
-        from ..kinematics.workspace import require_map
+        from ..kinematics.reachability.reachability_map import require_map
 
         require_map(workspace_map, robot, what="workspace_map")
     t = np.asarray(plan.t, float)
@@ -299,9 +299,9 @@ def reach_scene(reach_map: ReachabilityMap, robot: Any, *, title: str = "") -> V
     directions reached (0-100, the index bar). The map's frame is the world frame (the "head base frame" node is
     at the origin)."""
     from ..dynamics import stability as st
-    from ..kinematics.workspace import KIND_WHOLE_BODY, require_map
+    from ..kinematics.reachability.reachability_map import KIND_WHOLE_BODY, require_map
     from ..model.robot import BasePlacement
-    from ..motion.plan_many import WORKERS, RobotRecipe
+    from ..planning.plan_many import WORKERS, RobotRecipe
 
     m = require_map(reach_map, robot, kind=KIND_WHOLE_BODY, what="reach_map")
     q0 = WORKERS.get(RobotRecipe.of(robot), None, "rotated", 1).q_initial
@@ -508,7 +508,7 @@ class SceneNodes:
                                      position=data.map_frame_positions[0], wxyz=data.map_frame_wxyz[0])
         self.voxels = None
         if len(data.voxel_centers):
-            from .workspace import index_colors
+            from .reachability_figures import index_colors
 
             rgb = np.round(255 * index_colors(data.voxel_indices)).astype(np.uint8)
             n = len(data.voxel_centers)

@@ -1,0 +1,3 @@
+"""Sample robots and target sets for tests, benchmarks and the docs: snakes written the way published descriptions
+are (:mod:`.published`, :mod:`.published_quirks`, :mod:`.published_xacro`) and head targets reachable by
+construction (:mod:`.targets`). Nothing else in the package imports them."""
