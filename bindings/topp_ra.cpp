@@ -80,7 +80,7 @@ void bind_topp_ra(py::module_& m) {
       py::arg("x_end") = 0.0,
       "TOPP-RA over grid (N+1,) with the gridpoints' rows P u + Q x <= R (N+1, m each) and x <= x_max (N+1,), "
       "discretized as toppra's interpolation discretization in the core: topp_ra's result for the stage rows "
-      "motion._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)");
+      "retiming._topp.interpolated makes, to the bit (include/snakehead/topp_ra.hpp)");
   m.def(
       "solve_lp2d",
       [](double v_u, double v_x, Array rows_array, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {

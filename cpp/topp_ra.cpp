@@ -112,7 +112,7 @@ void fill_stage(std::vector<HalfPlane>& rows, double delta, double K_lo, double 
 // The stage rows of topp_ra_canonical, made stage by stage where they are used (no N x 2m matrices: the two passes
 // make each stage's rows once each, which costs less than writing and reading them back): stage i's rows are the
 // gridpoint rows of i at (u, x), then those of i+1 at (u, x + 2 delta_i u), each scaled as UnitRows scales them (the
-// interpolation discretization as motion._topp.interpolated makes it, to the bit).
+// interpolation discretization as retiming._topp.interpolated makes it, to the bit).
 struct CanonicalStages {
   const Eigen::Ref<const Eigen::VectorXd>& grid;
   const Eigen::Ref<const RowMatrixXd>& P;

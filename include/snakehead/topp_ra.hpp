@@ -97,7 +97,7 @@ ToppRaResult topp_ra(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen:
 // topp_ra over the constraints of the gridpoints themselves, in TOPP-RA's canonical form P u + Q x <= R (N+1 x m
 // each, finite) and x <= x_max (N+1; not NaN, inf for none), discretized here as toppra's "interpolation"
 // discretization does it (stage i: gridpoint i's rows at (u, x), gridpoint i+1's at (u, x + 2 delta_i u)), with u
-// free and x >= 0: the same result, to the bit, as topp_ra given the stage matrices motion._topp.interpolated makes
+// free and x >= 0: the same result, to the bit, as topp_ra given the stage matrices retiming._topp.interpolated makes
 // (A = [P_i, P_{i+1} + 2 delta_i Q_{i+1}], B = [Q_i, Q_{i+1}], C = [R_i, R_{i+1}]), without making them: each stage's
 // rows are made where a pass uses them.
 ToppRaResult topp_ra_canonical(const Eigen::Ref<const Eigen::VectorXd>& grid, const Eigen::Ref<const RowMatrixXd>& P,
