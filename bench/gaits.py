@@ -1,7 +1,7 @@
 """Gaits in MuJoCo: how fast each one moves the body, which way, and how well the robot knows where it went.
 
 Each gait (``snakehead.locomotion.gaits``, default parameters, 0.5 Hz, 1 s ramps) runs ``--cycles`` cycles from the body
-lying straight, on the default robot and generated snakes, on the friction ground (``snakehead.sim.GaitSimulator``:
+lying straight, on the default robot and generated snakes, on the friction ground (``snakehead.closed_loop.GaitSimulator``:
 friction 0.8, the servos' gains derived per joint). Per run: the virtual chassis' travel in body lengths per cycle
 and its direction in the body's starting frame (+90 deg = to the left), the turn in deg per cycle, the highest box
 point, the end tilt of the tail, and the pose estimate's error at the end (joint angles + a perfect IMU on the
@@ -22,7 +22,7 @@ import numpy as np
 from _robots import ROBOTS  # bench/_robots.py
 from snakehead import BasePlacement
 from snakehead.locomotion.gaits import make_gait
-from snakehead.sim import GaitSimulator
+from snakehead.closed_loop import GaitSimulator
 
 
 RUNS = [("rolling", 1), ("rolling", -1), ("sidewinding", 1), ("sidewinding", -1), ("turning", 1), ("turning", -1),

@@ -195,7 +195,7 @@ START = BasePlacement(0.3, -0.2, 0.7)
 
 @pytest.fixture(scope="module")
 def simulators(mujoco, robot):
-    from snakehead.sim import GaitSimulator
+    from snakehead.closed_loop import GaitSimulator
 
     return {"default": GaitSimulator(robot), "pitch_first": GaitSimulator(pitch_first())}
 
@@ -265,7 +265,7 @@ def test_runs_chain_from_state_to_state(simulators):
 
 
 def test_imu_heading_drift_shows_in_the_estimate(mujoco, robot):
-    from snakehead.sim import GaitSimulator
+    from snakehead.closed_loop import GaitSimulator
 
     sim = GaitSimulator(robot, imu_yaw_drift_deg_per_s=2.0)
     run = sim.run(sim.lying(START), make_gait("turning", 1, **QUICK), 1.0, rest_s=0.0)

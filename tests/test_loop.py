@@ -229,7 +229,7 @@ def test_curl_prediction_against_mujoco(mujoco, which):
     """The friction model predicts where a curl on the ground leaves the body, on two robots: within 5 cm and 5 deg
     of MuJoCo (measured 2026-12-01: default robot 3.4 cm and 3.4 deg of an 82 deg turn, pitch-first 2.6 cm and
     2.9 deg of 57 deg; not rate-dependent: the same in 6 s as in 2 s). The estimate follows the curl too."""
-    from snakehead.sim import GaitSimulator
+    from snakehead.closed_loop import GaitSimulator
 
     robot = SnakeRobot.default() if which == "default" else pitch_first()
     sim = GaitSimulator(robot)
@@ -251,7 +251,7 @@ def test_curl_prediction_against_mujoco(mujoco, which):
 def test_gaits_bring_the_body_to_a_goal(mujoco, robot):
     """next_step and the pose estimate, run after run: the body reaches a goal 0.5 m away and turned by 60 deg within
     the tolerance by its estimate, and within 10 cm and 6 deg in truth (the estimate drifts)."""
-    from snakehead.sim import GaitSimulator
+    from snakehead.closed_loop import GaitSimulator
 
     sim = GaitSimulator(robot)
     state = sim.lying(BasePlacement(0.0, 0.0, 0.0))
@@ -274,7 +274,8 @@ def test_gaits_bring_the_body_to_a_goal(mujoco, robot):
 def test_simulate_trajectory_continues_from_a_state(mujoco, robot):
     """A trajectory run from a SimState starts where the state is (not where ``base`` says) and goes on from its
     time; run in two halves chained by end_state, it ends where the whole run ends."""
-    from snakehead.sim import GaitSimulator, simulate_trajectory
+    from snakehead.closed_loop import GaitSimulator
+    from snakehead.sim import simulate_trajectory
 
     sim = GaitSimulator(robot)
     state = sim.lying(BasePlacement(0.5, 0.2, 1.0), c_curl(robot, 0.2))
