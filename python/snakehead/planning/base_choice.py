@@ -12,11 +12,11 @@ import numpy.typing as npt
 from .._errors import Infeasible
 from .._validate import joint_vector
 from ..solve.head_controller import HeadController
-from ..solve.whole_body import PlanSolves
+from ..solve.whole_body import PlanSolves, clear_of_obstacles, solve_checked_target
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import plan_cache_of, shape_key
-from .start_state import bending_state, lift_ends_safe
+from .start_state import bending_state, lift_ends_safe, shape_of
 from .target_solves import solve_kept
 
 #: The farthest (m) the planner moves the base by locomotion before a plan (a relocation). A target farther than
@@ -40,7 +40,6 @@ class Relocation:
     """A change of base that the targets need, carried out before the plan by locomotion (the paper's rolling gait
     or turning in place, Section 3.3 (3)): from placement ``start`` to ``base``, with the base's flat shape changed
     when ``shape_changed``; ``reason`` says why (what failed from the start)."""
-
     start: BasePlacement
     base: BasePlacement
     shape_changed: bool
@@ -51,14 +50,6 @@ class Relocation:
                 "to": {"x_m": self.base.x, "y_m": self.base.y, "yaw_rad": self.base.yaw},
                 "distance_m": float(np.hypot(self.base.x - self.start.x, self.base.y - self.start.y)),
                 "shape_changed": self.shape_changed, "reason": self.reason}
-
-
-def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
-    """``q_rest`` with the joints of the links lying on the ground (the base's, and the neck's before it lifts)
-    taken from ``q_shape``."""
-    q = np.asarray(q_rest, float).copy()
-    q[:robot.lift_joints.start] = q_shape[:robot.lift_joints.start]
-    return q
 
 
 def choose_base(controller: HeadController, targets: Any, obstacles: Sequence[Any] = (),
@@ -112,8 +103,6 @@ def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.
     """The first of ``targets`` not solved (with the base kept, :func:`solve_kept`) from the base at ``base`` with
     the flat shape of ``q_shape``, and its solution; (None, None) when all are; ("no curl", None) when the base's
     shape holds no stable curl of the neck and head, ("the start", None) when the start state is in an obstacle."""
-    from ..solve.whole_body import clear_of_obstacles
-
     try:
         q_bend = bending_state(controller, q_shape)
     except Infeasible:
@@ -154,8 +143,6 @@ def _relocated_for(controller: HeadController, target: Any, q0: np.ndarray, targ
     MAX_RELOCATION_M away, whose shape holds a stable curl of the neck and head (the bending state the plan lifts
     them from: the solve is told so, and looks further than a shape, e.g. a straight base, that holds none) and
     from which every target is solved; else None."""
-    from ..solve.whole_body import solve_checked_target
-
     robot, start = controller.robot, controller.base
     # the solve with the base kept is the first failure's (or, for a later target, made once and kept in solved)
     kept = solve_kept(controller, target.position, target.direction, q0, start, obstacles, solved)

@@ -11,6 +11,8 @@ from .._errors import InputError, MotionTooLong
 from .._validate import MAX_SAMPLES
 from ..model.robot import SnakeRobot
 from ..scenes.scene import Scene, Target
+from ..retiming.timing import resolve_limits
+from ..scenes.scene import check_target_count
 from ..trajectory import interpolation as interp
 
 #: s: the longest motion a plan may have: MAX_SAMPLES samples at the 2 ms control period (2000 s). Checked before
@@ -30,8 +32,6 @@ TIMING_OPTIONS = ("velocity_limit", "acceleration_limit", "torque_limit", "zmp_m
 
 def check_timing(robot: SnakeRobot, timing: dict[str, Any]) -> None:
     """InputError naming an unknown option of ``timing`` or a bad value (``retiming.timing.resolve_limits``)."""
-    from ..retiming.timing import resolve_limits
-
     unknown = [key for key in timing if key not in TIMING_OPTIONS]
     if unknown:
         raise InputError(f"timing has no option {unknown[0]!r}; its options are {', '.join(TIMING_OPTIONS)}")
@@ -67,8 +67,6 @@ def line_poses(a: Target, b: Target) -> list[np.ndarray]:
 def check_size(scene: Scene) -> dict[int, list[np.ndarray]]:
     """InputError (naming the scene) for a scene too large to plan, before anything is solved (see
     :func:`~snakehead.planning.planner.plan`); the poses along its line approaches (target index -> positions), which are counted here."""
-    from ..scenes.scene import check_target_count
-
     targets = scene.targets
     check_target_count(len(targets), f"scene {scene.name!r}")
     check_lines(targets)  # before the poses along the lines are made

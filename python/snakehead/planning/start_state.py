@@ -13,6 +13,7 @@ from ..dynamics import stability
 from ..collision import body_collisions as coll
 from ..model.robot import BasePlacement, SnakeRobot
 from .plan_cache import plan_cache_of, shape_key
+from .waypoints import Waypoints
 
 LIFT_STEPS = 16  # waypoints of the lift from the bending state to the initial state
 BENDING_GRID_DEG = 15.0  # deg: finest grid of the neck and head's yaw joints searched for the bending state
@@ -24,6 +25,14 @@ CURL_MARGIN_SLACK = 1e-9
 #: Curls spread over all of them whose composed centre of mass ground_curl checks against the robot's own (a chain
 #: the composition does not model then falls back to the exhaustive search).
 CURL_COM_SPREAD = 16
+
+
+def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
+    """``q_rest`` with the joints of the links lying on the ground (the base's, and the neck's before it lifts)
+    taken from ``q_shape``."""
+    q = np.asarray(q_rest, float).copy()
+    q[:robot.lift_joints.start] = q_shape[:robot.lift_joints.start]
+    return q
 
 
 def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
@@ -52,9 +61,6 @@ def lift_ends_safe(controller: HeadController, q_shape: np.ndarray) -> bool:
     and statically stable with DETOUR_MARGIN (``Waypoints.feasible``; the same at every placement on the flat
     ground; obstacles are the plan's to check). Without it the plan's first move goes from the curl on the ground
     straight to the target, for which there is often no safe path."""
-    from .base_choice import shape_of
-    from .waypoints import Waypoints
-
     q = shape_of(controller.robot, np.asarray(q_shape, float), controller.q_initial)
     return bool(Waypoints(controller.robot, BasePlacement()).feasible(q[None])[0])
 
@@ -200,5 +206,5 @@ def _line_margins(hull: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return (cross / np.hypot(edge[:, 0], edge[:, 1])).min(axis=1)
 
 
-__all__ = ["bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
+__all__ = ["shape_of", "bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
            "BENDING_CLEARANCE"]

@@ -8,7 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..solve.head_controller import HeadController
-from ..solve.whole_body import PlanSolves
+from ..solve.whole_body import PlanSolves, solve_checked_target
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement
 
@@ -18,8 +18,6 @@ def solve_kept(controller: HeadController, position: np.ndarray, direction: np.n
     """``solve.whole_body.solve_target`` with the base kept, kept in ``solved`` (one plan's: its obstacles are
     fixed) so that choose_base's solves of the chosen base are not repeated by the plan (the solve is
     deterministic: the same inputs give the same solution); its segmented solves and IK batches are shared there too."""
-    from ..solve.whole_body import solve_checked_target
-
     key = (np.asarray(position, float).tobytes(), np.asarray(direction, float).tobytes(),
            np.asarray(q_prev, float).tobytes(), base, near)
     if solved is not None and key in solved.kept:

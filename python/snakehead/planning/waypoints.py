@@ -17,6 +17,8 @@ from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..trajectory import interpolation as interp
 from . import plan_bounds
+from ..retiming.timing import RetimedTrajectory, retime
+from ..solve.whole_body import BodyProblem
 from ..trajectory.cartesian import tracking_interpolation
 from .plan_bounds import check_motion_length
 from .plan_cache import KeptMap
@@ -83,7 +85,6 @@ def densify(qs: np.ndarray, between: int = DENSIFY) -> np.ndarray:
 class Waypoints:
     """Accumulates the path's waypoints (label, q), the pauses and the stops, then times the whole path
     (``retiming.timing.retime``: TOPP-RA under the robot's limits and the ZMP) and samples it at the control period."""
-
     def __init__(self, robot: SnakeRobot, base: BasePlacement, obstacles: Sequence[Any] = ()) -> None:
         self.robot, self.base = robot, base
         self.obstacles = list(obstacles)
@@ -194,8 +195,6 @@ class Waypoints:
         """Static margins (m) of configurations qs (m, n) with CoM projections com_xy (m, 2) over the support of the
         links that lie on the ground whatever the pose (``solve.whole_body.BodyProblem.ground_links``: the base's
         and the neck's before it lifts, flat: their boxes' bottom corners), as ``check_solution`` takes it."""
-        from ..solve.whole_body import BodyProblem
-
         if self._problem is None:
             self._problem = BodyProblem(self.robot)
         prob, start = self._problem, self.robot.lift_joints.start
@@ -307,8 +306,6 @@ class Waypoints:
     def sample(self, notes: list, timing: dict[str, Any]) -> interp.JointTrajectory:
         """The fastest motion through the waypoints (``retiming.timing.retime``, options ``timing``) at 2 ms; fills in
         ``times`` (when each waypoint is reached)."""
-        from ..retiming.timing import retime
-
         # the plan checks its 2 ms samples itself (_finish: the ZMP by the paper's momenta, the ground, obstacles);
         # the retiming keeps the joint limits between its gridpoints by refining them
         timing = dict(timing, check_samples=False)
@@ -388,8 +385,6 @@ def concatenate_motions(a: Any, b: Any) -> Any:
     """Two retimed motions (``retiming.timing.RetimedTrajectory``), the second starting where and when (at rest) the
     first ends, as one sampled on one 2 ms grid; its ``waypoint_times`` the first's and the second's after its
     first. Of the second's samples only the last is used (its end: when and where)."""
-    from ..retiming.timing import RetimedTrajectory
-
     offset = float(a.t[-1])
     dt = float(a.t[1] - a.t[0]) if len(a.t) > 1 else interp.CONTROL_PERIOD
     t = interp.sample_times(0.0, offset + float(b.t[-1]), dt)
