@@ -123,7 +123,7 @@ def main() -> None:
     if args.out:
         from pathlib import Path
 
-        from snakehead.viz import dynamics, save
+        from snakehead.viz import dynamics_figures as dynamics, save
 
         P, L = stability.momenta(robot, t, q, base)
         for name, fig in (("sim_momenta", dynamics.plot_momenta(t, P, L, simulated=res)),

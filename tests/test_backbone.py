@@ -482,7 +482,7 @@ def test_curve_that_starts_straight(robot):
 
 
 def test_figures(tmp_path, default_backbone):
-    from snakehead.viz import backbone as bp
+    from snakehead.viz import backbone_figures as bp
     from snakehead.viz import save
 
     figs = [bp.plot_arc_discretisation(central_angle=2.0), bp.plot_initial_configuration(default_backbone),

@@ -495,7 +495,7 @@ def test_loop_report_entry(disturbed):
 def test_loop_figures(disturbed, tmp_path):
     from matplotlib.figure import Figure
 
-    from snakehead.viz import loop as loop_plots
+    from snakehead.viz import loop_figures as loop_plots
     from snakehead.viz import save
 
     _, run = disturbed

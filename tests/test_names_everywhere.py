@@ -330,7 +330,7 @@ def test_the_command_line_refuses_a_name_with_a_newline(tmp_path):
 def test_the_closed_loops_figures_show_names_as_they_are(robot, motion, name):
     """The finding: the loop's figures put target and phase names into matplotlib unescaped; ``$\\frac{$`` made the
     path figure and the GIF fail to draw (exit 2 after the whole loop had run)."""
-    from snakehead.viz import loop as loop_plots
+    from snakehead.viz import loop_figures as loop_plots
 
     run = make_loop_run(robot, motion, make_scene(name, "scene"))
     assert_shown_literally(loop_plots.plot_ground_path(run), name)
@@ -349,8 +349,8 @@ def test_every_figure_shows_a_name_literally(robot, motion, name):
     with Agg without an error, the name shown as it is (no text parsed as math); a name that is no name is refused
     where it enters."""
     from snakehead.viz import animation, body
-    from snakehead.viz import loop as loop_plots
-    from snakehead.viz import workspace as ws
+    from snakehead.viz import loop_figures as loop_plots
+    from snakehead.viz import reachability_figures as ws
 
     scene = scene_unless_refused(name)
     if scene is None:

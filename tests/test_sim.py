@@ -424,7 +424,7 @@ def test_missing_mujoco_names_the_extra(monkeypatch, robot):
 
 def test_plots_write_pngs(robot, lift, tmp_path):
     from snakehead.dynamics import stability
-    from snakehead.viz import dynamics, save
+    from snakehead.viz import dynamics_figures as dynamics, save
 
     t, q, res = lift
     P, L = stability.momenta(robot, t, q, res.base)

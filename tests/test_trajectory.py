@@ -523,7 +523,7 @@ def stable_lift_motion(robot):
 def test_figures_are_written(robot, tmp_path):
     """Figs. 11/13 for the lift of lift_motion; Figs. 18-20 for the stable lift timed over 2 s."""
     from snakehead.dynamics import stability
-    from snakehead.viz import body, dynamics, save
+    from snakehead.viz import body, dynamics_figures as dynamics, save
 
     fig = body.plot_interpolation_comparison(robot, *lift_motion(robot))
     # the clearance panel: joint space goes into the ground (Fig. 11), Eqs. 41-44 do not (Fig. 13)

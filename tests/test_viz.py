@@ -19,7 +19,8 @@ from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.geometry.shapes import shape_mesh
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.planning.plan_result import Plan
-from snakehead.viz import animation, body, dynamics, save, viewer
+from snakehead.viz import animation, body, save, viewer
+from snakehead.viz import dynamics_figures as dynamics
 
 
 @pytest.fixture(scope="module")
@@ -60,9 +61,9 @@ def plan(snake) -> Plan:
 def test_no_backend_is_chosen_at_import_or_when_drawing(tmp_path):
     """Importing snakehead.viz and making and saving a figure leave matplotlib's backend to the user."""
     code = ("import matplotlib, snakehead.viz, sys\n"
-            "from snakehead.viz import animation, backbone, body, dynamics, viewer, workspace\n"
+            "from snakehead.viz import animation, backbone_figures, body, dynamics_figures, viewer, reachability_figures\n"
             "from snakehead.viz import save\n"
-            "save(backbone.plot_area_vs_angle(), sys.argv[1])\n"
+            "save(backbone_figures.plot_area_vs_angle(), sys.argv[1])\n"
             "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot was imported'\n"
             "print(matplotlib.get_backend())\n")
     env = {**os.environ, "MPLBACKEND": "template"}

@@ -440,7 +440,7 @@ def test_shipped_head_map_g0(robot):
 # --- figures ------------------------------------------------------------------------------------------------
 def test_figures(small, tmp_path):
     from snakehead.viz import save
-    from snakehead.viz import workspace as wp
+    from snakehead.viz import reachability_figures as wp
 
     figures = wp.map_figures(small, k=2)
     assert list(figures) == ["map", "dexterous", "clusters"]

@@ -92,7 +92,9 @@ def _old_package(name: str) -> types.ModuleType:
             package = importlib.import_module(new)
             if attr in getattr(package, "__all__", ()):
                 _warn(f"{name}.{attr}", f"{new}.{attr}")
-                return getattr(package, attr)
+                value = getattr(package, attr)
+                setattr(module, attr, value)  # warned once: ``from old import name`` looks a name up twice
+                return value
         raise AttributeError(f"module {name!r} has no attribute {attr!r}")
 
     module.__getattr__ = __getattr__  # type: ignore[method-assign]
@@ -100,15 +102,23 @@ def _old_package(name: str) -> types.ModuleType:
 
 
 class _MovedLoader(importlib.abc.Loader):
+    def __init__(self) -> None:
+        self.own_spec: importlib.machinery.ModuleSpec | None = None
+
     def create_module(self, spec: importlib.machinery.ModuleSpec) -> types.ModuleType:
         if spec.name in MOVED_PACKAGES:
             _warn(spec.name, " and ".join(MOVED_PACKAGES[spec.name]))
             return _old_package(spec.name)
         _warn(spec.name, MOVED_MODULES[spec.name])
-        return importlib.import_module(MOVED_MODULES[spec.name])
+        module = importlib.import_module(MOVED_MODULES[spec.name])
+        self.own_spec = module.__spec__
+        return module
 
     def exec_module(self, module: types.ModuleType) -> None:
-        """Nothing to run: the module is the one at its new place."""
+        """Nothing to run: the module is the one at its new place. The import system has just given it the old
+        path's spec; it gets its own back (its name, for reloads and tools, stays the new one)."""
+        if self.own_spec is not None:
+            module.__spec__ = self.own_spec
 
 
 class MovedFinder(importlib.abc.MetaPathFinder):

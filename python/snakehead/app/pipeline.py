@@ -317,7 +317,7 @@ def _ros_outputs(name: str, out: Path, progress: Progress, plan: Any, run: LoopR
 
 def _loop_figures(scene: Scene, run: LoopRun, out: Path, s: dict, progress: Progress) -> list[str]:
     """The path from above and the animation of the whole sequence."""
-    from ..viz import loop as loop_plots
+    from ..viz import loop_figures as loop_plots
     from ..viz import save
 
     name = scene.name
@@ -367,7 +367,7 @@ def _dynamics_figures(scene: Scene, result: Any, sim_result: Any, out: Path, pro
                       kinds: Sequence[str] = DYNAMICS_FIGURES) -> list[str]:
     """The momenta and the ZMP (``kinds`` of :data:`DYNAMICS_FIGURES`), planned and (with ``sim_result``)
     simulated."""
-    from ..viz import dynamics, save
+    from ..viz import dynamics_figures as dynamics, save
     from ..viz._common import literal
 
     name = scene.name
@@ -598,7 +598,7 @@ def _preload_figures(progress: Progress) -> None:
         from matplotlib.backends import backend_agg  # noqa: F401
         from mpl_toolkits.mplot3d import Axes3D  # noqa: F401
 
-        from ..viz import animation, body, dynamics, viewer  # noqa: F401
+        from ..viz import animation, body, dynamics_figures, viewer  # noqa: F401
 
 
 def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: ReachabilityMap, out: Path,
