@@ -24,14 +24,14 @@ __all__ = ["feasible", "path_feasible", "finish_checks"]
 
 def feasible(way: Any, qs: np.ndarray, margin: float) -> np.ndarray:
     """(m,) bool: the planner's check of configurations qs (m, n) (``planning.planner._Waypoints``): the neck and head
-    above the ground (by -GROUND_TOLERANCE), the static margin at least ``margin`` (``way._margins``), no two
+    above the ground (by -GROUND_TOLERANCE), the static margin at least ``margin`` (``way.static_margins``), no two
     non-neighbouring links overlapping, clear of the obstacles; the clearances in one C++ call."""
     qs = np.asarray(qs, float)
     ground, self_, obstacle = sample_clearances(way.robot, qs, way.base, way.obstacles, made=way.checker)
     ok = (ground >= -GROUND_TOLERANCE) & (self_ > 0.0) & (obstacle > 0.0)
     if ok.any():
         rows = np.flatnonzero(ok)
-        ok[rows] = way._margins(qs[rows]) >= margin
+        ok[rows] = way.static_margins(qs[rows]) >= margin
     return ok
 
 
@@ -41,7 +41,7 @@ def path_feasible(way: Any, path: np.ndarray, checked: np.ndarray, margin: float
     support polygon changes as links touch or leave the ground, so it has no motion bound)."""
     if not check_path(way.robot, path, way.base, way.obstacles, made=way.checker).clear:
         return False
-    return bool((way._margins(np.asarray(checked, float)) >= margin).all())
+    return bool((way.static_margins(np.asarray(checked, float)) >= margin).all())
 
 
 def finish_checks(robot: SnakeRobot, base: BasePlacement, t: np.ndarray, q: np.ndarray, qd: np.ndarray,

@@ -180,7 +180,7 @@ class Waypoints:
             self._append(label if k == len(qs) - 1 else f"{label} ({k}/{len(qs) - 1})", qs[k])
         self.methods.append((label, method))
 
-    def _margins(self, qs: np.ndarray) -> np.ndarray:
+    def static_margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
         link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
         the smaller of that and the base's own (:meth:`_base_margins`): a motion must not lean on a neck or head
@@ -274,7 +274,7 @@ class Waypoints:
         return ok
 
     def _steadiest(self, dense: np.ndarray, middle: int) -> int:
-        """The index of the densified path dense (T, D, n) whose smallest static margin (:meth:`_margins`) is the
+        """The index of the densified path dense (T, D, n) whose smallest static margin (:meth:`static_margins`) is the
         largest: the first path within MARGIN_TIE of the largest (paths often share their smallest margin, at an
         end they share, equal but for round-off that depends on which configurations are computed together). Each
         path's margins are computed only while it may be that one: its smallest margin is at most its ends' and its
@@ -282,7 +282,7 @@ class Waypoints:
         best found by more than twice MARGIN_TIE."""
         T, D, nj = dense.shape
         ends = np.array([0, middle * (DENSIFY + 1), D - 1])
-        bound = self._margins(dense[:, ends].reshape(-1, nj)).reshape(T, len(ends)).min(axis=1)
+        bound = self.static_margins(dense[:, ends].reshape(-1, nj)).reshape(T, len(ends)).min(axis=1)
         worst = np.full(T, np.nan)
         order = np.argsort(-bound, kind="stable")
         for batch in np.array_split(order, max(1, T // DETOUR_BATCH)):
@@ -290,7 +290,7 @@ class Waypoints:
             batch = batch[bound[batch] >= best - 2 * MARGIN_TIE]
             if batch.size == 0:
                 break
-            worst[batch] = self._margins(dense[batch].reshape(-1, nj)).reshape(len(batch), D).min(axis=1)
+            worst[batch] = self.static_margins(dense[batch].reshape(-1, nj)).reshape(len(batch), D).min(axis=1)
         if not np.isfinite(worst).any():  # no configuration stands (e.g. none touches the ground): the first
             return 0
         return int(np.flatnonzero(worst >= np.nanmax(worst) - MARGIN_TIE)[0])
