@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any, IO, Iterator
 
 import numpy as np
+from numpy.lib import format as npy
 
 from ._errors import InputError
 from ._validate import input_file
@@ -118,8 +119,6 @@ def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str,
 
 def _read_npy(f: IO[bytes], size: int) -> np.ndarray:
     """One .npy array from a stream that holds ``size`` bytes: its header checked against ``size`` first."""
-    from numpy.lib import format as npy
-
     try:
         version = npy.read_magic(f)
     except ValueError as exc:

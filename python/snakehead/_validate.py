@@ -10,6 +10,7 @@ from __future__ import annotations
 import numbers
 import os
 import stat
+import unicodedata
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -274,7 +275,6 @@ RESERVED_FILE_NAMES = frozenset({"con", "prn", "aux", "nul", *(f"com{i}" for i i
 
 def _char(c: str) -> str:
     """A character as a message shows it: ``U+000A`` and its Unicode name where it has one."""
-    import unicodedata
 
     kind = {"Cc": "a control character", "Cs": "a lone surrogate"}.get(unicodedata.category(c), "")
     name = unicodedata.name(c, "") or kind
@@ -282,7 +282,6 @@ def _char(c: str) -> str:
 
 
 def _forbidden_chars(text: str, allowed: str = "") -> list[str]:
-    import unicodedata
 
     return sorted({c for c in text if c not in allowed and unicodedata.category(c) in NAME_FORBIDDEN_CATEGORIES})
 
@@ -346,7 +345,6 @@ def file_name_part(name: Any, what: str) -> str:
 def file_name_key(name: str) -> str:
     """What two names that name files must not share: names equal under Unicode normalisation and case folding
     ("Hole" and "hole", "é" composed and decomposed) are one file on macOS's and Windows's file systems."""
-    import unicodedata
 
     return unicodedata.normalize("NFC", unicodedata.normalize("NFD", name).casefold())
 

@@ -348,7 +348,7 @@ def _write_sea(spec: StyleSpec, folder: Path) -> Path:
 
 def _write_tail_mesh(path: Path, radius: float, length: float) -> None:
     """The SEA tail: a cylinder cap along z from 0 to ``length``, written as binary STL."""
-    import trimesh
+    import trimesh  # heavy to import: only the mesh style needs it
 
     cap = trimesh.creation.cylinder(radius=radius, height=length, sections=24)
     cap.apply_translation((0, 0, length / 2))
@@ -419,13 +419,13 @@ XACRO_DEFAULT_MODULES = 16
 def reu_xacro(spec: StyleSpec) -> str:
     """The ReU-style snake as a xacro file (:func:`snakehead.samples.published_xacro.reu_xacro`): expanded with
     ``n_modules = spec.n_joints`` it is :func:`reu_urdf` of ``spec``."""
-    from .published_xacro import reu_xacro as written
+    from .published_xacro import reu_xacro as written  # it builds on this module's pieces
 
     return written(spec)
 
 
 def _write_xacro(spec: StyleSpec, folder: Path) -> Path:
-    from .published_xacro import write_xacro
+    from .published_xacro import write_xacro  # it builds on this module's pieces
 
     return write_xacro(spec, folder)
 
@@ -487,7 +487,7 @@ def _mesh_file(link: int) -> tuple[str, str]:
 
 
 def _write_link_mesh(path: Path, file_type: str, length: float, section: float, head: bool, scale: float) -> None:
-    import trimesh
+    import trimesh  # heavy to import: only the mesh style needs it
 
     if head:
         # A rounded head: a capsule along x whose ends reach the link's two ends.

@@ -67,7 +67,7 @@ def _rx(a: float) -> np.ndarray:
 
 
 def _stl_box(path: Path, extents: tuple[float, float, float], centre: np.ndarray) -> None:
-    import trimesh
+    import trimesh  # heavy to import: only the cad style's meshes need it
 
     box = trimesh.creation.box(extents=extents)
     box.apply_translation(centre)
