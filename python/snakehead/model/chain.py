@@ -11,10 +11,13 @@ from .._validate import finite_array, joint_vector
 import numpy.typing as npt
 from .._errors import InputError, InputTypeError
 
+__all__ = ["Chain", "check_utf8"]
 
-def _check_utf8(text: str, name: str) -> None:
-    # The core takes UTF-8; a str that cannot be encoded (lone surrogates) would fail pybind11's conversion
-    # with an "incompatible function arguments" TypeError that names no argument.
+
+def check_utf8(text: str, name: str) -> None:
+    """InputError naming ``name`` for a str that is not valid UTF-8 (lone surrogates): the core takes UTF-8, and
+    pybind11's conversion of such a str fails with an "incompatible function arguments" TypeError that names no
+    argument."""
     try:
         text.encode("utf-8")
     except UnicodeEncodeError as exc:
@@ -54,7 +57,7 @@ class Chain:
         if not isinstance(base, str) or not isinstance(tip, str):
             raise InputTypeError("base and tip must be link names (str)")
         for name, text in (("urdf", urdf), ("base", base), ("tip", tip)):
-            _check_utf8(text, name)
+            check_utf8(text, name)
         return cls(_core.ChainModel.from_urdf(urdf, base, tip), urdf)
 
     # --- description -------------------------------------------------------------------------

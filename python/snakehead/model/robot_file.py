@@ -34,12 +34,13 @@ import os
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-
-
 from typing import Sequence
 
 from .._errors import InputError, InputTypeError
+from .._files import write_text_atomic
 from .._validate import file_problem, input_file
+from .body_frame import HEAD_AXES
+from .mass_properties import check_inertia_source
 
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
@@ -47,6 +48,19 @@ OPTIONAL_KEYS = ("root", "map", "head_axis", "xacro_args", "packages", "limits",
 
 #: A robot file is a few lines; anything larger is not one.
 MAX_FILE_BYTES = 64 * 1024
+
+
+def default_robot_file() -> Path:
+    """Path of the shipped robot file ``snake16.toml`` (package data; the source tree's copy when run in place)."""
+    for folder in (Path(__file__).resolve().parents[1] / "urdf", Path(__file__).resolve().parents[3] / "urdf"):
+        if (folder / "snake16.toml").exists():
+            return folder / "snake16.toml"
+    raise FileNotFoundError("snake16.toml is neither installed with the package nor in the source tree")
+
+
+def default_urdf_path() -> Path:
+    """Path of the shipped ``snake16.urdf`` (beside :func:`default_robot_file`)."""
+    return default_robot_file().with_name("snake16.urdf")
 
 
 @dataclass(frozen=True)
@@ -134,8 +148,6 @@ def read_robot_file(path: str | os.PathLike) -> RobotFile:
 
 def _inertia(data: dict, where: str) -> dict:
     """``inertia`` ("urdf" or "from_shapes") and ``density`` (kg/m^3, only with "from_shapes"), checked."""
-    from .mass_properties import check_inertia_source
-
     inertia, density = check_inertia_source(data.get("inertia", "urdf"), data.get("density"), where)
     return {"inertia": inertia, "density": density}
 
@@ -179,8 +191,6 @@ def _limits(data: dict, where: str) -> dict | None:
 
 
 def _head_axis(data: dict, where: str) -> str:
-    from .body_frame import HEAD_AXES
-
     value = data.get("head_axis", "x")
     if value not in HEAD_AXES:
         raise InputError(f"{where}: 'head_axis' must be one of {', '.join(HEAD_AXES)} (the head_tip frame's axis that "
@@ -209,8 +219,6 @@ def write_robot_file(path: str | os.PathLike, *, urdf: str | os.PathLike, base_e
               f"head_tip = {toml_string(head_tip)}"]
     if map is not None:
         lines.append(f"map = {toml_string(path_from(folder, map))}")
-    from .._files import write_text_atomic
-
     write_text_atomic(out, "\n".join(lines) + "\n")
     return out
 
