@@ -30,6 +30,7 @@ from .. import _core
 from .._validate import finite_array, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..model.physics import GRAVITY
+from .stability import momenta_from_velocities
 from .._errors import InputError
 
 #: Ramp (m) of the lifted share: a link whose distal points' lowest is this high is fully carried by the
@@ -188,8 +189,6 @@ def momentum_rates(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: 
     central difference (step :data:`MOMENTUM_STEP` rad on the largest joint; the error is of its square).
     :func:`newton_euler` computes the same rates exactly; this path uses the paper's equations.
     """
-    from .stability import momenta_from_velocities
-
     robot = as_robot(robot)
     base = as_base(base)
     single = np.ndim(q) == 1

@@ -23,6 +23,7 @@ import numpy as np
 from .. import _core
 from .._validate import finite_array, joint_vector
 from ..model.physics import GRAVITY  # g in Eq. 38 is (0, 0, -GRAVITY)
+from ..collision.path_proof import checker
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 import numpy.typing as npt
@@ -442,8 +443,6 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
     """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
     differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
     and the neck and head's lowest point per sample; ``kept`` as :func:`dynamic_stability_with_clearance`'s."""
-    from ..collision.path_proof import checker
-
     g = robot.geometry
     if contact == "ground":
         links, key_joints = robot.shaped_links, []

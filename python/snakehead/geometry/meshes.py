@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.spatial import ConvexHull, QhullError
 
 from .._errors import InputError
 from .._validate import MAX_COORDINATE_M, input_file
@@ -21,7 +22,7 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
     """The vertices (V, 3) of the convex hull of the mesh file ``path`` (STL, OBJ, DAE, PLY... through trimesh),
     scaled. A missing, unreadable, empty or flat mesh (flat as written or once scaled: thinner than
     :data:`MIN_MESH_THICKNESS_M`) is an InputError naming ``where`` and the path."""
-    import trimesh
+    import trimesh  # heavy to import (~0.2 s): only descriptions and scenes with meshes need it
 
     shown = repr(os.fspath(path))
     input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
@@ -52,8 +53,6 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
     if np.abs(vertices).max() > MAX_COORDINATE_M:
         raise InputError(f"{where}: mesh file {shown} has a vertex {np.abs(vertices).max():.3g} m from its "
                          f"origin (at most {MAX_COORDINATE_M:g} m; is the scale right?)")
-    from scipy.spatial import ConvexHull, QhullError
-
     try:
         hull = ConvexHull(vertices)
     except QhullError as exc:  # nearly flat, or coordinates whose round-off swamps the shape

@@ -11,8 +11,10 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from .._validate import finite_array, finite_float, positive, rotation_matrix, unit_vector3, vector3
+from .meshes import convex_hull_vertices
 from .shapes import Shape
 
 import numpy.typing as npt
@@ -190,8 +192,6 @@ class MeshObstacle:
     def load(cls, path: str | os.PathLike, position: npt.ArrayLike, yaw: float = 0.0,
              scale: npt.ArrayLike = (1.0, 1.0, 1.0), where: str = "mesh obstacle") -> "MeshObstacle":
         """A mesh obstacle from a file, standing at ``position`` (m), turned by ``yaw`` rad about the world z."""
-        from .meshes import convex_hull_vertices
-
         scale_v = vector3(scale, "mesh scale")
         if np.any(scale_v <= 0):
             raise InputError(f"{where}: mesh scale must be positive, got {scale_v.tolist()}")
@@ -212,8 +212,6 @@ class MeshObstacle:
 
     @cached_property
     def _planes(self) -> np.ndarray:
-        from scipy.spatial import ConvexHull
-
         return np.asarray(ConvexHull(self.world_vertices).equations)  # (F, 4): n . x + d, n outward
 
     def distance_to_points(self, x: np.ndarray) -> np.ndarray:

@@ -15,10 +15,12 @@ lowest points in closed form, many samples per call without the GIL) and answers
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from .. import _core
 
@@ -157,8 +159,6 @@ class ShapeSet:
 
 def _named_shape(message: str, shapes: tuple[Shape, ...]) -> str:
     """The core's message about "shape i" with what that shape is: its kind, frame and mesh file."""
-    import re
-
     found = re.search(r"\bshape (\d+)\b", message)
     if found is None or int(found.group(1)) >= len(shapes):
         return message
@@ -252,8 +252,6 @@ def shape_mesh(shape: Shape, segments: int = DRAW_SEGMENTS, hull: ShapeSet | Non
         if hull is not None and index is not None:
             v, f = np.asarray(hull.core.hull_vertices(index)), np.asarray(hull.core.hull_faces(index))
         else:
-            from scipy.spatial import ConvexHull
-
             assert shape.vertices is not None  # a convex shape has them (its constructor's contract)
             h = ConvexHull(shape.vertices)
             v, f = np.asarray(shape.vertices), h.simplices

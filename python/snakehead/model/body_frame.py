@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from .._errors import InputError
 from .chain import Chain
@@ -89,8 +90,6 @@ def suggest_home(body: Chain) -> np.ndarray:
     """Joint angles (n,) at which the body lies straight, by least squares from q = 0 within the limits: the side
     offsets of the frames from the line through the root (or the first joint) and the head tip, the joint axes
     across it, with a small pull towards 0."""
-    from scipy.optimize import least_squares
-
     child = np.asarray(body.model.joint_child_links)
     first = int(child[0]) if len(child) else 0
     reach = max(body.reach, STRAIGHT_TOLERANCE)

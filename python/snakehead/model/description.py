@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .._errors import InputError, InputTypeError
 from .._validate import input_file
@@ -294,8 +295,6 @@ def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], wher
 def origin_matrix(element: ET.Element, where: str = "origin") -> np.ndarray:
     """The pose (4, 4) an element's ``<origin xyz rpy>`` gives (identity without one); InputError naming ``where``
     and the attribute for one that is not three finite numbers."""
-    from scipy.spatial.transform import Rotation
-
     T = np.eye(4)
     origin = element.find("origin")
     if origin is None:
@@ -316,8 +315,6 @@ def origin_matrix(element: ET.Element, where: str = "origin") -> np.ndarray:
 
 def set_origin(joint: ET.Element, T: np.ndarray) -> None:
     """Write T (4, 4) as the element's ``<origin xyz rpy>``."""
-    from scipy.spatial.transform import Rotation
-
     origin = joint.find("origin")
     if origin is None:
         origin = ET.SubElement(joint, "origin")

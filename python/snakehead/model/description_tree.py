@@ -26,6 +26,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .._errors import InputError
 from .description import origin_matrix, set_origin
@@ -162,8 +163,6 @@ def _motion(joint: ET.Element, name: str, value: float, where: str) -> np.ndarra
     if joint.get("type") == "prismatic":
         T[:3, 3] = a * value
         return T
-    from scipy.spatial.transform import Rotation
-
     T[:3, :3] = Rotation.from_rotvec(a * value).as_matrix()
     return T
 

@@ -44,10 +44,13 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from .._errors import InputError, InputTypeError
+from scipy.spatial.transform import Rotation
 
-if TYPE_CHECKING:
-    from .description import Description
+from .._errors import InputError, InputTypeError
+from ..geometry.meshes import convex_hull_vertices
+from .description import Description, MeshResolver
+
+if TYPE_CHECKING:  # robot.py builds on this module (robot_build's rewrite_inertia)
     from .robot import SnakeRobot
 
 #: The robot file's ``inertia`` values: the URDF's ``<inertial>`` elements, or recomputed from the shapes.
@@ -111,7 +114,7 @@ def shape_unit_properties(kind: str, size: np.ndarray, vertices: np.ndarray | No
         v = 4.0 / 3.0 * math.pi * r ** 3
         return v, np.zeros(3), np.eye(3) * (0.4 * v * r * r)
     if kind in ("convex", "mesh"):
-        import trimesh
+        import trimesh  # heavy to import (~0.2 s): only mesh shapes need it
 
         hull = trimesh.convex.convex_hull(np.asarray(vertices, float))
         hull.density = 1.0
@@ -187,9 +190,6 @@ def rewrite_inertia(description: Description, inertia: str = "urdf", density: fl
     inertia, density = check_inertia_source(inertia, density, where)
     if inertia == "urdf":
         return description, None
-    from ..geometry.meshes import convex_hull_vertices
-    from .description import MeshResolver
-
     resolver = MeshResolver(description.folder, description.folders)
     text = description.text
     if not text.lstrip().startswith("<"):
@@ -217,8 +217,6 @@ def _numbers(text: str | None, count: int, what: str, default: str | None = None
 
 
 def _origin(element: ET.Element, where: str) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
     T = np.eye(4)
     origin = element.find("origin")
     if origin is not None:

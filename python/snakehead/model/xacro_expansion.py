@@ -20,6 +20,9 @@ import threading
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
+import xacro
+from xacro.substitution_args import convert_value
+
 from .._errors import InputError
 from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .safe_expression import ExpressionError, Namespace, evaluate
@@ -34,8 +37,6 @@ _LOCK = threading.Lock()
 def expand_xacro(path: Path, args: Mapping[str, str], folders: RobotFolders, *, trusted: bool = False) -> str:
     """The URDF text of the xacro file ``path`` expanded with ``args`` (name -> string). Raises InputError naming
     the file for a bad or refused description."""
-    import xacro
-
     with _LOCK, _hooks(xacro, folders, trusted):
         try:
             doc = xacro.process_file(os.fspath(path), mappings=dict(args))
@@ -128,8 +129,6 @@ class _Hooks:
         return args[name]
 
     def _eval(self, text: str) -> str:
-        from xacro.substitution_args import convert_value
-
         args = self.xacro.substitution_args_context.get("arg", {})
 
         def lookup(name: str) -> Any:

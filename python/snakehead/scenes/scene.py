@@ -65,6 +65,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._errors import InputError, InputTypeError
+from .._files import write_text_atomic
 from .._validate import (display_text, duration, file_name_part, file_problem, finite_float, name_text, sequence, unit_vector3,
                          world_position)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
@@ -323,8 +324,6 @@ def save_scene(scene: Scene, path: str | os.PathLike) -> Path:
     """Write ``scene`` as a scene file at ``path`` (atomically) that :func:`load_scene` reads back as the same
     scene: its robot file and mesh files named relative to the file's folder. Returns the path. InputError for an
     obstacle a scene file cannot hold (see :func:`scene_to_toml`) or a path that cannot be written."""
-    from .._files import write_text_atomic
-
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     out = Path(path)
