@@ -23,7 +23,7 @@ def planned() -> dict[str, Any]:
     H = robot.head_pose(controller.q_initial)
     pieces: list = []
     kept: list = []
-    real_concatenate, real_core = waypoints.concatenate_motions, stability._stability_in_core
+    real_concatenate, real_core = waypoints.concatenate_motions, stability.dynamic_stability_in_core
 
     def concatenate(a: Any, b: Any) -> Any:
         pieces.append((a, b))
@@ -34,11 +34,11 @@ def planned() -> dict[str, Any]:
         kept.append(args[8].resumed if len(args) > 8 and args[8] is not None else None)
         return out
 
-    waypoints.concatenate_motions, stability._stability_in_core = concatenate, core
+    waypoints.concatenate_motions, stability.dynamic_stability_in_core = concatenate, core
     try:
         plans = [snakehead.plan([(H[:3, 3] + [0.0, dy, -0.05], H[:3, 0])], controller=controller) for dy in (0.0, 0.03)]
     finally:
-        waypoints.concatenate_motions, stability._stability_in_core = real_concatenate, real_core
+        waypoints.concatenate_motions, stability.dynamic_stability_in_core = real_concatenate, real_core
     return {"robot": robot, "plans": plans, "pieces": pieces, "resumed": kept}
 
 

@@ -246,7 +246,7 @@ def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
             np.testing.assert_array_equal(getattr(again, name), getattr(fresh, name), err_msg=name)
         np.testing.assert_array_equal(clear, fresh_clear)
         assert (again.argmin, again.stable) == (fresh.argmin, fresh.stable)
-    runs = stability._polygons_along(robot, lift[:m], base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+    runs = stability.contact_configurations(robot, lift[:m], base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
     assert runs > 2, "the kept samples must hold several contact runs"
 
 
@@ -334,8 +334,8 @@ def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) ->
             stability.SAMPLE_CHUNK = 37
             try:
                 core, clearance = stability.dynamic_stability_with_clearance(robot, t, q, base, qd, contact=contact)
-                ref = stability._dynamic_stability_python(robot, t, q, base, qd, contact, stability.CONTACT_TOLERANCE,
-                                                          None, None)
+                ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, contact, stability.CONTACT_TOLERANCE,
+                                                           None, None)
             finally:
                 stability.SAMPLE_CHUNK = old
             np.testing.assert_allclose(core.margin, ref.margin, atol=1e-9, rtol=0, err_msg=f"{name} {contact}")
@@ -346,7 +346,7 @@ def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) ->
             assert core.argmin == ref.argmin and core.stable == ref.stable
             lowest = robot.lowest_z(robot.frames_many(q, base), robot.lifted_links).min(axis=1)
             np.testing.assert_array_equal(clearance, lowest)
-        runs = stability._polygons_along(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+        runs = stability.contact_configurations(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
         assert runs > 2, "the motion must change its contacts (the head lifts)"
 
 
@@ -380,11 +380,11 @@ def test_zmp_check_with_a_still_base_and_a_moving_one_equals_the_python_referenc
     np.testing.assert_allclose(core.zmp, ind["zmp"], atol=1e-11, rtol=0)
     np.testing.assert_allclose(core.margin, ind["margin"], atol=1e-11, rtol=0)
     assert core.argmin == int(np.argmin(ind["margin"])) and 0 < (ind["margin"] > 0).sum() < len(t)
-    ref = stability._dynamic_stability_python(robot, t, q, base, qd, "ground", stability.CONTACT_TOLERANCE, None,
-                                              None)
+    ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, "ground", stability.CONTACT_TOLERANCE, None,
+                                               None)
     np.testing.assert_allclose(core.margin, ref.margin, atol=1e-9, rtol=0)
     assert core.argmin == ref.argmin and core.stable == ref.stable
-    runs = stability._polygons_along(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2]
+    runs = stability.contact_configurations(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2]
     assert runs.max() + 1 > 200, "the neck must lift through many runs"
 
 

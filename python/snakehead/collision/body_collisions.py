@@ -23,6 +23,9 @@ import numpy.typing as npt
 from typing import Any, Sequence
 from .._errors import InputError, InputTypeError
 
+__all__ = ["GROUND_TOLERANCE", "ground_clearance", "below_ground", "touching_ground", "self_clearance",
+           "obstacle_shapes", "segment_closest", "CollisionReport", "collision_check"]
+
 #: A link whose shapes dip lower than this below the ground (m) is driven into it by the plan; a shape within
 #: this distance of the ground touches it (the base lies at exactly 0).
 GROUND_TOLERANCE = 1e-3
@@ -96,7 +99,7 @@ def self_clearance(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None
 
 
 class _ObstacleSets:
-    """The shape sets of obstacle lists already seen (a wall's 32 hulls cost ~5 ms to build; the planner checks the
+    """The shape sets of obstacle lists already seen (a wall's 32 hulls are costly to build; the planner checks the
     same obstacles many times a plan), keyed by the obstacles' identities and holding them so that no id is reused
     while its entry lives. Obstacles are immutable. At most ``size`` entries; the oldest go first."""
 
@@ -150,7 +153,6 @@ def segment_closest(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarr
     t_c = np.clip(t, 0.0, 1.0)
     s_c = np.where(a > eps, np.clip((t_c * b - c) / np.where(a > eps, a, 1.0), 0.0, 1.0), 0.0)
     return np.where((t < 0.0) | (t > 1.0), s_c, s), t_c
-
 
 
 @dataclass(frozen=True)

@@ -48,19 +48,13 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base
 from .body_collisions import GROUND_TOLERANCE, obstacle_shapes
 
 #: rad: the first sampling of a path that :func:`check_path` proves clear (largest joint change between samples).
-#: Measured with bench/path_check.py on the move paths of 12 plans (1759 configurations checked at MOVE_CHECK_STEP =
-#: 0.05 rad): 0.05 evaluates 1705 configurations (14.5 ms), 0.2 552 (4.5 ms), 0.5 331 (3.3 ms), every path proven
-#: clear at each: the bound proves most 0.5 rad steps at once and halves the others. 0.5 is MAX_WAYPOINT_STEP: the
-#: waypoints of a move and the midpoints the proof asks for.
+#: 0.5 is MAX_WAYPOINT_STEP: the waypoints of a move and the midpoints the proof asks for; the bound proves most
+#: such steps at once and halves the others, the fewest configurations evaluated (bench/path_check.py).
 PATH_FIRST_STEP = 0.5
 #: rad: intervals are not split below this largest joint change; one still unproven there fails the path.
 PATH_FLOOR_STEP = 1e-3
 #: rad: :func:`check_motion` evaluates a timed motion's samples where some joint has travelled this far (total
-#: variation) since the last one evaluated. Measured on the motions of 12 plans (~7,000 samples each, no obstacles;
-#: 2026-12-02, loaded 2-core machine): 0.05 evaluates ~260 configurations per motion (6.0 ms), 0.1 ~140 (3.8 ms),
-#: 0.2 ~83 (2.7 ms), 0.4 ~70 (3.0 ms), every motion proven clear at each; with an obstacle beside the head
-#: (bench/path_check.py, 6 motions) 0.05: 1510 configurations, 54 ms; 0.1: 936, 15 ms; 0.2: 692, 9.4 ms; 0.4: 608,
-#: 10.3 ms (every 2 ms sample: 42,174, 1456 ms).
+#: variation) since the last one evaluated: the fastest proof with and without obstacles (bench/path_check.py).
 MOTION_FIRST_STEP = 0.2
 
 __all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "PathReport", "MotionReport", "checker",
@@ -69,9 +63,9 @@ __all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "PathRepor
 
 def checker(robot: SnakeRobot, base: BasePlacement | None = None, obstacles: Sequence[Any] = ()) -> _core.PathChecker:
     """The C++ checker of the robot at ``base`` among ``obstacles``: the neck and head links' ground clearance
-    (floor -GROUND_TOLERANCE), the robot's self-collision pairs, every shaped link against every obstacle shape. Immutable (shared
-    by threads); the caller keeps it while robot, placement and obstacles stay (a plan's ``Waypoints`` does: with
-    obstacles it takes ~16 ms to build, 0.6 ms without)."""
+    (floor -GROUND_TOLERANCE), the robot's self-collision pairs, every shaped link against every obstacle shape.
+    Immutable (shared by threads); the caller keeps it while robot, placement and obstacles stay (a plan's
+    ``Waypoints`` does: obstacles make it costly to build)."""
     base = as_base(base)
     obstacles = list(obstacles)
     g = robot.geometry

@@ -33,6 +33,9 @@ from ..model.physics import GRAVITY
 from .stability import momenta_from_velocities
 from .._errors import InputError
 
+__all__ = ["LIFT_RAMP", "GRAVITY_MODELS", "lift_shares", "carried_weights", "InverseDynamics", "inverse_dynamics",
+           "newton_euler", "MOMENTUM_STEP", "momentum_rates"]
+
 #: Ramp (m) of the lifted share: a link whose distal points' lowest is this high is fully carried by the
 #: joints; on the ground (height 0) not at all; linear in between.
 LIFT_RAMP = 0.005

@@ -36,6 +36,9 @@ from .._validate import finite_array
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .._errors import InputError
 
+__all__ = ["RESTING_HEIGHT", "SLIP_FLOOR", "TRANSLATION_TOLERANCE", "balance_translation", "balance_motion",
+           "resting_contacts", "predict_slide"]
+
 #: A box whose bottom is within this height (m) of the lowest box bottom rests on the ground (flat shapes).
 RESTING_HEIGHT = 0.003
 #: Slips below this share of the largest shift count as none in the reweighting (keeps the weights finite).
@@ -118,8 +121,7 @@ def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.Arr
     changed in the body's frame), best keeps them where they were (``before`` (k, 2)) in the sense of friction:
     the minimiser of sum_i N_i |R(w) a_i + t - b_i|, by iteratively reweighted least squares (Gauss-Newton on the
     rotation, relinearised at every iteration). When a contact sticks at the optimum the iteration converges only
-    linearly: 60 iterations left the dissipation 1e-5 (relative) above SciPy's minimiser in a test, 200 matched it;
-    the default is 300 (a curl's prediction, ~40 steps, takes 0.1 s)."""
+    linearly, hence the default of 300 iterations (with margin over what matches SciPy's minimiser)."""
     b = finite_array(before, "before", (None, 2))
     a = finite_array(after, "after", b.shape)
     N = _loads(weights, len(b))

@@ -29,6 +29,12 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 import numpy.typing as npt
 from .._errors import Infeasible, InputError
 
+__all__ = ["CONTACT_TOLERANCE", "CONTACT_MODELS", "SAMPLE_CHUNK", "polygon_margin_many", "center_of_mass",
+           "hull_indices", "support_polygon", "static_margin", "static_margins_of_frames", "is_statically_stable",
+           "joint_velocities", "momenta_from_velocities", "momenta", "zmp", "DynamicStability", "dynamic_stability",
+           "CORE_CONTACT_MODELS", "KeptSamples", "dynamic_stability_with_clearance", "dynamic_stability_in_core",
+           "dynamic_stability_in_python", "support_margins", "support_polygons", "contact_configurations"]
+
 #: A base link counts as lying on the ground when the lowest point of its collision shapes is below this
 #: height (m). The default robot's flat base links sit at exactly 0.
 CONTACT_TOLERANCE = 1e-3
@@ -389,8 +395,8 @@ def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, bas
     t, q = _check_trajectory(robot, t, q)
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     if frames is None and with_frames is None and contact in CORE_CONTACT_MODELS:
-        return _stability_in_core(robot, t, q, base, qd, contact, tolerance)[0]
-    return _dynamic_stability_python(robot, t, q, base, qd, contact, tolerance, frames, with_frames)
+        return dynamic_stability_in_core(robot, t, q, base, qd, contact, tolerance)[0]
+    return dynamic_stability_in_python(robot, t, q, base, qd, contact, tolerance, frames, with_frames)
 
 
 #: The contact models whose dynamic stability runs in the C++ core in one call (``_core.zmp_check``); "endpoints"
@@ -434,15 +440,16 @@ def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt
     qd = joint_velocities(t, q) if qd is None else finite_array(qd, "qd", q.shape)
     if contact not in CORE_CONTACT_MODELS:
         raise InputError(f"contact must be one of {CORE_CONTACT_MODELS}, got {contact!r}")
-    return _stability_in_core(robot, t, q, base, qd, contact, tolerance, made, kept)
+    return dynamic_stability_in_core(robot, t, q, base, qd, contact, tolerance, made, kept)
 
 
-def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
-                       contact: str, tolerance: float, made: _core.PathChecker | None = None,
-                       kept: KeptSamples | None = None) -> tuple[DynamicStability, np.ndarray]:
-    """:func:`dynamic_stability` in one call of the C++ core (``_core.zmp_check``: the same momenta, np.gradient's
-    differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as :func:`_dynamic_stability_python`)
-    and the neck and head's lowest point per sample; ``kept`` as :func:`dynamic_stability_with_clearance`'s."""
+def dynamic_stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement,
+                              qd: np.ndarray, contact: str, tolerance: float, made: _core.PathChecker | None = None,
+                              kept: KeptSamples | None = None) -> tuple[DynamicStability, np.ndarray]:
+    """:func:`dynamic_stability` of arguments already checked, in one call of the C++ core (``_core.zmp_check``: the
+    same momenta, np.gradient's differences, ZMP, contact runs, chunks of SAMPLE_CHUNK samples and hulls as
+    :func:`dynamic_stability_in_python`) and the neck and head's lowest point per sample; ``made`` and ``kept`` as
+    :func:`dynamic_stability_with_clearance`'s."""
     g = robot.geometry
     if contact == "ground":
         links, key_joints = robot.shaped_links, []
@@ -469,11 +476,12 @@ def _stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: Ba
     return dyn, out["clearance"]
 
 
-def _dynamic_stability_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, qd: np.ndarray,
-                              contact: str, tolerance: float, frames: np.ndarray | None,
-                              with_frames: Callable[[slice, np.ndarray], None] | None) -> DynamicStability:
-    """:func:`dynamic_stability` in Python over the core's frames, momenta and hulls, :data:`SAMPLE_CHUNK` samples at
-    a time (the reference of the C++ path, and the path for contact "endpoints", given frames or ``with_frames``)."""
+def dynamic_stability_in_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement,
+                                qd: np.ndarray, contact: str, tolerance: float, frames: np.ndarray | None,
+                                with_frames: Callable[[slice, np.ndarray], None] | None) -> DynamicStability:
+    """:func:`dynamic_stability` of arguments already checked, in Python over the core's frames, momenta and hulls,
+    :data:`SAMPLE_CHUNK` samples at a time (the reference of the C++ path, and the path for contact "endpoints",
+    given frames or ``with_frames``)."""
     if frames is not None and np.shape(frames) != (q.shape[0], len(robot.link_names), 4, 4):
         frames = None
     n = len(t)
@@ -483,7 +491,7 @@ def _dynamic_stability_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, b
         rows = slice(start, min(n, start + SAMPLE_CHUNK))
         f = robot.frames_many(q[rows], base) if frames is None else frames[rows]
         P[rows], L[rows], com[rows] = _momenta(robot, q[rows], qd[rows], base, f)
-        chunks.append((rows, _polygons_along(robot, q[rows], base, contact, tolerance, f)))
+        chunks.append((rows, contact_configurations(robot, q[rows], base, contact, tolerance, f)))
         if with_frames is not None:
             with_frames(rows, f)
         del f
@@ -516,7 +524,7 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
     xy = finite_array(xy, "xy", (q.shape[0], 2))
-    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
+    pts, active, inv = contact_configurations(robot, q, base, contact, tolerance, frames)
     return polygon_margin_many(pts[inv], active[inv], xy)
 
 
@@ -536,7 +544,7 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     robot = as_robot(robot)
     base = as_base(base)
     q, _ = _joint_matrix(robot, q)
-    pts, active, inv = _polygons_along(robot, q, base, contact, tolerance, frames)
+    pts, active, inv = contact_configurations(robot, q, base, contact, tolerance, frames)
     vertex, count = _core.convex_hulls(np.ascontiguousarray(pts), np.ascontiguousarray(active))
     width = max(1, int(count.max()))
     vertices = np.take_along_axis(pts, np.maximum(vertex[:, :width], 0)[..., None], axis=1)
@@ -544,10 +552,11 @@ def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | 
     return vertices[inv], count[inv].astype(int)
 
 
-def _polygons_along(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
-                    frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The distinct contact configurations of q (T, n): their contact points (U, N, 2) and which touch (U, N), and
-    which of them each sample has (T,). ``frames``: q's world frames when the caller has them."""
+def contact_configurations(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, contact: str, tolerance: float,
+                           frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct contact configurations of q (T, n) (one per run of samples; see :func:`support_polygons`): their
+    contact points (U, N, 2) and which touch (U, N), and which of them each sample has (T,). ``frames``: q's world
+    frames when the caller has them."""
     if frames is None or frames.shape != (q.shape[0], len(robot.link_names), 4, 4):
         frames = None
     tolerance = float(finite_array(tolerance, "tolerance", ()))

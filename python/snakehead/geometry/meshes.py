@@ -12,6 +12,8 @@ from scipy.spatial import ConvexHull, QhullError
 from .._errors import InputError
 from .._validate import MAX_COORDINATE_M, input_file
 
+__all__ = ["MAX_MESH_BYTES", "MIN_MESH_THICKNESS_M", "convex_hull_vertices"]
+
 #: A collision mesh larger than this is not a snake module's (and would stall the hull).
 MAX_MESH_BYTES = 64 * 1024 * 1024
 #: A collision mesh thinner than this (m) once scaled is flat: a scale that is wrong (mm read as m twice, a 0).

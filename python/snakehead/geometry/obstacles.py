@@ -20,6 +20,8 @@ from .shapes import Shape
 import numpy.typing as npt
 from .._errors import InputError
 
+__all__ = ["WALL_HOLE_SIDES", "BoxObstacle", "WallWithHole", "MeshObstacle", "OBSTACLE_TYPES"]
+
 #: Sides of the polygon inscribed in a wall's hole: the pieces of the wall's solid meet the hole's circle at the
 #: polygon's vertices and stand into it by at most r (1 - cos(pi / 32)) = 0.5 % of its radius.
 WALL_HOLE_SIDES = 32

@@ -27,6 +27,9 @@ from .. import _core
 from typing import Sequence
 from .._errors import InputError
 
+__all__ = ["KINDS", "CONTACT_POINTS", "DRAW_SEGMENTS", "SHAPES_OF_KEPT", "Shape", "ShapeSet", "pair_distances",
+           "pair_min_distances", "shape_mesh", "shape_points"]
+
 KINDS = ("box", "cylinder", "sphere", "convex")
 
 #: How many lowest candidate points of a shape of each kind count as its possible ground contacts: a box rests on a

@@ -20,6 +20,9 @@ from .description import add_fixed_frames
 
 from pathlib import Path
 
+__all__ = ["STRAIGHT_TOLERANCE", "AXIS_TOLERANCE_DEG", "ALIGNED_SUFFIX", "HEAD_AXES", "Straightness", "NotStraight",
+           "straightness", "suggest_home", "body_frame", "aligned_frames"]
+
 #: Below this (rad, m) two frames turn and sit alike: a frame within it of the body frame's orientation needs no
 #: aligned twin (URDFs write pi/2 as 1.5708: 4e-6 rad off).
 STRAIGHT_TOLERANCE = 1e-4

@@ -33,7 +33,8 @@ from ..geometry.meshes import MAX_MESH_BYTES
 
 from typing import Mapping
 
-
+__all__ = ["Description", "read_description", "JOINT_TYPES", "GEOMETRY_KINDS", "check_description", "with_joint_limits",
+           "origin_matrix", "set_origin", "add_fixed_frames", "MeshResolver"]
 
 
 @dataclass(frozen=True)

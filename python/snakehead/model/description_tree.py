@@ -33,6 +33,8 @@ from .description import origin_matrix, set_origin
 
 from typing import Mapping
 
+__all__ = ["REVERSED_SUFFIX", "BranchLink", "TreeChanges", "JointOffsets", "body_description"]
+
 #: The suffix of the marker frame a turned-around moving joint moves (the parent link's frame on the joint).
 REVERSED_SUFFIX = "__reversed"
 

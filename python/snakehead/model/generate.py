@@ -25,6 +25,7 @@ from .physics import GRAVITY
 from typing import Any
 from .._errors import InputError, InputTypeError
 
+__all__ = ["holding_effort", "SnakeSpec", "snake_urdf"]
 
 
 def holding_effort(mass_per_metre: float, body_length: float) -> float:

@@ -53,6 +53,12 @@ from .description import Description, MeshResolver
 if TYPE_CHECKING:  # robot.py builds on this module (robot_build's rewrite_inertia)
     from .robot import SnakeRobot
 
+__all__ = ["INERTIA_SOURCES", "GYRATION_FACTOR", "MAX_LINK_SHARE", "MAX_DENSITY", "MIN_DENSITY", "TRIANGLE_TOLERANCE",
+           "Finding", "MassProperties", "shape_unit_properties", "combine", "shapes_mass_properties",
+           "check_inertia_source", "with_inertia", "rewrite_inertia", "link_shapes", "InertiaRewrite",
+           "inertia_from_shapes", "rigid_segments", "rewrite_inertia_text", "mass_findings", "findings_of",
+           "inertia_source"]
+
 #: The robot file's ``inertia`` values: the URDF's ``<inertial>`` elements, or recomputed from the shapes.
 INERTIA_SOURCES = ("urdf", "from_shapes")
 #: A radius of gyration above this many times the link's extent is flagged (see the module's docstring).

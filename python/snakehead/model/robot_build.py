@@ -28,7 +28,8 @@ from .robot_parts import RobotParts, joints_before, part_slices
 if TYPE_CHECKING:  # robot.py builds on this module
     from .robot import SnakeRobot
 
-__all__ = ["BuiltRobot", "build", "check_snake", "is_xml_text", "body_chain"]
+__all__ = ["BuiltRobot", "build", "urdf_source", "frame_name", "home_table", "checked_limits", "body_text",
+           "check_home_limits", "is_xml_text", "body_chain", "check_snake", "check_straight"]
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,9 @@ from .._validate import file_problem, input_file
 from .body_frame import HEAD_AXES
 from .mass_properties import check_inertia_source
 
+__all__ = ["REQUIRED_KEYS", "OPTIONAL_KEYS", "MAX_FILE_BYTES", "default_robot_file", "default_urdf_path", "RobotFile",
+           "read_toml", "check_keys", "read_robot_file", "write_robot_file", "path_from", "toml_string"]
+
 #: The keys of a robot file; the first four frame keys but ``root`` are required, with ``urdf``.
 REQUIRED_KEYS = ("urdf", "base_end", "neck_end", "head_tip")
 OPTIONAL_KEYS = ("root", "map", "head_axis", "xacro_args", "packages", "limits", "home", "inertia", "density")

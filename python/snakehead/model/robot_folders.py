@@ -21,6 +21,8 @@ from typing import Mapping
 from .._errors import InputError
 from .._validate import input_file
 
+__all__ = ["MAX_DESCRIPTION_BYTES", "RobotFolders"]
+
 #: A description file (URDF, xacro, an included xacro, a YAML file it loads) larger than this is not a snake's.
 MAX_DESCRIPTION_BYTES = 16 * 1024 * 1024
 

@@ -27,6 +27,9 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator, Mapping
 
+__all__ = ["MAX_STEPS", "MAX_ITEMS", "MAX_INT_BITS", "MAX_EXPRESSION_CHARS", "ExpressionError", "Namespace",
+           "SAFE_NAMES", "evaluate"]
+
 #: Steps (syntax nodes evaluated, comprehension items) one expression may take.
 MAX_STEPS = 1_000_000
 #: Items of a sequence (or characters of a string) an expression may build.

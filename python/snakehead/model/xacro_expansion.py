@@ -27,6 +27,8 @@ from .._errors import InputError
 from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .safe_expression import ExpressionError, Namespace, evaluate
 
+__all__ = ["TRUST_HINT", "expand_xacro"]
+
 #: What the error says when a description asks for what only a trusted one may do.
 TRUST_HINT = ("if you trust this description, load it with trust_xacro=True (snakehead --trust-xacro); "
               "see SECURITY.md")

@@ -75,10 +75,9 @@ from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 APPROACHES = ("free", "line")
 
 #: The most targets (entries of ``[[targets]]``, via poses included) a scene may hold. Each is a whole-body solve
-#: and a rest-to-rest move: ~0.4-0.8 s of planning and ~5 s of motion each on the default robot (bench/RESULTS.md,
-#: "Many targets"), so 1000 take minutes to plan; and a plan's motion is at most MAX_SAMPLES 2 ms samples (2000 s,
-#: ``planning.plan_bounds.MAX_MOTION_S``), 2 s per target at 1000 targets, about the shortest a move with a hold takes.
-#: A longer task is several scenes, planned one after the other.
+#: and a rest-to-rest move, so 1000 take minutes to plan (bench/RESULTS.md, "Many targets"); and a plan's motion is
+#: at most MAX_SAMPLES 2 ms samples (2000 s, ``planning.plan_bounds.MAX_MOTION_S``), 2 s per target at 1000 targets,
+#: about the shortest a move with a hold takes. A longer task is several scenes, planned one after the other.
 MAX_TARGETS = 1000
 #: The largest scene file (bytes): MAX_TARGETS targets written out in full (~200 bytes each), comments and obstacles.
 MAX_SCENE_FILE_BYTES = 1 << 20
@@ -420,4 +419,5 @@ def paper_scene(name: str) -> Scene:
 
 
 __all__ = ["Target", "Scene", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
-           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "MAX_SCENE_FILE_BYTES"]
+           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "MAX_SCENE_FILE_BYTES", "DEFAULT_LINE_STEP",
+           "check_target_count"]
