@@ -10,11 +10,16 @@ import importlib
 import inspect
 import pkgutil
 import re
+import sys
+from pathlib import Path
 
 from docutils import nodes
 from docutils.parsers.rst import Directive
 
 import snakehead
+
+sys.path.insert(0, str(Path(__file__).parent))  # this folder's helpers, imported next
+from layer_figure import LayersFigure, check_sections  # noqa: E402
 
 project = "snakehead"
 author = "the snakehead developers"
@@ -88,8 +93,6 @@ def write_api_pages(app) -> None:
     """One page per public module (``automodule`` with its members) and their index, under ``_api``. Written
     here, not by autosummary: some modules share their name with a function their package exports
     (``snakehead.sim.compare``), which autosummary's lookup by attribute would take for the function."""
-    from pathlib import Path
-
     folder = Path(app.srcdir) / API_DIR
     folder.mkdir(exist_ok=True)
     pages = {}
@@ -183,6 +186,8 @@ def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
 def setup(app):
     app.connect("autodoc-process-docstring", plain_text_to_rst)
     app.add_directive("snakehead-cli", CliHelp)
+    app.add_directive("snakehead-layers", LayersFigure)
+    app.connect("doctree-read", check_sections)
     app.connect("builder-inited", write_api_pages)
     app.connect("env-check-consistency", check_every_public_name)
     return {"parallel_read_safe": True}
