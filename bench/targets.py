@@ -92,7 +92,7 @@ def main() -> int:
     if args.generated is not None:
         from _robots import ROBOTS  # bench/_robots.py
 
-        from snakehead.kinematics.reachability import reachability_map as ws
+        from snakehead.kinematics import reachability as ws
 
         if args.generated not in ROBOTS:
             ap.error(f"--generated must be one of {', '.join(ROBOTS)}")

@@ -39,7 +39,7 @@ from snakehead import SnakeRobot, TracIK, default_robot_file
 from snakehead import sweep_defaults as defaults
 from snakehead.app.report import cpu_name
 from snakehead.kinematics import base_placement as bp
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 
 ROBOT_FILES = {"head": "snake16.toml", "head6": "snake16_head6.toml"}  # beside the default robot
 PAPER = {  # Table 2 and Section 2.2 of the paper

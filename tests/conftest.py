@@ -113,7 +113,7 @@ SMALL_MAP = dict(voxel=0.15, directions=6, rolls=2, cloud_samples=3000, seed=3, 
 def small_map():
     """The default robot's head map with SMALL_MAP's options, computed once per session."""
     from snakehead import SnakeRobot
-    from snakehead.kinematics.reachability import reachability_map as workspace
+    from snakehead.kinematics import reachability as workspace
 
     return workspace.compute(SnakeRobot.default(), progress=False, **SMALL_MAP)
 

@@ -17,7 +17,7 @@ import pytest
 import snakehead
 from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
 

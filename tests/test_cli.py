@@ -222,7 +222,7 @@ def test_plan_from_lying_straight_end_to_end(mujoco, tmp_path):  # --start runs 
 # workspace, help, bad arguments
 # ------------------------------------------------------------------------------------------------
 def test_workspace_writes_a_map(tmp_path):
-    from snakehead.kinematics.reachability import reachability_map as workspace
+    from snakehead.kinematics import reachability as workspace
 
     path = tmp_path / "map.npz"
     head6 = default_robot_file().with_name("snake16_head6.toml")

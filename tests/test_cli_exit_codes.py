@@ -168,7 +168,7 @@ def _interrupted(argv: list[str], work: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.parametrize("argv, work", [
-    (["workspace", "--voxel", "0.01", "--quiet"], "snakehead.kinematics.reachability.reachability_map.compute"),
+    (["workspace", "--voxel", "0.01", "--quiet"], "snakehead.kinematics.reachability.compute"),
     (["plan", "--position", "0.1", "0.5", "0.35", "--direction", "0", "1", "0", "--fast"],
      "snakehead.planning.planner.plan"),
     (["demo", "--fast"], "snakehead.planning.planner.plan"),

@@ -120,7 +120,7 @@ def test_bad_construction(robot, kwargs, message):
 
 
 def test_map_of_another_chain_is_rejected(robot):
-    from snakehead.kinematics.reachability import reachability_map as workspace
+    from snakehead.kinematics import reachability as workspace
 
     with pytest.raises(ValueError, match="another head chain"):
         HeadController(robot, workspace_map=workspace.map_for(head6_robot()))

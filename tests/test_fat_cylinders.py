@@ -14,7 +14,7 @@ import pytest
 
 import snakehead
 from snakehead.collision import body_collisions as coll
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.samples import published
 from snakehead.trajectory import cartesian
 from snakehead.planning import start_state, waypoints

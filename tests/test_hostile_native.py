@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from snakehead import Chain, TracIK, _core, default_urdf_path, limits
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 
 URDF = default_urdf_path()
 MAX_TIMEOUT_S = limits.MAX_TIMEOUT_S  # the core's (include/snakehead/limits.hpp)
@@ -182,7 +182,7 @@ def test_unbounded_or_blocking_paths_are_refused_at_once(tmp_path):
     assert r.returncode == 2 and "character device" in one_error_line(r.stderr)
     # compute(executor=...) reads the URDF for its workers with the same checks.
     with pytest.raises(ValueError, match="character device"):
-        ws._urdf_text(None, "/dev/zero")
+        ws.urdf_text(None, "/dev/zero")
 
 
 def test_urdfdom_messages_are_the_error_and_never_printed(capfd):

@@ -28,7 +28,7 @@ import snakehead
 from snakehead import SnakeRobot, default_urdf_path, sim
 from snakehead._files import atomic_open, write_text_atomic
 from snakehead.solve import neck as nk
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import read_robot_file, write_robot_file
 from snakehead.scenes import Scene, Target, load_scene
@@ -336,7 +336,7 @@ def test_a_zip_bomb_is_refused_before_it_is_unpacked(tmp_path, monkeypatch):
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("centers.npy", header.getvalue() + bytes(200_000_000))
     assert path.stat().st_size < 1_000_000
-    monkeypatch.setattr(ws, "MAX_MAP_BYTES", 64 << 20)
+    monkeypatch.setattr(ws.map_io, "MAX_MAP_BYTES", 64 << 20)
     with pytest.raises(ValueError, match="would unpack to 200000128 bytes, more than the 67108864 allowed"):
         ws.load(path)
     # a header that claims more than its member holds is refused before the array is allocated

@@ -34,7 +34,7 @@ def _check_against_sklearn(points: np.ndarray, k: int, seed: int) -> None:
 
 
 def test_the_default_maps_g0_is_scikit_learns() -> None:
-    from snakehead.kinematics.reachability import reachability_map as workspace
+    from snakehead.kinematics import reachability as workspace
     from snakehead.model.robot import SnakeRobot
 
     m = workspace.map_for(SnakeRobot.default(), progress=False)

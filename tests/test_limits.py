@@ -15,7 +15,7 @@ import snakehead
 from snakehead import _core, _validate, limits
 from snakehead import sweep_defaults as defaults
 from snakehead.app import cli
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.planning import whole_body_reach as rc
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -234,7 +234,7 @@ def test_the_mujoco_check_shows_its_errors_beside_the_plans(live):
 def test_a_snake_unlike_the_default_one(tmp_path):
     """13 joints from a pitch joint, 10 cm modules, a one-joint neck, parts named by link frames (a coarse map)."""
     import snakehead
-    from snakehead.kinematics.reachability import reachability_map as ws
+    from snakehead.kinematics import reachability as ws
     from snakehead.model.generate import SnakeSpec, snake_urdf
     from snakehead.model.robot_file import write_robot_file
 

@@ -20,7 +20,7 @@ from snakehead.app import cli
 from snakehead.app.robot_check import map_summary
 from snakehead.kinematics import base_placement as bp
 from snakehead.kinematics.reachability import map_queries as mq
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.robot_file import write_robot_file
 from conftest import SMALL_MAP, head6_robot
 
@@ -151,7 +151,7 @@ def test_a_map_of_another_head_is_refused_everywhere(robot, files, tmp_path, cap
 def _first(m, k):
     """The map with its first k voxels only (a whole map of too few voxels)."""
     return dataclasses.replace(m, centers=m.centers[:k], solved=m.solved[:k], voxel_ids=m.voxel_ids[:k],
-                               reached=m.reached[:k], hull_voxels=k, _cache={})
+                               reached=m.reached[:k], hull_voxels=k, cache={})
 
 
 def test_a_map_without_enough_voxels_is_refused_with_its_reason(robot, whole):

@@ -10,7 +10,7 @@ from snakehead import SnakeRobot, TracIK
 from snakehead.backbone.initial import initial_configuration
 from snakehead.kinematics import base_placement as bp
 from snakehead.kinematics.reachability import map_queries as mq
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import write_robot_file
 

@@ -17,7 +17,7 @@ import pytest
 
 import snakehead as sh
 from snakehead.app import cli
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.samples import published
 from snakehead.planning.plan_many import plan_many
 from snakehead.samples.targets import reachable_targets

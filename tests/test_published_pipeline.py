@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.samples import published
 
 from snakehead.samples.targets import reachable_targets

@@ -6,7 +6,7 @@ import pytest
 
 import snakehead as sh
 from snakehead.app import cli
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.planning import whole_body_reach as reach
 
 from conftest import plan_agrees

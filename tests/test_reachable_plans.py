@@ -171,7 +171,7 @@ def base_only_margin(robot, q, base):
 def generated():
     """A generated snake unlike the default: 13 joints starting with a pitch joint, 10 cm modules, 6 cm section,
     parts named by link frames (the base ends at a real link, not a marker), a 1-joint neck, a 6-DOF head."""
-    from snakehead.kinematics.reachability import reachability_map as ws
+    from snakehead.kinematics import reachability as ws
     from snakehead.model.generate import SnakeSpec, snake_urdf
 
     spec = SnakeSpec(n_joints=13, module_length=0.1, section=0.06, mass_per_module=0.3, first_axis="pitch",

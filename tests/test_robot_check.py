@@ -81,7 +81,7 @@ def test_no_relocation_on_the_command_line(tmp_path: Path) -> None:
 def test_a_map_without_a_dexterous_band_says_why_and_what_to_do(tmp_path: Path) -> None:
     """A 5-DOF head mapped with rolls reaches none of its rolled frames: the summary and the controller say free
     roll is needed; the workspace command's header says which directions it sweeps."""
-    from snakehead.kinematics.reachability import reachability_map as ws
+    from snakehead.kinematics import reachability as ws
 
     spec = SnakeSpec(n_joints=12, markers={"p0": 5, "b0": 7}, tip_name="tip", name="head5")
     robot = snakehead.SnakeRobot.from_urdf(snake_urdf(spec), base_end="p0", neck_end="b0", head_tip="tip")

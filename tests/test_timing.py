@@ -11,7 +11,7 @@ import snakehead
 from snakehead.dynamics import stability
 from snakehead.dynamics.inverse_dynamics import inverse_dynamics
 from snakehead.collision import body_collisions as coll
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.planning import start_state
 from snakehead.retiming import timing

@@ -10,7 +10,7 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead.solve import whole_body as wb
 from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead._errors import InputTypeError
 

@@ -13,7 +13,7 @@ import pytest
 
 from snakehead import Chain, SnakeRobot, default_robot_file
 from snakehead import sweep_defaults
-from snakehead.kinematics.reachability import reachability_map as ws
+from snakehead.kinematics import reachability as ws
 from snakehead._errors import InputError, InputTypeError
 from conftest import SMALL_MAP, head6_robot
 
@@ -467,8 +467,8 @@ def test_sweep_releases_the_gil(robot):
     ticks = [0]
     seen = []
     done = threading.Event()
-    o = ws._options(**{**SMALL, "voxel": 0.1}, any_roll=True, free_roll=False, approach_axis="x", epsilon=1e-5,
-                    threads=1, shard=None)
+    o = ws.core_options(**{**SMALL, "voxel": 0.1}, any_roll=True, free_roll=False, approach_axis="x", epsilon=1e-5,
+                        threads=1, shard=None)
 
     def run():
         _core.compute_reachability(robot.head_chain.model, o, lambda d, t: seen.append(ticks[0]) or True)

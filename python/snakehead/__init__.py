@@ -28,8 +28,8 @@ from .threads import core_threads, set_core_threads
 from .geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .kinematics.ik import TracIK
 from .kinematics.reachability.reachability_map import ReachabilityMap
-from .kinematics.reachability.reachability_map import compute as compute_map
-from .kinematics.reachability.reachability_map import load as load_map
+from .kinematics.reachability import compute as compute_map
+from .kinematics.reachability import load as load_map
 from .model.chain import Chain
 from .model.robot import BasePlacement, RobotParts, SnakeRobot, default_robot_file, default_urdf_path
 from .planning.plan_many import PlanError, plan_many

@@ -1,4 +1,4 @@
-"""The one way work is spread over an executor: maps (``kinematics.reachability.reachability_map.compute``), many plans
+"""The one way work is spread over an executor: maps (``kinematics.reachability.compute``), many plans
 (``planning.plan_many``) and the whole body's reach (``planning.whole_body_reach``).
 
 An executor is any ``concurrent.futures.Executor`` (a thread or process pool, Dask's ``client.get_executor()``) or a

@@ -27,7 +27,7 @@ MOVED_MODULES: dict[str, str] = {
     "snakehead.control.whole_body": "snakehead.solve.whole_body",
     "snakehead.control.initial_state": "snakehead.solve.initial_state",
     "snakehead.motion.reach_bounds": "snakehead.solve.pose_bounds",
-    "snakehead.kinematics.workspace": "snakehead.kinematics.reachability.reachability_map",
+    "snakehead.kinematics.workspace": "snakehead.kinematics.reachability",
     "snakehead.kinematics.map_queries": "snakehead.kinematics.reachability.map_queries",
     "snakehead.kinematics.kmeans": "snakehead.kinematics.reachability.kmeans",
     "snakehead.motion.interpolation": "snakehead.trajectory.interpolation",

@@ -1,8 +1,8 @@
 """The defaults of the robot's sweeps, defined once for the API, the command line and the docs.
 
-* A head map (Algorithm 1: ``snakehead workspace``, :func:`snakehead.kinematics.reachability.reachability_map.compute`): the C++ core's
+* A head map (Algorithm 1: ``snakehead workspace``, :func:`snakehead.kinematics.reachability.sweep.compute`): the C++ core's
   ``WorkspaceOptions`` (``include/snakehead/workspace.hpp``), which ``workspace_gen`` uses too, read from the core;
-  and how :func:`~snakehead.kinematics.reachability.reachability_map.default_map_options` scales the voxel to a head that has no map.
+  and how :func:`~snakehead.kinematics.reachability.map_cache.default_map_options` scales the voxel to a head that has no map.
 * A whole-body stable reachability map (``snakehead reach``, :func:`snakehead.planning.whole_body_reach.compute_reach`).
 """
 from __future__ import annotations

@@ -115,8 +115,8 @@ def _bounded_int(least: int, most: int) -> Callable[[str], int]:
 
 
 def _shard(text: str) -> str:
-    """An argument type: i/N with 0 <= i < N <= the most shards a map has (kinematics.reachability.reachability_map.MAX_SHARDS)."""
-    from ..kinematics.reachability.reachability_map import parse_shard
+    """An argument type: i/N with 0 <= i < N <= the most shards a map has (kinematics.reachability.MAX_SHARDS)."""
+    from ..kinematics.reachability import parse_shard
 
     try:
         parse_shard(text)
@@ -160,7 +160,7 @@ def _robot(args: argparse.Namespace) -> SnakeRobot:
 def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
     """The map given with --map, else None (the pipeline finds one): InputError unless a whole map (not a shard) of
     the robot's head with the voxels its dexterous centre G0 needs (the controller's check, made before any work)."""
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
 
     if args.map is None:
         return None
@@ -293,7 +293,7 @@ def _plan(args: argparse.Namespace) -> int:
 # workspace
 # ----------------------------------------------------------------------------------------------
 def _workspace(args: argparse.Namespace) -> int:
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
 
     out = Path(args.out)
     if out.suffix != ".npz":
@@ -399,7 +399,7 @@ def _reach_executor(args: argparse.Namespace) -> tuple[Any, Any]:
 
 def _merge_shards(args: argparse.Namespace, out: Path) -> int:
     """workspace --merge: the shards' files merged into --out (the one place shards are read as they are)."""
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
 
     given = [name for name, value in (("--shard", args.shard), ("--voxel", args.voxel)) if value is not None]
     if given:
@@ -419,7 +419,7 @@ def _merge_shards(args: argparse.Namespace, out: Path) -> int:
 # view
 # ----------------------------------------------------------------------------------------------
 def _view(args: argparse.Namespace) -> int:
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
     from ..viz import viewer
 
     if args.live:
@@ -605,12 +605,12 @@ def _add_plan(sub: Any) -> None:
 def _add_workspace(sub: Any) -> None:
     """snakehead workspace: a head's reachability map (Algorithm 1)."""
     from .. import sweep_defaults as defaults
-    from ..kinematics.reachability import reachability_map as ws
+    from ..kinematics import reachability as ws
 
     p = sub.add_parser("workspace", help="compute a reachability map of a robot's head (Algorithm 1)",
                        description="Compute the reachability map of a robot's head (neck_end -> head_tip; default "
                                    "robot: its 7-DOF head; the 6-DOF variant is the robot file snake16_head6.toml "
-                                   "beside the default one) with snakehead.kinematics.reachability.reachability_map.compute and save it "
+                                   "beside the default one) with snakehead.kinematics.reachability.compute and save it "
                                    "as .npz. For shards over many machines or without Python, use the workspace_gen "
                                    "executable installed with the package (workspace_gen --help).")
     p.add_argument("--out", required=True, metavar="MAP.npz", help="output file (.npz)")

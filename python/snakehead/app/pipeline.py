@@ -579,7 +579,7 @@ def _cores() -> int:
 
 def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress: Progress) -> ReachabilityMap:
     """``workspace_map``, else the robot's head map (cached, or computed and cached)."""
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
 
     if workspace_map is not None:
         return workspace_map

@@ -142,7 +142,7 @@ def suggest_split(robot: SnakeRobot) -> tuple[str, SnakeRobot] | None:
 
 def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
     """A line about the head's map (the robot file's, if any) and a problem with it (None when there is none)."""
-    from ..kinematics.reachability import reachability_map as workspace
+    from ..kinematics import reachability as workspace
 
     if robot.map_path is None:
         return "none (plan computes one and caches it)", None

@@ -19,18 +19,16 @@ So any robot whose model gives B0 for a neck configuration works here; nothing e
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
 from .._errors import InputError
 from .._validate import joint_vector, position_direction_pairs
+from ..backbone.initial import initial_configuration
+from ..model.robot import BasePlacement, SnakeRobot
 from .reachability.map_queries import direction_bits
-
-if TYPE_CHECKING:
-    from ..model.robot import BasePlacement, SnakeRobot
-    from .reachability.reachability_map import ReachabilityMap
+from .reachability.reachability_map import ReachabilityMap, require_map
 
 
 @dataclass
@@ -50,8 +48,6 @@ class PlacementCandidates:
 
     def placements(self) -> list[BasePlacement]:
         """The candidates as :class:`~snakehead.model.robot.BasePlacement` objects."""
-        from ..model.robot import BasePlacement
-
         return [BasePlacement(float(a), float(b), float(c)) for a, b, c in zip(self.x, self.y, self.yaw)]
 
 
@@ -62,13 +58,9 @@ def neck_frames(robot: SnakeRobot, base_configuration: npt.ArrayLike | None = No
 
     base_configuration: the whole-body joints whose base part is kept (default: ``backbone.initial_configuration``).
     The one function of inverse reachability that asks the robot model anything."""
-    from ..model.robot import BasePlacement
-
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise InputError(f"samples must be a positive integer, got {samples!r}")
     if base_configuration is None:
-        from ..backbone.initial import initial_configuration
-
         base_configuration = initial_configuration(robot)
     q0 = joint_vector(base_configuration, robot.n_joints, "base_configuration")
     neck = robot.parts.neck
@@ -91,8 +83,6 @@ def placements_from_frames(workspace_map: ReachabilityMap, frames: npt.ArrayLike
     k, and the map voxels whose sphere point in direction k lies within half a voxel of the height plane of the
     target; the target position seen from B0 is that point moved onto the plane, which fixes x, y. Kept: the
     best voxel per (frame, yaw) when its index is at least ``min_index``; returned: the ``limit`` best."""
-    from .reachability.reachability_map import require_map
-
     m = require_map(workspace_map, needs=("poses",), what="workspace_map")  # whole, with per-direction results
     p, d, single = position_direction_pairs(position, direction)
     if not single:
@@ -159,8 +149,6 @@ def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position:
     The base keeps the base joints of ``base_configuration`` (default: the initial configuration); the neck
     joints take ``neck_samples`` values each; yaws are sampled every 360 / ``yaw_samples`` degrees. See the
     module's doc. The result says, for each placement, the neck joints and the target as seen from B0."""
-    from .reachability.reachability_map import require_map
-
     require_map(workspace_map, robot, needs=("poses",), what="workspace_map")  # also: a map of this robot's head
     frames, neck_q = neck_frames(robot, base_configuration, neck_samples)
     return placements_from_frames(workspace_map, frames, neck_q, position, direction, yaw_samples=yaw_samples,

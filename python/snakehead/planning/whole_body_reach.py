@@ -41,7 +41,7 @@ from .. import _core, limits
 from .. import sweep_defaults as defaults
 from .._errors import InputError, InputTypeError
 from .._executors import as_executor, run_tasks, worker_count
-from ..kinematics.reachability import reachability_map as ws
+from ..kinematics import reachability as ws
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Target
 from .plan_many import WORKERS, RobotRecipe, plan_many
@@ -104,8 +104,8 @@ def check_options(robot: Any, voxel: Any = defaults.REACH_VOXEL_M,
     """``voxel`` (m) and ``directions`` checked (InputError naming the option) before any work; returns them."""
     if not isinstance(robot, SnakeRobot):
         raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
-    voxel = ws._real("voxel", voxel)
-    directions = ws._count("directions", directions, 1, MAX_DIRECTIONS)
+    voxel = ws.checked_real("voxel", voxel)
+    directions = ws.checked_count("directions", directions, 1, MAX_DIRECTIONS)
     side = 2.0 * robot.body_length
     if not (math.isfinite(voxel) and MIN_VOXEL_M <= voxel <= side / ws.MIN_VOXELS_PER_AXIS):
         raise InputError(f"voxel must be within [{MIN_VOXEL_M:g}, {side / ws.MIN_VOXELS_PER_AXIS:.4g}] m (at least "
@@ -389,7 +389,7 @@ def check_reach(m: ws.ReachabilityMap, robot: SnakeRobot, count: int, *, seed: i
     """Plan ``count`` sampled (voxel, direction) poses of the whole-body map ``m`` with :func:`snakehead.plan` (half
     among those the map reaches, half among the others, as far as there are) and compare."""
     m = ws.require_map(m, robot, needs=("poses",), kind=ws.KIND_WHOLE_BODY, what="the reach map")
-    count = ws._count("count", count, 1, 100_000)
+    count = ws.checked_count("count", count, 1, 100_000)
     bits = m.reached_units()
     rng = np.random.default_rng(seed)
     yes, no = np.argwhere(bits), np.argwhere(~bits)

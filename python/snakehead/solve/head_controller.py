@@ -67,7 +67,7 @@ class HeadController:
     """Segmented head control on a snake robot.
 
     robot: the robot (default: the shipped 16-joint snake). workspace_map: the head's reachability map, whose
-    dexterous centre G0 places the head's base (default: ``kinematics.reachability.reachability_map.map_for(robot)``: the robot
+    dexterous centre G0 places the head's base (default: ``kinematics.reachability.map_for(robot)``: the robot
     file's map, else a cached one, else one computed now with a progress bar). The dexterous workspace is the
     map's voxels of index 100 or, for a head that reaches 100 nowhere enough, its best band
     (``dexterous_threshold``, said in ``dexterous_note``).
@@ -81,7 +81,7 @@ class HeadController:
                  base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
                  timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
                  base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
-        from ..kinematics.reachability import reachability_map as workspace
+        from ..kinematics import reachability as workspace
 
         self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):

@@ -19,16 +19,13 @@ Everything is numpy; the map's frame is the chain's base frame. Placing a robot'
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
 from ..._errors import InputError
 from ..._validate import finite_float, position_direction_pairs as _poses
-
-if TYPE_CHECKING:
-    from .reachability_map import ReachabilityMap
+from .reachability_map import KIND_HEAD, ReachabilityMap, require_map
 
 #: Directions blended by :func:`reachability`.
 BLENDED_DIRECTIONS = 3
@@ -38,8 +35,6 @@ def _usable(m: ReachabilityMap, any_kind: bool = False) -> ReachabilityMap:
     """The map if pose queries can be asked of it: a whole map (a shard would answer False for its other shards'
     voxels) with per-direction results along the head's x-axis, a head map unless ``any_kind`` (whether a pose is
     reachable is asked of a whole-body map too); InputError otherwise (the one check of maps)."""
-    from .reachability_map import KIND_HEAD, ReachabilityMap, require_map
-
     kind = m.kind if any_kind and isinstance(m, ReachabilityMap) else KIND_HEAD
     return require_map(m, needs=("poses",), kind=kind)
 
@@ -48,26 +43,26 @@ def direction_bits(m: ReachabilityMap) -> np.ndarray:
     """(M, N) bool: direction k of voxel v was reached with some roll (its units OR-ed over the rolls when
     every roll counted on its own). Cached on the map."""
     _usable(m, any_kind=True)
-    if "direction_bits" not in m._cache:
+    if "direction_bits" not in m.cache:
         units = m.reached_units()
         n = int(m.params["directions"])
         if units.shape[1] != n:  # each roll counted: units are (direction, roll) frames, direction-major
             units = np.asarray(units.reshape(len(m), n, -1).any(axis=2))
-        m._cache["direction_bits"] = units
-    return m._cache["direction_bits"]
+        m.cache["direction_bits"] = units
+    return m.cache["direction_bits"]
 
 
 def _table(m: ReachabilityMap) -> np.ndarray:
     """The direction bits of every grid voxel, in a dense flat table over the grid padded by one voxel on each
     side (False there and outside the map's voxels): a lookup is one array access (cached on the map)."""
-    if "table" not in m._cache:
+    if "table" not in m.cache:
         n = int(m.grid_shape[0])
         bits = direction_bits(m)
         table = np.zeros((n + 2, n + 2, n + 2, bits.shape[1]), dtype=bool)
         i, j, l = m.voxel_ids // (n * n), (m.voxel_ids // n) % n, m.voxel_ids % n
         table[i + 1, j + 1, l + 1] = bits
-        m._cache["table"] = table.reshape(-1)
-    return m._cache["table"]
+        m.cache["table"] = table.reshape(-1)
+    return m.cache["table"]
 
 
 #: Cells per cube face edge, and candidate directions per cell, of the directions' lookup table.
@@ -94,7 +89,7 @@ def _direction_candidates(m: ReachabilityMap) -> np.ndarray:
     """(6 * cells^2, C): for each cube-map cell, the map's directions nearest its centre (cached on the map). A
     cell spans under 3 degrees; the map's directions are tens of degrees apart, so the few nearest to any
     direction in the cell are among them."""
-    if "candidates" not in m._cache:
+    if "candidates" not in m.cache:
         dirs = m.sphere_directions
         g = (np.arange(_CUBE_CELLS) + 0.5) / _CUBE_CELLS * 2.0 - 1.0
         u, v = np.meshgrid(g, g, indexing="ij")
@@ -110,8 +105,8 @@ def _direction_candidates(m: ReachabilityMap) -> np.ndarray:
         # the cosines written out, not a BLAS product (whose kernel rounds them), and ties kept in direction order
         # (the default sort orders them by the CPU's vector extensions): the same candidates on any machine
         cos = centres[:, :1] * dirs[:, 0] + centres[:, 1:2] * dirs[:, 1] + centres[:, 2:] * dirs[:, 2]
-        m._cache["candidates"] = np.argsort(-cos, axis=1, kind="stable")[:, :keep]
-    return m._cache["candidates"]
+        m.cache["candidates"] = np.argsort(-cos, axis=1, kind="stable")[:, :keep]
+    return m.cache["candidates"]
 
 
 def _padded(m: ReachabilityMap, ijk: np.ndarray) -> np.ndarray:
