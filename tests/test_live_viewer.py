@@ -288,7 +288,7 @@ def wait_in_page(driver, number: int, timeout: float = 60.0) -> dict:
 
 def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
     from test_viewer import _chromium, _hue_mask, _screenshot  # the browser as tests/test_viewer.py drives it
-    from snakehead.viz.viewer import _rgb
+    from snakehead.viz.viewer import rgb255
 
     driver = _chromium()
     try:
@@ -302,7 +302,7 @@ def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
         blue = 0
         for _ in range(60):  # the robot appears once the scene has arrived over the websocket and faded in
             time.sleep(1.0)
-            blue = _hue_mask(_screenshot(driver), _rgb("#2e86c1")).sum()  # the head's blue
+            blue = _hue_mask(_screenshot(driver), rgb255("#2e86c1")).sum()  # the head's blue
             if blue > 300:
                 break
         assert blue > 300

@@ -521,7 +521,7 @@ def test_the_viewer_shows_names_as_text(robot, motion, plain_page, name, tmp_pat
     folder = tmp_path_factory.mktemp("viewer")
     back = viewer.load_viewer_scene(viewer.save_viewer_scene(data, folder / "x_viewer.npz"))
     assert back.title == name and back.target_names.tolist() == [name] and back.name == scene.name
-    assert "/" not in viewer._node_name(name)
+    assert "/" not in viewer.node_name(name)
 
 
 def test_a_viewer_scene_file_with_a_control_character_is_refused(robot, motion, tmp_path):

@@ -324,7 +324,7 @@ def _pixels_served(browser, args: list, rgb, enough: int, tolerance_deg: float =
 
 def test_snakehead_view_serves_the_folder(browser, planned):
     """``snakehead view DIR`` serves the scenes of a plan's folder; the page shows the robot."""
-    blue, _ = _pixels_served(browser, [str(planned)], viewer._rgb("#2e86c1"), 300)  # the head's blue
+    blue, _ = _pixels_served(browser, [str(planned)], viewer.rgb255("#2e86c1"), 300)  # the head's blue
     assert blue > 300
 
 

@@ -1,6 +1,6 @@
 """The live viewer (``snakehead view --live``): drag the head's targets in a web browser and the plan follows.
 
-What it shows (viser; drawn with :mod:`.viewer`'s pieces): the robot's collision shapes, first in its initial state,
+What it shows (viser; drawn with :mod:`.viewer_nodes`' pieces): the robot's collision shapes, first in its initial state,
 then playing the plan of the current targets; each target as a gizmo (drag its arrows or planes to move it, its
 rings to turn it: its x-axis, the red arrow, is the head's direction) with its name; the scene's obstacles; the
 current plan's support polygon at its start, the ZMP's trace and the ZMP now, and the head tip's path. The panel:
@@ -32,6 +32,7 @@ The Python API (what tests and benchmarks drive, without a mouse): :class:`LiveV
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import logging
 import os
 import sys
@@ -46,20 +47,23 @@ import numpy.typing as npt
 
 from .._errors import InputError, InputTypeError
 from .._validate import unit_vector3, world_position
-from ..scenes.scene import Scene, Target
-from . import viewer as vw
+from ..model.robot import SnakeRobot
+from ..planning.planner import plan
+from ..scenes.scene import Scene, Target, save_scene, scene_to_toml
+from ..sim.simulate_plan import simulate
+from ..solve.head_controller import HeadController
 from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, gizmo_pose, live_motion
 from .live_panel import MOTION_WATCH_JS, ClientPanel, ClientPanels, DynamicsCheck, Replan, errors_text, shown_text
 from .save_folder import SaveFolder
 from .server_guard import ServerGuard, guarded_server
+from .viewer_arrays import FRAME_STEP_S, camera_for, obstacle_arrays
+from .viewer_nodes import add_ground, add_obstacles, camera_to
 
 __all__ = ["LiveViewer", "Replan", "DynamicsCheck", "MOTION_WATCH_JS", "MAX_TARGETS", "MAX_MOTION_S", "SPEEDS"]
 
 LOG = logging.getLogger("snakehead.viz.server")
 
 if TYPE_CHECKING:
-    from ..solve.head_controller import HeadController
-    from ..model.robot import SnakeRobot
     from ..planning.plan_result import Plan
 
 #: s between two steps of the player (30 per second).
@@ -108,7 +112,7 @@ class LiveViewer:
 
     def __init__(self, scene: Scene | None = None, *, robot: SnakeRobot | None = None,
                  robot_file: str | os.PathLike | None = None, controller: HeadController | None = None,
-                 host: str = "127.0.0.1", port: int = 8080, frame_step_s: float = vw.FRAME_STEP_S,
+                 host: str = "127.0.0.1", port: int = 8080, frame_step_s: float = FRAME_STEP_S,
                  save_dir: str | os.PathLike | None = None, allow_hosts: tuple[str, ...] | list[str] = ()) -> None:
         if scene is not None and not isinstance(scene, Scene):
             raise InputTypeError(f"scene must be a Scene (snakehead.load_scene), got {type(scene).__name__}")
@@ -267,16 +271,12 @@ class LiveViewer:
     def save_scene(self, path: str | os.PathLike) -> Path:
         """Write the current targets and the scene's obstacles as a scene file (TOML) at ``path``; the path. (The
         caller's own path, trusted: the page saves through :meth:`save_named`.)"""
-        from ..scenes.scene import save_scene
-
         return save_scene(self.scene(), path)
 
     def save_named(self, name: str) -> str:
         """Save the scene as the page's "save scene" does: as the bare file ``name`` (``.toml`` added) in the save
         folder, never over a file this session did not write (:class:`.save_folder.SaveFolder`); the bare name.
         InputError, in words a browser may be shown, if not saved."""
-        from ..scenes.scene import scene_to_toml
-
         return self.saves.write(name, scene_to_toml(self.scene(), self.saves.folder))
 
     def close(self) -> None:
@@ -357,8 +357,6 @@ class LiveViewer:
             self._replan(record, scene)
 
     def _replan(self, record: Replan, scene: Scene) -> None:
-        from ..planning.planner import plan
-
         self._say(f"Planning request {record.number} ({record.what}) ...")
         record.plan_started = time.time()
         try:
@@ -470,16 +468,12 @@ class LiveViewer:
             self._nodes.show(self._motion, self._motion.frame_at(self._t))
 
     def _run_check(self, motion: LiveMotion) -> None:
-        import importlib.util
-
         self._errors.content = errors_text(motion, None) + "\n\nMuJoCo: simulating ..."
         started = time.perf_counter()
         check = DynamicsCheck(motion.number)
         try:
             if importlib.util.find_spec("mujoco") is None:
                 raise InputError("MuJoCo is not installed (pip install snakehead[sim])")
-            from ..sim.simulate_plan import simulate
-
             check.simulation = simulate(motion.plan)
         except Exception as exc:  # noqa: BLE001 -- shown in the panel; the viewer keeps serving
             if not isinstance(exc, InputError):
@@ -513,16 +507,16 @@ class LiveViewer:
         s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
                                intensity=FILL_LIGHT)
         self._nodes = MotionNodes(s, self.robot, self.controller.q_initial, self.controller.base)
-        arrays = vw.obstacle_arrays(self._scene.obstacles)
-        vw.add_obstacles(s, f"{ROOT}/obstacles", **arrays)
+        arrays = obstacle_arrays(self._scene.obstacles)
+        add_obstacles(s, f"{ROOT}/obstacles", **arrays)
         self._gizmos = TargetGizmos(s, GIZMO_SHARE * self.robot.body_length, self._released)
         for target in self._targets:
             self._gizmos.add(target)
         shown = [self._nodes.start_positions, np.array([t.position for t in self._targets]),
                  arrays["obstacle_centres"], arrays["wall_vertices"], np.zeros((1, 3))]
         lo, hi = np.vstack(shown).min(axis=0), np.vstack(shown).max(axis=0)
-        vw.add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
-        vw.camera_to(self.server.initial_camera, *vw.camera_for(lo - 0.05, hi + 0.05))
+        add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
+        camera_to(self.server.initial_camera, *camera_for(lo - 0.05, hi + 0.05))
 
     def _panel(self) -> None:
         """The shared panel; each browser's own part is added when it connects (:meth:`_client_panel`)."""
@@ -580,9 +574,6 @@ class LiveViewer:
 def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str | os.PathLike | None,
                 controller: HeadController | None) -> HeadController:
     """The controller the viewer plans with (see :class:`LiveViewer`)."""
-    from ..solve.head_controller import HeadController
-    from ..model.robot import SnakeRobot
-
     if controller is not None:
         if not isinstance(controller, HeadController):
             raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")

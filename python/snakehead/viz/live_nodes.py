@@ -2,10 +2,10 @@
 
 * :class:`LiveMotion` / :func:`live_motion`: a plan's frames (the robot's shapes every ``frame_step_s`` of motion,
   the ZMP), its head tip's path and ZMP's trace, its support polygon at the start;
-* :class:`MotionNodes`: the viser nodes that play it -- the robot (:class:`.viewer.RobotNodes`), the ZMP, and
+* :class:`MotionNodes`: the viser nodes that play it -- the robot (:class:`.viewer_nodes.RobotNodes`), the ZMP, and
   paths of a fixed number of segments, so that a new plan moves the points of nodes that exist and rebuilds none;
 * :class:`TargetGizmos`: the targets as transform gizmos (the x-axis the head's direction) with their arrows and
-  names (:func:`.viewer.add_target_marker`), and the release of a gizmo as a callback.
+  names (:func:`.viewer_nodes.add_target_marker`), and the release of a gizmo as a callback.
 """
 from __future__ import annotations
 
@@ -16,8 +16,11 @@ import numpy as np
 import numpy.typing as npt
 
 from .._errors import InputError
+from ..dynamics.stability import support_polygon
 from ..scenes.scene import Target
-from . import viewer as vw
+from ..solve.head import frame_along
+from .viewer_arrays import FRAME_STEP_S, frame_indices, quaternions_wxyz, robot_meshes, shape_colors, shape_poses
+from .viewer_nodes import POLYGON_RGB, TIP_PATH_RGB, ZMP_RGB, RobotNodes, add_target_marker
 
 if TYPE_CHECKING:
     import viser
@@ -58,15 +61,13 @@ class LiveMotion:
         return int(np.clip(np.searchsorted(self.times, t + 1e-9, side="right") - 1, 0, len(self.times) - 1))
 
 
-def live_motion(number: int, plan: Plan, origins: np.ndarray, frame_step_s: float = vw.FRAME_STEP_S) -> LiveMotion:
+def live_motion(number: int, plan: Plan, origins: np.ndarray, frame_step_s: float = FRAME_STEP_S) -> LiveMotion:
     """The frames of ``plan`` the live viewer plays (``origins``: the shapes' frames in their links,
-    :func:`.viewer.robot_meshes`)."""
-    from ..dynamics.stability import support_polygon
-
+    :func:`.viewer_arrays.robot_meshes`)."""
     robot, t = plan.robot, np.asarray(plan.t, float)
-    idx = vw.frame_indices(t, frame_step_s)
+    idx = frame_indices(t, frame_step_s)
     frames = robot.frames_many(plan.q[idx], plan.base)
-    positions, wxyz = vw.shape_poses(robot, frames, origins)
+    positions, wxyz = shape_poses(robot, frames, origins)
     path = np.linspace(0, len(t) - 1, PATH_SEGMENTS + 1).round().astype(int)
     tip = robot.frames_many(plan.q[path], plan.base)[:, robot.link_index(robot.parts.head_tip), :3, 3]
     zmp = np.asarray(plan.stability.zmp, float)
@@ -103,10 +104,8 @@ def _closed_edges(polygon: np.ndarray, n: int) -> np.ndarray:
 def wxyz_along(direction: npt.ArrayLike) -> np.ndarray:
     """A quaternion (w, x, y, z) of the head's frame for ``direction`` (3,): x along it, z as near the world's up as
     can be (:func:`snakehead.solve.head.frame_along`, the frame the planner aims the head at)."""
-    from ..solve.head import frame_along
-
     x = np.asarray(direction, float) / np.linalg.norm(direction)
-    return vw._wxyz(frame_along(np.zeros(3), x)[:3, :3][None])[0]
+    return quaternions_wxyz(frame_along(np.zeros(3), x)[:3, :3][None])[0]
 
 
 def x_axis(wxyz: npt.ArrayLike) -> np.ndarray:
@@ -144,7 +143,7 @@ class TargetGizmos:
         node = f"{ROOT}/targets/{self._made}"
         handle = self.scene.add_transform_controls(node, scale=self.size, position=target.position,
                                                    wxyz=wxyz_along(target.direction), depth_test=False)
-        vw.add_target_marker(self.scene, node, target.name, np.zeros(3), np.array([1.0, 0.0, 0.0]))
+        add_target_marker(self.scene, node, target.name, np.zeros(3), np.array([1.0, 0.0, 0.0]))
         handle.on_update(self._released)
         self.handles.append(handle)
 
@@ -169,22 +168,22 @@ class TargetGizmos:
 # the motion's nodes
 # ----------------------------------------------------------------------------------------------
 class MotionNodes:
-    """What moves with the plan: the robot (its shapes, :class:`.viewer.RobotNodes`), the ZMP now, and per plan the
+    """What moves with the plan: the robot (its shapes, :class:`.viewer_nodes.RobotNodes`), the ZMP now, and per plan the
     head tip's path, the ZMP's trace and the support polygon (segment nodes of fixed size, their points moved)."""
 
     def __init__(self, scene_api: viser.SceneApi, robot: SnakeRobot, q: np.ndarray, base: BasePlacement) -> None:
-        meshes = vw.robot_meshes(robot)
+        meshes = robot_meshes(robot)
         self.origins = meshes.pop("origins")
-        positions, wxyz = vw.shape_poses(robot, robot.frames(q, base)[None], self.origins)
+        positions, wxyz = shape_poses(robot, robot.frames(q, base)[None], self.origins)
         self.start_positions = positions[0]
         s = scene_api
-        self.robot = vw.RobotNodes(s, f"{ROOT}/robot", meshes, vw.shape_colors(robot), positions[0], wxyz[0])
+        self.robot = RobotNodes(s, f"{ROOT}/robot", meshes, shape_colors(robot), positions[0], wxyz[0])
         nothing = np.zeros((PATH_SEGMENTS, 2, 3))
-        self.tip_path = s.add_line_segments(f"{ROOT}/head tip path", nothing, vw.TIP_PATH_RGB, thickness=0.002)
-        self.zmp_path = s.add_line_segments(f"{ROOT}/ZMP path", nothing, vw.ZMP_RGB, thickness=0.002)
+        self.tip_path = s.add_line_segments(f"{ROOT}/head tip path", nothing, TIP_PATH_RGB, thickness=0.002)
+        self.zmp_path = s.add_line_segments(f"{ROOT}/ZMP path", nothing, ZMP_RGB, thickness=0.002)
         self.polygon = s.add_line_segments(f"{ROOT}/support polygon", np.zeros((POLYGON_EDGES, 2, 3)),
-                                           vw.POLYGON_RGB, thickness=0.004)
-        self.zmp = s.add_icosphere(f"{ROOT}/ZMP", radius=0.008, color=vw.ZMP_RGB, cast_shadow=False, visible=False)
+                                           POLYGON_RGB, thickness=0.004)
+        self.zmp = s.add_icosphere(f"{ROOT}/ZMP", radius=0.008, color=ZMP_RGB, cast_shadow=False, visible=False)
         self.frame = -1
 
     def start(self, motion: LiveMotion) -> None:
