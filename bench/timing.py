@@ -28,7 +28,7 @@ import numpy as np
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.retiming import timing
+from snakehead.retiming import gridpoints, timing
 from snakehead.scenes import paper_scene
 
 #: The paper's Section 4: durations (s) and simulated head errors (mm, deg).
@@ -81,7 +81,7 @@ def run(name: str, sc: dict, *, simulate: bool, **limits) -> dict:
 
 
 class SolveClock:
-    """Wraps a grid solver (timing._solve_grid's signature): the run time and gridpoints of each call."""
+    """Wraps a grid solver (gridpoints.solve_grid's signature): the run time and gridpoints of each call."""
 
     def __init__(self, solve: Callable) -> None:
         self.solve, self.times, self.points = solve, [], []
@@ -104,7 +104,7 @@ def solver_rows(name: str, sc: dict, repeats: int) -> list[str]:
     plan = sc["plan"]
     holds, stops = np.diff(sc["times"]), [k for k, _, _ in sc["targets"]]
     rows = []
-    for solver, solve in (("toppra", toppra_solve_grid), ("core", timing._solve_grid)):
+    for solver, solve in (("toppra", toppra_solve_grid), ("core", gridpoints.solve_grid)):
         best: dict = {}
         for _ in range(repeats):  # the fastest of the repeats (the machine is shared)
             clock_ = SolveClock(solve)

@@ -39,7 +39,7 @@ def test_gravity_and_the_margins_are_defined_once():
 
 def test_the_users_read_the_one_definition():
     from snakehead.solve import whole_body
-    from snakehead.retiming import timing
+    from snakehead.retiming import stability_constraint, timing
     from snakehead.sim import mjcf, tracking
 
     for name in ("dynamics.stability", "dynamics.inverse_dynamics", "model.generate", "sim.gains", "sim.mjcf",
@@ -47,7 +47,7 @@ def test_the_users_read_the_one_definition():
         assert importlib.import_module(f"snakehead.{name}").GRAVITY is physics.GRAVITY, name
     assert whole_body.OBSTACLE_CLEARANCE is margins.OBSTACLE_CLEARANCE
     assert whole_body.SELF_CLEARANCE is margins.SELF_CLEARANCE and whole_body.MIN_MARGIN is margins.SOLUTION_MARGIN
-    assert timing.ZMP_MARGIN is margins.ZMP_MARGIN and timing.GRAVITY is physics.GRAVITY
+    assert timing.ZMP_MARGIN is margins.ZMP_MARGIN and stability_constraint.GRAVITY is physics.GRAVITY
     assert timing.FRICTION == 0.5 * physics.GROUND_FRICTION
     # the simulation's ground is the one the retiming's friction is a share of
     assert inspect.signature(mjcf.build_spec).parameters["friction"].default == physics.GROUND_FRICTION

@@ -14,7 +14,7 @@ from snakehead.collision import body_collisions as coll
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.planning import start_state
-from snakehead.retiming import timing
+from snakehead.retiming import grid_refinement, limit_check, timing
 from snakehead.trajectory.interpolation import MonotoneQuintic
 
 GENERATED = SnakeSpec(n_joints=14, module_length=0.08, section=0.045, mass_per_module=0.22, first_axis="yaw",
@@ -152,13 +152,13 @@ def test_stage_keys_match_exactly_equal_stages():
     """The refinement's memory of stages probed within the limits: a stage matches only one with the same four
     numbers (a bit apart is another stage)."""
     s, x = np.array([0.0, 0.1, 0.3, 0.4]), np.array([0.0, 0.25, 0.5, 0.0])
-    keys = timing._stage_keys(s, x)
+    keys = grid_refinement.stage_keys(s, x)
     assert keys.shape == (3,)
     s2 = np.array([0.0, 0.1, 0.2, 0.3, 0.4])
     x2 = np.array([0.0, 0.25, 0.4, 0.5, np.nextafter(0.0, 1.0)])
-    assert np.isin(timing._stage_keys(s2, x2), keys).tolist() == [True, False, False, False]
-    assert np.isin(keys, timing._stage_keys(s, x.copy())).all()
-    assert not np.isin(keys, timing._stage_keys(np.zeros(0), np.zeros(0))).any()
+    assert np.isin(grid_refinement.stage_keys(s2, x2), keys).tolist() == [True, False, False, False]
+    assert np.isin(keys, grid_refinement.stage_keys(s, x.copy())).all()
+    assert not np.isin(keys, grid_refinement.stage_keys(np.zeros(0), np.zeros(0))).any()
 
 
 def test_timing_does_not_depend_on_the_placement(lift):
@@ -371,7 +371,7 @@ def test_limit_ratios_are_the_numpy_formulas_to_the_bit():
     offset = rng.normal(size=(N, E)) * 0.1
     support = timing.Support(normal, offset, com, rng.uniform(0.01, 0.05, N), rng.uniform(0.005, 0.01, N))
     limits = timing.resolve_limits(robot)
-    got = timing._ratios(robot, snakehead.BasePlacement(), limits, support, np.zeros((N, n)), qd, qdd,
+    got = limit_check.limit_ratios(robot, snakehead.BasePlacement(), limits, support, np.zeros((N, n)), qd, qdd,
                          dyn=InverseDynamics(tau, Pdot, Ldot))
     force = Mg + Pdot[:, 2]
     up = force > 0

@@ -1,4 +1,4 @@
-"""TOPP-RA in the core (snakehead._core.topp_ra, retiming._topp) against toppra itself (tests/topp_reference.py: toppra's
+"""TOPP-RA in the core (snakehead._core.topp_ra, retiming.topp_ra) against toppra itself (tests/topp_reference.py: toppra's
 TOPPRA with its seidel solver over the same constraints, built by toppra's own constraint classes) on random paths,
 random limits and random robots; its 2-D LP against scipy's HiGHS; a closed-form bang-bang profile; retime's motions
 on both solvers; the steps retime is made of; bad input.
@@ -23,7 +23,7 @@ from snakehead import _core
 from snakehead._errors import Infeasible, InputError
 from snakehead.samples import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead.retiming import _topp, timing
+from snakehead.retiming import gridpoints, rest_to_rest, timeline, timing, topp_ra
 
 
 #: Controllable sets and path speeds: this share of their largest value (toppra's float32 velocity bound: ~1e-7).
@@ -79,8 +79,8 @@ def random_limits(robot: snakehead.SnakeRobot, rng: np.random.Generator) -> timi
 
 
 def grid_points(robot: snakehead.SnakeRobot, W: np.ndarray, limits: timing.RetimingLimits, grid_step: float
-                ) -> tuple[timing._Piece, timing.GridPoints]:
-    piece = timing._Piece(robot, snakehead.BasePlacement(), limits, W, 0, len(W) - 1, "monotone")
+                ) -> tuple[rest_to_rest.Piece, timing.GridPoints]:
+    piece = rest_to_rest.Piece(robot, snakehead.BasePlacement(), limits, W, 0, len(W) - 1, "monotone")
     return piece, timing.GridPoints.of(robot, piece.base, piece.f, piece.first_grid(grid_step), limits.zmp_margin)
 
 
@@ -120,14 +120,14 @@ def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRo
             _, points = grid_points(robot, W, limits, rng.uniform(0.01, 0.05))
         except Infeasible:  # the lifted body spans no support polygon somewhere: nothing to solve
             continue
-        ours = timing._solve_grid(robot, points, limits)
+        ours = gridpoints.solve_grid(robot, points, limits)
         try:
             ref = reference.toppra_solve_grid(robot, points, limits)
         except ZeroDivisionError:
             # toppra's seidel LP divides by zero on a row 0 u + 0 x <= g < 0 (the path stands still at its ends,
             # q' = q'' = 0, where the CoM is outside the polygon): the core reports that stage infeasible
             assert ours.sd is None
-            stage = _topp.interpolated(_canonical(robot, points, limits), points.s)
+            stage = topp_ra.interpolated(_canonical(robot, points, limits), points.s)
             A, B, C = (M[ours.failed_at] for M in stage)
             assert np.any((A == 0) & (B == 0) & (C < 0))
             continue
@@ -147,8 +147,8 @@ def test_core_matches_toppra_on_random_paths_and_limits(robot: snakehead.SnakeRo
 
 
 def test_canonical_solve_equals_the_stage_solve_to_the_bit(robot: snakehead.SnakeRobot) -> None:
-    """_topp.solve (the core discretizes the gridpoints' rows itself, _core.topp_ra_canonical) gives the result of
-    _core.topp_ra over the stage matrices of _topp.interpolated, to the bit: feasible and infeasible paths."""
+    """topp_ra.solve (the core discretizes the gridpoints' rows itself, _core.topp_ra_canonical) gives the result of
+    _core.topp_ra over the stage matrices of topp_ra.interpolated, to the bit: feasible and infeasible paths."""
     rng = np.random.default_rng(23)
     kinds = set()
     for _ in range(12):
@@ -158,7 +158,7 @@ def test_canonical_solve_equals_the_stage_solve_to_the_bit(robot: snakehead.Snak
         except Infeasible:
             continue
         rows = _canonical(robot, points, limits)
-        ours, ref = _topp.solve(points.s, rows), _topp.solve_stages(points.s, rows)
+        ours, ref = topp_ra.solve(points.s, rows), topp_ra.solve_stages(points.s, rows)
         assert ours.failed_at == ref.failed_at
         np.testing.assert_array_equal(ours.K, ref.K)
         assert (ours.sd is None) == (ref.sd is None)
@@ -191,9 +191,9 @@ def test_canonical_solve_refuses_malformed_rows() -> None:
 
 
 def _canonical(robot: snakehead.SnakeRobot, points: timing.GridPoints, limits: timing.RetimingLimits
-               ) -> _topp.Canonical:
-    F, g = timing.stability_rows(robot, points.support, timing._stability_limits(limits), timing.SOLVE_ZMP_EXTRA_M)
-    return _topp.canonical(timing._path_limits(limits), points.dq, points.ddq, points.tau_a, points.tau_b,
+               ) -> topp_ra.Canonical:
+    F, g = timing.stability_rows(robot, points.support, gridpoints.stability_limits(limits), timing.SOLVE_ZMP_EXTRA_M)
+    return topp_ra.canonical(gridpoints.path_limits(limits), points.dq, points.ddq, points.tau_a, points.tau_b,
                            points.tau_hold, np.einsum("nkj,nj->nk", F, points.w_a),
                            np.einsum("nkj,nj->nk", F, points.w_b), g)
 
@@ -211,7 +211,7 @@ def test_core_reports_infeasible_where_toppra_does(reference: Any) -> None:
             continue
         if points.support.static[1:].min() > 0:
             continue  # stable all along: feasible
-        ours = timing._solve_grid(robot, points, limits)
+        ours = gridpoints.solve_grid(robot, points, limits)
         try:
             ref = reference.toppra_solve_grid(robot, points, limits)
         except ZeroDivisionError:
@@ -229,15 +229,15 @@ def test_closed_form_bang_bang_profile_and_duration() -> None:
     grid = np.linspace(0.0, L, 61)
     ones, zeros = np.ones((len(grid), 1)), np.zeros((len(grid), 1))
     none = np.zeros((len(grid), 0))
-    limits = _topp.PathLimits(np.array([v]), np.array([a]), np.array([np.inf]), 1e6)
-    rows = _topp.canonical(limits, ones, zeros, zeros, zeros, zeros, none, none, none)
+    limits = topp_ra.PathLimits(np.array([v]), np.array([a]), np.array([np.inf]), 1e6)
+    rows = topp_ra.canonical(limits, ones, zeros, zeros, zeros, zeros, none, none, none)
     assert rows.P.shape == (len(grid), 2)  # the torque rows left out: no limit
-    solution = _topp.solve(grid, rows)
+    solution = topp_ra.solve(grid, rows)
     assert solution.sd is not None and solution.failed_at == -1
     exact = np.minimum.reduce([2 * a * grid, np.full_like(grid, v * v), 2 * a * (L - grid)])
     assert np.abs(solution.sd ** 2 - exact).max() < 1e-6
     assert np.allclose(solution.K[:, 1], np.minimum(v * v, 2 * a * (L - grid)), atol=1e-9)
-    line = timing._Timeline(1)
+    line = timeline.Timeline(1)
     line.add_piece(lambda s, order: np.asarray(s)[:, None] if order == 0 else np.full((len(s), 1), float(order == 1)),
                    grid, solution.sd)
     assert line.end == pytest.approx(L / v + v / a, rel=1e-6)
@@ -288,8 +288,8 @@ def test_refined_grid_points_equal_a_fresh_computation() -> None:
         assert np.allclose(getattr(merged.support, field), getattr(fresh.support, field), atol=1e-12), field
     xy = rng.uniform(-0.3, 0.3, (len(merged.s), 2))  # the same polygons, whatever their padding
     assert np.allclose(merged.support.margins(xy), fresh.support.margins(xy), atol=1e-12)
-    assert np.array_equal(timing._topp.solve(merged.s, _canonical(robot, merged, limits)).sd,
-                          timing._topp.solve(fresh.s, _canonical(robot, fresh, limits)).sd)
+    assert np.array_equal(topp_ra.solve(merged.s, _canonical(robot, merged, limits)).sd,
+                          topp_ra.solve(fresh.s, _canonical(robot, fresh, limits)).sd)
 
 
 def test_refined_grid_rows_equal_rows_computed_on_the_refined_grid() -> None:
@@ -310,31 +310,31 @@ def test_refined_grid_rows_equal_rows_computed_on_the_refined_grid() -> None:
     assert added.support.offset.shape[1] < coarse.support.offset.shape[1]  # the padding is exercised
     for kept, new in ((coarse, added), (added, coarse)):
         kept, new = dataclasses.replace(kept, rows={}), dataclasses.replace(new, rows={})
-        timing._grid_rows(robot, kept, limits)
+        gridpoints.grid_rows(robot, kept, limits)
         merged = kept.merged(new)
-        carried = timing._grid_rows(robot, merged, limits)
-        fresh = timing._grid_rows(robot, dataclasses.replace(merged, rows={}), limits)
+        carried = gridpoints.grid_rows(robot, merged, limits)
+        fresh = gridpoints.grid_rows(robot, dataclasses.replace(merged, rows={}), limits)
         for name in ("P", "Q", "R", "x_max"):
             np.testing.assert_array_equal(getattr(carried.canonical, name), getattr(fresh.canonical, name), name)
         assert (carried.joint, carried.edges) == (fresh.joint, fresh.edges) == (carried.joint, coarse.support.offset.shape[1])
-        np.testing.assert_array_equal(timing._topp.solve(merged.s, _canonical(robot, merged, limits)).sd,
-                                      timing._solve_grid(robot, merged, limits).sd)
+        np.testing.assert_array_equal(topp_ra.solve(merged.s, _canonical(robot, merged, limits)).sd,
+                                      gridpoints.solve_grid(robot, merged, limits).sd)
 
 
 def test_first_grid_and_checked_waypoints() -> None:
     robot = snakehead.SnakeRobot.default()
     W = np.zeros((3, robot.n_joints))
     W[1, 10], W[2, 10] = 0.1, 0.5
-    piece = timing._Piece(robot, snakehead.BasePlacement(), timing.resolve_limits(robot), W, 0, 2, "monotone")
+    piece = rest_to_rest.Piece(robot, snakehead.BasePlacement(), timing.resolve_limits(robot), W, 0, 2, "monotone")
     grid = piece.first_grid(0.02)
     assert np.all(np.diff(grid) <= 0.02 + 1e-12) and np.all(np.diff(grid) > 0)
     assert np.isin(piece.knots, grid).all()  # every waypoint a gridpoint
     assert (np.searchsorted(grid, piece.knots[1]) >= timing.MIN_GRID_PER_SEGMENT)  # the short segment still has 8
     assert piece.near(len(grid) - 2, grid) == 1
     with pytest.raises(InputError, match="waypoint 1 has joint"):
-        timing._checked_waypoints(robot, np.vstack([W[0], robot.upper + 0.1]))
+        timing.checked_waypoints(robot, np.vstack([W[0], robot.upper + 0.1]))
     with pytest.raises(InputError, match="at least two"):
-        timing._checked_waypoints(robot, W[:1])
+        timing.checked_waypoints(robot, W[:1])
 
 
 # ------------------------------------------------------------------------------------------------
@@ -377,13 +377,13 @@ def test_many_threads_same_result() -> None:
 
 
 def test_refinement_probing_only_changed_stages_gives_the_same_grid(monkeypatch: pytest.MonkeyPatch) -> None:
-    """_Piece._refine probes again only the stages whose ends or speeds changed since a round found them within the
+    """Piece._refine probes again only the stages whose ends or speeds changed since a round found them within the
     limits: the same grid and profile as probing every stage every round."""
     robot = snakehead.SnakeRobot.default()
     W = random_waypoints(robot, np.random.default_rng(2))
     limits = timing.resolve_limits(robot, acceleration_limit=4.0)
     probed: list[tuple[int, int]] = []  # per round: stages probed, stages
-    original = timing._stages_over
+    original = rest_to_rest.stages_over
 
     def spy(*args: object, only: np.ndarray | None = None) -> np.ndarray:
         assert only is not None
@@ -394,12 +394,13 @@ def test_refinement_probing_only_changed_stages_gives_the_same_grid(monkeypatch:
         return original(*args)  # type: ignore[arg-type]
 
     def timed() -> tuple[np.ndarray, np.ndarray]:
-        return timing._Piece(robot, snakehead.BasePlacement(), limits, W, 0, 2, "monotone").time(timing.GRID_STEP, [])
+        piece = rest_to_rest.Piece(robot, snakehead.BasePlacement(), limits, W, 0, 2, "monotone")
+        return piece.time(timing.GRID_STEP, [])
 
-    monkeypatch.setattr(timing, "_stages_over", spy)
+    monkeypatch.setattr(rest_to_rest, "stages_over", spy)
     grid, sd = timed()
     assert len(probed) >= 2, "the path needs no refinement: no test"
-    monkeypatch.setattr(timing, "_stages_over", every_stage)
+    monkeypatch.setattr(rest_to_rest, "stages_over", every_stage)
     grid_all, sd_all = timed()
     assert np.array_equal(grid, grid_all) and np.array_equal(sd, sd_all)
     assert probed[0][0] == probed[0][1]  # the first round probes every stage

@@ -1,10 +1,10 @@
-"""The reference for snakehead's TOPP-RA (snakehead._core.topp_ra via snakehead.retiming._topp): toppra's own TOPPRA
-with its seidel solver over the same constraints, built with toppra's constraint classes as snakehead.retiming.timing
+"""The reference for snakehead's TOPP-RA (snakehead._core.topp_ra via snakehead.retiming.topp_ra): toppra's own TOPPRA
+with its seidel solver over the same constraints, built with toppra's constraint classes as snakehead.retiming
 did before the core solved them (toppra's joint velocity constraint with the x cap, its joint acceleration
 constraint, and the torque and stability rows as canonical linear constraints, all with toppra's interpolation
 discretization).
 
-``toppra_solve_grid`` has the signature of ``timing._solve_grid``; ``toppra_solver()`` swaps it in for a block, so
+``toppra_solve_grid`` has the signature of ``gridpoints.solve_grid``; ``toppra_solver()`` swaps it in for a block, so
 that a whole ``retime`` runs on toppra (tests/test_topp_ra.py, bench/timing.py --solvers).
 """
 from __future__ import annotations
@@ -20,7 +20,7 @@ from toppra.constraint import (DiscretizationType, JointAccelerationConstraint, 
 from toppra.constraint.linear_constraint import canlinear_colloc_to_interpolate
 from toppra.interpolator import AbstractGeometricPath
 
-from snakehead.retiming import _topp, timing
+from snakehead.retiming import gridpoints, rest_to_rest, timing, topp_ra
 
 #: toppra needs finite limits: "none" is a limit no motion here comes near.
 BIG = 1e6
@@ -81,11 +81,11 @@ class CappedVelocityConstraint(JointVelocityConstraint):
 
 
 def toppra_constraints(robot: Any, points: timing.GridPoints, limits: timing.RetimingLimits) -> list:
-    """The constraints of ``timing._solve_grid`` as toppra's constraint objects."""
-    path_limits = timing._path_limits(limits)
+    """The constraints of ``gridpoints.solve_grid`` as toppra's constraint objects."""
+    path_limits = gridpoints.path_limits(limits)
     n = robot.n_joints
     box_F, tau = np.vstack([np.eye(n), -np.eye(n)]), np.minimum(path_limits.torque, BIG)
-    F, g = timing.stability_rows(robot, points.support, timing._stability_limits(limits), timing.SOLVE_ZMP_EXTRA_M)
+    F, g = timing.stability_rows(robot, points.support, gridpoints.stability_limits(limits), timing.SOLVE_ZMP_EXTRA_M)
     acc = np.minimum(path_limits.acceleration, BIG)
     return [CappedVelocityConstraint(np.minimum(path_limits.velocity, BIG), path_limits.x_cap),
             JointAccelerationConstraint(np.column_stack([-acc, acc]),
@@ -94,23 +94,23 @@ def toppra_constraints(robot: Any, points: timing.GridPoints, limits: timing.Ret
             RowsConstraint(points.w_a, points.w_b, np.zeros_like(points.w_a), F, g, identical=False)]
 
 
-def toppra_solve_grid(robot: Any, points: timing.GridPoints, limits: timing.RetimingLimits) -> _topp.Solution:
-    """``timing._solve_grid`` by toppra: TOPPRA with the seidel solver, rest to rest."""
+def toppra_solve_grid(robot: Any, points: timing.GridPoints, limits: timing.RetimingLimits) -> topp_ra.Solution:
+    """``gridpoints.solve_grid`` by toppra: TOPPRA with the seidel solver, rest to rest."""
     instance = algo.TOPPRA(toppra_constraints(robot, points, limits), GridPath(points), gridpoints=points.s,
                            solver_wrapper="seidel")
     _, sd, _, K = instance.compute_parameterization(0.0, 0.0, return_data=True)
     if sd is not None and not np.isnan(sd).any():
-        return _topp.Solution(sd, K, -1)
+        return topp_ra.Solution(sd, K, -1)
     bad = np.flatnonzero(np.isnan(K).any(axis=1))
-    return _topp.Solution(None, K, int(bad.max()) if bad.size else 0)
+    return topp_ra.Solution(None, K, int(bad.max()) if bad.size else 0)
 
 
 @contextlib.contextmanager
 def toppra_solver(solve: Callable = toppra_solve_grid) -> Iterator[None]:
     """retime solves with ``solve`` (toppra by default) inside the block."""
-    saved = timing._solve_grid
-    timing._solve_grid = solve
+    saved = rest_to_rest.solve_grid
+    rest_to_rest.solve_grid = solve
     try:
         yield
     finally:
-        timing._solve_grid = saved
+        rest_to_rest.solve_grid = saved

@@ -33,7 +33,7 @@ MOVED_MODULES: dict[str, str] = {
     "snakehead.motion.interpolation": "snakehead.trajectory.interpolation",
     "snakehead.motion.cartesian": "snakehead.trajectory.cartesian",
     "snakehead.motion.timing": "snakehead.retiming.timing",
-    "snakehead.motion._topp": "snakehead.retiming._topp",
+    "snakehead.motion._topp": "snakehead.retiming.topp_ra",
     "snakehead.motion.planner": "snakehead.planning.planner",
     "snakehead.motion.plan_many": "snakehead.planning.plan_many",
     "snakehead.motion.plan_result": "snakehead.planning.plan_result",

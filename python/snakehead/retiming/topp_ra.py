@@ -1,13 +1,13 @@
-"""The TOPP-RA side of :mod:`snakehead.retiming.timing`: the path's constraints at the gridpoints in TOPP-RA's
-canonical form, their discretization, and the solve in the C++ core (``snakehead._core.topp_ra``,
-``include/snakehead/topp_ra.hpp``).
+"""TOPP-RA (Pham and Pham 2018) over the gridpoints of a path: its constraints in the canonical form the C++ core
+takes (:class:`Canonical`: rows ``P u + Q x <= R`` and a bound on x, with u = s'' and x = s'^2), their
+discretization, and the solve in the core (``snakehead._core.topp_ra``, ``include/snakehead/topp_ra.hpp``), whose
+passes and per-stage 2-D LPs are those of the ``toppra`` package's ``seidel`` solver.
 
-Along a path q(s) with u = s'' and x = s'^2 (Pham and Pham 2018), each constraint at a gridpoint is a row
-``P u + Q x <= R``: the joint accelerations q' u + q'' x, the torques tau_a u + tau_b x + tau_hold, the stability
-rows F (w_a u + w_b x) <= g; the joint velocities q' s' bound x alone. All are computed for every gridpoint at
-once. The discretization is toppra's *interpolation* one: stage i keeps the rows of gridpoint i at (u, x) and those
-of gridpoint i+1 at the state it reaches there, (u, x + 2 delta_i u), so that a stage's constant path acceleration
-keeps the limits at both of its ends.
+The rows are the joints' (:mod:`.joint_constraints`) and the stability rows F (w_a u + w_b x) <= g
+(:mod:`.stability_constraint`), computed for every gridpoint at once. The discretization is toppra's
+*interpolation* one: stage i keeps the rows of gridpoint i at (u, x) and those of gridpoint i+1 at the state it
+reaches there, (u, x + 2 delta_i u), so that a stage's constant path acceleration keeps the limits at both of its
+ends.
 """
 from __future__ import annotations
 
@@ -16,17 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
+from .joint_constraints import PathLimits, acceleration_rows, torque_rows, velocity_bound
 
-
-@dataclass(frozen=True)
-class PathLimits:
-    """The limits TOPP-RA is given, per joint (n,): velocity (rad/s), acceleration (rad/s^2), torque (N m); inf
-    for none. x_cap: the cap on x = s'^2 where the joint velocities leave it unbounded (a path that stands still)."""
-
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    torque: np.ndarray
-    x_cap: float
+__all__ = ["PathLimits", "Canonical", "Solution", "canonical", "interpolated", "solve", "solve_stages"]
 
 
 @dataclass(frozen=True)
@@ -54,18 +46,13 @@ def canonical(limits: PathLimits, dq: np.ndarray, ddq: np.ndarray, tau_a: np.nda
               tau_hold: np.ndarray, stability_a: np.ndarray, stability_b: np.ndarray, stability_g: np.ndarray
               ) -> Canonical:
     """The canonical rows at N+1 gridpoints from q', q'' (N+1, n); the torque tau_a u + tau_b x + tau_hold
-    (N+1, n each); the stability rows stability_a u + stability_b x <= stability_g (N+1, k each). A joint's rows
-    are left out where its limit is inf."""
-    acc, tau = np.isfinite(limits.acceleration), np.isfinite(limits.torque)
-    a_lim, t_lim = limits.acceleration[acc], limits.torque[tau]
-    P = np.hstack([dq[:, acc], -dq[:, acc], tau_a[:, tau], -tau_a[:, tau], stability_a])
-    Q = np.hstack([ddq[:, acc], -ddq[:, acc], tau_b[:, tau], -tau_b[:, tau], stability_b])
-    hold = tau_hold[:, tau]
-    R = np.hstack([np.broadcast_to(a_lim, (len(dq), len(a_lim))), np.broadcast_to(a_lim, (len(dq), len(a_lim))),
-                   t_lim - hold, t_lim + hold, stability_g])
-    with np.errstate(divide="ignore"):
-        sd_max = (limits.velocity / np.abs(dq)).min(axis=1)  # inf where no joint moves
-    return Canonical(P, Q, R, np.minimum(sd_max ** 2, limits.x_cap))
+    (N+1, n each); the stability rows stability_a u + stability_b x <= stability_g (N+1, k each). Columns: the
+    accelerations', the torques', then the stability rows."""
+    acc, tau = acceleration_rows(limits, dq, ddq), torque_rows(limits, tau_a, tau_b, tau_hold)
+    P = np.hstack([acc[0], tau[0], stability_a])
+    Q = np.hstack([acc[1], tau[1], stability_b])
+    R = np.hstack([acc[2], tau[2], stability_g])
+    return Canonical(P, Q, R, velocity_bound(limits, dq))
 
 
 def interpolated(rows: Canonical, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
