@@ -153,3 +153,6 @@ def base_placements(robot: SnakeRobot, workspace_map: ReachabilityMap, position:
     frames, neck_q = neck_frames(robot, base_configuration, neck_samples)
     return placements_from_frames(workspace_map, frames, neck_q, position, direction, yaw_samples=yaw_samples,
                                   min_index=min_index, limit=limit)
+
+
+__all__ = ["PlacementCandidates", "neck_frames", "placements_from_frames", "base_placements"]

@@ -15,17 +15,16 @@ from __future__ import annotations
 import math
 import os
 import weakref
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _core
+from .._errors import InputError, InputTypeError
 from .._validate import (ORTHONORMAL_TOLERANCE, duration, finite_array, integer, joint_vector, pose as check_pose,
                          positive, within_limits)
 from ..model.chain import Chain
-
-import numpy.typing as npt
-from typing import Any
-from .._errors import InputError, InputTypeError
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
 #: Bounds that leave the roll about the target's x-axis free.
@@ -33,6 +32,7 @@ FREE_ROLL = (0.0, 0.0, 0.0, np.inf, 0.0, 0.0)
 
 
 def _bounds(bounds: Any) -> np.ndarray:
+    """``bounds`` as the 6 per-axis tolerances (vx vy vz wx wy wz, each >= 0, inf for a free axis)."""
     try:
         b = np.asarray(bounds, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -76,6 +76,7 @@ def _poses(poses: npt.ArrayLike) -> np.ndarray:
 
 
 def _seed(seed: int | None) -> int | None:
+    """``seed`` as an unsigned 64-bit integer, or None."""
     return None if seed is None else integer(seed, "seed", least=0, most=2**64 - 1)
 
 
@@ -254,3 +255,6 @@ def _streams(streams: npt.ArrayLike | None, count: int) -> list[int] | None:
 def pose_error(target: Any, current: Any) -> np.ndarray:
     """The IK pose error (vx vy vz wx wy wz) of ``current`` relative to ``target``, in the target's frame."""
     return _core.pose_error(check_pose(target, "target"), check_pose(current, "current"))
+
+
+__all__ = ["TracIK", "SOLVE_TYPES", "FREE_ROLL", "pose_error"]

@@ -5,7 +5,8 @@ It follows scikit-learn's ``KMeans(init="k-means++", n_init, random_state)`` ste
 ``numpy.random.RandomState(random_state)`` for the greedy k-means++ seeding (2 + log k candidates per centre), the
 same Lloyd's iterations with the same stopping rule (labels unchanged, or the centres' squared shift within
 ``tol`` times the data's mean variance), the best start by inertia -- so that it gives scikit-learn's clusters
-(tested against it) without importing it: scikit-learn's import alone took 0.8 s of every ``snakehead demo``.
+(tested against it) without importing it (scikit-learn is slow to import, and every ``snakehead demo`` clusters a
+map).
 """
 from __future__ import annotations
 

@@ -147,6 +147,7 @@ def reachability(m: ReachabilityMap, positions: npt.ArrayLike, directions: npt.A
 
 
 def _reachability(m: ReachabilityMap, p: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """:func:`reachability`'s scores of the checked poses p, d (K, 3)."""
     dirs = m.sphere_directions
     h, r = m.voxel_size, 0.5 * m.voxel_size
     n = int(m.grid_shape[0])
@@ -255,3 +256,6 @@ def inverse(m: ReachabilityMap, position: npt.ArrayLike, direction: npt.ArrayLik
     return BaseFrameCandidates(poses=poses, index=np.repeat(index[rows], len(turns)),
                                voxels=np.repeat(rows, len(turns)), directions=np.repeat(ks, len(turns)),
                                turns=np.tile(turns, len(rows)))
+
+
+__all__ = ["BLENDED_DIRECTIONS", "direction_bits", "reachable", "reachability", "BaseFrameCandidates", "inverse"]

@@ -118,6 +118,7 @@ class ReachabilityMap:
 
     @property
     def voxel_size(self) -> float:
+        """The voxels' edge (m)."""
         return float(self.params["voxel_size"])
 
     def __len__(self) -> int:
