@@ -1,5 +1,5 @@
 """The whole-body solve's proof that a target is out of the lifted chain's reach with the base kept
-(``BodyProblem.out_of_reach``, through ``_TargetSearch.beyond_reach`` and ``lifted_candidates``): it must never
+(``BodyProblem.out_of_reach``, through ``TargetSearch.beyond_reach`` and ``lifted_candidates``): it must never
 refuse a target the kept base reaches (the heads of real poses, reachable-by-construction targets of the "same"
 set, the "shape" set's targets from their own base shape), on the default robot and on others; and what it
 refuses, the lifted chain's IK (the whole batch, no proof asked) and the segmented solve do not reach either."""
@@ -32,9 +32,9 @@ def controller(request, tmp_path_factory) -> sh.HeadController:
     return sh.HeadController(robot, method="free_roll", seed=1)
 
 
-def _search(controller, position, direction, q_prev=None) -> wb._TargetSearch:
-    return wb._TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), q_prev, None, (),
-                            DETOUR_MARGIN, wb.SOLVE_BUDGET, controller.body_problem, 0, None)
+def _search(controller, position, direction, q_prev=None) -> wb.TargetSearch:
+    return wb.TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), q_prev, None, (),
+                           DETOUR_MARGIN, wb.SOLVE_BUDGET, controller.body_problem, 0, None)
 
 
 def test_never_refuses_the_head_of_a_real_pose(controller):
@@ -67,7 +67,7 @@ def _batch(controller, q, position, direction, rng) -> tuple[np.ndarray, np.ndar
     T0 = robot.frame(q, robot.lift_frame, controller.base)
     target = np.linalg.inv(T0) @ frame_along(position, direction)
     angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
-    poses = np.concatenate([wb._rolled(target, angles)] * wb.CANDIDATE_SEEDS)
+    poses = np.concatenate([wb.rolled_frames(target, angles)] * wb.CANDIDATE_SEEDS)
     inits = np.vstack([np.tile(q[robot.lift_joints.start:], (wb.CANDIDATE_ROLLS, 1)),
                        rng.uniform(ik.lower, ik.upper, (wb.CANDIDATE_ROLLS * (wb.CANDIDATE_SEEDS - 1), ik.n_joints))])
     return poses, inits
@@ -126,7 +126,7 @@ def test_choice_of_base_past_the_proof_is_deterministic(controller):
 
 
 def test_candidates_skip_the_random_starts_of_rolls_the_current_joints_miss(controller):
-    """lifted_candidates' IK (``_rolls_reached``) solves every roll from the current joints, then from random
+    """lifted_candidates' IK (``rolls_reached``) solves every roll from the current joints, then from random
     starts only the rolls reached from there: each target it solves gives, bit for bit, what one batch of all of
     them gives (its index in the batch is its stream), and the others are reported not found at their start. On
     the default robot and on others; targets of other base shapes asked from the initial one, where some rolls are
@@ -139,7 +139,7 @@ def test_candidates_skip_the_random_starts_of_rolls_the_current_joints_miss(cont
             break
         poses, inits = _batch(controller, controller.q_initial, t.position, t.direction, rng)
         q_all, ok_all = ik.ik_many(poses, inits)
-        q, ok = wb._rolls_reached(ik, poses, inits)
+        q, ok = wb.rolls_reached(ik, poses, inits)
         first = ok_all[:wb.CANDIDATE_ROLLS]
         solved = np.concatenate([np.ones(wb.CANDIDATE_ROLLS, bool), first])
         np.testing.assert_array_equal(q[solved], q_all[solved])

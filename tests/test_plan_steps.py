@@ -1,5 +1,5 @@
 """The named steps of plan() (planning.planner), of the base's choice (planning.base_choice) and of the whole-body solve
-(solve.whole_body._TargetSearch), each on its own, against independent computations (distances by hand, the
+(solve.whole_body.TargetSearch), each on its own, against independent computations (distances by hand, the
 uncached bending state, the solves of the public entry points)."""
 import numpy as np
 import pytest
@@ -243,7 +243,7 @@ def test_relocated_for_a_target_out_of_reach(controller):
 def search_for(controller, position, direction, **kw):
     options = dict(q_prev=None, base=None, obstacles=(), min_margin=DETOUR_MARGIN, budget=wb.SOLVE_BUDGET, problem=None,
                    seed=0, shape_ok=None) | kw
-    return wb._TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), **options)
+    return wb.TargetSearch(controller, np.asarray(position, float), np.asarray(direction, float), **options)
 
 
 def test_beyond_reach_is_the_reach_of_the_last_joint(controller):
@@ -270,7 +270,8 @@ def test_consider_keeps_the_best_attempt_and_returns_only_a_solution(controller,
     assert search.consider(controller.q_initial, controller.base, wb.STAGES[1], 0) is None
     worst = search.best
     found = search.consider(t.q, t.base, wb.STAGES[1], 1)  # the configuration the target was made from
-    assert found is not None and found.success and search.best is found and wb._rank(found) > wb._rank(worst)
+    assert found is not None and found.success and search.best is found
+    assert wb.solution_rank(found) > wb.solution_rank(worst)
     assert search.consider(controller.q_initial, controller.base, wb.STAGES[1], 2) is None
     assert search.best is found
 

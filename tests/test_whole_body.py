@@ -7,7 +7,7 @@ import pytest
 
 import snakehead
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.solve import whole_body as wb
+from snakehead.solve import target_search, whole_body as wb
 from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
 from snakehead.kinematics import reachability as ws
@@ -80,8 +80,8 @@ def test_gradients_match_finite_differences(default):
     q0[prob.free] += rng.normal(0, 0.05, prob.free.sum())
     base = BasePlacement(0.1, -0.2, 0.3)
     box = snakehead.BoxObstacle([0.3, 0.5, 0.2], [0.1, 0.1, 0.1])
-    obj = wb._Objective(prob, q0, base, np.array([0.1, 0.5, 0.3]), np.array([0.0, 1.0, 0.0]), True, [box],
-                        0.005, 0.002, 0.002, None)
+    obj = wb.RefinementProblem(prob, q0, base, np.array([0.1, 0.5, 0.3]), np.array([0.0, 1.0, 0.0]), True, [box],
+                               0.005, 0.002, 0.002, None)
     z = obj.pack(q0, base)
     e = obj.evaluate(z)
     h = 1e-7
@@ -221,7 +221,7 @@ def test_beyond_the_lifted_chain_reach_is_out_of_reach_without_ik(default, gener
         raise AssertionError("no IK should run for a target beyond the reach")
 
     monkeypatch.setattr(controller, "solve", no_ik)
-    monkeypatch.setattr(wb, "lifted_candidates", no_ik)
+    monkeypatch.setattr(target_search, "lifted_candidates", no_ik)
     sol = wb.solve_target(controller, far, [1.0, 0.0, 0.0], allow_base_move=False)
     assert not sol.success and sol.reason == "out of reach" and sol.base == controller.base
     assert sol.position_error_m > 0.05
@@ -352,8 +352,8 @@ def test_solve_is_deterministic_and_its_work_counted(default):
     assert (first.base, first.reason, first.static_margin_m) == (again.base, again.reason, again.static_margin_m)
     far = np.array([3.0, 0.0, 0.05])  # out of reach of every placement the search tries
     for budget in (1, 3, 7):
-        search = wb._TargetSearch(controller, far, np.array([0.0, 0.0, 1.0]), None, None, (), wb.MIN_MARGIN, budget,
-                                  prob, 0, None)
+        search = wb.TargetSearch(controller, far, np.array([0.0, 0.0, 1.0]), None, None, (), wb.MIN_MARGIN, budget,
+                                 prob, 0, None)
         assert search.base_moved() is None and search.spent == budget
     sol = wb.solve_whole_body(robot, far, [0, 0, 1], [(controller.q_initial, controller.base)] * 3, problem=prob,
                               budget=2)
@@ -379,7 +379,7 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
         return solve_checked(self, position, direction, q_prev, base, accept, allow_base_move)
 
     kept_calls = []
-    base_kept = wb._TargetSearch.base_kept
+    base_kept = wb.TargetSearch.base_kept
 
     def counted_kept(self, near):
         kept_calls.append((self.position.tobytes(), self.q_now.tobytes(), self.base))
@@ -393,8 +393,8 @@ def test_relocation_solves_nothing_twice(default, monkeypatch):
         return lifted_candidates(prob, q_now, base, position, direction, seed)
 
     monkeypatch.setattr(type(controller), "solve_checked", counted)
-    monkeypatch.setattr(wb._TargetSearch, "base_kept", counted_kept)
-    monkeypatch.setattr(wb, "lifted_candidates", counted_ik)
+    monkeypatch.setattr(wb.TargetSearch, "base_kept", counted_kept)
+    monkeypatch.setattr(target_search, "lifted_candidates", counted_ik)
     t = reachable_targets(controller, "shape", 1, np.random.default_rng(3))[0]
     target = snakehead.scenes.Target("t", t.position, t.direction)
     memo = wb.PlanSolves()
@@ -421,7 +421,7 @@ def test_rolled_frames_are_roll_about_x():
 
     T = frame_from_direction([0.3, -0.2, 0.4], [0.2, 0.5, 0.8])
     angles = 2 * np.pi * np.arange(wb.CANDIDATE_ROLLS) / wb.CANDIDATE_ROLLS
-    got = wb._rolled(T, angles)
+    got = wb.rolled_frames(T, angles)
     for k, a in enumerate(angles):
         np.testing.assert_array_equal(got[k], roll_about_x(T, a))
         # independent: the rotation about the frame's own x-axis keeps x and turns y towards z by the angle

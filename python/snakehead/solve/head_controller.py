@@ -9,8 +9,7 @@ Given where the head must be and where it must point, find all the joint angles:
 4. the head joints by TRAC-IK towards the position and the direction (``head.rotated_frames`` or
    ``head.free_roll``);
 5. (static part) the centre of mass inside the support polygon.
-Trajectories to the solution (steps 2, 5 dynamic, 6) are planned by ``trajectory`` and checked by
-``stability``; ``scenarios`` strings them together.
+The motions to the solution (steps 2, 5 dynamic, 6) are the planner's (:mod:`snakehead.planning.planner`).
 """
 from __future__ import annotations
 
@@ -21,18 +20,18 @@ import numpy as np
 
 from . import head as head_ik
 from . import neck as nk
+from .body_problem import BodyProblem
 from .initial_state import stable_initial_configuration
 from ..dynamics import stability
 from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
+from ..kinematics import reachability as workspace
 from ..kinematics.ik import TracIK
+from ..kinematics.reachability.reachability_map import ReachabilityMap
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 
 import numpy.typing as npt
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 from .._errors import InputError, InputTypeError, entry_point, inputs_checked
-
-if TYPE_CHECKING:
-    from ..kinematics.reachability.reachability_map import ReachabilityMap
 
 #: TRAC-IK calls of the head's free-roll solve from different starts (an unseeded solver's calls search anew).
 FREE_ROLL_ATTEMPTS = 3
@@ -81,8 +80,6 @@ class HeadController:
                  base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
                  timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
                  base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
-        from ..kinematics import reachability as workspace
-
         self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):
             raise InputError(f"method must be 'rotated' or 'free_roll', got {method!r}")
@@ -119,8 +116,8 @@ class HeadController:
     @property
     def _free_roll_attempts(self) -> int:
         """TRAC-IK calls of the head's free-roll solve: FREE_ROLL_ATTEMPTS, or one for a seeded solver, whose
-        later calls would run the same seeded restarts to the same budget after one other first descent (a failing
-        call costs the whole budget, ~7 ms; over 90 plans of reachable targets no later call ever succeeded)."""
+        later calls would run the same seeded restarts to the same budget after one other first descent, and a
+        failing call costs the whole budget)."""
         return 1 if self.ik.seed is not None else FREE_ROLL_ATTEMPTS
 
     # --- the process ---------------------------------------------------------------------------
@@ -273,11 +270,10 @@ class HeadController:
                             neck=neck, head=head)
 
     @property
-    def body_problem(self) -> Any:
-        """The geometry the whole-body solve needs for this robot (``solve.whole_body.BodyProblem``), made once."""
+    def body_problem(self) -> BodyProblem:
+        """The geometry the whole-body solve needs for this robot (:class:`~.body_problem.BodyProblem`), made
+        once."""
         if getattr(self, "_body_problem", None) is None:
-            from .whole_body import BodyProblem
-
             self._body_problem = BodyProblem(self.robot)
         return self._body_problem
 

@@ -3,7 +3,7 @@
 ``backbone.initial_configuration`` chooses the base arc's central angle on Eq. 24's support polygon of the base
 links' end points (``stability.static_margin``'s default contact model): the modules' own sections lying on the
 ground. The plans check every configuration on the points of the collision shapes that actually touch the ground
-(``contact="ground"``, and the base's own support: ``whole_body.BodyProblem.margins``). On a body whose lowest
+(``contact="ground"``, and the base's own support: :mod:`.base_support`). On a body whose lowest
 points are not on its modules (passive wheels, skids, sensor pods hanging below it: the ``wheeled`` sample's wheels
 reach 1 mm below the modules, at the middle of each one) the two polygons differ: the wheels' polygon lacks the
 half module at each end of the base, and with the neck and head lifted the centre of mass lies near P0, at the
@@ -26,10 +26,15 @@ import math
 
 import numpy as np
 
+from .. import backbone
+from .._errors import Infeasible
+from ..backbone.base_arc import arc_angle_limit, arc_joint_angles, optimize_base_arc
+from ..backbone.initial import SHAPE_SEARCH, UpCurveShape
 from ..dynamics import stability
 from ..collision import body_collisions as coll
 from ..margins import DETOUR_MARGIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
+from .base_support import ground_links, static_margins
 
 #: m: the static margin (on the actual ground contacts) the initial state keeps when the paper's configuration
 #: does not keep DETOUR_MARGIN: the plan's static margin and the ZMP's on top, room for the lift's dynamics.
@@ -43,14 +48,12 @@ def initial_margins(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | Non
     smaller static margin of the polygon of the shape points touching the ground and of the base's own (the links
     lying on the ground whatever the pose); -inf where a lifted link dips into the ground (more than
     GROUND_TOLERANCE) or two links overlap."""
-    from .whole_body import BodyProblem
-
     base = BasePlacement() if base is None else base
     qs = np.atleast_2d(np.asarray(qs, float))
     frames = robot.frames_many(qs, base)
     com = stability.center_of_mass(robot, qs, base, frames=frames)
     margin = np.minimum(stability.static_margins_of_frames(robot, frames, com, "ground", stability.CONTACT_TOLERANCE),
-                        BodyProblem(robot).margins(frames))
+                        static_margins(robot, frames, ground_links(robot)))
     ground = coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min(axis=1, initial=np.inf)
     clear = (ground >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(robot, qs, base) > 0.0)
     return np.where(clear, margin, -np.inf)
@@ -59,11 +62,6 @@ def initial_margins(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | Non
 def stable_initial_configuration(robot: SnakeRobot) -> np.ndarray:
     """The initial configuration q (n,) of Section 3.3 (1) (``backbone.initial_configuration``), its base arc
     chosen on the body's actual ground contacts when the paper's does not stand on them (see the module)."""
-    from .. import backbone
-    from ..backbone.base_arc import arc_angle_limit, arc_joint_angles, optimize_base_arc
-    from ..backbone.initial import SHAPE_SEARCH, UpCurveShape
-    from .._errors import Infeasible
-
     q0 = backbone.initial_configuration(robot)
     if initial_margins(robot, q0)[0] >= DETOUR_MARGIN:
         return q0

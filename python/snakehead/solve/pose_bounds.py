@@ -1,8 +1,9 @@
 """Necessary conditions for a whole-body pose that puts the head tip at a position, pointing along a direction:
 cheap tests that prove the whole-body solve cannot pass its exact checks
-(``solve.whole_body.check_solution``: the head within its position and direction tolerances, the static margin
-of the links lying on the ground, the lifted links above the ground), so that a reach map (``planning.whole_body_reach``)
-need not run it. Every test allows for the checks' tolerances; none depends on how the solve searches.
+(:func:`~snakehead.solve.solution_checks.check_solution`: the head within its position and direction tolerances,
+the static margin of the links lying on the ground, the lifted links above the ground), so that a reach map
+(``planning.whole_body_reach``) need not run it. Every test allows for the checks' tolerances; none depends on how
+the solve searches.
 
 * ground (any base): the links rigidly attached to the head tip are a fixed shape around the tip; with the tip
   at the position and pointing along the direction, for the best roll about the direction, their lowest point is
@@ -13,7 +14,7 @@ need not run it. Every test allows for the checks' tolerances; none depends on h
 * stability (base kept): each lifted link's centre of mass lies within its chain distance of the tip and of the
   frame the neck lifts from; the centre of mass of the whole body then lies in a convex set, and when an axis
   separates that set from the support polygon of the links on the ground shrunk by the margin, the pose cannot
-  be stable (the check's margin is at most the margin over those links, ``BodyProblem.margin``).
+  be stable (the check's margin is at most the margin over those links, :mod:`.base_support`).
 """
 from __future__ import annotations
 
@@ -24,6 +25,8 @@ import numpy as np
 from .. import _core
 from ..collision.body_collisions import GROUND_TOLERANCE
 from ..model.robot import BasePlacement, SnakeRobot
+from . import base_support
+from .solution_checks import DIRECTION_TOLERANCE, POSITION_TOLERANCE
 
 __all__ = ["PoseBounds", "ROLL_SAMPLES"]
 
@@ -35,8 +38,7 @@ SEPARATING_AXES = 48
 
 
 def _tolerances() -> tuple[float, float]:
-    from .whole_body import DIRECTION_TOLERANCE, POSITION_TOLERANCE
-
+    """The solution checks' position (m) and direction (rad) tolerances."""
     return float(POSITION_TOLERANCE), float(DIRECTION_TOLERANCE)
 
 
@@ -119,14 +121,11 @@ class PoseBounds:
     def unstable(self, positions: np.ndarray, q: np.ndarray, base: BasePlacement, min_margin: float) -> np.ndarray:
         """Whether no pose with the base kept (placement ``base``, flat shape of ``q``) that puts the tip at the
         positions can hold the centre of mass inside the ground links' support polygon by ``min_margin``."""
-        from .whole_body import BodyProblem
-
         pos_tol, _ = _tolerances()
         robot = self.robot
         p = np.atleast_2d(positions)
-        prob = BodyProblem(robot)
         F = robot.frames(q, base)
-        poly, _ = prob.contact_points(F)
+        poly, _ = base_support.contact_points(robot, F, base_support.ground_links(robot))
         hull = poly[np.asarray(_core.convex_hull_2d(np.ascontiguousarray(poly[:, :2])))][:, :2]
         if len(hull) < 3:
             return np.ones(len(p), bool)  # (the margin is -inf)
