@@ -3,6 +3,7 @@
 #include "snakehead/core_threads.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
+#include "snakehead/random_numbers.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr_jl.hpp>
@@ -21,7 +22,6 @@
 #include <deque>
 #include <functional>
 #include <mutex>
-#include <random>
 #include <thread>
 
 #include <unistd.h>  // getpid: the worker pool's fork safety
@@ -55,44 +55,6 @@ constexpr double kProgress = 0.3;
 // Measured on the 2-core development machine (1000 targets, 5 ms): racing at once (0) gave a 20-40 % higher
 // mean time than 0.02-0.1, which were alike; the medians are the same (most targets never reach the race).
 constexpr double kInlineFraction = 0.05;
-
-// ---------------------------------------------------------------------------------------------------------
-// Random numbers: a deterministic generator and our own uniform mapping (std::uniform_real_distribution
-// is implementation-defined, and seeded results should not depend on the standard library).
-
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ULL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
-
-// SplitMix64 as the generator itself: 8 bytes of state, so seeding one per call costs nothing (a Mersenne
-// twister's 2.5 kB state took a noticeable share of a 20 us solve), and statistically ample for restarts.
-struct Rng {
-  std::uint64_t state = 0;
-  void seed(std::uint64_t s) { state = s; }
-  std::uint64_t operator()() {
-    state += 0x9E3779B97F4A7C15ULL;
-    std::uint64_t z = state;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-  }
-};
-
-double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-// Unseeded calls draw their generators' seeds from a per-thread generator seeded once by the OS.
-Rng& thread_rng() {
-  thread_local Rng rng = [] {
-    std::random_device rd;
-    Rng r;
-    r.seed((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
-    return r;
-  }();
-  return rng;
-}
 
 // ---------------------------------------------------------------------------------------------------------
 // The worker pool: threads made once. A job is shared between its submitter and the worker that runs it, so
@@ -219,8 +181,7 @@ struct Problem {
   double epsilon;
   SolveType type;
   const Eigen::VectorXd& q_init;
-  const Eigen::VectorXd& sample_lo;  // finite sampling range ([-pi, pi] for continuous joints)
-  const Eigen::VectorXd& sample_hi;
+  const SamplingRange& range;  // where restarts are drawn from
 };
 
 struct CallControl {
@@ -251,7 +212,7 @@ double manipulability_score(SolveType type, const Matrix6Xd& jac) {
 // One solver's per-call state: workspace, generator, best solution (guarded by c.result).
 class Search {
  public:
-  Search(const Problem& p, CallControl& c, Rng& rng)
+  Search(const Problem& p, CallControl& c, SplitMix64& rng)
       : p(p), c(c), rng(rng), n(p.model.n_joints()), jac(6, n), dr(6, n), jac_try(6, n), dr_try(6, n), dr_step(6, n), dq(n),
         q_try(n) {}
 
@@ -304,9 +265,7 @@ class Search {
     }
   }
 
-  void random_configuration(Eigen::VectorXd& q) {
-    for (int i = 0; i < n; ++i) q[i] = p.sample_lo[i] + (p.sample_hi[i] - p.sample_lo[i]) * uniform01(rng);
-  }
+  void random_configuration(Eigen::VectorXd& q) { p.range.draw(rng, q); }
 
   void clamp(Eigen::VectorXd& q) const {
     q = q.cwiseMax(p.model.lower()).cwiseMin(p.model.upper());
@@ -314,7 +273,7 @@ class Search {
 
   const Problem& p;
   CallControl& c;
-  Rng& rng;
+  SplitMix64& rng;
   const int n;
   Matrix6Xd jac, dr, jac_try, dr_try, dr_step;
   Eigen::VectorXd dq, q_try;
@@ -576,19 +535,12 @@ void check_pose(const Eigen::Isometry3d& target, const char* what) {
 struct TracIK::Impl {
   std::shared_ptr<const ChainModel> model;
   TracIKOptions options;
-  Eigen::VectorXd sample_lo, sample_hi;
+  SamplingRange range;
   mutable WorkerPool pool;  // thread-safe (its crew's mutex guards it) and fork-safe
 
   Impl(std::shared_ptr<const ChainModel> m, const TracIKOptions& o)
-      : model(std::move(m)), options(o), pool(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {
-    const int n = model->n_joints();
-    sample_lo.resize(n);
-    sample_hi.resize(n);
-    for (int i = 0; i < n; ++i) {
-      sample_lo[i] = std::isfinite(model->lower()[i]) ? model->lower()[i] : -M_PI;
-      sample_hi[i] = std::isfinite(model->upper()[i]) ? model->upper()[i] : M_PI;
-    }
-  }
+      : model(std::move(m)), options(o), range(*model),
+        pool(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {}
 
   void check_q_init(const Eigen::Ref<const Eigen::VectorXd>& q) const {
     model->check_configuration(q, "q_init");
@@ -606,12 +558,12 @@ struct TracIK::Impl {
   // (a worker that the scheduler has parked could otherwise hold the caller for milliseconds).
   struct CallState {
     CallState(const ChainModel& model, const Eigen::Isometry3d& target, const Eigen::VectorXd& q0,
-              const TracIKOptions& o, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi)
-        : q_init(q0), p{model, target, o.bounds, o.epsilon, o.solve_type, q_init, lo, hi}, sq(p, c, rng_sq) {}
+              const TracIKOptions& o, const SamplingRange& range)
+        : q_init(q0), p{model, target, o.bounds, o.epsilon, o.solve_type, q_init, range}, sq(p, c, rng_sq) {}
     Eigen::VectorXd q_init;
     Problem p;
     CallControl c;
-    Rng rng_sq;
+    SplitMix64 rng_sq;
     Search sq;  // the SQP half
   };
 
@@ -620,9 +572,9 @@ struct TracIK::Impl {
   IKResult run(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, const TracIKOptions& o,
                IKAlgorithm algorithm, Schedule schedule, std::uint64_t stream) const {
     const auto t0 = Clock::now();
-    auto st = std::make_shared<CallState>(*model, target, q_init, o, sample_lo, sample_hi);
+    auto st = std::make_shared<CallState>(*model, target, q_init, o, range);
     CallControl& c = st->c;
-    Rng rng_nr;
+    SplitMix64 rng_nr;
     if (o.seed) {
       c.budgeted = true;
       // (timeout <= limits::kMaxTimeoutSeconds, so the budget fits a long: at most 6e10 evaluations)
@@ -634,8 +586,8 @@ struct TracIK::Impl {
       schedule = Schedule::Interleaved;
     } else {
       c.deadline = deadline_after(t0, o.timeout);
-      rng_nr.seed(thread_rng()());
-      st->rng_sq.seed(thread_rng()());
+      rng_nr.seed(thread_generator()());
+      st->rng_sq.seed(thread_generator()());
     }
     Search nr(st->p, c, rng_nr);
     Search& sq = st->sq;

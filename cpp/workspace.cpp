@@ -20,37 +20,12 @@
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
 #include "snakehead/npz.hpp"
+#include "snakehead/random_numbers.hpp"
 #include "snakehead/trac_ik.hpp"
 #include "qhull_run.hpp"
 
 namespace snakehead {
 namespace {
-
-// SplitMix64: turns (seed, index) into well-mixed, independent stream seeds.
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ULL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
-
-std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t salt, std::uint64_t index) {
-  return splitmix64(splitmix64(seed ^ splitmix64(salt)) ^ index);
-}
-
-// Uniform in [0, 1) from 53 random bits: the same numbers on every standard library (unlike
-// std::uniform_real_distribution, whose algorithm is unspecified).
-double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-Eigen::VectorXd random_configuration(const ChainModel& model, std::mt19937_64& rng) {
-  Eigen::VectorXd q(model.n_joints());
-  for (int i = 0; i < model.n_joints(); ++i) {
-    const double lo = std::isfinite(model.lower()[i]) ? model.lower()[i] : -M_PI;
-    const double hi = std::isfinite(model.upper()[i]) ? model.upper()[i] : M_PI;
-    q[i] = lo + (hi - lo) * unit_uniform(rng);
-  }
-  return q;
-}
 
 constexpr std::uint64_t kCloudSalt = 0xC10D;
 constexpr std::uint64_t kVoxelSalt = 0x70CE1;
@@ -133,8 +108,8 @@ ReachBound::ReachBound(const ChainModel& model, const WorkspaceOptions& o)
   arm2_ = arm_ - link.translation().norm();
   const Eigen::Vector3d axis = segs[n - 1].axis;
   const double rho = (elbow - elbow.dot(axis) * axis).norm();
-  const double lo = std::isfinite(model.lower()[n - 1]) ? model.lower()[n - 1] : -M_PI;
-  const double hi = std::isfinite(model.upper()[n - 1]) ? model.upper()[n - 1] : M_PI;
+  const SamplingRange range(model);  // the last joint's range
+  const double lo = range.lo[n - 1], hi = range.hi[n - 1];
   const int samples = 64;
   const double step = (hi - lo) / (samples - 1);
   const Eigen::Isometry3d post_inv = segs[n - 1].post.inverse();
@@ -334,8 +309,13 @@ std::vector<Eigen::Vector3d> sample_tip_positions(const ChainModel& model, int s
     throw InputError("samples must be between 1 and " + std::to_string(limits::kMaxCloudSamples) + ", got " +
                      std::to_string(samples));
   std::mt19937_64 rng(stream_seed(seed, kCloudSalt, 0));
+  const SamplingRange range(model);
   std::vector<Eigen::Vector3d> pts(samples);
-  for (int k = 0; k < samples; ++k) pts[k] = forward_kinematics(model, random_configuration(model, rng)).translation();
+  Eigen::VectorXd q;
+  for (int k = 0; k < samples; ++k) {
+    range.draw(rng, q);
+    pts[k] = forward_kinematics(model, q).translation();
+  }
   return pts;
 }
 
@@ -389,6 +369,7 @@ VoxelEvaluation evaluate_tiles(const ChainModel& model, const WorkspaceOptions& 
   const std::vector<Eigen::Vector3d> dirs = fibonacci_directions(options.directions);
   const int n_rolls = options.free_roll ? 1 : options.rolls;
   const ReachBound bound(model, options);
+  const SamplingRange range(model);
   const double radius = 0.5 * options.voxel_size;
   int n_threads = options.threads > 0 ? options.threads : core_threads();
   n_threads = static_cast<int>(
@@ -533,7 +514,7 @@ VoxelEvaluation evaluate_tiles(const ChainModel& model, const WorkspaceOptions& 
               targets[f] = approach_frame(p, d, 2.0 * M_PI * r / n_rolls, options.approach);
               possible[f] = in_reach && (options.free_roll ? probe_possible[dir] : bound.possible(targets[f]));
               my_cheap += !possible[f];
-              guesses[f] = random_configuration(model, rng);
+              range.draw(rng, guesses[f]);
               seeds[f] = rng();
             }
           }
