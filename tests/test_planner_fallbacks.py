@@ -5,7 +5,7 @@ ZMP check (0 of 6, as the issue found):
 
 * during the lift, "the ZMP comes within 3.3 mm of its edge at t = 0.25 s": a link lifted off the ground between two
   of the retiming's gridpoints and the probes between them measured the ZMP against a gridpoint's larger polygon
-  (``retiming.timing._probe_support`` now takes each probe's own where the two gridpoints' polygons differ);
+  (``retiming.grid_refinement.probe_support`` now takes each probe's own where the two gridpoints' polygons differ);
 * at a sample of the move to the target, the ZMP a few micrometres inside 5 mm, or 1.2 mm from the edge in the lift
   of a relocated base: the same path is now timed again, slower (``planning.fallbacks``), and the first motion that
   passes is kept; a failure lists what was tried.

@@ -55,7 +55,7 @@ def configurations(robot: snakehead.SnakeRobot, draws: int = 2000, seed: int = 3
 
 def fit_inputs(robot: snakehead.SnakeRobot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     lift = np.arange(robot.lift_joints.start, robot.n_joints)
-    return lift, cartesian.tracked_points(robot), cartesian._self_pairs(robot, lift)
+    return lift, cartesian.tracked_points(robot), cartesian.lifted_self_pairs(robot, lift)
 
 
 def test_one_step_is_the_numpy_step(styled):

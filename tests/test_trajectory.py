@@ -623,7 +623,7 @@ def test_monotone_quintic_values_are_scipys_ppoly_to_the_bit():
     f = MonotoneQuintic(times, way)
     t = np.r_[rng.uniform(times[0] - 1.0, times[-1] + 1.0, 40000), times, np.nextafter(times, np.inf)]
     for nu, got in zip((0, 1, 2), f.derivatives(t)):
-        np.testing.assert_array_equal(got, f._pieces[nu](t))
+        np.testing.assert_array_equal(got, f.pieces[nu](t))
     for k in range(1, 8):
         x = np.cumsum(rng.uniform(1e-3, 1.0, 12))
         c = rng.normal(size=(k, 11, 3)) * 10.0 ** rng.uniform(-4, 4, (k, 1, 1))

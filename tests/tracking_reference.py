@@ -18,7 +18,7 @@ import numpy.typing as npt
 from snakehead.geometry.shapes import pair_distances
 from snakehead.model.robot import BasePlacement, SnakeRobot
 from snakehead.planning import waypoints
-from snakehead.trajectory.cartesian import TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING, TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE, TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation, _self_pairs, _tracking_interpolation
+from snakehead.trajectory.cartesian import TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING, TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE, TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation, lifted_self_pairs, tracking_interpolation_with
 
 
 def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,
@@ -73,7 +73,7 @@ def numpy_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, pts_idx:
     """The lifted joints of q's interior samples fitted to P by the numpy loop (a ``cartesian.LiftedFit``)."""
     q = q.copy()
     lo, hi = robot.lower[lift], robot.upper[lift]
-    pairs = _self_pairs(robot, lift)
+    pairs = lifted_self_pairs(robot, lift)
     lam2 = TRACKING_DAMPING ** 2
     current = q[0, lift].copy()
     for j in range(1, len(q) - 1):
@@ -93,7 +93,7 @@ def numpy_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, pts_idx:
 def tracking_interpolation_numpy(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
                                  base: BasePlacement | None = None) -> TrackingInterpolation:
     """``cartesian.tracking_interpolation`` with the numpy fit (as it was before the core's TrackingFit)."""
-    return _tracking_interpolation(robot, q_start, q_end, n, base, numpy_fit)
+    return tracking_interpolation_with(robot, q_start, q_end, n, base, numpy_fit)
 
 
 @contextlib.contextmanager

@@ -42,7 +42,8 @@ moves at -dy/dt there = -2 pi f a sin(delta): sidewinding with delta = +pi/2 goe
 axis at +2 pi f for delta = +pi/2; the arc stays lying on the ground, so the body itself turns about its axis at
 -2 pi f and rolls (as a cylinder rolling on the ground) towards +y.
 
-:meth:`Gait.trajectory` samples a run at the 2 ms control period; :mod:`snakehead.closed_loop.gait_runner` runs it in MuJoCo.
+:meth:`Gait.trajectory` samples a run at the 2 ms control period; :mod:`snakehead.closed_loop.gait_runner` runs it
+in MuJoCo.
 """
 from __future__ import annotations
 
@@ -58,6 +59,9 @@ from ..trajectory.interpolation import CONTROL_PERIOD
 import numpy.typing as npt
 from typing import Any, Callable
 from .._errors import InputError, InputTypeError
+
+__all__ = ["MIN_JOINTS_PER_WAVE", "Wave", "Gait", "virtual_chassis", "rolling", "sidewinding", "turning",
+           "linear_progression", "lateral_undulation", "GAITS", "make_gait"]
 
 #: The fewest joints of a kind per wave (fewer alias the wave: it no longer looks like a wave on the body).
 MIN_JOINTS_PER_WAVE = 3.0
@@ -186,8 +190,8 @@ class Gait:
 
     def shape_height(self, robot: SnakeRobot, samples: int = 40) -> float:
         """How high (m) the gait's shape reaches over one cycle at full amplitude: the largest extent of the links'
-        collision shapes across the plane of the body (along the virtual chassis' z-axis). Resting on that plane, no link
-        rises higher than this; sidewinding and turning lift links by design, to about this height."""
+        collision shapes across the plane of the body (along the virtual chassis' z-axis). Resting on that plane, no
+        link rises higher than this; sidewinding and turning lift links by design, to about this height."""
         robot = as_robot(robot)
         samples = integer(samples, "samples", least=1, most=10_000)
         t = self.ramp_s + np.linspace(0.0, self.period_s, samples, endpoint=False)
@@ -212,7 +216,8 @@ class Gait:
         return t, self.joint_angles(robot, t, cycles)
 
 
-def virtual_chassis(points: np.ndarray, previous: np.ndarray | None = None, forward: npt.ArrayLike | None = None) -> np.ndarray:
+def virtual_chassis(points: np.ndarray, previous: np.ndarray | None = None, forward: npt.ArrayLike | None = None
+                    ) -> np.ndarray:
     """The virtual chassis (4, 4) of body points (k, 3) given in some frame (world): origin at their centroid,
     axes the principal axes of the points (x the longest), z turned up (+z of the frame) and x kept close to
     ``previous``'s x-axis (a 3x3 or 4x4 frame) or, without one, close to ``forward`` (e.g. tail -> head).
@@ -270,9 +275,8 @@ def turning(direction: int = 1, *, yaw_amplitude: float = 0.6, pitch_amplitude: 
 
 def linear_progression(direction: int = 1, *, amplitude: float = 0.5, waves: float = 1.0, frequency: float = 0.5,
                        ramp_s: float = 1.0) -> Gait:
-    """Creep along the body's axis; direction +1 towards the head (a pitch wave running towards the head: on the
-    default robot 0.17 m per cycle at the defaults, bench/RESULTS.md). amplitude (rad) of the pitch joints, waves
-    per body length, frequency Hz."""
+    """Creep along the body's axis; direction +1 towards the head (a pitch wave running towards the head;
+    bench/RESULTS.md measures how far). amplitude (rad) of the pitch joints, waves per body length, frequency Hz."""
     direction = _direction(direction)
     return Gait("linear_progression", Wave(0.0), Wave(amplitude, direction * waves), frequency, direction, "forward",
                 ramp_s, dict(amplitude=amplitude, waves=waves, frequency=frequency, ramp_s=ramp_s))

@@ -6,10 +6,9 @@ Poses are :class:`~snakehead.model.robot.BasePlacement` s of the root frame (x, 
 rigid motions (:func:`compose`, :func:`relative`).
 
 * The curl: the plan starts in the bending state (the base on its arc, neck and head curled flat), and a body
-  lying straight gets there by a joint motion on the ground that slides and turns it (0.76 m and 179 deg on the
-  default robot). :func:`curl_displacement` predicts that motion with the quasi-static friction model of
-  :mod:`snakehead.dynamics.sliding`; :func:`straight_pose_for` is where a straight body must lie for the curl to
-  leave its base at a given placement.
+  lying straight gets there by a joint motion on the ground that slides and turns it. :func:`curl_displacement`
+  predicts that motion with the quasi-static friction model of :mod:`snakehead.dynamics.sliding`;
+  :func:`straight_pose_for` is where a straight body must lie for the curl to leave its base at a given placement.
 * The gaits (:mod:`snakehead.locomotion.gaits`): every run starts and ends with the body straight, and runs whole
   cycles, its amplitudes scaled down for a smaller effect (:func:`gait_run`). Turning in place turns it about
   its middle; sidewinding carries it sideways, square to its axis. Nothing carries it along its axis on an
@@ -35,6 +34,10 @@ from ..dynamics.sliding import predict_slide
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gaits import Gait, make_gait, virtual_chassis
 from .._errors import InputError
+
+__all__ = ["wrap_angle", "compose", "relative", "inverse", "CURL_STEPS", "flat_shape", "curl_path",
+           "curl_displacement", "straight_pose_for", "chassis_offset", "AMPLITUDE_EXPONENT", "MIN_AMPLITUDE_SCALE",
+           "GaitRates", "Tolerance", "LocomotionStep", "gait_run", "next_step"]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -66,7 +69,7 @@ def inverse(a: BasePlacement) -> BasePlacement:
 # ------------------------------------------------------------------------------------------------
 # the curl on the ground
 # ------------------------------------------------------------------------------------------------
-#: Steps of the predicted curl (the prediction converges to < 1 mm with 30 on the default robot).
+#: Steps of the predicted curl (enough for the prediction to converge: bench/RESULTS.md).
 CURL_STEPS = 40
 
 
@@ -126,8 +129,7 @@ def chassis_offset(robot: SnakeRobot) -> BasePlacement:
 
 
 #: How a gait's effect per cycle grows with the scale k of its amplitudes (both waves scaled alike), as k**exponent:
-#: measured on the default robot at 0.5 Hz, whole cycles (sidewinding 101, 204, 307, 391 mm per cycle at k = 0.25,
-#: 0.5, 0.75, 1; turning 8, 20, 34, 46 deg; linear progression 20, 54, 171 mm per cycle at 0.25, 0.5, 1).
+#: fitted to whole cycles of the default robot at 0.5 Hz (bench/RESULTS.md, "Gaits").
 AMPLITUDE_EXPONENT = {"sidewinding": 1.0, "turning": 1.25, "linear_progression": 1.6}
 #: The smallest amplitude scale a run uses (smaller waves barely move the body).
 MIN_AMPLITUDE_SCALE = 0.1
@@ -140,8 +142,8 @@ class GaitRates:
     sideways_m: how far a sidewinding cycle carries the body (m); sideways_angle_rad: the direction it goes for
     ``direction`` +1, from the body's axis (+pi/2: square to its left; -1 goes the mirror way); turn_rad: how far
     a turning cycle turns it (rad, > 0); forward_m: how far a cycle of linear progression carries it along its axis
-    (m; first guess 0.15, the default robot does 0.17 at 0.5 Hz). :meth:`update` learns them from runs: the effect over the cycles run at the
-    run's amplitude scale k, over k**AMPLITUDE_EXPONENT, summed over every run so far.
+    (m; first guess 0.15). :meth:`update` learns them from runs: the effect over the cycles run at the run's
+    amplitude scale k, over k**AMPLITUDE_EXPONENT, summed over every run so far.
     """
 
     sideways_m: float
@@ -154,8 +156,8 @@ class GaitRates:
 
     @classmethod
     def first_guess(cls, robot: SnakeRobot) -> "GaitRates":
-        """0.25 body lengths per sidewinding cycle, square to the body; 40 deg per turning cycle (the default
-        robot does 0.28 and 46 at 0.5 Hz: bench/RESULTS.md, "Gaits")."""
+        """0.25 body lengths per sidewinding cycle, square to the body; 40 deg per turning cycle (a little less
+        than the default robot does: bench/RESULTS.md, "Gaits")."""
         return cls(sideways_m=0.25 * as_robot(robot).body_length)
 
     def update(self, step: "LocomotionStep", start: BasePlacement, end: BasePlacement,

@@ -5,12 +5,10 @@ the bending state must start.
 
 Why the body's middle as a disc: the gaits are turning in place and sidewinding, and each keeps the body within
 :func:`swept_radius` of its middle (the virtual chassis) and within :func:`swept_half_width` of its axis,
-measured on the gaits' own shapes over a cycle (the straight body reaches 0.695 m from its middle on the default
-robot, the gaits' waves 0.657 m; the sidewinding wave 0.12 m across its axis where the straight body is 0.022 m
-wide). So the middle's path is planned on a grid (:data:`RESOLUTION_M`) over the free space of the obstacles'
-footprints (the ground-level outline of their convex shapes) inflated by that radius plus :data:`CLEARANCE_M`:
-grid A* (8-connected, octile heuristic: :func:`astar`), then shortcut by line of sight (:func:`shortcut`). The body
-then turns at each waypoint square to the next leg and sidewinds along it.
+measured on the gaits' own shapes over a cycle. So the middle's path is planned on a grid (:data:`RESOLUTION_M`)
+over the free space of the obstacles' footprints (the ground-level outline of their convex shapes) inflated by that
+radius plus :data:`CLEARANCE_M`: grid A* (8-connected, octile heuristic: :func:`astar`), then shortcut by line of
+sight (:func:`shortcut`). The body then turns at each waypoint square to the next leg and sidewinds along it.
 
 The clearance is a budget, stated once: :data:`EXECUTION_M` (how far a gait leg ends off its line: the loop's
 waypoint tolerance) plus :data:`DRIFT_M` (how far the dead reckoning drifts over a route between fixes).
@@ -36,19 +34,31 @@ from typing import Any, Sequence
 
 import numpy as np
 import numpy.typing as npt
+from scipy.ndimage import distance_transform_edt
+from scipy.spatial import ConvexHull
 
 from .._errors import InputError, Infeasible
 from .._validate import non_negative
+from ..geometry.shapes import shape_points
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from .gaits import make_gait, virtual_chassis
+
+__all__ = ["RESOLUTION_M", "EXECUTION_M", "DRIFT_M", "CLEARANCE_M", "GOAL_CLEARANCE_M", "SWEEP_SAMPLES",
+           "GROUND_HEIGHT_M", "GRID_MARGIN_M", "DETOUR_M", "DETOUR_COST", "MIN_LEG_M", "MAX_STAGING_M", "ClearanceGrid",
+           "footprints", "clearance_grid", "astar", "segment_clear", "shortcut", "Route", "half_width",
+           "swept_extents", "swept_radius", "swept_half_width", "PROFILE_STEPS", "PROFILE_RAMP_STEPS", "SWEPT_GAITS",
+           "PROFILE_SEGMENT_SAMPLES", "SweepProfile", "sweep_profile", "profile_slack", "band_clearance", "plan_route",
+           "TURN_OVERSHOOT", "TURN_SLACK_DEG", "turn_slack", "sweep_clear"]
 
 #: Grid resolution (m).
 RESOLUTION_M = 0.025
 #: The execution margin (m): how much of a route's clearance the body may lose off its line before the route is
-#: planned again from where it is (snakehead.closed_loop.loop: a sidewinding run drifts a few centimetres along the body's
-#: axis, a turn shifts the middle by a few), and what every gait run's predicted sweep keeps from the obstacles.
+#: planned again from where it is (snakehead.closed_loop.loop: a sidewinding run drifts a few centimetres along the
+#: body's axis, a turn shifts the middle by a few), and what every gait run's predicted sweep keeps from the
+#: obstacles.
 EXECUTION_M = 0.06
-#: How far the dead reckoning drifts over a route (m): the onboard estimate drifts 2-5 % of the distance the body
-#: travels (30-110 mm over the 4 m routes of bench/loop.py's box poses, bench/RESULTS.md).
+#: How far the dead reckoning drifts over a route (m): the onboard estimate drifts a few per cent of the distance the
+#: body travels (bench/RESULTS.md).
 DRIFT_M = 0.12
 #: Clearance (m) a route keeps from every obstacle beyond the gaits' swept extent: the budget of both.
 CLEARANCE_M = EXECUTION_M + DRIFT_M
@@ -86,8 +96,6 @@ class ClearanceGrid:
     clearance: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
-        from scipy.ndimage import distance_transform_edt
-
         if self.occupied.any():
             self.distance = distance_transform_edt(~self.occupied) * self.resolution
         else:
@@ -119,10 +127,6 @@ class ClearanceGrid:
 def footprints(obstacles: Sequence[Any], below: float = GROUND_HEIGHT_M) -> list[np.ndarray]:
     """The ground-level outlines (convex polygons (V, 2), counter-clockwise) of the obstacles' convex shapes whose
     lowest point is below ``below`` m."""
-    from scipy.spatial import ConvexHull
-
-    from ..geometry.shapes import shape_points
-
     out = []
     for ob in obstacles:
         for shape in ob.shapes():
@@ -258,8 +262,6 @@ def half_width(robot: SnakeRobot) -> float:
 def _chassis_extents(robot: SnakeRobot, q: np.ndarray) -> tuple[float, float]:
     """The largest distance (m) in the ground plane of the body's hull points from its virtual chassis' origin, and
     across its axis, over the shapes ``q`` (T, n)."""
-    from .gaits import virtual_chassis
-
     F = robot.frames_many(q)
     pts, centres = robot.hull_points(F), robot.link_centres(F)
     radius = across = 0.0
@@ -279,8 +281,6 @@ def swept_extents(robot: SnakeRobot) -> tuple[float, float]:
     """(radius, half width) m: how far from its middle and from its axis the body reaches while lying straight
     or in any shape of a full-amplitude cycle of turning or sidewinding (SWEEP_SAMPLES shapes a cycle; the
     smaller-amplitude runs stay within them)."""
-    from .gaits import make_gait
-
     robot = as_robot(robot)
     if robot in _SWEPT:
         return _SWEPT[robot]
@@ -336,8 +336,6 @@ def _slabs(robot: SnakeRobot, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray,
     among them) PROFILE_SEGMENT_SAMPLES times, each sample counted in the slab of its nearest axis point u_j (half
     a cell apart): the samples' y from lo_j to hi_j (lo_j > hi_j: none); every point of the body within ``pad``
     of a sample (its edges') or between two on one line across the axis (its inside)."""
-    from .gaits import virtual_chassis
-
     F = robot.frames_many(q)
     pts, centres = robot.hull_points(F), robot.link_centres(F)  # (T, k, M, 3), (T, k, 3)
     ia, ib = np.triu_indices(pts.shape[2], 1)
@@ -367,8 +365,6 @@ def sweep_profile(robot: SnakeRobot, gait: str, scale: float = 1.0) -> SweepProf
     one: the samples' spacing along the edges, and half a cell either way. Tighter than the band of
     :func:`swept_half_width` over the whole length: near the ends the wave stays nearer the axis, and a slab
     holds only the side the body reaches."""
-    from .gaits import make_gait
-
     robot = as_robot(robot)
     if gait not in SWEPT_GAITS:
         raise InputError(f"gait must be one of {', '.join(SWEPT_GAITS)}, got {gait!r}")
@@ -538,8 +534,8 @@ def plan_route(robot: SnakeRobot, obstacles: Sequence[Any], start_middle: BasePl
     return Route(waypoints, np.array(headings), staged, R, creep and escaped, escaped, staging_creep and staged)
 
 
-#: A turning run is taken to turn by up to TURN_OVERSHOOT times what the rates predict (the default robot's runs turn
-#: within 15 % of it: bench/RESULTS.md, "Gaits"), and by TURN_SLACK_DEG more either way (a cycle's own sway).
+#: A turning run is taken to turn by up to TURN_OVERSHOOT times what the rates predict (bench/RESULTS.md, "Gaits"),
+#: and by TURN_SLACK_DEG more either way (a cycle's own sway).
 TURN_OVERSHOOT = 2.0
 TURN_SLACK_DEG = 5.0
 
@@ -570,10 +566,10 @@ def sweep_clear(grid: ClearanceGrid, robot: SnakeRobot, gait: str, start_middle:
                 end_middle: BasePlacement, scale: float = 1.0, margin: float = EXECUTION_M) -> bool:
     """Whether a gait run (``gait`` at amplitude ``scale``) that takes the body's middle from ``start_middle`` to
     ``end_middle`` (predicted) stays clear of the obstacles: turning, the disc of :func:`swept_radius` about the
-    middle at both ends, or the sector it may turn through (:func:`turn_slack`), ``margin`` clear; sidewinding, its :func:`sweep_profile` at ``scale`` moved from start
-    to end at the start's heading, and linear progression, the band of the straight body's half width about its
-    axis, likewise: ``margin`` clear, or, where the run starts or ends nearer than that, no nearer than the nearer
-    of its two ends and never touching."""
+    middle at both ends, or the sector it may turn through (:func:`turn_slack`), ``margin`` clear; sidewinding, its
+    :func:`sweep_profile` at ``scale`` moved from start to end at the start's heading, and linear progression, the
+    band of the straight body's half width about its axis, likewise: ``margin`` clear, or, where the run starts or
+    ends nearer than that, no nearer than the nearer of its two ends and never touching."""
     robot = as_robot(robot)
     reach = swept_radius(robot)
     a = np.array([start_middle.x, start_middle.y])

@@ -71,7 +71,8 @@ class Piece:
             if not split.any():
                 break
             refined = refined_grid(points.s, split)
-            if len(refined) > REFINE_GROWTH * first_size + REFINE_EXTRA_POINTS:  # not a local defect: say so rather than grow on
+            # a grid that would grow beyond that is not a local defect: say so rather than grow on
+            if len(refined) > REFINE_GROWTH * first_size + REFINE_EXTRA_POINTS:
                 notes.append(f"waypoints {self.i0}..{self.i1}: {split.sum()} of {len(split)} stages still break a "
                              "limit between gridpoints after refining; see check")
                 break

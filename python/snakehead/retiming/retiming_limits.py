@@ -52,7 +52,8 @@ def _joint_limit(value: npt.ArrayLike | None, n: int, name: str, default: np.nda
         try:
             limit = np.asarray(value, float)
         except (TypeError, ValueError):
-            raise InputTypeError(f"{name} must be a number or an array of {n} numbers, got {type(value).__name__}") from None
+            raise InputTypeError(f"{name} must be a number or an array of {n} numbers, "
+                                 f"got {type(value).__name__}") from None
         if limit.ndim == 0:
             limit = np.full(n, float(limit))
         if limit.shape != (n,):
@@ -63,8 +64,9 @@ def _joint_limit(value: npt.ArrayLike | None, n: int, name: str, default: np.nda
 
 
 def resolve_limits(robot: SnakeRobot, *, velocity_limit: npt.ArrayLike | None = None,
-                   acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT, torque_limit: npt.ArrayLike | None = None,
-                   zmp_margin: float = ZMP_MARGIN, friction: float = FRICTION) -> RetimingLimits:
+                   acceleration_limit: npt.ArrayLike | None = ACCELERATION_LIMIT,
+                   torque_limit: npt.ArrayLike | None = None, zmp_margin: float = ZMP_MARGIN,
+                   friction: float = FRICTION) -> RetimingLimits:
     """The limits :func:`~snakehead.retiming.timing.retime` uses, from its keywords (see there); ValueError/TypeError
     for bad ones."""
     robot = as_robot(robot)

@@ -18,6 +18,12 @@ import numpy.typing as npt
 from typing import Any, Callable, Literal
 from .._errors import InputError
 
+__all__ = ["TrackingInterpolation", "CartesianInterpolation", "joint_angle_towards", "cartesian_interpolation",
+           "cartesian_trajectory", "TRACKING_DAMPING", "TRACKING_ITERATIONS", "TRACKING_CLEARANCE",
+           "TRACKING_GROUND_WEIGHT", "TRACKING_CONTINUITY", "TRACKING_SELF_CLEARANCE", "TRACKING_SELF_STEP",
+           "TRACKING_STEP_TOLERANCE", "lifted_self_pairs", "tracking_fit", "tracked_points", "tracking_interpolation",
+           "LiftedFit", "tracking_interpolation_with"]
+
 
 @dataclass(frozen=True)
 class TrackingInterpolation:
@@ -99,7 +105,8 @@ def _interpolation_parameters(n: int | npt.ArrayLike) -> np.ndarray:
 
 
 def cartesian_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int | npt.ArrayLike,
-                            base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False) -> Any:
+                            base: BasePlacement | None = None, *, aim: str = "segment", full_output: bool = False
+                            ) -> Any:
     """Whole-body interpolation in Cartesian space, Eqs. 41-44: n configurations (n, 16) from q_start to q_end.
 
     ``n`` is the number of samples (t_j of Eq. 41 evenly spaced in [0, 1]) or the t_j themselves, a
@@ -208,16 +215,14 @@ TRACKING_CONTINUITY = 0.03
 #: apart (m), with the ground's weight: thick links (e.g. cylinders wider than a module is long) folded by the
 #: interpolated points would otherwise overlap, and the planner would fall back to a detour for the whole move.
 TRACKING_SELF_CLEARANCE = 0.005
-#: Step (rad) of the finite differences of the self-clearance term's distances. GJK's distances carry noise of
-#: ~1e-7 m: at 1e-6 rad the differences were mostly that noise, and the fit of a folding fat-cylinder neck
-#: (RSNAKE-style) ended anywhere from -2 to +3.6 mm apart as ulps changed (numpy's BLAS kernel, the sample count);
-#: at 1e-5 to 1e-3 rad it ends 3.0-3.7 mm apart, the same on every kernel.
+#: Step (rad) of the finite differences of the self-clearance term's distances: large enough that GJK's distance
+#: noise (~1e-7 m) does not make the differences, so that the fit does not change with round-off (bench/RESULTS.md).
 TRACKING_SELF_STEP = 1e-4
 #: A sample's fit stops after a step (rad, largest joint change) smaller than this.
 TRACKING_STEP_TOLERANCE = 1e-7
 
 
-def _self_pairs(robot: SnakeRobot, lift: np.ndarray) -> np.ndarray:
+def lifted_self_pairs(robot: SnakeRobot, lift: np.ndarray) -> np.ndarray:
     """The self-collision pairs (P, 2) of shapes that the lifted joints ``lift`` move apart: one shape on a link
     that they move, the other not on the same rigid run of links."""
     pairs = robot.self_collision_pairs
@@ -234,7 +239,7 @@ def tracking_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, point
     TRACKING_* settings."""
     return _core.TrackingFit(robot.body.model, robot.geometry.core, robot.root_pose(base), lift.astype(np.int64),
                              points.astype(np.int64), np.asarray(robot.lifted_links, np.int64),
-                             np.ascontiguousarray(_self_pairs(robot, lift), np.int64), damping=TRACKING_DAMPING,
+                             np.ascontiguousarray(lifted_self_pairs(robot, lift), np.int64), damping=TRACKING_DAMPING,
                              iterations=TRACKING_ITERATIONS, step_tolerance=TRACKING_STEP_TOLERANCE,
                              clearance=TRACKING_CLEARANCE, ground_weight=TRACKING_GROUND_WEIGHT,
                              continuity=TRACKING_CONTINUITY, self_clearance=TRACKING_SELF_CLEARANCE,
@@ -263,10 +268,10 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     Where the interpolated points cannot be met (a straight line between two poses shortens the chain, while links
     keep their lengths), the fit is the closest in the least-squares sense; ``deviation`` says how far it is.
 
-    The fit runs in the C++ core (:func:`tracking_fit`, ``_core.TrackingFit``; the GIL released), step for step what
-    the numpy code it replaced did (tests/tracking_reference.py, tests/test_tracking_fit.py).
+    The fit runs in the C++ core (:func:`tracking_fit`, ``_core.TrackingFit``; the GIL released), step for step as
+    the numpy reference does (tests/tracking_reference.py, tests/test_tracking_fit.py).
     """
-    return _tracking_interpolation(robot, q_start, q_end, n, base, _core_fit)
+    return tracking_interpolation_with(robot, q_start, q_end, n, base, _core_fit)
 
 
 #: A fit of the lifted joints: (robot, base, lift, points, q (S, n), targets (S, m, 3)) -> q with rows 1 .. S-2's
@@ -279,8 +284,8 @@ def _core_fit(robot: SnakeRobot, base: BasePlacement, lift: np.ndarray, points: 
     return tracking_fit(robot, base, lift, points).fit(q, P)
 
 
-def _tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
-                            base: BasePlacement | None, fit: LiftedFit) -> TrackingInterpolation:
+def tracking_interpolation_with(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt.ArrayLike, n: int,
+                              base: BasePlacement | None, fit: LiftedFit) -> TrackingInterpolation:
     """:func:`tracking_interpolation` with the lifted joints fitted by ``fit`` (the core's, or the numpy reference's
     in the tests)."""
     robot = as_robot(robot)

@@ -17,6 +17,9 @@ from .._validate import finite_array, finite_float, joint_vector, positive, samp
 import numpy.typing as npt
 from .._errors import Infeasible, InputError
 
+__all__ = ["CONTROL_PERIOD", "JointTrajectory", "joint_spline", "MonotoneQuintic", "sample_times", "joint_trajectory",
+           "joint_interpolation", "minimum_jerk"]
+
 #: The joint controller's period (s), Section 4.
 CONTROL_PERIOD = 0.002
 
@@ -84,14 +87,14 @@ class MonotoneQuintic:
         self.v = v
         # each segment's quintic in its local s = (t - t_k) / h (the Hermite basis above, expanded): q(s) =
         # sum_i c_i s^i; scipy's PPoly holds it in t - t_k (c_i / h^i, highest power first) and its derivatives'
-        # coefficients; the core evaluates them (``_core.evaluate_piecewise_polynomial``: PPoly's numbers to the bit,
-        # ~4x faster on a plan's thousands of samples)
+        # coefficients; the core evaluates them (``_core.evaluate_piecewise_polynomial``: PPoly's numbers to the bit)
         dp, hv0, hv1 = np.diff(self.q, axis=0), h * v[:-1], h * v[1:]
         c = np.stack([self.q[:-1], hv0, np.zeros_like(dp), 10 * dp - 6 * hv0 - 4 * hv1, -15 * dp + 8 * hv0 + 7 * hv1,
                       6 * dp - 3 * hv0 - 3 * hv1], axis=1)  # (K-1, 6, n)
         c = c / h[:, :, None] ** np.arange(6.0)[None, :, None]
         position = PPoly(np.ascontiguousarray(c[:, ::-1].transpose(1, 0, 2)), self.times)
-        self._pieces = (position, position.derivative(1), position.derivative(2))
+        #: q, q' and q'' as scipy PPoly (the coefficients the core evaluates)
+        self.pieces = (position, position.derivative(1), position.derivative(2))
 
     def __call__(self, t: npt.ArrayLike, nu: int = 0) -> np.ndarray:
         if nu not in (0, 1, 2):
@@ -106,7 +109,7 @@ class MonotoneQuintic:
         t = np.ascontiguousarray(np.atleast_1d(np.asarray(t, float)).ravel())
         if not np.isfinite(t).all():
             raise InputError("t must be finite")
-        return [_core.evaluate_piecewise_polynomial(self._pieces[nu].c, self._pieces[nu].x, t) for nu in orders]
+        return [_core.evaluate_piecewise_polynomial(self.pieces[nu].c, self.pieces[nu].x, t) for nu in orders]
 
 
 def sample_times(t0: float, t1: float, dt: float = CONTROL_PERIOD) -> np.ndarray:
