@@ -15,6 +15,7 @@ import numpy as np
 from scipy import optimize
 
 from .._validate import finite_array, finite_float, positive
+from ..dynamics import stability
 from ..model.robot import YAW, BasePlacement, SnakeRobot, as_robot
 from .curves import SpaceCurve
 from .discretize import joint_intervals
@@ -23,14 +24,21 @@ import numpy.typing as npt
 from typing import Any
 from .._errors import Infeasible, InputError
 
-def _check_central_angle(theta: float) -> float:
+__all__ = ["CHORD_MODES", "ArcOptimum", "PlaneArc", "arc_angle_limit", "arc_area_maximum", "arc_joint_angles",
+           "arc_segment_area", "base_arc", "checked_central_angle", "checked_turn", "exact_chord_radius",
+           "optimize_base_arc", "polygon_area"]
+
+
+def checked_central_angle(theta: float) -> float:
+    """A central angle (rad) checked to be finite and in (0, 2 pi] (InputError otherwise)."""
     th = finite_float(theta, "central_angle")
     if not 0.0 < th <= 2.0 * math.pi:
         raise InputError(f"central_angle must be in (0, 2*pi] rad, got {th!r}")
     return th
 
 
-def _check_turn(turn: int) -> int:
+def checked_turn(turn: int) -> int:
+    """A turning sense checked to be +1 (left) or -1 (right) (InputError otherwise)."""
     if turn not in (1, -1):
         raise InputError(f"turn must be +1 (left, counter-clockwise from above) or -1 (right), got {turn!r}")
     return int(turn)
@@ -56,8 +64,8 @@ class PlaneArc:
 
     def __post_init__(self) -> None:
         positive(self.radius, "radius")
-        _check_central_angle(self.central_angle)
-        _check_turn(self.turn)
+        checked_central_angle(self.central_angle)
+        checked_turn(self.turn)
         object.__setattr__(self, "start", finite_array(self.start, "start", (2,)))
         finite_float(self.heading, "heading")
         finite_float(self.height, "height")
@@ -118,7 +126,7 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     ----------
     length : arc length l (m), > 0; it starts at the tail end (at the first selected joint when ``joints``
         does not start at joint 0) and must reach past the last selected joint
-        (the default robot's base is 0.646 m: :func:`base_length`).
+        (the default robot's base is 0.646 m: :attr:`SnakeRobot.base_length`).
     central_angle : theta (rad), in (0, 2 pi].
     robot : the snake.
     joints : which joints lie on the arc; default ``robot.parts.base``.
@@ -140,8 +148,8 @@ def arc_joint_angles(length: float, central_angle: float, robot: SnakeRobot, *,
     central angle outside (0, 2 pi], an unknown chord mode, or a length that does not reach the joints.
     """
     l = positive(length, "length")
-    theta = _check_central_angle(central_angle)
-    turn = _check_turn(turn)
+    theta = checked_central_angle(central_angle)
+    turn = checked_turn(turn)
     if chords not in CHORD_MODES:
         raise InputError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
     robot = as_robot(robot)
@@ -173,7 +181,7 @@ def exact_chord_radius(chords: npt.ArrayLike, central_angle: float) -> float:
     c = finite_array(chords, "chords", (None,))
     if np.any(c <= 0):
         raise InputError("chord lengths must be positive")
-    theta = _check_central_angle(central_angle)
+    theta = checked_central_angle(central_angle)
 
     def span(r: Any) -> float:
         return float(np.sum(2.0 * np.arcsin(np.minimum(c / (2.0 * r), 1.0))))
@@ -202,13 +210,13 @@ def base_arc(robot: SnakeRobot, central_angle: float, base: BasePlacement | None
     link's x-axis, so the end tangent is the robot's P0 x-axis (the yaw angles add up to theta). ``anchor``
     says which end of the body lies exactly on the arc: ``"tail"`` -- the arc starts at the tail end;
     ``"end"`` -- the arc is translated so that it ends at the robot's P0 (``base_end``), which then is the
-    exact G1 join with a curve continuing the body (what :func:`initial_backbone` uses). Either way the
+    exact G1 join with a curve continuing the body (what :func:`~snakehead.backbone.initial.initial_backbone` uses). Either way the
     other joints lie within the discretisation error of the arc (about 1.4 cm at theta = 3 on the default
     robot, growing with theta).
     """
     robot = as_robot(robot)
-    theta = _check_central_angle(central_angle)
-    turn = _check_turn(turn)
+    theta = checked_central_angle(central_angle)
+    turn = checked_turn(turn)
     if anchor not in ("tail", "end"):
         raise InputError(f"anchor must be 'tail' or 'end', got {anchor!r}")
     base = BasePlacement() if base is None else base
@@ -282,16 +290,10 @@ def polygon_area(vertices: npt.ArrayLike) -> float:
     return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
-def _stability() -> Any:
-    from ..dynamics import stability  # imported lazily: stability.py imports robot only, not this module
-    return stability
-
-
 def _support_area_and_margin(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None) -> tuple[float, float]:
     """(area of the support polygon (m^2), static margin of the whole-body CoM (m, > 0 inside))."""
-    st = _stability()
-    poly = st.support_polygon(robot, q, base)
-    return polygon_area(poly), float(st.static_margin(robot, q, base))
+    poly = stability.support_polygon(robot, q, base)
+    return polygon_area(poly), float(stability.static_margin(robot, q, base))
 
 
 def arc_angle_limit(robot: SnakeRobot, *, turn: int = 1, chords: str = "arclength") -> float:
@@ -302,7 +304,7 @@ def arc_angle_limit(robot: SnakeRobot, *, turn: int = 1, chords: str = "arclengt
     on minor arcs (:func:`exact_chord_radius`).
     """
     robot = as_robot(robot)
-    turn = _check_turn(turn)
+    turn = checked_turn(turn)
     if chords not in CHORD_MODES:
         raise InputError(f"chords must be one of {CHORD_MODES}, got {chords!r}")
     l = robot.base_length
@@ -363,13 +365,13 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
     ----------
     robot : the snake.
     q_up : joint angles (rad) of the joints after the base (neck and head), held fixed while theta varies;
-        default: the up curve of :func:`initial_backbone`'s default :class:`UpCurveShape`.
+        default: the up curve of :func:`~snakehead.backbone.initial.initial_backbone`'s default :class:`~snakehead.backbone.initial.UpCurveShape`.
     base : where the tail lies (default ``BasePlacement()``).
     min_margin : required static margin (m), >= 0.
     turn : +1 left, -1 right.
     bounds : (theta_lo, theta_hi) rad; default (0.05, :func:`arc_angle_limit`).
     chords : the base's discretisation (:func:`arc_joint_angles`); default ``"arclength"`` (Eq. 9), the one
-        :func:`initial_backbone` uses.
+        :func:`~snakehead.backbone.initial.initial_backbone` uses.
     n_grid : points of the coarse scan before the bounded scalar refinement (scipy.optimize.minimize_scalar).
 
     The scan finds the best feasible grid angle; the refinement maximises the area between its neighbours,
@@ -390,15 +392,15 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
       4.23 rad (242 deg, area 536.6 cm^2).
     """
     robot = as_robot(robot)
-    turn = _check_turn(turn)
+    turn = checked_turn(turn)
     min_margin = finite_float(min_margin, "min_margin")
     if min_margin < 0:
         raise InputError(f"min_margin must be >= 0 m, got {min_margin}")
     nb = robot.parts.base.stop
     if q_up is None:
-        from .initial import UpCurveShape, _q_up_for  # the default up curve (initial.py builds on this module)
+        from .initial import UpCurveShape, up_curve_joint_angles  # a cycle: initial.py builds on this module
 
-        q_up = _q_up_for(robot, UpCurveShape.for_robot(robot), turn)[0]
+        q_up = up_curve_joint_angles(robot, UpCurveShape.for_robot(robot), turn)[0]
     q_up = finite_array(q_up, "q_up", (robot.n_joints - nb,))
     lim = arc_angle_limit(robot, turn=turn, chords=chords)
     lo, hi = (0.05, lim) if bounds is None else (

@@ -29,6 +29,9 @@ from ..model.body_frame import AXIS_TOLERANCE_DEG
 import numpy.typing as npt
 from .._errors import InputError
 
+__all__ = ["DEFAULT_FD_STEP", "DEFAULT_RTOL", "STRAIGHT_TOLERANCE", "SpaceCurve", "cubic_bezier",
+           "planar_bezier_length"]
+
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
 DEFAULT_FD_STEP = 2e-3
 
@@ -325,7 +328,7 @@ def cubic_bezier(control_points: npt.ArrayLike) -> SpaceCurve:
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(64)
 
 
-def _planar_bezier_length(B: np.ndarray) -> float:
+def planar_bezier_length(B: np.ndarray) -> float:
     """Length of the planar cubic Bezier with (4, 2) control points (64-point Gauss-Legendre)."""
     t = 0.5 * (_GL_X + 1.0)
     u = 1.0 - t

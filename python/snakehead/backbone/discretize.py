@@ -51,6 +51,8 @@ from .curves import SpaceCurve
 import numpy.typing as npt
 from .._errors import InputError, InputTypeError
 
+__all__ = ["curve_joint_angles", "discretize", "joint_intervals"]
+
 
 def joint_intervals(s_joints: npt.ArrayLike, kinds: Sequence[str], curve_length: float) -> np.ndarray:
     """The [s1, s2] of Eqs. 5-6 for each joint (see the module notes, "Joint intervals"): (m, 2) m.

@@ -10,14 +10,18 @@ import numpy as np
 from scipy import optimize
 
 from .._validate import finite_array, positive
+from ..dynamics import stability
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
-from .base_arc import (ArcOptimum, PlaneArc, _check_central_angle, _check_turn, arc_joint_angles, base_arc,
+from .base_arc import (ArcOptimum, PlaneArc, arc_joint_angles, base_arc, checked_central_angle, checked_turn,
                        optimize_base_arc)
-from .curves import SpaceCurve, _planar_bezier_length, cubic_bezier
+from .curves import SpaceCurve, cubic_bezier, planar_bezier_length
 from .discretize import curve_joint_angles
 
 from typing import Any
 from .._errors import Infeasible, InputError, InputTypeError
+
+__all__ = ["HEIGHT_SHARE", "REACH_SHARE", "SHAPE_SEARCH", "InitialBackbone", "UpCurveShape", "initial_backbone",
+           "initial_configuration", "up_curve", "up_curve_joint_angles", "up_length"]
 
 #: The default up curve's end point as shares of the neck and head's length (0.55 m and -0.10 m of 0.738 m on
 #: the default robot), so that the shape scales with any robot.
@@ -95,11 +99,11 @@ class UpCurveShape:
             raise Infeasible(f"the head tip (reach {self.reach}, height {self.height}) is {chord:.4g} m from P0, "
                              f"beyond the {L:.4g} m the neck and head can reach")
         a_max = L
-        while _planar_bezier_length(pts(a_max)) < L:
+        while planar_bezier_length(pts(a_max)) < L:
             a_max *= 2.0
             if a_max > 1e3 * L:
                 raise Infeasible("no handle length gives the curve the body's length")
-        a = optimize.brentq(lambda a: _planar_bezier_length(pts(a)) - L, 0.0, a_max, xtol=1e-14, rtol=1e-14)
+        a = optimize.brentq(lambda a: planar_bezier_length(pts(a)) - L, 0.0, a_max, xtol=1e-14, rtol=1e-14)
         return pts(a)
 
 
@@ -120,8 +124,11 @@ def up_length(robot: SnakeRobot) -> float:
     return robot.body_length - robot.base_length
 
 
-def _q_up_for(robot: SnakeRobot, shape: UpCurveShape, turn: int) -> tuple[np.ndarray, SpaceCurve, np.ndarray, float]:
-    """Joint angles after the base for ``shape``, computed at theta = pi and the default placement.
+def up_curve_joint_angles(robot: SnakeRobot, shape: UpCurveShape, turn: int
+                          ) -> tuple[np.ndarray, SpaceCurve, np.ndarray, float]:
+    """The joint angles (rad) after the base that lay the neck and head along ``shape``'s up curve (Eqs. 3-7),
+    computed at theta = pi and the default placement, with the curve (world), its (4, 3) control points (m) and
+    its phase at P0 (rad). Infeasible when Eqs. 3-7 cannot follow the curve.
 
     The up curve is rigidly attached to the arc's end frame, so its curvature, torsion and initial phase, and
     hence these angles, do not depend on the arc's central angle or the placement.
@@ -191,20 +198,20 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
     """
     robot = as_robot(robot)
     base = BasePlacement() if base is None else base
-    turn = _check_turn(turn)
+    turn = checked_turn(turn)
     if shape is None:
         try:
             return initial_backbone(robot, central_angle=central_angle, shape=UpCurveShape.for_robot(robot),
                                     base=base, turn=turn, min_margin=min_margin)
         except Infeasible as first_error:
             return _searched_backbone(robot, central_angle, base, turn, min_margin, first_error)
-    q_up, _, _, phi0 = _q_up_for(robot, shape, turn)
+    q_up, _, _, phi0 = up_curve_joint_angles(robot, shape, turn)
     optimum = None
     if central_angle is None:
         optimum = optimize_base_arc(robot, q_up, base, min_margin=min_margin, turn=turn)
         theta = optimum.central_angle
     else:
-        theta = _check_central_angle(central_angle)
+        theta = checked_central_angle(central_angle)
     q_base = arc_joint_angles(robot.base_length, theta, robot, turn=turn)
     q = np.concatenate([q_base, q_up])
     bad = np.flatnonzero((q < robot.lower - 1e-12) | (q > robot.upper + 1e-12))
@@ -220,8 +227,6 @@ def initial_backbone(robot: SnakeRobot, *, central_angle: float | None = None,
 def _searched_backbone(robot: SnakeRobot, central_angle: float | None, base: BasePlacement | None, turn: int,
                        min_margin: float, first_error: Infeasible) -> InitialBackbone:
     """The backbone of SHAPE_SEARCH's shapes with the largest static margin (see :func:`initial_backbone`)."""
-    from ..dynamics import stability
-
     L = up_length(robot)
     best, best_margin = None, -math.inf
     for h, r, a in SHAPE_SEARCH:

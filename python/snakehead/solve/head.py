@@ -15,14 +15,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validate import finite_array, finite_float, integer, pose, unit_vector3, vector3
-from ..kinematics.ik import TracIK
+from ..kinematics.ik import FREE_ROLL, TracIK
 
 import numpy.typing as npt
 from typing import Any, Callable
 from .._errors import InputTypeError
 
-#: Tolerances (vx vy vz wx wy wz, target frame) that leave the roll about the head's x-axis free.
-FREE_ROLL_BOUNDS = np.array([0.0, 0.0, 0.0, np.inf, 0.0, 0.0])
+__all__ = ["FREE_ROLL_BOUNDS", "HeadIKResult", "angle_between_deg", "frame_along", "frame_from_direction", "free_roll",
+           "position_and_direction_error", "roll_about_x", "rotated_frames", "select"]
+
+#: Tolerances (vx vy vz wx wy wz, target frame) that leave the roll about the head's x-axis free (TRAC-IK's).
+FREE_ROLL_BOUNDS = np.array(FREE_ROLL)
 
 
 def frame_from_direction(position: npt.ArrayLike, direction: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)

@@ -33,6 +33,8 @@ import numpy.typing as npt
 from typing import Any, Callable
 from .._errors import InputError, InputTypeError, entry_point, inputs_checked
 
+__all__ = ["FREE_ROLL_ATTEMPTS", "HeadController", "HeadSolution"]
+
 #: TRAC-IK calls of the head's free-roll solve from different starts (an unseeded solver's calls search anew).
 FREE_ROLL_ATTEMPTS = 3
 
@@ -152,7 +154,8 @@ class HeadController:
         if base is not None and not isinstance(base, BasePlacement):
             raise InputTypeError(f"base must be a BasePlacement, got {type(base).__name__}")
         if accept is not None and not callable(accept):
-            raise InputTypeError(f"accept must be a callable accept(q, base) -> bool or None, got {type(accept).__name__}")
+            raise InputTypeError("accept must be a callable accept(q, base) -> bool or None, got "
+                                 f"{type(accept).__name__}")
         inputs_checked()
         return self.solve_checked(position, direction, q_prev, base, accept, allow_base_move)
 

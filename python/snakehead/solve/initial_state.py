@@ -36,6 +36,8 @@ from ..margins import DETOUR_MARGIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from .base_support import ground_links, static_margins
 
+__all__ = ["ANGLE_GRID", "INITIAL_MARGIN", "initial_margins", "stable_initial_configuration"]
+
 #: m: the static margin (on the actual ground contacts) the initial state keeps when the paper's configuration
 #: does not keep DETOUR_MARGIN: the plan's static margin and the ZMP's on top, room for the lift's dynamics.
 INITIAL_MARGIN = DETOUR_MARGIN + ZMP_MARGIN

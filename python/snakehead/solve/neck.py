@@ -19,6 +19,10 @@ from ..model.robot import BasePlacement
 import numpy.typing as npt
 from .._errors import InputError, InputTypeError
 
+__all__ = ["CONTINUITY_TOLERANCE", "DEFAULT_H", "FIT_ITERATIONS", "FIT_TOLERANCE", "GRID_FRACTION", "GRID_POINTS",
+           "NeckGoal", "NeckSolution", "RangeCheck", "accepted_range", "base_move_into_range", "dexterous_distance",
+           "neck_goal", "solve_neck"]
+
 #: Eq. 22's weight of the direction term (the paper: "h can be set 0.01").
 DEFAULT_H = 0.01
 #: How much lower (m^2) Eq. 22's cost from another start must be to leave the minimum reached from q_init.
@@ -86,7 +90,8 @@ def accepted_range(P_hd: npt.ArrayLike, P0: npt.ArrayLike, Lc: float, neck_lengt
         reason = f"target too far: the neck must span {span:.4f} m but is {neck_length:.4f} m long"
         ok = False
     elif neck_length - span >= slack:
-        reason = f"target too close: the neck ({neck_length:.4f} m) would have {neck_length - span:.4f} m slack (> {slack:.4f} m)"
+        reason = (f"target too close: the neck ({neck_length:.4f} m) would have {neck_length - span:.4f} m slack "
+                  f"(> {slack:.4f} m)")
         ok = False
     else:
         reason = "in range"
@@ -96,6 +101,8 @@ def accepted_range(P_hd: npt.ArrayLike, P0: npt.ArrayLike, Lc: float, neck_lengt
 
 @dataclass(frozen=True)
 class NeckSolution:
+    """Eq. 22's minimum: the neck joints and the neck end frame B0 they reach."""
+
     q: np.ndarray  # (n_neck,) joint angles (rad)
     frame: np.ndarray  # (4, 4) world pose of the neck end B0 reached
     cost: float  # Eq. 22's E_n at q
@@ -109,10 +116,9 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
 
     ``neck`` is the chain from the base's end frame (P0) to the neck end frame (B0); ``P0_frame`` (4, 4) is
     the world pose of P0. Eq. 22 is a sum of squares of six residuals, so it is solved by a bounded
-    Levenberg-Marquardt with the analytic Jacobian in the C++ core (``_core.fit_neck``, neck_fit.hpp; a
-    general-purpose scipy minimiser costs ~10x more), started from ``q_init`` and from the best point of a coarse
-    grid (GRID_POINTS per joint; Eq. 22 is not convex); the minimum reached from ``q_init`` is kept unless the grid's
-    is lower by more than ``CONTINUITY_TOLERANCE``.
+    Levenberg-Marquardt with the analytic Jacobian in the C++ core (``_core.fit_neck``, neck_fit.hpp), started from
+    ``q_init`` and from the best point of a coarse grid (GRID_POINTS per joint; Eq. 22 is not convex); the minimum
+    reached from ``q_init`` is kept unless the grid's is lower by more than ``CONTINUITY_TOLERANCE``.
     """
     if not isinstance(neck, Chain):
         raise InputTypeError(f"neck must be a snakehead Chain, got {type(neck).__name__}")
@@ -124,7 +130,8 @@ def solve_neck(neck: Chain, P0_frame: npt.ArrayLike, goal: NeckGoal, h: float = 
         T = P0_frame @ neck.fk(np.zeros(0))
         ra = T[:3, 0]
         cost = float(np.sum((T[:3, 3] - goal.P_d) ** 2) + h * np.sum(np.cross(goal.r_d, ra) ** 2))
-        return NeckSolution(q=np.zeros(0), frame=T, cost=cost, position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
+        return NeckSolution(q=np.zeros(0), frame=T, cost=cost,
+                            position_error_m=float(np.linalg.norm(T[:3, 3] - goal.P_d)),
                             direction_error_deg=angle_between_deg(ra, goal.r_d))
     q_init = None if q_init is None else finite_array(q_init, "q_init", (neck.n_joints,))
     best_q, best_cost = _core.fit_neck(neck.model, P0_frame, goal.P_d, goal.r_d, q_init, h=h,
@@ -142,8 +149,9 @@ def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: Bas
     """The planar move of the base (as the rolling gait or turning in place would give) that brings P_hd in range.
 
     ``P0_local`` (4, 4) is P0's pose relative to the body frame (fixed while the base keeps its shape);
-    ``height`` the body frame's height above the ground (``SnakeRobot.body_axis_height``). The base turns so that P0's body axis points horizontally at the target, then slides along it
-    so that the neck must span the middle of the accepted band. Returns None when no placement can do it
+    ``height`` the body frame's height above the ground (``SnakeRobot.body_axis_height``). The base turns so that
+    P0's body axis points horizontally at the target, then slides along it so that the neck must span the middle of
+    the accepted band. Returns None when no placement can do it
     (the target is too high for the neck and head to reach from the ground).
     """
     P_hd = vector3(P_hd, "P_hd")
