@@ -189,7 +189,7 @@ _MARKDOWN_SPECIAL = frozenset("\\`*_[]<>&|~$#")
 
 def markdown_text(text: Any) -> str:
     r"""``text`` (a name, a message) as Markdown shows it literally, within a line or a table cell: each character
-    that Markdown reads as markup (:data:`_MARKDOWN_SPECIAL`) backslash-escaped (``<script>`` is text, a ``|`` does
+    that Markdown reads as markup (``_MARKDOWN_SPECIAL``) backslash-escaped (``<script>`` is text, a ``|`` does
     not split a cell, a ``\`` stays), a leading ``-``, ``+``, ``=`` or ``1.`` kept from starting a list (in a list
     item), line breaks and other control characters made spaces and lone surrogates U+FFFD (a name has none: they
     are refused where names enter; a message may). Surrounding whitespace is dropped, as a table cell drops it."""

@@ -11,8 +11,8 @@ orientation of one link (an IMU's attitude), never the simulator's positions.
   corners, cylinder rims, sphere and hull vertices: :class:`ShapePoints`) that are lowest, a material point of the
   link. Between two updates the body is moved by the translation that balances
   the friction of those contact points (``odometry="friction"``, the default: the weighted geometric median of
-  the shifts that would keep each still, loads the links' masses, :func:`snakehead.dynamics.sliding.
-  balance_translation`; contacts slip where the others outpull them, and stay put where they hold), or by the
+  the shifts that would keep each still, loads the links' masses,
+  :func:`snakehead.dynamics.sliding.balance_translation`; contacts slip where the others outpull them, and stay put where they hold), or by the
   average of those shifts (``odometry="no-slip"``: every contact assumed not to slip).
 * The virtual chassis (:func:`snakehead.locomotion.gaits.virtual_chassis`, after Rollinson and Choset, "Virtual
   Chassis for Snake Robots", IROS 2011): a frame at the centroid of the body's points whose x-axis is the principal

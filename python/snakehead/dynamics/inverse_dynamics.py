@@ -186,7 +186,7 @@ def momentum_rates(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: 
                    base: BasePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Rates of the linear and angular momentum (about the world origin) of Eqs. 33-34: (dP/dt, dL/dt), (T, 3) each.
 
-    q, qd, qdd (T, n) (or (n,) -> (3,)). The momenta of Eqs. 25-31 (:func:`stability.momenta_from_velocities`) are
+    q, qd, qdd (T, n) (or (n,) -> (3,)). The momenta of Eqs. 25-31 (:func:`~snakehead.dynamics.stability.momenta_from_velocities`) are
     linear in the joint velocities, P = A(q) qd, so dP/dt = A(q) qdd + (dA/dq . qd) qd: the first term is the
     momentum of the velocity qdd, the second the derivative of P(q, v) at fixed v = qd along qd, taken here by a
     central difference (step :data:`MOMENTUM_STEP` rad on the largest joint; the error is of its square).

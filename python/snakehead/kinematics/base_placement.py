@@ -1,7 +1,7 @@
 """Where to put a robot's base so that its head reaches a target: the head map's inverse reachability, on the
 ground.
 
-:func:`map_queries.inverse` gives the poses of the head's base frame B0 from which the head reaches a target
+:func:`~snakehead.kinematics.reachability.map_queries.inverse` gives the poses of the head's base frame B0 from which the head reaches a target
 (position, direction). A robot cannot put B0 anywhere: its base lies on the ground (a planar placement: x, y,
 yaw) and its neck moves B0 relative to the base. :func:`base_placements` intersects the two:
 

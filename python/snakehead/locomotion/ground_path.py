@@ -361,7 +361,7 @@ def sweep_profile(robot: SnakeRobot, gait: str, scale: float = 1.0) -> SweepProf
     chassis frame: the straight body's shapes and a cycle's at every amplitude up to the PROFILE_STEPS step at or
     above ``scale`` (the ramps' too: PROFILE_RAMP_STEPS envelopes a step), both directions, SWEEP_SAMPLES a
     cycle; per slab across the axis (half a grid cell wide, out to the swept radius) the samples' extent across
-    it (:func:`_slabs`), filled with points half a cell apart. Every point of those shapes lies within ``pad`` of
+    it (``_slabs``), filled with points half a cell apart. Every point of those shapes lies within ``pad`` of
     one: the samples' spacing along the edges, and half a cell either way. Tighter than the band of
     :func:`swept_half_width` over the whole length: near the ends the wave stays nearer the axis, and a slab
     holds only the side the body reaches."""

@@ -70,7 +70,7 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
 
     The curl :func:`ground_curl_exhaustive` finds (the largest margin among the curls clear of themselves, every
     curl's margin from the robot's own kinematics), found without the kinematics of every curl: the margins from
-    the chain's transforms composed joint by joint (:func:`_curl_com`, :func:`_line_margins`: the same to
+    the chain's transforms composed joint by joint (``_curl_com``, ``_line_margins``: the same to
     round-off, far below CURL_MARGIN_SLACK); the curls are checked for self-clearance in that order until one
     passes, and the exhaustive margins then rank the curls whose fast margin is within twice the slack of that
     one's (every curl that can be ranked before the answer: the result is the exhaustive one's)."""

@@ -183,7 +183,7 @@ class Waypoints:
     def static_margins(self, qs: np.ndarray) -> np.ndarray:
         """Static margins (m) of configurations qs (m, n): the CoM's distance inside the support polygon of every
         link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
-        the smaller of that and the base's own (:meth:`_base_margins`): a motion must not lean on a neck or head
+        the smaller of that and the base's own (``_base_margins``): a motion must not lean on a neck or head
         link that touches the ground at a checked configuration and may leave it in between."""
         com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
         margin = stability.support_margins(self.robot, qs, com, self.base, contact=PLAN_CONTACT)

@@ -14,7 +14,7 @@ from .published import REU_THIRDS, XACRO_DEFAULT_MODULES, StyleSpec, _num, _part
 
 def reu_xacro(spec: StyleSpec) -> str:
     """The ReU-style snake as a xacro file: a ``module`` macro unrolled by a recursive ``modules`` macro over
-    ``$(arg n_modules)`` modules. Expanded with ``n_modules = spec.n_joints`` it is :func:`reu_urdf` of ``spec``
+    ``$(arg n_modules)`` modules. Expanded with ``n_modules = spec.n_joints`` it is :func:`~snakehead.samples.published.reu_urdf` of ``spec``
     (same links, joints, numbers). ``spec.n_joints`` only sets the servo effort; the arg sets the length."""
     return _xacro_properties(spec) + _XACRO_LINK_MACROS + _xacro_module_macros() + _XACRO_CHAIN
 

@@ -39,7 +39,7 @@ physics step as in a servo's inner loop, with the velocity gain integrated impli
 distal links). Gravity compensation (``gravity_compensation``):
 
 * "supported" (default): each joint holds the weight of the run of lifted links hanging from it, up to the
-  first link that rests on the ground in the plan (:func:`carried_weights`, :func:`gravity_torques`); links
+  first link that rests on the ground in the plan (:func:`~snakehead.dynamics.inverse_dynamics.carried_weights`, :func:`~snakehead.sim.tracking.gravity_torques`); links
   on the ground are carried by the ground;
 * "bias": MuJoCo's ``qfrc_bias`` (gravity + Coriolis) on every joint, the textbook term for a fixed-base arm.
   For a snake lying on the ground it is wrong at the base joints: it is the torque that would hold the whole

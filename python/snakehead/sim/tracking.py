@@ -131,7 +131,7 @@ def center_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray:
 class SimState:
     """A snapshot of the simulated robot: MuJoCo's qpos and qvel, and the simulated time (s). Any model of the same
     robot takes it (obstacles and ground settings add no state): a gait run, a curl and a head plan continue from
-    one another's states (:class:`snakehead.sim.GaitSimulator`, :func:`simulate_trajectory` with ``state=``)."""
+    one another's states (:class:`snakehead.closed_loop.GaitSimulator`, :func:`simulate_trajectory` with ``state=``)."""
 
     qpos: np.ndarray
     qvel: np.ndarray
@@ -154,7 +154,7 @@ class SimState:
 
 @dataclass
 class SimResult:
-    """What :func:`simulate` recorded, one row per control tick (``control_dt`` apart), after settling.
+    """What :func:`simulate_trajectory` recorded, one row per control tick (``control_dt`` apart), after settling.
 
     t (N,) s, starting at the planned t[0]; q, qdot, q_ref (N, n) rad, rad/s; tau (N, n) N m applied joint
     torques; head_pose (N, 4, 4) world pose of ``head_tip``; P (N, 3) kg m/s and L (N, 3) kg m^2/s momenta about
@@ -250,7 +250,7 @@ def sample_count_covering(span: float, period: float) -> int:
     return int(math.ceil(max(span, 0.0) / period - 1e-9)) + 1
 
 
-#: Modes of gravity compensation in :func:`simulate`.
+#: Modes of gravity compensation in :func:`simulate_trajectory`.
 GRAVITY_COMPENSATION = ("supported", "bias", "none")
 
 def _compensated_mode(gravity_compensation: str) -> str:

@@ -28,7 +28,7 @@ CONTROL_PERIOD = 0.002
 class JointTrajectory:
     """A sampled joint trajectory: t (T,) s, q (T, n) rad, qd (T, n) rad/s, qdd (T, n) rad/s^2, and the
     spline it samples (``spline(t, nu)`` evaluates the nu-th derivative anywhere; None for
-    :func:`cartesian_trajectory`)."""
+    :func:`~snakehead.trajectory.cartesian.cartesian_trajectory`)."""
 
     t: np.ndarray
     q: np.ndarray

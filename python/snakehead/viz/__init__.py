@@ -5,9 +5,9 @@ backend is chosen at import or at all, and nothing needs closing), and :func:`sa
 to a file, atomically. By topic:
 
 * :mod:`.body` -- the body in 3-D with its scene: Figs. 17/22 (snapshots), Fig. 8 (a head solution), Figs. 11/13;
-* :mod:`.backbone` -- backbone curves and their links: Figs. 2-3 and 14, the base arc's area against its angle;
-* :mod:`.workspace` -- reachability maps: Figs. 4-7;
-* :mod:`.dynamics` -- momenta (Figs. 18-19) and the ZMP in the support polygon (Fig. 20);
+* :mod:`.backbone_figures` -- backbone curves and their links: Figs. 2-3 and 14, the base arc's area against its angle;
+* :mod:`.reachability_figures` -- reachability maps: Figs. 4-7;
+* :mod:`.dynamics_figures` -- momenta (Figs. 18-19) and the ZMP in the support polygon (Fig. 20);
 * :mod:`.animation` -- a plan's motion as a GIF (:func:`~.animation.animate`);
 * :mod:`.viewer` -- the interactive 3-D viewer (viser): a standalone HTML page per plan and ``snakehead view``;
 * :mod:`.live` -- the live viewer (``snakehead view --live``): drag the head's targets, the plan follows

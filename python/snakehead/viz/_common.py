@@ -67,7 +67,7 @@ def save(figure: Figure | BodyAnimation, path: PathLike, *, dpi: float | None = 
     """Write a figure (PNG, PDF, SVG, ... by the suffix) or an animation (``.gif``) to ``path``; returns the path.
 
     The file appears whole or not at all: it is written under a temporary name in the same folder and renamed
-    (:func:`snakehead._files.atomic_open`). Missing parent folders are created. Figures are cropped to what is
+    (``snakehead._files.atomic_open``). Missing parent folders are created. Figures are cropped to what is
     drawn (``bbox_inches="tight"``) at ``dpi`` (default :data:`DEFAULT_DPI`); an animation has its own size.
     """
     from .animation import BodyAnimation

@@ -83,7 +83,7 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     believed it was (dead reckoning, dashed; a fix is a jump of it); the body's footprint at the start, after every
     ground phase and at the end; the targets (crosses, their height written beside them). Phases are numbered
     along the path and listed in the legend with their times. Axes in m, equal scales. Names (the scene's, the
-    targets', the phases') are shown as they are (:func:`~snakehead.viz._common.literal`); ``title`` replaces the
+    targets', the phases') are shown as they are (``literal``); ``title`` replaces the
     title as given (matplotlib's mathtext applies to it)."""
     _check(run)
     from matplotlib.collections import PolyCollection

@@ -27,7 +27,7 @@ request passes :class:`ServerGuard` before viser sees it:
   at once.
 
 How: viser starts its server with ``websockets.asyncio.server.serve`` on a thread of its own, inside
-``viser.ViserServer()``. :func:`guarded_server` makes that call pass through :func:`_guarded_serve`, which adds the
+``viser.ViserServer()``. :func:`guarded_server` makes that call pass through ``_guarded_serve``, which adds the
 guard's ``process_request``, ``process_response``, message size and connection class to viser's own (its static
 page server stays behind the guard). If viser ever starts its server another way the guard is not applied, and
 :func:`guarded_server` stops the server and raises rather than serve unguarded.

@@ -100,7 +100,7 @@ def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
 
 def load_viewer_scene(path: str | Path) -> ViewerScene:
     """Read a scene written by :func:`save_viewer_scene`: ValueError if the file is not one, is damaged (see
-    :func:`snakehead._files.read_npz`) or its arrays disagree (shapes, kinds, indices)."""
+    ``snakehead._files.read_npz``) or its arrays disagree (shapes, kinds, indices)."""
     where = f"{os.fspath(path)}"
     contents = read_npz(path, "viewer scene", max_bytes=MAX_SCENE_BYTES)
     version = contents.pop("format", None)

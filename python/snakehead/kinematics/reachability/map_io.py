@@ -85,7 +85,7 @@ _KINDS = {"text": "U", "int": "iu", "bool": "b", "float": "fiu"}
 
 
 def validate_map_arrays(arrays: dict[str, np.ndarray], where: str = "the map") -> None:
-    """Check the arrays of a map file (as :func:`snakehead._files.read_npz` returns them) before a map is made of
+    """Check the arrays of a map file (as ``snakehead._files.read_npz`` returns them) before a map is made of
     them: InputError naming the field for a missing key, metadata of the wrong type, shapes that disagree, indices
     outside [0, 100] or not 100 * solved / tried, solved counts outside [0, tried], NaN or non-positive sizes,
     voxel ids duplicated, out of order or outside the grid, voxel centres that are not their voxels' centres,
@@ -231,7 +231,7 @@ def load(path: str | os.PathLike) -> ReachabilityMap:
 
     A map file of the first format loads too: its voxels were those of the convex hull, and it lacks the
     per-direction results (``m.lacks == ("reached",)``; queries then say so). InputError for a missing, foreign,
-    damaged or inconsistent file (:func:`snakehead._files.read_npz`, :func:`validate_map_arrays`), naming what is
+    damaged or inconsistent file (``snakehead._files.read_npz``, :func:`validate_map_arrays`), naming what is
     wrong. A shard loads too, for :func:`merge`; everything that uses a map refuses it
     (:meth:`ReachabilityMap.require_whole_for`)."""
     z = read_npz(path, "the map", max_bytes=MAX_MAP_BYTES)  # a regular file; sizes checked before unpacking
