@@ -4,7 +4,7 @@ support polygon, for many configurations at once.
 
 A pose that stands only because a lifted link rests on the ground cannot be reached from the air (the body tips
 just before the link touches down): the whole-body solve's checks take the smaller of this margin and the one over
-every contact (:func:`~snakehead.solve.solution_checks.check_solutions`).
+every contact (:func:`~.solution_checks.check_solutions`).
 """
 from __future__ import annotations
 

@@ -59,7 +59,7 @@ class BodyProblem:
 
     @property
     def pose_bounds(self) -> PoseBounds:
-        """The robot's necessary conditions of a pose (:class:`~snakehead.solve.pose_bounds.PoseBounds`), made
+        """The robot's necessary conditions of a pose (:class:`~.pose_bounds.PoseBounds`), made
         once: the solve asks them before an IK batch or a segmented solve that they prove cannot succeed."""
         if self._pose_bounds is None:
             self._pose_bounds = PoseBounds.of(self.robot, np.zeros(self.robot.n_joints))
@@ -108,7 +108,7 @@ class BodyProblem:
     # --- the support polygon and the static margin ---------------------------------------------------------
     def contact_points(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World (P, 3) bottom points of the ground links' shapes and their links (P,)
-        (:func:`.base_support.contact_points`)."""
+        (:func:`~.base_support.contact_points`)."""
         return base_support.contact_points(self.robot, F, self.ground_links)
 
     def com_and_jacobian(self, F: np.ndarray, base: BasePlacement) -> tuple[np.ndarray, np.ndarray]:
@@ -125,7 +125,7 @@ class BodyProblem:
 
     def margins(self, frames: np.ndarray) -> np.ndarray:
         """:meth:`margin` of many configurations at once, from their world frames (K, n_links, 4, 4): (K,)
-        (:func:`.base_support.static_margins` over the ground links)."""
+        (:func:`~.base_support.static_margins` over the ground links)."""
         return base_support.static_margins(self.robot, frames, self.ground_links)
 
     def margin_and_gradient(self, F: np.ndarray, base: BasePlacement) -> tuple[float, np.ndarray]:

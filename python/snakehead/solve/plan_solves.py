@@ -15,8 +15,8 @@ class PlanSolves:
     targets' solves ask for the same ones): the whole-body solves with the base kept (``kept``: the planner's
     :func:`~snakehead.planning.target_solves.solve_kept` keys them), and the segmented solves
     (:meth:`HeadController.solve_checked <snakehead.solve.head_controller.HeadController.solve_checked>`) and the
-    lifted chain's IK candidates (:func:`~snakehead.solve.whole_body_starts.lifted_candidates`) of
-    :func:`~snakehead.solve.target_search.solve_checked_target`. Every one is deterministic (the same arguments give
+    lifted chain's IK candidates (:func:`~.whole_body_starts.lifted_candidates`) of
+    :func:`~.target_search.solve_checked_target`. Every one is deterministic (the same arguments give
     the same solution: the IK is seeded, its searches bounded by counts), so an entry stands for a solve again.
     Owned by one plan: its controller and obstacles are fixed for its life, and it is dropped with the plan (no bound
     on its size: a plan solves a bounded number of targets)."""

@@ -1,6 +1,6 @@
 """Necessary conditions for a whole-body pose that puts the head tip at a position, pointing along a direction:
 cheap tests that prove the whole-body solve cannot pass its exact checks
-(:func:`~snakehead.solve.solution_checks.check_solution`: the head within its position and direction tolerances,
+(:func:`~.solution_checks.check_solution`: the head within its position and direction tolerances,
 the static margin of the links lying on the ground, the lifted links above the ground), so that a reach map
 (``planning.whole_body_reach``) need not run it. Every test allows for the checks' tolerances; none depends on how
 the solve searches.

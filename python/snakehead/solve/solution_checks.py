@@ -45,7 +45,7 @@ def check_solution(robot: SnakeRobot, q: np.ndarray, base: BasePlacement, positi
                    obstacle_clearance: float = OBSTACLE_CLEARANCE, problem: BodyProblem | None = None) -> dict:
     """Exact checks of a configuration: head errors, static margin (support polygon of the boxes lying on the
     ground), lowest lifted box corner, separating-axis self clearance, obstacle clearance, and the verdict
-    (None or one of ``REASONS``).
+    (None or one of ``whole_body_solution.REASONS``).
 
     With ``problem``, the static margin is also taken without the lifted links (only the links that lie on the
     ground whatever the pose: ``BodyProblem.ground_links``), and the smaller one counts: a pose that stands only

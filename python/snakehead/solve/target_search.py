@@ -35,7 +35,7 @@ def solve_target(controller: HeadController, position: npt.ArrayLike, direction:
 
     Stages, the first that passes every exact check wins:
 
-    1. the paper's segmented solve (:meth:`~snakehead.solve.head_controller.HeadController.solve`) from the base
+    1. the paper's segmented solve (:meth:`~.head_controller.HeadController.solve`) from the base
        as it is;
     2. the base kept: the lifted chain's IK candidates (:func:`~.whole_body_starts.lifted_candidates`), then the
        whole-body optimisation over the lifted joints from the best of them and from the segmented solution;
@@ -192,7 +192,7 @@ class TargetSearch:
         return self.refine_kept()
 
     def segmented_solve(self) -> WholeBodySolution | None:
-        """Stage 1: the paper's segmented solve (:meth:`~snakehead.solve.head_controller.HeadController.solve_checked`)
+        """Stage 1: the paper's segmented solve (:meth:`~.head_controller.HeadController.solve_checked`)
         from the base as it is, clear of the obstacles."""
         seg = self.segmented_at(self.q_now, self.base, clear=True)
         self.segmented = seg
@@ -211,7 +211,7 @@ class TargetSearch:
         return [c.copy() for c in found]
 
     def segmented_at(self, q_prev: np.ndarray, base: BasePlacement, clear: bool) -> Any:
-        """The segmented solve (:meth:`~snakehead.solve.head_controller.HeadController.solve_checked`, the base kept)
+        """The segmented solve (:meth:`~.head_controller.HeadController.solve_checked`, the base kept)
         from ``q_prev`` at ``base``, its solution required to clear the obstacles when ``clear``; kept in the plan's
         :class:`~.plan_solves.PlanSolves` (the relocation's search and the solve at the base it finds ask for the same
         one)."""

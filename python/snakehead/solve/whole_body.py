@@ -1,6 +1,6 @@
 """The stability-aware whole-body solve: every joint and the base's placement at once.
 
-The paper's segmented solve (:class:`~snakehead.solve.head_controller.HeadController`: the base on its arc, the neck
+The paper's segmented solve (:class:`~.head_controller.HeadController`: the base on its arc, the neck
 by Eqs. 18-22, the head by TRAC-IK) reaches many targets in milliseconds, but it checks stability instead of
 seeking it and keeps the base where it is. When it fails, leaves the centre of mass outside the support polygon,
 puts a link in the ground or into an obstacle, the whole-body solve maximises the static margin (Eqs. 23-24) over
