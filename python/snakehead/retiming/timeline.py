@@ -67,18 +67,28 @@ class Timeline:
                     if nu == 0:
                         o[lo:hi] = item["q"]
                 continue
-            tt = item["t"]
-            i = np.clip(np.searchsorted(tt, t[lo:hi], side="right") - 1, 0, len(tt) - 2)
-            tau = np.clip(t[lo:hi] - tt[i], 0.0, tt[i + 1] - tt[i])
-            s = np.clip(item["s"][i] + item["sd"][i] * tau + 0.5 * item["u"][i] * tau ** 2, item["s"][i],
-                        item["s"][i + 1])
-            sd = np.maximum(item["sd"][i] + item["u"][i] * tau, 0.0)
-            d = dict(zip(path_orders, path_derivatives(item["f"], s, path_orders)))
-            for o, nu in zip(out, orders):
-                if nu == 0:
-                    o[lo:hi] = d[0]
-                elif nu == 1:
-                    o[lo:hi] = d[1] * sd[:, None]
-                else:
-                    o[lo:hi] = d[1] * item["u"][i][:, None] + d[2] * (sd ** 2)[:, None]
+            for o, value in zip(out, _piece_values(item, t[lo:hi], orders, path_orders)):
+                o[lo:hi] = value
         return out
+
+
+def _piece_values(item: dict[str, Any], t: np.ndarray, orders: tuple[int, ...], path_orders: tuple[int, ...]
+                  ) -> list[np.ndarray]:
+    """The derivatives of the given ``orders`` at times t (N,) within a piece (an item of :class:`Timeline`): each
+    stage at its constant path acceleration u, so qd = q' s' and qdd = q' u + q'' s'^2. ``path_orders``: the path's
+    derivatives they need."""
+    tt = item["t"]
+    i = np.clip(np.searchsorted(tt, t, side="right") - 1, 0, len(tt) - 2)
+    tau = np.clip(t - tt[i], 0.0, tt[i + 1] - tt[i])
+    s = np.clip(item["s"][i] + item["sd"][i] * tau + 0.5 * item["u"][i] * tau ** 2, item["s"][i], item["s"][i + 1])
+    sd = np.maximum(item["sd"][i] + item["u"][i] * tau, 0.0)
+    d = dict(zip(path_orders, path_derivatives(item["f"], s, path_orders)))
+    values = []
+    for nu in orders:
+        if nu == 0:
+            values.append(d[0])
+        elif nu == 1:
+            values.append(d[1] * sd[:, None])
+        else:
+            values.append(d[1] * item["u"][i][:, None] + d[2] * (sd ** 2)[:, None])
+    return values
