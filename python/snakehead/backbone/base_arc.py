@@ -21,7 +21,7 @@ from .curves import SpaceCurve
 from .discretize import joint_intervals
 
 import numpy.typing as npt
-from typing import Any
+from typing import Any, Callable
 from .._errors import Infeasible, InputError
 
 __all__ = ["CHORD_MODES", "ArcOptimum", "PlaneArc", "arc_angle_limit", "arc_area_maximum", "arc_joint_angles",
@@ -403,10 +403,7 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
         q_up = up_curve_joint_angles(robot, UpCurveShape.for_robot(robot), turn)[0]
     q_up = finite_array(q_up, "q_up", (robot.n_joints - nb,))
     lim = arc_angle_limit(robot, turn=turn, chords=chords)
-    lo, hi = (0.05, lim) if bounds is None else (
-        finite_float(bounds[0], "bounds[0]"), finite_float(bounds[1], "bounds[1]"))
-    if not 0 < lo < hi <= lim + 1e-12:
-        raise InputError(f"bounds must satisfy 0 < lo < hi <= {lim:.6g} (joint limits), got ({lo}, {hi})")
+    lo, hi = _angle_bounds(bounds, lim)
     if int(n_grid) < 5:
         raise InputError("n_grid must be >= 5")
     l = robot.base_length
@@ -419,10 +416,32 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
 
     thetas = np.linspace(lo, hi, int(n_grid))
     rows = np.array([(t, *evaluate(t)) for t in thetas])
+    best, area, margin = _refined_best(evaluate, thetas, rows, min_margin)
+    eq2_angle, eq2_area = arc_area_maximum(l)
+    area_pi = evaluate(math.pi)[0] if lo <= math.pi <= hi else float("nan")
+    return ArcOptimum(central_angle=best, area=area, margin=margin, q=q_of(best), angle_limit=lim,
+                      eq2_angle=eq2_angle, eq2_area=eq2_area, area_at_eq2_angle=area_pi, grid=rows)
+
+
+def _angle_bounds(bounds: tuple[float, float] | None, lim: float) -> tuple[float, float]:
+    """:func:`optimize_base_arc`'s (theta_lo, theta_hi), rad: ``bounds`` checked against the joint-limit bound
+    ``lim``, default (0.05, lim)."""
+    lo, hi = (0.05, lim) if bounds is None else (
+        finite_float(bounds[0], "bounds[0]"), finite_float(bounds[1], "bounds[1]"))
+    if not 0 < lo < hi <= lim + 1e-12:
+        raise InputError(f"bounds must satisfy 0 < lo < hi <= {lim:.6g} (joint limits), got ({lo}, {hi})")
+    return lo, hi
+
+
+def _refined_best(evaluate: Callable[[float], tuple[float, float]], thetas: np.ndarray, rows: np.ndarray,
+                  min_margin: float) -> tuple[float, float, float]:
+    """The largest area among the scanned angles ``thetas`` whose margin is at least ``min_margin`` (``rows``:
+    their (theta, area, margin)), refined between its neighbours (cut at the margin's boundary where a neighbour
+    falls short of it): (theta, area, margin). Infeasible when no scanned angle keeps the margin."""
     feasible = rows[:, 2] >= min_margin
     if not feasible.any():
-        raise Infeasible(f"no central angle in [{lo:.4g}, {hi:.4g}] rad keeps the centre of mass inside the "
-                         f"support polygon by {min_margin} m (best margin {rows[:, 2].max():.4g} m)")
+        raise Infeasible(f"no central angle in [{thetas[0]:.4g}, {thetas[-1]:.4g}] rad keeps the centre of mass "
+                         f"inside the support polygon by {min_margin} m (best margin {rows[:, 2].max():.4g} m)")
     k = int(np.argmax(np.where(feasible, rows[:, 1], -np.inf)))
     a = thetas[max(k - 1, 0)]
     b = thetas[min(k + 1, len(thetas) - 1)]
@@ -440,7 +459,4 @@ def optimize_base_arc(robot: SnakeRobot, q_up: npt.ArrayLike | None = None, base
     area, margin = evaluate(best)
     if margin < min_margin or area < rows[k, 1]:  # refinement fell off the feasible side: keep the grid point
         best, area, margin = float(thetas[k]), float(rows[k, 1]), float(rows[k, 2])
-    eq2_angle, eq2_area = arc_area_maximum(l)
-    area_pi = evaluate(math.pi)[0] if lo <= math.pi <= hi else float("nan")
-    return ArcOptimum(central_angle=best, area=area, margin=margin, q=q_of(best), angle_limit=lim,
-                      eq2_angle=eq2_angle, eq2_area=eq2_area, area_at_eq2_angle=area_pi, grid=rows)
+    return best, area, margin

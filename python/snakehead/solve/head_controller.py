@@ -218,38 +218,13 @@ class HeadController:
         timings: dict[str, float] = {}
         q = q.copy()
         parts = self.robot.parts
-        position = desired[:3, 3]
 
         t0 = time.perf_counter()
-        # Eqs. 18-22 pivot on P0; on a neck that begins with yaw joints, on the frame where its lifting begins
-        # (the joints before it keep the initial state's angles: see SnakeRobot.lift_joints)
-        lift = self.robot.lift_joints
-        q[parts.neck.start:lift.start] = self.q_initial[parts.neck.start:lift.start]
-        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
-        goal = nk.neck_goal(P0_frame[:3, 3], position, self.Lc)
-        neck = self._solve_lift(P0_frame, goal, q[lift])
-        q[lift] = neck.q
+        goal, neck = self._place_neck(base, q, desired[:3, 3])
         timings["neck"] = time.perf_counter() - t0
 
-        # Step 4: the head, from the neck end frame B0.
         t0 = time.perf_counter()
-        target = np.linalg.inv(neck.frame) @ desired
-        q_close = q[parts.head].copy() if keep_close else None
-
-        def accepted(q_head: Any) -> bool:
-            if accept is None:
-                return True
-            q_full = q.copy()
-            q_full[parts.head] = q_head
-            return bool(accept(q_full, base))
-
-        if self.method == "free_roll":
-            head = head_ik.free_roll(self.ik, target, q_init=q[parts.head], attempts=self._free_roll_attempts)
-        if self.method == "rotated" or (accept is not None and head.success and not accepted(head.q)):
-            # The paper's rolled frames give a set of candidates to choose from (also when the free-roll
-            # solution fails the caller's test).
-            head = head_ik.rotated_frames(self.ik, target, self.n_frames, q_init=q[parts.head], q_prev=q_close,
-                                          accept=None if accept is None else accepted)
+        head = self._solve_head(base, q, neck, desired, keep_close, accept)
         timings["head"] = time.perf_counter() - t0
         if head.success:
             q[parts.head] = head.q
@@ -260,17 +235,49 @@ class HeadController:
         pe, de = head_ik.position_and_direction_error(achieved, desired)
         margin = self._static_margin(q, base)
         timings["check"] = time.perf_counter() - t0
-        if head.success:
-            message = "solved" if margin > 0 else "solved, but the centre of mass is outside the support polygon"
-        elif head.solved:
-            message = (f"none of the {head.solved} head solutions found passed the caller's acceptance test")
-        else:
-            message = (f"the head IK found no solution from the neck end frame ({head.tried} frames tried): "
-                       "the target lies outside the head's workspace from there")
         return HeadSolution(q=q, base=base, base_moved=False, head_frame=achieved, desired_frame=desired,
-                            position_error_m=pe, direction_error_deg=de, success=head.success, message=message,
-                            static_stable=margin > 0, static_margin_m=margin, timings=timings, neck_goal=goal,
-                            neck=neck, head=head)
+                            position_error_m=pe, direction_error_deg=de, success=head.success,
+                            message=_head_message(head, margin), static_stable=margin > 0, static_margin_m=margin,
+                            timings=timings, neck_goal=goal, neck=neck, head=head)
+
+    def _place_neck(self, base: BasePlacement, q: np.ndarray, position: np.ndarray
+                    ) -> tuple[nk.NeckGoal, nk.NeckSolution]:
+        """Step 3: the neck end frame by Eqs. 18-22 towards ``position``; sets the neck's joints in ``q``.
+
+        Eqs. 18-22 pivot on P0; on a neck that begins with yaw joints, on the frame where its lifting begins (the
+        joints before it keep the initial state's angles: see ``SnakeRobot.lift_joints``)."""
+        lift = self.robot.lift_joints
+        neck_start = self.robot.parts.neck.start
+        q[neck_start:lift.start] = self.q_initial[neck_start:lift.start]
+        P0_frame = self.robot.frame(q, self.robot.lift_frame, base)
+        goal = nk.neck_goal(P0_frame[:3, 3], position, self.Lc)
+        neck = self._solve_lift(P0_frame, goal, q[lift])
+        q[lift] = neck.q
+        return goal, neck
+
+    def _solve_head(self, base: BasePlacement, q: np.ndarray, neck: nk.NeckSolution, desired: np.ndarray,
+                    keep_close: bool, accept: Callable[..., bool] | None) -> head_ik.HeadIKResult:
+        """Step 4: the head joints by TRAC-IK from the neck end frame B0 towards the desired frame (4, 4), the
+        other joints those of ``q``; with ``keep_close``, the rolled frames' solution nearest ``q``'s head."""
+        head_part = self.robot.parts.head
+        target = np.linalg.inv(neck.frame) @ desired
+        q_close = q[head_part].copy() if keep_close else None
+
+        def accepted(q_head: Any) -> bool:
+            if accept is None:
+                return True
+            q_full = q.copy()
+            q_full[head_part] = q_head
+            return bool(accept(q_full, base))
+
+        if self.method == "free_roll":
+            head = head_ik.free_roll(self.ik, target, q_init=q[head_part], attempts=self._free_roll_attempts)
+        if self.method == "rotated" or (accept is not None and head.success and not accepted(head.q)):
+            # The paper's rolled frames give a set of candidates to choose from (also when the free-roll
+            # solution fails the caller's test).
+            head = head_ik.rotated_frames(self.ik, target, self.n_frames, q_init=q[head_part], q_prev=q_close,
+                                          accept=None if accept is None else accepted)
+        return head
 
     @property
     def body_problem(self) -> BodyProblem:
@@ -291,3 +298,13 @@ class HeadController:
             poly = self._polygons[key] = stability.support_polygon(self.robot, q, base)
         c = stability.center_of_mass(self.robot, q, base)
         return float(stability.polygon_margin_many(poly[None], np.ones((1, len(poly)), bool), c[None, :2])[0])
+
+
+def _head_message(head: head_ik.HeadIKResult, margin: float) -> str:
+    """What a segmented solution says: solved (and whether it stands), or why the head's IK found nothing."""
+    if head.success:
+        return "solved" if margin > 0 else "solved, but the centre of mass is outside the support polygon"
+    if head.solved:
+        return f"none of the {head.solved} head solutions found passed the caller's acceptance test"
+    return (f"the head IK found no solution from the neck end frame ({head.tried} frames tried): "
+            "the target lies outside the head's workspace from there")
