@@ -3,7 +3,7 @@
 
 Each interpreter given runs a worker that plans the reachable-by-construction targets of a set (as bench/plan_speed.py:
 default robot, ``HeadController(method="free_roll", seed=1)`` warmed up by one plan), keeping the path each plan
-retimes (``retiming.timing.retime``'s waypoints and options) and the motion it checks (``path_check.finish_checks``'s
+retimes (``retiming.timing.retime``'s waypoints and options) and the motion it checks (``planning.motion_checks.finish_checks``'s
 t, q, qd, placement). Then, path by path and alternately between the workers, each times its own retiming of the path
 and its own ZMP pass over the motion from scratch (``stability.dynamic_stability_with_clearance``, contact "ground",
 nothing kept), and the pass again with the samples its motion shares with the first plan's (the lift) kept from a
@@ -29,7 +29,8 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
 
     import snakehead
     from snakehead.dynamics import stability
-    from snakehead.collision import path_proof as path_check
+    from snakehead.collision import path_proof
+    from snakehead.planning import motion_checks, waypoints
     from snakehead.retiming import timing
     from snakehead.samples.targets import reachable_targets
 
@@ -39,7 +40,7 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
     snakehead.plan([(H[:3, 3], H[:3, 0])], controller=controller)
     retimed: list[tuple] = []
     checked: list[tuple] = []
-    real_retime, real_finish = timing.retime, path_check.finish_checks
+    real_retime, real_finish = waypoints.retime, motion_checks.finish_checks
 
     def keep_retime(robot: snakehead.SnakeRobot, waypoints: np.ndarray, base: object = None, **options: object) -> object:
         retimed.append((np.array(waypoints), base, options))
@@ -50,12 +51,12 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
         checked.append((base, t, q, qd))
         return real_finish(robot, base, t, q, qd, *args, **kwargs)
 
-    timing.retime, path_check.finish_checks = keep_retime, keep_finish
+    waypoints.retime, motion_checks.finish_checks = keep_retime, keep_finish
     try:
         for t in reachable_targets(controller, kind, count, np.random.default_rng(seed)):
             snakehead.plan([(t.position, t.direction)], controller=controller)
     finally:
-        timing.retime, path_check.finish_checks = real_retime, real_finish
+        waypoints.retime, motion_checks.finish_checks = real_retime, real_finish
     print("ready", flush=True)
     for line in sys.stdin:
         k = int(line)
@@ -66,7 +67,7 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
             motion = timing.retime(robot, W, base, **options)
             best_retime = min(best_retime, time.process_time() - cpu)
         where, t, q, qd = checked[k]
-        made = path_check.checker(robot, where)
+        made = path_proof.checker(robot, where)
         for _ in range(repeat):
             cpu = time.process_time()
             dyn, _ = stability.dynamic_stability_with_clearance(robot, t, q, where, qd, contact="ground", made=made)

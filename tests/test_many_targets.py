@@ -16,7 +16,7 @@ from snakehead.solve import whole_body
 from snakehead.solve.head_controller import HeadController
 from snakehead.dynamics import stability
 from snakehead.model.robot import SnakeRobot
-from snakehead.planning import plan_bounds
+from snakehead.planning import plan_bounds, waypoints
 from snakehead.retiming import timing
 from snakehead.samples.targets import reachable_targets
 from snakehead.scenes import MAX_TARGETS, Scene, Target, load_scene, scene_from_dict
@@ -207,7 +207,7 @@ def test_a_path_that_cannot_be_timed_still_fits_the_longest_motion(three, contro
     def untimeable(*args, **kwargs):
         raise Infeasible("no motion along the path keeps every limit near waypoint 3")
 
-    monkeypatch.setattr(timing, "retime", untimeable)
+    monkeypatch.setattr(waypoints, "retime", untimeable)  # the name the path of moves times itself with
     monkeypatch.setattr(plan_bounds, "MAX_MOTION_S", 30.0)
     result = snakehead.plan(three, controller=controller)
     assert not result.success and "cannot be timed" in result.failure
