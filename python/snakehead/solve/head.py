@@ -90,6 +90,7 @@ class HeadIKResult:
 
     @property
     def success(self) -> bool:
+        """Whether a frame was solved (and accepted)."""
         return self.q is not None
 
 

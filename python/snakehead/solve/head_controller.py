@@ -25,6 +25,7 @@ from .initial_state import stable_initial_configuration
 from ..dynamics import stability
 from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
 from ..kinematics import reachability as workspace
+from ..kinematics import ik
 from ..kinematics.ik import TracIK
 from ..kinematics.reachability.reachability_map import ReachabilityMap
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
@@ -43,7 +44,7 @@ FREE_ROLL_ATTEMPTS = 3
 class HeadSolution:
     """The result of ``HeadController.solve``. Positions in m (world), angles in rad unless named _deg."""
 
-    q: np.ndarray  # (16,) all joint angles; the best attempt even when success is False
+    q: np.ndarray  # (n,) all joint angles; the best attempt even when success is False
     base: BasePlacement  # the base placement used (moved when the target was out of range)
     base_moved: bool
     head_frame: np.ndarray  # (4, 4) achieved head_tip pose in the world (by whole-body FK)
@@ -61,6 +62,7 @@ class HeadSolution:
 
     @property
     def head_position(self) -> np.ndarray:
+        """The achieved head position (3,) m, world."""
         return self.head_frame[:3, 3]
 
 
@@ -80,7 +82,7 @@ class HeadController:
 
     def __init__(self, robot: SnakeRobot | None = None, workspace_map: ReachabilityMap | None = None,
                  base_pose: BasePlacement | None = None, *, method: str = "rotated", n_frames: int = 10,
-                 timeout: float = 0.005, epsilon: float = 1e-5, seed: int | None = None, slack: float | None = None,
+                 timeout: float = ik.DEFAULT_TIMEOUT_S, epsilon: float = ik.DEFAULT_EPSILON, seed: int | None = None, slack: float | None = None,
                  base_configuration: npt.ArrayLike | None = None, allow_base_move: bool = True) -> None:
         self.robot = as_robot(robot) if robot is not None else SnakeRobot.default()
         if method not in ("rotated", "free_roll"):
@@ -142,7 +144,7 @@ class HeadController:
         ``allow_base_move``: whether a target out of range may move the base (default: the controller's
         ``allow_base_move``).
 
-        ``accept``: an optional test ``accept(q (16,), base) -> bool`` of a whole-body solution (e.g. no
+        ``accept``: an optional test ``accept(q (n,), base) -> bool`` of a whole-body solution (e.g. no
         collision with an obstacle). Only accepted solutions are kept: with free roll, when its solution is
         rejected, the ``n_frames`` rolled frames of the paper's method are solved and filtered.
         """

@@ -126,6 +126,7 @@ class TargetSearch:
         return self.spent >= self.budget
 
     def check(self, q: np.ndarray, b: BasePlacement) -> dict:
+        """:meth:`check_many` of one configuration."""
         return self.check_many([q], b)[0]
 
     def check_many(self, qs: Sequence[np.ndarray], b: BasePlacement) -> list[dict]:
