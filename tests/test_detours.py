@@ -36,7 +36,7 @@ def plain_joint_path(way, qa, qb, n):
             if way.path_feasible(path):
                 return path, "joint space via a stable detour"
     flat = wp.densify(paths).reshape(-1, qa.size)
-    worst = way._margins(flat).reshape(len(W), -1).min(axis=1)
+    worst = way.static_margins(flat).reshape(len(W), -1).min(axis=1)
     return wp.split_steps(paths[steadiest(worst)]), "joint space (no stable detour found)"
 
 
@@ -95,11 +95,11 @@ def test_the_steadiest_detour_is_the_largest_smallest_margin_first_of_equals(con
         s = np.linspace(0.0, 1.0, 6)[:, None]
         paths = np.concatenate([qa + s[None] * (W[:, None] - qa), W[:, None] + s[None, 1:] * (qb - W[:, None])], 1)
         dense = wp.densify(paths)
-        worst = way._margins(dense.reshape(-1, robot.n_joints)).reshape(len(W), -1).min(axis=1)
+        worst = way.static_margins(dense.reshape(-1, robot.n_joints)).reshape(len(W), -1).min(axis=1)
         assert way._steadiest(dense, 5) == steadiest(worst)
         tied = dense.copy()
         tied[:, -1] = dense[0, -1]  # one end shared exactly
-        tied_worst = way._margins(tied.reshape(-1, robot.n_joints)).reshape(len(W), -1).min(axis=1)
+        tied_worst = way.static_margins(tied.reshape(-1, robot.n_joints)).reshape(len(W), -1).min(axis=1)
         assert way._steadiest(tied, 5) == steadiest(tied_worst)
 
 
