@@ -60,3 +60,27 @@ def test_the_values_are_the_documented_ones():
     assert margins.ZMP_MARGIN == 0.005 and margins.DETOUR_MARGIN == 0.01 == 2 * margins.ZMP_MARGIN
     assert margins.OBSTACLE_CLEARANCE == 0.002 and margins.EXACT_DISTANCE_WITHIN == 0.005
     assert margins.SELF_CLEARANCE == 0.002 and margins.SOLUTION_MARGIN == margins.ZMP_MARGIN
+
+
+def test_trac_iks_defaults_are_written_once_and_are_the_cores():
+    """TRAC-IK's default budget and tolerance: kinematics.ik's, used by every Python entry point, equal to the C++
+    core's (TracIKOptions in include/snakehead/trac_ik.hpp; the bindings' kdl_nr_jl_ik)."""
+    import re
+
+    from snakehead import _core
+    from snakehead.kinematics import ik
+    from snakehead.solve.head_controller import HeadController
+
+    assert definitions("DEFAULT_TIMEOUT_S") == ["kinematics/ik.py"]
+    assert definitions("DEFAULT_EPSILON") == ["kinematics/ik.py"]
+    header = (Path(__file__).resolve().parents[1] / "include/snakehead/trac_ik.hpp")
+    if header.is_file():  # (the source tree's; an installed wheel alone has no headers)
+        options = re.search(r"struct TracIKOptions \{(.*?)\};", header.read_text(), re.S).group(1)
+        assert float(re.search(r"double timeout = ([0-9.e-]+);", options).group(1)) == ik.DEFAULT_TIMEOUT_S
+        assert float(re.search(r"double epsilon = ([0-9.e-]+);", options).group(1)) == ik.DEFAULT_EPSILON
+    signature = _core.kdl_nr_jl_ik.__doc__.splitlines()[0]
+    assert float(re.search(r"timeout: [^,=]+= ([0-9.e-]+)", signature).group(1)) == ik.DEFAULT_TIMEOUT_S
+    assert float(re.search(r"epsilon: [^,=)]+= ([0-9.e-]+)", signature).group(1)) == ik.DEFAULT_EPSILON
+    for fn in (ik.TracIK.__init__, ik.TracIK.from_chain, HeadController.__init__):
+        params = inspect.signature(fn).parameters
+        assert params["timeout"].default is ik.DEFAULT_TIMEOUT_S and params["epsilon"].default is ik.DEFAULT_EPSILON

@@ -27,6 +27,10 @@ from .._validate import (ORTHONORMAL_TOLERANCE, duration, finite_array, integer,
 from ..model.chain import Chain
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
+#: s: a solve's budget by default (TracIKOptions' in include/snakehead/trac_ik.hpp; tests/test_shared_numbers.py).
+DEFAULT_TIMEOUT_S = 0.005
+#: The allowed residual per axis (m, rad) by default (TracIKOptions' too).
+DEFAULT_EPSILON = 1e-5
 #: Bounds that leave the roll about the target's x-axis free.
 FREE_ROLL = (0.0, 0.0, 0.0, np.inf, 0.0, 0.0)
 
@@ -109,12 +113,12 @@ class TracIK:
     Without a seed, ``timeout`` is wall-clock time, and what a call finds depends on the machine's load.
     """
 
-    def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = 0.005,
-                 epsilon: float = 1e-5, solve_type: str = "Speed", seed: int | None = None, bounds: Any = None) -> None:
+    def __init__(self, urdf: str | os.PathLike, base: str, tip: str, timeout: float = DEFAULT_TIMEOUT_S,
+                 epsilon: float = DEFAULT_EPSILON, solve_type: str = "Speed", seed: int | None = None, bounds: Any = None) -> None:
         self._init(Chain.from_urdf(urdf, base, tip), timeout, epsilon, solve_type, seed, bounds)
 
     @classmethod
-    def from_chain(cls, chain: Chain, timeout: float = 0.005, epsilon: float = 1e-5, solve_type: str = "Speed",
+    def from_chain(cls, chain: Chain, timeout: float = DEFAULT_TIMEOUT_S, epsilon: float = DEFAULT_EPSILON, solve_type: str = "Speed",
                    seed: int | None = None, bounds: Any = None) -> "TracIK":
         """A solver for an existing :class:`Chain` (its model is copied into the solver)."""
         if not isinstance(chain, Chain):
@@ -257,4 +261,4 @@ def pose_error(target: Any, current: Any) -> np.ndarray:
     return _core.pose_error(check_pose(target, "target"), check_pose(current, "current"))
 
 
-__all__ = ["TracIK", "SOLVE_TYPES", "FREE_ROLL", "pose_error"]
+__all__ = ["TracIK", "SOLVE_TYPES", "FREE_ROLL", "DEFAULT_TIMEOUT_S", "DEFAULT_EPSILON", "pose_error"]
