@@ -3,7 +3,7 @@ over an executor (a thread or process pool, Dask: ``snakehead._executors``, as m
 
 What travels to a worker is picklable: the scene and a :class:`RobotRecipe` (how to build the robot again from its
 description), never a live robot or controller (their C++ objects do not pickle). Each worker thread builds the robot
-and its :class:`~snakehead.control.HeadController` once and reuses them for the plans it makes
+and its :class:`~snakehead.solve.HeadController` once and reuses them for the plans it makes
 (:class:`WorkerControllers`); the plan comes back without its robot, and the caller's robot is put back in it.
 """
 from __future__ import annotations

@@ -131,7 +131,7 @@ class ReachabilityMap:
         naming the map and what to do) when it is
 
         * a shard of a map: its G0, dexterous band and queries would be those of a part of the map (shards load, and
-          :func:`merge` takes them as they are: the one place that does);
+          :func:`~snakehead.kinematics.reachability.map_io.merge` takes them as they are: the one place that does);
         * a map of another chain than ``chain`` (a :class:`Chain`, or a SnakeRobot's head chain), by the chains'
           kinematics hash;
         * lacking what the caller ``needs``: ``"voxels"`` (at least one), ``"G0"`` (the dexterous centre:
