@@ -20,6 +20,7 @@ import snakehead
 
 sys.path.insert(0, str(Path(__file__).parent))  # this folder's helpers, imported next
 from layer_figure import LayersFigure, check_sections  # noqa: E402
+from python_refs import resolve  # noqa: E402
 
 project = "snakehead"
 author = "the snakehead developers"
@@ -41,6 +42,11 @@ autodoc_typehints = "signature"
 autodoc_default_options = {"members": True, "undoc-members": True, "show-inheritance": True,
                            "ignore-module-all": True}
 myst_heading_anchors = 3
+# Every cross-reference must resolve (with -W, a broken one fails the build); python_refs.resolve finds the names
+# docstrings use as their module sees them.
+nitpicky = True
+# The base class of the C++ core's classes: pybind11's, not importable, documented nowhere.
+nitpick_ignore = [("py:class", "pybind11_builtins.pybind11_object")]
 
 
 def shared_numbers() -> str:
@@ -59,9 +65,13 @@ rst_epilog = shared_numbers()
 suppress_warnings = ["myst.header"]
 
 
+#: The C++ core's module, documented beside the public ones: its classes appear in the package's signatures.
+CORE_MODULE = "snakehead._core"
+
+
 def public_modules() -> list[str]:
-    """Every module of the package whose dotted name has no part starting with an underscore."""
-    names = ["snakehead"]
+    """Every module of the package whose dotted name has no part starting with an underscore, and the C++ core."""
+    names = ["snakehead", CORE_MODULE]
     for info in pkgutil.walk_packages(snakehead.__path__, "snakehead."):
         if not any(part.startswith("_") for part in info.name.split(".")):
             names.append(info.name)
@@ -111,6 +121,9 @@ def write_api_pages(app) -> None:
         path = folder / f"{modname}.rst"
         if not path.exists() or path.read_text() != text:
             path.write_text(text)
+    for stale in folder.glob("snakehead*.rst"):  # the page of a module that was moved or removed
+        if stale.stem not in pages:
+            stale.unlink()
     index = ["Modules", "=======", "", ".. toctree::", "   :maxdepth: 1", ""]
     index += [f"   {name} <{name}>" for name in pages]
     text = "\n".join(index) + "\n"
@@ -150,6 +163,14 @@ _FIELD = re.compile(r"^[A-Za-z_][\w /*,()]*? : \S")  # "name : what it is", as t
 _ITEM = re.compile(r"^(\s*)([-*]|\d+\.) \S")
 
 
+def parseable_signature(app, what, name, obj, options, signature, return_annotation):
+    """A dataclass field with a ``default_factory`` shows its default as ``<factory>``, which Sphinx cannot parse as
+    Python: it then splits the signature at every comma, ``tuple[str, ...]`` included. Written ``...`` instead."""
+    if signature and "<factory>" in signature:
+        return signature.replace("<factory>", "..."), return_annotation
+    return None
+
+
 def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
     """The docstrings are written for ``help()``: plain text with a little reStructuredText (````code````, roles).
     Make the plain-text habits valid reStructuredText: norms written |a - b| are not substitutions; a parameter
@@ -185,9 +206,11 @@ def plain_text_to_rst(app, what, name, obj, options, lines) -> None:
 
 def setup(app):
     app.connect("autodoc-process-docstring", plain_text_to_rst)
+    app.connect("autodoc-process-signature", parseable_signature)
     app.add_directive("snakehead-cli", CliHelp)
     app.add_directive("snakehead-layers", LayersFigure)
     app.connect("doctree-read", check_sections)
+    app.connect("missing-reference", resolve)
     app.connect("builder-inited", write_api_pages)
     app.connect("env-check-consistency", check_every_public_name)
     return {"parallel_read_safe": True}
