@@ -1,8 +1,10 @@
-"""Sphinx configuration of snakehead's documentation: ``python -m sphinx -W -b html docs docs/_build/html``.
+"""Sphinx configuration of snakehead's documentation: ``python3 -m sphinx -W -q -b html docs build/docs-html``.
 
-The API reference is generated from the docstrings of every public module (autosummary, recursively); the build
-then checks that every public name of the package is documented (a warning, so an error with ``-W``), and the
-CLI reference is the argparse help of ``snakehead`` itself.
+The API reference is generated from the docstrings of every public module and of the C++ core (a page each, written
+at build time); the build then checks that every public name of the package is documented and that every
+cross-reference resolves (nitpicky, with ``python_refs``): warnings, so errors with ``-W``. The CLI reference is the
+argparse help of ``snakehead`` itself; the architecture page's figure is drawn from the import-linter contract
+(``layer_figure``).
 """
 from __future__ import annotations
 
@@ -15,8 +17,12 @@ from pathlib import Path
 
 from docutils import nodes
 from docutils.parsers.rst import Directive
+from sphinx.util import logging
 
 import snakehead
+from snakehead import sweep_defaults
+from snakehead.app.cli import build_parser
+from snakehead.planning import whole_body_reach
 
 sys.path.insert(0, str(Path(__file__).parent))  # this folder's helpers, imported next
 from layer_figure import LayersFigure, check_sections  # noqa: E402
@@ -52,11 +58,10 @@ nitpick_ignore = [("py:class", "pybind11_builtins.pybind11_object")]
 def shared_numbers() -> str:
     """Substitutions for the numbers the pages quote, from where each is defined (``|reach_voxel|`` ...), so that
     the pages cannot drift from the code: the sweeps' defaults (snakehead.sweep_defaults) and limits."""
-    from snakehead import sweep_defaults as defaults
-    from snakehead.planning import whole_body_reach as rc
-
-    numbers = {"reach_voxel": f"{defaults.REACH_VOXEL_M:g}", "reach_directions": defaults.REACH_DIRECTIONS,
-               "reach_min_voxel": f"{rc.MIN_VOXEL_M:g}", "reach_max_directions": rc.MAX_DIRECTIONS}
+    numbers = {"reach_voxel": f"{sweep_defaults.REACH_VOXEL_M:g}",
+               "reach_directions": sweep_defaults.REACH_DIRECTIONS,
+               "reach_min_voxel": f"{whole_body_reach.MIN_VOXEL_M:g}",
+               "reach_max_directions": whole_body_reach.MAX_DIRECTIONS}
     return "\n".join(f".. |{name}| replace:: {value}" for name, value in numbers.items())
 
 
@@ -133,8 +138,7 @@ def write_api_pages(app) -> None:
 
 
 def check_every_public_name(app, env) -> None:
-    from sphinx.util import logging
-
+    """Warn for each public function and class of the package that no API page documents."""
     logger = logging.getLogger("snakehead.docs")
     documented = set(env.get_domain("py").objects)
     for name, where in sorted(public_names().items()):
@@ -146,8 +150,6 @@ class CliHelp(Directive):
     """``.. snakehead-cli::``: the help of ``snakehead`` and of each subcommand, as argparse prints it."""
 
     def run(self):
-        from snakehead.app.cli import build_parser
-
         parser = build_parser()
         out = [nodes.literal_block(text=parser.format_help())]
         for action in parser._subparsers._group_actions:  # the subcommands, in the order they are listed
