@@ -1,7 +1,7 @@
 """Sample snake robots written the way published descriptions are, for tests and benchmarks.
 
 ``write_robot(style, folder)`` writes one robot into ``folder``: its description (URDF or xacro), any mesh files it
-uses, and a robot file (TOML, see DESIGN.md) naming its frames; it returns the robot file's path. Nothing here is
+uses, and a robot file (TOML, see docs/own_snake.rst) naming its frames; it returns the robot file's path. Nothing here is
 kept in git: every style is generated on the fly, small enough to write in milliseconds.
 
 The styles (:data:`STYLES`), each modelled on a public description but sized near the default robot so that it
