@@ -11,6 +11,7 @@ void bind_support(pybind11::module_& m);
 void bind_shape_set(pybind11::module_& m);
 void bind_dynamics(pybind11::module_& m);
 void bind_path_check(pybind11::module_& m);
+void bind_zmp_check(pybind11::module_& m);
 void bind_topp_ra(pybind11::module_& m);
 void bind_tracking_fit(pybind11::module_& m);
 void bind_limits(pybind11::module_& m);

@@ -35,6 +35,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_shape_set(m);
   snakehead::bindings::bind_dynamics(m);
   snakehead::bindings::bind_path_check(m);
+  snakehead::bindings::bind_zmp_check(m);
   snakehead::bindings::bind_topp_ra(m);
   snakehead::bindings::bind_tracking_fit(m);
   snakehead::bindings::bind_limits(m);

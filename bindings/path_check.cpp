@@ -8,6 +8,7 @@
 
 #include "bindings.hpp"
 #include "index_arrays.hpp"
+#include "sample_arrays.hpp"
 #include "snakehead/path_check.hpp"
 
 namespace py = pybind11;
@@ -16,14 +17,8 @@ namespace snakehead::bindings {
 
 namespace {
 
-using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Doubles = SampleArray;
 using Indices = IndexArray;
-
-long samples_of(const char* what, const Doubles& q, long n) {
-  if (q.ndim() != 2 || q.shape(1) != n)
-    throw InputError(std::string(what) + " must have shape (T, " + std::to_string(n) + ")");
-  return static_cast<long>(q.shape(0));
-}
 
 // What a proof evaluated (PathVerdict's and MotionVerdict's counts and smallest values) into d.
 template <class Verdict>
@@ -35,12 +30,6 @@ void put_counts(py::dict& d, const Verdict& v) {
   d["ground"] = v.ground;
   d["self"] = v.self;
   d["obstacle"] = v.obstacle;
-}
-
-py::array_t<double> array_of(const std::vector<double>& v, std::vector<py::ssize_t> shape) {
-  py::array_t<double> out(shape);
-  std::copy(v.begin(), v.end(), out.mutable_data());
-  return out;
 }
 
 }  // namespace
@@ -151,60 +140,6 @@ void bind_path_check(py::module_& m) {
           "path_check.hpp): evaluated where a joint has travelled first_step (rad) since the last, each interval "
           "proven with the joints' total variation or halved. A dict as check_path's (without segments) and "
           "obstacle_lower (T,): a lower bound of the obstacle distance from each sample to the next");
-
-  py::class_<ZmpPrefix, std::shared_ptr<ZmpPrefix>>(
-      m, "ZmpPrefix",
-      "What zmp_check computed sample by sample over the first samples of a motion, for a later check of a motion "
-      "that begins with the same samples (path_check.hpp); immutable")
-      .def_property_readonly("samples", &ZmpPrefix::size, "how many samples it holds");
-
-  m.def(
-      "zmp_check",
-      [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
-         long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
-         double tolerance, long chunk, double gravity, std::optional<std::shared_ptr<const ZmpPrefix>> resume,
-         long keep) {
-        const long n = c.n_joints();
-        const long T = samples_of("q", q, n);
-        if (t.ndim() != 1 || t.shape(0) != T) throw InputError("t must have shape (T,) like q");
-        if (samples_of("qd", qd, n) != T) throw InputError("qd must have the shape of q");
-        ZmpCheckSpec spec;
-        spec.contact_shapes = index_list("contact_shapes", contact_shapes);
-        spec.points_per_shape = points_per_shape;
-        spec.clearance_shapes = index_list("clearance_shapes", clearance_shapes);
-        spec.ground_key = ground_key;
-        spec.key_joints = std::move(key_joints);
-        spec.tolerance = tolerance;
-        spec.chunk = chunk;
-        spec.gravity = gravity;
-        ZmpCheck z;
-        std::shared_ptr<ZmpPrefix> kept = keep > 0 ? std::make_shared<ZmpPrefix>() : nullptr;
-        {
-          py::gil_scoped_release release;
-          const RigidBodyChain chain = chain_dynamics(c.model());
-          z = zmp_check(c, chain, spec, t.data(), q.data(), qd.data(), T, resume ? resume->get() : nullptr, keep,
-                        kept.get());
-        }
-        const auto N = static_cast<py::ssize_t>(T);
-        py::dict d;
-        d["zmp"] = array_of(z.zmp, {N, 2});
-        d["margin"] = array_of(z.margin, {N});
-        d["P"] = array_of(z.linear, {N, 3});
-        d["L"] = array_of(z.angular, {N, 3});
-        d["com"] = array_of(z.com, {N, 3});
-        d["clearance"] = array_of(z.clearance, {N});
-        d["resumed"] = z.resumed;
-        d["kept"] = kept ? py::cast(std::shared_ptr<const ZmpPrefix>(kept)) : py::none();
-        return d;
-      },
-      py::arg("checker"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("contact_shapes"),
-      py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
-      py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"), py::arg("resume") = py::none(), py::arg("keep") = 0,
-      "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin "
-      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from "
-      "snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when "
-      "everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the "
-      "ZmpPrefix of the first keep samples (else None)");
 }
 
 }  // namespace snakehead::bindings

@@ -262,4 +262,18 @@ void momenta(const RigidBodyChain& chain, const double* frames, const double* qd
   }
 }
 
+RigidBodyChain chain_dynamics(const ChainModel& model) {
+  RigidBodyChain chain;
+  for (const auto& s : model.segments()) {
+    chain.joint_child.push_back(model.link_index(s.link));
+    chain.axis.push_back(s.axis);
+  }
+  for (const auto& link : model.links()) {
+    chain.mass.push_back(link.mass);
+    chain.com.push_back(link.com);
+    chain.inertia.push_back(link.inertia);
+  }
+  return chain;
+}
+
 }  // namespace snakehead

@@ -22,6 +22,9 @@ struct RigidBodyChain {
   void validate() const;                  // throws InputError naming what is inconsistent
 };
 
+// The chain's masses, centres of mass, inertias, joint axes and child links for momenta / newton_euler.
+RigidBodyChain chain_dynamics(const ChainModel& model);
+
 // One pass for T samples. frames: T x L x 4 x 4 (row-major) link poses in an inertial frame in which the root link
 // is still (the world, or the root's own); qd, qdd: T x n; share: T x L lifted shares in [0, 1] (nullptr: every
 // link's weight counts in full); gravity: gravity in that frame (zero: inertial terms only). Out: tau (T x n)

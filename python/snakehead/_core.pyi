@@ -289,7 +289,7 @@ class PathChecker:
         """
 class ZmpPrefix:
     """
-    What zmp_check computed sample by sample over the first samples of a motion, for a later check of a motion that begins with the same samples (path_check.hpp); immutable
+    What zmp_check computed sample by sample over the first samples of a motion, for a later check of a motion that begins with the same samples (zmp_check.hpp); immutable
     """
     @property
     def samples(self) -> int:
@@ -490,5 +490,5 @@ def urdf_root_link(urdf: str) -> str:
     """
 def zmp_check(checker: PathChecker, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], contact_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], points_per_shape: typing.SupportsInt | typing.SupportsIndex, clearance_shapes: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], ground_key: bool, key_joints: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], tolerance: typing.SupportsFloat | typing.SupportsIndex, chunk: typing.SupportsInt | typing.SupportsIndex, gravity: typing.SupportsFloat | typing.SupportsIndex, resume: ZmpPrefix | None = None, keep: typing.SupportsInt | typing.SupportsIndex = 0) -> dict:
     """
-    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (path_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the ZmpPrefix of the first keep samples (else None)
+    The ZMP check of a sampled motion (Eqs. 25-40) in one pass (zmp_check.hpp): a dict of zmp (T, 2), margin (T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the ZmpPrefix of the first keep samples (else None)
     """

@@ -11,7 +11,6 @@
 #include "snakehead/dynamics.hpp"
 #include "snakehead/model.hpp"
 #include "snakehead/parallel_for.hpp"
-#include "snakehead/path_check.hpp"
 
 namespace {
 
