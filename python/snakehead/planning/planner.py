@@ -4,7 +4,7 @@ It strings the control process of Section 3.3 together on any snake robot. The b
 (Figs. 17b, 22a: the base on its optimised arc, the neck and head curled flat on the ground inside it:
 :func:`bending_state`) and lifts the head to the initial state of Section 3.3 (1) (the base arc joined to the
 neck-and-head Bezier: ``backbone.initial_configuration``). Each target is solved by the
-:class:`~snakehead.control.HeadController` and reached by a whole-body move (Section 3.2: the Cartesian
+:class:`~snakehead.solve.HeadController` and reached by a whole-body move (Section 3.2: the Cartesian
 interpolation of Eqs. 41-44 where it is valid, else joint space through a stable detour when needed; see
 ``Waypoints.move``), or, for targets approached along a line, by the head's poses solved every few millimetres
 along it. The waypoints are joined by the multi-segment interpolation at 2 ms, and the result is checked at every
@@ -86,7 +86,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     targets : a :class:`~snakehead.scenes.Scene`, a scene file's path, or (position, direction) pairs (m, world;
         the direction is the head's x-axis), each then held 1 s.
     robot : the snake (default: the scene's robot file, else ``SnakeRobot.default()``).
-    controller : a :class:`~snakehead.control.HeadController` to solve the head with (default: one for ``robot``
+    controller : a :class:`~snakehead.solve.HeadController` to solve the head with (default: one for ``robot``
         with its head's map, ``method`` and ``seed``).
     obstacles : more obstacles (``geometry.BoxObstacle``, ``geometry.WallWithHole``) besides the scene's.
     base : where the base lies at first (default: the scene's, else ``BasePlacement()``); when a target cannot be

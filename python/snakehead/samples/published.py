@@ -59,7 +59,7 @@ from ..model.generate import SnakeSpec, holding_effort, snake_urdf
 from .._errors import InputError, InputTypeError
 
 STYLES = ("sea", "reu", "rsnake", "mesh", "xacro", "one_joint_neck", "head6")
-#: Styles with the quirks of descriptions found in public repositories (model/published_quirks.py).
+#: Styles with the quirks of descriptions found in public repositories (published_quirks.py).
 QUIRK_STYLES = ("cad", "reu_reversed", "wheeled", "cmu_masses", "backwards_head")
 ALL_STYLES = STYLES + QUIRK_STYLES
 
@@ -411,7 +411,7 @@ def _write_reu(spec: StyleSpec, folder: Path) -> Path:
     return _reu_robot_file(folder, "reu_snake", urdf.name)
 
 
-# --- "xacro": the ReU snake as a xacro macro (model/published_xacro.py) ------------------------------------------
+# --- "xacro": the ReU snake as a xacro macro (published_xacro.py) -----------------------------------------------------
 #: The xacro file's own default module count; the robot file passes the spec's through ``xacro_args``.
 XACRO_DEFAULT_MODULES = 16
 

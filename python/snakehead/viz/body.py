@@ -1,7 +1,7 @@
 """Figures of the body in 3-D: its collision shapes coloured by part, with the scene's targets and obstacles.
 
 * :func:`plot_snapshots` -- Figs. 17 and 22: the whole body at a plan's key states, one panel per state.
-* :func:`plot_head_solution` -- one :class:`~snakehead.control.HeadController` solution: the robot at it and the
+* :func:`plot_head_solution` -- one :class:`~snakehead.solve.HeadController` solution: the robot at it and the
   neck geometry of Fig. 8.
 * :func:`plot_interpolation_comparison` -- Fig. 11 against Fig. 13: a joint-space interpolation that drives the
   head into the ground beside the Cartesian interpolation of Eqs. 41-44 that does not.

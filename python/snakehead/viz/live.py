@@ -16,7 +16,7 @@ browser sends is checked here: a speed not offered, a time that is not a number 
 is not finite are refused (the panel says so to that browser) and playback goes on. At most :data:`MAX_TARGETS`
 targets; a motion longer than :data:`MAX_MOTION_S` is not played.
 
-How: one :class:`~snakehead.control.HeadController` (one robot, its map and its TRAC-IK threads) plans every
+How: one :class:`~snakehead.solve.HeadController` (one robot, its map and its TRAC-IK threads) plans every
 target set in one worker thread. Each change (a gizmo released, a target added or removed) is a request; a request
 made while a plan runs supersedes it: that plan finishes (a plan cannot be stopped) and is dropped, and the newest
 target set is planned next, so that only the latest target set's motion is drawn, never two at once. A new motion
@@ -103,7 +103,7 @@ class LiveViewer:
     scene: the targets, obstacles, base and robot file to start from (default: one target where the robot's head
     is in its initial state, no obstacles). robot: the robot (default: ``robot_file``'s, else the scene's robot
     file's, else the shipped one); robot_file: the robot file the saved scene names (default: the scene's).
-    controller: the :class:`~snakehead.control.HeadController` that plans every request (default: one for the
+    controller: the :class:`~snakehead.solve.HeadController` that plans every request (default: one for the
     robot with seed 1, as ``snakehead plan``). save_dir: the one folder the page saves into (default
     ``./snakehead-scenes``, :mod:`.save_folder`); allow_hosts: host names the server answers to besides this
     machine's (:mod:`.server_guard`). Served at :attr:`url` (http://HOST:PORT/?token=..., the next free port if
