@@ -35,6 +35,8 @@ from docutils import nodes
 from sphinx import addnodes
 from sphinx.util.nodes import make_refnode
 
+from snakehead._moved import MOVED_MODULES, MOVED_PACKAGES
+
 _MISSING = object()
 #: {(id of a documented object, or of a value with its name): documented full name}, built once per build.
 _INDEX: dict[tuple[int, str], str] = {}
@@ -62,9 +64,19 @@ def _absolute(name: str) -> Any:
     return _MISSING
 
 
+def old_path(name: str) -> bool:
+    """Whether a dotted path goes through a module or package that moved (``snakehead._moved``): such a path
+    resolves, with a warning the first time only, so it is refused by name."""
+    parts = name.split(".")
+    prefixes = {".".join(parts[:i]) for i in range(1, len(parts) + 1)}
+    return not prefixes.isdisjoint(MOVED_MODULES) or not prefixes.isdisjoint(MOVED_PACKAGES)
+
+
 def _quiet_lookup(name: str, where: Any | None) -> Any:
     """``name`` from ``where`` (attributes), or absolute when ``where`` is None; _MISSING when it is not there or
-    when reaching it warns (an old path kept for users)."""
+    when it is an old path kept for users (it warns on import)."""
+    if where is None and old_path(name):
+        return _MISSING
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
