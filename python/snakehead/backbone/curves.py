@@ -29,7 +29,7 @@ from ..model.body_frame import AXIS_TOLERANCE_DEG
 import numpy.typing as npt
 from .._errors import InputError
 
-__all__ = ["DEFAULT_FD_STEP", "DEFAULT_RTOL", "STRAIGHT_TOLERANCE", "SpaceCurve", "cubic_bezier",
+__all__ = ["DEFAULT_FD_STEP", "DEFAULT_RTOL", "STRAIGHT_CURVATURE_RATIO", "SpaceCurve", "cubic_bezier",
            "planar_bezier_length"]
 
 #: Relative finite-difference step (times t1 - t0) used when no derivatives are supplied.
@@ -40,7 +40,7 @@ DEFAULT_RTOL = 1e-10
 
 #: A curve counts as straight (tau = 0, Frenet frame undefined) where its curvature is below this times its
 #: largest curvature (sampled on 257 points of [t0, t1]).
-STRAIGHT_TOLERANCE = 1e-7
+STRAIGHT_CURVATURE_RATIO = 1e-7
 
 # ---------------------------------------------------------------------------------------------------
 # general space curves: Eqs. 3-7
@@ -124,7 +124,7 @@ class SpaceCurve:
 
         kappa = |r' x r''| / |r'|^3,   tau = (r' x r'') . r''' / |r' x r''|^2.
 
-        Where the curve is straight (kappa below ``STRAIGHT_TOLERANCE`` times its largest) tau is 0.
+        Where the curve is straight (kappa below ``STRAIGHT_CURVATURE_RATIO`` times its largest) tau is 0.
         """
         ts = np.atleast_1d(np.asarray(t, dtype=np.float64))
         k = np.empty(ts.shape)
@@ -142,7 +142,7 @@ class SpaceCurve:
         speed = float(np.linalg.norm(d1))
         kappa = math.sqrt(c2) / speed ** 3  # Eq. 7
         # straight here: the Frenet frame (and tau) is undefined; finite-difference noise must not twist phi
-        straight = c2 == 0.0 or kappa <= STRAIGHT_TOLERANCE * self._kappa_max
+        straight = c2 == 0.0 or kappa <= STRAIGHT_CURVATURE_RATIO * self._kappa_max
         tau = 0.0 if straight else float(c @ d3) / c2  # Eq. 7
         return kappa, tau, speed
 
@@ -180,7 +180,7 @@ class SpaceCurve:
         self._straight = False
         self._kappa_max = float(norms.max())
         # an inflection flips the binormal B = r' x r'' / |r' x r''| (and the normal) across a zero of kappa
-        ok = norms > STRAIGHT_TOLERANCE * norms.max()
+        ok = norms > STRAIGHT_CURVATURE_RATIO * norms.max()
         B = cs[ok] / np.linalg.norm(cs[ok], axis=1)[:, None]
         flips = np.flatnonzero(np.einsum("ij,ij->i", B[1:], B[:-1]) < 0.0)
         if len(flips):
@@ -291,7 +291,7 @@ class SpaceCurve:
         if self._straight:
             return 0.0
         k0 = self._kappa_tau(self.t0)[0]
-        if np.all(np.isfinite(F[:, 1])) and k0 > STRAIGHT_TOLERANCE * 1e3 * self._kappa_max:
+        if np.all(np.isfinite(F[:, 1])) and k0 > STRAIGHT_CURVATURE_RATIO * 1e3 * self._kappa_max:
             N = F[:, 1]
             return math.atan2(float(N @ R[:, 2]), float(N @ R[:, 1]))
         # the curve starts straight (kappa(t0) = 0): take the normal where it first bends and undo the

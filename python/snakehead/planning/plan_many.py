@@ -14,20 +14,19 @@ import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import Any, Sequence
 
 from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong
 from .._executors import as_executor, run_tasks
+from .._validate import integer
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene
+from ..solve.head_controller import HeadController
 from .plan_bounds import TIMING_OPTIONS
 from .plan_result import Plan, PlanProgress, ProgressCallback
 from .planner import as_scene, plan
 
 __all__ = ["plan_many", "plan_one", "PlanError", "RobotRecipe", "WorkerControllers", "WORKERS", "KEPT_CONTROLLERS"]
-
-if TYPE_CHECKING:
-    from ..solve.head_controller import HeadController
 
 #: Controllers a worker thread keeps (one per robot, method and seed): the least recently used is dropped.
 KEPT_CONTROLLERS = 4
@@ -73,8 +72,6 @@ class WorkerControllers:
 
     def get(self, recipe: RobotRecipe | None, robot_file: str | None, method: str, seed: int | None
             ) -> HeadController:
-        from ..solve.head_controller import HeadController
-
         kept: OrderedDict = self._local.__dict__.setdefault("kept", OrderedDict())
         key = (recipe, robot_file, method, seed)
         if key in kept:
@@ -122,8 +119,6 @@ _PLAN_OPTIONS = tuple(k for k in inspect.signature(plan).parameters if k not in 
 
 def _check_options(options: dict, executor: Any) -> None:
     """InputError for plan options plan_many does not take, or values plan() would refuse, before any work."""
-    from .._validate import integer
-
     unknown = sorted(set(options) - set(_PLAN_OPTIONS))
     if unknown:
         raise InputError(f"plan_many has no option {unknown[0]!r}; plan's options are {', '.join(_PLAN_OPTIONS)}"

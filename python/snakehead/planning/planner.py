@@ -28,17 +28,18 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
-from .._validate import integer, joint_vector
+from .._validate import integer, joint_vector, sequence
+from ..retiming.timing import resolve_limits
 from ..solve.head_controller import HeadController
 from ..solve.whole_body import PlanSolves, clear_of_obstacles
 from ..model.robot import BasePlacement, SnakeRobot
-from ..scenes.scene import Scene, Target
+from ..scenes.scene import Scene, Target, load_scene
 from . import plan_bounds
 from .base_choice import choose_base, out_of_range, shape_of
 from .fallbacks import retime_slower
@@ -49,17 +50,11 @@ from .target_solves import solve_noted
 from .waypoints import Waypoints
 from .plan_cache import plan_cache_of
 
-if TYPE_CHECKING:
-    from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
+from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 
 
 def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
     """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
-    import os
-
-    from .._validate import sequence
-    from ..scenes.scene import load_scene
-
     if isinstance(targets, Scene):
         scene = targets
         obstacles = sequence(obstacles, "obstacles")
@@ -227,8 +222,6 @@ class _Progress:
 
     def __init__(self, progress: ProgressCallback | None, scene: Scene, t_start: float, robot: SnakeRobot,
                  timing: dict[str, Any] | None) -> None:
-        from ..retiming.timing import resolve_limits
-
         self.progress, self.scene, self.t_start = progress, scene, t_start
         self.count = len(scene.targets)
         self.velocity = resolve_limits(robot, **(timing or {})).velocity  # for the least duration of the moves

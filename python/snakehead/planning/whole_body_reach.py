@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -49,8 +49,9 @@ from ..solve.pose_bounds import PoseBounds
 
 __all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "MAX_WORKERS", "KEPT_CHUNK"]
 
-if TYPE_CHECKING:
-    from ..solve.head_controller import HeadController
+from ..solve.head_controller import HeadController
+from ..solve.whole_body import LIFTED_IK_TIMEOUT_S, POSITION_TOLERANCE
+from ..margins import DETOUR_MARGIN
 
 #: Relative bearings (the direction's heading minus the bearing from the base to the target) at which the
 #: relocation is solved per layer and direction; a voxel takes the nearest one's answer.
@@ -157,8 +158,6 @@ def unreachable(robot: SnakeRobot, positions: np.ndarray, directions: np.ndarray
     necessary conditions): with any base lying flat, or (``kept``) with the base as it lies at the start (the
     planner's initial configuration at ``BasePlacement()``, its margin ``DETOUR_MARGIN``), where the solve with the
     base kept cannot succeed."""
-    from ..margins import DETOUR_MARGIN
-
     controller = WORKERS.get(RobotRecipe.of(robot), None, "rotated", 1)
     q0, start = controller.q_initial, BasePlacement()
     bounds = PoseBounds.of(robot, q0)
@@ -331,8 +330,6 @@ def _run(pool: Any, fn: Callable[..., list], tasks: list, stage: str, progress: 
 
 def _as_map(robot: SnakeRobot, grid: ReachGrid, reached: np.ndarray, placements: np.ndarray, joints: np.ndarray,
             seed: int | None, seconds: float, workers: int, command: str) -> ws.ReachabilityMap:
-    from ..solve.whole_body import LIFTED_IK_TIMEOUT_S, POSITION_TOLERANCE
-
     M, N = reached.shape
     params = dict(voxel_size=grid.voxel, directions=N, rolls=0, any_roll=True, free_roll=True, approach_axis="x",
                   timeout=LIFTED_IK_TIMEOUT_S, epsilon=POSITION_TOLERANCE, cloud_samples=ws.MIN_CLOUD_SAMPLES,
