@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from snakehead import default_robot_file, default_urdf_path
-from snakehead.app import cli
+from snakehead.app import cli, commands
 from snakehead.model.robot_file import write_robot_file
 
 SMALL_MAP = ["--voxel", "0.2", "--directions", "2", "--rolls", "1", "--quiet"]
@@ -115,7 +115,7 @@ def test_an_internal_error_is_3_with_one_line(command, monkeypatch, capsys, tmp_
     def broken(args):
         raise KeyError("a bug")
 
-    monkeypatch.setattr(cli, f"_{command}", broken)
+    monkeypatch.setattr(commands, f"{command}_command", broken)
     argv = {"info": ["info"], "demo": ["demo", "--out", str(tmp_path)],
             "plan": ["plan", "--out", str(tmp_path), "--position", "0", "0.5", "0.3", "--direction", "0", "1", "0"],
             "workspace": ["workspace", "--out", str(tmp_path / "m.npz")], "view": ["view", str(tmp_path)]}[command]

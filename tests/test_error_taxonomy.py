@@ -210,7 +210,7 @@ def test_the_figure_process_keeps_the_fault_of_its_errors():
         raise KeyError("a bug")
 
     with pytest.raises(InputError, match="No space left"):
-        pipeline._Beside(unwritable, pipeline.Progress()).files()
+        pipeline.Beside(unwritable, pipeline.Progress()).files()
     with pytest.raises(RuntimeError, match="KeyError"):
         pipeline._Beside(broken, pipeline.Progress()).files()
 
@@ -237,11 +237,11 @@ def test_a_figure_process_that_dies_is_replaced_by_drawing_here(monkeypatch):
         return ["drawn here.png"]
 
     for work, said_what in [(dies_when_forked, "died (exit code -9)"), (hangs_when_forked, "gave no answer in 1 s")]:
-        monkeypatch.setattr(pipeline, "FIGURE_PROCESS_TIMEOUT_S", 1.0)
+        monkeypatch.setattr("snakehead.app.beside.FIGURE_PROCESS_TIMEOUT_S", 1.0)
         progress = pipeline.Progress()
         said: list[str] = []
         monkeypatch.setattr(progress, "say", said.append)
-        assert pipeline._Beside(work, progress).files() == ["drawn here.png"]
+        assert pipeline.Beside(work, progress).files() == ["drawn here.png"]
         assert any(said_what in line for line in said), said
 
 
@@ -276,10 +276,10 @@ def test_the_figure_process_never_collects_the_parents_solvers(monkeypatch):
         gc.collect()
         return [f"drawn {'beside' if os.getpid() != parent else 'here'}"]
 
-    monkeypatch.setattr(pipeline, "FIGURE_PROCESS_TIMEOUT_S", 20.0)  # a regression hangs (the join)
+    monkeypatch.setattr("snakehead.app.beside.FIGURE_PROCESS_TIMEOUT_S", 20.0)  # a regression hangs (the join)
     gc.disable()  # the cycle must still be there at the fork
     try:
-        assert pipeline._Beside(collects, pipeline.Progress()).files() == ["drawn beside"]
+        assert pipeline.Beside(collects, pipeline.Progress()).files() == ["drawn beside"]
     finally:
         gc.enable()
     assert gc.collect() > 0  # and the parent frees it
@@ -295,4 +295,4 @@ def test_a_process_beside_raises_snakeheads_own_errors_as_they_are():
             raise error
 
         with pytest.raises(type(error), match=str(error)):
-            pipeline._Beside(fails, pipeline.Progress()).result()
+            pipeline.Beside(fails, pipeline.Progress()).result()

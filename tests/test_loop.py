@@ -702,13 +702,14 @@ def check_replay(robot, scene, monkeypatch, **options):
 
 def test_sensing_option_of_the_command_line():
     """--sensing reaches the pipeline's settings (and so the loop), both spellings; a wrong one is a usage error."""
-    from snakehead.app.cli import _settings, build_parser
+    from snakehead.app.cli import build_parser
+    from snakehead.app.commands import settings_of
 
     parser = build_parser()
     for command in ("plan", "demo"):
         extra = ["--out", "x"] + (["--position", "0", "0.5", "0.3", "--direction", "0", "1", "0"] if command == "plan" else [])
         args = parser.parse_args([command, *extra, "--sensing", "outside-fix"])
-        assert _settings(args).sensing == "outside fix" and _settings(args).as_dict()["sensing"] == "outside fix"
-        assert _settings(parser.parse_args([command, *extra])).sensing == "onboard"
+        assert settings_of(args).sensing == "outside fix" and settings_of(args).as_dict()["sensing"] == "outside fix"
+        assert settings_of(parser.parse_args([command, *extra])).sensing == "onboard"
         with pytest.raises(SystemExit, match="^2$"):  # argparse's usage error
             parser.parse_args([command, *extra, "--sensing", "gps"])

@@ -394,15 +394,16 @@ def test_the_head_solutions_message_is_shown_as_it_is(robot):
 def test_the_pipelines_titles_show_names_as_they_are(robot, motion, tmp_path):
     """The pipeline's own titles (snapshots, momenta, ZMP; the description or the scene's name) with a hostile
     description and target name: the files are written."""
-    from snakehead.app.pipeline import FAST, Progress, _dynamics_figures, _loop_figures, _plan_outputs
+    from snakehead.app.pipeline import FAST, Progress
+    from snakehead.app.scene_outputs import write_dynamics_figures, write_loop_figures, write_plan_outputs
 
     scene = Scene("scene $1$ `x`", (Target("$\\frac{$ <script>", [0.3, 0.1, 0.2], [1.0, 0.0, 0.0]),),
                   description="costs $\\frac{$ | <b>bold</b>\nsecond line")
     plan = make_plan(robot, motion, scene)
     progress = Progress(quiet=True)
-    files = _plan_outputs(scene, plan, tmp_path, FAST, progress, False)
-    files += _dynamics_figures(scene, plan, None, tmp_path, progress)
-    files += _loop_figures(scene, make_loop_run(robot, motion, scene), tmp_path, {"max_frames": 2}, progress)
+    files = write_plan_outputs(scene, plan, tmp_path, FAST, progress, False)
+    files += write_dynamics_figures(scene, plan, None, tmp_path, progress)
+    files += write_loop_figures(scene, make_loop_run(robot, motion, scene), tmp_path, {"max_frames": 2}, progress)
     assert len(files) == 8
     for f in files:
         assert (tmp_path / f).stat().st_size > 0 and (tmp_path / f).parent == tmp_path

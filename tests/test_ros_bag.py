@@ -472,13 +472,14 @@ def test_the_pipeline_writes_a_loops_bag(loop_run, tmp_path):
     head phases' trajectory; nothing for a loop that failed before its first phase."""
     import dataclasses
 
-    from snakehead.app.pipeline import Progress, _ros_outputs
+    from snakehead.app.pipeline import Progress
+    from snakehead.app.scene_outputs import write_ros_outputs
 
-    files = _ros_outputs("loop", tmp_path, Progress(quiet=True), loop_run.plan, loop_run)
+    files = write_ros_outputs("loop", tmp_path, Progress(quiet=True), loop_run.plan, loop_run)
     assert files == ["loop.mcap", "loop_joint_trajectory.yaml"]
     assert "/snakehead/planned_joint_states" in read_bag(tmp_path / "loop.mcap")
     nothing = dataclasses.replace(loop_run, phases=[], plan=None, head=None, failure="no plan reaches the targets")
-    assert _ros_outputs("none", tmp_path, Progress(quiet=True), None, nothing) == []
+    assert write_ros_outputs("none", tmp_path, Progress(quiet=True), None, nothing) == []
     assert not (tmp_path / "none.mcap").exists()
 
 

@@ -87,10 +87,10 @@ def test_share_per_worker() -> None:
 
 
 def test_reach_pool_workers_take_their_share() -> None:
-    from snakehead.app.cli import _reach_executor
+    from snakehead.app.commands import reach_executor
 
     args = argparse.Namespace(scheduler=None, workers=2)
-    pool, close = _reach_executor(args)
+    pool, close = reach_executor(args)
     try:
         got = {pool.submit(sh.core_threads).result(timeout=120) for _ in range(4)}
     finally:
