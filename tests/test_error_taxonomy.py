@@ -212,7 +212,7 @@ def test_the_figure_process_keeps_the_fault_of_its_errors():
     with pytest.raises(InputError, match="No space left"):
         pipeline.Beside(unwritable, pipeline.Progress()).files()
     with pytest.raises(RuntimeError, match="KeyError"):
-        pipeline._Beside(broken, pipeline.Progress()).files()
+        pipeline.Beside(broken, pipeline.Progress()).files()
 
 
 def test_a_figure_process_that_dies_is_replaced_by_drawing_here(monkeypatch):
