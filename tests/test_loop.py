@@ -347,7 +347,7 @@ def test_locomotion_leaves_two_boxes_and_goes_round_them(mujoco, robot):
         est.base = run.estimate.base
 
     routes = []
-    why = loop._locomotion(fake, est, straight_goal, lc.Tolerance(), rates, routes, lambda text: None, ground,
+    why = loop.route_follower.follow(fake, est, straight_goal, lc.Tolerance(), rates, routes, lambda text: None, ground,
                            lambda: None)
     assert why is None and routes
     off = lc.relative(straight_goal, est.base)
@@ -399,7 +399,7 @@ def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(mujoco, robot):
                     for q, b in zip(path, slide))
         loop = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))], obstacles=[wall]),
                           robot=robot)
-        results[shift] = (dense, loop._straight_failure(goal, q_bend))
+        results[shift] = (dense, loop.goal_checks.straight_failure(goal, q_bend))
     dense, why = results[0.04]
     assert dense < gp.GOAL_CLEARANCE_M and why is not None and "into its curl" in why
     dense, why = results[1.0]
@@ -617,7 +617,7 @@ def check_replay(robot, scene, monkeypatch, **options):
     import dataclasses
 
     from snakehead import HeadController
-    from snakehead.closed_loop import loop as loop_mod
+    from snakehead.closed_loop import episode as loop_mod  # where the loop simulates the lifted body
     from snakehead.closed_loop.gait_runner import replay_estimate
     from snakehead.closed_loop.loop import ClosedLoop
 
