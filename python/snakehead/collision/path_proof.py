@@ -1,4 +1,5 @@
-"""Proofs that a path or a timed motion stays clear, in C++ batches (``_core.PathChecker``, include/snakehead/path_check.hpp).
+"""Proofs that a path or a timed motion stays clear, in C++ batches (``_core.PathChecker``,
+include/snakehead/path_check.hpp).
 
 * :func:`sample_clearances` -- each configuration's smallest ground clearance (the neck and head links), self
   clearance and obstacle distance, in one call without the GIL.
@@ -131,7 +132,8 @@ def check_path(robot: SnakeRobot, waypoints: np.ndarray, base: BasePlacement | N
     -GROUND_TOLERANCE), of themselves and of ``obstacles`` everywhere along them, not only at samples (the motion
     bound of the module's docstring)."""
     W = np.ascontiguousarray(waypoints, float).reshape(-1, robot.n_joints)
-    d = (made if made is not None else checker(robot, base, obstacles)).check_path(W, float(first_step), float(floor_step), bool(stop_at_violation))
+    proof = made if made is not None else checker(robot, base, obstacles)
+    d = proof.check_path(W, float(first_step), float(floor_step), bool(stop_at_violation))
     return PathReport(clear=bool(d["clear"]), segments=d["segments"], **_counts(d))
 
 
@@ -159,5 +161,6 @@ def check_motion(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | None =
     and head links, by -GROUND_TOLERANCE), of itself and of ``obstacles`` at and between its samples, evaluating
     only some (the module's docstring)."""
     Q = np.ascontiguousarray(qs, float).reshape(-1, robot.n_joints)
-    d = (made if made is not None else checker(robot, base, obstacles)).check_motion(Q, float(first_step), float(floor_step))
+    proof = made if made is not None else checker(robot, base, obstacles)
+    d = proof.check_motion(Q, float(first_step), float(floor_step))
     return MotionReport(clear=bool(d["clear"]), obstacle_lower=d["obstacle_lower"], **_counts(d))

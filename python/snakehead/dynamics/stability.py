@@ -1,7 +1,7 @@
 """Stability of the snake's whole-body motion: paper Section 3.1, Eqs. 23-40.
 
 Everything is in the world frame (z up, ground at z = 0). Where the base lies is a parameter
-``base`` (a :class:`~snakehead.robot.BasePlacement`, default ``BasePlacement()``: tail at the origin,
+``base`` (a :class:`~snakehead.model.robot.BasePlacement`, default ``BasePlacement()``: tail at the origin,
 body along +x).
 
 * :func:`center_of_mass` -- Eq. 23, for one configuration (n,) or a trajectory (T, n).
@@ -414,7 +414,7 @@ class KeptSamples:
     how many samples the last check took over (0 when the motion did not begin with them: the core compares them bit
     for bit, with the robot and contact model, and computes everything otherwise). At the placement it was made at,
     the result is the same as without it to the bit; at another placement on the ground (the base turned about z and
-    moved in x, y; include/snakehead/path_check.hpp, ZmpPrefix) its momenta, CoM and polygons are moved there: the
+    moved in x, y; include/snakehead/zmp_check.hpp, ZmpPrefix) its momenta, CoM and polygons are moved there: the
     same up to round-off (~1e-15 m), the contact runs and clearances to the bit."""
 
     samples: int
@@ -461,9 +461,10 @@ def dynamic_stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, b
         raise InputError("the base part has no links with collision shapes; no support polygon")
     resume = kept.core if kept is not None else None
     keep = kept.samples if kept is not None and resume is None else 0
-    out = _core.zmp_check(made if made is not None else checker(robot, base), t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float),
-                          g.shapes_of(links), g.contact_points_per_shape, g.shapes_of(robot.lifted_links),
-                          contact == "ground", key_joints, tolerance, SAMPLE_CHUNK, GRAVITY, resume, max(0, keep))
+    made = made if made is not None else checker(robot, base)
+    out = _core.zmp_check(made, t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float), g.shapes_of(links),
+                          g.contact_points_per_shape, g.shapes_of(robot.lifted_links), contact == "ground",
+                          key_joints, tolerance, SAMPLE_CHUNK, GRAVITY, resume, max(0, keep))
     if kept is not None:
         kept.resumed = int(out["resumed"])
         if out["kept"] is not None:
@@ -528,18 +529,18 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
     return polygon_margin_many(pts[inv], active[inv], xy)
 
 
-def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *, contact: str = "endpoints",
-                     tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
+                     contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                     frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
     ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).
 
     Row k holds its polygon's ``count[k]`` vertices counter-clockwise first (the rest is padding): 0 where no link
     touches the ground, 1 for a point, 2 for a segment (collinear contacts). The polygons are built once per run
     of consecutive samples with one contact configuration (joints rounded to 1e-12 rad, so that a spline's
-    round-off in a still base does not split it): the base joints decide the base's contacts; with contact="ground" also the joints before the
-    last link on the ground (those after it move nothing that touches). ``frames``: the world frames of ``q``
-    (T, n_links, 4, 4), when the caller has them.
+    round-off in a still base does not split it): the base joints decide the base's contacts; with contact="ground"
+    also the joints before the last link on the ground (those after it move nothing that touches). ``frames``: the
+    world frames of ``q`` (T, n_links, 4, 4), when the caller has them.
     """
     robot = as_robot(robot)
     base = as_base(base)

@@ -1,6 +1,6 @@
 """The obstacles of a scene, one model for planning (:mod:`snakehead.collision.body_collisions`) and simulation
 (:mod:`snakehead.sim`): boxes, a wall with a round hole and meshes (their convex hulls). Scene files
-(:mod:`snakehead.scenes`) describe them. Each obstacle gives its convex :meth:`shapes` in the world (the wall as
+(:mod:`snakehead.scenes`) describe them. Each obstacle gives its convex ``shapes()`` in the world (the wall as
 convex pieces around a polygon inscribed in its hole, so that collisions with it err on the safe side).
 """
 from __future__ import annotations
@@ -58,7 +58,8 @@ class BoxObstacle:
         """A box standing upright, turned by ``yaw`` rad about the world z-axis."""
         yaw = finite_float(yaw, "box yaw")
         c, s = np.cos(yaw), np.sin(yaw)
-        return cls(np.asarray(centre, float), np.asarray(size, float), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
+        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        return cls(np.asarray(centre, float), np.asarray(size, float), R)
 
 
 @dataclass(frozen=True)

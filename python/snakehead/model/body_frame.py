@@ -197,5 +197,6 @@ def aligned_frames(text: str, body: Chain, body_in_root: np.ndarray, parts: list
         out[key] = frames[key] + ALIGNED_SUFFIX
         twins.append((frames[key], out[key], Ra))
     if twins:
-        text = add_fixed_frames(text if text.lstrip().startswith("<") else Path(text).read_text(encoding="utf-8"), twins)
+        xml = text if text.lstrip().startswith("<") else Path(text).read_text(encoding="utf-8")
+        text = add_fixed_frames(xml, twins)
     return out, text

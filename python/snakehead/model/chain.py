@@ -34,7 +34,8 @@ class Chain:
 
     def __init__(self, model: _core.ChainModel, urdf: str | None = None) -> None:
         if not isinstance(model, _core.ChainModel):
-            raise InputTypeError(f"model must be a snakehead._core.ChainModel (use Chain.from_urdf), got {type(model).__name__}")
+            raise InputTypeError("model must be a snakehead._core.ChainModel (use Chain.from_urdf), got "
+                                 f"{type(model).__name__}")
         self._model = model
         #: The URDF the chain was read from (a path or the XML), when known: lets workers rebuild it.
         self.urdf = urdf

@@ -7,8 +7,8 @@ limits, mesh paths resolved and collision meshes loaded as their convex hulls.
 * :func:`with_joint_limits` -- ``continuous`` joints turned into revolute ones with the limits a robot file gives
   (a snake's planner needs bounded joints; a continuous joint without limits is an error naming it).
 * :class:`MeshResolver` -- ``package://NAME/...``, ``file://...`` and relative mesh paths to files inside the
-  robot's folders: the robot file's ``[packages]`` first, then ``ROS_PACKAGE_PATH``; :func:`~snakehead.geometry.meshes.convex_hull_vertices`
-  loads one with trimesh.
+  robot's folders: the robot file's ``[packages]`` first, then ``ROS_PACKAGE_PATH``;
+  :func:`~snakehead.geometry.meshes.convex_hull_vertices` loads one with trimesh.
 
 Errors are :class:`snakehead.InputError` naming the file and the element.
 """
@@ -277,7 +277,8 @@ def with_joint_limits(text: str, limits: Mapping[str, tuple[float, float]], wher
     missing = [name for name in (needed or []) if name not in limits]
     if missing:
         raise InputError(f"{where}: continuous joint{'s' if len(missing) > 1 else ''} {', '.join(map(repr, missing))} "
-                         f"{'need' if len(missing) > 1 else 'needs'} limits: add them to the robot file's [limits] table (joint = [lower, upper] in rad)")
+                         f"{'need' if len(missing) > 1 else 'needs'} limits: add them to the robot file's [limits] "
+                         "table (joint = [lower, upper] in rad)")
     for name, (lower, upper) in limits.items():
         joint = joints[name]
         if joint.get("type") not in ("revolute", "continuous"):

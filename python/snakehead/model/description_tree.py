@@ -96,7 +96,8 @@ class _Tree:
             parent, child = self.ends(name)
             for role, link in (("parent", parent), ("child", child)):
                 if link not in self.links:
-                    raise InputError(f"{where}: joint {name!r} names {role} link {link!r}, which the URDF does not have")
+                    raise InputError(f"{where}: joint {name!r} names {role} link {link!r}, which the URDF does not "
+                                     "have")
             if child in self.parent_joint:
                 raise InputError(f"{where}: link {child!r} is the child of two joints, {self.parent_joint[child]!r} "
                                  f"and {name!r}")

@@ -174,7 +174,8 @@ def snake_urdf(spec: SnakeSpec | None = None, **kwargs: Any) -> str:
     limit = math.radians(spec.joint_limit_deg)
     n = spec.n_joints
     header = spec.comment or (
-        f"{spec.name}: a snake robot written by snakehead.model.snake_urdf. {n + 1} links, {n} revolute joints "
+        f"{spec.name}: a snake robot written by snakehead.model.generate.snake_urdf. {n + 1} links, {n} revolute "
+        f"joints "
         f"alternating yaw (local z) and pitch (local y), joint 1 {spec.first_axis}; +-{spec.joint_limit_deg:g} deg; "
         f"modules {spec.module_length:g} m long, {spec.section:g} m square, {spec.mass_per_module:g} kg each; "
         f"{spec.length:.6g} m, {spec.total_mass:.6g} kg in all.")

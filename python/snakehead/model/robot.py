@@ -129,7 +129,8 @@ class SnakeRobot:
     # --- construction ---------------------------------------------------------------------------
     @classmethod
     def from_urdf(cls, urdf: str | os.PathLike, *, base_end: str, neck_end: str, head_tip: str,
-                  root: str | None = None, head_axis: str = "x", packages: Mapping[str, str | os.PathLike] | None = None,
+                  root: str | None = None, head_axis: str = "x",
+                  packages: Mapping[str, str | os.PathLike] | None = None,
                   limits: Mapping[str, tuple[float, float]] | None = None,
                   xacro_args: Mapping[str, object] | None = None, trust_xacro: bool = False,
                   home: Mapping[str, float] | None = None, inertia: str = "urdf",
@@ -206,8 +207,8 @@ class SnakeRobot:
 
     def __repr__(self) -> str:
         where = self.source or (self.urdf if not self.urdf.lstrip().startswith("<") else "<URDF text>")
-        return (f"SnakeRobot({where!r}, {self.n_joints} joints: base {self.parts.base.stop - self.parts.base.start}, "
-                f"neck {self.parts.neck.stop - self.parts.neck.start}, head {self.parts.head.stop - self.parts.head.start})")
+        base, neck, head = (s.stop - s.start for s in (self.parts.base, self.parts.neck, self.parts.head))
+        return f"SnakeRobot({where!r}, {self.n_joints} joints: base {base}, neck {neck}, head {head})"
 
     # --- joints and parts -----------------------------------------------------------------------
     @property

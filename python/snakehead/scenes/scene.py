@@ -38,12 +38,12 @@ A scene file is TOML::
 
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
 
-Names (:func:`snakehead._validate.name_text`): a target's name is one line of printable text of at most
+Names (``snakehead._validate.name_text``): a target's name is one line of printable text of at most
 :data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator
-characters (newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``, backticks and
-any script are names like others, shown literally in every figure and report. A scene's name also names its output
-files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name besides
-(:func:`~snakehead._validate.file_name_part`: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,
+characters (newline, tab, NUL, escape, zero-width and bidirectional marks); ``$``, ``\\``, ``<script>``, ``|``,
+backticks and any script are names like others, shown literally in every figure and report. A scene's name also
+names its output files (``NAME_trajectory.csv``, ``NAME.html``...), so it is a portable file name besides
+(``file_name_part``: no ``/ \\ < > : " | ? *``, not ``.``, ``..`` or a Windows device name,
 at most 100 bytes). A description may also hold newlines and tabs. Anything else is an
 :class:`~snakehead._errors.InputError` naming the field.
 
@@ -66,8 +66,8 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError
 from .._files import write_text_atomic
-from .._validate import (display_text, duration, file_name_part, file_problem, finite_float, name_text, sequence, unit_vector3,
-                         world_position)
+from .._validate import (display_text, duration, file_name_part, file_problem, finite_float, name_text, sequence,
+                         unit_vector3, world_position)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
@@ -191,7 +191,8 @@ class Scene:
             try:
                 position, direction = item
             except (TypeError, ValueError):
-                raise InputError(f"targets[{k}] must be a (position, direction) pair or a Target, got {item!r}") from None
+                raise InputError(f"targets[{k}] must be a (position, direction) pair or a Target, "
+                                 f"got {item!r}") from None
             label = name if len(items) == 1 else f"{name} {k + 1}"
             targets.append(Target(label, position, direction, hold_s=hold_s))
         return cls(name=name, targets=tuple(targets), obstacles=sequence(obstacles, "obstacles"), base=base)
