@@ -145,6 +145,8 @@ class PathChecker {
   };
 
  private:
+  void measure_reach();  // joint_of_shape_ and reach_ (constant for revolute joints)
+  void list_items();     // items_ from the spec, its shape indices checked
   void joints_at(const Eigen::VectorXd& q, Joints& out, std::vector<double>& frames) const;
   friend class PathProof;
   const ChainModel& model_;
