@@ -246,10 +246,6 @@ class SnakeRobot:
         """Index of a frame in :attr:`link_names` (ValueError for a frame not on the body)."""
         return self.body.link_index(name)
 
-    def _joints_before(self, link_index: int) -> int:
-        # kept for solve.whole_body until it calls robot_parts.joints_before(robot.body, link_index)
-        return rp.joints_before(self.body, link_index)
-
     def sub_chain(self, base: str, tip: str) -> Chain:
         """The chain between two frames of the body (cached; chains are immutable)."""
         key = (base, tip)
@@ -537,10 +533,6 @@ class SnakeRobot:
     def frames_many(self, qs: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
         """``frames`` along a trajectory: qs (T, n) -> (T, n_links, 4, 4)."""
         return kin.forward_kinematics_many(self, qs, as_base(base))
-
-    def _frames_many_checked(self, qs: np.ndarray, base: BasePlacement) -> np.ndarray:
-        # kept for solve.whole_body until it calls frames.forward_kinematics_unchecked(robot, qs, base)
-        return kin.forward_kinematics_unchecked(self, qs, base)
 
     def frame(self, q: np.ndarray, name: str, base: BasePlacement | None = None) -> np.ndarray:
         """World pose (4, 4) of one named frame (a link or a marker)."""
