@@ -16,6 +16,7 @@ from snakehead.geometry.obstacles import BoxObstacle, MeshObstacle
 from snakehead.samples import published
 from snakehead.scenes import load_scene
 from snakehead._errors import InputError
+from snakehead.ground_contact import GROUND_TOLERANCE
 
 
 def scene_with_a_mesh(folder: Path, mesh: str, position: str) -> Path:
@@ -77,9 +78,9 @@ def test_cylinder_support_polygon_is_the_hull_of_the_bottom_lines(tmp_path: Path
                 ends.append(c + sign * s.size[1] / 2 * a - s.size[0] * np.array([0.0, 0.0, 1.0]))
         else:  # the tail, a faceted mesh: its hull's vertices within the contact tolerance of the ground
             v = s.vertices @ B[:3, :3].T + B[:3, 3]
-            ends.extend(v[v[:, 2] <= stability.CONTACT_TOLERANCE])
+            ends.extend(v[v[:, 2] <= GROUND_TOLERANCE])
     ends = np.array(ends)
-    assert np.abs(ends[:, 2]).max() <= stability.CONTACT_TOLERANCE  # on the ground
+    assert np.abs(ends[:, 2]).max() <= GROUND_TOLERANCE  # on the ground
     hull = ends[ConvexHull(ends[:, :2]).vertices, :2]
     poly = stability.support_polygon(robot, q, contact="footprint")
     assert len(poly) == len(hull)

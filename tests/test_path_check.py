@@ -20,6 +20,7 @@ from snakehead.margins import EXACT_DISTANCE_WITHIN
 from snakehead.geometry.shapes import shape_points
 from snakehead.samples.published import write_robot
 from snakehead.model.robot import BasePlacement, SnakeRobot
+from snakehead.ground_contact import GROUND_TOLERANCE
 
 FINE = 100  # brute force: points per interval
 
@@ -246,7 +247,7 @@ def test_zmp_check_takes_over_a_kept_prefix_to_the_bit() -> None:
             np.testing.assert_array_equal(getattr(again, name), getattr(fresh, name), err_msg=name)
         np.testing.assert_array_equal(clear, fresh_clear)
         assert (again.argmin, again.stable) == (fresh.argmin, fresh.stable)
-    runs = stability.contact_configurations(robot, lift[:m], base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+    runs = stability.contact_configurations(robot, lift[:m], base, "ground", GROUND_TOLERANCE)[2].max() + 1
     assert runs > 2, "the kept samples must hold several contact runs"
 
 
@@ -296,7 +297,7 @@ def independent_zmp_check(robot: SnakeRobot, t, q, qd, base, contact: str, qdd=N
 
     links = sorted({s.frame for s in robot.geometry.shapes}) if contact == "ground" else robot.base_links
     return zmp_reference.zmp_check(robot, t, q, qd, base, links, robot.geometry.contact_points_per_shape,
-                                   stability.CONTACT_TOLERANCE, qdd=qdd)
+                                   GROUND_TOLERANCE, qdd=qdd)
 
 
 def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) -> None:
@@ -334,7 +335,7 @@ def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) ->
             stability.SAMPLE_CHUNK = 37
             try:
                 core, clearance = stability.dynamic_stability_with_clearance(robot, t, q, base, qd, contact=contact)
-                ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, contact, stability.CONTACT_TOLERANCE,
+                ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, contact, GROUND_TOLERANCE,
                                                            None, None)
             finally:
                 stability.SAMPLE_CHUNK = old
@@ -346,7 +347,7 @@ def test_zmp_check_equals_the_python_reference(robots: dict[str, SnakeRobot]) ->
             assert core.argmin == ref.argmin and core.stable == ref.stable
             lowest = robot.lowest_z(robot.frames_many(q, base), robot.lifted_links).min(axis=1)
             np.testing.assert_array_equal(clearance, lowest)
-        runs = stability.contact_configurations(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2].max() + 1
+        runs = stability.contact_configurations(robot, q, base, "ground", GROUND_TOLERANCE)[2].max() + 1
         assert runs > 2, "the motion must change its contacts (the head lifts)"
 
 
@@ -380,11 +381,11 @@ def test_zmp_check_with_a_still_base_and_a_moving_one_equals_the_python_referenc
     np.testing.assert_allclose(core.zmp, ind["zmp"], atol=1e-11, rtol=0)
     np.testing.assert_allclose(core.margin, ind["margin"], atol=1e-11, rtol=0)
     assert core.argmin == int(np.argmin(ind["margin"])) and 0 < (ind["margin"] > 0).sum() < len(t)
-    ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, "ground", stability.CONTACT_TOLERANCE, None,
+    ref = stability.dynamic_stability_in_python(robot, t, q, base, qd, "ground", GROUND_TOLERANCE, None,
                                                None)
     np.testing.assert_allclose(core.margin, ref.margin, atol=1e-9, rtol=0)
     assert core.argmin == ref.argmin and core.stable == ref.stable
-    runs = stability.contact_configurations(robot, q, base, "ground", stability.CONTACT_TOLERANCE)[2]
+    runs = stability.contact_configurations(robot, q, base, "ground", GROUND_TOLERANCE)[2]
     assert runs.max() + 1 > 200, "the neck must lift through many runs"
 
 
@@ -417,7 +418,7 @@ def test_zmp_check_takes_gravity_from_the_caller() -> None:
     q, qd = q0 + s * (q1 - q0), (6 * t * (1 - t))[:, None] * (q1 - q0)
     g = robot.geometry
     args = (path_check.checker(robot), t, q, qd, g.shapes_of(robot.shaped_links), g.contact_points_per_shape,
-            g.shapes_of(robot.lifted_links), True, [], stability.CONTACT_TOLERANCE, stability.SAMPLE_CHUNK)
+            g.shapes_of(robot.lifted_links), True, [], GROUND_TOLERANCE, stability.SAMPLE_CHUNK)
     M = robot.total_mass
     for gravity in (GRAVITY, 3.0 * GRAVITY):
         out = _core.zmp_check(*args, gravity)

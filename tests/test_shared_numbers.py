@@ -84,3 +84,20 @@ def test_trac_iks_defaults_are_written_once_and_are_the_cores():
     for fn in (ik.TracIK.__init__, ik.TracIK.from_chain, HeadController.__init__):
         params = inspect.signature(fn).parameters
         assert params["timeout"].default is ik.DEFAULT_TIMEOUT_S and params["epsilon"].default is ik.DEFAULT_EPSILON
+
+
+def test_what_counts_as_touching_the_ground_is_defined_once():
+    """One tolerance for the planner's ground, one for a body that is simulated or measured (ground_contact)."""
+    from snakehead import ground_contact
+    from snakehead.collision import body_collisions
+    from snakehead.dynamics import sliding, stability
+    from snakehead.solve import base_support
+
+    assert definitions("GROUND_TOLERANCE") == ["ground_contact.py"]
+    assert definitions("RESTING_TOLERANCE") == ["ground_contact.py"]
+    for gone in ("CONTACT_TOLERANCE", "CONTACT_BAND", "RESTING_HEIGHT"):  # its earlier names
+        assert definitions(gone) == [], gone
+    assert body_collisions.GROUND_TOLERANCE is stability.GROUND_TOLERANCE is base_support.GROUND_TOLERANCE \
+        is ground_contact.GROUND_TOLERANCE
+    assert sliding.RESTING_TOLERANCE is ground_contact.RESTING_TOLERANCE
+    assert ground_contact.GROUND_TOLERANCE == 1e-3 and ground_contact.RESTING_TOLERANCE == 3e-3

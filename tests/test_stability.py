@@ -9,6 +9,7 @@ from shape_reference import box_corners, lowest_z_by_sampling
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics import stability as st
 from snakehead._errors import InputError, InputTypeError
+from snakehead.ground_contact import GROUND_TOLERANCE
 
 
 def _pin():
@@ -123,7 +124,7 @@ def test_ground_contact_counts_only_the_corners_that_touch(robot, pitch):
     q = np.zeros(16)
     q[7] = pitch  # the neck's first pitch joint lifts the neck and head a little
     corners = box_corners(robot, robot.frames(q)[None], robot.shaped_links)[0]
-    touching = corners[corners[:, 2] <= st.CONTACT_TOLERANCE, :2]
+    touching = corners[corners[:, 2] <= GROUND_TOLERANCE, :2]
     hull = touching[ConvexHull(touching).vertices]
     poly = st.support_polygon(robot, q, contact="ground")
     assert len(poly) == len(hull)
@@ -462,7 +463,7 @@ def test_static_margins_of_a_batch_match_qhull(robot, contact):
     order = np.argsort(corners[..., 2], axis=-1, kind="stable")[..., :robot.geometry.contact_points_per_shape]
     corners = np.take_along_axis(corners, order[..., None], axis=2).reshape(len(qs), -1, 3)
     for k in range(len(qs)):
-        touching = corners[k][corners[k][:, 2] <= st.CONTACT_TOLERANCE, :2]
+        touching = corners[k][corners[k][:, 2] <= GROUND_TOLERANCE, :2]
         ref = margin_to_hull(touching, com_reference(robot, frames[k])[:2])
         assert got[k] == pytest.approx(ref, abs=1e-9)
         assert st.static_margin(robot, qs[k], base, contact=contact) == pytest.approx(ref, abs=1e-9)

@@ -13,6 +13,7 @@ from snakehead.collision import body_collisions as coll
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead._errors import InputTypeError
+from snakehead.ground_contact import GROUND_TOLERANCE
 
 
 @pytest.fixture(scope="module")
@@ -253,7 +254,7 @@ def _mixed_batch(robot, controller, prob, rng, count):
 
 def test_body_problem_margins_of_a_batch_match_qhull(default):
     """BodyProblem.margins (a batch at once: the contacts masked, the core's hull per sample) against Qhull's hull of
-    each sample's ground-link box corners within CONTACT_BAND of each link's lowest, and the centre of mass summed
+    each sample's ground-link box corners within GROUND_TOLERANCE of each link's lowest, and the centre of mass summed
     link by link; collinear contacts give -inf."""
     from hull_reference import com_reference, hull_vertices, margin_to_hull
     from shape_reference import box_corners
@@ -269,7 +270,7 @@ def test_body_problem_margins_of_a_batch_match_qhull(default):
         kept = []
         for link in prob.ground_links:
             c = box_corners(robot, frames[k:k + 1], [link])[0]
-            kept.append(c[c[:, 2] <= c[:, 2].min() + wb.CONTACT_BAND, :2])
+            kept.append(c[c[:, 2] <= c[:, 2].min() + GROUND_TOLERANCE, :2])
         pts = np.concatenate(kept)
         xy = com_reference(robot, frames[k])[:2]
         ref = margin_to_hull(pts, xy) if hull_vertices(pts) is not None else -np.inf
@@ -308,11 +309,11 @@ def test_check_solutions_of_a_batch_match_independent_checks(default):
             order = np.argsort(corners.reshape(-1, 8, 3)[..., 2], axis=-1, kind="stable")
             lowest = np.take_along_axis(corners.reshape(-1, 8, 3), order[..., None], 1)[:, :4].reshape(-1, 3)
             xy = com_reference(robot, F)[:2]
-            whole = margin_to_hull(lowest[lowest[:, 2] <= stability.CONTACT_TOLERANCE, :2], xy)
+            whole = margin_to_hull(lowest[lowest[:, 2] <= GROUND_TOLERANCE, :2], xy)
             own = []
             for link in prob.ground_links:
                 c = box_corners(robot, F[None], [link])[0]
-                own.append(c[c[:, 2] <= c[:, 2].min() + wb.CONTACT_BAND, :2])
+                own.append(c[c[:, 2] <= c[:, 2].min() + GROUND_TOLERANCE, :2])
             own_pts = np.concatenate(own)
             base_own = margin_to_hull(own_pts, xy) if hull_vertices(own_pts) is not None else -np.inf
             margin = min(whole, base_own)

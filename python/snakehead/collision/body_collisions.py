@@ -22,13 +22,11 @@ from ..geometry.shapes import ShapeSet, pair_distances, pair_min_distances
 import numpy.typing as npt
 from typing import Any, Sequence
 from .._errors import InputError, InputTypeError
+from ..ground_contact import GROUND_TOLERANCE
 
 __all__ = ["GROUND_TOLERANCE", "ground_clearance", "below_ground", "touching_ground", "self_clearance",
            "obstacle_shapes", "segment_closest", "CollisionReport", "collision_check"]
 
-#: A link whose shapes dip lower than this below the ground (m) is driven into it by the plan; a shape within
-#: this distance of the ground touches it (the base lies at exactly 0).
-GROUND_TOLERANCE = 1e-3
 
 _WORLD = np.eye(4)[None, None]  # (1, 1, 4, 4): the one frame of the obstacles' shapes
 

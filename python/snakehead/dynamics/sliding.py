@@ -35,12 +35,11 @@ import numpy.typing as npt
 from .._validate import finite_array
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .._errors import InputError
+from ..ground_contact import RESTING_TOLERANCE
 
-__all__ = ["RESTING_HEIGHT", "SLIP_FLOOR", "TRANSLATION_TOLERANCE", "balance_translation", "balance_motion",
+__all__ = ["SLIP_FLOOR", "TRANSLATION_TOLERANCE", "balance_translation", "balance_motion",
            "resting_contacts", "predict_slide"]
 
-#: A box whose bottom is within this height (m) of the lowest box bottom rests on the ground (flat shapes).
-RESTING_HEIGHT = 0.003
 #: Slips below this share of the largest shift count as none in the reweighting (keeps the weights finite).
 SLIP_FLOOR = 1e-9
 #: The iteration stops when a step is below this share of the largest shift.
@@ -150,13 +149,13 @@ def balance_motion(before: npt.ArrayLike, after: npt.ArrayLike, weights: npt.Arr
 def resting_contacts(robot: SnakeRobot, q: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Where a body lying flat with joints ``q`` (n,) touches the ground: the centres (k, 2) of its links' collision
     capsules in the body frame's ground plane (m), and their loads (the links' masses, kg). ValueError unless every
-    link with shapes rests on the ground (its bottom within RESTING_HEIGHT of the lowest): the model is for flat
+    link with shapes rests on the ground (its bottom within RESTING_TOLERANCE of the lowest): the model is for flat
     shapes."""
     robot = as_robot(robot)
     F = robot.frames(np.asarray(q, float), BasePlacement())[None]  # the default placement: the body frame
     low = robot.lowest_z(F)[0]
     links = robot.shaped_links
-    if low.max() > low.min() + RESTING_HEIGHT:
+    if low.max() > low.min() + RESTING_TOLERANCE:
         k = int(np.argmax(low))
         raise InputError(f"the shape is not flat on the ground: the link {robot.link_names[links[k]]!r} "
                          f"is {1000 * (low[k] - low.min()):.1f} mm above the lowest (keep the pitch joints at 0)")

@@ -28,16 +28,14 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 import numpy.typing as npt
 from .._errors import Infeasible, InputError
+from ..ground_contact import GROUND_TOLERANCE
 
-__all__ = ["CONTACT_TOLERANCE", "CONTACT_MODELS", "SAMPLE_CHUNK", "polygon_margin_many", "center_of_mass",
+__all__ = ["CONTACT_MODELS", "SAMPLE_CHUNK", "polygon_margin_many", "center_of_mass",
            "hull_indices", "support_polygon", "static_margin", "static_margins_of_frames", "is_statically_stable",
            "joint_velocities", "momenta_from_velocities", "momenta", "zmp", "DynamicStability", "dynamic_stability",
            "CORE_CONTACT_MODELS", "KeptSamples", "dynamic_stability_with_clearance", "dynamic_stability_in_core",
            "dynamic_stability_in_python", "support_margins", "support_polygons", "contact_configurations"]
 
-#: A base link counts as lying on the ground when the lowest point of its collision shapes is below this
-#: height (m). The default robot's flat base links sit at exactly 0.
-CONTACT_TOLERANCE = 1e-3
 
 #: Contact models of :func:`support_polygon`.
 CONTACT_MODELS = ("endpoints", "footprint", "ground")
@@ -163,7 +161,7 @@ def _hull_ccw(pts: np.ndarray) -> np.ndarray:
 
 
 def support_polygon(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
-                    contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+                    contact: str = "endpoints", tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
     """Support polygon of the base part on the ground, Eq. 24: (k, 2) world (x, y) vertices, counter-clockwise.
 
     ``contact`` selects the contact points p_i of Eq. 24:
@@ -196,7 +194,7 @@ def support_polygon(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | N
 
 
 def static_margin(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
-                  contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE) -> float:
+                  contact: str = "endpoints", tolerance: float = GROUND_TOLERANCE) -> float:
     """Signed distance (m) from the CoM's ground projection to the support polygon's edge; > 0 inside.
 
     Static stability (Section 3.1): the robot is statically stable if c is in C (Eq. 23, 24).
@@ -212,7 +210,7 @@ def static_margin(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | Non
 
 
 def static_margins_of_frames(robot: SnakeRobot, frames: np.ndarray, com: np.ndarray, contact: str = "endpoints",
-                             tolerance: float = CONTACT_TOLERANCE) -> np.ndarray:
+                             tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
     """:func:`static_margin` of many configurations at once from their world frames (T, n_links, 4, 4)
     (:meth:`SnakeRobot.frames_many`) and centres of mass (T, 3) (:func:`center_of_mass`): (T,) m. Each sample's
     support polygon is the hull of its own touching contact points (the C++ core's hull, one per sample, without
@@ -226,7 +224,7 @@ def static_margins_of_frames(robot: SnakeRobot, frames: np.ndarray, com: np.ndar
 
 
 def is_statically_stable(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
-                         contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                         contact: str = "endpoints", tolerance: float = GROUND_TOLERANCE,
                          margin: float = 0.0) -> bool:
     """True when the CoM's ground projection lies inside the support polygon by more than ``margin`` m."""
     return static_margin(robot, q, base, contact=contact, tolerance=tolerance) > float(margin)
@@ -375,7 +373,7 @@ class DynamicStability:
 
 def dynamic_stability(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, base: BasePlacement | None = None,
                       qd: npt.ArrayLike | None = None, *, contact: str = "endpoints",
-                      tolerance: float = CONTACT_TOLERANCE, frames: np.ndarray | None = None,
+                      tolerance: float = GROUND_TOLERANCE, frames: np.ndarray | None = None,
                       with_frames: Callable[[slice, np.ndarray], None] | None = None) -> DynamicStability:
     """Dynamic stability of a trajectory (Section 3.1): is the ZMP inside the support polygon at every sample?
 
@@ -424,7 +422,7 @@ class KeptSamples:
 
 def dynamic_stability_with_clearance(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike,
                                      base: BasePlacement | None = None, qd: npt.ArrayLike | None = None, *,
-                                     contact: str = "ground", tolerance: float = CONTACT_TOLERANCE,
+                                     contact: str = "ground", tolerance: float = GROUND_TOLERANCE,
                                      made: _core.PathChecker | None = None, kept: KeptSamples | None = None
                                      ) -> tuple[DynamicStability, np.ndarray]:
     """:func:`dynamic_stability` (contact "ground" or "footprint") and, from the same frames in the same C++ pass,
@@ -512,7 +510,7 @@ def dynamic_stability_in_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray,
 
 
 def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base: BasePlacement | None = None, *,
-                    contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                    contact: str = "endpoints", tolerance: float = GROUND_TOLERANCE,
                     frames: np.ndarray | None = None) -> np.ndarray:
     """Signed distance (m, > 0 inside) of points ``xy`` (T, 2) to the support polygon of configuration ``q[k]``
     (T, n) at each sample (see :func:`support_polygon` for ``contact``): e.g. a ZMP along a trajectory.
@@ -530,7 +528,7 @@ def support_margins(robot: SnakeRobot, q: npt.ArrayLike, xy: npt.ArrayLike, base
 
 
 def support_polygons(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | None = None, *,
-                     contact: str = "endpoints", tolerance: float = CONTACT_TOLERANCE,
+                     contact: str = "endpoints", tolerance: float = GROUND_TOLERANCE,
                      frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The support polygon of every configuration of a trajectory at once (see :func:`support_polygon` for
     ``contact`` and ``tolerance``): q (T, n) -> vertices (T, N, 2) world (x, y) and count (T,).

@@ -12,11 +12,10 @@ import numpy as np
 
 from .. import _core
 from ..model.robot import SnakeRobot
+from ..ground_contact import GROUND_TOLERANCE
 
-__all__ = ["CONTACT_BAND", "contact_points", "first_lifted_link", "ground_links", "link_coms", "static_margins"]
+__all__ = ["contact_points", "first_lifted_link", "ground_links", "link_coms", "static_margins"]
 
-#: A ground link's shape points within this height (m) of its lowest point touch the ground (its support).
-CONTACT_BAND = 1e-3
 
 
 def first_lifted_link(robot: SnakeRobot) -> int:
@@ -34,13 +33,13 @@ def ground_links(robot: SnakeRobot) -> np.ndarray:
 
 
 def contact_points(robot: SnakeRobot, F: np.ndarray, links: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """World (P, 3) bottom points of the shapes of ``links`` (within CONTACT_BAND of each link's lowest: a box's
+    """World (P, 3) bottom points of the shapes of ``links`` (within GROUND_TOLERANCE of each link's lowest: a box's
     bottom corners, a cylinder's bottom line) and their links (P,), from the frames (n_links, 4, 4)."""
     pts, owner = robot.lowest_points(F[None], links)
     pts = pts[0]
     lowest = np.full(len(robot.link_names), np.inf)
     np.minimum.at(lowest, owner, pts[:, 2])
-    keep = pts[:, 2] <= lowest[owner] + CONTACT_BAND
+    keep = pts[:, 2] <= lowest[owner] + GROUND_TOLERANCE
     return pts[keep], owner[keep]
 
 
@@ -64,7 +63,7 @@ def static_margins(robot: SnakeRobot, frames: np.ndarray, links: np.ndarray) -> 
     for link in np.unique(owner):
         mine = owner == link
         lowest[:, mine] = z[:, mine].min(axis=1, keepdims=True)
-    keep = z <= lowest + CONTACT_BAND
+    keep = z <= lowest + GROUND_TOLERANCE
     heavy, c_i = link_coms(robot, frames)
     c = (m[heavy, None] * c_i).sum(-2) / m[heavy].sum()
     xy = np.ascontiguousarray(pts[..., :2])

@@ -34,6 +34,7 @@ from ..dynamics import stability
 from ..collision import body_collisions as coll
 from ..margins import DETOUR_MARGIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
+from ..ground_contact import GROUND_TOLERANCE
 from .base_support import ground_links, static_margins
 
 __all__ = ["ANGLE_GRID", "INITIAL_MARGIN", "initial_margins", "stable_initial_configuration"]
@@ -54,7 +55,7 @@ def initial_margins(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | Non
     qs = np.atleast_2d(np.asarray(qs, float))
     frames = robot.frames_many(qs, base)
     com = stability.center_of_mass(robot, qs, base, frames=frames)
-    margin = np.minimum(stability.static_margins_of_frames(robot, frames, com, "ground", stability.CONTACT_TOLERANCE),
+    margin = np.minimum(stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE),
                         static_margins(robot, frames, ground_links(robot)))
     ground = coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min(axis=1, initial=np.inf)
     clear = (ground >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(robot, qs, base) > 0.0)

@@ -16,6 +16,7 @@ from ..geometry.shapes import pair_min_distances
 from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE, SOLUTION_MARGIN
 from ..model.frames import forward_kinematics_unchecked
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from ..ground_contact import GROUND_TOLERANCE
 
 if TYPE_CHECKING:  # (annotations only: body_problem builds on pose_bounds, which takes this module's tolerances)
     from .body_problem import BodyProblem
@@ -74,7 +75,7 @@ def check_solutions(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, posi
     pe = np.linalg.norm(head[:, :3, 3] - position, axis=1)
     de = np.degrees(np.arccos(np.clip(head[:, :3, 0] @ direction, -1.0, 1.0)))
     com = stability.center_of_mass(robot, qs, base, frames=frames)
-    margin = stability.static_margins_of_frames(robot, frames, com, "ground", stability.CONTACT_TOLERANCE)
+    margin = stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE)
     if problem is not None:
         margin = np.minimum(margin, problem.margins(frames))
     lifted = robot.lifted_links

@@ -24,7 +24,6 @@ Its parts, one module each (every name is importable from here too):
 from __future__ import annotations
 
 from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE, SELF_CLEARANCE
-from .base_support import CONTACT_BAND
 from .body_problem import LIFTED_IK_TIMEOUT_S, BodyProblem
 from .plan_solves import PlanSolves
 from .whole_body_refinement import (MAX_ITERATIONS, PAIR_RANGE, SOLVE_BUDGET, RefinementProblem, refine,
@@ -36,7 +35,7 @@ from .whole_body_solution import REASONS, STAGES, WholeBodySolution, check_rank,
 from .whole_body_starts import (CANDIDATE_ROLLS, CANDIDATE_SEEDS, base_shapes, continue_from, lifted_candidates,
                                 placements, rolled_frames, rolls_reached)
 
-__all__ = ["BodyProblem", "CANDIDATE_ROLLS", "CANDIDATE_SEEDS", "CONTACT_BAND", "DIRECTION_TOLERANCE",
+__all__ = ["BodyProblem", "CANDIDATE_ROLLS", "CANDIDATE_SEEDS", "DIRECTION_TOLERANCE",
            "EXACT_DISTANCE_WITHIN", "LIFTED_IK_TIMEOUT_S", "MAX_ITERATIONS", "MIN_MARGIN", "OBSTACLE_CLEARANCE",
            "PAIR_RANGE", "POSITION_TOLERANCE", "PlanSolves", "REASONS", "RefinementProblem", "SELF_CLEARANCE",
            "SOLVE_BUDGET", "STAGES", "TargetSearch", "WholeBodySolution", "base_shapes", "check_rank",
