@@ -49,8 +49,8 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base
 from .body_collisions import GROUND_TOLERANCE, obstacle_shapes
 
 #: rad: the first sampling of a path that :func:`check_path` proves clear (largest joint change between samples).
-#: 0.5 is MAX_WAYPOINT_STEP: the waypoints of a move and the midpoints the proof asks for; the bound proves most
-#: such steps at once and halves the others, the fewest configurations evaluated (bench/path_check.py).
+#: The planner splits a move into steps of at most this (``planning.waypoints.MAX_WAYPOINT_STEP``); the bound proves
+#: most such steps at once and halves the others, the fewest configurations evaluated (bench/path_check.py).
 PATH_FIRST_STEP = 0.5
 #: rad: intervals are not split below this largest joint change; one still unproven there fails the path.
 PATH_FLOOR_STEP = 1e-3

@@ -33,7 +33,9 @@ FALLBACK_SPEED = 0.1  # rad/s: the pace of a path that the retiming cannot time 
 #                        the motion would be longer than MAX_MOTION_S)
 DENSIFY = 3  # configurations checked between consecutive waypoints of a move, at least
 MOVE_CHECK_STEP = 0.05  # rad: a move's configurations are checked at most this far apart (largest joint change)
-MAX_WAYPOINT_STEP = 0.5  # rad: a move's steps longer than this (largest joint change) are split into equal ones
+# rad: a move's steps longer than this (largest joint change) are split into equal ones: the clearance proof's first
+# sampling, so that it evaluates the waypoints themselves
+MAX_WAYPOINT_STEP = path_proof.PATH_FIRST_STEP
 DETOUR_BATCH = 16  # detour candidates screened at once, shortest first
 #: A move whose tracked path fails its check and that finds no stable joint-space detour either is fitted once more
 #: with this many times the samples: between two samples the path is a straight joint segment, and where thick links
