@@ -318,7 +318,7 @@ def test_contacts_measured_tick_by_tick_when_not_decodable(mujoco, robot, monkey
     them measured tick by tick with ground_contacts: the same result as the decoded ones here."""
     t, q = quintic(flat_of(Q_LIFTED), Q_LIFTED, 0.1)
     decoded = sim.simulate_trajectory(robot, t, q, settle=0.05)
-    monkeypatch.setattr(tracking, "_contacts_decodable", lambda model: False)
+    monkeypatch.setattr(sim.measurements, "contacts_decodable", lambda model: False)
     live = sim.simulate_trajectory(robot, t, q, settle=0.05)
     np.testing.assert_array_equal(live.zmp, decoded.zmp)
     for a, b in zip(live.contact_forces, decoded.contact_forces):

@@ -31,9 +31,9 @@ from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..locomotion.gaits import Gait, virtual_chassis
 from .estimate import AttitudeFilter, BodyPose, BodyPoseEstimator, ShapePoints, pose_error
 from ..sim.sensors import OnboardSensors
-from ..sim.gains import default_gains
-from ..sim.mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, _mujoco, build_model
-from ..sim.tracking import SimState, _gains
+from ..sim.gains import default_gains, gain_vector
+from ..sim.mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, build_model, import_mujoco
+from ..sim.tracking import SimState
 
 import numpy.typing as npt
 from typing import Any
@@ -157,7 +157,7 @@ class GaitSimulator:
                  imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
                  control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
                  odometry: str = "friction", sensors: OnboardSensors | None = None, **model_options: Any) -> None:
-        self._mj = _mujoco()
+        self._mj = import_mujoco()
         self.robot = as_robot(robot)
         n = self.robot.n_joints
         armature = model_options.get("armature", 1e-3)
@@ -166,8 +166,8 @@ class GaitSimulator:
             kp_load, kd_load = default_gains(self.robot, armature=armature)
             kp = kp_load if kp is None else kp
             kd = kd_load if kd is None else kd
-        self.kp = _gains(kp, n, "kp", allow_zero=False)
-        self.kd = _gains(kd, n, "kd", allow_zero=True)
+        self.kp = gain_vector(kp, n, "kp", allow_zero=False)
+        self.kd = gain_vector(kd, n, "kd", allow_zero=True)
         m = self.sim.model
         m.actuator_biasprm[:, 1] = -self.kp
         m.actuator_biasprm[:, 2] = -self.kd

@@ -47,8 +47,8 @@ class RouteFollower:
                ground: Callable[[GaitRun, str, str], None], current_state: Callable[[], SimState]) -> str | None:
         """Step 2's gait runs from the estimate ``est`` to ``straight_goal`` within ``tolerance``, run by ``sim``
         from ``current_state()`` (the simulation's state now), ``rates`` learning from each: along the route
-        (:meth:`_route`, recorded in ``routes``), planned again from the estimate whenever the body drifts off it
-        (:meth:`_route_holds`, after every run), each run's sweep checked before it runs (:meth:`_sweep_failure`: a
+        (``_route``, recorded in ``routes``), planned again from the estimate whenever the body drifts off it
+        (``_route_holds``, after every run), each run's sweep checked before it runs (``_sweep_failure``: a
         run that fails it is made smaller, one cycle at half its amplitude, until it passes or is as small as a run
         gets); ``ground`` records each run and moves the estimate, ``say`` tells. None when done (at the goal, or
         out of runs), else why the body cannot go on."""
@@ -155,7 +155,7 @@ class RouteFollower:
 
     def _checked_step(self, here: BasePlacement, step: lc.LocomotionStep, rates: lc.GaitRates,
                       grid: gp.ClearanceGrid | None) -> tuple[lc.LocomotionStep, str | None]:
-        """``step`` when its sweep is clear (:meth:`_sweep_failure`), else one cycle at half its amplitude, and
+        """``step`` when its sweep is clear (``_sweep_failure``), else one cycle at half its amplitude, and
         so on (a smaller run sweeps less: its waves are smaller, it goes less far; the next run goes on) down to
         MIN_AMPLITUDE_SCALE; and why the last tried is not clear (None when it is)."""
         if grid is None:

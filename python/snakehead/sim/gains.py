@@ -17,12 +17,10 @@ Gains (:func:`default_gains`), per joint:
   tiny).
 
 With the damping integrated implicitly (MuJoCo's ``implicitfast``) the loop is stable at any kp when
-kd / kp > timestep / 2, so the rule holds for any robot. Where the constants come from: the former defaults
-(kp = 200 N m/rad, kd = 3 N m s/rad on every joint) were tuned on the default robot; 1 deg gives 207 N m/rad at
-its joint 10 (the head part's first joint, the one that lifts it), and 15 ms is their kd / kp. On the default robot
-the rule gives kp from 4.4 N m/rad (joint 16) to 1170 N m/rad (joint 1); uniform gains were measured to leave a
-heavy snake's head 7-8 mm off, and softer head joints than these to make links chatter on the ground as the neck
-lifts (bench/RESULTS.md).
+kd / kp > timestep / 2, so the rule holds for any robot. Where the constants come from: uniform gains of
+kp = 200 N m/rad and kd = 3 N m s/rad suit the default robot; 1 deg gives 207 N m/rad at its joint 10 (the head
+part's first joint, the one that lifts it), and 15 ms is their kd / kp. On the default robot the rule gives kp from
+4.4 N m/rad (joint 16) to 1170 N m/rad (joint 1). Why not uniform gains, nor softer head joints: bench/RESULTS.md.
 
 Torque limits (:func:`default_torque_limits`): the URDF's effort where it gives one (the robot's servos), else
 EFFORT_MARGIN x tau_j (the joint's load, with half again to accelerate it).
@@ -32,10 +30,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 from ..model.physics import GRAVITY
 from ..model.robot import SnakeRobot, as_robot
 from .._errors import InputError
+from .._validate import finite_array
 
 #: How far a joint may give under its whole load (rad).
 HOLD_DEFLECTION = math.radians(1.0)
@@ -43,6 +43,19 @@ HOLD_DEFLECTION = math.radians(1.0)
 TIME_CONSTANT = 0.015
 #: Torque limit (x the joint's load) for joints whose URDF gives no effort.
 EFFORT_MARGIN = 1.5
+
+
+def gain_vector(x: npt.ArrayLike, n: int, name: str, allow_zero: bool) -> np.ndarray:
+    """A gain given as a number or per joint, as (n,): finite, > 0 (>= 0 with ``allow_zero``, for a damping);
+    InputError naming ``name`` otherwise."""
+    a = finite_array(x, name)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    elif a.shape != (n,):
+        raise InputError(f"{name} must be a number or shape ({n},), got shape {a.shape}")
+    if np.any(a < 0) or (not allow_zero and np.any(a <= 0)):
+        raise InputError(f"{name} must be {'>= 0' if allow_zero else '> 0'}, got {a.tolist()}")
+    return a
 
 
 def joint_gravity_torques(robot: SnakeRobot) -> np.ndarray:

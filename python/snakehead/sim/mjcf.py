@@ -1,13 +1,5 @@
-"""Optional dynamics check in MuJoCo: the paper's "dynamics software" (Section 4).
-
-The planned joint trajectory is tracked by a PD controller with gravity compensation on a free-floating
-model of the robot lying on a ground plane with friction, so the body can really slide or tip. What the
-paper compares (Figs. 18-20, 23-25) is recorded: the head frame, the linear and angular momentum about the
-world origin, the zero-moment point (centre of pressure of the ground contact forces), and whether the base
-moved.
-
-MuJoCo is an optional extra (``pip install snakehead[sim]``); it is imported only when a function here needs
-it, so ``import snakehead`` works without it.
+"""The robot's MuJoCo model, on which :func:`snakehead.sim.simulate_trajectory` tracks a plan and the closed loop
+runs its gaits.
 
 Model (:func:`build_spec`, a ``mujoco.MjSpec`` built element by element, never XML text; :func:`build_model` compiles
 it), generated from the robot's own data, not from the URDF importer:
@@ -29,26 +21,8 @@ it), generated from the robot's own data, not from the URDF importer:
 * servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
   0.02 N m s/rad -- our choice, not the paper's.
 
-Controller (:func:`snakehead.sim.simulate_trajectory`, in ``tracking.py``): every ``control_dt`` (2 ms) the reference q_ref, qdot_ref and the gravity term are
-updated (zero-order hold); the joint torque is
-
-    tau = kp (q_ref - q) + kd (qdot_ref - qdot) + g_mj(q, qdot)     clipped to +-torque_limit
-
-where g_mj is a gravity term on the joints. The PD part is a MuJoCo affine actuator, i.e. evaluated at every
-physics step as in a servo's inner loop, with the velocity gain integrated implicitly (stable for the light
-distal links). Gravity compensation (``gravity_compensation``):
-
-* "supported" (default): each joint holds the weight of the run of lifted links hanging from it, up to the
-  first link that rests on the ground in the plan (:func:`~snakehead.dynamics.inverse_dynamics.carried_weights`, :func:`~snakehead.sim.tracking.gravity_torques`); links
-  on the ground are carried by the ground;
-* "bias": MuJoCo's ``qfrc_bias`` (gravity + Coriolis) on every joint, the textbook term for a fixed-base arm.
-  For a snake lying on the ground it is wrong at the base joints: it is the torque that would hold the whole
-  distal body as a cantilever from the tail, so the base pitch joints push against the ground;
-* "none": PD only.
-
-Default gains and torque limits come from each joint's load (:mod:`snakehead.sim.gains`), so they suit any robot's
-masses; the torque limit is the URDF's effort (a 3 N m servo cannot lift the default robot's head part from flat:
-joint 10 needs ~3.9 N m).
+MuJoCo is an optional extra (``pip install snakehead[sim]``); it is imported only when a function needs it
+(:func:`import_mujoco`), so ``import snakehead`` works without it.
 """
 from __future__ import annotations
 
@@ -82,13 +56,14 @@ _MISSING = ("MuJoCo is needed for snakehead.sim; it is an optional extra: "
             "pip install 'snakehead[sim]' (or pip install mujoco)")
 
 
-def _mujoco() -> Any:
-    """Import MuJoCo lazily; ImportError naming the extra when it is missing."""
+def import_mujoco() -> Any:
+    """The ``mujoco`` module, imported on first use; ImportError naming the extra when it is missing."""
     try:
-        import mujoco
+        import mujoco  # here, not at the top: MuJoCo is an optional extra
     except ImportError as exc:  # pragma: no cover - mujoco is installed where the tests run
         raise ImportError(_MISSING) from exc
     return mujoco
+
 
 #: Horizontal strips of the staircase that stands for a wall's round hole in the simulation.
 DEFAULT_HOLE_SLICES = 32
@@ -224,7 +199,7 @@ def add_shape_geom(spec: Any, body: Any, robot: SnakeRobot, k: int, **options: A
     """Add the ``k``-th shape of ``robot.geometry`` to the MjSpec ``body`` as geom ``shape_<k>`` (a convex mesh:
     with its asset ``hull_<k>``, the hull's vertices; MuJoCo takes their hull); ``options`` (contype, friction...)
     go to the geom. Returns the geom."""
-    mj = _mujoco()
+    mj = import_mujoco()
     shape = robot.geometry.shapes[k]
     g = shape_geom(shape)
     extra = {}
@@ -259,7 +234,7 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     ``joint_damping`` N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default
     :func:`snakehead.sim.gains.default_torque_limits`: the URDF effort), ``contact_solref`` (time constant s, damping ratio) of every contact.
     """
-    mj = _mujoco()
+    mj = import_mujoco()
     robot = as_robot(robot)
     timestep = duration(timestep, "timestep", maximum=MAX_TIMESTEP)
     friction = positive(friction, "friction")
@@ -384,7 +359,7 @@ class SimModel:
     def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
         """Put the body frame at ``base`` (the root link at ``robot.root_pose(base)``, raised by ``lift`` m) and the
         joints at ``q``; zero velocities; kinematics."""
-        mj = _mujoco()
+        mj = import_mujoco()
         T = self.robot.root_pose(base)
         data.qpos[:] = 0.0
         data.qvel[:] = 0.0
@@ -404,7 +379,7 @@ class SimModel:
 
 def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
     """Compile :func:`build_spec` (same keyword arguments) into a :class:`SimModel`."""
-    mj = _mujoco()
+    mj = import_mujoco()
     robot = as_robot(robot)
     spec = build_spec(robot, **kwargs)
     try:
