@@ -9,11 +9,11 @@ orientation of one link (an IMU's attitude), never the simulator's positions.
 * Planar position, by contact odometry: the links that touch the ground (the lowest point of their shapes within
   ``contact_height`` of it) hold it through their contact points -- the middle of the link's shape points (box
   corners, cylinder rims, sphere and hull vertices: :class:`ShapePoints`) that are lowest, a material point of the
-  link. Between two updates the body is moved by the translation that balances
-  the friction of those contact points (``odometry="friction"``, the default: the weighted geometric median of
-  the shifts that would keep each still, loads the links' masses,
-  :func:`snakehead.dynamics.sliding.balance_translation`; contacts slip where the others outpull them, and stay put where they hold), or by the
-  average of those shifts (``odometry="no-slip"``: every contact assumed not to slip).
+  link. Between two updates the body is moved by the translation that balances the friction of those contact
+  points (``odometry="friction"``, the default: the weighted geometric median of the shifts that would keep each
+  still, loads the links' masses, :func:`snakehead.dynamics.sliding.balance_translation`; contacts slip where the
+  others outpull them, and stay put where they hold), or by the average of those shifts (``odometry="no-slip"``:
+  every contact assumed not to slip).
 * The virtual chassis (:func:`snakehead.locomotion.gaits.virtual_chassis`, after Rollinson and Choset, "Virtual
   Chassis for Snake Robots", IROS 2011): a frame at the centroid of the body's points whose x-axis is the principal
   axis of the shape (its direction kept from update to update, towards the head when the body is straight) and
@@ -37,12 +37,17 @@ import numpy as np
 
 from .._validate import finite_array, joint_vector, rotation_matrix
 from ..dynamics.sliding import balance_translation
+from ..geometry.shapes import shape_points
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..locomotion.gaits import virtual_chassis
+from ..sim.sensors import so3_exp
 
 import numpy.typing as npt
 from typing import Any
 from .._errors import InputError
+
+__all__ = ["CONTACT_HEIGHT", "PATCH_HEIGHT", "ODOMETRY", "BodyPose", "pose_error", "ShapePoints", "BodyPoseEstimator",
+           "TILT_TIME_CONSTANT_S", "AttitudeFilter"]
 
 #: A link whose lowest shape point is within this height (m) of the ground touches it.
 CONTACT_HEIGHT = 0.003
@@ -113,8 +118,6 @@ class ShapePoints:
     the middle of each link's shapes (the centre of their bounding box in the link frame; a box's centre)."""
 
     def __init__(self, robot: SnakeRobot, links: np.ndarray | None = None, segments: int = 16) -> None:
-        from ..geometry.shapes import shape_points
-
         self.links = np.asarray(robot.shaped_links if links is None else links, dtype=np.intp).reshape(-1)
         geometry = robot.geometry
         local, owner = [], []
@@ -293,8 +296,6 @@ class AttitudeFilter:
 
     def reset(self, accel: npt.ArrayLike, yaw: float = 0.0) -> np.ndarray:
         """Start level with the accelerometer's gravity ``accel`` (3,) (read at rest), heading ``yaw`` rad."""
-        from ..sim.sensors import so3_exp
-
         up = finite_array(accel, "accel", (3,))
         up = up / np.linalg.norm(up)  # the world's z in the IMU's axes: R^T z
         z = np.array([0.0, 0.0, 1.0])
@@ -307,8 +308,6 @@ class AttitudeFilter:
 
     def update(self, gyro: npt.ArrayLike, accel: npt.ArrayLike, dt: float) -> np.ndarray:
         """One control period of ``dt`` s: the new orientation (3, 3)."""
-        from ..sim.sensors import so3_exp
-
         a = np.asarray(accel, float)
         norm = float(np.linalg.norm(a))
         w = np.asarray(gyro, float)

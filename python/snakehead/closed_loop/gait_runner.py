@@ -39,6 +39,8 @@ import numpy.typing as npt
 from typing import Any
 from .._errors import InputError, InputTypeError
 
+__all__ = ["SensorLog", "replay_estimate", "GaitRun", "GaitSimulator"]
+
 
 @dataclass
 class SensorLog:

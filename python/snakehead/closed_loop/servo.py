@@ -23,6 +23,10 @@ import numpy as np
 from ..model.robot import SnakeRobot
 from ..sim.sensors import HeadReading, mean_pose, so3_log
 
+__all__ = ["HEAD_FRAMES", "SERVO_POSITION_TOL_M", "SERVO_DIRECTION_TOL_DEG", "SERVO_ITERATIONS", "SERVO_MAX_POSITION_M",
+           "SERVO_MAX_DIRECTION_DEG", "SERVO_MOVE_S", "SERVO_HOLD_S", "SERVO_DAMPING", "DIRECTION_WEIGHT_M",
+           "JACOBIAN_STEP", "servo_joints", "root_from_head_reading", "head_error", "head_jacobian", "servo_step"]
+
 #: Frames of the head camera averaged per measurement (a 30 Hz camera for under a second).
 HEAD_FRAMES = 25
 #: The final approach stops when the measured error is below these (m, deg), or after SERVO_ITERATIONS moves: about

@@ -5,11 +5,14 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError, invariant
 from .._validate import finite_array
+from ..dynamics import stability
 from ..solve.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .tracking import SimResult, check_trajectory
 
 from typing import Any
+
+__all__ = ["SPAN_TOLERANCE", "in_span", "check_plan_span", "compare", "zmp_margins"]
 
 
 #: How far (s) a time may lie outside a simulated span and still be compared (floating-point rounding).
@@ -83,8 +86,6 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
       of the boxes); ``zmp_min_margin_m`` the smallest signed distance (positive inside);
     * ``base_slide_m``, ``base_lift_m``, ``max_torque_nm``, ``torque_saturation_fraction``.
     """
-    from ..dynamics import stability
-
     robot = as_robot(robot)
     if not isinstance(result, SimResult):
         raise InputTypeError(f"result must be a SimResult, got {type(result).__name__}")
@@ -141,8 +142,6 @@ def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t: np.ndarray, pla
     to the tick, with ``contact="ground"`` by default: the footprint of every link lying on the ground in the plan
     (the one the planner checks its own ZMP against). Ticks without ground load get NaN.
     """
-    from ..dynamics import stability
-
     base = result.base if base is None else as_base(base)
     n = robot.n_joints
     out = np.full(len(result.t), np.nan)

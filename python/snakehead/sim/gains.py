@@ -37,6 +37,9 @@ from ..model.robot import SnakeRobot, as_robot
 from .._errors import InputError
 from .._validate import finite_array
 
+__all__ = ["HOLD_DEFLECTION", "TIME_CONSTANT", "EFFORT_MARGIN", "gain_vector", "joint_gravity_torques", "default_gains",
+           "default_torque_limits"]
+
 #: How far a joint may give under its whole load (rad).
 HOLD_DEFLECTION = math.radians(1.0)
 #: The time constant kd / kp of every joint's loop (s).

@@ -143,9 +143,9 @@ def _centers_of_pressure(points: list, forces: list) -> np.ndarray:
 class TickLog:
     """What the tracking loop records at each control tick: MuJoCo's arrays copied as they are (the state into
     arrays made for every tick, the contacts and their constraint forces of every physics step into growing arrays),
-    and after the loop the :class:`SimResult`'s quantities computed from them, all ticks at once. They are the numbers
-    :func:`momenta_of_state`, :func:`ground_contacts` and :func:`center_of_pressure` give tick by tick, to the bit
-    (tested), for a fifth of the loop's Python, which cost more than MuJoCo's physics.
+    and after the loop the :class:`~snakehead.sim.tracking.SimResult`'s quantities computed from them, all ticks at
+    once. They are the numbers :func:`momenta_of_state`, :func:`ground_contacts` and :func:`center_of_pressure` give
+    tick by tick, to the bit (tested), for much less of the loop's Python (measured: bench/RESULTS.md).
 
     A tick's ZMP is the centre of pressure of the ground's impulse over all of the tick's physics steps (every step's
     contacts together: the steps are equal), which is what carries the momenta from one tick to the next; one step

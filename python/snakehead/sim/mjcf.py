@@ -42,6 +42,10 @@ import numpy.typing as npt
 from typing import Any
 from .._errors import InputError, InputTypeError, InternalError
 
+__all__ = ["DEFAULT_TIMESTEP", "DEFAULT_CONTROL_DT", "MAX_TIMESTEP", "MAX_CONTROL_DT", "MAX_PHYSICS_STEPS",
+           "import_mujoco", "DEFAULT_HOLE_SLICES", "obstacle_boxes", "FREE_JOINT", "FLOOR", "shape_geom",
+           "add_shape_geom", "build_spec", "SimModel", "build_model"]
+
 
 #: Physics timestep (s) and control period (s) used by default.
 DEFAULT_TIMESTEP = 0.001

@@ -33,7 +33,14 @@ import numpy.typing as npt
 
 from .._errors import InputError
 from .._validate import finite_float
+from ..collision.body_collisions import obstacle_shapes
+from ..geometry.shapes import Shape, ShapeSet, pair_min_distances
 from ..model.physics import GRAVITY  # the simulated world's (sim.mjcf sets MuJoCo's gravity to it)
+
+__all__ = ["ENCODER_COUNTS_PER_REV", "GYRO_NOISE_DENSITY", "GYRO_BIAS_RANDOM_WALK", "ACCEL_NOISE_DENSITY",
+           "HEAD_POSITION_NOISE_M", "HEAD_DIRECTION_NOISE_DEG", "HEAD_HALF_FOV_DEG", "MARKER_AHEAD_M", "HEAD_RANGE_M",
+           "SIGHT_RADIUS_M", "so3_log", "so3_exp", "Encoders", "Imu", "target_frame", "marker_frame", "HeadReading",
+           "mean_pose", "HeadSensor", "occluded", "OnboardSensors"]
 
 #: Encoder counts per joint revolution: 12-bit absolute magnetic encoders (AS5045/AS5048-class; the Dynamixel
 #: X-series servos also report 4096 counts/rev): a step of 0.088 deg.
@@ -250,9 +257,6 @@ def occluded(a: npt.ArrayLike, b: npt.ArrayLike, obstacles: Sequence[Any]) -> bo
     of SIGHT_RADIUS_M along it, against their convex shapes)."""
     if not obstacles:
         return False
-    from ..collision.body_collisions import obstacle_shapes
-    from ..geometry.shapes import Shape, ShapeSet, pair_min_distances
-
     a, b = np.asarray(a, float), np.asarray(b, float)
     axis = b - a
     length = float(np.linalg.norm(axis))

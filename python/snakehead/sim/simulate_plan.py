@@ -4,11 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..planning.plan_result import Plan
 from .compare import check_plan_span, compare
 from .tracking import SimResult, simulate_trajectory
 
 from typing import Any
 from .._errors import InputTypeError, entry_point, inputs_checked
+
+__all__ = ["PlanSimulation", "simulate"]
 
 
 @dataclass
@@ -20,7 +23,7 @@ class PlanSimulation:
     every number of :func:`snakehead.sim.compare`; result: the raw :class:`SimResult`.
     """
 
-    plan: object
+    plan: Plan
     result: SimResult
     metrics: dict
 
@@ -45,8 +48,6 @@ def simulate(plan: Any, **options: Any) -> PlanSimulation:
     ``options`` go to :func:`snakehead.sim.simulate_trajectory` (gains, torque limits, friction, hole_slices...).
     Needs MuJoCo (``pip install snakehead[sim]``).
     """
-    from ..planning.plan_result import Plan
-
     if not isinstance(plan, Plan):
         raise InputTypeError(f"plan must be a snakehead Plan (from snakehead.plan), got {type(plan).__name__}")
     options.setdefault("obstacles", list(plan.obstacles))
