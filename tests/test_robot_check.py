@@ -103,10 +103,10 @@ def test_a_map_without_a_dexterous_band_says_why_and_what_to_do(tmp_path: Path) 
 
 
 def test_the_paper_column_is_for_the_papers_robot(tmp_path: Path) -> None:
-    from snakehead.app.report import _is_default_robot
+    from snakehead.app.report import is_default_robot
 
-    assert _is_default_robot(snakehead.SnakeRobot.default())
+    assert is_default_robot(snakehead.SnakeRobot.default())
     spec = SnakeSpec(n_joints=12, markers={"p0": 5, "b0": 7}, tip_name="tip", name="other")
     other = snakehead.SnakeRobot.from_urdf(snake_urdf(spec), base_end="p0", neck_end="b0", head_tip="tip")
-    assert not _is_default_robot(other)
+    assert not is_default_robot(other)
     assert np.isfinite(other.body_axis_height)

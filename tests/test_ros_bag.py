@@ -194,7 +194,7 @@ def test_tf_places_the_root_and_the_targets(plan, written):
     frames = tf_frames(written.topics["/tf"])
     assert set(frames) == {robot.description_root, "target/target"}
     t = plan.t - plan.t[0]
-    expected = np.round(t[ros_bag._every(plan.t, ros_bag.TF_PERIOD)] * 1e9)
+    expected = np.round(t[ros_bag.samples_every(plan.t, ros_bag.TF_PERIOD)] * 1e9)
     for child, poses in frames.items():
         assert [s for s, _ in poses] == expected.tolist()
     assert np.allclose(np.diff(expected)[:-1], ros_bag.TF_PERIOD * 1e9, atol=2e6)  # 20 Hz, the last sample too
@@ -306,7 +306,7 @@ def test_markers(plan, written):
     arrow = first.markers[0]
     tip = np.array([arrow.pose.position.x, arrow.pose.position.y, arrow.pose.position.z]) + [0, arrow.scale.x, 0]
     np.testing.assert_allclose(tip, TARGET[0], atol=1e-12)  # it ends at the target, along +y
-    idx = ros_bag._every(plan.t, ros_bag.MARKER_PERIOD)
+    idx = ros_bag.samples_every(plan.t, ros_bag.MARKER_PERIOD)
     assert len(ground) == len(idx)
     for (s, m), k in zip(ground, idx):
         polygon, zmp = m.markers
@@ -489,8 +489,8 @@ def test_the_yamls_float_rows_read_back_exactly() -> None:
     rng = np.random.default_rng(0)
     row = np.r_[rng.standard_normal(500) * 10.0 ** rng.integers(-30, 30, 500), 1e-5, -1e-5, 1e16, -3e20, 0.0, -0.0,
                 1.0, 5e-324, 1.7976931348623157e308, 123456789012345678.0]
-    text = ros_bag._yaml_floats(row)
-    assert text == ", ".join(map(ros_bag._yaml_float, row.tolist()))
+    text = ros_bag.yaml_floats(row)
+    assert text == ", ".join(map(ros_bag.yaml_float, row.tolist()))
     back = yaml.safe_load(f"[{text}]")
     assert all(isinstance(x, float) for x in back)
     np.testing.assert_array_equal(np.array(back), row)
@@ -503,7 +503,7 @@ def test_the_trajectory_csv_is_csvs_row_by_row(tmp_path: Path) -> None:
     from snakehead.app import report
 
     rng = np.random.default_rng(1)
-    n_rows = report._CSV_BLOCK + 7
+    n_rows = report.CSV_BLOCK_ROWS + 7
     plan = SimpleNamespace(t=np.arange(n_rows) * 0.002, q=rng.standard_normal((n_rows, 3)) * [1.0, 1e-8, -0.0])
     names = ["a", "b,c", 'd"e']
     path = write_trajectory_csv(plan, tmp_path / "t.csv", names)

@@ -198,12 +198,12 @@ def test_the_gif_frames_are_full_redraws(plan, tmp_path):
     assert len(frames) == len(anim) == 4
     body_art, trace, clock = anim._artists
     robot = plan.robot
-    tip = anim._frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
+    tip = anim.frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
     canvas = FigureCanvasAgg(anim.figure)
     for k in (0, 3):
-        body_art.set_verts(body.body_faces(robot, anim._frames[k])[0])
+        body_art.set_verts(body.body_faces(robot, anim.frames[k])[0])
         trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
-        clock.set_text(animation._clock_time(anim.times[k]))  # the clock's time: its words are still
+        clock.set_text(animation.clock_time(anim.times[k]))  # the clock's time: its words are still
         canvas.draw()
         full = np.asarray(canvas.buffer_rgba())
         assert np.abs(full.astype(int) - frames[k]).max() <= 1, k

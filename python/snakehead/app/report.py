@@ -23,24 +23,32 @@ import json
 import math
 import os
 import platform
+import re
+import unicodedata
+from importlib import metadata
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from .._files import atomic_open, write_text_atomic
-
-from typing import Any
+from .. import __version__
 from .._errors import InputError
+from .._files import atomic_open, write_text_atomic
+from ..model.robot import default_robot_file
 
-#: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
-#: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
-def _is_default_robot(robot: Any) -> bool:
-    from ..model.robot import default_robot_file
+__all__ = ["PAPER", "SIM_KEYS", "CSV_BLOCK_ROWS", "is_default_robot", "jsonable", "scenario_entry", "environment",
+           "cpu_name", "write_json", "write_trajectory_csv", "markdown_text", "markdown_code", "summary_markdown",
+           "write_summary"]
 
+
+def is_default_robot(robot: Any) -> bool:
+    """Whether ``robot`` was read from the shipped robot file (the paper's numbers are that robot's)."""
     source = getattr(robot, "source", None)
     return source is not None and Path(source).resolve() == default_robot_file().resolve()
 
 
+#: The paper's reported results (Section 4), beside which ours are put. The momentum errors are of the
+#: magnitudes ("the maximum errors of the angular and linear momentum magnitudes").
 PAPER: dict[str, dict[str, Any]] = {
     "spheres": {"section": "4.1 (Figs. 17-20)", "position_error_m": 1.8e-3, "direction_error_deg": 0.76,
                 "max_angular_momentum_magnitude_error": 0.0383, "max_linear_momentum_magnitude_error": 0.216,
@@ -112,7 +120,7 @@ def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict 
         "relocation": None if result.relocation is None else result.relocation.as_dict(),
         "notes": list(result.notes),
     }
-    if result.name in PAPER and _is_default_robot(result.robot):  # the paper's numbers are its robot's
+    if result.name in PAPER and is_default_robot(result.robot):  # the paper's numbers are its robot's
         entry["paper"] = dict(PAPER[result.name])
     if extra:
         entry.update(extra)
@@ -121,10 +129,6 @@ def scenario_entry(result: Any, sim_metrics: dict | None = None, *, extra: dict 
 
 def environment() -> dict:
     """The machine and the versions of snakehead and its main dependencies."""
-    from importlib import metadata
-
-    from .. import __version__
-
     versions: dict[str, str | None] = {"snakehead": __version__, "python": platform.python_version()}
     for dist in ("numpy", "scipy", "matplotlib", "mujoco", "scikit-learn", "pillow"):
         try:
@@ -172,14 +176,14 @@ def write_trajectory_csv(result: Any, path: str | os.PathLike, joint_names: list
     with atomic_open(path, "w", newline="") as f:  # a failed write leaves no CSV cut mid-row
         csv.writer(f).writerow(["time_s"] + [f"{n}_rad" for n in names])  # (rows end in "\r\n", as csv's)
         row = ",".join(["%.6f"] + ["%.7f"] * q.shape[1]) + "\r\n"  # numbers: nothing to quote
-        for start in range(0, len(t), _CSV_BLOCK):  # formatted a block of rows at once, in C
-            block = np.column_stack([t[start:start + _CSV_BLOCK], q[start:start + _CSV_BLOCK]]).tolist()
+        for start in range(0, len(t), CSV_BLOCK_ROWS):  # formatted a block of rows at once, in C
+            block = np.column_stack([t[start:start + CSV_BLOCK_ROWS], q[start:start + CSV_BLOCK_ROWS]]).tolist()
             f.write("".join([row % tuple(values) for values in block]))
     return path
 
 
 #: Rows of the trajectory CSV formatted at once (a bounded copy of the trajectory).
-_CSV_BLOCK = 4096
+CSV_BLOCK_ROWS = 4096
 
 
 #: What Markdown (CommonMark and GitHub's tables, strikethrough and math) reads as markup within a line: escapes,
@@ -193,9 +197,6 @@ def markdown_text(text: Any) -> str:
     not split a cell, a ``\`` stays), a leading ``-``, ``+``, ``=`` or ``1.`` kept from starting a list (in a list
     item), line breaks and other control characters made spaces and lone surrogates U+FFFD (a name has none: they
     are refused where names enter; a message may). Surrounding whitespace is dropped, as a table cell drops it."""
-    import re
-    import unicodedata
-
     def one(c: str) -> str:
         category = unicodedata.category(c)
         if category in ("Cc", "Zl", "Zp"):
@@ -215,9 +216,6 @@ def markdown_code(text: Any) -> str:
     """``text`` (a file name) as a Markdown code span that shows it literally: fenced by one backtick more than its
     longest run of backticks, padded with a space where it begins or ends with one (CommonMark's rule); line breaks
     and other control characters made spaces (a code span cannot hold a line break)."""
-    import re
-    import unicodedata
-
     t = "".join(" " if unicodedata.category(c) in ("Cc", "Zl", "Zp") else "\ufffd" if unicodedata.category(c) == "Cs"
                 else c for c in str(text))
     fence = "`" * (max((len(r) for r in re.findall("`+", t)), default=0) + 1)

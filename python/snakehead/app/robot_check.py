@@ -9,16 +9,21 @@ a split of the parts that does (computed, by trying it).
 """
 from __future__ import annotations
 
-from .._errors import Infeasible, InputError
-
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._errors import Infeasible, InputError
+from ..backbone.initial import initial_configuration
+from ..kinematics import reachability
 from ..model.mass_properties import inertia_source, mass_findings
 from ..model.body_frame import AXIS_TOLERANCE_DEG, NotStraight, straightness, suggest_home
 from ..model.robot import ALIGNED_SUFFIX, SnakeRobot
 from ..model.robot_file import toml_string
+from ..planning.start_state import ground_curl
+
+__all__ = ["SPLIT_SEARCH", "PartReport", "RobotCheck", "frame_position", "describe_parts", "design_problems",
+           "suggest_split", "map_summary", "check_robot", "description_lines", "home_suggestion", "check_lines"]
 
 #: How far (joints) a suggested split moves base_end and neck_end from the robot file's.
 SPLIT_SEARCH = (1, -1, 2, -2, 3, -3)
@@ -88,9 +93,6 @@ def describe_parts(robot: SnakeRobot) -> list[PartReport]:
 
 def design_problems(robot: SnakeRobot) -> list[str]:
     """What keeps the planner from starting on this robot (empty when nothing does)."""
-    from ..backbone.initial import initial_configuration
-    from ..planning.start_state import ground_curl
-
     problems = []
     try:
         q = initial_configuration(robot)
@@ -142,11 +144,9 @@ def suggest_split(robot: SnakeRobot) -> tuple[str, SnakeRobot] | None:
 
 def map_summary(robot: SnakeRobot) -> tuple[str, str | None]:
     """A line about the head's map (the robot file's, if any) and a problem with it (None when there is none)."""
-    from ..kinematics import reachability as workspace
-
     if robot.map_path is None:
         return "none (plan computes one and caches it)", None
-    m = workspace.load(robot.map_path)
+    m = reachability.load(robot.map_path)
     try:  # the planner's check: a whole map of this head with voxels enough for G0
         m.require_whole_for(robot, needs=("G0",), what="the map")
     except InputError as exc:

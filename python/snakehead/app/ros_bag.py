@@ -45,16 +45,31 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
+from mcap.writer import CompressionType, Writer
+from scipy.spatial import ConvexHull
+from scipy.spatial.transform import Rotation
 
+from .. import __version__
 from .._errors import invariant
 from .._files import atomic_open, write_text_atomic
+from ..dynamics import stability
+from ..planning.waypoints import PLAN_CONTACT
+from ..solve.head import frame_along
 from ..trajectory.interpolation import CONTROL_PERIOD
 from . import ros_messages as msgs
 
 if TYPE_CHECKING:
+    from ..closed_loop.loop import LoopRun
     from ..model.robot import SnakeRobot
     from ..planning.plan_result import Plan
-    from ..closed_loop.loop import LoopRun
+
+__all__ = ["WORLD_FRAME", "TARGET_FRAME_PREFIX", "TRUE_BASE_FRAME", "ESTIMATED_BASE_FRAME", "JOINT_STATES",
+           "PLANNED_JOINT_STATES", "TF", "ROBOT_DESCRIPTION", "MARKERS", "TOPIC_TYPES", "TF_PERIOD", "MARKER_PERIOD",
+           "STATIC_MARKER_PERIOD", "TARGET_COLOR", "OBSTACLE_COLOR", "POLYGON_COLOR", "ZMP_COLOR",
+           "SIMULATED_ZMP_COLOR", "ARROW_LENGTH", "TARGET_DOT", "ZMP_DOT", "LINE_WIDTH", "TEXT_HEIGHT",
+           "GROUND_MARK_Z", "samples_every", "joint_names", "held_values", "frame_name", "target_frames", "IDENTITY",
+           "target_markers", "obstacle_markers", "ground_markers", "write_plan_bag", "write_loop_bag", "yaml_float",
+           "yaml_floats", "write_joint_trajectory"]
 
 #: The fixed frame everything is placed in (world coordinates: z up, the ground at z = 0).
 WORLD_FRAME = "world"
@@ -121,10 +136,6 @@ class _Bag:
 
     def write(self, path: str | os.PathLike) -> Path:
         """Write the bag to ``path`` atomically; returns the path."""
-        from mcap.writer import CompressionType, Writer
-
-        from .. import __version__
-
         self.records.sort(key=lambda r: (r[0], r[1]))
         with atomic_open(path, "wb") as f:
             writer = Writer(f, compression=CompressionType.ZSTD)
@@ -156,7 +167,7 @@ def _stamps(seconds: np.ndarray) -> np.ndarray:
     return np.maximum(np.round(np.asarray(seconds, float) * 1e9), 0).astype(np.int64)
 
 
-def _every(t: np.ndarray, period: float) -> np.ndarray:
+def samples_every(t: np.ndarray, period: float) -> np.ndarray:
     """Indices of the samples at (or just after) t[0], t[0] + period, ..., and the last one."""
     grid = t[0] + period * np.arange(int(np.floor((t[-1] - t[0]) / period + 1e-9)) + 1)
     return np.unique(np.r_[np.searchsorted(t, grid - 1e-9), len(t) - 1].clip(0, len(t) - 1))
@@ -204,8 +215,6 @@ def frame_name(name: str) -> str:
 def target_frames(targets: Sequence[Any]) -> list[tuple[str, np.ndarray]]:
     """(frame id, world pose (4, 4)) of each target (``name``, ``position``, ``direction``): the x-axis along its
     direction, z as near world z as can be; names made frame ids and unique (a "_2" for the second of a name)."""
-    from ..solve.head import frame_along
-
     out: list[tuple[str, np.ndarray]] = []
     for tg in targets:
         base = TARGET_FRAME_PREFIX + frame_name(tg.name)
@@ -220,8 +229,6 @@ def target_frames(targets: Sequence[Any]) -> list[tuple[str, np.ndarray]]:
 
 def _quaternions(T: np.ndarray) -> np.ndarray:
     """Unit quaternions (..., 4) as (x, y, z, w) of the rotations of poses T (..., 4, 4)."""
-    from scipy.spatial.transform import Rotation
-
     T = np.asarray(T, float)
     return Rotation.from_matrix(T[..., :3, :3].reshape(-1, 3, 3)).as_quat().reshape(T.shape[:-2] + (4,))
 
@@ -277,8 +284,6 @@ def target_markers(targets: Sequence[Any], diameters: dict[str, float] | None = 
 def obstacle_markers(obstacles: Sequence[Any]) -> list[dict]:
     """The obstacles' convex shapes (namespace "obstacles"): boxes as cubes, spheres and cylinders as such, convex
     pieces (a wall's around its hole, a mesh's hull) as one triangle list per obstacle."""
-    from scipy.spatial import ConvexHull
-
     out: list[dict] = []
     for obstacle in obstacles:
         triangles = []
@@ -323,11 +328,8 @@ def _add_static_markers(bag: _Bag, targets: Sequence[Any], obstacles: Sequence[A
 def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None) -> None:
     """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``;
     with ``simulated`` (a SimResult of the plan), its ZMP beside (namespace "zmp_simulated")."""
-    from ..dynamics import stability
-    from ..planning.waypoints import PLAN_CONTACT
-
     t = np.asarray(plan.t, float)
-    idx = _every(t, MARKER_PERIOD)
+    idx = samples_every(t, MARKER_PERIOD)
     vertices, count = stability.support_polygons(plan.robot, plan.q[idx], plan.base, contact=PLAN_CONTACT)
     stamps = _stamps(t0_s + t[idx] - t[0])
     sim_zmp = None
@@ -356,7 +358,7 @@ def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
     bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.description_text}))
     goals = target_frames(plan.targets)
     children = [robot.description_root] + [f for f, _ in goals]
-    idx = _every(t, TF_PERIOD)
+    idx = samples_every(t, TF_PERIOD)
     roots = robot.description_root_pose(robot.root_pose(plan.base), np.asarray(plan.q, float)[idx])
     fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
     poses = np.concatenate([roots[:, None], fixed], axis=1)
@@ -391,7 +393,7 @@ def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
     bag.add(ROBOT_DESCRIPTION, 0, _encoder(TOPIC_TYPES[ROBOT_DESCRIPTION])({"data": robot.description_text}))
     targets = run.plan.targets if run.plan is not None else list(run.scene.targets)
     goals = target_frames(targets)
-    idx = _every(t, TF_PERIOD)
+    idx = samples_every(t, TF_PERIOD)
     body = robot.body_in_root
     moving = np.stack([robot.description_root_pose(roots[idx], q[idx]), roots[idx] @ body], axis=1)
     fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
@@ -412,7 +414,7 @@ def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
 
 
 # --- the trajectory for controllers -------------------------------------------------------------------------------
-def _yaml_float(x: float) -> str:
+def yaml_float(x: float) -> str:
     """``x`` as a YAML float that reads back exactly (Python's shortest repr, with a "." that YAML 1.1 needs)."""
     text = repr(x)
     return text.replace("e", ".0e") if "e" in text and "." not in text else text
@@ -422,8 +424,8 @@ def _yaml_float(x: float) -> str:
 _BARE_EXPONENT = re.compile(r"(?<![\d.])(\d+)e")
 
 
-def _yaml_floats(row: np.ndarray) -> str:
-    """``row``'s floats as :func:`_yaml_float` writes them, joined by ", " (the list's repr, made in C: a plan's
+def yaml_floats(row: np.ndarray) -> str:
+    """``row``'s floats as :func:`yaml_float` writes them, joined by ", " (the list's repr, made in C: a plan's
     YAML has ~10^5 floats)."""
     text = repr(row.tolist())[1:-1]
     return _BARE_EXPONENT.sub(r"\1.0e", text) if "e" in text else text
@@ -452,7 +454,7 @@ def write_joint_trajectory(plan: Plan, path: str | os.PathLike) -> Path:
              "joint_names: [" + ", ".join(map(_yaml_string, plan.robot.joint_names)) + "]", "points:"]
     for s, row, rate in zip(_stamps(t - t[0]).tolist(), q, qd):
         time = msgs.stamp(s)
-        lines += [f"  - positions: [{_yaml_floats(row)}]", f"    velocities: [{_yaml_floats(rate)}]",
+        lines += [f"  - positions: [{yaml_floats(row)}]", f"    velocities: [{yaml_floats(rate)}]",
                   "    accelerations: []", "    effort: []",
                   f"    time_from_start: {{sec: {time['sec']}, nanosec: {time['nanosec']}}}"]
     return write_text_atomic(path, "\n".join(lines) + "\n")

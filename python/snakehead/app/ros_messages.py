@@ -2,8 +2,9 @@
 text the ROS 2 MCAP profile carries, and their CDR encoding. No ROS installation is needed.
 
 * :data:`DEFINITIONS` -- each message's fields as in ROS 2 Humble's ``.msg`` files (comments and default values
-  left out; Jazzy's are the same but for a constant Marker adds, ARROW_STRIP, which is not on the wire): ``sensor_msgs/msg/JointState``, ``tf2_msgs/msg/TFMessage``,
-  ``std_msgs/msg/String``, ``visualization_msgs/msg/MarkerArray`` and what they contain.
+  left out; Jazzy's are the same but for a constant Marker adds, ARROW_STRIP, which is not on the wire):
+  ``sensor_msgs/msg/JointState``, ``tf2_msgs/msg/TFMessage``, ``std_msgs/msg/String``,
+  ``visualization_msgs/msg/MarkerArray`` and what they contain.
 * :func:`schema_text` -- a type's definition followed by those of every type it uses, each after a line of 80 ``=``
   and ``MSG: pkg/Type``: the ``ros2msg`` schema encoding of the MCAP ``ros2`` profile (what ``ros2 bag record``
   writes).
@@ -11,8 +12,8 @@ text the ROS 2 MCAP profile carries, and their CDR encoding. No ROS installation
   its 4-byte encapsulation header), by mcap-ros2-support's encoder for the schema text.
 * :func:`joint_state_cdr`, :func:`tf_message_cdr` -- many ``sensor_msgs/msg/JointState`` or
   ``tf2_msgs/msg/TFMessage`` messages at once, laid out by hand with numpy: a motion sampled every 2 ms has tens of
-  thousands of joint states, which the generic encoder takes about a second for (60 us each). Their layout is
-  checked against two independent decoders in the tests (rosbags' and mcap-ros2-support's).
+  thousands of joint states, too many for the generic encoder, one message at a time. Their layout is checked
+  against two independent decoders in the tests (rosbags' and mcap-ros2-support's).
 """
 from __future__ import annotations
 
@@ -23,10 +24,17 @@ from typing import Any, Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
+# mcap-ros2-support's Writer encodes with this encoder but takes no pre-encoded messages and no channel metadata,
+# which a bag needs (snakehead.app.ros_bag): its encoder, private to the package, is used directly (tested with 0.6)
+from mcap_ros2._dynamic import serialize_dynamic
+
 from .._errors import invariant
 
-#: Field definitions per type (ROS 2 Humble; Jazzy has the same fields). Nested types are named ``pkg/Type`` as .msg files
-#: name them.
+__all__ = ["DEFINITIONS", "ARROW", "CUBE", "SPHERE", "CYLINDER", "LINE_STRIP", "TEXT_VIEW_FACING", "TRIANGLE_LIST",
+           "dependencies", "schema_text", "encoder", "stamp", "joint_state_cdr", "tf_message_cdr"]
+
+#: Field definitions per type (ROS 2 Humble; Jazzy has the same fields). Nested types are named ``pkg/Type`` as .msg
+#: files name them.
 DEFINITIONS: dict[str, str] = {
     "builtin_interfaces/msg/Time": "int32 sec\nuint32 nanosec\n",
     "builtin_interfaces/msg/Duration": "int32 sec\nuint32 nanosec\n",
@@ -97,10 +105,6 @@ def schema_text(type_name: str) -> str:
 
 def encoder(type_name: str) -> Callable[[Any], bytes]:
     """A CDR encoder of ``type_name`` messages given as nested dicts (field name -> value; lists for arrays)."""
-    # mcap-ros2-support's Writer encodes with this function's encoders but takes no pre-encoded messages and no
-    # channel metadata, which a bag needs (see snakehead.app.ros_bag); its encoders are used directly.
-    from mcap_ros2._dynamic import serialize_dynamic
-
     return serialize_dynamic(type_name, schema_text(type_name))[type_name]
 
 

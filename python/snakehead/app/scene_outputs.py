@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 from ..viz import animation, body, save, viewer
 from ..viz import dynamics_figures as dynamics
 from ..viz import loop_figures as loop_plots
-from ..viz._common import literal
+from ..viz.figure_style import literal
 from . import report as rep
 from . import ros_bag
 from .progress import Progress

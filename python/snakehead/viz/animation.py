@@ -14,30 +14,36 @@ from dataclasses import dataclass, field
 from typing import IO, TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.transforms import IdentityTransform
+from PIL import Image
 
-from ._common import literal, new_figure, setup_axes3d
-from .body import Sphere, body_faces, draw_body, draw_scenery, plan_spheres, scene_bounds, view_angles
 from .._errors import InputError
+from .body import draw_body, draw_scenery
+from .figure_geometry import Sphere, body_faces, plan_spheres, scene_bounds, view_angles
+from .figure_style import literal, new_figure, setup_axes3d
 
 if TYPE_CHECKING:
     from matplotlib.text import Text
     from mpl_toolkits.mplot3d.art3d import Line3D, Poly3DCollection
-    from PIL import Image
 
     from ..planning.plan_result import Plan
 
 
+__all__ = ["BodyAnimation", "PALETTE_FRAMES", "gif_palette", "animate", "clock_time"]
+
 @dataclass
 class BodyAnimation:
     """Frames of a plan's motion drawn on one figure. ``figure``: the Matplotlib figure (showing the first frame
-    once drawn); ``times`` (F,) s: the plan's time of each frame; ``fps``: frames per second of the GIF."""
+    once drawn); ``times`` (F,) s: the plan's time of each frame; ``fps``: frames per second of the GIF;
+    ``frames`` (F, L, 4, 4): the world frames of the body's links at each frame; ``plan``: the plan drawn."""
 
     figure: Figure
     times: np.ndarray
     fps: float
-    _frames: np.ndarray = field(repr=False)  # (F, L, 4, 4) world frames of the body at each frame
-    _plan: Plan = field(repr=False)
+    frames: np.ndarray = field(repr=False)
+    plan: Plan = field(repr=False)
     _artists: tuple[Poly3DCollection, Line3D, Text] = field(repr=False)  # what moves: body, tip trace, clock time
     _speedup: float = 1.0
 
@@ -46,15 +52,12 @@ class BodyAnimation:
 
     def images(self) -> Iterator[Image.Image]:
         """Each frame as an RGBA :class:`PIL.Image.Image` (the figure's size at its dpi)."""
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from PIL import Image
-
-        fig, plan = self.figure, self._plan
+        fig, plan = self.figure, self.plan
         robot = plan.robot
         canvas = FigureCanvasAgg(fig)
         ax = fig.axes[0]
         body, trace, clock = self._artists
-        tip = self._frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
+        tip = self.frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
         # what a full draw puts after the body: the trace and any still artist of a higher zorder, in draw order
         added = [a for a in ax.get_children() if a in (*ax.collections, *ax.lines, *ax.patches, *ax.texts)]
         over = sorted([a for a in added if a is not body and (a is trace or a.get_zorder() > body.get_zorder())],
@@ -67,10 +70,10 @@ class BodyAnimation:
         width, height = canvas.get_width_height()
         for k in range(len(self)):
             canvas.restore_region(background)
-            body.set_verts(body_faces(robot, self._frames[k])[0])
+            body.set_verts(body_faces(robot, self.frames[k])[0])
             body.do_3d_projection()
             trace.set_data_3d(tip[: k + 1, 0], tip[: k + 1, 1], tip[: k + 1, 2])
-            clock.set_text(_clock_time(self.times[k]))
+            clock.set_text(clock_time(self.times[k]))
             for artist in (body, *over):
                 ax.draw_artist(artist)
             fig.draw_artist(clock)
@@ -80,11 +83,8 @@ class BodyAnimation:
 
     def write_gif(self, file: IO[bytes]) -> None:
         """Write the frames as a looping GIF into an open binary file (:func:`snakehead.viz.save` names one), every
-        frame in one palette (:func:`gif_palette`; each pixel its nearest colour, not dithered): a third of the time
-        of a palette chosen per frame, half the file, and closer to the drawing (the per-frame palettes lost the
-        light grey of the 3-D axes' panes)."""
-        from PIL import Image
-
+        frame in one palette (:func:`gif_palette`; each pixel its nearest colour, not dithered): faster than a
+        palette per frame, a smaller file, and it keeps the light grey of the 3-D axes' panes."""
         frames = [im.convert("RGB") for im in self.images()]  # (opaque: the figure's background is)
         palette = gif_palette(frames)
         frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in frames]
@@ -99,8 +99,6 @@ PALETTE_FRAMES = 10
 def gif_palette(frames: Sequence[Image.Image]) -> Image.Image:
     """One 256-colour palette (a "P" image) for RGB ``frames`` of one size: median cut over PALETTE_FRAMES of them,
     evenly spread, side by side (the still background is in all, the body in its poses along the motion)."""
-    from PIL import Image
-
     picks = [frames[k] for k in np.unique(np.linspace(0, len(frames) - 1, PALETTE_FRAMES).round().astype(int))]
     width, height = picks[0].size
     strip = Image.new("RGB", (width, height * len(picks)))
@@ -136,11 +134,12 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
     (trace,) = ax.plot(tip[:1, 0], tip[:1, 1], tip[:1, 2], ":", color="k", lw=1.0)
     clock = _clock(fig, f"{literal(plan.name)}: t = ", t[idx], f" s  (x{speedup:.1f} speed)")
     fig.subplots_adjust(left=0.0, right=0.96, bottom=0.02, top=0.98)
-    return BodyAnimation(figure=fig, times=t[idx], fps=fps, _frames=frames, _plan=plan,
+    return BodyAnimation(figure=fig, times=t[idx], fps=fps, frames=frames, plan=plan,
                          _artists=(body, trace, clock), _speedup=speedup)
 
 
-def _clock_time(t: float) -> str:
+def clock_time(t: float) -> str:
+    """The clock's time as the animation writes it: s with one decimal."""
     return f"{t:.1f}"
 
 
@@ -148,13 +147,10 @@ def _clock(fig: Figure, before: str, times: np.ndarray, after: str) -> Text:
     """The clock at the top, centred: "NAME: t = 12.3 s  (x2.4 speed)". Only the time changes from frame to frame,
     so it is the only text drawn anew per frame (the returned artist, right-aligned in the room of the longest
     time); the words around it are still (drawn once, with the background). Text is most of a frame's drawing."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.transforms import IdentityTransform
-
     style: dict[str, Any] = dict(va="top", fontsize=9, transform=IdentityTransform())  # in pixels, once measured
     y = 0.98 * fig.bbox.height
     parts = [fig.text(0, y, before, ha="left", **style),
-             fig.text(0, y, max((_clock_time(v) for v in (times[0], times[-1])), key=len), ha="right", **style),
+             fig.text(0, y, max((clock_time(v) for v in (times[0], times[-1])), key=len), ha="right", **style),
              fig.text(0, y, after, ha="left", **style)]
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     renderer = canvas.get_renderer()
@@ -163,6 +159,6 @@ def _clock(fig: Figure, before: str, times: np.ndarray, after: str) -> Text:
     parts[0].set_x(x)
     parts[1].set_x(x + widths[0] + widths[1])
     parts[2].set_x(x + widths[0] + widths[1])
-    parts[1].set_text(_clock_time(times[0]))
+    parts[1].set_text(clock_time(times[0]))
     return parts[1]
 

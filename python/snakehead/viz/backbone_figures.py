@@ -22,11 +22,13 @@ from matplotlib.figure import Figure
 from .. import backbone as bb
 from ..dynamics import stability
 from ..model.robot import BasePlacement, SnakeRobot
-from ._common import LINK_COLOR, new_figure
-from .body import body_points
+from .figure_geometry import body_points
+from .figure_style import LINK_COLOR, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+
+__all__ = ["plot_arc_discretisation", "plot_initial_configuration", "plot_area_vs_angle"]
 
 _BC = "#1f77b4"  # backbone curves
 _UP = "#d62728"  # the up curve

@@ -1,293 +1,75 @@
 """Figures of the body in 3-D: its collision shapes coloured by part, with the scene's targets and obstacles.
 
-* :func:`plot_snapshots` -- Figs. 17 and 22: the whole body at a plan's key states, one panel per state.
+* :func:`plot_snapshots` -- Figs. 17 and 22: the whole body at a plan's key states, one panel per state
+  (:func:`save_snapshots` writes the same picture faster).
 * :func:`plot_head_solution` -- one :class:`~snakehead.solve.HeadController` solution: the robot at it and the
   neck geometry of Fig. 8.
 * :func:`plot_interpolation_comparison` -- Fig. 11 against Fig. 13: a joint-space interpolation that drives the
   head into the ground beside the Cartesian interpolation of Eqs. 41-44 that does not.
+* :func:`draw_body` and :func:`draw_scenery`: the body and the scenery on 3-D axes (the animation's too).
 
-The geometry the figures, the animation and the 3-D viewer share: :func:`body_faces` (the faces of every collision
-shape: boxes, cylinders, spheres, mesh hulls, from :func:`snakehead.geometry.shapes.shape_mesh`, coplanar triangles
-merged into one polygon, so that a box is drawn as its six faces), :func:`shape_footprints` (the shapes seen from
-above), :func:`box_faces` and :func:`mesh_obstacle_faces` (obstacles), :func:`wall_faces` (a wall with a hole), :func:`part_colors` (base grey,
-neck orange, head blue).
-
-Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`. Positions in
-m, times in s, world frame with z up and the ground at z = 0.
+The geometry they draw (faces, footprints, obstacles, spheres, bounds) is in :mod:`.figure_geometry`, re-exported
+here. Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`.
+Positions in m, times in s, world frame with z up and the ground at z = 0.
 """
 from __future__ import annotations
 
 import os
-import weakref
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 import numpy.typing as npt
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+from .._errors import InputError
+from .._files import atomic_open
 from ..collision import body_collisions as coll
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
-from ..geometry.shapes import shape_mesh
 from ..model.robot import BasePlacement, SnakeRobot
 from ..trajectory.cartesian import cartesian_interpolation
-from .._errors import InputError
-from ._common import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, SPHERE_COLOR, WALL_COLOR, ink_mask, literal,
-                      new_figure, setup_axes3d)
-
-#: Colour of box obstacles in the figures.
-OBSTACLE_COLOR = "#8d6e63"
-#: Segments around a cylinder's or a sphere's axis in the figures.
-FIGURE_SEGMENTS = 16
-#: in: blank figure on either side of the snapshots' panels, for the tick labels that reach beyond them.
-SNAPSHOT_SIDE_IN = 0.5
+from .figure_files import DEFAULT_DPI, crop_and_write_png, ink_mask, save
+from .figure_geometry import (FIGURE_SEGMENTS, BodyDrawing, Sphere, body_drawing, body_faces, body_points, box_faces,
+                              convex_facets, hole_rim, mesh_obstacle_faces, part_colors, plan_spheres, scene_bounds,
+                              shape_footprints, view_angles, wall_faces)
+from .figure_style import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, OBSTACLE_COLOR, SPHERE_COLOR, WALL_COLOR,
+                           literal, new_figure, setup_axes3d)
 
 if TYPE_CHECKING:
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
-    from ..solve.head_controller import HeadSolution
     from ..planning.plan_result import Plan
+    from ..solve.head_controller import HeadSolution
 
-#: A sphere drawn at a target: (centre (3,) m, diameter m).
-Sphere = tuple[npt.ArrayLike, float]
+__all__ = [
+    "SNAPSHOT_SIDE_IN", "draw_scenery", "draw_body", "snapshot_states", "plot_snapshots", "save_snapshots",
+    "plot_head_solution", "plot_interpolation_comparison",
+    # re-exported: the geometry (figure_geometry) and the colours (figure_style) the figures draw with
+    "FIGURE_SEGMENTS", "BodyDrawing", "Sphere", "body_drawing", "body_faces", "body_points", "box_faces",
+    "convex_facets", "hole_rim", "mesh_obstacle_faces", "part_colors", "plan_spheres", "scene_bounds",
+    "shape_footprints", "view_angles", "wall_faces", "BASE_COLOR", "NECK_COLOR", "HEAD_COLOR", "OBSTACLE_COLOR",
+]
 
+#: in: blank figure on either side of the snapshots' panels, for the tick labels that reach beyond them.
+SNAPSHOT_SIDE_IN = 0.5
+#: Colours of the two interpolations of Figs. 11 and 13.
 _JOINT_SPACE = "#c0392b"
 _CARTESIAN = "#1f77b4"
 
 
-
-# ----------------------------------------------------------------------------------------------
-# geometry shared with the animation and the viewer
-# ----------------------------------------------------------------------------------------------
-def part_colors(robot: SnakeRobot) -> list[str]:
-    """A colour per frame of ``robot.link_names``: base grey, neck orange, head blue."""
-    names = robot.link_names
-    base_end = names.index(robot.parts.base_end)
-    neck_end = names.index(robot.parts.neck_end)
-    return [BASE_COLOR if i <= base_end else NECK_COLOR if i <= neck_end else HEAD_COLOR for i in range(len(names))]
-
-
-def convex_facets(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
-    """The faces of a convex triangle mesh as polygons: each plane's triangles merged into one polygon, its corners
-    (indices into ``vertices``) in order around it, points inside it or on its edges left out (a box's 12 triangles
-    are its 6 faces; a cylinder's caps are two polygons)."""
-    v = np.asarray(vertices, float)
-    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
-    scale = max(float(np.ptp(v, axis=0).max()) if len(v) else 0.0, 1e-12)
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    n = np.cross(b - a, c - a)
-    norm = np.linalg.norm(n, axis=1)
-    good = norm > 1e-12 * scale * scale
-    f, n, a = f[good], n[good] / norm[good, None], a[good]
-    n *= np.where(np.einsum("ij,ij->i", n, a - v.mean(axis=0)) < 0, -1.0, 1.0)[:, None]  # outward, whatever the winding
-    d = np.einsum("ij,ij->i", n, a)
-    planes: list[tuple[np.ndarray, float, list[int]]] = []
-    for i in range(len(f)):
-        for pn, pd, members in planes:
-            if np.abs(pn - n[i]).max() < 1e-6 and abs(pd - d[i]) < 1e-6 * scale:
-                members.append(i)
-                break
-        else:
-            planes.append((n[i], float(d[i]), [i]))
-    out = []
-    for pn, _, members in planes:
-        idx = np.unique(f[members])
-        u = np.cross(pn, [1.0, 0.0, 0.0] if abs(pn[0]) < 0.9 else [0.0, 1.0, 0.0])
-        u /= np.linalg.norm(u)
-        w = np.cross(pn, u)
-        out.append(idx[_hull_2d(np.column_stack([v[idx] @ u, v[idx] @ w]), 1e-9 * scale)])
-    return out
-
-
-def _hull_2d(p: np.ndarray, tol: float) -> np.ndarray:
-    """Indices of the corners of the convex hull of 2-D points (k, 2), in order around it (monotone chain)."""
-    order = np.lexsort((p[:, 1], p[:, 0]))
-
-    def half(seq: np.ndarray) -> list[int]:
-        chain: list[int] = []
-        for i in seq:
-            while len(chain) >= 2:
-                o, a = p[chain[-2]], p[chain[-1]]
-                if (a[0] - o[0]) * (p[i][1] - o[1]) - (a[1] - o[1]) * (p[i][0] - o[0]) > tol * tol:
-                    break
-                chain.pop()
-            chain.append(int(i))
-        return chain
-
-    lower, upper = half(order), half(order[::-1])
-    return np.array(lower[:-1] + upper[:-1] if len(order) > 2 else list(order), dtype=np.int64)
-
-
-class _BodyDrawing:
-    """The polygons of every collision shape of a robot in its link frames (made once per robot: see
-    :func:`_drawing`): ``vertices`` (V, 3), the frame of each (``vertex_frame`` (V,)), ``polygons`` (index arrays
-    into the vertices) and the shape of each polygon (``polygon_shape``)."""
-
-    def __init__(self, robot: SnakeRobot, segments: int) -> None:
-        geometry = robot.geometry
-        verts, frames, polys, owner, shape_vertices = [], [], [], [], []
-        start = 0
-        for k, shape in enumerate(geometry.shapes):
-            v, f = shape_mesh(shape, segments, hull=geometry, index=k)
-            for poly in convex_facets(v, f):
-                polys.append(poly + start)
-                owner.append(k)
-            verts.append(v)
-            frames.append(np.full(len(v), shape.frame))
-            shape_vertices.append(np.arange(start, start + len(v)))
-            start += len(v)
-        self.vertices = np.concatenate(verts) if verts else np.zeros((0, 3))
-        self.vertex_frame = np.concatenate(frames) if frames else np.zeros(0, np.int64)
-        self.polygons = polys
-        self.polygon_shape = np.array(owner, dtype=np.int64)
-        self.shape_vertices = shape_vertices
-        self.shape_frames = np.array([s.frame for s in geometry.shapes], dtype=np.int64)
-
-    def world(self, frames: np.ndarray) -> np.ndarray:
-        F = frames[self.vertex_frame]
-        return np.einsum("vij,vj->vi", F[:, :3, :3], self.vertices) + F[:, :3, 3]
-
-
-_DRAWINGS: "weakref.WeakKeyDictionary[SnakeRobot, dict[int, _BodyDrawing]]" = weakref.WeakKeyDictionary()
-
-
-def _drawing(robot: SnakeRobot, segments: int = FIGURE_SEGMENTS) -> _BodyDrawing:
-    per_robot = _DRAWINGS.setdefault(robot, {})
-    if segments not in per_robot:
-        per_robot[segments] = _BodyDrawing(robot, segments)
-    return per_robot[segments]
-
-
-def body_faces(robot: SnakeRobot, frames: npt.ArrayLike) -> tuple[list[np.ndarray], list[str]]:
-    """The faces of every collision shape (boxes, cylinders, spheres, mesh hulls): a list of polygons, each (k, 3)
-    world corners (m), and one colour per polygon (its link's part). A box gives its 6 faces, a cylinder its
-    :data:`FIGURE_SEGMENTS` sides and two caps.
-
-    frames (L, 4, 4): world poses of ``robot.link_names`` (``robot.frames``); frames without shapes draw nothing.
-    """
-    frames = np.asarray(frames, float)
-    drawing = _drawing(robot)
-    W = drawing.world(frames)
-    colors = part_colors(robot)
-    shape_color = [colors[int(f)] for f in drawing.shape_frames]
-    return [W[p] for p in drawing.polygons], [shape_color[int(k)] for k in drawing.polygon_shape]
-
-
-def shape_footprints(robot: SnakeRobot, frames: npt.ArrayLike, links: npt.ArrayLike | None = None) -> list[np.ndarray]:
-    """Each collision shape of ``links`` (default all) seen from above: its outline (k, 2) m in the ground plane,
-    in order around it, at ``frames`` (L, 4, 4)."""
-    frames = np.asarray(frames, float)
-    drawing = _drawing(robot)
-    W = drawing.world(frames)
-    keep = np.arange(len(drawing.shape_frames)) if links is None else \
-        np.flatnonzero(np.isin(drawing.shape_frames, np.asarray(links)))
-    out = []
-    for k in keep:
-        xy = W[drawing.shape_vertices[int(k)], :2]
-        scale = max(float(np.ptp(xy, axis=0).max()), 1e-12)
-        out.append(xy[_hull_2d(xy, 1e-9 * scale)])
-    return out
-
-
-_BOX_CORNERS = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
-_BOX_QUADS = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
-
-
-def mesh_obstacle_faces(mesh: MeshObstacle) -> list[np.ndarray]:
-    """A mesh obstacle's hull as its faces: a list of polygons (k, 3) of world corners (m)."""
-    from scipy.spatial import ConvexHull
-
-    v = mesh.world_vertices
-    return [v[p] for p in convex_facets(v, ConvexHull(v).simplices)]
-
-
-def box_faces(box: BoxObstacle) -> np.ndarray:
-    """A box obstacle's six faces: (6, 4, 3) world corners (m)."""
-    corners = box.centre + (_BOX_CORNERS * np.asarray(box.size, float)) @ np.asarray(box.rotation, float).T
-    return corners[_BOX_QUADS]
-
-
-def wall_faces(wall: WallWithHole, n: int = 64) -> np.ndarray:
-    """The wall's mid-plane as quads tiling the rectangle minus the hole: (K, 4, 3) world corners (m).
-
-    Each quad joins two neighbouring points of the hole's rim to the points where the same rays from the hole's
-    centre leave the rectangle; the rays include the rectangle's corners, so the tiling is exact up to the rim's
-    ``n``-gon.
-    """
-    R = wall.rotation
-    half = wall.size[:2] / 2
-    off = wall.hole_offset
-    r = wall.hole_diameter / 2
-    corners = np.array([[sx, sy] for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]) * half + off
-    angles = np.sort(np.r_[np.linspace(0, 2 * np.pi, n, endpoint=False),
-                           np.arctan2(corners[:, 1], corners[:, 0]) % (2 * np.pi)])
-    d = np.column_stack([np.cos(angles), np.sin(angles)])
-    # distance along each ray to the rectangle [off - half, off + half] (the hole's centre is inside it)
-    with np.errstate(divide="ignore"):
-        tx = np.where(d[:, 0] > 0, (off[0] + half[0]) / d[:, 0],
-                      np.where(d[:, 0] < 0, (off[0] - half[0]) / d[:, 0], np.inf))
-        ty = np.where(d[:, 1] > 0, (off[1] + half[1]) / d[:, 1],
-                      np.where(d[:, 1] < 0, (off[1] - half[1]) / d[:, 1], np.inf))
-    outer = d * np.minimum(tx, ty)[:, None]
-    inner = d * r
-    nxt = np.roll(np.arange(len(angles)), -1)
-    quads = np.stack([inner, inner[nxt], outer[nxt], outer], axis=1)  # (K, 4, 2) in (width, height)
-    return wall.centre + quads @ R[:, :2].T
-
-
-def hole_rim(wall: WallWithHole, n: int = 65) -> np.ndarray:
-    """The hole's rim: (n, 3) world points (m), closed (the last equals the first)."""
-    th = np.linspace(0, 2 * np.pi, n)
-    return wall.centre + (wall.hole_diameter / 2) * (np.outer(np.cos(th), wall.rotation[:, 0])
-                                                     + np.outer(np.sin(th), wall.rotation[:, 1]))
-
-
-def plan_spheres(plan: Plan) -> list[Sphere]:
-    """The spheres a plan's scene draws at its targets (targets with a ``sphere_diameter``)."""
-    scene = getattr(plan, "scene", None)
-    if scene is None:
-        return []
-    return [(t.position, float(t.sphere_diameter)) for t in scene.targets if t.sphere_diameter is not None]
-
-
 def _sphere_mesh(centre: np.ndarray, diameter: float, n: int = 14) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sphere as ``plot_surface`` takes it: the grids X, Y, Z (n // 2 + 1, n) m."""
     u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2 + 1))
     r = diameter / 2
     return (centre[0] + r * np.cos(u) * np.sin(v), centre[1] + r * np.sin(u) * np.sin(v), centre[2] + r * np.cos(v))
 
 
-def scene_bounds(plan: Plan, spheres: Sequence[Sphere] = (), margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners (3,) m of a box holding the body over the whole motion, the scenery and the ground."""
-    step = max(1, len(plan.q) // 200)
-    pts = plan.robot.frames_many(plan.q[::step], plan.base)[..., :3, 3].reshape(-1, 3)
-    extra = [pts, np.zeros((1, 3))]
-    extra += [np.asarray(c, float)[None] for c, _ in spheres]
-    extra += [tg.position[None] for tg in plan.targets]
-    for ob in plan.obstacles:
-        if isinstance(ob, WallWithHole):
-            R = ob.rotation
-            half = ob.size[:2] / 2
-            corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half + ob.hole_offset
-            extra.append(ob.centre + corners @ R[:, :2].T)
-        elif isinstance(ob, BoxObstacle):
-            extra.append(box_faces(ob).reshape(-1, 3))
-        elif isinstance(ob, MeshObstacle):
-            extra.append(ob.world_vertices)
-    allp = np.vstack(extra)
-    return allp.min(axis=0) - margin, allp.max(axis=0) + margin
-
-
-def view_angles(plan: Plan) -> tuple[float, float]:
-    """(elevation, azimuth) in degrees: from behind and to the side of the head's approach."""
-    return (18.0, -58.0) if plan.obstacles else (22.0, -62.0)
-
-
 def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: bool = True) -> None:
     """The spheres, the plan's obstacles (boxes; walls with the hole's rim) and, with ``arrows``, each target as an
     arrow along its direction ending at the target."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     for centre, diameter in spheres:
         ax.plot_surface(*_sphere_mesh(np.asarray(centre, float), diameter), color=SPHERE_COLOR, alpha=0.55,
                         linewidth=0)
@@ -309,8 +91,6 @@ def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: b
 def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
     """The collision shapes at ``frames`` (L, 4, 4) as one collection of polygons (returned, so that it can be
     moved: ``set_verts(body_faces(robot, frames)[0])``)."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     faces, colors = body_faces(robot, frames)
     shapes = Poly3DCollection(faces, facecolors=colors, edgecolors="k", linewidths=0.15, alpha=alpha)
     ax.add_collection3d(shapes, autolim=False)  # polygons of several sizes (NaN-padded): the caller sets the limits
@@ -318,8 +98,7 @@ def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 
 
 
 def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
-    from matplotlib.patches import Patch
-
+    """The legend under the snapshots: the parts, the spheres, the wall, the obstacles."""
     handles = [Patch(color=BASE_COLOR, label="base part"), Patch(color=NECK_COLOR, label="neck part"),
                Patch(color=HEAD_COLOR, label="head part")]
     if spheres:
@@ -382,11 +161,6 @@ def save_snapshots(plan: Plan, path: str | os.PathLike, *, spheres: Sequence[Sph
     drawn once and copied into the others, and only what differs -- the body, the head tip, the panel's title and
     the scenery drawn over the body -- is drawn per panel (as :func:`snakehead.viz.animation.animate` draws its
     frames). The panels sit on whole pixels (they move by less than half a pixel)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    from .._files import atomic_open
-    from ._common import DEFAULT_DPI, crop_and_write_png
-
     path = Path(path)
     layout = _SnapshotLayout(plan, spheres, n_panels, columns, title)
     fig = layout.figure
@@ -423,8 +197,6 @@ def save_snapshots(plan: Plan, path: str | os.PathLike, *, spheres: Sequence[Sph
     with atomic_open(path, "wb") as f:
         if crop_and_write_png(fig, pixels, f, DEFAULT_DPI):
             return path
-    from ._common import save
-
     return save(plot_snapshots(plan, spheres=spheres, n_panels=n_panels, columns=columns, title=title), path)
 
 
@@ -488,6 +260,7 @@ class _SnapshotLayout:
         return self.grid[k].get_position(self.figure)
 
     def panel(self, k: int) -> Axes3D:
+        """Panel k: its 3-D axes over the scene's box, with the ground and the scenery."""
         ax = self.figure.add_subplot(self.grid[k], projection="3d", computed_zorder=False)
         setup_axes3d(ax, self.lo, self.hi, self.elev, self.azim, labels=False, zoom=1.2)
         draw_scenery(ax, self.plan, self.spheres)
@@ -583,17 +356,10 @@ def plot_head_solution(robot: SnakeRobot, solution: HeadSolution) -> Figure:
 # ----------------------------------------------------------------------------------------------
 # Fig. 11 against Fig. 13
 # ----------------------------------------------------------------------------------------------
-def body_points(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
-    """Points along the body's axis, tail end to head tip: the root frame, every joint, the head tip.
-
-    frames (..., L, 4, 4) (``robot.frames`` / ``frames_many``) -> (..., n + 2, 3) m.
-    """
-    idx = np.r_[0, robot.joint_frames, robot.link_index(robot.parts.head_tip)]
-    return np.take(frames, idx, axis=-3)[..., :3, 3]
-
-
 def _draw_snapshots(ax: Axes3D, robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, color: str,
                     k: int = 6) -> np.ndarray:
+    """The body at ``k`` of the configurations ``qs`` (its axis, the base's and the lowest point's marks) in
+    ``color``, and the shape points in the ground over the whole motion; the indices of the configurations drawn."""
     frames = robot.frames_many(qs, base)
     pts = body_points(robot, frames)
     n_base = robot.parts.base.stop + 1  # points 0 .. n_base: the root, the base's joints and P0 (the neck's first)

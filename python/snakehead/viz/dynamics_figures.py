@@ -15,14 +15,18 @@ import numpy as np
 import numpy.typing as npt
 from matplotlib.figure import Figure
 
+from .._errors import InputError
 from ..dynamics import stability as st
 from ..model.robot import BasePlacement, SnakeRobot
-from ._common import PLANNED_COLOR, SIMULATED_COLOR, new_figure
-from .._errors import InputError
+from ..sim.compare import zmp_margins
+from .figure_geometry import shape_footprints
+from .figure_style import PLANNED_COLOR, SIMULATED_COLOR, new_figure
 
 
 if TYPE_CHECKING:
     from ..sim.tracking import SimResult
+
+__all__ = ["Momenta", "plot_momenta", "MOMENTA_LAYOUT", "ZMP_LAYOUT", "distinct_support_polygons", "plot_zmp"]
 
 #: A second run to draw beside the planned one: a simulation result (``t``, ``P``, ``L``) or (t, P, L) arrays.
 Momenta = Union["SimResult", tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike]]
@@ -82,8 +86,6 @@ ZMP_LAYOUT = dict(left=0.052, right=0.9885, bottom=0.108, top=0.881, wspace=0.13
 
 def _base_footprint(ax: Any, robot: SnakeRobot, frames: np.ndarray) -> None:
     """The base's collision shapes seen from above (grey)."""
-    from .body import shape_footprints
-
     for xy in shape_footprints(robot, frames, robot.base_links):
         ax.fill(xy[:, 0], xy[:, 1], color="0.85", ec="0.6", lw=0.8, zorder=1)
 
@@ -129,8 +131,6 @@ def plot_zmp(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, *, base: Bas
             zorder=6)
     margins_sim = None
     if simulated is not None:
-        from ..sim.compare import zmp_margins
-
         z = simulated.zmp
         ax.plot(z[:, 0], z[:, 1], "-", color=SIMULATED_COLOR, lw=0.7, alpha=0.8, label="ZMP simulated (MuJoCo)",
                 zorder=5)

@@ -88,7 +88,7 @@ FILL_LIGHT = 1.5
 #: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
 GROUND_MARGIN_M = 0.2
 #: Targets at most in the live viewer (a scene with more is refused at start; "add target" stops there): each adds
-#: a few seconds to the motion and to every plan (203 targets took 8-15 s a plan, a 613 s motion and 200 MB).
+#: a few seconds to the motion and to every plan.
 MAX_TARGETS = 16
 #: s: the longest motion the live viewer plays (a longer plan is reported, not drawn).
 MAX_MOTION_S = 300.0

@@ -28,6 +28,9 @@ if TYPE_CHECKING:
     from ..model.robot import BasePlacement, SnakeRobot
     from ..planning.plan_result import Plan
 
+__all__ = ["PATH_SEGMENTS", "POLYGON_EDGES", "ROOT", "LiveMotion", "live_motion", "wxyz_along", "x_axis", "gizmo_pose",
+           "TargetGizmos", "MotionNodes"]
+
 #: Segments of the head tip's path and of the ZMP's trace: fixed, so that a new plan moves their points only.
 PATH_SEGMENTS = 200
 #: Edges of the support polygon's node (a polygon of fewer repeats its last vertex; one of more is resampled).

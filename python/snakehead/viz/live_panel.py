@@ -20,6 +20,8 @@ if TYPE_CHECKING:
     from .live_nodes import LiveMotion
 
 
+__all__ = ["Replan", "DynamicsCheck", "ClientPanel", "ClientPanels", "shown_text", "errors_text", "MOTION_WATCH_JS"]
+
 @dataclass
 class Replan:
     """One request (a target moved, added or removed) and what became of it. Times are epoch seconds

@@ -16,24 +16,32 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, Iterator
 
-if TYPE_CHECKING:
-    from PIL import Image
-
-    from ..model.robot import SnakeRobot
-    from ..closed_loop.loop import LoopRun
-
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from PIL import Image
 
-from .._files import atomic_open
-from ._common import literal
-from .body import body_faces
 from .._errors import InputError, InputTypeError
+from .._files import atomic_open
+from ..closed_loop.loop import LoopRun
+from ..locomotion.ground_path import footprints
+from .figure_geometry import body_drawing, body_faces, part_colors, shape_footprints
+from .figure_style import BASE_COLOR, HEAD_COLOR, NECK_COLOR, literal
+
+if TYPE_CHECKING:
+    from ..model.robot import SnakeRobot
+
+__all__ = ["KIND_COLORS", "PART_COLORS", "TARGET_COLOR", "OBSTACLE_COLOR", "ROUTE_COLOR", "plot_ground_path",
+           "LoopAnimation", "animate_loop"]
 
 #: Colours of the phases by kind, and of the body's parts (as the other figures draw them).
 KIND_COLORS = {"gait": "#2e7d32", "curl": "#8e24aa", "lift": "#ef6c00", "move": "#1565c0", "hold": "#6d4c41",
                "servo": "#00838f"}
-PART_COLORS = ("#7f8c8d", "#e67e22", "#2e86c1")  # base, neck, head
+PART_COLORS = (BASE_COLOR, NECK_COLOR, HEAD_COLOR)
 TARGET_COLOR = "#c0392b"
 OBSTACLE_COLOR = "#9e9e9e"
 ROUTE_COLOR = "#455a64"
@@ -41,20 +49,15 @@ ROUTE_COLOR = "#455a64"
 
 def _obstacle_outlines(run: LoopRun) -> list[np.ndarray]:
     """The ground-level outlines of the scene's obstacles (walls, boxes) seen from above."""
-    from ..locomotion.ground_path import footprints
-
     return footprints(run.scene.obstacles)
 
 def _part_colors(robot: SnakeRobot, per_polygon: bool = False) -> list[str]:
     """A colour per collision shape (of ``robot.geometry``), or per polygon of
-    :func:`snakehead.viz.body.body_faces` (this module's palette)."""
-    from .body import _drawing
-
-    names = robot.link_names
-    base_end, neck_end = names.index(robot.parts.base_end), names.index(robot.parts.neck_end)
-    d = _drawing(robot)
+    :func:`~.figure_geometry.body_faces`: the colour of its link's part (:data:`PART_COLORS`)."""
+    colors = part_colors(robot)
+    d = body_drawing(robot)
     frame = d.shape_frames[d.polygon_shape] if per_polygon else d.shape_frames
-    return [PART_COLORS[0] if i <= base_end else PART_COLORS[1] if i <= neck_end else PART_COLORS[2] for i in frame]
+    return [colors[i] for i in frame]
 
 
 def _frames(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -64,14 +67,11 @@ def _frames(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 def _footprint(robot: SnakeRobot, frames: np.ndarray) -> list[np.ndarray]:
     """The collision shapes' outlines seen from above: one (k, 2) polygon per shape."""
-    from .body import shape_footprints
-
     return shape_footprints(robot, frames)
 
 
 def _check(run: Any) -> None:
-    from ..closed_loop.loop import LoopRun
-
+    """InputTypeError unless ``run`` is a LoopRun, InputError unless it ran a phase."""
     if not isinstance(run, LoopRun):
         raise InputTypeError(f"run must be a snakehead.closed_loop.loop.LoopRun (ClosedLoop.run), got {type(run).__name__}")
     if not run.phases:
@@ -86,10 +86,6 @@ def plot_ground_path(run: LoopRun, *, size: tuple[float, float] = (6.5, 6.0), ti
     targets', the phases') are shown as they are (``literal``); ``title`` replaces the
     title as given (matplotlib's mathtext applies to it)."""
     _check(run)
-    from matplotlib.collections import PolyCollection
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
     robot = run.robot
     fig = Figure(figsize=size)
     ax = fig.add_subplot(1, 1, 1)
@@ -171,9 +167,6 @@ class LoopAnimation:
 
     def images(self) -> Iterator[Image.Image]:
         """Each frame as an RGB :class:`PIL.Image.Image`."""
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from PIL import Image
-
         canvas = FigureCanvasAgg(self.figure)
         body, clock = self._artists
         for k in range(len(self)):
@@ -206,8 +199,6 @@ def animate_loop(run: LoopRun, *, max_frames: int = 100, fps: float = 10.0, size
     than real time: the title gives the factor), the tail's path on the ground, the targets, the phase and the
     clock in the title."""
     _check(run)
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     fps = float(fps)
     if not (np.isfinite(fps) and fps > 0):
         raise InputError(f"fps must be positive, got {fps!r}")

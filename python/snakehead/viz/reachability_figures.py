@@ -16,26 +16,31 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+import matplotlib
+import matplotlib.colors as mcolors
 import numpy as np
 import numpy.typing as npt
+from matplotlib.collections import PatchCollection
 from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
 
-from ..kinematics.reachability.reachability_map import Clusters, ReachabilityMap
-from ._common import literal, new_figure
 from .._errors import InputError
+from ..kinematics.reachability.reachability_map import Clusters, ReachabilityMap
+from .figure_style import literal, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.colors import BoundaryNorm, Colormap
+
+__all__ = ["N_STEPS", "index_colors", "plot_map", "plot_section", "figure_map", "plot_dexterous", "plot_clusters",
+           "map_figures"]
 
 #: 20 colours over [0, 100]: red for low reachability through to blue for high (the paper's bar).
 N_STEPS = 20
 
 
 def _cmap_norm() -> tuple[Colormap, BoundaryNorm]:
-    import matplotlib
-    import matplotlib.colors as mcolors
-
+    """The paper's bar: :data:`N_STEPS` colours of ``jet_r`` over [0, 100] and the norm that bins an index."""
     cmap = matplotlib.colormaps["jet_r"].resampled(N_STEPS)
     norm = mcolors.BoundaryNorm(np.linspace(0.0, 100.0, N_STEPS + 1), cmap.N)
     return cmap, norm
@@ -102,9 +107,6 @@ def plot_section(m: ReachabilityMap, ax: Axes | None = None, axis: str = "z", va
                  colorbar: bool = True) -> Figure:
     """The voxels of the grid layer containing ``axis = value`` as squares (Figs. 4(b), 5(b))."""
     _check(m)
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Rectangle
-
     if axis not in ("x", "y", "z"):
         raise InputError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
     k = "xyz".index(axis)

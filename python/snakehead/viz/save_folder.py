@@ -20,6 +20,9 @@ import threading
 from pathlib import Path
 
 from .._errors import InputError, InputTypeError
+from .._files import atomic_open
+
+__all__ = ["DEFAULT_SAVE_DIR", "SCENE_FILE_SUFFIX", "MAX_NAME_CHARS", "MAX_SAVED_FILES", "bare_name", "SaveFolder"]
 
 LOG = logging.getLogger("snakehead.viz.server")
 
@@ -126,8 +129,6 @@ class SaveFolder:
     def _replace(target: Path, text: str, mine: tuple[int, int]) -> tuple[int, int]:
         """The session's own file replaced whole (a new file renamed over it), if it is still the session's: a file
         put in its place by anyone else is not touched."""
-        from .._files import atomic_open
-
         try:
             stat = os.lstat(target)
         except FileNotFoundError:  # removed meanwhile: a new file again

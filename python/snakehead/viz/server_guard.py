@@ -46,12 +46,19 @@ import threading
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 from urllib.parse import parse_qsl, urlencode, urlsplit
 
+import msgspec
+import websockets.asyncio.server as ws_server
+from websockets.asyncio.server import ServerConnection
+
 from .._errors import InputError
 
 if TYPE_CHECKING:
     import viser
-    from websockets.asyncio.server import ServerConnection
     from websockets.http11 import Request, Response
+
+__all__ = ["TOKEN_BYTES", "TOKEN_PARAMETER", "COOKIE_PREFIX", "LOOPBACK_NAMES", "MAX_MESSAGE_BYTES",
+           "MAX_REFUSED_MESSAGES", "MAX_CLIENTS", "CLIENT_MESSAGES", "SECURITY_HEADERS", "REFUSED_HOST",
+           "REFUSED_ORIGIN", "REFUSED_TOKEN", "REFUSED_FULL", "ServerGuard", "host_name", "guarded_server"]
 
 LOG = logging.getLogger("snakehead.viz.server")
 
@@ -176,8 +183,6 @@ class ServerGuard:
     # --- websocket messages ------------------------------------------------------------------------------------
     def admits(self, data: Any) -> bool:
         """Whether a message a client sent goes on to viser (see :data:`CLIENT_MESSAGES`)."""
-        import msgspec
-
         if not isinstance(data, bytes):
             return False
         try:
@@ -198,8 +203,6 @@ class ServerGuard:
     def connection_class(self) -> type:
         """A websockets ``ServerConnection`` whose ``recv`` drops what :meth:`admits` refuses, and closes the
         connection after :data:`MAX_REFUSED_MESSAGES` of them."""
-        from websockets.asyncio.server import ServerConnection
-
         guard = self
 
         class GuardedConnection(ServerConnection):
@@ -287,8 +290,7 @@ def guarded_server(guard: ServerGuard, host: str, port: int) -> viser.ViserServe
     """A viser server at ``host``:``port`` (the next free port if it is taken) behind ``guard``, printing nothing.
     RuntimeError (the server stopped) if the guard could not be put in front of it."""
     global _original_serve, _pending
-    import viser
-    import websockets.asyncio.server as ws_server
+    import viser  # heavy: imported when a server starts, not with the viewer's modules
 
     with _starting:
         if _original_serve is None:

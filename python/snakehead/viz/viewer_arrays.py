@@ -23,7 +23,7 @@ from ..geometry.shapes import Shape, shape_mesh
 from ..kinematics.reachability.reachability_map import KIND_WHOLE_BODY, require_map
 from ..model.robot import BasePlacement
 from ..planning.plan_many import WORKERS, RobotRecipe
-from .body import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
+from .figure_geometry import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
 
 if TYPE_CHECKING:
     from ..kinematics.reachability.reachability_map import ReachabilityMap
