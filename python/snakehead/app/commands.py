@@ -117,7 +117,7 @@ def _done(command: str, out: Path, report: dict, progress: Progress) -> int:
 
 def demo_command(args: argparse.Namespace) -> int:
     """snakehead demo: the paper's two scenarios through the pipeline."""
-    from . import pipeline  # the figures (matplotlib) and the closed loop: loaded by demo and plan only
+    from . import pipeline  # heavy (its figures, the closed loop): loaded by demo and plan only
 
     start = _start(args, paper_default=True)
     out = _writable_dir(args.out)
@@ -138,7 +138,7 @@ def demo_command(args: argparse.Namespace) -> int:
 
 def plan_command(args: argparse.Namespace) -> int:
     """snakehead plan: head targets, or a scene file's, through the pipeline."""
-    from . import pipeline  # the figures (matplotlib) and the closed loop: loaded by demo and plan only
+    from . import pipeline  # heavy (its figures, the closed loop): loaded by demo and plan only
 
     if args.scene is not None and (args.position is not None or args.direction is not None):
         raise UsageError("give --scene or --position/--direction, not both")
@@ -282,7 +282,7 @@ def _merge_shards(args: argparse.Namespace, out: Path) -> int:
 
 def view_command(args: argparse.Namespace) -> int:
     """snakehead view: DIR's scenes (and --map's) served until Ctrl-C, or (--live) the live viewer."""
-    from ..viz import viewer  # the figures' colours (matplotlib) and viser's pages: loaded by view only
+    from ..viz import viewer  # the viewer's modules: loaded by view only
 
     if args.live:
         if args.map is not None:
@@ -319,7 +319,7 @@ def view_command(args: argparse.Namespace) -> int:
 
 def _view_live(args: argparse.Namespace) -> int:
     """snakehead view --live: the live viewer served until Ctrl-C."""
-    from ..viz.live import LiveViewer  # as view_command's viewer
+    from ..viz.live import LiveViewer  # the live viewer's modules: loaded by view --live only
 
     scene = load_scene(args.scene) if args.scene is not None else None
     live = LiveViewer(scene, robot_file=args.robot, host=args.host, port=args.port, save_dir=args.save_dir,

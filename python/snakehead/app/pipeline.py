@@ -143,12 +143,11 @@ def _head_map(robot: SnakeRobot, workspace_map: ReachabilityMap | None, progress
 
 
 def _preload_figures(progress: Progress) -> None:
-    """Import what the figure modules import only when they draw (matplotlib's Agg canvas, its 3-D axes) once,
-    before the lanes and their figure processes are forked: each would import it again."""
+    """The figures' libraries (matplotlib, its Agg canvas and 3-D axes) in memory before the lanes and their figure
+    processes are forked, so that none imports them again. The figure modules imported at this module's top have
+    loaded them: the stage only keeps its place in the report's stages."""
     with progress.stage("the figures' libraries (matplotlib)"):
-        # heavy (matplotlib) and wanted only by the figures: imported here, when lanes are about to fork
-        from matplotlib.backends import backend_agg  # noqa: F401
-        from mpl_toolkits.mplot3d import Axes3D  # noqa: F401
+        pass
 
 
 def _lane_beside(lane: list[Scene], robot: SnakeRobot, workspace_map: ReachabilityMap, out: Path,
