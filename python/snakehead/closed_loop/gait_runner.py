@@ -348,52 +348,14 @@ class GaitSimulator:
     def _run(self, state: SimState, q_plan: np.ndarray, name: str, rest_s: float, record_every: int,
              start_estimate: BodyPose | None, *, gait: Gait | None, cycles: float) -> GaitRun:
         """Track the reference q_plan (one row per control tick) from ``state``, then rest; record and estimate."""
-        rest_s = finite_float(rest_s, "rest_s")
-        if rest_s < 0:
-            raise InputError(f"rest_s must be >= 0, got {rest_s!r}")
-        if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
-            raise InputError(f"record_every must be a positive integer, got {record_every!r}")
-        if start_estimate is not None and not isinstance(start_estimate, BodyPose):
-            raise InputTypeError(f"start_estimate must be a BodyPose, got {type(start_estimate).__name__}")
+        rest_s = _checked_run_options(rest_s, record_every, start_estimate)
         self.restore(state)
-        n_rest = int(round(rest_s / self.control_dt))
-        q_plan = np.vstack([q_plan, np.repeat(q_plan[-1:], n_rest, axis=0)])
-        t = self.control_dt * np.arange(len(q_plan))
-        qd_plan = np.gradient(q_plan, self.control_dt, axis=0) if len(q_plan) > 1 else np.zeros_like(q_plan)
-        qd_plan[len(q_plan) - n_rest:] = 0.0
-
-        start_truth = truth = self.true_pose()
+        q_plan, qd_plan = self._reference(q_plan, rest_s)
+        start_truth = self.true_pose()
         est0 = start_truth if start_estimate is None else start_estimate
         q0, R0 = self.measured_joints(), self.measured_attitude()
         self.estimator.reset(q0, R0, (est0.base.x, est0.base.y), est0.base.yaw)
-        estimate = self.estimator.pose()
-        readings: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-        rec: dict[str, list] = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact", "rt",
-                                                "re")}
-        for k in range(len(q_plan)):
-            self._step(q_plan[k], qd_plan[k])
-            self.time = state.time + (k + 1) * self.control_dt
-            q_sensed, R_sensed, imu = self._sense()
-            if imu is not None:
-                readings.append((q_sensed, *imu))
-            self.estimator.update(q_sensed, R_sensed)
-            if k % record_every == 0 or k == len(q_plan) - 1:
-                estimate = self.estimator.pose()
-                truth = self.true_pose(truth)
-                h, c = self._shape_heights()
-                rec["t"].append(self.time)
-                rec["q"].append(self.joint_angles())
-                rec["q_ref"].append(q_plan[k])
-                rec["ct"].append(truth.chassis[:3, 3])
-                rec["ce"].append(estimate.chassis[:3, 3])
-                rec["ht"].append(truth.heading)
-                rec["he"].append(estimate.heading)
-                rec["height"].append(h)
-                rec["contact"].append(c)
-                rec["rt"].append(truth.root)
-                rec["re"].append(estimate.root)
-            if not np.all(np.isfinite(self.data.qpos)):
-                raise RuntimeError(f"the simulation diverged {t[k]:.3f} s into the {name} run")
+        arr, readings, estimate, truth = self._track(state, q_plan, qd_plan, record_every, name, start_truth)
         end = self._snapshot(self.time)
         log = None
         if self.sensors is not None:
@@ -402,7 +364,6 @@ class GaitSimulator:
                             accel=np.array([r[2] for r in readings]), dt=self.control_dt,
                             imu_link=self.estimator.imu_link, odometry=self.estimator.odometry,
                             tilt_time_constant_s=1.0 / self.attitude.gain)
-        arr = {k: np.asarray(v) for k, v in rec.items()}
         # headings unwrapped from the start's, so that turns beyond half a revolution count in full
         heading_truth = np.unwrap(np.concatenate([[start_truth.heading], arr["ht"]]))[1:]
         heading_estimate = np.unwrap(np.concatenate([[est0.heading], arr["he"]]))[1:]
@@ -417,3 +378,63 @@ class GaitSimulator:
                        name=name, root_truth=arr["rt"], root_estimate=arr["re"], start_estimate=est0,
                        sensor_log=log)
 
+    def _reference(self, q_plan: np.ndarray, rest_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """The reference of a run: q_plan (one row per control tick) then ``rest_s`` s holding its last row, and
+        its rates (0 while resting)."""
+        n_rest = int(round(rest_s / self.control_dt))
+        q_plan = np.vstack([q_plan, np.repeat(q_plan[-1:], n_rest, axis=0)])
+        qd_plan = np.gradient(q_plan, self.control_dt, axis=0) if len(q_plan) > 1 else np.zeros_like(q_plan)
+        qd_plan[len(q_plan) - n_rest:] = 0.0
+        return q_plan, qd_plan
+
+    def _track(self, state: SimState, q_plan: np.ndarray, qd_plan: np.ndarray, record_every: int, name: str,
+               truth: BodyPose) -> tuple[dict[str, np.ndarray], list, BodyPose, BodyPose]:
+        """Step the servos along the reference from ``state``'s time, the estimator reading the senses at every
+        tick; every ``record_every`` ticks (and the last) the record's row. The record's arrays, the IMU's
+        readings, and the estimate and the truth (``truth``: the start's) at the end."""
+        estimate = self.estimator.pose()
+        readings: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        rec: dict[str, list] = {k: [] for k in ("t", "q", "q_ref", "ct", "ce", "ht", "he", "height", "contact", "rt",
+                                                "re")}
+        for k in range(len(q_plan)):
+            self._step(q_plan[k], qd_plan[k])
+            self.time = state.time + (k + 1) * self.control_dt
+            q_sensed, R_sensed, imu = self._sense()
+            if imu is not None:
+                readings.append((q_sensed, *imu))
+            self.estimator.update(q_sensed, R_sensed)
+            if k % record_every == 0 or k == len(q_plan) - 1:
+                estimate = self.estimator.pose()
+                truth = self.true_pose(truth)
+                self._record_row(rec, q_plan[k], truth, estimate)
+            if not np.all(np.isfinite(self.data.qpos)):
+                raise RuntimeError(f"the simulation diverged {self.control_dt * k:.3f} s into the {name} run")
+        return {k: np.asarray(v) for k, v in rec.items()}, readings, estimate, truth
+
+    def _record_row(self, rec: dict[str, list], q_ref: np.ndarray, truth: BodyPose, estimate: BodyPose) -> None:
+        """One row of a run's record: the time, the joints and their reference, the chassis and the heading (true
+        and estimated), the body's height and its share of links on the ground, the root frame's poses."""
+        h, c = self._shape_heights()
+        rec["t"].append(self.time)
+        rec["q"].append(self.joint_angles())
+        rec["q_ref"].append(q_ref)
+        rec["ct"].append(truth.chassis[:3, 3])
+        rec["ce"].append(estimate.chassis[:3, 3])
+        rec["ht"].append(truth.heading)
+        rec["he"].append(estimate.heading)
+        rec["height"].append(h)
+        rec["contact"].append(c)
+        rec["rt"].append(truth.root)
+        rec["re"].append(estimate.root)
+
+
+def _checked_run_options(rest_s: float, record_every: int, start_estimate: BodyPose | None) -> float:
+    """A run's ``rest_s`` (s, >= 0), checked with ``record_every`` (a positive integer) and ``start_estimate``."""
+    rest_s = finite_float(rest_s, "rest_s")
+    if rest_s < 0:
+        raise InputError(f"rest_s must be >= 0, got {rest_s!r}")
+    if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
+        raise InputError(f"record_every must be a positive integer, got {record_every!r}")
+    if start_estimate is not None and not isinstance(start_estimate, BodyPose):
+        raise InputTypeError(f"start_estimate must be a BodyPose, got {type(start_estimate).__name__}")
+    return rest_s

@@ -92,28 +92,8 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
     base = result.base if base is None else as_base(base)
     planned_t, planned_q = check_trajectory(robot, planned_t, planned_q)
 
-    pos_err, dir_err = [], []
-    for time, pos, dirn in _targets(robot, planned_t, planned_q, base, targets):
-        if not in_span(result, time):  # the caller's targets and result do not go together
-            raise InputError(f"target time {time} s is outside the simulated span [{result.t[0]}, {result.t[-1]}]")
-        p = np.array([np.interp(time, result.t, result.head_position[:, i]) for i in range(3)])
-        x = np.array([np.interp(time, result.t, result.head_direction[:, i]) for i in range(3)])
-        x /= np.linalg.norm(x)
-        pos_err.append(float(np.linalg.norm(p - pos)))
-        dir_err.append(angle_between_deg(x, dirn))
-
-    # planned momenta on the simulated ticks within the plan
-    inside = result.t <= planned_t[-1] + 1e-9
-    ts = result.t[inside]
-    Pp, Lp = stability.momenta(robot, planned_t, planned_q, base)
-    Pp = np.column_stack([np.interp(ts, planned_t, Pp[:, i]) for i in range(3)])
-    Lp = np.column_stack([np.interp(ts, planned_t, Lp[:, i]) for i in range(3)])
-    Ps, Ls = result.P[inside], result.L[inside]
-    dP = np.linalg.norm(Ps - Pp, axis=1)
-    dL = np.linalg.norm(Ls - Lp, axis=1)
-    dPm = np.abs(np.linalg.norm(Ps, axis=1) - np.linalg.norm(Pp, axis=1))
-    dLm = np.abs(np.linalg.norm(Ls, axis=1) - np.linalg.norm(Lp, axis=1))
-
+    pos_err, dir_err = _head_errors(result, _targets(robot, planned_t, planned_q, base, targets))
+    dP, dL, dPm, dLm = _momentum_errors(robot, planned_t, planned_q, base, result)
     margins = zmp_margins(robot, result, planned_t, planned_q, base)
     ok = np.isfinite(margins)
     return {
@@ -132,6 +112,38 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
         "max_torque_nm": float(np.abs(result.tau).max()),
         "torque_saturation_fraction": result.saturation_fraction,
     }
+
+
+def _head_errors(result: SimResult, targets: list) -> tuple[list[float], list[float]]:
+    """The simulated head's position errors (m) and direction errors (deg) at ``targets``' (time, position,
+    direction), the head interpolated between ticks."""
+    pos_err, dir_err = [], []
+    for time, pos, dirn in targets:
+        if not in_span(result, time):  # the caller's targets and result do not go together
+            raise InputError(f"target time {time} s is outside the simulated span [{result.t[0]}, {result.t[-1]}]")
+        p = np.array([np.interp(time, result.t, result.head_position[:, i]) for i in range(3)])
+        x = np.array([np.interp(time, result.t, result.head_direction[:, i]) for i in range(3)])
+        x /= np.linalg.norm(x)
+        pos_err.append(float(np.linalg.norm(p - pos)))
+        dir_err.append(angle_between_deg(x, dirn))
+    return pos_err, dir_err
+
+
+def _momentum_errors(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, base: BasePlacement,
+                     result: SimResult) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """On the simulated ticks within the plan: |P_sim - P_plan|, |L_sim - L_plan| and the differences of their
+    magnitudes, (T,) each (the planned momenta interpolated to the ticks)."""
+    inside = result.t <= planned_t[-1] + 1e-9
+    ts = result.t[inside]
+    Pp, Lp = stability.momenta(robot, planned_t, planned_q, base)
+    Pp = np.column_stack([np.interp(ts, planned_t, Pp[:, i]) for i in range(3)])
+    Lp = np.column_stack([np.interp(ts, planned_t, Lp[:, i]) for i in range(3)])
+    Ps, Ls = result.P[inside], result.L[inside]
+    dP = np.linalg.norm(Ps - Pp, axis=1)
+    dL = np.linalg.norm(Ls - Lp, axis=1)
+    dPm = np.abs(np.linalg.norm(Ps, axis=1) - np.linalg.norm(Pp, axis=1))
+    dLm = np.abs(np.linalg.norm(Ls, axis=1) - np.linalg.norm(Lp, axis=1))
+    return dP, dL, dPm, dLm
 
 
 def zmp_margins(robot: SnakeRobot, result: SimResult, planned_t: np.ndarray, planned_q: np.ndarray,
