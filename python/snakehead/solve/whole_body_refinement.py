@@ -1,5 +1,5 @@
 """The whole-body optimisation (SLSQP) of one target from given starts: every joint and, optionally, the base's
-placement at once.
+placement at once:
 
     maximise   the static margin of the centre of mass in the support polygon (Eqs. 23-24)
     over       the base's yaw joints (its flat shape: pitch joints flat, the base lying on the ground), the
