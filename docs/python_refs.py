@@ -125,9 +125,15 @@ def home_modules(obj: Any) -> list[types.ModuleType]:
 
 
 def lookup(target: str, modname: str | None, classname: str | None, documented: Any = _MISSING) -> Any:
-    """What ``target`` names in the docstring of ``modname`` (and ``classname``): a member of the class, a name in
-    the module's namespace or in the home modules of the ``documented`` object whose signature or docstring holds
-    the reference, a submodule of the package, a name imported for the type checker, else an absolute path."""
+    """What ``target`` names in the docstring of ``modname`` (and ``classname``): with a leading dot, a name
+    relative to the docstring's package; a member of the class, a name in the module's namespace or in the home
+    modules of the ``documented`` object whose signature or docstring holds the reference, a submodule of the
+    package, a name imported for the type checker, else an absolute path."""
+    if target.startswith(".") and modname:  # relative to the docstring's package, as in a relative import
+        package = modname if hasattr(sys.modules.get(modname), "__path__") else modname.rpartition(".")[0]
+        obj = _quiet_lookup(f"{package}.{target.lstrip('.')}", None) if package else _MISSING
+        if obj is not _MISSING:
+            return obj
     target = target.lstrip(".~")
     scopes: list[Any] = []
     module = _quiet_lookup(modname, None) if modname else _MISSING
