@@ -1,7 +1,8 @@
 """The MuJoCo plant (an optional extra: ``pip install snakehead[sim]``): the robot's model built with MjSpec
-(:mod:`.mjcf`), PD control with gravity compensation at the 2 ms control period (:mod:`.tracking`), the servos' gains
-and torque limits (:mod:`.gains`), the robot's own senses (:mod:`.sensors`), and a plan simulated and compared with
-itself as the paper does in Section 4 (:mod:`.simulate_plan`, :mod:`.compare`).
+(:mod:`.mjcf`), PD control with gravity compensation at the 2 ms control period (:mod:`.tracking`) and what it
+records (:mod:`.measurements`: momenta, ground contacts, ZMP), the servos' gains and torque limits (:mod:`.gains`),
+the robot's own senses (:mod:`.sensors`), and a plan simulated and compared with itself as the paper does in
+Section 4 (:mod:`.simulate_plan`, :mod:`.compare`).
 """
 from .. import _moved
 from . import gains
