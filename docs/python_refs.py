@@ -248,6 +248,8 @@ def resolve(app, env, node, contnode) -> nodes.Node | None:
     if node.get("refdomain") != "py":
         return None
     target = node["reftarget"]
+    if node.get("refspecific") and not target.startswith("."):
+        target = "." + target  # Sphinx keeps ``.name``'s dot as this flag
     documented = documented_object(node)
     obj = lookup(target, node.get("py:module"), node.get("py:class"), documented)
     if obj is _MISSING:
