@@ -27,9 +27,12 @@ class Progress:
         return time.perf_counter() - self.t0
 
     def say(self, text: str) -> None:
-        """A line on the stream (stderr by default) after the time since the start, unless quiet."""
+        """A line on the stream (stderr by default) after the time since the start, unless quiet. Written in one
+        write with its line end: a process beside this one stopped by a Ctrl-C leaves no line without its end."""
         if not self.quiet:
-            print(f"[{self.elapsed():7.1f} s] {text}", file=self.stream or sys.stderr, flush=True)
+            stream = self.stream or sys.stderr
+            stream.write(f"[{self.elapsed():7.1f} s] {text}\n")
+            stream.flush()
 
     @contextlib.contextmanager
     def stage(self, what: str) -> Iterator[None]:
