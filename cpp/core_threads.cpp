@@ -37,12 +37,14 @@ int default_threads() {
       return v;
     }
     const int omp = parse_count(std::getenv("OMP_NUM_THREADS"));
-    return omp > 0 ? omp : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    return omp > 0 ? omp : hardware_threads();
   }();
   return n;
 }
 
 }  // namespace
+
+int hardware_threads() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
 
 int core_threads() {
   const int n = chosen.load(std::memory_order_relaxed);

@@ -3,7 +3,9 @@
 #include "snakehead/core_threads.hpp"
 #include "snakehead/kinematics.hpp"
 #include "snakehead/limits.hpp"
+#include "snakehead/parallel_for.hpp"
 #include "snakehead/random_numbers.hpp"
+#include "snakehead/worker_pool.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr_jl.hpp>
@@ -18,28 +20,22 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
-#include <functional>
 #include <mutex>
-#include <thread>
-
-#include <unistd.h>  // getpid: the worker pool's fork safety
 
 namespace snakehead {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Nominal kinematics evaluations per second that turn a seeded call's timeout into an evaluation budget.
-// Measured: a seeded call on an unreachable target of the 7-DOF head (Newton and SLSQP interleaved, SLSQP's
-// own bookkeeping included) manages about 0.7 evaluations per microsecond on the development machine (AMD
-// EPYC, 2.6 GHz), so there a failing seeded call takes about the timeout.
+// Nominal kinematics evaluations per second that turn a seeded call's timeout into an evaluation budget: about the
+// rate of a seeded call on an unreachable target of the 7-DOF head (Newton and SLSQP interleaved, SLSQP's own
+// bookkeeping included) on the development machine, so that there a failing seeded call takes about its timeout
+// (bench/RESULTS.md).
 constexpr double kEvaluationsPerSecond = 7.0e5;
 // A seeded call reads no clock at all: the budget alone ends it (every local search is bounded -- kNewtonIterations,
 // kSqpEvaluations -- and each makes at least one evaluation, so the budget is always reached). It takes about its
-// timeout at the nominal rate, longer on a slower or loaded machine (a seeded 10 ms call took 0.37 s with ASan and
-// UBSan on the 2-core development machine at load 6), and gives the same answer whatever the load.
+// timeout at the nominal rate, longer on a slower, loaded or sanitized machine, and gives the same answer whatever
+// the load.
 
 // Local-search limits. A Newton descent that has not converged in this many iterations is treated as
 // stuck; so is an SLSQP run that used its evaluations.
@@ -47,129 +43,13 @@ constexpr int kNewtonIterations = 60;
 constexpr int kSqpEvaluations = 120;
 constexpr double kMaxStep = 0.6;  // rad (or m): largest joint change of one Newton step
 constexpr double kLambda0 = 1e-2;  // initial Levenberg-Marquardt damping
+// A descent must fall below kProgress times its error of kProgressWindow iterations earlier, else it restarts: on the
+// default robot's 6- and 7-DOF heads quick abandonment and restarts beat long descents (bench/RESULTS.md).
 constexpr int kProgressWindow = 3;
 constexpr double kProgress = 0.3;
-// (Tuned on the default robot's 6- and 7-DOF heads: quick abandonment and restarts beat long descents;
-// median evaluations per solve 26 -> 16 against demanding a 10 % decrease every 8 iterations.)
-// Share of the timeout that a Speed call spends on KDL-RR in the calling thread before it starts the race.
-// Measured on the 2-core development machine (1000 targets, 5 ms): racing at once (0) gave a 20-40 % higher
-// mean time than 0.02-0.1, which were alike; the medians are the same (most targets never reach the race).
+// Share of the timeout that a Speed call spends on KDL-RR in the calling thread before it starts the race: most
+// targets are solved before it ends, without a thread hand-off (bench/RESULTS.md).
 constexpr double kInlineFraction = 0.05;
-
-// ---------------------------------------------------------------------------------------------------------
-// The worker pool: threads made once. A job is shared between its submitter and the worker that runs it, so
-// a caller may either wait for it (a batch, whose jobs write into the caller's arrays) or abandon it (a
-// race, whose SQP half owns everything it touches and is told to stop).
-//
-// Fork. The threads and their queue (a crew) belong to the process that made them: a forked child has none of
-// the threads, and the crew's mutex may be held there forever (a worker held it at the fork). So the pool
-// remembers each crew's process: in a forked child it neither uses nor joins the parent's crew (that copy is
-// left as it is, a small leak per fork) and makes a crew of its own when it is first used there.
-
-class WorkerPool {
- public:
-  struct Job {
-    explicit Job(std::function<void()> f) : fn(std::move(f)) {}
-    std::function<void()> fn;
-    bool running = false;  // guarded by the crew's mutex
-    std::mutex m;
-    std::condition_variable cv;
-    bool done = false;  // guarded by m
-  };
-  using JobPtr = std::shared_ptr<Job>;
-
-  explicit WorkerPool(int n) : size_(n), crew_(new Crew(n)) {}
-  ~WorkerPool() {
-    Crew* crew = crew_.load(std::memory_order_acquire);
-    if (crew->owner == ::getpid()) delete crew;  // joins its threads; a parent's copy in a child is left alone
-  }
-  WorkerPool(const WorkerPool&) = delete;
-  WorkerPool& operator=(const WorkerPool&) = delete;
-  int size() const { return size_; }
-
-  void submit(const JobPtr& job) { crew().submit(job); }
-
-  // Removes the job if no worker has taken it yet. Returns false when it is already running (or done).
-  bool cancel(const JobPtr& job) { return crew().cancel(job); }
-
-  // Removes the job if it is still queued, else waits until it has finished.
-  void cancel_or_wait(const JobPtr& job) {
-    if (cancel(job)) return;
-    std::unique_lock<std::mutex> lock(job->m);
-    job->cv.wait(lock, [&] { return job->done; });
-  }
-
- private:
-  // The threads of one process and their queue.
-  struct Crew {
-    explicit Crew(int n) : owner(::getpid()) {
-      for (int i = 0; i < n; ++i) threads.emplace_back([this] { loop(); });
-    }
-    ~Crew() {
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        quit = true;
-      }
-      cv.notify_all();
-      for (auto& t : threads) t.join();
-    }
-    void submit(const JobPtr& job) {
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        queue.push_back(job);
-      }
-      cv.notify_one();
-    }
-    bool cancel(const JobPtr& job) {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (job->running) return false;
-      auto it = std::find(queue.begin(), queue.end(), job);
-      if (it == queue.end()) return false;
-      queue.erase(it);
-      return true;
-    }
-    void loop() {
-      for (;;) {
-        JobPtr job;
-        {
-          std::unique_lock<std::mutex> lock(mutex);
-          cv.wait(lock, [&] { return quit || !queue.empty(); });
-          if (queue.empty()) return;  // quitting; queued jobs are still run (they are told to stop)
-          job = std::move(queue.front());
-          queue.pop_front();
-          job->running = true;
-        }
-        job->fn();  // jobs catch their own exceptions
-        {
-          std::lock_guard<std::mutex> lock(job->m);
-          job->done = true;
-        }
-        job->cv.notify_all();
-      }
-    }
-
-    const pid_t owner;  // the process whose threads these are
-    std::vector<std::thread> threads;
-    std::mutex mutex;
-    std::condition_variable cv;
-    std::deque<JobPtr> queue;
-    bool quit = false;
-  };
-
-  // This process's crew: the one made in the constructor, or in a forked child one of its own, made by the
-  // child's first user (a compare-exchange, so that threads of the child that come at once agree on one crew).
-  Crew& crew() {
-    Crew* crew = crew_.load(std::memory_order_acquire);
-    const pid_t me = ::getpid();  // one system call: nothing beside a thread hand-off
-    if (crew->owner == me) return *crew;
-    auto mine = std::make_unique<Crew>(size_);
-    if (crew_.compare_exchange_strong(crew, mine.get(), std::memory_order_acq_rel)) return *mine.release();
-    return *crew;  // another thread of this child made it first (ours is joined and freed)
-  }
-
-  const int size_;
-  std::atomic<Crew*> crew_;
-};
 
 // ---------------------------------------------------------------------------------------------------------
 // One call's problem and shared control.
@@ -535,12 +415,10 @@ void check_pose(const Eigen::Isometry3d& target, const char* what) {
 struct TracIK::Impl {
   std::shared_ptr<const ChainModel> model;
   TracIKOptions options;
-  SamplingRange range;
-  mutable WorkerPool pool;  // thread-safe (its crew's mutex guards it) and fork-safe
+  std::shared_ptr<const SamplingRange> range;
 
   Impl(std::shared_ptr<const ChainModel> m, const TracIKOptions& o)
-      : model(std::move(m)), options(o), range(*model),
-        pool(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {}
+      : model(std::move(m)), options(o), range(std::make_shared<const SamplingRange>(*model)) {}
 
   void check_q_init(const Eigen::Ref<const Eigen::VectorXd>& q) const {
     model->check_configuration(q, "q_init");
@@ -553,13 +431,17 @@ struct TracIK::Impl {
   // mode: how the two solvers are scheduled.
   enum class Schedule { Race, Interleaved };
 
-  // Everything one call's searches share. Heap-allocated and shared with a racing SQP job, so that the
-  // caller can return as soon as it has an answer without waiting for the worker to notice the stop
-  // (a worker that the scheduler has parked could otherwise hold the caller for milliseconds).
+  // Everything one call's searches share. Heap-allocated and shared with a racing SQP job, so that the caller can
+  // return as soon as it has an answer without waiting for the worker to notice the stop (a worker that the
+  // scheduler has parked could otherwise hold the caller for milliseconds); it holds the model and the sampling
+  // range too, so that the job may outlive the solver.
   struct CallState {
-    CallState(const ChainModel& model, const Eigen::Isometry3d& target, const Eigen::VectorXd& q0,
-              const TracIKOptions& o, const SamplingRange& range)
-        : q_init(q0), p{model, target, o.bounds, o.epsilon, o.solve_type, q_init, range}, sq(p, c, rng_sq) {}
+    CallState(std::shared_ptr<const ChainModel> m, std::shared_ptr<const SamplingRange> r,
+              const Eigen::Isometry3d& target, const Eigen::VectorXd& q0, const TracIKOptions& o)
+        : model(std::move(m)), range(std::move(r)), q_init(q0),
+          p{*model, target, o.bounds, o.epsilon, o.solve_type, q_init, *range}, sq(p, c, rng_sq) {}
+    std::shared_ptr<const ChainModel> model;
+    std::shared_ptr<const SamplingRange> range;
     Eigen::VectorXd q_init;
     Problem p;
     CallControl c;
@@ -567,32 +449,16 @@ struct TracIK::Impl {
     Search sq;  // the SQP half
   };
 
-  // The pool is destroyed before the other members (declared after them), so a job still running when the
-  // solver is destroyed finishes while the model and the sampling ranges it refers to still exist.
   IKResult run(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, const TracIKOptions& o,
                IKAlgorithm algorithm, Schedule schedule, std::uint64_t stream) const {
     const auto t0 = Clock::now();
-    auto st = std::make_shared<CallState>(*model, target, q_init, o, range);
-    CallControl& c = st->c;
+    auto st = std::make_shared<CallState>(model, range, target, q_init, o);
     SplitMix64 rng_nr;
-    if (o.seed) {
-      c.budgeted = true;
-      // (timeout <= limits::kMaxTimeoutSeconds, so the budget fits a long: at most 6e10 evaluations)
-      c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
-      c.deadline = Clock::time_point::max();  // unused: a seeded call never reads the clock (should_stop)
-      const std::uint64_t base = splitmix64(*o.seed ^ splitmix64(stream));
-      rng_nr.seed(splitmix64(base ^ 0x6E72ULL));
-      st->rng_sq.seed(splitmix64(base ^ 0x737170ULL));
-      schedule = Schedule::Interleaved;
-    } else {
-      c.deadline = deadline_after(t0, o.timeout);
-      rng_nr.seed(thread_generator()());
-      st->rng_sq.seed(thread_generator()());
-    }
-    Search nr(st->p, c, rng_nr);
+    if (o.seed) schedule = Schedule::Interleaved;
+    start(o, stream, t0, st->c, rng_nr, st->rng_sq);
+    Search nr(st->p, st->c, rng_nr);
     Search& sq = st->sq;
     const auto inline_end = deadline_after(t0, kInlineFraction * o.timeout);
-
     if (algorithm == IKAlgorithm::KdlRR) {
       kdl_rr_loop(nr, q_init);
     } else if (algorithm == IKAlgorithm::Sqp) {
@@ -600,48 +466,76 @@ struct TracIK::Impl {
     } else if (schedule == Schedule::Interleaved) {
       interleaved_loop(nr, sq, inline_end);
     } else {
-      // Race. For Speed, KDL-RR first runs alone in this thread for a short while (kInlineFraction of the
-      // timeout): its descent from q_init solves most targets in tens of microseconds, less than it takes
-      // to wake a worker thread and to stop it again. Only targets that survive this are raced.
-      Eigen::VectorXd q = q_init;
-      const bool speed = o.solve_type == SolveType::Speed;
-      if (speed) {
+      race(st, nr, o.solve_type == SolveType::Speed, inline_end);
+    }
+    return result(target, q_init, t0, nr, sq, st->c);
+  }
+
+  // The call's control and generators: a seeded call is bounded by its evaluation budget and draws from the streams
+  // of (seed, stream); an unseeded one by the clock, its generators seeded by this thread's generator.
+  static void start(const TracIKOptions& o, std::uint64_t stream, Clock::time_point t0, CallControl& c,
+                    SplitMix64& rng_nr, SplitMix64& rng_sq) {
+    if (o.seed) {
+      c.budgeted = true;
+      // (timeout <= limits::kMaxTimeoutSeconds, so the budget fits a long: at most 6e10 evaluations)
+      c.max_evals = std::max(50L, static_cast<long>(o.timeout * kEvaluationsPerSecond));
+      c.deadline = Clock::time_point::max();  // unused: a seeded call never reads the clock (should_stop)
+      const std::uint64_t base = splitmix64(*o.seed ^ splitmix64(stream));
+      rng_nr.seed(splitmix64(base ^ 0x6E72ULL));
+      rng_sq.seed(splitmix64(base ^ 0x737170ULL));
+    } else {
+      c.deadline = deadline_after(t0, o.timeout);
+      rng_nr.seed(thread_generator()());
+      rng_sq.seed(thread_generator()());
+    }
+  }
+
+  // Race: KDL-RR in this thread, SQP on the worker pool, until one solves (Speed) or the time is up. For Speed,
+  // KDL-RR first runs alone in this thread for a short while (kInlineFraction of the timeout): its descent from q_init
+  // solves most targets in tens of microseconds, less than it takes to wake a worker thread and to stop it again.
+  // Only targets that survive this are raced.
+  static void race(const std::shared_ptr<CallState>& st, Search& nr, bool speed, Clock::time_point inline_end) {
+    Eigen::VectorXd q = st->q_init;
+    if (speed) {
+      newton_descent(nr, q);
+      while (!nr.should_stop() && Clock::now() < inline_end) {
+        nr.random_configuration(q);
         newton_descent(nr, q);
-        while (!nr.should_stop() && Clock::now() < inline_end) {
-          nr.random_configuration(q);
-          newton_descent(nr, q);
-        }
-      }
-      if (!nr.should_stop()) {
-        // The job owns a reference to the call state; it never touches this stack frame.
-        auto job = std::make_shared<WorkerPool::Job>([st] {
-          try {
-            sqp_loop(st->sq, st->q_init);
-          } catch (...) {  // e.g. std::bad_alloc: give up the SQP half, never take the process down
-            st->c.stop.store(true);
-          }
-        });
-        pool.submit(job);
-        try {
-          if (speed) {
-            for (;;) {  // KDL-RR restarts
-              nr.random_configuration(q);
-              newton_descent(nr, q);
-              if (nr.should_stop()) break;
-            }
-          } else {
-            kdl_rr_loop(nr, q_init);
-          }
-        } catch (...) {
-          c.stop.store(true);
-          pool.cancel(job);
-          throw;
-        }
-        c.stop.store(true);
-        pool.cancel(job);  // if it is running, it stops at its next evaluation, on its own time
       }
     }
+    if (nr.should_stop()) return;
+    // The job owns a reference to the call state; it never touches this stack frame.
+    auto job = std::make_shared<WorkerPool::Job>([st] {
+      try {
+        sqp_loop(st->sq, st->q_init);
+      } catch (...) {  // e.g. std::bad_alloc: give up the SQP half, never take the process down
+        st->c.stop.store(true);
+      }
+    });
+    WorkerPool& pool = WorkerPool::process();
+    pool.submit(job);
+    try {
+      if (speed) {
+        for (;;) {  // KDL-RR restarts
+          nr.random_configuration(q);
+          newton_descent(nr, q);
+          if (nr.should_stop()) break;
+        }
+      } else {
+        kdl_rr_loop(nr, st->q_init);
+      }
+    } catch (...) {
+      st->c.stop.store(true);
+      pool.cancel(job);
+      throw;
+    }
+    st->c.stop.store(true);
+    pool.cancel(job);  // if it is running, it stops at its next evaluation, on its own time
+  }
 
+  // The better of the two searches' solutions (q_init when neither found one) and the call's figures.
+  IKResult result(const Eigen::Isometry3d& target, const Eigen::VectorXd& q_init, Clock::time_point t0,
+                  const Search& nr, const Search& sq, CallControl& c) const {
     IKResult res;
     {
       std::lock_guard<std::mutex> lock(c.result);  // the SQP half may still be running
@@ -677,7 +571,7 @@ const ChainModel& TracIK::model() const { return *impl_->model; }
 std::shared_ptr<const ChainModel> TracIK::shared_model() const { return impl_->model; }
 const TracIKOptions& TracIK::options() const { return impl_->options; }
 int TracIK::n_joints() const { return impl_->model->n_joints(); }
-int TracIK::n_workers() const { return impl_->pool.size(); }
+int TracIK::n_workers() const { return hardware_threads(); }
 
 bool TracIK::solve(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
                    Eigen::VectorXd& q_out) const {
@@ -719,38 +613,16 @@ void TracIK::solve_many(const std::vector<Eigen::Isometry3d, Eigen::aligned_allo
   }
   q_out.resize(n, T);
   std::vector<char> found(static_cast<std::size_t>(T), 0);
-  std::atomic<Eigen::Index> next{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    try {
-      for (Eigen::Index k; !failed.load() && (k = next.fetch_add(1)) < T;) {
-        Eigen::VectorXd q0 = q_inits.col(k).cwiseMax(impl_->model->lower()).cwiseMin(impl_->model->upper());
-        const std::uint64_t stream = streams != nullptr ? (*streams)[static_cast<std::size_t>(k)]
-                                                        : static_cast<std::uint64_t>(k);
-        IKResult r = impl_->run(targets[k], q0, impl_->options, IKAlgorithm::TracIK, Impl::Schedule::Interleaved,
-                                stream);
-        q_out.col(k) = r.q;
-        found[k] = r.found;
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-      failed.store(true);
-    }
-  };
-  // The calling thread works too, so one thread fewer from the pool: more threads than cores would let the
-  // scheduler park a thread, mid-target, for longer than a timeout. At most core_threads() in all.
-  const int helpers = std::min(impl_->pool.size(), core_threads()) - 1;
-  std::vector<WorkerPool::JobPtr> jobs(static_cast<std::size_t>(std::min<Eigen::Index>(helpers, T)));
-  for (auto& j : jobs) {
-    j = std::make_shared<WorkerPool::Job>(work);
-    impl_->pool.submit(j);
-  }
-  work();
-  for (auto& j : jobs) impl_->pool.cancel_or_wait(j);
-  if (error) std::rethrow_exception(error);
+  // One target at a time to each thread, the calling thread's included; at most core_threads() threads, and no more
+  // than the machine has (more threads than cores would let the scheduler park a thread, mid-target, for longer than
+  // a timeout).
+  parallel_for_each(T, std::min(hardware_threads(), core_threads()), [&](int, long k) {
+    Eigen::VectorXd q0 = q_inits.col(k).cwiseMax(impl_->model->lower()).cwiseMin(impl_->model->upper());
+    const std::uint64_t stream = streams != nullptr ? (*streams)[static_cast<std::size_t>(k)] : static_cast<std::uint64_t>(k);
+    IKResult r = impl_->run(targets[k], q0, impl_->options, IKAlgorithm::TracIK, Impl::Schedule::Interleaved, stream);
+    q_out.col(k) = r.q;
+    found[static_cast<std::size_t>(k)] = r.found;
+  });
   ok.assign(found.begin(), found.end());
 }
 

@@ -2,7 +2,7 @@
 child (os.fork, a fork-context process pool), and the parent's solver still works after.
 
 The child neither uses nor joins the parent's worker threads (a forked child has none of them; joining them was a
-SIGSEGV or a hang) and starts its own when it needs them (cpp/trac_ik.cpp, WorkerPool)."""
+SIGSEGV or a hang) and starts its own when it needs them (cpp/worker_pool.cpp, WorkerPool)."""
 from __future__ import annotations
 
 import faulthandler

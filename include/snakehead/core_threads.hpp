@@ -17,6 +17,9 @@ inline constexpr const char* kCoreThreadsVariable = "SNAKEHEAD_NUM_THREADS";
 // InputError naming SNAKEHEAD_NUM_THREADS when that variable is set to anything but such a number.
 int core_threads();
 
+// The machine's hardware threads (std::thread::hardware_concurrency, at least 1).
+int hardware_threads();
+
 // Sets it for this process (1 <= n <= limits::kMaxThreads, else InputError); 0 restores the default.
 // Takes effect from the next batch; safe from any thread.
 void set_core_threads(int n);

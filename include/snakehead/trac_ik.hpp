@@ -10,7 +10,7 @@
 //
 // The pose error, per-axis tolerances and the convergence test are those of pose_error.hpp.
 //
-// Threads. A TracIK owns a pool of worker threads (one per core), made once in the constructor. A Speed call
+// Threads. The SQP half of a raced call runs on the core's worker pool (worker_pool.hpp). A Speed call
 // first runs KDL-RR alone in the calling thread for 5 % of the timeout: its descent from q_init solves most
 // targets in tens of microseconds, with no thread hand-off at all. Only then is the SQP search handed to a
 // worker while the caller continues with KDL-RR; the first solution stops both, and the caller returns at
@@ -21,7 +21,7 @@
 //
 // Fork. A TracIK may be used and destroyed in a forked child of the process that made it (os.fork, a fork-context
 // process pool): the child neither uses nor joins the parent's workers, which it does not have, and starts
-// workers of its own when it first needs them.
+// workers of its own when it first needs them (worker_pool.hpp).
 //
 // Determinism. Without a seed, restarts draw from a per-thread random generator and the race is decided
 // by timing. With a seed, the call is a pure function of (model, target, q_init, options): both solvers
@@ -102,7 +102,7 @@ class TracIK {
   IKResult solve_ex(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& q_init,
                     const TracIKOptions& options, IKAlgorithm algorithm = IKAlgorithm::TracIK) const;
 
-  // Solve many targets across core_threads() threads (core_threads.hpp: the calling thread and pool workers).
+  // Solve many targets across core_threads() threads (core_threads.hpp: the calling thread and the worker pool's).
   // q_inits is n x T (one column per target). Each target gets the full timeout; its two solvers run interleaved in
   // one thread (the seeded schedule above, on the clock when unseeded). With a seed, target k uses a generator derived from (seed, k), so results do not depend on
   // which thread solved it. q_out is resized to n x T; ok to T. `streams` (T values, or nullptr for 0..T-1): the
@@ -112,7 +112,8 @@ class TracIK {
                   const Eigen::Ref<const Eigen::MatrixXd>& q_inits, Eigen::MatrixXd& q_out,
                   std::vector<bool>& ok, const std::vector<std::uint64_t>* streams = nullptr) const;
 
-  // Number of worker threads in the pool.
+  // The threads a batch (solve_many) may use beside the bound core_threads() sets: the machine's hardware threads.
+  // (Threads come from the core's one worker pool, worker_pool.hpp.)
   int n_workers() const;
 
  private:

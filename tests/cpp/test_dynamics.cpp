@@ -10,7 +10,6 @@
 #include "snakehead/core_threads.hpp"
 #include "snakehead/dynamics.hpp"
 #include "snakehead/model.hpp"
-#include "snakehead/parallel_for.hpp"
 
 namespace {
 
@@ -117,25 +116,4 @@ TEST(NewtonEuler, ThreadsGiveTheSerialResultBitForBit) {
   const std::vector<double> serial = along(model, 1001, 1);
   EXPECT_EQ(along(model, 1001, 2), serial);
   EXPECT_EQ(along(model, 1001, 7), serial);
-}
-
-TEST(ParallelFor, EverySampleOnceAndTheEarliestErrorRethrown) {
-  snakehead::set_core_threads(4);
-  std::vector<int> seen(1000, 0);
-  snakehead::parallel_for(1000, 10, [&](long begin, long end) {
-    for (long k = begin; k < end; ++k) ++seen[static_cast<std::size_t>(k)];
-  });
-  EXPECT_EQ(std::vector<int>(1000, 1), seen);
-  try {
-    snakehead::parallel_for(1000, 10, [](long begin, long) {
-      if (begin > 0) throw std::runtime_error("range at " + std::to_string(begin));
-    });
-    ADD_FAILURE() << "no exception";
-  } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "range at 250");  // the second of four ranges, the earliest that failed
-  }
-  int calls = 0;
-  snakehead::parallel_for(15, 10, [&](long begin, long end) { calls += static_cast<int>(end - begin) + 100 * (begin != 0); });
-  EXPECT_EQ(calls, 15);  // fewer than two ranges' worth: one range, on the calling thread
-  snakehead::set_core_threads(0);
 }

@@ -191,6 +191,24 @@ TEST(TracIK, SolvesReachableTargetsWithEveryAlgorithm) {
   }
 }
 
+TEST(TracIK, ARacedCallsSqpHalfMayOutliveTheSolverAndItsModel) {
+  // Distance races both halves to the timeout; the SQP half on the worker pool stops at its next evaluation, which may
+  // come after the solver (and the only other owner of its model) is gone: it holds the model itself.
+  std::mt19937 rng(12);
+  for (int k = 0; k < 20; ++k) {
+    auto model = std::make_shared<const ChainModel>(ChainModel::from_urdf(kSnake, "neck_end", "head_tip"));
+    const Eigen::Isometry3d target = forward_kinematics(*model, random_q(*model, rng));
+    const Eigen::VectorXd q0 = random_q(*model, rng);
+    TracIKOptions o;
+    o.timeout = 0.002;
+    o.solve_type = SolveType::Distance;
+    auto ik = std::make_unique<TracIK>(std::move(model), o);
+    const IKResult r = ik->solve_ex(target, q0, o);
+    ik.reset();
+    EXPECT_EQ(r.q.size(), 7);
+  }
+}
+
 TEST(TracIK, EverySolveTypeSolvesAndRanksItsSolutions) {
   const auto model = head7();
   std::mt19937 rng(4);
