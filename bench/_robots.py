@@ -8,8 +8,8 @@ import tempfile
 from pathlib import Path
 
 from snakehead import SnakeRobot
-from snakehead.samples import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
+from snakehead.samples import published
 
 _FOLDER = Path(tempfile.mkdtemp(prefix="snakehead-bench-robots-"))
 

@@ -17,8 +17,8 @@ import numpy as np
 
 from snakehead import SnakeRobot
 from snakehead.app.report import cpu_name
-from snakehead.solve.head_controller import HeadController
 from snakehead.scenes import paper_scene
+from snakehead.solve.head_controller import HeadController
 
 
 def run(controller: HeadController, targets) -> dict:

@@ -18,12 +18,11 @@ import platform
 import time
 
 import numpy as np
-
 from _robots import ROBOTS  # bench/_robots.py
-from snakehead import BasePlacement
-from snakehead.locomotion.gaits import make_gait
-from snakehead.closed_loop import GaitSimulator
 
+from snakehead import BasePlacement
+from snakehead.closed_loop import GaitSimulator
+from snakehead.locomotion.gaits import make_gait
 
 RUNS = [("rolling", 1), ("rolling", -1), ("sidewinding", 1), ("sidewinding", -1), ("turning", 1), ("turning", -1),
         ("lateral_undulation", 1)]

@@ -28,8 +28,8 @@ def worker(kind: str, count: int, seed: int, repeat: int) -> None:
     import numpy as np
 
     import snakehead
-    from snakehead.dynamics import stability
     from snakehead.collision import path_proof
+    from snakehead.dynamics import stability
     from snakehead.planning import motion_checks, waypoints
     from snakehead.retiming import timing
     from snakehead.samples.targets import reachable_targets

@@ -24,14 +24,14 @@ import sys
 import time
 
 import numpy as np
-
 from _robots import ROBOTS  # bench/_robots.py
+
 from snakehead import BasePlacement, HeadController
+from snakehead.closed_loop.loop import ClosedLoop
 from snakehead.collision import body_collisions as coll
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.locomotion import goals as lc
 from snakehead.scenes import Scene
-from snakehead.closed_loop.loop import ClosedLoop
 
 SPHERE_1 = (-0.0405, 0.5443, 0.3)
 #: Starts with obstacles in the way are at least this far (m) from the target's foot (nearer, none fits between).

@@ -105,8 +105,8 @@ def record(count: int, sets: list[str], seed: int) -> tuple[list, list, Any]:
 
 def end_checks(motions: list, repeat: int) -> None:
     """The end checks of the recorded motions: released Python, the C++ pass from scratch and resumed."""
-    from snakehead.dynamics import stability
     from snakehead.collision import path_proof as path_check
+    from snakehead.dynamics import stability
     from snakehead.planning import motion_checks
 
     rows: dict[str, list[float]] = {"old": [], "scratch": [], "kept": [], "zmp": [], "zmp kept": [], "proof": []}
@@ -142,8 +142,8 @@ def end_checks(motions: list, repeat: int) -> None:
 
 def between_samples(motions: list, repeat: int) -> None:
     """Ground, self and an obstacle beside the head's path: every 2 ms sample against check_motion's proof."""
-    from snakehead.geometry import BoxObstacle
     from snakehead.collision import path_proof as path_check
+    from snakehead.geometry import BoxObstacle
 
     print("| clearances of the timed motions, an obstacle beside the head | configurations evaluated | proven clear "
           "| total (ms) |")
@@ -175,8 +175,8 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     from snakehead.collision import path_proof as path_check
-    from snakehead.planning import motion_checks
     from snakehead.margins import DETOUR_MARGIN
+    from snakehead.planning import motion_checks
 
     paths, motions, plans = record(args.count, args.sets.split(","), args.seed)
     print(f"{len(plans)} plans ({sum(p.success for p in plans)} succeeded), {len(motions)} timed motions, "

@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from snakehead import BasePlacement, SnakeRobot, sim
-from snakehead.sim import tracking
 from snakehead.dynamics import stability
+from snakehead.sim import tracking
 
 Q_A = np.array([0.879, 0.0, 0.879, 0.0, 0.879, 0.0, 0.879, 0.0,
                 1.485, -1.208, 0.151, -0.2, 0.292, 0.977, -0.451, 0.599])
@@ -123,7 +123,8 @@ def main() -> None:
     if args.out:
         from pathlib import Path
 
-        from snakehead.viz import dynamics_figures as dynamics, save
+        from snakehead.viz import dynamics_figures as dynamics
+        from snakehead.viz import save
 
         P, L = stability.momenta(robot, t, q, base)
         for name, fig in (("sim_momenta", dynamics.plot_momenta(t, P, L, simulated=res)),

@@ -20,8 +20,8 @@ import platform
 import time
 
 import numpy as np
-
 from _robots import ROBOTS  # bench/_robots.py
+
 from snakehead import sim
 from snakehead.backbone import initial_configuration
 from snakehead.dynamics import stability

@@ -13,8 +13,8 @@ import time
 import numpy as np
 
 from snakehead import SnakeRobot
-from snakehead.dynamics import stability as st
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability as st
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.trajectory import cartesian as cart
 from snakehead.trajectory import interpolation as interp

@@ -33,11 +33,11 @@ def worker(mode: str, kind: str, count: int, seed: int) -> None:
     import contextlib
 
     import numpy as np
+    from tracking_reference import numpy_tracking
 
     import snakehead
     from snakehead.planning import waypoints
     from snakehead.samples.targets import reachable_targets
-    from tracking_reference import numpy_tracking
 
     robot = snakehead.SnakeRobot.default()
     controller = snakehead.HeadController(robot, method="free_roll", seed=1)
@@ -73,10 +73,10 @@ def worker(mode: str, kind: str, count: int, seed: int) -> None:
 def per_call(recorded: list[list]) -> list[str]:
     """The recorded calls timed with each implementation in this process (fastest of 3), and their q's difference."""
     import numpy as np
+    from tracking_reference import tracking_interpolation_numpy
 
     import snakehead
     from snakehead.trajectory.cartesian import tracking_interpolation
-    from tracking_reference import tracking_interpolation_numpy
 
     robot = snakehead.SnakeRobot.default()
     times: dict[str, list[float]] = {m: [] for m in MODES}

@@ -26,9 +26,9 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import resource
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path

@@ -142,6 +142,7 @@ def reachable_plan_in_mujoco(robot):
     """One reachable target ("same" kind, seed 0) of ``robot`` planned and run in MuJoCo: the simulation (asserts the
     plan succeeded and the head arrived within 2 mm and 1 deg)."""
     import numpy as np
+
     import snakehead
     from snakehead.samples.targets import reachable_targets
 

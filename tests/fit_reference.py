@@ -19,10 +19,9 @@ reports -DBL_MAX) tests/minkowski_reference.py's branch and bound on the Minkows
 from __future__ import annotations
 
 import coal
+import minkowski_reference as minkowski
 import numpy as np
 import pinocchio as pin
-
-import minkowski_reference as minkowski
 
 BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
 

@@ -13,16 +13,14 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import generated_specs
 
 import snakehead
-from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
-
-from conftest import generated_specs
-
 
 ROBOTS = generated_specs()
 

@@ -7,15 +7,13 @@ import math
 
 import numpy as np
 import pytest
-
-from snakehead._errors import Infeasible
 from scipy import optimize
 from scipy.spatial import ConvexHull
 
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.dynamics import stability
 from snakehead import backbone as bb
-from snakehead._errors import InputError
+from snakehead._errors import Infeasible, InputError
+from snakehead.dynamics import stability
 
 L_BASE = 0.646  # tail end to P0 on the default robot (m)
 
@@ -221,6 +219,7 @@ def test_initial_phase_takes_a_frame_tilted_within_the_axis_tolerance():
     """A body frame whose x is tilted off the start tangent by less than AXIS_TOLERANCE_DEG (a bent base whose
     yaw axes a description writes 0.6 deg off) gives the phase of its projection; beyond it, an error."""
     from scipy.spatial.transform import Rotation
+
     from snakehead.model.body_frame import AXIS_TOLERANCE_DEG
 
     r, ders = helix(0.8, 0.25, True)

@@ -4,10 +4,10 @@ import threading
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import head6_robot
 
 import snakehead
 from snakehead import Chain, SnakeRobot
-from conftest import head6_robot
 
 SNAKE = str(snakehead.default_urdf_path())
 CHAINS = [

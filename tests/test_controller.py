@@ -1,12 +1,12 @@
 """HeadController: the segmented head control of Section 3.3 on the default robot and its shipped map."""
 import numpy as np
 import pytest
+from conftest import head6_robot
 
 from snakehead import SnakeRobot
 from snakehead.dynamics import stability
 from snakehead.scenes import paper_scene
 from snakehead.solve.head_controller import HeadController
-from conftest import head6_robot
 
 
 @pytest.fixture(scope="module")

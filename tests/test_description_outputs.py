@@ -18,12 +18,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import yaml
+from test_ros_bag import read_bag
 
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.app import ros_bag
 from snakehead.app.report import write_trajectory_csv
 from snakehead.samples.published import write_robot
-from test_ros_bag import read_bag
 
 pin = pytest.importorskip("pinocchio")
 pytest.importorskip("rosbags")

@@ -348,6 +348,7 @@ def test_quirk_plans_track_in_mujoco(tmp_path, mujoco, style):
     body running against its tree (reu_reversed): a reachable target planned on the rewritten model is followed in
     MuJoCo (built from the same rewritten model) within 2 mm and 1 deg, the base in place."""
     from conftest import reachable_plan_in_mujoco
+
     from snakehead.samples.published import write_robot
 
     robot = SnakeRobot.from_file(write_robot(style, tmp_path))

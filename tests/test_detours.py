@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead.solve.head_controller import HeadController
 from snakehead.planning import start_state
 from snakehead.planning import waypoints as wp
+from snakehead.solve.head_controller import HeadController
 
 
 def plain_joint_path(way, qa, qb, n):

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 import snakehead
-from snakehead import Infeasible, InputError, InputTypeError, InternalError
-from snakehead import _core
+from snakehead import Infeasible, InputError, InputTypeError, InternalError, _core
 from snakehead._errors import invariant
 from snakehead._files import write_text_atomic
 from snakehead.app import cli, pipeline

@@ -15,10 +15,9 @@ import pytest
 import snakehead
 from snakehead.collision import body_collisions as coll
 from snakehead.kinematics import reachability as ws
+from snakehead.planning import start_state, waypoints
 from snakehead.samples import published
 from snakehead.trajectory import cartesian
-from snakehead.planning import start_state, waypoints
-
 
 
 @pytest.fixture(scope="module")

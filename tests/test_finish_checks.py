@@ -10,8 +10,8 @@ import pytest
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.trajectory import interpolation as interp
 from snakehead.planning import waypoints
+from snakehead.trajectory import interpolation as interp
 
 
 @pytest.fixture(scope="module")

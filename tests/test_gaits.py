@@ -5,13 +5,12 @@ import math
 
 import numpy as np
 import pytest
+from conftest import pitch_first
 
 from snakehead import BasePlacement, InputError, SnakeRobot
 from snakehead.backbone import initial_configuration
-from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.locomotion.gaits import GAITS, Gait, Wave, make_gait, virtual_chassis
-
-from conftest import pitch_first
+from snakehead.model.generate import SnakeSpec, snake_urdf
 
 
 @pytest.fixture(scope="module")

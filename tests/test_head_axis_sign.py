@@ -11,12 +11,12 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
+from test_reachable_plans import verify_plan
 
 import snakehead
 from snakehead.app import cli
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.samples.targets import reachable_targets
-from test_reachable_plans import verify_plan
 
 #: The default robot's numbers and frames (snake16.urdf is written from them)
 SPEC = SnakeSpec(markers={"p0": 7, "b0": 9}, name="turned_head_snake")

@@ -9,8 +9,8 @@ from __future__ import annotations
 import os
 import resource
 import shutil
-import subprocess
 import stat
+import subprocess
 import sys
 import sysconfig
 import textwrap

@@ -22,16 +22,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from snakehead import InputError
-
 import snakehead
-from snakehead import SnakeRobot, default_urdf_path, sim
+from snakehead import InputError, SnakeRobot, default_urdf_path, sim
 from snakehead._files import atomic_open, write_text_atomic
-from snakehead.solve import neck as nk
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import read_robot_file, write_robot_file
 from snakehead.scenes import Scene, Target, load_scene
+from snakehead.solve import neck as nk
 
 URDF = default_urdf_path()
 MAP = URDF.with_name("snake16_head7.npz")
@@ -436,7 +434,8 @@ def test_durations_and_sizes_have_limits():
         resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
         import numpy as np, snakehead
         from snakehead import sim
-        from snakehead.motion import gaits, interpolation
+        from snakehead.locomotion import gaits
+        from snakehead.trajectory import interpolation
         from snakehead.scenes import Scene, Target
         robot = snakehead.SnakeRobot.default()
         q = np.zeros((2, robot.n_joints))

@@ -5,10 +5,14 @@ import pytest
 
 import snakehead
 from snakehead.dynamics import stability
-from snakehead.dynamics.inverse_dynamics import (carried_weights, inverse_dynamics, lift_shares, momentum_rates,
-                                                 newton_euler)
+from snakehead.dynamics.inverse_dynamics import (
+    carried_weights,
+    inverse_dynamics,
+    lift_shares,
+    momentum_rates,
+    newton_euler,
+)
 from snakehead.model.generate import SnakeSpec, snake_urdf
-
 
 GENERATED = SnakeSpec(n_joints=11, module_length=0.11, section=0.05, mass_per_module=0.3, first_axis="pitch",
                       markers={"p0": 5, "b0": 6}, tip_name="tip", name="gen11")

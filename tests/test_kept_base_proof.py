@@ -7,15 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import pitch_first
 
 import snakehead as sh
-from snakehead.solve import whole_body as wb
-from snakehead.solve.head import frame_along
 from snakehead.margins import DETOUR_MARGIN
 from snakehead.samples import published
 from snakehead.samples.targets import reachable_targets
-
-from conftest import pitch_first
+from snakehead.solve import whole_body as wb
+from snakehead.solve.head import frame_along
 
 
 def _robot(name: str, folder) -> sh.SnakeRobot:

@@ -9,6 +9,7 @@ import pytest
 from snakehead import InputError
 from snakehead.kinematics.reachability.kmeans import kmeans
 
+
 def _sklearn_cluster():
     """scikit-learn's clustering, for the comparisons only (skipped without it, a failure in CI)."""
     return pytest.importorskip("sklearn.cluster")

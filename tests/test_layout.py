@@ -34,6 +34,16 @@ def test_no_two_modules_share_a_name():
     assert sorted(names.keys() & packages) == []  # a module named like a package (viz/dynamics.py) reads as one
 
 
+#: The longest module the layout allows (DESIGN.md): past it, a module holds more than one concept.
+MAX_MODULE_LINES = 600
+
+
+def test_no_module_is_over_the_line_limit():
+    lengths = {str(p.relative_to(PACKAGE)): len(p.read_text().splitlines()) for p in _modules()}
+    assert {name: n for name, n in lengths.items() if n > MAX_MODULE_LINES} == {}
+    assert max(lengths.values()) > 100  # the walk found the package's modules
+
+
 def test_submodules_take_only_the_core_from_the_root_package():
     """``from .. import X`` and ``from snakehead import X`` inside the package may only take modules (``_core``,
     ``limits``, ...), not the names the root re-exports (``plan``, ``SnakeRobot``): those would be upward imports

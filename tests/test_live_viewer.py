@@ -288,6 +288,7 @@ def wait_in_page(driver, number: int, timeout: float = 60.0) -> dict:
 
 def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
     from test_viewer import _chromium, _hue_mask, _screenshot  # the browser as tests/test_viewer.py drives it
+
     from snakehead.viz.viewer import rgb255
 
     driver = _chromium()

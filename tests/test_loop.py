@@ -7,14 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import pitch_first
 from scipy import optimize
 
 from snakehead import BasePlacement, SnakeRobot
 from snakehead.dynamics.sliding import balance_motion, balance_translation, predict_slide
 from snakehead.locomotion import goals as lc
 from snakehead.locomotion.gaits import make_gait
-
-from conftest import pitch_first
 
 
 @pytest.fixture(scope="module")
@@ -329,9 +328,9 @@ def test_locomotion_leaves_two_boxes_and_goes_round_them(mujoco, robot):
     check's, tested against brute force in test_ground_path.py)."""
     from types import SimpleNamespace
 
+    from snakehead.closed_loop.loop import ClosedLoop
     from snakehead.geometry.obstacles import BoxObstacle
     from snakehead.scenes import Scene
-    from snakehead.closed_loop.loop import ClosedLoop
 
     boxes = [BoxObstacle.from_yaw([0.5925, 1.1913, 0.125], [0.25, 0.25, 0.25], -0.3018),
              BoxObstacle.from_yaw([0.0189, 1.3699, 0.125], [0.25, 0.25, 0.25], -0.3018)]
@@ -368,13 +367,13 @@ def test_a_goal_whose_curl_sweeps_into_an_obstacle_is_refused(mujoco, robot):
     wall that the straight body before the curl clears by 0.2 m but the curling body (at the sliding model's
     placements, every step, exact geometry) comes within GOAL_CLEARANCE_M of is refused, naming the curl; the same
     wall moved 1 m away is not."""
-    from snakehead.dynamics.sliding import predict_slide
+    from snakehead.closed_loop.loop import ClosedLoop
     from snakehead.collision import body_collisions as coll
+    from snakehead.dynamics.sliding import predict_slide
     from snakehead.geometry.obstacles import BoxObstacle
     from snakehead.locomotion import ground_path as gp
     from snakehead.planning.planner import bending_state
     from snakehead.scenes import Scene
-    from snakehead.closed_loop.loop import ClosedLoop
 
     goal = BasePlacement(0.0, 0.0, 0.0)
     probe = ClosedLoop(Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))]), robot=robot)
@@ -417,8 +416,8 @@ def controller(robot):
 def disturbed(mujoco, controller):
     """The paper's sphere 1 from the straight pose whose curl alone reaches it, disturbed by 10 cm and 20 deg
     without the loop knowing: it believes it lies at the undisturbed pose."""
-    from snakehead.scenes import Scene
     from snakehead.closed_loop.loop import ClosedLoop
+    from snakehead.scenes import Scene
 
     scene = Scene.from_targets([(np.array([-0.0405, 0.5443, 0.3]), np.array([0.0, 1.0, 0.0]))], name="sphere",
                                hold_s=0.5)
@@ -549,8 +548,8 @@ def test_the_hole_from_behind_its_wall(controller):
     """The paper's hole scene from behind its wall (snakehead plan --scene hole.toml --start 0.2 1.4 3.1416): the
     body goes around the wall on a planned route, never touching it, and the head gets through the hole on its own
     senses."""
-    from snakehead.scenes import paper_scene
     from snakehead.closed_loop.loop import ClosedLoop
+    from snakehead.scenes import paper_scene
 
     loop = ClosedLoop(paper_scene("hole"), controller=controller)
     run = loop.run(BasePlacement(0.2, 1.4, 3.1416))

@@ -12,14 +12,14 @@ import pytest
 import snakehead
 from snakehead import InputError, PlanProgress
 from snakehead._errors import Infeasible, MotionTooLong
-from snakehead.solve import whole_body
-from snakehead.solve.head_controller import HeadController
 from snakehead.dynamics import stability
 from snakehead.model.robot import SnakeRobot
 from snakehead.planning import plan_bounds, waypoints
 from snakehead.retiming import timing
 from snakehead.samples.targets import reachable_targets
 from snakehead.scenes import MAX_TARGETS, Scene, Target, load_scene, scene_from_dict
+from snakehead.solve import whole_body
+from snakehead.solve.head_controller import HeadController
 
 
 @pytest.fixture(scope="module")

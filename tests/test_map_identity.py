@@ -11,18 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import SMALL_MAP, head6_robot
 
 import snakehead
-from snakehead import HeadController, SnakeRobot, default_urdf_path
-from snakehead import _core
+from snakehead import HeadController, SnakeRobot, _core, default_urdf_path
 from snakehead._errors import InputError, InputTypeError
 from snakehead.app import cli
 from snakehead.app.robot_check import map_summary
 from snakehead.kinematics import base_placement as bp
-from snakehead.kinematics.reachability import map_queries as mq
 from snakehead.kinematics import reachability as ws
+from snakehead.kinematics.reachability import map_queries as mq
 from snakehead.model.robot_file import write_robot_file
-from conftest import SMALL_MAP, head6_robot
 
 # Small maps of the default robot's 7-DOF head: about half a second each.
 SMALL = SMALL_MAP

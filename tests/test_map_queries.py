@@ -9,8 +9,8 @@ import pytest
 from snakehead import SnakeRobot, TracIK
 from snakehead.backbone.initial import initial_configuration
 from snakehead.kinematics import base_placement as bp
-from snakehead.kinematics.reachability import map_queries as mq
 from snakehead.kinematics import reachability as ws
+from snakehead.kinematics.reachability import map_queries as mq
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import write_robot_file
 

@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 from snakehead import InputError, SnakeRobot
 from snakehead.app.robot_check import check_lines, check_robot
 from snakehead.model import mass_properties as mp
-from snakehead.samples.published import write_robot
 from snakehead.model.robot_file import read_robot_file
+from snakehead.samples.published import write_robot
 
 R_SHELL, L_MODULE = 0.025, 0.05
 

@@ -3,7 +3,6 @@ depths to) against closed forms, apart and in penetration: two spheres, two boxe
 and a rotated box, a sphere and a rotated cylinder; and a box against the convex hull of its own corners."""
 import numpy as np
 import pytest
-
 from minkowski_reference import Shape, signed_distance, support
 from shape_reference import SIGNS
 from test_shape_set import random_poses

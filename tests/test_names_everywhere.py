@@ -39,8 +39,8 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead._errors import InputError
 from snakehead._validate import MAX_NAME_BYTES, MAX_NAME_CHARS, file_name_part
 from snakehead.app import report as rep
-from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.geometry.obstacles import BoxObstacle
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.planning.plan_result import Plan, TargetResult

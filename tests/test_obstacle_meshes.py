@@ -10,13 +10,13 @@ import trimesh
 from scipy.spatial import ConvexHull
 
 import snakehead
-from snakehead.dynamics import stability
+from snakehead._errors import InputError
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.geometry.obstacles import BoxObstacle, MeshObstacle
+from snakehead.ground_contact import GROUND_TOLERANCE
 from snakehead.samples import published
 from snakehead.scenes import load_scene
-from snakehead._errors import InputError
-from snakehead.ground_contact import GROUND_TOLERANCE
 
 
 def scene_with_a_mesh(folder: Path, mesh: str, position: str) -> Path:

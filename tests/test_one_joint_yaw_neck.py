@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_reachable_plans import verify_plan
 
 import snakehead
 from snakehead.app import cli
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.model.robot_file import write_robot_file
 from snakehead.samples.targets import reachable_targets
-from test_reachable_plans import verify_plan
 
 #: 13 joints, yaw first: base joints 1-6, the neck joint 7 (yaw), the head joints 8-13 (pitch first)
 SPEC = SnakeSpec(n_joints=13, module_length=0.10, section=0.06, mass_per_module=0.3, first_axis="yaw",

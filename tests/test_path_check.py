@@ -13,14 +13,15 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from snakehead import set_core_threads
+from snakehead.collision import body_collisions as coll
+from snakehead.collision import path_proof as path_check
 from snakehead.dynamics import stability
 from snakehead.geometry import BoxObstacle
-from snakehead.collision import body_collisions as coll, path_proof as path_check
-from snakehead.margins import EXACT_DISTANCE_WITHIN
 from snakehead.geometry.shapes import shape_points
-from snakehead.samples.published import write_robot
-from snakehead.model.robot import BasePlacement, SnakeRobot
 from snakehead.ground_contact import GROUND_TOLERANCE
+from snakehead.margins import EXACT_DISTANCE_WITHIN
+from snakehead.model.robot import BasePlacement, SnakeRobot
+from snakehead.samples.published import write_robot
 
 FINE = 100  # brute force: points per interval
 

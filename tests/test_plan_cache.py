@@ -1,17 +1,16 @@
 """The plans' caches a HeadController owns (``plan_cache_of(controller)``): bounded maps, entries equal to what they
 cache (recomputed without the cache), and plans that do not depend on what is kept."""
-import threading
-
 import gc
+import threading
 import weakref
 
 import numpy as np
 import pytest
 
 import snakehead
-from snakehead.solve.head_controller import HeadController
 from snakehead.planning import start_state
 from snakehead.planning.plan_cache import KEPT_LIFTS, KeptMap, PlanCache, plan_cache_of, shape_key
+from snakehead.solve.head_controller import HeadController
 
 
 @pytest.fixture(scope="module")

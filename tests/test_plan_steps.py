@@ -6,16 +6,16 @@ import pytest
 
 import snakehead
 from snakehead._errors import InputError, InputTypeError, MotionTooLong
-from snakehead.solve import whole_body as wb
-from snakehead.solve.head_controller import HeadController
 from snakehead.geometry import BoxObstacle
 from snakehead.margins import DETOUR_MARGIN
 from snakehead.planning import base_choice, plan_bounds, planner, start_state
-from snakehead.planning.plan_result import PlanProgress
-from snakehead.samples.targets import reachable_targets
-from snakehead.planning.waypoints import Waypoints
-from snakehead.scenes import Scene, Target
 from snakehead.planning.plan_cache import plan_cache_of
+from snakehead.planning.plan_result import PlanProgress
+from snakehead.planning.waypoints import Waypoints
+from snakehead.samples.targets import reachable_targets
+from snakehead.scenes import Scene, Target
+from snakehead.solve import whole_body as wb
+from snakehead.solve.head_controller import HeadController
 
 
 @pytest.fixture(scope="module")

@@ -3,18 +3,16 @@ kinematic success and every check by independent computations."""
 import numpy as np
 import pytest
 
-from snakehead._errors import Infeasible
-
 import snakehead
 from snakehead import SnakeRobot
-from snakehead.solve.head_controller import HeadController
-from snakehead.dynamics import stability
+from snakehead._errors import Infeasible, InputError
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.margins import DETOUR_MARGIN
 from snakehead.planning import start_state
-from snakehead.scenes import paper_scene
-from snakehead._errors import InputError
 from snakehead.planning.plan_cache import plan_cache_of
+from snakehead.scenes import paper_scene
+from snakehead.solve.head_controller import HeadController
 
 HOLE = paper_scene("hole")
 WALL = HOLE.obstacles[0]

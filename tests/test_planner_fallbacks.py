@@ -17,13 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_reachable_plans import verify_plan
 
 import snakehead
 from snakehead.margins import ZMP_MARGIN
 from snakehead.planning import fallbacks
-from snakehead.samples.targets import reachable_targets
 from snakehead.retiming.timing import ACCELERATION_LIMIT
-from test_reachable_plans import verify_plan
+from snakehead.samples.targets import reachable_targets
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
 from _robots import reu_as_written  # noqa: E402

@@ -14,15 +14,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import plan_agrees
 
 import snakehead as sh
 from snakehead.app import cli
 from snakehead.kinematics import reachability as ws
-from snakehead.samples import published
 from snakehead.planning.plan_many import plan_many
+from snakehead.samples import published
 from snakehead.samples.targets import reachable_targets
-
-from conftest import plan_agrees
 
 STYLE = "sea"
 #: The reach map's grid: voxels of a quarter of its side (the coarsest allowed: 4 x 4 voxels per layer), 2 directions.

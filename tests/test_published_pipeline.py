@@ -16,9 +16,7 @@ import pytest
 import snakehead
 from snakehead.kinematics import reachability as ws
 from snakehead.samples import published
-
 from snakehead.samples.targets import reachable_targets
-
 
 CLI = [sys.executable, "-m", "snakehead"]
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from snakehead import _core
+from snakehead._errors import InputError, InputTypeError
 from snakehead.model.chain import Chain
 from snakehead.samples.published import STYLES, StyleSpec, style_spec, write_robot
-from snakehead._errors import InputError, InputTypeError
 
 #: (base, neck, head) joints of each style, written out here rather than read from the module under test.
 PARTS = {"sea": (7, 2, 7), "reu": (7, 2, 7), "rsnake": (6, 2, 6), "mesh": (6, 2, 7), "xacro": (5, 2, 7),

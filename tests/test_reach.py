@@ -3,13 +3,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import plan_agrees
 
 import snakehead as sh
 from snakehead.app import cli
 from snakehead.kinematics import reachability as ws
 from snakehead.planning import whole_body_reach as reach
-
-from conftest import plan_agrees
 
 VOXEL, DIRECTIONS = 0.6, 2  # a tiny grid: 5 x 5 voxels x 2 layers, 2 directions
 

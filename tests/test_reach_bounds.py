@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import snakehead as sh
-from snakehead.solve.whole_body import BodyProblem
 from snakehead.collision import body_collisions as coll
 from snakehead.margins import DETOUR_MARGIN
 from snakehead.planning import whole_body_reach as reach
 from snakehead.solve.pose_bounds import PoseBounds
+from snakehead.solve.whole_body import BodyProblem
 
 
 @pytest.fixture(scope="module")

@@ -7,17 +7,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from snakehead._errors import Infeasible
+from shape_reference import box_corners
 
 import snakehead
-from shape_reference import box_corners
-from snakehead.solve import whole_body as wb
-from snakehead.dynamics import stability
-from snakehead.collision import body_collisions as coll
 from snakehead import margins
+from snakehead._errors import Infeasible
+from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.planning import start_state, waypoints
 from snakehead.samples.targets import reachable_targets
+from snakehead.solve import whole_body as wb
 
 
 @pytest.fixture(scope="module")

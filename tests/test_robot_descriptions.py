@@ -10,8 +10,8 @@ import pytest
 
 import snakehead
 from snakehead import InputError, SnakeRobot
-from snakehead.samples import published
 from snakehead.model.robot import ALIGNED_SUFFIX
+from snakehead.samples import published
 
 
 @pytest.fixture(scope="module")

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from snakehead.closed_loop.estimate import AttitudeFilter
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.sim import sensors as sn
-from snakehead.closed_loop.estimate import AttitudeFilter
 
 
 def _chi2_bounds(n):
@@ -178,9 +178,9 @@ def test_ground_run_estimate_replays_from_its_sensor_stream_alone():
     the locomotion would command from it."""
     pytest.importorskip("mujoco")
     from snakehead import BasePlacement, SnakeRobot
+    from snakehead.closed_loop.gait_runner import GaitSimulator, replay_estimate
     from snakehead.locomotion import goals as lc
     from snakehead.locomotion.gaits import make_gait
-    from snakehead.closed_loop.gait_runner import GaitSimulator, replay_estimate
 
     robot = SnakeRobot.default()
     sim = GaitSimulator(robot, sensors=sn.OnboardSensors.realistic(seed=3))

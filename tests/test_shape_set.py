@@ -7,8 +7,8 @@ import pickle
 import coal
 import numpy as np
 import pytest
-
 from minkowski_reference import Shape, signed_distance
+
 from snakehead import _core
 from snakehead._errors import InputError
 

@@ -5,7 +5,6 @@ import importlib
 import inspect
 from pathlib import Path
 
-
 import snakehead
 from snakehead import margins
 from snakehead.model import physics
@@ -38,9 +37,9 @@ def test_gravity_and_the_margins_are_defined_once():
 
 
 def test_the_users_read_the_one_definition():
-    from snakehead.solve import whole_body
     from snakehead.retiming import stability_constraint, timing
     from snakehead.sim import mjcf, tracking
+    from snakehead.solve import whole_body
 
     for name in ("dynamics.stability", "dynamics.inverse_dynamics", "model.generate", "sim.gains", "sim.mjcf",
                  "sim.tracking"):  # (by module: dynamics.inverse_dynamics is also a function's name)
@@ -101,3 +100,16 @@ def test_what_counts_as_touching_the_ground_is_defined_once():
         is ground_contact.GROUND_TOLERANCE
     assert sliding.RESTING_TOLERANCE is ground_contact.RESTING_TOLERANCE
     assert ground_contact.GROUND_TOLERANCE == 1e-3 and ground_contact.RESTING_TOLERANCE == 3e-3
+
+
+def test_the_estimate_and_the_simulator_use_the_planners_numbers():
+    """The pose estimate's contact band is the resting tolerance; the simulated controller's period is the
+    planner's control period (one number each, not a copy that can drift)."""
+    from snakehead import ground_contact
+    from snakehead.closed_loop import estimate
+    from snakehead.sim import mjcf
+    from snakehead.trajectory import interpolation
+
+    assert estimate.CONTACT_HEIGHT is ground_contact.RESTING_TOLERANCE
+    assert mjcf.DEFAULT_CONTROL_DT is interpolation.CONTROL_PERIOD
+    assert definitions("CONTROL_PERIOD") == ["trajectory/interpolation.py"]

@@ -4,11 +4,10 @@ import sys
 import numpy as np
 import pytest
 
-
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
-from snakehead.sim import tracking  # noqa: E402
-from snakehead.dynamics import stability  # noqa: E402
 from snakehead._errors import InputTypeError
+from snakehead.dynamics import stability  # noqa: E402
+from snakehead.sim import tracking  # noqa: E402
 
 #: A curled base (yaw joints 0.879 rad) with the neck turned inwards and the head part raised 0.42 m:
 #: statically stable with a ~3 cm margin (endpoints polygon) all along the joint-space path from flat.
@@ -424,7 +423,8 @@ def test_missing_mujoco_names_the_extra(monkeypatch, robot):
 
 def test_plots_write_pngs(robot, lift, tmp_path):
     from snakehead.dynamics import stability
-    from snakehead.viz import dynamics_figures as dynamics, save
+    from snakehead.viz import dynamics_figures as dynamics
+    from snakehead.viz import save
 
     t, q, res = lift
     P, L = stability.momenta(robot, t, q, res.base)

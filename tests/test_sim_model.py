@@ -6,7 +6,6 @@ import math
 import numpy as np
 import pytest
 
-
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402
 from snakehead.backbone import initial_configuration  # noqa: E402
 from snakehead.dynamics import stability  # noqa: E402

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 import trimesh  # noqa: E402
 
 from snakehead import BasePlacement, SnakeRobot, sim  # noqa: E402

@@ -3,12 +3,12 @@ forms, ZMP at rest and against an independent finite-difference computation; bad
 import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
+from shape_reference import box_corners, lowest_z_by_sampling
 
 import snakehead
-from shape_reference import box_corners, lowest_z_by_sampling
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.dynamics import stability as st
 from snakehead._errors import InputError, InputTypeError
+from snakehead.dynamics import stability as st
 from snakehead.ground_contact import GROUND_TOLERANCE
 
 
@@ -140,8 +140,8 @@ def test_lowest_points_against_sampled_surfaces(robot, which, tmp_path):
     """The core's lowest z and lowest candidate points (the ground contacts) of every shape kind against densely
     sampled surfaces in numpy, on random configurations at a random placement: boxes (the default robot, a generated
     snake), cylinders and a mesh tail (sea), spheres (head6), STL/OBJ hulls (mesh), offset cylinders (rsnake)."""
-    from snakehead.samples import published
     from snakehead.model.generate import SnakeSpec, snake_urdf
+    from snakehead.samples import published
 
     if which == "generated":
         spec = SnakeSpec(n_joints=11, module_length=0.09, section=0.06, first_axis="pitch", markers={"p0": 5, "b0": 7},

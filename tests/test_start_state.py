@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import generated_specs
 
 import snakehead
 from snakehead._errors import Infeasible
 from snakehead.dynamics import stability
 from snakehead.model.generate import snake_urdf
 from snakehead.model.robot_file import write_robot_file
-
-from conftest import generated_specs
 from snakehead.planning import start_state as ss
 
 SPECS = generated_specs()  # long20 (a 2-joint neck beginning with a yaw joint), pitchy (pitch first, heavy)
@@ -101,8 +100,8 @@ def test_a_straight_base_has_no_curl_by_either_search():
 
 @pytest.fixture(scope="module")
 def reu(tmp_path_factory):
-    from snakehead.solve.head_controller import HeadController
     from snakehead.samples import published
+    from snakehead.solve.head_controller import HeadController
 
     robot = snakehead.SnakeRobot.from_file(published.write_robot("reu", tmp_path_factory.mktemp("reu") / "reu"))
     return HeadController(robot, method="free_roll", seed=1)

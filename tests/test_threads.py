@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import snakehead as sh
-from snakehead import threads as ct
 from snakehead import limits
+from snakehead import threads as ct
 
 
 def test_set_and_restore() -> None:

@@ -5,12 +5,11 @@ against direct computations; holds, stops and bad input."""
 import numpy as np
 import pytest
 
-from snakehead._errors import Infeasible
-
 import snakehead
+from snakehead._errors import Infeasible
+from snakehead.collision import body_collisions as coll
 from snakehead.dynamics import stability
 from snakehead.dynamics.inverse_dynamics import inverse_dynamics
-from snakehead.collision import body_collisions as coll
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.planning import start_state

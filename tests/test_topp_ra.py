@@ -21,10 +21,9 @@ from scipy.optimize import linprog
 import snakehead
 from snakehead import _core
 from snakehead._errors import Infeasible, InputError
-from snakehead.samples import published
 from snakehead.model.generate import SnakeSpec, snake_urdf
 from snakehead.retiming import gridpoints, rest_to_rest, timeline, timing, topp_ra
-
+from snakehead.samples import published
 
 #: Controllable sets and path speeds: this share of their largest value (toppra's float32 velocity bound: ~1e-7).
 REL_TOL = 1e-6

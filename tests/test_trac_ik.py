@@ -6,12 +6,12 @@ import threading
 
 import numpy as np
 import pytest
+from conftest import head6_robot
 
 import snakehead
 from snakehead import TracIK
-from snakehead.kinematics.ik import FREE_ROLL, pose_error
 from snakehead._errors import InputTypeError
-from conftest import head6_robot
+from snakehead.kinematics.ik import FREE_ROLL, pose_error
 
 EPS = 1e-5
 

@@ -2,18 +2,16 @@
 closed forms and brute force, ground clearance, box and wall collisions against brute force; bad input."""
 import numpy as np
 import pytest
-
-from snakehead._errors import Infeasible
 from scipy.optimize import lsq_linear
 from scipy.spatial.transform import Rotation
 
 from snakehead import BasePlacement, SnakeRobot
+from snakehead._errors import Infeasible, InputTypeError
 from snakehead.collision import body_collisions as coll
 from snakehead.geometry import obstacles as obs
 from snakehead.geometry.shapes import Shape, ShapeSet, pair_distances
 from snakehead.trajectory import cartesian as cart
 from snakehead.trajectory import interpolation as interp
-from snakehead._errors import InputTypeError
 
 
 @pytest.fixture(scope="module")
@@ -523,7 +521,8 @@ def stable_lift_motion(robot):
 def test_figures_are_written(robot, tmp_path):
     """Figs. 11/13 for the lift of lift_motion; Figs. 18-20 for the stable lift timed over 2 s."""
     from snakehead.dynamics import stability
-    from snakehead.viz import body, dynamics_figures as dynamics, save
+    from snakehead.viz import body, save
+    from snakehead.viz import dynamics_figures as dynamics
 
     fig = body.plot_interpolation_comparison(robot, *lift_motion(robot))
     # the clearance panel: joint space goes into the ground (Fig. 11), Eqs. 41-44 do not (Fig. 13)

@@ -16,8 +16,8 @@ import pytest
 
 from snakehead import InputError, SnakeRobot
 from snakehead.model.description import MeshResolver, read_description
-from snakehead.samples.published import write_robot
 from snakehead.model.robot_folders import RobotFolders
+from snakehead.samples.published import write_robot
 
 LAMBDA_PAYLOAD = ("${(lambda: [c for c in ().__class__.__base__.__subclasses__() if c.__name__ == '_wrap_close'][0]"
                   ".__init__.__globals__['system']('touch {marker}'))()}")

@@ -13,8 +13,8 @@ import pytest
 from matplotlib.figure import Figure
 
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.dynamics import stability
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
 from snakehead.geometry.obstacles import BoxObstacle, WallWithHole
 from snakehead.geometry.shapes import shape_mesh
 from snakehead.model.generate import SnakeSpec, snake_urdf

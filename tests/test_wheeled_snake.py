@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_reachable_plans import verify_plan
 
 import snakehead
 from snakehead import backbone, margins
-from snakehead.solve.initial_state import INITIAL_MARGIN, initial_margins, stable_initial_configuration
 from snakehead.samples.published import write_robot
 from snakehead.samples.targets import reachable_targets
-from test_reachable_plans import verify_plan
+from snakehead.solve.initial_state import INITIAL_MARGIN, initial_margins, stable_initial_configuration
 
 
 @pytest.fixture(scope="module")

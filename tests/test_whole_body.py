@@ -7,13 +7,14 @@ import pytest
 
 import snakehead
 from snakehead import BasePlacement, SnakeRobot
-from snakehead.solve import target_search, whole_body as wb
-from snakehead.dynamics import stability
+from snakehead._errors import InputTypeError
 from snakehead.collision import body_collisions as coll
+from snakehead.dynamics import stability
+from snakehead.ground_contact import GROUND_TOLERANCE
 from snakehead.kinematics import reachability as ws
 from snakehead.model.generate import SnakeSpec, snake_urdf
-from snakehead._errors import InputTypeError
-from snakehead.ground_contact import GROUND_TOLERANCE
+from snakehead.solve import target_search
+from snakehead.solve import whole_body as wb
 
 
 @pytest.fixture(scope="module")

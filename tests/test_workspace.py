@@ -10,12 +10,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from snakehead import Chain, SnakeRobot, default_robot_file
-from snakehead import sweep_defaults
-from snakehead.kinematics import reachability as ws
-from snakehead._errors import InputError, InputTypeError
 from conftest import SMALL_MAP, head6_robot
+
+from snakehead import Chain, SnakeRobot, default_robot_file, sweep_defaults
+from snakehead._errors import InputError, InputTypeError
+from snakehead.kinematics import reachability as ws
 
 SMALL = SMALL_MAP
 
@@ -439,8 +438,8 @@ def test_shipped_head_map_g0(robot):
 
 # --- figures ------------------------------------------------------------------------------------------------
 def test_figures(small, tmp_path):
-    from snakehead.viz import save
     from snakehead.viz import reachability_figures as wp
+    from snakehead.viz import save
 
     figures = wp.map_figures(small, k=2)
     assert list(figures) == ["map", "dexterous", "clusters"]

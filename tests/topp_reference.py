@@ -15,8 +15,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 import toppra.algorithm as algo
-from toppra.constraint import (DiscretizationType, JointAccelerationConstraint, JointVelocityConstraint,
-                               LinearConstraint)
+from toppra.constraint import DiscretizationType, JointAccelerationConstraint, JointVelocityConstraint, LinearConstraint
 from toppra.constraint.linear_constraint import canlinear_colloc_to_interpolate
 from toppra.interpolator import AbstractGeometricPath
 

@@ -18,7 +18,19 @@ import numpy.typing as npt
 from snakehead.geometry.shapes import pair_distances
 from snakehead.model.robot import BasePlacement, SnakeRobot
 from snakehead.planning import waypoints
-from snakehead.trajectory.cartesian import TRACKING_CLEARANCE, TRACKING_CONTINUITY, TRACKING_DAMPING, TRACKING_GROUND_WEIGHT, TRACKING_ITERATIONS, TRACKING_SELF_CLEARANCE, TRACKING_SELF_STEP, TRACKING_STEP_TOLERANCE, TrackingInterpolation, lifted_self_pairs, tracking_interpolation_with
+from snakehead.trajectory.cartesian import (
+    TRACKING_CLEARANCE,
+    TRACKING_CONTINUITY,
+    TRACKING_DAMPING,
+    TRACKING_GROUND_WEIGHT,
+    TRACKING_ITERATIONS,
+    TRACKING_SELF_CLEARANCE,
+    TRACKING_SELF_STEP,
+    TRACKING_STEP_TOLERANCE,
+    TrackingInterpolation,
+    lifted_self_pairs,
+    tracking_interpolation_with,
+)
 
 
 def _self_term(robot: SnakeRobot, qj: np.ndarray, lift: np.ndarray, pairs: np.ndarray, base: BasePlacement,

@@ -23,13 +23,11 @@ Start with ``SnakeRobot.default()``. The layers are drawn in ``docs/architecture
 """
 from . import _moved
 from ._errors import Infeasible, InputError, InputTypeError, InternalError, MotionTooLong
-from .solve.head_controller import HeadController, HeadSolution
-from .threads import core_threads, set_core_threads
 from .geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from .kinematics.ik import TracIK
-from .kinematics.reachability.reachability_map import ReachabilityMap
 from .kinematics.reachability import compute as compute_map
 from .kinematics.reachability import load as load_map
+from .kinematics.reachability.reachability_map import ReachabilityMap
 from .model.chain import Chain
 from .model.robot import BasePlacement, RobotParts, SnakeRobot, default_robot_file, default_urdf_path
 from .planning.plan_many import PlanError, plan_many
@@ -37,6 +35,8 @@ from .planning.plan_result import Plan, PlanProgress, TargetResult
 from .planning.planner import plan
 from .scenes.scene import Scene, Target, load_scene
 from .sim.simulate_plan import PlanSimulation, simulate
+from .solve.head_controller import HeadController, HeadSolution
+from .threads import core_threads, set_core_threads
 
 __all__ = ["Infeasible", "InputError", "InputTypeError", "InternalError", "MotionTooLong", "SnakeRobot", "BasePlacement", "RobotParts", "Chain", "TracIK", "HeadController", "HeadSolution",
            "ReachabilityMap", "compute_map", "load_map", "plan", "plan_many", "PlanError", "Plan", "PlanProgress", "TargetResult", "simulate",

@@ -9,14 +9,13 @@ import os
 import zipfile
 import zlib
 from pathlib import Path
-from typing import Any, IO, Iterator
+from typing import IO, Any, Iterator
 
 import numpy as np
 from numpy.lib import format as npy
 
 from ._errors import InputError
 from ._validate import input_file
-
 
 
 def _umask() -> int:

@@ -16,7 +16,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 import numpy.typing as npt
 
 from ._errors import InputError, InputTypeError

@@ -27,8 +27,7 @@ import sys
 
 from .._errors import Infeasible, InputError
 from .cli_options import OneLineParser, add_commands
-from .exit_status import (EXIT_BAD_INPUT, EXIT_INTERNAL_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_UNSUCCESSFUL,
-                          UsageError)
+from .exit_status import EXIT_BAD_INPUT, EXIT_INTERNAL_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_UNSUCCESSFUL, UsageError
 
 __all__ = ["main", "build_parser", "MAX_ERROR_CHARS", "EXIT_OK", "EXIT_UNSUCCESSFUL", "EXIT_BAD_INPUT",
            "EXIT_INTERNAL_ERROR", "EXIT_INTERRUPTED", "UsageError"]

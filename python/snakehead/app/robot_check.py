@@ -16,8 +16,8 @@ import numpy as np
 from .._errors import Infeasible, InputError
 from ..backbone.initial import initial_configuration
 from ..kinematics import reachability
-from ..model.mass_properties import inertia_source, mass_findings
 from ..model.body_frame import AXIS_TOLERANCE_DEG, NotStraight, straightness, suggest_home
+from ..model.mass_properties import inertia_source, mass_findings
 from ..model.robot import ALIGNED_SUFFIX, SnakeRobot
 from ..model.robot_file import toml_string
 from ..planning.start_state import ground_curl

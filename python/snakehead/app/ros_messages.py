@@ -26,7 +26,7 @@ import numpy.typing as npt
 
 # mcap-ros2-support's Writer encodes with this encoder but takes no pre-encoded messages and no channel metadata,
 # which a bag needs (snakehead.app.ros_bag): its encoder, private to the package, is used directly (tested with 0.6)
-from mcap_ros2._dynamic import serialize_dynamic
+from mcap_ros2._dynamic import serialize_dynamic  # noqa: PLC2701 (see above)
 
 from .._errors import invariant
 

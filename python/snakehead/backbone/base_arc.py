@@ -10,19 +10,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 from scipy import optimize
 
+from .._errors import Infeasible, InputError
 from .._validate import finite_array, finite_float, positive
 from ..dynamics import stability
 from ..model.robot import YAW, BasePlacement, SnakeRobot, as_robot
 from .curves import SpaceCurve
 from .discretize import joint_intervals
-
-import numpy.typing as npt
-from typing import Any, Callable
-from .._errors import Infeasible, InputError
 
 __all__ = ["CHORD_MODES", "ArcOptimum", "PlaneArc", "arc_angle_limit", "arc_area_maximum", "arc_joint_angles",
            "arc_segment_area", "base_arc", "checked_central_angle", "checked_turn", "exact_chord_radius",

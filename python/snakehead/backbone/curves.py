@@ -21,13 +21,12 @@ import math
 from typing import Any, Callable, Sequence
 
 import numpy as np
+import numpy.typing as npt
 from scipy import integrate, optimize
 
+from .._errors import InputError
 from .._validate import finite_array, finite_float, positive
 from ..model.body_frame import AXIS_TOLERANCE_DEG
-
-import numpy.typing as npt
-from .._errors import InputError
 
 __all__ = ["DEFAULT_FD_STEP", "DEFAULT_RTOL", "STRAIGHT_CURVATURE_RATIO", "SpaceCurve", "cubic_bezier",
            "planar_bezier_length"]

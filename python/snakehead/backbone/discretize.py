@@ -43,13 +43,12 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError
 from .._validate import finite_array, finite_float, positive
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from .curves import SpaceCurve
-
-import numpy.typing as npt
-from .._errors import InputError, InputTypeError
 
 __all__ = ["curve_joint_angles", "discretize", "joint_intervals"]
 

@@ -5,20 +5,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import optimize
 
+from .._errors import Infeasible, InputError, InputTypeError
 from .._validate import finite_array, positive
 from ..dynamics import stability
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
-from .base_arc import (ArcOptimum, PlaneArc, arc_joint_angles, base_arc, checked_central_angle, checked_turn,
-                       optimize_base_arc)
+from .base_arc import (
+    ArcOptimum,
+    PlaneArc,
+    arc_joint_angles,
+    base_arc,
+    checked_central_angle,
+    checked_turn,
+    optimize_base_arc,
+)
 from .curves import SpaceCurve, cubic_bezier, planar_bezier_length
 from .discretize import curve_joint_angles
-
-from typing import Any
-from .._errors import Infeasible, InputError, InputTypeError
 
 __all__ = ["HEIGHT_SHARE", "REACH_SHARE", "SHAPE_SEARCH", "InitialBackbone", "UpCurveShape", "initial_backbone",
            "initial_configuration", "up_curve", "up_curve_joint_angles", "up_length"]

@@ -32,25 +32,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError
 from .._validate import finite_array, joint_vector, rotation_matrix
 from ..dynamics.sliding import balance_translation
 from ..geometry.shapes import shape_points
-from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from ..ground_contact import RESTING_TOLERANCE
 from ..locomotion.gaits import virtual_chassis
+from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..sim.sensors import so3_exp
-
-import numpy.typing as npt
-from typing import Any
-from .._errors import InputError
 
 __all__ = ["CONTACT_HEIGHT", "PATCH_HEIGHT", "ODOMETRY", "BodyPose", "pose_error", "ShapePoints", "BodyPoseEstimator",
            "TILT_TIME_CONSTANT_S", "AttitudeFilter"]
 
-#: A link whose lowest shape point is within this height (m) of the ground touches it.
-CONTACT_HEIGHT = 0.003
+#: A link whose lowest shape point is within this height (m) of the ground touches it: the planner's resting band.
+CONTACT_HEIGHT = RESTING_TOLERANCE
 #: A link's shape points within this height (m) of its lowest make its contact patch.
 PATCH_HEIGHT = 0.001
 #: How the estimate moves the body between updates (see the module).

@@ -23,21 +23,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError
 from .._validate import finite_array, finite_float, joint_vector
-from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..locomotion.gaits import Gait, virtual_chassis
-from .estimate import AttitudeFilter, BodyPose, BodyPoseEstimator, ShapePoints, pose_error
-from ..sim.sensors import OnboardSensors
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..sim.gains import default_gains, gain_vector
 from ..sim.mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, build_model, import_mujoco
+from ..sim.sensors import OnboardSensors
 from ..sim.tracking import SimState
-
-import numpy.typing as npt
-from typing import Any
-from .._errors import InputError, InputTypeError
+from .estimate import AttitudeFilter, BodyPose, BodyPoseEstimator, ShapePoints, pose_error
 
 __all__ = ["SensorLog", "replay_estimate", "GaitRun", "GaitSimulator"]
 

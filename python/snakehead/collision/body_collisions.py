@@ -11,18 +11,17 @@ All of it runs on :mod:`snakehead.geometry.shapes` (the C++ core on Debian's FCL
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError
 from .._validate import finite_array
-from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..geometry.obstacles import OBSTACLE_TYPES
 from ..geometry.shapes import ShapeSet, pair_distances, pair_min_distances
-
-import numpy.typing as npt
-from typing import Any, Sequence
-from .._errors import InputError, InputTypeError
 from ..ground_contact import GROUND_TOLERANCE
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 __all__ = ["GROUND_TOLERANCE", "ground_clearance", "below_ground", "touching_ground", "self_clearance",
            "obstacle_shapes", "segment_closest", "CollisionReport", "collision_check"]

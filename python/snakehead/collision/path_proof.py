@@ -58,8 +58,8 @@ PATH_FLOOR_STEP = 1e-3
 #: variation) since the last one evaluated: the fastest proof with and without obstacles (bench/path_check.py).
 MOTION_FIRST_STEP = 0.2
 
-__all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "PathReport", "MotionReport", "checker",
-           "sample_clearances", "check_path", "check_motion"]
+__all__ = ["PATH_FIRST_STEP", "PATH_FLOOR_STEP", "MOTION_FIRST_STEP", "ProofCounts", "PathReport", "MotionReport",
+           "checker", "sample_clearances", "check_path", "check_motion"]
 
 
 def checker(robot: SnakeRobot, base: BasePlacement | None = None, obstacles: Sequence[Any] = ()) -> _core.PathChecker:
@@ -94,7 +94,7 @@ def sample_clearances(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | N
 
 
 @dataclass(frozen=True)
-class _ProofCounts:
+class ProofCounts:
     """What a proof evaluated: the configurations (``samples``), intervals ``proven`` and ``unproven`` (at the floor),
     ``violations`` (evaluated samples below a floor) and the smallest ground, self and obstacle values evaluated
     (m)."""
@@ -109,16 +109,16 @@ class _ProofCounts:
 
 
 def _counts(d: dict) -> dict[str, Any]:
-    """The core's counts and smallest values (``check_path``'s and ``check_motion``'s dicts) as _ProofCounts' fields."""
+    """The core's counts and smallest values (``check_path``'s and ``check_motion``'s dicts) as ProofCounts' fields."""
     return {"samples": int(d["samples"]), "proven": int(d["proven"]), "unproven": int(d["unproven"]),
             "violations": int(d["violations"]), "ground": float(d["ground"]), "self_clearance": float(d["self"]),
             "obstacle": float(d["obstacle"])}
 
 
 @dataclass(frozen=True)
-class PathReport(_ProofCounts):
+class PathReport(ProofCounts):
     """What :func:`check_path` proved: ``clear`` (every segment proven clear), ``segments`` (K-1,) bool, and the
-    counts of :class:`_ProofCounts`."""
+    counts of :class:`ProofCounts`."""
 
     clear: bool
     segments: np.ndarray
@@ -138,11 +138,11 @@ def check_path(robot: SnakeRobot, waypoints: np.ndarray, base: BasePlacement | N
 
 
 @dataclass(frozen=True)
-class MotionReport(_ProofCounts):
+class MotionReport(ProofCounts):
     """What :func:`check_motion` proved about a sampled motion of T samples: ``clear`` (no violation, nothing
     unproven: ``unproven`` counts intervals between two consecutive samples at the floor), ``obstacle_lower`` (T,) m:
     a lower bound of the smallest obstacle distance from each sample to the next (the last: at it), <= 0 where an
-    interval is violated or unproven, +inf without obstacles; and the counts of :class:`_ProofCounts`."""
+    interval is violated or unproven, +inf without obstacles; and the counts of :class:`ProofCounts`."""
 
     clear: bool
     obstacle_lower: np.ndarray

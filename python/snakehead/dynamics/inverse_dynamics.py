@@ -27,11 +27,11 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import _core
-from .._validate import finite_array, positive
-from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-from ..model.physics import GRAVITY
-from .stability import momenta_from_velocities
 from .._errors import InputError
+from .._validate import finite_array, positive
+from ..model.physics import GRAVITY
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from .stability import momenta_from_velocities
 
 __all__ = ["LIFT_RAMP", "GRAVITY_MODELS", "lift_shares", "carried_weights", "InverseDynamics", "inverse_dynamics",
            "newton_euler", "MOMENTUM_STEP", "momentum_rates"]

@@ -32,10 +32,10 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from .._validate import finite_array
-from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .._errors import InputError
+from .._validate import finite_array
 from ..ground_contact import RESTING_TOLERANCE
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 __all__ = ["SLIP_FLOOR", "TRANSLATION_TOLERANCE", "balance_translation", "balance_motion",
            "resting_contacts", "predict_slide"]

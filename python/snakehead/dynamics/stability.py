@@ -19,16 +19,15 @@ from dataclasses import dataclass
 from typing import Callable, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _core
-from .._validate import finite_array, joint_vector
-from ..model.physics import GRAVITY  # g in Eq. 38 is (0, 0, -GRAVITY)
-from ..collision.path_proof import checker
-from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-
-import numpy.typing as npt
 from .._errors import Infeasible, InputError
+from .._validate import finite_array, joint_vector
+from ..collision.path_proof import checker
 from ..ground_contact import GROUND_TOLERANCE
+from ..model.physics import GRAVITY  # g in Eq. 38 is (0, 0, -GRAVITY)
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 
 __all__ = ["CONTACT_MODELS", "SAMPLE_CHUNK", "polygon_margin_many", "center_of_mass",
            "hull_indices", "support_polygon", "static_margin", "static_margins_of_frames", "is_statically_stable",

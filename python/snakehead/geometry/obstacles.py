@@ -11,14 +11,13 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import ConvexHull
 
+from .._errors import InputError
 from .._validate import finite_array, finite_float, positive, rotation_matrix, unit_vector3, vector3
 from .meshes import convex_hull_vertices
 from .shapes import Shape
-
-import numpy.typing as npt
-from .._errors import InputError
 
 __all__ = ["WALL_HOLE_SIDES", "BoxObstacle", "WallWithHole", "MeshObstacle", "OBSTACLE_TYPES"]
 

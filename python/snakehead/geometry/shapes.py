@@ -18,13 +18,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Sequence
 
 import numpy as np
 from scipy.spatial import ConvexHull
 
 from .. import _core
-
-from typing import Sequence
 from .._errors import InputError
 
 __all__ = ["KINDS", "CONTACT_POINTS", "DRAW_SEGMENTS", "SHAPES_OF_KEPT", "Shape", "ShapeSet", "pair_distances",

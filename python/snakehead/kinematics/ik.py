@@ -22,8 +22,8 @@ import numpy.typing as npt
 
 from .. import _core
 from .._errors import InputError, InputTypeError
-from .._validate import (ORTHONORMAL_TOLERANCE, duration, finite_array, integer, joint_vector, pose as check_pose,
-                         positive, within_limits)
+from .._validate import ORTHONORMAL_TOLERANCE, duration, finite_array, integer, joint_vector, positive, within_limits
+from .._validate import pose as check_pose
 from ..model.chain import Chain
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
@@ -93,10 +93,10 @@ def _renew_generators() -> None:
     was copied as it was at the fork: held, if another thread of the parent was drawing then, and never released
     in the child, whose next draw would wait for ever.)"""
     for solver in list(_LIVE_SOLVERS):
-        old = solver._rng.bit_generator
+        old = solver._rng.bit_generator  # noqa: SLF001 (TracIK's own generator, renewed by its module)
         new = type(old)()
         new.state = old.state
-        solver._rng = np.random.Generator(new)
+        solver._rng = np.random.Generator(new)  # noqa: SLF001
 
 
 os.register_at_fork(after_in_child=_renew_generators)

@@ -49,16 +49,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError
 from .._validate import duration, finite_array, finite_float, integer, positive, sample_count
 from ..model.robot import PITCH, YAW, SnakeRobot, as_robot
 from ..trajectory.interpolation import CONTROL_PERIOD
-
-import numpy.typing as npt
-from typing import Any, Callable
-from .._errors import InputError, InputTypeError
 
 __all__ = ["MIN_JOINTS_PER_WAVE", "Wave", "Gait", "virtual_chassis", "rolling", "sidewinding", "turning",
            "linear_progression", "lateral_undulation", "GAITS", "make_gait"]

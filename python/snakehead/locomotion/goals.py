@@ -29,11 +29,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from .._errors import InputError
 from .._validate import finite_array, positive
 from ..dynamics.sliding import predict_slide
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gaits import Gait, make_gait, virtual_chassis
-from .._errors import InputError
 
 __all__ = ["wrap_angle", "compose", "relative", "inverse", "CURL_STEPS", "flat_shape", "curl_path",
            "curl_displacement", "straight_pose_for", "chassis_offset", "AMPLITUDE_EXPONENT", "MIN_AMPLITUDE_SCALE",

@@ -37,7 +37,7 @@ import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import ConvexHull
 
-from .._errors import InputError, Infeasible
+from .._errors import Infeasible, InputError
 from .._validate import non_negative
 from ..geometry.shapes import shape_points
 from ..model.robot import BasePlacement, SnakeRobot, as_robot

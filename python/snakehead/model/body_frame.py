@@ -10,6 +10,7 @@ the planner can read their axes as the paper does.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -17,8 +18,6 @@ from scipy.optimize import least_squares
 from .._errors import InputError
 from .chain import Chain
 from .description import add_fixed_frames
-
-from pathlib import Path
 
 __all__ = ["STRAIGHT_TOLERANCE", "AXIS_TOLERANCE_DEG", "ALIGNED_SUFFIX", "HEAD_AXES", "Straightness", "NotStraight",
            "straightness", "suggest_home", "body_frame", "aligned_frames"]

@@ -4,12 +4,11 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _core
-from .._validate import finite_array, joint_vector
-
-import numpy.typing as npt
 from .._errors import InputError, InputTypeError
+from .._validate import finite_array, joint_vector
 
 __all__ = ["Chain", "check_utf8"]
 

@@ -21,17 +21,16 @@ import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .._errors import InputError, InputTypeError
 from .._validate import input_file
+from ..geometry.meshes import MAX_MESH_BYTES
 from .robot_folders import MAX_DESCRIPTION_BYTES, RobotFolders
 from .xacro_expansion import expand_xacro
-from ..geometry.meshes import MAX_MESH_BYTES
-
-from typing import Mapping
 
 __all__ = ["Description", "read_description", "JOINT_TYPES", "GEOMETRY_KINDS", "check_description", "with_joint_limits",
            "origin_matrix", "set_origin", "add_fixed_frames", "MeshResolver"]

@@ -24,14 +24,13 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from typing import Mapping
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .._errors import InputError
 from .description import origin_matrix, set_origin
-
-from typing import Mapping
 
 __all__ = ["REVERSED_SUFFIX", "BranchLink", "TreeChanges", "JointOffsets", "body_description"]
 

@@ -17,13 +17,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
+from .._errors import InputError, InputTypeError
 from .._validate import finite_float
 from .physics import GRAVITY
-
-from typing import Any
-from .._errors import InputError, InputTypeError
 
 __all__ = ["holding_effort", "SnakeSpec", "snake_urdf"]
 

@@ -43,7 +43,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
-
 from scipy.spatial.transform import Rotation
 
 from .._errors import InputError, InputTypeError

@@ -17,8 +17,7 @@ import numpy as np
 
 from .. import _core
 from .._errors import InputError, InputTypeError
-from .body_frame import (AXIS_TOLERANCE_DEG, HEAD_AXES, STRAIGHT_TOLERANCE, NotStraight, aligned_frames,
-                         body_frame)
+from .body_frame import AXIS_TOLERANCE_DEG, HEAD_AXES, STRAIGHT_TOLERANCE, NotStraight, aligned_frames, body_frame
 from .chain import Chain, check_utf8
 from .description import MeshResolver, read_description, with_joint_limits
 from .description_tree import JointOffsets, TreeChanges, body_description

@@ -71,7 +71,7 @@ class _Hooks:
 
     def __init__(self, xacro: Any, original: dict[str, Any], folders: RobotFolders, trusted: bool) -> None:
         self.xacro, self.original, self.folders, self.trusted = xacro, original, folders, trusted
-        names = xacro._global_symbols["xacro"]
+        names = xacro._global_symbols["xacro"]  # noqa: SLF001 (xacro has no public table; its version is pinned)
         self.functions = Namespace(arg=self.arg, load_yaml=self.load_yaml, abs_filename=xacro.abs_filename_spec,
                                    dotify=xacro.YamlDictWrapper, tokenize=xacro.tokenize,
                                    **{k: names[k] for k in ("message", "warning", "error", "fatal")})

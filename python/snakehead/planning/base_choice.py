@@ -11,10 +11,10 @@ import numpy.typing as npt
 
 from .._errors import Infeasible
 from .._validate import joint_vector
-from ..solve.head_controller import HeadController
-from ..solve.whole_body import PlanSolves, clear_of_obstacles, solve_checked_target
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
+from ..solve.head_controller import HeadController
+from ..solve.whole_body import PlanSolves, clear_of_obstacles, solve_checked_target
 from .plan_cache import plan_cache_of, shape_key
 from .start_state import bending_state, lift_ends_safe, shape_of
 from .target_solves import solve_kept

@@ -10,9 +10,8 @@ import numpy as np
 from .._errors import InputError, MotionTooLong
 from .._validate import MAX_SAMPLES
 from ..model.robot import SnakeRobot
-from ..scenes.scene import Scene, Target
 from ..retiming.timing import resolve_limits
-from ..scenes.scene import check_target_count
+from ..scenes.scene import Scene, Target, check_target_count
 from ..trajectory import interpolation as interp
 
 #: s: the longest motion a plan may have: MAX_SAMPLES samples at the 2 ms control period (2000 s). Checked before

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from ..dynamics import stability
 from ..collision import body_collisions as coll
+from ..dynamics import stability
 from ..margins import EXACT_DISTANCE_WITHIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Scene

@@ -35,22 +35,21 @@ import numpy.typing as npt
 
 from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
 from .._validate import integer, joint_vector, sequence
+from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
+from ..model.robot import BasePlacement, SnakeRobot
 from ..retiming.timing import resolve_limits
+from ..scenes.scene import Scene, Target, load_scene
 from ..solve.head_controller import HeadController
 from ..solve.whole_body import PlanSolves, clear_of_obstacles
-from ..model.robot import BasePlacement, SnakeRobot
-from ..scenes.scene import Scene, Target, load_scene
 from . import plan_bounds
 from .base_choice import choose_base, out_of_range, shape_of
 from .fallbacks import retime_slower
 from .plan_bounds import check_size, check_timing
+from .plan_cache import plan_cache_of
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
 from .start_state import LIFT_STEPS, bending_state
 from .target_solves import solve_noted
 from .waypoints import Waypoints
-from .plan_cache import plan_cache_of
-
-from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 
 
 def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:

@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import Infeasible
-from ..solve.head_controller import HeadController
-from ..dynamics import stability
 from ..collision import body_collisions as coll
+from ..dynamics import stability
 from ..model.robot import BasePlacement, SnakeRobot
+from ..solve.head_controller import HeadController
 from .plan_cache import plan_cache_of, shape_key
 from .waypoints import Waypoints
 

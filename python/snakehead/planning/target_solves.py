@@ -7,10 +7,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..solve.head_controller import HeadController
-from ..solve.whole_body import PlanSolves, solve_checked_target
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement
+from ..solve.head_controller import HeadController
+from ..solve.whole_body import PlanSolves, solve_checked_target
 
 
 def solve_kept(controller: HeadController, position: np.ndarray, direction: np.ndarray, q_prev: np.ndarray,

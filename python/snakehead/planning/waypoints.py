@@ -10,16 +10,15 @@ import numpy.typing as npt
 
 from .. import _core
 from .._errors import Infeasible, MotionTooLong
-from ..dynamics import stability
 from ..collision import path_proof
-from . import motion_checks
+from ..dynamics import stability
 from ..margins import DETOUR_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
-from ..trajectory import interpolation as interp
-from . import plan_bounds
 from ..retiming.timing import RetimedTrajectory, retime
 from ..solve.whole_body import BodyProblem
+from ..trajectory import interpolation as interp
 from ..trajectory.cartesian import tracking_interpolation
+from . import motion_checks, plan_bounds
 from .plan_bounds import check_motion_length
 from .plan_cache import KeptMap
 

@@ -44,14 +44,14 @@ from .._executors import as_executor, run_tasks, worker_count
 from ..kinematics import reachability as ws
 from ..model.robot import BasePlacement, SnakeRobot
 from ..scenes.scene import Target
-from .plan_many import WORKERS, RobotRecipe, plan_many
 from ..solve.pose_bounds import PoseBounds
+from .plan_many import WORKERS, RobotRecipe, plan_many
 
 __all__ = ["compute_reach", "check_reach", "check_options", "reach_grid", "top_height", "estimated_solves", "unreachable", "ReachGrid", "ReachCheck", "relocation_task", "kept_task", "BEARING_BINS", "MIN_VOXEL_M", "MAX_DIRECTIONS", "MAX_SOLVES", "MAX_WORKERS", "KEPT_CHUNK"]
 
+from ..margins import DETOUR_MARGIN
 from ..solve.head_controller import HeadController
 from ..solve.whole_body import LIFTED_IK_TIMEOUT_S, POSITION_TOLERANCE
-from ..margins import DETOUR_MARGIN
 
 #: Relative bearings (the direction's heading minus the bearing from the base to the target) at which the
 #: relocation is solved per layer and direction; a voxel takes the nearest one's answer.

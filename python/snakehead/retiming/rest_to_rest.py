@@ -6,9 +6,9 @@ import numpy as np
 
 from .._errors import Infeasible
 from ..model.robot import BasePlacement, SnakeRobot
+from .grid_refinement import REFINE_EXTRA_POINTS, REFINE_GROWTH, REFINE_ROUNDS, refined_grid, stage_keys, stages_over
 from .gridpoints import GridPoints, first_grid, solve_grid
 from .joint_path import path_function
-from .grid_refinement import REFINE_EXTRA_POINTS, REFINE_GROWTH, REFINE_ROUNDS, refined_grid, stage_keys, stages_over
 from .retiming_limits import RetimingLimits
 
 __all__ = ["Piece"]

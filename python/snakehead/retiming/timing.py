@@ -43,15 +43,22 @@ from .._validate import MAX_SAMPLES, finite_array, positive
 from ..margins import ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..trajectory.interpolation import CONTROL_PERIOD, JointTrajectory, sample_times
-from .gridpoints import (GRID_STEP, MAX_GRID_POINTS, MAX_JOINT_SPEED, MIN_GRID_PER_SEGMENT, PATH_SPEED_FACTOR,
-                         SOLVE_SHARE, SOLVE_ZMP_EXTRA_M, GridPoints)
+from .grid_refinement import PROBES, REFINE_EXTRA_POINTS, REFINE_GROWTH, REFINE_ROUNDS, REFINE_ZMP_M
+from .gridpoints import (
+    GRID_STEP,
+    MAX_GRID_POINTS,
+    MAX_JOINT_SPEED,
+    MIN_GRID_PER_SEGMENT,
+    PATH_SPEED_FACTOR,
+    SOLVE_SHARE,
+    SOLVE_ZMP_EXTRA_M,
+    GridPoints,
+)
 from .joint_path import INTERPOLATIONS, PathFunction
 from .limit_check import BINDING_SHARE, BINDING_ZMP_M, LimitCheck, check_limits
 from .path_dynamics import momentum_rate_coefficients
-from .grid_refinement import PROBES, REFINE_EXTRA_POINTS, REFINE_GROWTH, REFINE_ROUNDS, REFINE_ZMP_M
 from .rest_to_rest import Piece
-from .retiming_limits import (ACCELERATION_LIMIT, FRICTION, TORQUE_SHARE, VELOCITY_SHARE, RetimingLimits,
-                              resolve_limits)
+from .retiming_limits import ACCELERATION_LIMIT, FRICTION, TORQUE_SHARE, VELOCITY_SHARE, RetimingLimits, resolve_limits
 from .stability_constraint import FRICTION_SIDES, MIN_NORMAL_SHARE, stability_rows
 from .support_polygon import ZMP_DYNAMIC_ROOM, Support, required_margins
 from .timeline import Timeline

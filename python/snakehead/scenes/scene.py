@@ -66,8 +66,17 @@ import numpy as np
 
 from .._errors import InputError, InputTypeError
 from .._files import write_text_atomic
-from .._validate import (display_text, duration, file_name_part, file_problem, finite_float, name_text, sequence,
-                         unit_vector3, world_position)
+from .._validate import (
+    display_text,
+    duration,
+    file_name_part,
+    file_problem,
+    finite_float,
+    name_text,
+    sequence,
+    unit_vector3,
+    world_position,
+)
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string

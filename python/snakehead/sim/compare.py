@@ -1,16 +1,16 @@
 """Compare a simulation with its plan, as the paper does in Section 4 (Figs. 18-20, 23-25)."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .._errors import InputError, InputTypeError, invariant
 from .._validate import finite_array
 from ..dynamics import stability
-from ..solve.head import angle_between_deg
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from ..solve.head import angle_between_deg
 from .tracking import SimResult, check_trajectory
-
-from typing import Any
 
 __all__ = ["SPAN_TOLERANCE", "in_span", "check_plan_span", "compare", "zmp_margins"]
 

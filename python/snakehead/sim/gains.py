@@ -32,10 +32,10 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from ..model.physics import GRAVITY
-from ..model.robot import SnakeRobot, as_robot
 from .._errors import InputError
 from .._validate import finite_array
+from ..model.physics import GRAVITY
+from ..model.robot import SnakeRobot, as_robot
 
 __all__ = ["HOLD_DEFLECTION", "TIME_CONSTANT", "EFFORT_MARGIN", "gain_vector", "joint_gravity_torques", "default_gains",
            "default_torque_limits"]

@@ -28,28 +28,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError, InternalError
 from .._validate import duration, finite_array, non_negative, positive
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from ..trajectory.interpolation import CONTROL_PERIOD
 from .gains import default_torque_limits
-
-import numpy.typing as npt
-from typing import Any
-from .._errors import InputError, InputTypeError, InternalError
 
 __all__ = ["DEFAULT_TIMESTEP", "DEFAULT_CONTROL_DT", "MAX_TIMESTEP", "MAX_CONTROL_DT", "MAX_PHYSICS_STEPS",
            "import_mujoco", "DEFAULT_HOLE_SLICES", "obstacle_boxes", "FREE_JOINT", "FLOOR", "shape_geom",
            "add_shape_geom", "build_spec", "SimModel", "build_model"]
 
 
-#: Physics timestep (s) and control period (s) used by default.
+#: Physics timestep (s) and control period (s) used by default; the simulated controller runs at the planner's rate.
 DEFAULT_TIMESTEP = 0.001
-DEFAULT_CONTROL_DT = 0.002
+DEFAULT_CONTROL_DT = CONTROL_PERIOD
 #: Upper limits (s) on the physics timestep and the control period, and on the physics steps of one run (10^8: about
 #: an hour of computing, 28 hours of motion at 1 ms): beyond them a run would never end or not be a simulation.
 MAX_TIMESTEP = 0.1

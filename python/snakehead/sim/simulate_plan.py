@@ -3,13 +3,12 @@ the paper's Section 4, in one call."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
+from .._errors import InputTypeError, entry_point, inputs_checked
 from ..planning.plan_result import Plan
 from .compare import check_plan_span, compare
 from .tracking import SimResult, simulate_trajectory
-
-from typing import Any
-from .._errors import InputTypeError, entry_point, inputs_checked
 
 __all__ = ["PlanSimulation", "simulate"]
 

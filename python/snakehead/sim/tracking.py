@@ -42,8 +42,17 @@ from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .gains import default_gains, gain_vector
 from .measurements import TickLog, center_of_pressure, ground_contacts, momenta_of_state, momenta_per_body
-from .mjcf import (DEFAULT_CONTROL_DT, DEFAULT_HOLE_SLICES, DEFAULT_TIMESTEP, MAX_CONTROL_DT,
-                   MAX_PHYSICS_STEPS, MAX_TIMESTEP, SimModel, build_model, import_mujoco)
+from .mjcf import (
+    DEFAULT_CONTROL_DT,
+    DEFAULT_HOLE_SLICES,
+    DEFAULT_TIMESTEP,
+    MAX_CONTROL_DT,
+    MAX_PHYSICS_STEPS,
+    MAX_TIMESTEP,
+    SimModel,
+    build_model,
+    import_mujoco,
+)
 
 # the simulation's own names, then the measurements it records, importable from here as they always were
 __all__ = ["SimState", "SimResult", "simulate_trajectory", "check_trajectory", "sample_count_covering",

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core
-from ..model.robot import SnakeRobot
 from ..ground_contact import GROUND_TOLERANCE
+from ..model.robot import SnakeRobot
 
 __all__ = ["contact_points", "first_lifted_link", "ground_links", "link_coms", "static_margins"]
 

@@ -11,15 +11,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputTypeError
 from .._validate import finite_array, finite_float, integer, pose, unit_vector3, vector3
 from ..kinematics.ik import FREE_ROLL, TracIK
-
-import numpy.typing as npt
-from typing import Any, Callable
-from .._errors import InputTypeError
 
 __all__ = ["FREE_ROLL_BOUNDS", "HeadIKResult", "angle_between_deg", "frame_along", "frame_from_direction", "free_roll",
            "position_and_direction_error", "roll_about_x", "rotated_frames", "select"]

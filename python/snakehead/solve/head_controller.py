@@ -15,24 +15,23 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
+import numpy.typing as npt
 
+from .._errors import InputError, InputTypeError, entry_point, inputs_checked
+from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
+from ..dynamics import stability
+from ..kinematics import ik
+from ..kinematics import reachability as workspace
+from ..kinematics.ik import TracIK
+from ..kinematics.reachability.reachability_map import ReachabilityMap
+from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from . import head as head_ik
 from . import neck as nk
 from .body_problem import BodyProblem
 from .initial_state import stable_initial_configuration
-from ..dynamics import stability
-from .._validate import duration, integer, joint_vector, positive, unit_vector3, vector3, within_limits
-from ..kinematics import reachability as workspace
-from ..kinematics import ik
-from ..kinematics.ik import TracIK
-from ..kinematics.reachability.reachability_map import ReachabilityMap
-from ..model.robot import BasePlacement, SnakeRobot, as_robot
-
-import numpy.typing as npt
-from typing import Any, Callable
-from .._errors import InputError, InputTypeError, entry_point, inputs_checked
 
 __all__ = ["FREE_ROLL_ATTEMPTS", "HeadController", "HeadSolution"]
 

@@ -30,11 +30,11 @@ from .. import backbone
 from .._errors import Infeasible
 from ..backbone.base_arc import arc_angle_limit, arc_joint_angles, optimize_base_arc
 from ..backbone.initial import SHAPE_SEARCH, UpCurveShape
-from ..dynamics import stability
 from ..collision import body_collisions as coll
+from ..dynamics import stability
+from ..ground_contact import GROUND_TOLERANCE
 from ..margins import DETOUR_MARGIN, ZMP_MARGIN
 from ..model.robot import BasePlacement, SnakeRobot
-from ..ground_contact import GROUND_TOLERANCE
 from .base_support import ground_links, static_margins
 
 __all__ = ["ANGLE_GRID", "INITIAL_MARGIN", "initial_margins", "stable_initial_configuration"]

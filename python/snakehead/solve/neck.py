@@ -9,15 +9,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _core
+from .._errors import InputError, InputTypeError
 from .._validate import finite_array, finite_float, pose, positive, vector3
 from ..model.chain import Chain
-from .head import angle_between_deg
 from ..model.robot import BasePlacement
-
-import numpy.typing as npt
-from .._errors import InputError, InputTypeError
+from .head import angle_between_deg
 
 __all__ = ["CONTINUITY_TOLERANCE", "DEFAULT_H", "FIT_ITERATIONS", "FIT_TOLERANCE", "GRID_FRACTION", "GRID_POINTS",
            "NeckGoal", "NeckSolution", "RangeCheck", "accepted_range", "base_move_into_range", "dexterous_distance",

@@ -13,10 +13,10 @@ from .._validate import finite_float, joint_vector, unit_vector3, vector3
 from ..collision import body_collisions as coll
 from ..dynamics import stability
 from ..geometry.shapes import pair_min_distances
+from ..ground_contact import GROUND_TOLERANCE
 from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE, SOLUTION_MARGIN
 from ..model.frames import forward_kinematics_unchecked
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
-from ..ground_contact import GROUND_TOLERANCE
 
 if TYPE_CHECKING:  # (annotations only: body_problem builds on pose_bounds, which takes this module's tolerances)
     from .body_problem import BodyProblem

@@ -18,8 +18,8 @@ from . import neck as nk
 from .body_problem import BodyProblem
 from .head_controller import HeadController
 from .plan_solves import PlanSolves
-from .whole_body_refinement import SOLVE_BUDGET, refine
 from .solution_checks import MIN_MARGIN, check_solutions, clear_of_obstacles
+from .whole_body_refinement import SOLVE_BUDGET, refine
 from .whole_body_solution import STAGES, WholeBodySolution, check_rank, solution_rank
 from .whole_body_starts import base_shapes, continue_from, lifted_candidates, placements
 

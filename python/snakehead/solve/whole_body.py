@@ -26,14 +26,27 @@ from __future__ import annotations
 from ..margins import EXACT_DISTANCE_WITHIN, OBSTACLE_CLEARANCE, SELF_CLEARANCE
 from .body_problem import LIFTED_IK_TIMEOUT_S, BodyProblem
 from .plan_solves import PlanSolves
-from .whole_body_refinement import (MAX_ITERATIONS, PAIR_RANGE, SOLVE_BUDGET, RefinementProblem, refine,
-                                    solve_whole_body)
-from .solution_checks import (DIRECTION_TOLERANCE, MIN_MARGIN, POSITION_TOLERANCE, check_solution, check_solutions,
-                              clear_of_obstacles)
+from .solution_checks import (
+                                    DIRECTION_TOLERANCE,
+                                    MIN_MARGIN,
+                                    POSITION_TOLERANCE,
+                                    check_solution,
+                                    check_solutions,
+                                    clear_of_obstacles,
+)
 from .target_search import TargetSearch, solve_checked_target, solve_target
+from .whole_body_refinement import MAX_ITERATIONS, PAIR_RANGE, SOLVE_BUDGET, RefinementProblem, refine, solve_whole_body
 from .whole_body_solution import REASONS, STAGES, WholeBodySolution, check_rank, solution_rank
-from .whole_body_starts import (CANDIDATE_ROLLS, CANDIDATE_SEEDS, base_shapes, continue_from, lifted_candidates,
-                                placements, rolled_frames, rolls_reached)
+from .whole_body_starts import (
+                                    CANDIDATE_ROLLS,
+                                    CANDIDATE_SEEDS,
+                                    base_shapes,
+                                    continue_from,
+                                    lifted_candidates,
+                                    placements,
+                                    rolled_frames,
+                                    rolls_reached,
+)
 
 __all__ = ["BodyProblem", "CANDIDATE_ROLLS", "CANDIDATE_SEEDS", "DIRECTION_TOLERANCE",
            "EXACT_DISTANCE_WITHIN", "LIFTED_IK_TIMEOUT_S", "MAX_ITERATIONS", "MIN_MARGIN", "OBSTACLE_CLEARANCE",

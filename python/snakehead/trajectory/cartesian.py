@@ -6,17 +6,16 @@ link (Eqs. 42-44); :func:`cartesian_trajectory` times such a motion.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Callable, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _core
+from .._errors import InputError
 from .._validate import finite_array, joint_vector, positive
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .interpolation import CONTROL_PERIOD, JointTrajectory, minimum_jerk, sample_times
-
-import numpy.typing as npt
-from typing import Any, Callable, Literal
-from .._errors import InputError
 
 __all__ = ["TrackingInterpolation", "CartesianInterpolation", "joint_angle_towards", "cartesian_interpolation",
            "cartesian_trajectory", "TRACKING_DAMPING", "TRACKING_ITERATIONS", "TRACKING_CLEARANCE",

@@ -9,13 +9,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from .. import _core
-from .._validate import finite_array, finite_float, joint_vector, positive, sample_count
-
-import numpy.typing as npt
 from .._errors import Infeasible, InputError
+from .._validate import finite_array, finite_float, joint_vector, positive, sample_count
 
 __all__ = ["CONTROL_PERIOD", "JointTrajectory", "joint_spline", "MonotoneQuintic", "sample_times", "joint_trajectory",
            "joint_interpolation", "minimum_jerk"]

@@ -32,11 +32,36 @@ from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement, SnakeRobot
 from ..trajectory.cartesian import cartesian_interpolation
 from .figure_files import DEFAULT_DPI, crop_and_write_png, ink_mask, save
-from .figure_geometry import (FIGURE_SEGMENTS, BodyDrawing, Sphere, body_drawing, body_faces, body_points, box_faces,
-                              convex_facets, hole_rim, mesh_obstacle_faces, part_colors, plan_spheres, scene_bounds,
-                              shape_footprints, view_angles, wall_faces)
-from .figure_style import (BASE_COLOR, GROUND_COLOR, HEAD_COLOR, NECK_COLOR, OBSTACLE_COLOR, SPHERE_COLOR, WALL_COLOR,
-                           literal, new_figure, setup_axes3d)
+from .figure_geometry import (
+    FIGURE_SEGMENTS,
+    BodyDrawing,
+    Sphere,
+    body_drawing,
+    body_faces,
+    body_points,
+    box_faces,
+    convex_facets,
+    hole_rim,
+    mesh_obstacle_faces,
+    part_colors,
+    plan_spheres,
+    scene_bounds,
+    shape_footprints,
+    view_angles,
+    wall_faces,
+)
+from .figure_style import (
+    BASE_COLOR,
+    GROUND_COLOR,
+    HEAD_COLOR,
+    NECK_COLOR,
+    OBSTACLE_COLOR,
+    SPHERE_COLOR,
+    WALL_COLOR,
+    literal,
+    new_figure,
+    setup_axes3d,
+)
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.axes3d import Axes3D

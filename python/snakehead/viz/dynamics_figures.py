@@ -22,7 +22,6 @@ from ..sim.compare import zmp_margins
 from .figure_geometry import shape_footprints
 from .figure_style import PLANNED_COLOR, SIMULATED_COLOR, new_figure
 
-
 if TYPE_CHECKING:
     from ..sim.tracking import SimResult
 

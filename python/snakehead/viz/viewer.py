@@ -42,14 +42,48 @@ import numpy as np
 from .._errors import InputError
 from .._files import write_text_atomic
 from .server_guard import ServerGuard, guarded_server
-from .viewer_arrays import (CAMERA_FOV_DEG, CAMERA_VIEW_DEG, FRAME_STEP_S, MESH_FIELDS, OBSTACLE_FIELDS,
-                            VIEWER_SEGMENTS, ViewerScene, camera_for, distinct_polygons, frame_indices,
-                            obstacle_arrays, quaternions_wxyz, reach_scene, rgb255, robot_meshes, shape_colors,
-                            shape_poses, viewer_scene)
+from .viewer_arrays import (
+    CAMERA_FOV_DEG,
+    CAMERA_VIEW_DEG,
+    FRAME_STEP_S,
+    MESH_FIELDS,
+    OBSTACLE_FIELDS,
+    VIEWER_SEGMENTS,
+    ViewerScene,
+    camera_for,
+    distinct_polygons,
+    frame_indices,
+    obstacle_arrays,
+    quaternions_wxyz,
+    reach_scene,
+    rgb255,
+    robot_meshes,
+    shape_colors,
+    shape_poses,
+    viewer_scene,
+)
 from .viewer_file import MAX_SCENE_BYTES, SCENE_FORMAT, SCENE_SUFFIX, load_viewer_scene, save_viewer_scene, scenes_in
-from .viewer_nodes import (COM_RGB, CUBE_TRIANGLES, CUBE_VERTICES, OBSTACLE_RGB, POLYGON_RGB, TARGET_ARROW_M,
-                           TARGET_LABEL_HEIGHT_M, TARGET_RGB, TIP_PATH_RGB, WALL_RGB, ZMP_RGB, RobotNodes, SceneNodes,
-                           add_ground, add_obstacles, add_target_marker, camera_to, light_scene, node_name)
+from .viewer_nodes import (
+    COM_RGB,
+    CUBE_TRIANGLES,
+    CUBE_VERTICES,
+    OBSTACLE_RGB,
+    POLYGON_RGB,
+    TARGET_ARROW_M,
+    TARGET_LABEL_HEIGHT_M,
+    TARGET_RGB,
+    TIP_PATH_RGB,
+    WALL_RGB,
+    ZMP_RGB,
+    RobotNodes,
+    SceneNodes,
+    add_ground,
+    add_obstacles,
+    add_target_marker,
+    camera_to,
+    light_scene,
+    node_name,
+)
 
 if TYPE_CHECKING:
     import viser

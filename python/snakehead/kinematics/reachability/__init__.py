@@ -5,12 +5,38 @@ merge: :mod:`.map_io`), a robot's map computed once and cached (:mod:`.map_cache
 many poses at once (:mod:`.map_queries`) and the k-means++ of its clusters (:mod:`.kmeans`)."""
 from .map_cache import cache_dir, default_map_options, map_for
 from .map_io import FORMAT, FORMATS, MAX_MAP_BYTES, load, merge, save, validate_map_arrays
-from .reachability_map import (DEXTEROUS_MIN_SHARE, G0_MIN_VOXELS, KIND_HEAD, KIND_WHOLE_BODY, MAP_KINDS,
-                               MAP_PARAMETERS, TABLE2_BINS, Clusters, ReachabilityMap, require_map)
+from .reachability_map import (
+                               DEXTEROUS_MIN_SHARE,
+                               G0_MIN_VOXELS,
+                               KIND_HEAD,
+                               KIND_WHOLE_BODY,
+                               MAP_KINDS,
+                               MAP_PARAMETERS,
+                               TABLE2_BINS,
+                               Clusters,
+                               ReachabilityMap,
+                               require_map,
+)
 from .sweep import check_options, compute, evaluate, urdf_text
-from .sweep_options import (MAX_CLOUD_SAMPLES, MAX_DIRECTIONS, MAX_FRAMES_PER_VOXEL, MAX_ROLLS, MAX_SEED, MAX_SHARDS,
-                            MAX_THREADS, MAX_TIMEOUT_S, MAX_VOXELS_PER_AXIS, MIN_CLOUD_SAMPLES, MIN_VOXELS_PER_AXIS,
-                            check_grid, checked_count, checked_real, core_options, mapped_chain, parse_shard)
+from .sweep_options import (
+                               MAX_CLOUD_SAMPLES,
+                               MAX_DIRECTIONS,
+                               MAX_FRAMES_PER_VOXEL,
+                               MAX_ROLLS,
+                               MAX_SEED,
+                               MAX_SHARDS,
+                               MAX_THREADS,
+                               MAX_TIMEOUT_S,
+                               MAX_VOXELS_PER_AXIS,
+                               MIN_CLOUD_SAMPLES,
+                               MIN_VOXELS_PER_AXIS,
+                               check_grid,
+                               checked_count,
+                               checked_real,
+                               core_options,
+                               mapped_chain,
+                               parse_shard,
+)
 from .voxel_sphere import approach_frame, fibonacci_directions
 
 __all__ = [

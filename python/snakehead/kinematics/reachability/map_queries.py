@@ -24,7 +24,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..._errors import InputError
-from ..._validate import finite_float, position_direction_pairs as _poses
+from ..._validate import finite_float
+from ..._validate import position_direction_pairs as _poses
 from .reachability_map import KIND_HEAD, ReachabilityMap, require_map
 
 #: Directions blended by :func:`reachability`.

@@ -32,6 +32,7 @@ from .map_io import merge
 from .reachability_map import MAP_PARAMETERS, ReachabilityMap
 from .sweep_options import MAX_SHARDS, check_grid, checked_count, core_options, mapped_chain
 
+
 def check_options(chain_or_robot: Chain | SnakeRobot, **options: Any) -> _core.WorkspaceOptions:
     """The checks :func:`compute` makes of its options before any work (``voxel``, ``directions``, ``rolls``,
     ``any_roll``, ``free_roll``, ``approach_axis``, ``timeout``, ``epsilon``, ``cloud_samples``, ``seed``, ``threads``,
