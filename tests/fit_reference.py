@@ -1,5 +1,5 @@
 """An independent statement of the tracking fit's objective (include/snakehead/tracking_fit.hpp,
-``cartesian.tracking_interpolation``), for tests/test_tracking_fit.py: what each interior sample's lifted joints
+``cartesian.tracking_interpolation``), for tests/sim/test_tracking_fit.py: what each interior sample's lifted joints
 minimise, evaluated without snakehead's kinematics or distances.
 
 At sample j, with the joints before the lift at their linear interpolation and ``current`` the previous sample's

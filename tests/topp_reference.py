@@ -5,7 +5,7 @@ constraint, and the torque and stability rows as canonical linear constraints, a
 discretization).
 
 ``toppra_solve_grid`` has the signature of ``gridpoints.solve_grid``; ``toppra_solver()`` swaps it in for a block, so
-that a whole ``retime`` runs on toppra (tests/test_topp_ra.py, bench/timing.py --solvers).
+that a whole ``retime`` runs on toppra (tests/retiming/test_topp_ra.py, bench/timing.py --solvers).
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ split of one step's stacked system into :func:`tracking_system` (the setup befor
 are cartesian's own, shared).
 
 ``tracking_interpolation_numpy`` has the signature and result of ``cartesian.tracking_interpolation``;
-``numpy_tracking()`` swaps it into the planner (``planning.waypoints``) for a block (tests/test_tracking_fit.py,
+``numpy_tracking()`` swaps it into the planner (``planning.waypoints``) for a block (tests/sim/test_tracking_fit.py,
 bench/tracking_fit.py).
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """An independent reference for the ZMP check (``_core.zmp_check``, reached through ``dynamics.stability``), for
-tests/test_path_check.py: nothing here calls snakehead's kinematics, momenta, lowest points or hulls.
+tests/collision/test_path_check.py: nothing here calls snakehead's kinematics, momenta, lowest points or hulls.
 
 * world link frames: pinocchio's forward kinematics of the robot's URDF, placed by the robot's root pose;
 * momenta: pinocchio's centroidal momentum (Eqs. 25-31 summed by another library), moved to the world origin;

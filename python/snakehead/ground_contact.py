@@ -1,4 +1,4 @@
-"""What counts as touching the ground, each tolerance defined once (tests/test_shared_numbers.py).
+"""What counts as touching the ground, each tolerance defined once (tests/package/test_shared_numbers.py).
 
 The planner's ground (the support polygon, the clearance checks, the whole-body solve's ground links) is exact: a
 link lies at height 0, and a millimetre separates touching from lifted. A body that is simulated or measured rocks

@@ -27,7 +27,7 @@ from .._validate import pose as check_pose
 from ..model.chain import Chain
 
 SOLVE_TYPES = ("Speed", "Distance", "Manip1", "Manip2")
-#: s: a solve's budget by default (TracIKOptions' in include/snakehead/trac_ik.hpp; tests/test_shared_numbers.py).
+#: s: a solve's budget by default (TracIKOptions' in include/snakehead/trac_ik.hpp; tests/package/test_shared_numbers.py).
 DEFAULT_TIMEOUT_S = 0.005
 #: The allowed residual per axis (m, rad) by default (TracIKOptions' too).
 DEFAULT_EPSILON = 1e-5

@@ -69,7 +69,7 @@ class BodyProblem:
         """Whether no pose of the lifted chain from the frame it lifts from in ``q`` at ``base`` (the links before
         it kept) puts the head at ``position`` along ``direction`` within the checks' tolerances: the first frame
         rigid with the tip is then farther from that frame than the chain between them
-        (``PoseBounds.out_of_reach``, its soundness tested in tests/test_reach_bounds.py). The lifted chain's IK
+        (``PoseBounds.out_of_reach``, its soundness tested in tests/solve/test_reach_bounds.py). The lifted chain's IK
         cannot succeed there either: its tolerance (``epsilon``, 1e-5 per axis) is inside the checks'."""
         origin = self.robot.frame(q, self.robot.lift_frame, base)[:3, 3]
         return bool(self.pose_bounds.out_of_reach(position, direction, origin)[0])

@@ -268,7 +268,7 @@ def tracking_interpolation(robot: SnakeRobot, q_start: npt.ArrayLike, q_end: npt
     keep their lengths), the fit is the closest in the least-squares sense; ``deviation`` says how far it is.
 
     The fit runs in the C++ core (:func:`tracking_fit`, ``_core.TrackingFit``; the GIL released), step for step as
-    the numpy reference does (tests/tracking_reference.py, tests/test_tracking_fit.py).
+    the numpy reference does (tests/tracking_reference.py, tests/sim/test_tracking_fit.py).
     """
     return tracking_interpolation_with(robot, q_start, q_end, n, base, _core_fit)
 

@@ -78,7 +78,7 @@ def plot_momenta(t: npt.ArrayLike, P: npt.ArrayLike, L: npt.ArrayLike, *, simula
 # The figures' margins and gaps (fractions of the figure, as subplots_adjust takes them): what tight_layout chose on
 # the paper's scenes, widened to the widest seen, set at once -- tight_layout measures every tick label by drawing
 # the figure, a third of the figure's time. Tick labels of any magnitude fit (the momenta's in scientific notation
-# have at most 5 characters; tests/test_viz.py checks that no text leaves the figure or overlaps another panel).
+# have at most 5 characters; tests/viz/test_viz.py checks that no text leaves the figure or overlaps another panel).
 MOMENTA_LAYOUT = dict(left=0.067, right=0.9885, bottom=0.097, wspace=0.32, hspace=0.19)
 ZMP_LAYOUT = dict(left=0.052, right=0.9885, bottom=0.108, top=0.881, wspace=0.13)
 

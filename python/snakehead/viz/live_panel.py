@@ -200,7 +200,7 @@ def errors_text(motion: LiveMotion, check: DynamicsCheck | None) -> str:
     return "\n".join(lines)
 
 
-#: JavaScript for measuring the viewer in a browser (tests/test_live_viewer.py, bench/live_latency.py): the time
+#: JavaScript for measuring the viewer in a browser (tests/viz/test_live_viewer.py, bench/live_latency.py): the time
 #: (Date.now(), ms) each "motion N playing" first appears in the panel, and the second frame painted after it.
 MOTION_WATCH_JS = """
 window.__motions = {};

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_reachable_plans import verify_plan
+from plan_verification import verify_plan
 
 import snakehead
 from snakehead import backbone, margins

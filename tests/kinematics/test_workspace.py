@@ -29,7 +29,7 @@ def small(small_map):
     return small_map
 
 
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def workspace_gen() -> str:

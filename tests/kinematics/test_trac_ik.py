@@ -428,7 +428,7 @@ def test_pose_and_start_forms_accepted(solver7, head7):
 def test_mixed_chain_with_continuous_and_prismatic_joints():
     # Unbounded (continuous) and prismatic joints; position-only target (all rotation bounds open).
     from pathlib import Path
-    chain = snakehead.Chain.from_urdf(Path(__file__).parent / "data" / "mixed_chain.urdf", "world", "tool")
+    chain = snakehead.Chain.from_urdf(Path(__file__).resolve().parents[1] / "data" / "mixed_chain.urdf", "world", "tool")
     assert "continuous" in chain.joint_types and "prismatic" in chain.joint_types
     ik = TracIK.from_chain(chain, timeout=0.02, bounds=[0, 0, 0, np.inf, np.inf, np.inf], seed=10)  # not the clock
     rng = np.random.default_rng(10)

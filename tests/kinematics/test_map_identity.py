@@ -25,7 +25,7 @@ from snakehead.model.robot_file import write_robot_file
 
 # Small maps of the default robot's 7-DOF head: about half a second each.
 SMALL = SMALL_MAP
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 POSE = ([0.2, 0.0, 0.1], [1.0, 0.0, 0.0])  # a pose in the head's base frame
 
 

@@ -18,7 +18,7 @@ from snakehead.app import cli
 from snakehead.kinematics import reachability as ws
 from snakehead.planning import whole_body_reach as rc
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = Path(snakehead.__file__).parent
 #: The header's name of each Python name.
 CPP_NAMES = {"MAX_TIMEOUT_S": "kMaxTimeoutSeconds", "MAX_URDF_BYTES": "kMaxUrdfBytes", "MAX_URDF_DEPTH": "kMaxUrdfDepth",

@@ -11,7 +11,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from test_reachable_plans import verify_plan
+from plan_verification import verify_plan
 
 import snakehead
 from snakehead.app import cli

@@ -42,7 +42,7 @@ def test_passes():
 
 @pytest.fixture
 def tests(pytester: pytest.Pytester) -> pytest.Pytester:
-    pytester.makeconftest(Path(__file__).with_name("conftest.py").read_text())
+    pytester.makeconftest((Path(__file__).resolve().parents[1] / "conftest.py").read_text())
     pytester.makepyfile(test_generated=TESTS)
     return pytester
 
@@ -75,7 +75,7 @@ def test_under_ci_a_missing_import_fails_naming_the_package(tests: pytest.Pytest
 
 def test_a_module_level_skip_under_ci_is_a_collection_error(pytester: pytest.Pytester,
                                                             monkeypatch: pytest.MonkeyPatch) -> None:
-    pytester.makeconftest(Path(__file__).with_name("conftest.py").read_text())
+    pytester.makeconftest((Path(__file__).resolve().parents[1] / "conftest.py").read_text())
     pytester.makepyfile(test_module_level="import pytest\n\npytest.importorskip('pinocchio_nowhere')\n\n\n"
                                           "def test_x():\n    pass\n")
     monkeypatch.delenv("CI", raising=False)

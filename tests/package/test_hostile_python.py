@@ -422,7 +422,7 @@ def test_maps_as_the_sweep_writes_them_load(tmp_path, options):
         whole = ws.merge([m, other])
         ws.save(whole, tmp_path / "whole.npz")
         assert np.array_equal(ws.load(tmp_path / "whole.npz").solved, whole.solved)
-    assert ws.load(Path(__file__).parent / "data" / "map_format1.npz").lacks == ("reached",)
+    assert ws.load(Path(__file__).resolve().parents[1] / "data" / "map_format1.npz").lacks == ("reached",)
 
 
 # --- finding 7: durations and sizes without end -------------------------------------------------------------

@@ -88,7 +88,7 @@ def test_generator_writes_the_default_robot():
     """urdf/generate_snake16.py writes the committed snake16.urdf with snake_urdf."""
     import importlib.util
 
-    urdf_dir = Path(__file__).resolve().parents[1] / "urdf"  # the source tree's (the script is not installed)
+    urdf_dir = Path(__file__).resolve().parents[2] / "urdf"  # the source tree's (the script is not installed)
     path = urdf_dir / "generate_snake16.py"
     spec = importlib.util.spec_from_file_location("generate_snake16", path)
     mod = importlib.util.module_from_spec(spec)

@@ -37,7 +37,7 @@ from snakehead import Infeasible, InputError, default_urdf_path
 from snakehead.model.generate import SnakeSpec, snake_urdf
 
 URDF = default_urdf_path()
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 SNAKE = snake_urdf(SnakeSpec(n_joints=8, markers={"p0": 3, "b0": 4}))  # a small robot: quick to parse and solve
 SNAKE_FRAMES = {"base_end": "p0", "neck_end": "b0", "head_tip": "head_tip"}
 CALL_TIMEOUT_S = 120.0  # a case that has not returned by then hangs (the slowest valid case takes ~10 s)

@@ -21,7 +21,7 @@ from snakehead.geometry.shapes import pair_distances
 from snakehead.samples import published
 from snakehead.trajectory import cartesian
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from tracking_reference import tracking_system  # noqa: E402
 
 STYLES = ["default", "sea", "mesh", "rsnake", "head6"]
@@ -169,7 +169,7 @@ def one_sided_gradients(obj, x, q_lin, target, current, pairs, h=1e-7) -> tuple[
 
 
 def distance_accuracy(obj, pair) -> float:
-    """m: how close the core's signed distance of a pair is to the exact one (tests/test_shape_set.py's bounds: ~1e-6
+    """m: how close the core's signed distance of a pair is to the exact one (tests/geometry/test_shape_set.py's bounds: ~1e-6
     on polytopes and spheres; libccd's GJK and EPA on a cylinder stop up to 5e-6 and 3e-5 short)."""
     return 3e-5 if "cylinder" in (obj.shapes[pair[0]].kind, obj.shapes[pair[1]].kind) else 1e-6
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_reachable_plans import verify_plan
+from plan_verification import verify_plan
 
 import snakehead
 from snakehead.margins import ZMP_MARGIN
@@ -25,7 +25,7 @@ from snakehead.planning import fallbacks
 from snakehead.retiming.timing import ACCELERATION_LIMIT
 from snakehead.samples.targets import reachable_targets
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 from _robots import reu_as_written  # noqa: E402
 
 

@@ -3,7 +3,7 @@
 * Scene files written by :func:`snakehead.scenes.save_scene` read back as the same scene.
 * The Python API of :class:`snakehead.viz.live.LiveViewer` (what a release of a gizmo does, without a mouse): one
   viewer for the module, planning short motions of the default robot.
-* A real browser (Debian's headless Chromium, as ``tests/test_viewer.py`` drives it): the page draws the robot,
+* A real browser (Debian's headless Chromium, as ``tests/viz/test_viewer.py`` drives it): the page draws the robot,
   and moving a target through the API makes a new motion that reaches the page. The latency from the request to
   the browser showing the new motion is printed (measured, never asserted: speed is measured in
   ``bench/live_latency.py``).
@@ -287,7 +287,7 @@ def wait_in_page(driver, number: int, timeout: float = 60.0) -> dict:
 
 
 def test_the_page_draws_the_robot_and_a_moved_target_plays_there(live):
-    from test_viewer import _chromium, _hue_mask, _screenshot  # the browser as tests/test_viewer.py drives it
+    from test_viewer import _chromium, _hue_mask, _screenshot  # the browser as tests/viz/test_viewer.py drives it
 
     from snakehead.viz.viewer import rgb255
 
