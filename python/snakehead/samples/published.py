@@ -45,18 +45,36 @@ split between its links by length); marker frames are links without geometry hun
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
-from xml.sax.saxutils import quoteattr
+from typing import Any, Callable
 
+from .._errors import InputError, InputTypeError
 from .._validate import finite_float
 from ..model.generate import SnakeSpec, holding_effort, snake_urdf
-from .._errors import InputError, InputTypeError
+from .urdf_text import (
+    box_inertia,
+    cylinder,
+    cylinder_inertia,
+    fixed_joint,
+    inertial,
+    link,
+    mesh,
+    moving_joint,
+    robot,
+    shape,
+    sphere,
+    write_robot_file,
+)
+
+__all__ = [
+    "STYLES", "QUIRK_STYLES", "ALL_STYLES", "HALF_PI", "StyleSpec", "DEFAULT_SPECS", "style_spec", "write_robot",
+    "parts_comment", "snake_spec", "SEA_TAIL_MESH", "REU_THIRDS", "reu_urdf", "reu_robot_file", "XACRO_DEFAULT_MODULES",
+    "reu_xacro", "RSNAKE_VISUAL_MESH", "MESH_OBJ_LINK", "MESH_DAE_LINK", "MM",
+]
 
 STYLES = ("sea", "reu", "rsnake", "mesh", "xacro", "one_joint_neck", "head6")
 #: Styles with the quirks of descriptions found in public repositories (published_quirks.py).
@@ -64,8 +82,6 @@ QUIRK_STYLES = ("cad", "reu_reversed", "wheeled", "cmu_masses", "backwards_head"
 ALL_STYLES = STYLES + QUIRK_STYLES
 
 HALF_PI = math.pi / 2
-
-Vec3 = Sequence[float]
 
 
 @dataclass(frozen=True)
@@ -177,116 +193,9 @@ def write_robot(style: str, folder: str | os.PathLike, **overrides: Any) -> Path
     return _WRITERS[style](spec, out)
 
 
-# --- XML pieces --------------------------------------------------------------------------------------------------
-def _num(x: float) -> str:
-    # Python's shortest text that reads back as the same double: two writers of one snake agree exactly.
-    text = repr(float(x))
-    return text[:-2] if text.endswith(".0") else text
-
-
-def _vec(v: Vec3) -> str:
-    return " ".join(_num(c) for c in v)
-
-
-def _origin(xyz: Vec3 = (0, 0, 0), rpy: Vec3 = (0, 0, 0)) -> str:
-    return f'<origin xyz="{_vec(xyz)}" rpy="{_vec(rpy)}"/>'
-
-
-def _box(size: Vec3) -> str:
-    return f'<box size="{_vec(size)}"/>'
-
-
-def _cylinder(radius: float, length: float) -> str:
-    return f'<cylinder radius="{_num(radius)}" length="{_num(length)}"/>'
-
-
-def _sphere(radius: float) -> str:
-    return f'<sphere radius="{_num(radius)}"/>'
-
-
-def _mesh(filename: str, scale: float = 1.0) -> str:
-    scale_attr = "" if scale == 1.0 else f' scale="{_vec((scale, scale, scale))}"'
-    return f"<mesh filename={quoteattr(filename)}{scale_attr}/>"
-
-
-def _shape(kind: str, geometry: str, xyz: Vec3 = (0, 0, 0), rpy: Vec3 = (0, 0, 0)) -> str:
-    """A ``<visual>`` or ``<collision>`` element."""
-    return f"    <{kind}>\n      {_origin(xyz, rpy)}\n      <geometry>{geometry}</geometry>\n    </{kind}>\n"
-
-
-def _inertial(mass: float, com: Vec3, diagonal: Vec3) -> str:
-    ixx, iyy, izz = diagonal
-    return (f"    <inertial>\n      {_origin(com)}\n      <mass value=\"{_num(mass)}\"/>\n"
-            f"      <inertia ixx=\"{_num(ixx)}\" ixy=\"0\" ixz=\"0\" iyy=\"{_num(iyy)}\" iyz=\"0\" izz=\"{_num(izz)}\"/>\n"
-            f"    </inertial>\n")
-
-
-def _cylinder_inertia(mass: float, radius: float, length: float, along: int) -> tuple[float, float, float]:
-    """Principal inertias of a solid cylinder whose axis is link axis ``along`` (0 x, 1 y, 2 z)."""
-    axial = mass * radius * radius / 2
-    transverse = mass * (3 * radius * radius + length * length) / 12
-    diagonal = [transverse] * 3
-    diagonal[along] = axial
-    return diagonal[0], diagonal[1], diagonal[2]
-
-
-def _box_inertia(mass: float, size: Vec3) -> tuple[float, float, float]:
-    x, y, z = size
-    return mass * (y * y + z * z) / 12, mass * (x * x + z * z) / 12, mass * (x * x + y * y) / 12
-
-
-def _link(name: str, body: str = "") -> str:
-    if not body:
-        return f"  <link name={quoteattr(name)}/>\n"
-    return f"  <link name={quoteattr(name)}>\n{body}  </link>\n"
-
-
-def _fixed_joint(name: str, parent: str, child: str, xyz: Vec3 = (0, 0, 0), rpy: Vec3 = (0, 0, 0)) -> str:
-    return (f"  <joint name={quoteattr(name)} type=\"fixed\">\n    <parent link={quoteattr(parent)}/>\n"
-            f"    <child link={quoteattr(child)}/>\n    {_origin(xyz, rpy)}\n  </joint>\n")
-
-
-def _moving_joint(name: str, parent: str, child: str, xyz: Vec3, rpy: Vec3, axis: str, spec: StyleSpec,
-                  effort: float, continuous: bool = False) -> str:
-    # A continuous joint keeps its effort and velocity in <limit>, its range only in the robot file's [limits].
-    bounds = "" if continuous else f'lower="{_num(-spec.limit)}" upper="{_num(spec.limit)}" '
-    return (f"  <joint name={quoteattr(name)} type=\"{'continuous' if continuous else 'revolute'}\">\n"
-            f"    <parent link={quoteattr(parent)}/>\n    <child link={quoteattr(child)}/>\n"
-            f"    {_origin(xyz, rpy)}\n    <axis xyz=\"{axis}\"/>\n"
-            f"    <limit {bounds}effort=\"{_num(effort)}\" velocity=\"{_num(spec.velocity)}\"/>\n  </joint>\n")
-
-
-def _robot(name: str, comment: str, body: Sequence[str], namespaces: str = "") -> str:
-    return ('<?xml version="1.0"?>\n' + f"<!-- {comment.replace('--', '- -')} -->\n"
-            + f"<robot name={quoteattr(name)}{namespaces}>\n" + "".join(body) + "</robot>\n")
-
-
-# --- robot files -------------------------------------------------------------------------------------------------
-def _toml_value(v: Any) -> str:
-    if isinstance(v, str):
-        return json.dumps(v)  # a JSON string is a valid TOML basic string (same escapes)
-    if isinstance(v, bool) or not isinstance(v, (int, float, list, tuple)):
-        raise InputTypeError(f"cannot write {v!r} to a robot file")
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    return repr(finite_float(v, "value")) if isinstance(v, float) else str(v)
-
-
-def _write_robot_file(path: Path, comment: str, keys: dict[str, Any], tables: dict[str, dict[str, Any]]) -> Path:
-    """A robot file: ``keys`` (None values left out), then each non-empty table of ``tables``."""
-    lines = [f"# {line}" for line in comment.splitlines()]
-    lines += [f"{k} = {_toml_value(v)}" for k, v in keys.items() if v is not None and not isinstance(v, dict)]
-    for k, v in keys.items():
-        if isinstance(v, dict):
-            lines.append(f"{k} = {{ " + ", ".join(f"{json.dumps(a)} = {_toml_value(b)}" for a, b in v.items()) + " }")
-    for table, entries in tables.items():
-        if entries:
-            lines += ["", f"[{table}]"] + [f"{json.dumps(a)} = {_toml_value(b)}" for a, b in entries.items()]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
-
-
-def _parts_comment(spec: StyleSpec) -> str:
+# --- the styles' shared pieces (their URDF and robot-file text: urdf_text.py) ------------------------------------
+def parts_comment(spec: StyleSpec) -> str:
+    """The description's comment on the parts of ``spec``: each part's joints, the modules' length, mass, limit."""
     return (f"parts: base {spec.base_joints} joints, neck {spec.neck_joints}, head {spec.head_joints}; "
             f"modules {spec.module_length:g} m, {spec.mass_per_module:g} kg, +-{spec.joint_limit_deg:g} deg")
 
@@ -311,39 +220,39 @@ def _write_sea(spec: StyleSpec, folder: Path) -> Path:
     effort = spec.servo_effort(tail_length + spec.n_joints * L)
     _write_tail_mesh(folder / SEA_TAIL_MESH, r, tail_length)
     along_z = (0.0, 0.0, half / 2)
-    parts = [_link("kdl_dummy_root"),
+    parts = [link("kdl_dummy_root"),
              # The published description turns the chain so that its modules' z runs along the root's -x.
-             _fixed_joint("kdl_dummy_root_to_tail", "kdl_dummy_root", "tail", rpy=(0, -HALF_PI, 0)),
-             _link("tail", _inertial(spec.mass(tail_length), (0, 0, tail_length / 2),
-                                     _cylinder_inertia(spec.mass(tail_length), r, tail_length, 2))
-                   + _shape("visual", _mesh("package://sea_snake/" + SEA_TAIL_MESH))
-                   + _shape("collision", _mesh("package://sea_snake/" + SEA_TAIL_MESH)))]
+             fixed_joint("kdl_dummy_root_to_tail", "kdl_dummy_root", "tail", rpy=(0, -HALF_PI, 0)),
+             link("tail", inertial(spec.mass(tail_length), (0, 0, tail_length / 2),
+                                   cylinder_inertia(spec.mass(tail_length), r, tail_length, 2))
+                  + shape("visual", mesh("package://sea_snake/" + SEA_TAIL_MESH))
+                  + shape("collision", mesh("package://sea_snake/" + SEA_TAIL_MESH)))]
     parent, offset = "tail", tail_length
-    cylinder_half = _inertial(spec.mass(half), along_z, _cylinder_inertia(spec.mass(half), r, half, 2))
-    cylinder_half += _shape("visual", _cylinder(r, half), along_z) + _shape("collision", _cylinder(r, half), along_z)
+    cylinder_half = inertial(spec.mass(half), along_z, cylinder_inertia(spec.mass(half), r, half, 2))
+    cylinder_half += shape("visual", cylinder(r, half), along_z) + shape("collision", cylinder(r, half), along_z)
     for k in range(1, spec.n_joints + 1):
         body, output = f"module{k}__body", f"module{k}__output"
         # Every axis is the module's x; each module's frame turns 90 deg about the body (z) from the last one's,
         # so the axes alternate between yaw and pitch.
         twist = 0.0 if k == 1 else HALF_PI
-        parts += [_moving_joint(f"module{k}__joint", parent, body, (0, 0, offset), (0, 0, twist), "1 0 0", spec,
-                                effort),
-                  _link(body, cylinder_half),
-                  _fixed_joint(f"module{k}__body_to_output", body, output, (0, 0, half)),
-                  _link(output, cylinder_half)]
+        parts += [moving_joint(f"module{k}__joint", parent, body, (0, 0, offset), (0, 0, twist), "1 0 0",
+                               spec.limit, effort, spec.velocity),
+                  link(body, cylinder_half),
+                  fixed_joint(f"module{k}__body_to_output", body, output, (0, 0, half)),
+                  link(output, cylinder_half)]
         parent, offset = output, half
         marker = _boundary_after(spec, k)
         if marker:
-            parts += [_fixed_joint(f"{marker}_joint", parent, marker, (0, 0, offset)), _link(marker)]
+            parts += [fixed_joint(f"{marker}_joint", parent, marker, (0, 0, offset)), link(marker)]
             parent, offset = marker, 0.0
-    parts += [_fixed_joint("head_tip_joint", parent, "head_tip", (0, 0, offset)), _link("head_tip")]
+    parts += [fixed_joint("head_tip_joint", parent, "head_tip", (0, 0, offset)), link("head_tip")]
     urdf = folder / "sea_snake.urdf"
-    urdf.write_text(_robot(spec.name, f"{spec.name}: SEA-snake style sample robot written by snakehead.model."
-                                      f"published; {_parts_comment(spec)}", parts), encoding="utf-8")
-    return _write_robot_file(folder / "sea_snake.toml", "SEA-snake style: dummy root, modules along z, head's z",
-                             {"urdf": urdf.name, "root": "kdl_dummy_root", "base_end": "base_end",
-                              "neck_end": "neck_end", "head_tip": "head_tip", "head_axis": "z"},
-                             {"packages": {"sea_snake": "."}})
+    urdf.write_text(robot(spec.name, f"{spec.name}: SEA-snake style sample robot written by snakehead.model."
+                                     f"published; {parts_comment(spec)}", parts), encoding="utf-8")
+    return write_robot_file(folder / "sea_snake.toml", "SEA-snake style: dummy root, modules along z, head's z",
+                            {"urdf": urdf.name, "root": "kdl_dummy_root", "base_end": "base_end",
+                             "neck_end": "neck_end", "head_tip": "head_tip", "head_axis": "z"},
+                            {"packages": {"sea_snake": "."}})
 
 
 def _write_tail_mesh(path: Path, radius: float, length: float) -> None:
@@ -368,9 +277,9 @@ def _reu_axis(joint: int) -> str:
 def _cylinder_along_x(spec: StyleSpec, length: float) -> str:
     centre = (length / 2, 0.0, 0.0)
     # A URDF cylinder runs along its own z: turned by 90 deg about y it runs along the link's x.
-    shape = _cylinder(spec.radius, length)
-    return (_inertial(spec.mass(length), centre, _cylinder_inertia(spec.mass(length), spec.radius, length, 0))
-            + _shape("visual", shape, centre, (0, HALF_PI, 0)) + _shape("collision", shape, centre, (0, HALF_PI, 0)))
+    tube = cylinder(spec.radius, length)
+    return (inertial(spec.mass(length), centre, cylinder_inertia(spec.mass(length), spec.radius, length, 0))
+            + shape("visual", tube, centre, (0, HALF_PI, 0)) + shape("collision", tube, centre, (0, HALF_PI, 0)))
 
 
 def reu_urdf(spec: StyleSpec) -> str:
@@ -378,37 +287,39 @@ def reu_urdf(spec: StyleSpec) -> str:
     L = spec.module_length
     tail_length = L / 2
     effort = spec.servo_effort(tail_length + spec.n_joints * L)
-    parts = [_link("reu_tail", _cylinder_along_x(spec, tail_length))]
+    parts = [link("reu_tail", _cylinder_along_x(spec, tail_length))]
     parent, offset = "reu_tail", tail_length
     for k in range(1, spec.n_joints + 1):
         names = [f"reu_module_{part}_{k}" for part, _ in REU_THIRDS]
         lengths = [share * L for _, share in REU_THIRDS]
-        parts.append(_moving_joint(f"reu_joint_{k}", parent, names[0], (offset, 0, 0), (0, 0, 0), _reu_axis(k), spec,
-                                   effort))
+        parts.append(moving_joint(f"reu_joint_{k}", parent, names[0], (offset, 0, 0), (0, 0, 0), _reu_axis(k),
+                                  spec.limit, effort, spec.velocity))
         for i, (name, length) in enumerate(zip(names, lengths)):
-            parts.append(_link(name, _cylinder_along_x(spec, length)))
+            parts.append(link(name, _cylinder_along_x(spec, length)))
             if i + 1 < len(names):
-                parts.append(_fixed_joint(f"{name}_to_{REU_THIRDS[i + 1][0]}", name, names[i + 1], (length, 0, 0)))
+                parts.append(fixed_joint(f"{name}_to_{REU_THIRDS[i + 1][0]}", name, names[i + 1], (length, 0, 0)))
         parent, offset = names[-1], lengths[-1]
         marker = _boundary_after(spec, k)
         if marker:
-            parts += [_fixed_joint(f"{marker}_joint", parent, marker, (offset, 0, 0)), _link(marker)]
+            parts += [fixed_joint(f"{marker}_joint", parent, marker, (offset, 0, 0)), link(marker)]
             parent, offset = marker, 0.0
-    parts += [_fixed_joint("head_tip_joint", parent, "head_tip", (offset, 0, 0)), _link("head_tip")]
-    return _robot(spec.name, f"{spec.name}: ReU-snake style sample robot written by snakehead.samples.published; "
-                             f"{_parts_comment(spec)}", parts)
+    parts += [fixed_joint("head_tip_joint", parent, "head_tip", (offset, 0, 0)), link("head_tip")]
+    return robot(spec.name, f"{spec.name}: ReU-snake style sample robot written by snakehead.samples.published; "
+                            f"{parts_comment(spec)}", parts)
 
 
-def _reu_robot_file(folder: Path, stem: str, description: str, xacro_args: dict[str, Any] | None = None) -> Path:
-    return _write_robot_file(folder / f"{stem}.toml", "ReU-snake style: three links per module, modules along x",
-                             {"urdf": description, "xacro_args": xacro_args, "root": "reu_tail",
-                              "base_end": "base_end", "neck_end": "neck_end", "head_tip": "head_tip"}, {})
+def reu_robot_file(folder: Path, stem: str, description: str, xacro_args: dict[str, Any] | None = None) -> Path:
+    """Write the ReU-style snake's robot file ``folder/stem.toml`` for the description file ``description`` (a URDF,
+    or a xacro file expanded with ``xacro_args``); return its path."""
+    return write_robot_file(folder / f"{stem}.toml", "ReU-snake style: three links per module, modules along x",
+                            {"urdf": description, "xacro_args": xacro_args, "root": "reu_tail",
+                             "base_end": "base_end", "neck_end": "neck_end", "head_tip": "head_tip"}, {})
 
 
 def _write_reu(spec: StyleSpec, folder: Path) -> Path:
     urdf = folder / "reu_snake.urdf"
     urdf.write_text(reu_urdf(spec), encoding="utf-8")
-    return _reu_robot_file(folder, "reu_snake", urdf.name)
+    return reu_robot_file(folder, "reu_snake", urdf.name)
 
 
 # --- "xacro": the ReU snake as a xacro macro (published_xacro.py) -----------------------------------------------------
@@ -440,31 +351,31 @@ def _write_rsnake(spec: StyleSpec, folder: Path) -> Path:
     effort = spec.servo_effort((spec.n_joints + 1) * L)
     centre = (0.0, L / 2, 0.0)
     # The cylinder (along its z) is turned 90 deg about x to run along the module (y), centred mid-module.
-    module_body = (_inertial(spec.mass(L), centre, _cylinder_inertia(spec.mass(L), r, L, 1))
-                   + _shape("visual", _mesh(RSNAKE_VISUAL_MESH, 0.001))
-                   + _shape("collision", _cylinder(r, L), centre, (HALF_PI, 0, 0)))
-    parts = [_link("module_0", module_body)]
+    module_body = (inertial(spec.mass(L), centre, cylinder_inertia(spec.mass(L), r, L, 1))
+                   + shape("visual", mesh(RSNAKE_VISUAL_MESH, 0.001))
+                   + shape("collision", cylinder(r, L), centre, (HALF_PI, 0, 0)))
+    parts = [link("module_0", module_body)]
     parent, offset = "module_0", L
     for k in range(1, spec.n_joints + 1):
         axis = "0 0 1" if k % 2 == 1 else "1 0 0"  # yaw (up), pitch (across the body)
-        parts += [_moving_joint(f"module_{k}_joint", parent, f"module_{k}", (0, offset, 0), (0, 0, 0), axis, spec,
-                                effort),
-                  _link(f"module_{k}", module_body)]
+        parts += [moving_joint(f"module_{k}_joint", parent, f"module_{k}", (0, offset, 0), (0, 0, 0), axis,
+                               spec.limit, effort, spec.velocity),
+                  link(f"module_{k}", module_body)]
         parent, offset = f"module_{k}", L
         marker = _boundary_after(spec, k)
         if marker:
-            parts += [_fixed_joint(f"{marker}_joint", parent, marker, (0, offset, 0)), _link(marker)]
+            parts += [fixed_joint(f"{marker}_joint", parent, marker, (0, offset, 0)), link(marker)]
             parent, offset = marker, 0.0
     # A head frame turned so that its x runs along the body (y), as a camera frame would be added.
-    parts += [_fixed_joint("head_tip_joint", parent, "head_tip", (0, offset, 0), (0, 0, HALF_PI)), _link("head_tip")]
+    parts += [fixed_joint("head_tip_joint", parent, "head_tip", (0, offset, 0), (0, 0, HALF_PI)), link("head_tip")]
     urdf = folder / "rsnake.urdf"
-    urdf.write_text(_robot(spec.name, f"{spec.name}: HEBI R8 (RSNAKE) style sample robot written by snakehead.model."
-                                      f"published; visual meshes deliberately absent; {_parts_comment(spec)}", parts),
+    urdf.write_text(robot(spec.name, f"{spec.name}: HEBI R8 (RSNAKE) style sample robot written by snakehead.model."
+                                     f"published; visual meshes deliberately absent; {parts_comment(spec)}", parts),
                     encoding="utf-8")
     # The visual meshes' package is known but its files are not there: a loader must not need visuals.
-    return _write_robot_file(folder / "rsnake.toml", "RSNAKE style: modules along y, offset cylinders, no root key",
-                             {"urdf": urdf.name, "base_end": "base_end", "neck_end": "neck_end",
-                              "head_tip": "head_tip"}, {"packages": {"rsnake_description": "."}})
+    return write_robot_file(folder / "rsnake.toml", "RSNAKE style: modules along y, offset cylinders, no root key",
+                            {"urdf": urdf.name, "base_end": "base_end", "neck_end": "neck_end",
+                             "head_tip": "head_tip"}, {"packages": {"rsnake_description": "."}})
 
 
 # --- "mesh": SolidWorks export -----------------------------------------------------------------------------------
@@ -475,15 +386,15 @@ MESH_DAE_LINK = 3
 MM = 0.001
 
 
-def _mesh_file(link: int) -> tuple[str, str]:
-    """(file name, trimesh file type) of link ``link``'s collision mesh: binary STL on even links, ASCII STL on
-    odd ones, one OBJ, one COLLADA (DAE)."""
-    if link == MESH_OBJ_LINK:
-        return f"link{link}.obj", "obj"
-    if link == MESH_DAE_LINK:
-        return f"link{link}.dae", "dae"
-    name = "base_link" if link == 0 else f"link{link}"
-    return f"{name}.STL", "stl" if link % 2 == 0 else "stl_ascii"
+def _mesh_file(index: int) -> tuple[str, str]:
+    """(file name, trimesh file type) of link ``index``'s collision mesh (0: base_link): binary STL on even links,
+    ASCII STL on odd ones, one OBJ, one COLLADA (DAE)."""
+    if index == MESH_OBJ_LINK:
+        return f"link{index}.obj", "obj"
+    if index == MESH_DAE_LINK:
+        return f"link{index}.dae", "dae"
+    name = "base_link" if index == 0 else f"link{index}"
+    return f"{name}.STL", "stl" if index % 2 == 0 else "stl_ascii"
 
 
 def _write_link_mesh(path: Path, file_type: str, length: float, section: float, head: bool, scale: float) -> None:
@@ -491,14 +402,14 @@ def _write_link_mesh(path: Path, file_type: str, length: float, section: float, 
 
     if head:
         # A rounded head: a capsule along x whose ends reach the link's two ends.
-        shape = trimesh.creation.capsule(height=max(length - section, 1e-3), radius=section / 2)
-        shape.apply_transform(trimesh.transformations.rotation_matrix(HALF_PI, (0, 1, 0)))
+        solid = trimesh.creation.capsule(height=max(length - section, 1e-3), radius=section / 2)
+        solid.apply_transform(trimesh.transformations.rotation_matrix(HALF_PI, (0, 1, 0)))
     else:
-        shape = trimesh.creation.box(extents=(length, section, section))
-    shape.apply_translation((length / 2, 0, 0))
-    shape.apply_scale(1 / scale)
+        solid = trimesh.creation.box(extents=(length, section, section))
+    solid.apply_translation((length / 2, 0, 0))
+    solid.apply_scale(1 / scale)
     path.parent.mkdir(parents=True, exist_ok=True)
-    shape.export(path, file_type=file_type)
+    solid.export(path, file_type=file_type)
 
 
 def _write_mesh(spec: StyleSpec, folder: Path) -> Path:
@@ -516,32 +427,35 @@ def _write_mesh(spec: StyleSpec, folder: Path) -> Path:
         reference = f"package://cad_snake/meshes/{file_name}" if i % 2 == 0 else f"meshes/{file_name}"
         m = spec.mass(length)
         centre = (length / 2, 0.0, 0.0)
-        parts.append(_link(name, _inertial(m, centre, _box_inertia(m, (length, s, s)))
-                           + _shape("visual", _mesh(reference, scale)) + _shape("collision", _mesh(reference, scale))))
+        parts.append(link(name, inertial(m, centre, box_inertia(m, (length, s, s)))
+                          + shape("visual", mesh(reference, scale)) + shape("collision", mesh(reference, scale))))
     parent, offset = names[0], lengths[0]
     for k in range(1, n + 1):
         axis = "0 0 1" if k % 2 == 1 else "0 1 0"
-        parts.append(_moving_joint(f"joint{k}", parent, names[k], (offset, 0, 0), (0, 0, 0), axis, spec, effort,
-                                   continuous=True))
+        parts.append(moving_joint(f"joint{k}", parent, names[k], (offset, 0, 0), (0, 0, 0), axis, spec.limit, effort,
+                                  spec.velocity, continuous=True))
         limits[f"joint{k}"] = [-spec.limit, spec.limit]
         parent, offset = names[k], lengths[k]
         marker = _boundary_after(spec, k)
         if marker:
-            parts += [_fixed_joint(f"{marker}_joint", parent, marker, (offset, 0, 0)), _link(marker)]
+            parts += [fixed_joint(f"{marker}_joint", parent, marker, (offset, 0, 0)), link(marker)]
             parent, offset = marker, 0.0
-    parts += [_fixed_joint("head_tip_joint", parent, "head_tip", (offset, 0, 0)), _link("head_tip")]
+    parts += [fixed_joint("head_tip_joint", parent, "head_tip", (offset, 0, 0)), link("head_tip")]
     urdf = folder / "cad_snake.urdf"
-    urdf.write_text(_robot(spec.name, f"{spec.name}: SolidWorks-export style sample robot written by snakehead.model."
-                                      f"published; collision meshes, continuous joints; {_parts_comment(spec)}",
-                           parts), encoding="utf-8")
-    return _write_robot_file(folder / "cad_snake.toml", "CAD export style: mesh collisions, continuous joints",
-                             {"urdf": urdf.name, "root": "base_link", "base_end": "base_end",
-                              "neck_end": "neck_end", "head_tip": "head_tip"},
-                             {"packages": {"cad_snake": "."}, "limits": limits})
+    urdf.write_text(robot(spec.name, f"{spec.name}: SolidWorks-export style sample robot written by snakehead.model."
+                                     f"published; collision meshes, continuous joints; {parts_comment(spec)}",
+                          parts), encoding="utf-8")
+    return write_robot_file(folder / "cad_snake.toml", "CAD export style: mesh collisions, continuous joints",
+                            {"urdf": urdf.name, "root": "base_link", "base_end": "base_end",
+                             "neck_end": "neck_end", "head_tip": "head_tip"},
+                            {"packages": {"cad_snake": "."}, "limits": limits})
 
 
 # --- "one_joint_neck" and "head6": the default convention --------------------------------------------------------
-def _snake_spec(spec: StyleSpec, first_axis: str = "yaw") -> SnakeSpec:
+def snake_spec(spec: StyleSpec, first_axis: str = "yaw") -> SnakeSpec:
+    """``spec`` as the default convention's :class:`~snakehead.model.generate.SnakeSpec` (for
+    :func:`~snakehead.model.generate.snake_urdf`), its marker frames ``base_end`` and ``neck_end`` between the parts;
+    joint 1's axis is ``first_axis``."""
     return SnakeSpec(n_joints=spec.n_joints, module_length=spec.module_length, section=spec.thickness,
                      mass_per_module=spec.mass_per_module, joint_limit_deg=spec.joint_limit_deg, effort=spec.effort,
                      velocity=spec.velocity, name=spec.name, first_axis=first_axis,
@@ -549,34 +463,34 @@ def _snake_spec(spec: StyleSpec, first_axis: str = "yaw") -> SnakeSpec:
 
 
 def _default_robot_file(folder: Path, stem: str, urdf: str, comment: str) -> Path:
-    return _write_robot_file(folder / f"{stem}.toml", comment,
-                             {"urdf": urdf, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
-                              "head_tip": "head_tip"}, {})
+    return write_robot_file(folder / f"{stem}.toml", comment,
+                            {"urdf": urdf, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
+                             "head_tip": "head_tip"}, {})
 
 
 def _write_one_joint_neck(spec: StyleSpec, folder: Path) -> Path:
     urdf = folder / "snake_one_joint_neck.urdf"
     # the neck's one joint pitches (it lifts the head's base): the axes alternate from whichever joint 1 needs
     first = "pitch" if spec.base_joints % 2 == 0 else "yaw"
-    urdf.write_text(snake_urdf(_snake_spec(spec, first)), encoding="utf-8")
+    urdf.write_text(snake_urdf(snake_spec(spec, first)), encoding="utf-8")
     return _default_robot_file(folder, "snake_one_joint_neck", urdf.name, "default convention, one-joint neck")
 
 
 def _with_sphere_head(urdf: str, head_link: str, length: float, radius: float) -> str:
     """``urdf`` with the collision of ``head_link`` (a link along x of ``length`` m) replaced by two spheres."""
     root = ET.fromstring(urdf)
-    link = root.find(f"link[@name='{head_link}']")
-    if link is None:
+    head = root.find(f"link[@name='{head_link}']")
+    if head is None:
         raise InputError(f"no link {head_link!r}")
-    for old in link.findall("collision"):
-        link.remove(old)
+    for old in head.findall("collision"):
+        head.remove(old)
     for x in (length / 4, 3 * length / 4):
-        link.append(ET.fromstring(_shape("collision", _sphere(radius), (x, 0, 0)).strip()))
+        head.append(ET.fromstring(shape("collision", sphere(radius), (x, 0, 0)).strip()))
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
 def _write_head6(spec: StyleSpec, folder: Path) -> Path:
-    snake = _snake_spec(spec)
+    snake = snake_spec(spec)
     urdf = folder / "snake_head6.urdf"
     urdf.write_text(_with_sphere_head(snake_urdf(snake), f"link_{spec.n_joints}", snake.link_length(spec.n_joints),
                                       spec.thickness / 2), encoding="utf-8")

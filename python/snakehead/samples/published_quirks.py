@@ -33,7 +33,22 @@ import numpy as np
 
 from .._errors import InputError
 from ..model.generate import snake_urdf
-from .published import HALF_PI, _box_inertia, _cylinder, _cylinder_inertia, _fixed_joint, _inertial, _link, _mesh, _moving_joint, _num, _parts_comment, _robot, _shape, _snake_spec, _vec, _write_robot_file, reu_urdf
+from .published import HALF_PI, parts_comment, reu_urdf, snake_spec
+from .urdf_text import (
+    box_inertia,
+    cylinder,
+    cylinder_inertia,
+    fixed_joint,
+    inertial,
+    link,
+    mesh,
+    moving_joint,
+    num,
+    robot,
+    shape,
+    vec,
+    write_robot_file,
+)
 
 if TYPE_CHECKING:
     from .published import StyleSpec
@@ -76,8 +91,8 @@ def _stl_box(path: Path, extents: tuple[float, float, float], centre: np.ndarray
 
 
 def _inertial_full(mass: float, com: tuple[float, ...] | np.ndarray, inertia: dict[str, float]) -> str:
-    values = " ".join(f'{k}="{_num(v)}"' for k, v in inertia.items())
-    return (f"    <inertial>\n      <origin xyz=\"{_vec(tuple(float(c) for c in com))}\" rpy=\"0 0 0\"/>\n      <mass value=\"{_num(mass)}\"/>\n"
+    values = " ".join(f'{k}="{num(v)}"' for k, v in inertia.items())
+    return (f"    <inertial>\n      <origin xyz=\"{vec(tuple(float(c) for c in com))}\" rpy=\"0 0 0\"/>\n      <mass value=\"{num(mass)}\"/>\n"
             f"      <inertia {values}/>\n    </inertial>\n")
 
 
@@ -107,41 +122,42 @@ def _write_cad(spec: StyleSpec, folder: Path) -> Path:
         _stl_box(folder / mesh_name, (length, s, s), centre)
         mass = spec.mass(length) - (collar_mass if k % 4 == 2 else 0.0) - (mount_mass if k % 4 == 3 else 0.0)
         reference = f"package://cad_snake_sw/{mesh_name}"
-        parts.append(_link(name, _inertial(mass, centre, _box_inertia(mass, (length, s, s)))
-                           + _shape("visual", _mesh(reference)) + _shape("collision", _mesh(reference))))
+        parts.append(link(name, inertial(mass, centre, box_inertia(mass, (length, s, s)))
+                          + shape("visual", mesh(reference)) + shape("collision", mesh(reference))))
         if k % 4 == 2:  # a sensor collar round the module's middle, mounted half a turn about the body's axis
-            parts += [_fixed_joint(f"collar{k}_joint", name, f"collar{k}", centre, (0, 0, 0)),
-                      _link(f"collar{k}", _inertial(collar_mass, (0, 0, 0),
-                                                    _cylinder_inertia(collar_mass, s / 2, 0.012, 0))
-                            + _shape("collision", _cylinder(s / 2, 0.012), (0, 0, 0), (0, HALF_PI, 0)))]
+            parts += [fixed_joint(f"collar{k}_joint", name, f"collar{k}", centre, (0, 0, 0)),
+                      link(f"collar{k}", inertial(collar_mass, (0, 0, 0),
+                                                  cylinder_inertia(collar_mass, s / 2, 0.012, 0))
+                           + shape("collision", cylinder(s / 2, 0.012), (0, 0, 0), (0, HALF_PI, 0)))]
             parts[-2] = parts[-2].replace('rpy="0 0 0"', f'rpy="{CAD_COLLAR_TURN} 0 0"')
         if k % 4 == 3:  # an IMU mount on top of a yaw module
             mount = rot[k].T @ (centre_world + np.array([0.0, 0.0, s / 2 + 0.004]) - pos[k])
-            parts += [_fixed_joint(f"imu{k}_joint", name, f"imu{k}", mount),
-                      _link(f"imu{k}", _inertial(mount_mass, (0, 0, 0), _box_inertia(mount_mass, (0.02, 0.016, 0.008)))
-                            + _shape("collision", '<box size="0.02 0.016 0.008"/>'))]
+            parts += [fixed_joint(f"imu{k}_joint", name, f"imu{k}", mount),
+                      link(f"imu{k}", inertial(mount_mass, (0, 0, 0), box_inertia(mount_mass, (0.02, 0.016, 0.008)))
+                           + shape("collision", '<box size="0.02 0.016 0.008"/>'))]
     for k in range(1, n + 1):
         xyz = rot[k - 1].T @ (pos[k] - pos[k - 1])
         if k == 1:
-            rpy = f"0 0 {_num(CAD_DRIFT)}"
+            rpy = f"0 0 {num(CAD_DRIFT)}"
         elif k % 2 == 0:
             rpy = f"{CAD_PITCH_ROLLS[(k // 2 - 1) % len(CAD_PITCH_ROLLS)]} 0 0"
         else:  # back from a pitch frame, turned by the drift about the joint's own axis: Rx(-pi/2) Rz(d) = Ry(d) Rx(-pi/2)
-            rpy = f"{CAD_YAW_ROLL} {_num(CAD_DRIFT)} 0"
-        joint = _moving_joint(f"joint{k}", names[k - 1], names[k], xyz, (0, 0, 0), "0 0 1", spec, effort)
+            rpy = f"{CAD_YAW_ROLL} {num(CAD_DRIFT)} 0"
+        joint = moving_joint(f"joint{k}", names[k - 1], names[k], xyz, (0, 0, 0), "0 0 1", spec.limit, effort,
+                             spec.velocity)
         parts.append(joint.replace('rpy="0 0 0"', f'rpy="{rpy}"'))
     tip = rot[n].T @ (np.array([starts[n + 1], 0.0, 0.0]) - pos[n])
-    parts += [_fixed_joint("head_tip_joint", names[n], "head_tip", tip, (-HALF_PI if n % 2 == 0 else 0, 0, 0)),
-              _link("head_tip")]
+    parts += [fixed_joint("head_tip_joint", names[n], "head_tip", tip, (-HALF_PI if n % 2 == 0 else 0, 0, 0)),
+              link("head_tip")]
     urdf = folder / "cad_snake_sw.urdf"
-    urdf.write_text(_robot(spec.name, f"{spec.name}: written by snakehead.samples.published_quirks in the manner of a "
-                                      f"SolidWorks to URDF export; {_parts_comment(spec)}", parts), encoding="utf-8")
+    urdf.write_text(robot(spec.name, f"{spec.name}: written by snakehead.samples.published_quirks in the manner of a "
+                                     f"SolidWorks to URDF export; {parts_comment(spec)}", parts), encoding="utf-8")
     b, nn = spec.base_joints, spec.neck_joints
-    return _write_robot_file(folder / "cad_snake_sw.toml",
-                             "SolidWorks export style: near-right angles, frames off the line, curved at q = 0",
-                             {"urdf": urdf.name, "root": "base_link", "base_end": f"link{b}",
-                              "neck_end": f"link{b + nn}", "head_tip": "head_tip"},
-                             {"packages": {"cad_snake_sw": "."}, "home": cad_home(spec)})
+    return write_robot_file(folder / "cad_snake_sw.toml",
+                            "SolidWorks export style: near-right angles, frames off the line, curved at q = 0",
+                            {"urdf": urdf.name, "root": "base_link", "base_end": f"link{b}",
+                             "neck_end": f"link{b + nn}", "head_tip": "head_tip"},
+                            {"packages": {"cad_snake_sw": "."}, "home": cad_home(spec)})
 
 
 # --- "reu_reversed": the tree written from the head --------------------------------------------------------------
@@ -158,33 +174,34 @@ def _write_reu_reversed(spec: StyleSpec, folder: Path) -> Path:
     def along_z(length: float) -> str:
         centre = (0.0, 0.0, length / 2)
         m = spec.mass(length)
-        return (_inertial(m, centre, _cylinder_inertia(m, r, length, 2))
-                + _shape("visual", _cylinder(r, length), centre) + _shape("collision", _cylinder(r, length), centre))
+        return (inertial(m, centre, cylinder_inertia(m, r, length, 2))
+                + shape("visual", cylinder(r, length), centre) + shape("collision", cylinder(r, length), centre))
 
-    parts = [_link("kdl_dummy_root"),
-             _fixed_joint("kdl_dummy_root_to_head", "kdl_dummy_root", "head", rpy=(0, 0, 0)).replace(
+    parts = [link("kdl_dummy_root"),
+             fixed_joint("kdl_dummy_root_to_head", "kdl_dummy_root", "head", rpy=(0, 0, 0)).replace(
                  'rpy="0 0 0"', 'rpy="0 -1.57079632679 0"'),
-             _link("head", along_z(cap))]
+             link("head", along_z(cap))]
     parent, offset, twist = "head", cap, "0"
     for m in range(1, n + 1):
         inp, out = f"mod_{m}_in", f"mod_{m}_out"
-        parts.append(_fixed_joint(f"{parent}_to_{inp}", parent, inp, (0, 0, offset)).replace(
+        parts.append(fixed_joint(f"{parent}_to_{inp}", parent, inp, (0, 0, offset)).replace(
             'rpy="0 0 0"', f'rpy="0 0 {twist}"'))
-        parts += [_link(inp, along_z(a)),
-                  _moving_joint(f"mod_{m}_joint", inp, out, (0, 0, a), (0, 0, 0), "0 1 0", spec, effort),
-                  _link(out, along_z(L - a))]
+        parts += [link(inp, along_z(a)),
+                  moving_joint(f"mod_{m}_joint", inp, out, (0, 0, a), (0, 0, 0), "0 1 0", spec.limit, effort,
+                               spec.velocity),
+                  link(out, along_z(L - a))]
         parent, offset, twist = out, L - a, REVERSED_TWIST
-    parts += [_fixed_joint(f"{parent}_to_tail", parent, "tail", (0, 0, offset)).replace(
-        'rpy="0 0 0"', f'rpy="0 0 {twist}"'), _link("tail", along_z(cap))]
+    parts += [fixed_joint(f"{parent}_to_tail", parent, "tail", (0, 0, offset)).replace(
+        'rpy="0 0 0"', f'rpy="0 0 {twist}"'), link("tail", along_z(cap))]
     urdf = folder / "reu_reversed.urdf"
-    urdf.write_text(_robot(spec.name, f"{spec.name}: written by snakehead.samples.published_quirks in the manner of "
-                                      f"the CMU snakes' descriptions (tree from the head); {_parts_comment(spec)}",
-                           parts), encoding="utf-8")
+    urdf.write_text(robot(spec.name, f"{spec.name}: written by snakehead.samples.published_quirks in the manner of "
+                                     f"the CMU snakes' descriptions (tree from the head); {parts_comment(spec)}",
+                          parts), encoding="utf-8")
     b, nn = spec.base_joints, spec.neck_joints
     # The chain from the tail up to mod_K_in crosses joints n .. K.
-    return _write_robot_file(folder / "reu_reversed.toml", "head at the URDF's root: the body runs against the tree",
-                             {"urdf": urdf.name, "root": "tail", "base_end": f"mod_{n - b + 1}_in",
-                              "neck_end": f"mod_{n - b - nn + 1}_in", "head_tip": "kdl_dummy_root"}, {})
+    return write_robot_file(folder / "reu_reversed.toml", "head at the URDF's root: the body runs against the tree",
+                            {"urdf": urdf.name, "root": "tail", "base_end": f"mod_{n - b + 1}_in",
+                             "neck_end": f"mod_{n - b - nn + 1}_in", "head_tip": "kdl_dummy_root"}, {})
 
 
 # --- "wheeled": passive wheels off every module ------------------------------------------------------------------
@@ -202,7 +219,7 @@ def wheel_joints(spec: StyleSpec) -> list[str]:
 
 
 def _write_wheeled(spec: StyleSpec, folder: Path) -> Path:
-    snake = _snake_spec(spec)
+    snake = snake_spec(spec)
     text = snake_urdf(snake)
     s = spec.thickness
     rw = 0.6 * s
@@ -212,23 +229,23 @@ def _write_wheeled(spec: StyleSpec, folder: Path) -> Path:
             name = f"wheel_{i}_{side}"
             xyz = (snake.link_length(i) / 2, sign * (s / 2 + WHEEL_WIDTH / 2 + 0.002), -s / 2 + rw - WHEEL_DROP)
             continuous = (2 * i + (side == "right")) % 3 != 0
-            joint = _moving_joint(f"{name}_joint", f"link_{i}", name, xyz, (0, 0, 0), "0 0 1", spec, 1.0,
-                                  continuous=continuous)
+            joint = moving_joint(f"{name}_joint", f"link_{i}", name, xyz, (0, 0, 0), "0 0 1", spec.limit, 1.0,
+                                 spec.velocity, continuous=continuous)
             joint = joint.replace('rpy="0 0 0"', 'rpy="-1.5708 0 0"')
             if not continuous:  # the exporter's default range for a passive joint
-                joint = joint.replace(f'lower="{_num(-spec.limit)}" upper="{_num(spec.limit)}"',
+                joint = joint.replace(f'lower="{num(-spec.limit)}" upper="{num(spec.limit)}"',
                                       'lower="-7" upper="7"')
             if (i, side) == ZERO_AXIS_WHEEL:
                 joint = joint.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>')
-            wheels += [joint, _link(name, _inertial(WHEEL_MASS, (0, 0, 0),
-                                                    _cylinder_inertia(WHEEL_MASS, rw, WHEEL_WIDTH, 2))
-                                    + _shape("collision", _cylinder(rw, WHEEL_WIDTH)))]
+            wheels += [joint, link(name, inertial(WHEEL_MASS, (0, 0, 0),
+                                                  cylinder_inertia(WHEEL_MASS, rw, WHEEL_WIDTH, 2))
+                                   + shape("collision", cylinder(rw, WHEEL_WIDTH)))]
     text = text.replace("</robot>", "".join(wheels) + "</robot>")
     urdf = folder / "wheeled_snake.urdf"
     urdf.write_text(text, encoding="utf-8")
-    return _write_robot_file(folder / "wheeled_snake.toml", "passive wheels on every module, held at zero",
-                             {"urdf": urdf.name, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
-                              "head_tip": "head_tip"}, {})
+    return write_robot_file(folder / "wheeled_snake.toml", "passive wheels on every module, held at zero",
+                            {"urdf": urdf.name, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
+                             "head_tip": "head_tip"}, {})
 
 
 # --- "cmu_masses": the ReU description's inertial data -----------------------------------------------------------
@@ -236,43 +253,43 @@ def _write_cmu_masses(spec: StyleSpec, folder: Path) -> Path:
     root = ET.fromstring(reu_urdf(spec))
     L = spec.module_length
     joint_mass = spec.mass_per_module - CMU_SHELL_MASS
-    for link in root.findall("link"):
-        name = link.get("name", "")
+    for element in root.findall("link"):
+        name = element.get("name", "")
         if not name.startswith("reu_module_"):
             continue
-        for old in link.findall("inertial") + link.findall("collision") + link.findall("visual"):
-            link.remove(old)
+        for old in element.findall("inertial") + element.findall("collision") + element.findall("visual"):
+            element.remove(old)
         if name.startswith("reu_module_in_"):
             body = _inertial_full(joint_mass, (0, 0, 0), CMU_UNIT_INERTIA)
-            body += _shape("visual", _cylinder(0.006, 0.02), (0, 0, 0), (0, HALF_PI, 0))
+            body += shape("visual", cylinder(0.006, 0.02), (0, 0, 0), (0, HALF_PI, 0))
         elif name.startswith("reu_module_body_"):
             # the shell's collision covers the whole module: from -0.2 L to 0.8 L in the body link's frame
             centre = (0.3 * L, 0.0, 0.0)
             body = _inertial_full(CMU_SHELL_MASS, (0.3 * L, 0, 0), CMU_SHELL_INERTIA)
-            body += _shape("collision", _cylinder(spec.radius, L), centre, (0, HALF_PI, 0))
+            body += shape("collision", cylinder(spec.radius, L), centre, (0, HALF_PI, 0))
         else:
             body = _inertial_full(0.0, (0, 0, 0), CMU_UNIT_INERTIA)
-        for element in ET.fromstring(f"<x>{body}</x>"):
-            link.append(element)
+        for child in ET.fromstring(f"<x>{body}</x>"):
+            element.append(child)
     urdf = folder / "cmu_masses.urdf"
     urdf.write_text('<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", encoding="utf-8")
-    return _write_robot_file(folder / "cmu_masses.toml", "ReU inertial data: 1 kg joint links without geometry",
-                             {"urdf": urdf.name, "root": "reu_tail", "base_end": "base_end", "neck_end": "neck_end",
-                              "head_tip": "head_tip", "inertia": "from_shapes"}, {})
+    return write_robot_file(folder / "cmu_masses.toml", "ReU inertial data: 1 kg joint links without geometry",
+                            {"urdf": urdf.name, "root": "reu_tail", "base_end": "base_end", "neck_end": "neck_end",
+                             "head_tip": "head_tip", "inertia": "from_shapes"}, {})
 
 
 # --- "backwards_head": a head frame that looks back --------------------------------------------------------------
 def _write_backwards_head(spec: StyleSpec, folder: Path) -> Path:
-    root = ET.fromstring(snake_urdf(_snake_spec(spec)))
+    root = ET.fromstring(snake_urdf(snake_spec(spec)))
     origin = root.find("joint[@name='head_tip_joint']/origin")
     if origin is None:
         raise InputError("the default-convention URDF has no head_tip_joint origin")
     origin.set("rpy", f"0 0 {BACKWARDS_TURN}")
     urdf = folder / "backwards_head.urdf"
     urdf.write_text('<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", encoding="utf-8")
-    return _write_robot_file(folder / "backwards_head.toml", "the head frame's x points back along the body",
-                             {"urdf": urdf.name, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
-                              "head_tip": "head_tip", "head_axis": "-x"}, {})
+    return write_robot_file(folder / "backwards_head.toml", "the head frame's x points back along the body",
+                            {"urdf": urdf.name, "root": "link_0", "base_end": "base_end", "neck_end": "neck_end",
+                             "head_tip": "head_tip", "head_axis": "-x"}, {})
 
 
 QUIRK_WRITERS: dict[str, Callable[["StyleSpec", Path], Path]] = {

@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-from .published import REU_THIRDS, XACRO_DEFAULT_MODULES, StyleSpec, _num, _parts_comment, _reu_robot_file
-
+from .published import REU_THIRDS, XACRO_DEFAULT_MODULES, StyleSpec, parts_comment, reu_robot_file
+from .urdf_text import num
 
 # --- "xacro": the ReU snake as a xacro macro ---------------------------------------------------------------------
 
@@ -25,19 +25,19 @@ def _xacro_properties(spec: StyleSpec) -> str:
     effort = spec.servo_effort(L / 2 + spec.n_joints * L)
     return f'''<?xml version="1.0"?>
 <!-- {spec.name}: the ReU-style sample snake as a xacro macro, written by snakehead.samples.published;
-     {_parts_comment(spec)}. Expand with the PyPI xacro package (no ROS needed: no $(find ...) here). -->
+     {parts_comment(spec)}. Expand with the PyPI xacro package (no ROS needed: no $(find ...) here). -->
 <robot name={quoteattr(spec.name)} xmlns:xacro="http://www.ros.org/wiki/xacro">
   <xacro:arg name="n_modules" default="{XACRO_DEFAULT_MODULES}"/>
   <xacro:property name="n_modules" value="$(arg n_modules)"/>
-  <xacro:property name="module_length" value="{_num(L)}"/>
-  <xacro:property name="radius" value="{_num(spec.radius)}"/>
-  <xacro:property name="module_mass" value="{_num(spec.mass_per_module)}"/>
+  <xacro:property name="module_length" value="{num(L)}"/>
+  <xacro:property name="radius" value="{num(spec.radius)}"/>
+  <xacro:property name="module_mass" value="{num(spec.mass_per_module)}"/>
   <xacro:property name="head_joints" value="{spec.head_joints}"/>
   <xacro:property name="neck_joints" value="{spec.neck_joints}"/>
   <xacro:property name="base_joints" value="${{n_modules - neck_joints - head_joints}}"/>
-  <xacro:property name="limit" value="${{radians({_num(spec.joint_limit_deg)})}}"/>
-  <xacro:property name="effort" value="{_num(effort)}"/>
-  <xacro:property name="velocity" value="{_num(spec.velocity)}"/>
+  <xacro:property name="limit" value="${{radians({num(spec.joint_limit_deg)})}}"/>
+  <xacro:property name="effort" value="{num(effort)}"/>
+  <xacro:property name="velocity" value="{num(spec.velocity)}"/>
 
 '''
 
@@ -143,4 +143,4 @@ _XACRO_CHAIN = '''  <xacro:cylinder_link name="reu_tail" length="${module_length
 def write_xacro(spec: StyleSpec, folder: Path) -> Path:
     path = folder / "reu_snake.urdf.xacro"
     path.write_text(reu_xacro(spec), encoding="utf-8")
-    return _reu_robot_file(folder, "reu_snake_xacro", path.name, {"n_modules": spec.n_joints})
+    return reu_robot_file(folder, "reu_snake_xacro", path.name, {"n_modules": spec.n_joints})

@@ -24,11 +24,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..solve.whole_body import MIN_MARGIN
-from ..dynamics import stability
-from ..collision import body_collisions as coll
-from ..model.robot import BasePlacement
 from .._errors import Infeasible, InputError
+from ..collision import body_collisions as coll
+from ..dynamics import stability
+from ..model.robot import BasePlacement
+from ..solve.whole_body import MIN_MARGIN
 
 if TYPE_CHECKING:
     from ..solve.head_controller import HeadController
