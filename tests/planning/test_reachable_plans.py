@@ -184,7 +184,7 @@ def test_generated_snake_plans_other_shapes(generated):
 
 
 def test_margins_after_the_lift_on_a_generated_snake(generated):
-    """``Waypoints._margins`` after the lift: the smaller of the ground contact's margin and that over the links
+    """``Waypoints.static_margins`` after the lift: the smaller of the ground contact's margin and that over the links
     that stay on the ground (here the base's last link is a real link, not a marker: the 'footprint' model leaves
     it out, the planner must not). Independent: stability.static_margin and scipy's hull."""
     robot = generated.robot
@@ -198,7 +198,7 @@ def test_margins_after_the_lift_on_a_generated_snake(generated):
     qs = np.clip(qs, robot.lower, robot.upper)
     expected = [min(stability.static_margin(robot, q, way.base, contact="ground"), base_only_margin(robot, q, way.base))
                 for q in qs]
-    np.testing.assert_allclose(way._margins(qs), expected, atol=1e-9)
+    np.testing.assert_allclose(way.static_margins(qs), expected, atol=1e-9)
     footprint = [stability.static_margin(robot, q, way.base, contact="footprint") for q in qs]
     assert np.max(np.array(expected) - footprint) > 0.01  # the case: the footprint model would refuse far more
 

@@ -124,7 +124,7 @@ def test_a_shape_whose_lift_ends_unsafe_is_no_base_to_choose(reu):
     lifted = base_choice.shape_of(reu.robot, flat, reu.q_initial)
     way = Waypoints(reu.robot, snakehead.BasePlacement(0.7, -0.6, 2.8))  # independent: the checks one by one
     ground, self_, _ = path_check.sample_clearances(reu.robot, lifted[None], way.base, made=way.checker)
-    assert ground[0] >= 0.0 and self_[0] > 0.0 and 0.0 < way._margins(lifted[None])[0] < DETOUR_MARGIN
+    assert ground[0] >= 0.0 and self_[0] > 0.0 and 0.0 < way.static_margins(lifted[None])[0] < DETOUR_MARGIN
     assert not ss.lift_ends_safe(reu, flat) and not base_choice.has_curl(reu, flat)
     assert ss.lift_ends_safe(reu, reu.q_initial) and base_choice.has_curl(reu, reu.q_initial)
 
