@@ -45,10 +45,18 @@ class ItemLoop {
  public:
   ItemLoop(long n, const std::function<void(int, long)>& body) : n_(n), body_(body) {}
 
-  // Worker w: items until none is left or the loop is stopped.
-  void work(int w) {
+  // Worker w: items until none is left or the loop is stopped. A worker on the watching thread (no pool thread took
+  // it) also asks the watch between its items, every period, so that a stop is heard however the work was dealt.
+  void work(int w, const LoopWatch* watch = nullptr) {
+    auto asked = std::chrono::steady_clock::now();
     try {
-      for (long i; !stop_.load(std::memory_order_relaxed) && (i = next_.fetch_add(1)) < n_;) body_(w, i);
+      for (long i; !stop_.load(std::memory_order_relaxed) && (i = next_.fetch_add(1)) < n_;) {
+        body_(w, i);
+        if (watch != nullptr && std::chrono::steady_clock::now() - asked >= watch->period) {
+          ask(*watch);
+          asked = std::chrono::steady_clock::now();
+        }
+      }
     } catch (...) {
       fail(std::current_exception());
     }
@@ -66,8 +74,20 @@ class ItemLoop {
     stop_ = true;
   }
 
-  void stop() { stop_ = true; }
+  // Asks the watch whether to go on: false stops the loop (and the loop reports it), an exception fails it.
+  void ask(const LoopWatch& watch) {
+    try {
+      if (!watch.keep_going()) {
+        watch_stopped_ = true;
+        stop_ = true;
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  }
+
   bool stopped() const { return stop_.load(); }
+  bool stopped_by_watch() const { return watch_stopped_.load(); }
 
   // Waits until `workers` have ended or `period` has passed; true when they have ended.
   bool wait_for(int workers, std::chrono::milliseconds period) {
@@ -84,26 +104,17 @@ class ItemLoop {
   const std::function<void(int, long)>& body_;
   std::atomic<long> next_{0};
   std::atomic<bool> stop_{false};
+  std::atomic<bool> watch_stopped_{false};
   std::mutex mutex_;
   std::condition_variable cv_;
   int ended_ = 0;
   std::exception_ptr error_;
 };
 
-// The watcher's side: watch->keep_going() every period until the `workers` started have ended.
-bool watch_loop(ItemLoop& loop, int workers, const LoopWatch& watch) {
-  bool go_on = true;
-  while (!loop.wait_for(workers, watch.period)) {
-    if (loop.stopped()) continue;
-    try {
-      go_on = watch.keep_going();
-    } catch (...) {
-      loop.fail(std::current_exception());
-      continue;
-    }
-    if (!go_on) loop.stop();
-  }
-  return go_on;
+// The watcher's side: the watch every period until the `workers` started have ended.
+void watch_loop(ItemLoop& loop, int workers, const LoopWatch& watch) {
+  while (!loop.wait_for(workers, watch.period))
+    if (!loop.stopped()) loop.ask(watch);
 }
 
 }  // namespace
@@ -111,6 +122,13 @@ bool watch_loop(ItemLoop& loop, int workers, const LoopWatch& watch) {
 bool parallel_for_each(long n, int threads, const std::function<void(int, long)>& body, const LoopWatch* watch) {
   const int workers = static_cast<int>(std::max<long>(1, std::min<long>(std::max(threads, 1), n)));
   ItemLoop loop(n, body);
+  if (watch != nullptr) {  // a stop asked for before the loop (a pending Ctrl-C) is heard before any item starts
+    loop.ask(*watch);
+    if (loop.stopped()) {
+      loop.rethrow();
+      return false;
+    }
+  }
   WorkerPool& pool = WorkerPool::process();
   std::vector<char> here(static_cast<std::size_t>(workers), 1);  // workers the calling thread runs
   std::vector<WorkerPool::JobPtr> jobs;
@@ -125,13 +143,12 @@ bool parallel_for_each(long n, int threads, const std::function<void(int, long)>
     }
   } catch (...) {  // no memory for another job: the calling thread runs the rest
   }
-  bool go_on = true;
-  if (watch != nullptr && !jobs.empty()) go_on = watch_loop(loop, static_cast<int>(jobs.size()), *watch);
+  if (watch != nullptr && !jobs.empty()) watch_loop(loop, static_cast<int>(jobs.size()), *watch);
   for (int w = 0; w < workers; ++w)
-    if (here[static_cast<std::size_t>(w)]) loop.work(w);
+    if (here[static_cast<std::size_t>(w)]) loop.work(w, watch);
   for (const auto& job : jobs) pool.run_or_wait(job);
   loop.rethrow();
-  return go_on;
+  return !loop.stopped_by_watch();
 }
 
 }  // namespace snakehead

@@ -33,9 +33,10 @@ void parallel_for(long n, long grain, Body&& body) {
   run_ranges(parts, [&](long p) { body(n * p / parts, n * (p + 1) / parts); });
 }
 
-// A watcher of a parallel_for_each: called on the calling thread about every `period` while the workers run; it
-// returns false to stop the loop (no item is started after), and may throw (the loop stops; its exception is
-// rethrown unless a worker's came first).
+// A watcher of a parallel_for_each: called on the calling thread once before any item starts and then about every
+// `period` while the items run (between its own items when the calling thread has to work them); it returns false
+// to stop the loop (no item is started after), and may throw (the loop stops; its exception is rethrown unless a
+// worker's came first).
 struct LoopWatch {
   std::function<bool()> keep_going;
   std::chrono::milliseconds period{100};

@@ -118,6 +118,23 @@ TEST(ParallelForEach, TheWatchRunsOnTheCallingThreadAndMayStopTheLoop) {
   }
 }
 
+TEST(ParallelForEach, AStopBeforeTheStartRunsNoItemAndOneWorkerStillHearsTheWatch) {
+  std::atomic<long> done{0};
+  const snakehead::LoopWatch no{[] { return false; }, std::chrono::milliseconds(1000)};
+  EXPECT_FALSE(snakehead::parallel_for_each(1000, 2, [&](int, long) { ++done; }, &no));
+  EXPECT_EQ(done.load(), 0);  // asked before the first item, however short the loop
+  // One worker (on the pool, or on the calling thread between its asks when no pool thread is free): still heard.
+  int watched = 0;
+  const snakehead::LoopWatch third{[&] { return ++watched < 3; }, std::chrono::milliseconds(2)};
+  const bool finished = snakehead::parallel_for_each(100000, 1, [&](int, long) {
+    ++done;
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }, &third);
+  EXPECT_FALSE(finished);
+  EXPECT_EQ(watched, 3);
+  EXPECT_LT(done.load(), 100000);
+}
+
 TEST(WorkerPool, AJobTakenBackRunsOnTheCallerAndAnAbandonedOneEndsOnItsOwn) {
   snakehead::WorkerPool& pool = snakehead::WorkerPool::process();
   std::atomic<bool> ran{false};
