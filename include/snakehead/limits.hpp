@@ -33,6 +33,10 @@ constexpr int kMaxFramesPerVoxel = 4096;         // directions x rolls
 constexpr int kMaxCloudSamples = 10'000'000;     // configurations sampled for the hull
 constexpr int kMaxThreads = 256;
 
+// Terrains (include/snakehead/terrain.hpp): each triangle keeps about 200 bytes (its normals, box and tree node).
+constexpr long kMaxTerrainCells = 1L << 20;       // heightfield cells (two triangles each): 1024 x 1024
+constexpr long kMaxTerrainTriangles = 2'000'000;  // mesh triangles
+
 }  // namespace limits
 
 // A number as a short text for messages (%g: "1e+300", "0.0003"; std::to_string gives 300 digits or "0.000000").
