@@ -19,4 +19,5 @@ void bind_core_threads(pybind11::module_& m);
 void bind_neck_fit(pybind11::module_& m);
 void bind_piecewise_polynomial(pybind11::module_& m);
 void bind_limit_ratios(pybind11::module_& m);
+void bind_terrain(pybind11::module_& m);
 }  // namespace snakehead::bindings

@@ -26,6 +26,8 @@ void bind_limits(py::module_& m) {
   c.attr("MAX_FRAMES_PER_VOXEL") = limits::kMaxFramesPerVoxel;
   c.attr("MAX_CLOUD_SAMPLES") = limits::kMaxCloudSamples;
   c.attr("MAX_THREADS") = limits::kMaxThreads;
+  c.attr("MAX_TERRAIN_CELLS") = limits::kMaxTerrainCells;
+  c.attr("MAX_TERRAIN_TRIANGLES") = limits::kMaxTerrainTriangles;
 }
 
 }  // namespace snakehead::bindings

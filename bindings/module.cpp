@@ -26,7 +26,7 @@ PYBIND11_MODULE(_core, m) {
       "snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, "
       "convex-shape distances (FCL), "
       "inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, "
-      "piecewise polynomials, a timed motion's use of its limits, "
+      "piecewise polynomials, a timed motion's use of its limits, terrain surfaces (planes, heightfields, meshes), "
       "and the limits on what callers may ask for";
   snakehead::bindings::bind_model(m);
   snakehead::bindings::bind_trac_ik(m);
@@ -43,6 +43,7 @@ PYBIND11_MODULE(_core, m) {
   snakehead::bindings::bind_neck_fit(m);
   snakehead::bindings::bind_piecewise_polynomial(m);
   snakehead::bindings::bind_limit_ratios(m);
+  snakehead::bindings::bind_terrain(m);
 
   // A sweep stopped because its progress callback returned False (not an error of the input).
   py::register_exception<snakehead::Cancelled>(m, "Cancelled");

@@ -179,10 +179,26 @@ TerrainSurface::TerrainSurface(Vertices v, Faces f) : vertices(std::move(v)), fa
   build(0, static_cast<int>(faces.size()));
 }
 
+// Each vertex's first copy: vertices at the same place are one (an STL file repeats every vertex per triangle), so
+// that the triangles around a vertex or an edge share its pseudonormal.
+static std::vector<int> welded(const Vertices& v) {
+  std::vector<int> order(static_cast<std::size_t>(v.rows())), first(order.size());
+  std::iota(order.begin(), order.end(), 0);
+  const auto row = [&](int i) { return std::array<double, 3>{v(i, 0), v(i, 1), v(i, 2)}; };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return row(a) < row(b) || (row(a) == row(b) && a < b); });
+  for (std::size_t k = 0; k < order.size(); ++k)
+    first[static_cast<std::size_t>(order[k])] =
+        k > 0 && row(order[k]) == row(order[k - 1]) ? first[static_cast<std::size_t>(order[k - 1])] : order[k];
+  return first;
+}
+
 void TerrainSurface::make_pseudonormals() {
   vertex_normals_.assign(static_cast<std::size_t>(vertices.rows()), Eigen::Vector3d::Zero());
+  const std::vector<int> same = welded(vertices);
   std::unordered_map<std::uint64_t, Eigen::Vector3d> edges;
-  const auto key = [](int u, int w) {
+  const auto key = [&](int u, int w) {
+    u = same[static_cast<std::size_t>(u)];
+    w = same[static_cast<std::size_t>(w)];
     return (static_cast<std::uint64_t>(std::min(u, w)) << 32) | static_cast<std::uint32_t>(std::max(u, w));
   };
   for (std::size_t i = 0; i < faces.size(); ++i) {
@@ -191,7 +207,7 @@ void TerrainSurface::make_pseudonormals() {
       const Eigen::Vector3d e1 = (corner(fi, (k + 1) % 3) - corner(fi, k)).normalized();
       const Eigen::Vector3d e2 = (corner(fi, (k + 2) % 3) - corner(fi, k)).normalized();
       const double angle = std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
-      vertex_normals_[static_cast<std::size_t>(faces[i][k])] += angle * face_normals[i];
+      vertex_normals_[static_cast<std::size_t>(same[static_cast<std::size_t>(faces[i][k])])] += angle * face_normals[i];
       auto [it, fresh] = edges.try_emplace(key(faces[i][k], faces[i][(k + 1) % 3]), Eigen::Vector3d::Zero());
       it->second += face_normals[i];
     }
@@ -199,6 +215,7 @@ void TerrainSurface::make_pseudonormals() {
   edge_normals_.resize(faces.size());
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (int k = 0; k < 3; ++k) edge_normals_[i][k] = edges.at(key(faces[i][k], faces[i][(k + 1) % 3]));
+  for (std::size_t i = 0; i < same.size(); ++i) vertex_normals_[i] = vertex_normals_[static_cast<std::size_t>(same[i])];
 }
 
 // Builds the subtree over order_[first, first + count): split at the median of the longest axis of the triangles'

@@ -1,12 +1,12 @@
 """
-snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, piecewise polynomials, a timed motion's use of its limits, and the limits on what callers may ask for
+snakehead's C++ core: chain model, kinematics, TRAC-IK, workspace sweep, support polygons, box collisions, convex-shape distances (FCL), inverse dynamics, the neck's fit (Eq. 22), path checks, time-optimal path parameterization (TOPP-RA), the tracking interpolation's fit, piecewise polynomials, a timed motion's use of its limits, terrain surfaces (planes, heightfields, meshes), and the limits on what callers may ask for
 """
 from __future__ import annotations
 import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'center_of_mass', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'limit_ratios', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
+__all__: list[str] = ['Cancelled', 'ChainModel', 'Limits', 'PathChecker', 'ShapeSet', 'Terrain', 'ToppRaResult', 'TracIK', 'TrackingFit', 'WorkspaceOptions', 'ZmpPrefix', 'approach_frame', 'boundary', 'boundary_voxels', 'center_of_mass', 'compute_reachability', 'convex_hull', 'convex_hull_2d', 'convex_hulls', 'core_threads', 'evaluate_piecewise_polynomial', 'evaluate_voxels', 'fibonacci_directions', 'fit_neck', 'hull_margins', 'kdl_nr_jl_ik', 'limit_ratios', 'momenta', 'newton_euler', 'newton_euler_along', 'pose_error', 'read_urdf_file', 'sample_tip_positions', 'save_map', 'set_core_threads', 'shape_lowest_points', 'shape_lowest_z', 'shape_pair_distances', 'shape_pair_min_distances', 'solve_lp2d', 'topp_ra', 'topp_ra_canonical', 'urdf_root_link', 'zmp_check']
 class ChainModel:
     """
     Immutable serial chain between two links of a URDF.
@@ -355,11 +355,69 @@ class Limits:
     MAX_FRAMES_PER_VOXEL: typing.ClassVar[int] = 4096
     MAX_IK_JOINTS: typing.ClassVar[int] = 1000
     MAX_ROLLS: typing.ClassVar[int] = 360
+    MAX_TERRAIN_CELLS: typing.ClassVar[int] = 1048576
+    MAX_TERRAIN_TRIANGLES: typing.ClassVar[int] = 2000000
     MAX_THREADS: typing.ClassVar[int] = 256
     MAX_TIMEOUT_S: typing.ClassVar[float] = 86400.0
     MAX_URDF_BYTES: typing.ClassVar[int] = 8388608
     MAX_URDF_DEPTH: typing.ClassVar[int] = 100
     MAX_VOXELS_PER_AXIS: typing.ClassVar[int] = 256
+class Terrain:
+    """
+    The ground as a surface: a plane, a heightfield (triangulated grid) or a triangle mesh (immutable; safe to share between threads). See include/snakehead/terrain.hpp.
+    """
+    @staticmethod
+    def heightfield(heights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> Terrain:
+        """
+        heights (nx, ny) m at x0 + i sx / (nx - 1), y0 + j sy / (ny - 1); size (sx, sy) m; origin (x0, y0, z0) m, z0 added to every height. Each cell is split along its diagonal from (i, j) to (i + 1, j + 1)
+        """
+    @staticmethod
+    def mesh(vertices: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], faces: typing.Annotated[numpy.typing.ArrayLike, numpy.int64]) -> Terrain:
+        """
+        A triangle surface: vertices (V, 3) m, faces (F, 3) int (its normals by the right-hand rule point to the positive side)
+        """
+    @staticmethod
+    def plane(normal: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> Terrain:
+        """
+        A plane through point (3,) with the upward normal (3,) (any length, n_z > 0)
+        """
+    def __getstate__(self) -> tuple:
+        ...
+    def __setstate__(self, arg0: tuple) -> None:
+        ...
+    def capsule_clearance(self, a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], radii: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Capsules' clearance (m): segments a -> b (N, 3), radii (N,); see include/snakehead/terrain.hpp
+        """
+    def height(self, xy: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The surface's z (m) under each point (N, 2) -> (N,); NaN where there is no surface
+        """
+    def normal(self, xy: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The unit upward normal of the facet under each point (N, 2) -> (N, 3); NaN where none
+        """
+    def signed_distance(self, points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Signed distance (m) of points (N, 3) to the surface, > 0 above -> (N,)
+        """
+    def sphere_clearance(self, centres: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], radii: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Spheres' signed distance minus radius: centres (N, 3), radii (N,)
+        """
+    @property
+    def faces(self) -> numpy.typing.NDArray[numpy.int64]:
+        """
+        The surface's triangles (F, 3) (none for a plane)
+        """
+    @property
+    def kind(self) -> str:
+        ...
+    @property
+    def vertices(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The surface's triangles' vertices (V, 3) (none for a plane)
+        """
 class Cancelled(Exception):
     pass
 def approach_frame(point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], roll: typing.SupportsFloat | typing.SupportsIndex = 0.0, axis: str = 'x') -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:

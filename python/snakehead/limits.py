@@ -10,7 +10,8 @@ from __future__ import annotations
 from ._core import Limits as _Core
 
 __all__ = ["MAX_TIMEOUT_S", "MAX_URDF_BYTES", "MAX_URDF_DEPTH", "MAX_IK_JOINTS", "MAX_VOXELS_PER_AXIS",
-           "MAX_DIRECTIONS", "MAX_ROLLS", "MAX_FRAMES_PER_VOXEL", "MAX_CLOUD_SAMPLES", "MAX_THREADS", "CORE_LIMITS"]
+           "MAX_DIRECTIONS", "MAX_ROLLS", "MAX_FRAMES_PER_VOXEL", "MAX_CLOUD_SAMPLES", "MAX_THREADS", "MAX_TERRAIN_CELLS",
+           "MAX_TERRAIN_TRIANGLES", "CORE_LIMITS"]
 
 #: s: the longest timeout or duration (one day; a steady-clock deadline overflows beyond ~292 years).
 MAX_TIMEOUT_S: float = float(_Core.MAX_TIMEOUT_S)
@@ -27,7 +28,11 @@ MAX_ROLLS: int = int(_Core.MAX_ROLLS)
 MAX_FRAMES_PER_VOXEL: int = int(_Core.MAX_FRAMES_PER_VOXEL)
 MAX_CLOUD_SAMPLES: int = int(_Core.MAX_CLOUD_SAMPLES)
 MAX_THREADS: int = int(_Core.MAX_THREADS)
+#: A terrain: the most cells of a heightfield's grid (two triangles each) and triangles of a mesh.
+MAX_TERRAIN_CELLS: int = int(_Core.MAX_TERRAIN_CELLS)
+MAX_TERRAIN_TRIANGLES: int = int(_Core.MAX_TERRAIN_TRIANGLES)
 
 #: Every name above: the core's name (a class attribute of ``_core.Limits``) is the same.
 CORE_LIMITS = ("MAX_TIMEOUT_S", "MAX_URDF_BYTES", "MAX_URDF_DEPTH", "MAX_IK_JOINTS", "MAX_VOXELS_PER_AXIS",
-               "MAX_DIRECTIONS", "MAX_ROLLS", "MAX_FRAMES_PER_VOXEL", "MAX_CLOUD_SAMPLES", "MAX_THREADS")
+               "MAX_DIRECTIONS", "MAX_ROLLS", "MAX_FRAMES_PER_VOXEL", "MAX_CLOUD_SAMPLES", "MAX_THREADS",
+               "MAX_TERRAIN_CELLS", "MAX_TERRAIN_TRIANGLES")

@@ -148,6 +148,23 @@ TEST(Terrain, MeshSignsByPseudonormalsAtEdgesAndVertices) {
   EXPECT_NEAR(one_distance(t, {0.5, -0.1, -0.1}), std::sqrt(0.02), 1e-15);   // nearest: the edge 0-1
 }
 
+TEST(Terrain, RepeatedVerticesAreOne) {
+  // The tetrahedron as an STL file holds it: three vertices per triangle. Signs as with shared vertices.
+  const std::array<std::array<int, 3>, 4> shared = {{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  Eigen::Matrix<double, 4, 3, Eigen::RowMajor> corners;
+  corners << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Vertices v(12, 3);
+  std::vector<std::array<int, 3>> faces;
+  for (int f = 0; f < 4; ++f) {
+    for (int k = 0; k < 3; ++k) v.row(3 * f + k) = corners.row(shared[f][k]);
+    faces.push_back({3 * f, 3 * f + 1, 3 * f + 2});
+  }
+  const Terrain t = Terrain::mesh(v, faces);
+  EXPECT_NEAR(one_distance(t, {-0.1, -0.1, -0.1}), std::sqrt(0.03), 1e-15);
+  EXPECT_NEAR(one_distance(t, {0.5, -0.1, -0.1}), std::sqrt(0.02), 1e-15);
+  EXPECT_NEAR(one_distance(t, {0.5, 0.01, 0.01}), -0.01, 1e-15);
+}
+
 TEST(Terrain, CapsulesAndSpheres) {
   const Terrain flat = Terrain::plane({0, 0, 1}, {0, 0, 0});
   const Terrain grid = grid_of(3, 3, 2.0, 2.0, {-1.0, -1.0, 0.0}, [](double, double) { return 0.0; });

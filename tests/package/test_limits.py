@@ -24,7 +24,8 @@ PACKAGE = Path(snakehead.__file__).parent
 CPP_NAMES = {"MAX_TIMEOUT_S": "kMaxTimeoutSeconds", "MAX_URDF_BYTES": "kMaxUrdfBytes", "MAX_URDF_DEPTH": "kMaxUrdfDepth",
              "MAX_IK_JOINTS": "kMaxIKJoints", "MAX_VOXELS_PER_AXIS": "kMaxVoxelsPerAxis",
              "MAX_DIRECTIONS": "kMaxDirections", "MAX_ROLLS": "kMaxRolls", "MAX_FRAMES_PER_VOXEL": "kMaxFramesPerVoxel",
-             "MAX_CLOUD_SAMPLES": "kMaxCloudSamples", "MAX_THREADS": "kMaxThreads"}
+             "MAX_CLOUD_SAMPLES": "kMaxCloudSamples", "MAX_THREADS": "kMaxThreads",
+             "MAX_TERRAIN_CELLS": "kMaxTerrainCells", "MAX_TERRAIN_TRIANGLES": "kMaxTerrainTriangles"}
 
 
 def cpp_value(text: str) -> float:

@@ -12,7 +12,7 @@ from scipy.spatial import ConvexHull, QhullError
 from .._errors import InputError
 from .._validate import MAX_COORDINATE_M, input_file
 
-__all__ = ["MAX_MESH_BYTES", "MIN_MESH_THICKNESS_M", "convex_hull_vertices"]
+__all__ = ["MAX_MESH_BYTES", "MIN_MESH_THICKNESS_M", "convex_hull_vertices", "read_mesh_file"]
 
 #: A collision mesh larger than this is not a snake module's (and would stall the hull).
 MAX_MESH_BYTES = 64 * 1024 * 1024
@@ -24,19 +24,8 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
     """The vertices (V, 3) of the convex hull of the mesh file ``path`` (STL, OBJ, DAE, PLY... through trimesh),
     scaled. A missing, unreadable, empty or flat mesh (flat as written or once scaled: thinner than
     :data:`MIN_MESH_THICKNESS_M`) is an InputError naming ``where`` and the path."""
-    import trimesh  # heavy to import (~0.2 s): only descriptions and scenes with meshes need it
-
     shown = repr(os.fspath(path))
-    input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
-    if os.path.getsize(path) == 0:
-        raise InputError(f"{where}: mesh file {shown} is empty (0 bytes)")
-    try:
-        loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
-        vertices = np.asarray(loaded.vertices, dtype=float)
-    except Exception as exc:  # trimesh raises many kinds for a bad file
-        raise InputError(f"{where}: cannot read mesh file {shown}: {' '.join(str(exc).split())}") from None
-    if vertices.ndim != 2 or vertices.shape[1] != 3:  # e.g. an OBJ "v" line with two coordinates
-        raise InputError(f"{where}: mesh file {shown} has vertices of shape {vertices.shape}, not (V, 3)")
+    vertices, _ = read_mesh_file(path, where)
     vertices = vertices[np.all(np.isfinite(vertices), axis=1)]
     if len(vertices) == 0:
         raise InputError(f"{where}: mesh file {shown} has no vertices (not a mesh trimesh reads: STL, OBJ, PLY, "
@@ -61,6 +50,27 @@ def convex_hull_vertices(path: Path, scale: np.ndarray, where: str) -> np.ndarra
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else "qhull failed"
         raise InputError(f"{where}: mesh file {shown} has no convex hull ({first})") from None
     return np.ascontiguousarray(vertices[hull.vertices])
+
+
+def read_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices (V, 3) float and triangles (F, 3) int of the mesh file ``path`` (STL, OBJ, DAE, PLY... through
+    trimesh, as written: not merged, not repaired). A missing, oversized (:data:`MAX_MESH_BYTES`), empty or
+    unreadable file is an InputError naming ``where`` and the path; the values are not checked further."""
+    import trimesh  # heavy to import (~0.2 s): only descriptions and scenes with meshes need it
+
+    shown = repr(os.fspath(path))
+    input_file(path, f"{where}: mesh file", MAX_MESH_BYTES)
+    if os.path.getsize(path) == 0:
+        raise InputError(f"{where}: mesh file {shown} is empty (0 bytes)")
+    try:
+        loaded: Any = trimesh.load(os.fspath(path), force="mesh", process=False)
+        vertices = np.asarray(loaded.vertices, dtype=float)
+        faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
+    except Exception as exc:  # trimesh raises many kinds for a bad file
+        raise InputError(f"{where}: cannot read mesh file {shown}: {' '.join(str(exc).split())}") from None
+    if vertices.ndim != 2 or vertices.shape[1] != 3:  # e.g. an OBJ "v" line with two coordinates
+        raise InputError(f"{where}: mesh file {shown} has vertices of shape {vertices.shape}, not (V, 3)")
+    return vertices, faces
 
 
 def _thickness(vertices: np.ndarray) -> float:
