@@ -36,6 +36,10 @@ A scene file is TOML::
     file = "rock.stl"                       #   scene file), its origin at position (m), turned by yaw (rad,
     position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
 
+    [terrain]                               # optional: the ground (default: flat, z = 0); kind = "plane",
+    kind = "plane"                          #   "heightfield", "mesh" or "steps" and their keys
+    pitch_deg = -5.0                        #   (:mod:`snakehead.scenes.terrain_table`)
+
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
 
 Names (``snakehead._validate.name_text``): a target's name is one line of printable text of at most
@@ -58,7 +62,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -80,6 +84,8 @@ from .._validate import (
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
+from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, Terrain
+from .terrain_table import terrain_entry, terrain_from_table
 
 APPROACHES = ("free", "line")
 
@@ -142,7 +148,8 @@ class Target:
 
 @dataclass(frozen=True)
 class Scene:
-    """Targets (visited in order) and obstacles; optionally the robot file and the base placement they go with."""
+    """Targets (visited in order) and obstacles; optionally the robot file and the base placement they go with, and
+    the terrain (flat ground, z = 0, by default; the planner does not use it yet)."""
 
     name: str
     targets: tuple[Target, ...]
@@ -151,6 +158,7 @@ class Scene:
     base: BasePlacement | None = None
     description: str = ""
     path: Path | None = None
+    terrain: Terrain = field(default_factory=FlatGround)
 
     def __post_init__(self) -> None:
         file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
@@ -179,6 +187,9 @@ class Scene:
         object.__setattr__(self, "obstacles", obstacles)
         if self.base is not None and not isinstance(self.base, BasePlacement):
             raise InputTypeError(f"scene base must be a BasePlacement, got {type(self.base).__name__}")
+        if not isinstance(self.terrain, TERRAIN_TYPES):
+            raise InputTypeError(f"scene terrain must be one of {[t.__name__ for t in TERRAIN_TYPES]}, got "
+                                 f"{type(self.terrain).__name__}")
 
     @property
     def reported(self) -> tuple[Target, ...]:
@@ -208,7 +219,7 @@ class Scene:
 
 
 # --- files ------------------------------------------------------------------------------------------------
-_SCENE_KEYS = (("targets",), ("name", "description", "robot", "base", "obstacles"))
+_SCENE_KEYS = (("targets",), ("name", "description", "robot", "base", "obstacles", "terrain"))
 _TARGET_KEYS = (("name", "position", "direction"), ("hold_s", "approach", "step_m", "via", "sphere_diameter"))
 _BASE_KEYS = ((), ("x", "y", "yaw"))
 _OBSTACLE_KEYS = {
@@ -312,9 +323,10 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
             raise InputError(f"{where}: {key} must be a string, got {data[key]!r}")
+    terrain = terrain_from_table(data["terrain"], folder, where) if "terrain" in data else FlatGround()
     try:
         return Scene(name=data.get("name", name), targets=targets, obstacles=obstacles, robot_file=robot_file,
-                     base=base, description=data.get("description", ""))
+                     base=base, description=data.get("description", ""), terrain=terrain)
     except ValueError as exc:  # a name or a description refused by Scene: the file's fault
         raise InputError(f"{where}: {exc}") from None
 
@@ -325,7 +337,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
     p = Path(path)
     scene = scene_from_dict(data, name=p.stem, folder=p.resolve().parent, where=f"scene file {os.fspath(p)!r}")
     return Scene(name=scene.name, targets=scene.targets, obstacles=scene.obstacles, robot_file=scene.robot_file,
-                 base=scene.base, description=scene.description, path=p)
+                 base=scene.base, description=scene.description, path=p, terrain=scene.terrain)
 
 
 # --- writing ----------------------------------------------------------------------------------------------
@@ -343,7 +355,7 @@ def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
     """The scene file (TOML text) of ``scene``, its paths relative to ``folder`` (where the file goes). Numbers are
     written to their last digit, so that they read back exactly. InputError for what a scene file cannot say: a box
     not upright (turned other than about z), a wall not standing on the ground (as ``WallWithHole.standing`` makes
-    it), a mesh obstacle tilted."""
+    it), a mesh obstacle tilted, a terrain generated rather than read from a file (a heightfield's or a mesh's)."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     where = Path(folder).resolve()
@@ -360,6 +372,9 @@ def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
     for k, ob in enumerate(scene.obstacles):
         entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]")
         lines += ["", "[[obstacles]]"] + [f"{key} = {v}" for key, v in entry.items()]
+    terrain = terrain_entry(scene.terrain, where, f"scene {scene.name!r}, terrain")
+    if terrain is not None:
+        lines += ["", "[terrain]"] + [f"{key} = {v}" for key, v in terrain.items()]
     return "\n".join(lines) + "\n"
 
 

@@ -42,8 +42,8 @@ def _named(path: Path, where: str) -> str:
 def _check_grid(shape: tuple[int, ...], path: Path, where: str) -> None:
     """InputError unless ``shape`` is a grid of at least 2 x 2 and at most MAX_TERRAIN_CELLS cells."""
     if len(shape) != 2 or shape[0] < 2 or shape[1] < 2:
-        raise InputError(f"{_named(path, where)}: expected a 2-D array of finite heights (at least 2 x 2), got "
-                         f"shape {tuple(shape)}")
+        raise InputError(f"{_named(path, where)}: expected a 2-D array of finite heights, got shape {tuple(shape)} "
+                         "(at least 2 x 2)")
     cells = (shape[0] - 1) * (shape[1] - 1)
     if cells > MAX_TERRAIN_CELLS:
         raise InputError(f"{_named(path, where)}: {shape[0]} x {shape[1]} heights are {cells} cells; at most "
