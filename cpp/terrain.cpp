@@ -138,12 +138,13 @@ class TerrainSurface {
     int face = -1;
     TriangleHit hit;
   };
-  Closest closest(const Eigen::Vector3d& p) const;
+  // The closest point within sqrt(bound2) (an upper bound of the distance: the search starts there).
+  Closest closest(const Eigen::Vector3d& p, double bound2 = kInf) const;
   double signed_distance(const Eigen::Vector3d& p) const;
   // The highest point of the surface on the vertical line through (x, y): its z and face (-1: none).
   std::pair<double, int> highest(double x, double y) const;
-  // The squared distance of segment p q to the surface (0 when it meets it).
-  double segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& q) const;
+  // The squared distance of segment p q to the surface (0 when it meets it); bound2: an upper bound of it.
+  double segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double bound2 = kInf) const;
 
   Vertices vertices;
   Faces faces;
@@ -248,8 +249,9 @@ int TerrainSurface::build(int first, int count) {
   return index;
 }
 
-TerrainSurface::Closest TerrainSurface::closest(const Eigen::Vector3d& p) const {
+TerrainSurface::Closest TerrainSurface::closest(const Eigen::Vector3d& p, double bound2) const {
   Closest best;
+  best.distance2 = bound2;
   int stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -285,7 +287,11 @@ Eigen::Vector3d TerrainSurface::pseudonormal(const Closest& c) const {
 
 double TerrainSurface::signed_distance(const Eigen::Vector3d& p) const {
   if (!p.allFinite()) return kNaN;
-  const Closest c = closest(p);
+  // The surface point straight above or below bounds the distance (a little over it, so that it is found).
+  const double z = highest(p.x(), p.y()).first;
+  const double bound2 = std::isnan(z) ? kInf : (p.z() - z) * (p.z() - z) * (1.0 + 1e-9) + 1e-300;
+  Closest c = closest(p, bound2);
+  if (c.face < 0) c = closest(p);  // (round-off kept the bound below every triangle)
   const double d = std::sqrt(c.distance2);
   return (p - c.hit.point).dot(pseudonormal(c)) >= 0.0 ? d : -d;
 }
@@ -323,11 +329,11 @@ std::pair<double, int> TerrainSurface::highest(double x, double y) const {
   return {face < 0 ? kNaN : best, face};
 }
 
-double TerrainSurface::segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& q) const {
+double TerrainSurface::segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double bound2) const {
   Box segment;
   segment.grow(p);
   segment.grow(q);
-  double best = kInf;
+  double best = bound2;
   int stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -335,8 +341,9 @@ double TerrainSurface::segment_distance2(const Eigen::Vector3d& p, const Eigen::
     const Node& node = nodes_[stack[--top]];
     if (node.box.distance2(segment) >= best) continue;
     if (node.left >= 0) {
-      stack[top++] = node.left;
-      stack[top++] = node.right;
+      const bool left_first = nodes_[node.left].box.distance2(segment) <= nodes_[node.right].box.distance2(segment);
+      stack[top++] = left_first ? node.right : node.left;
+      stack[top++] = left_first ? node.left : node.right;
       continue;
     }
     for (int k = node.first; k < node.first + node.count; ++k) {
@@ -560,7 +567,7 @@ void Terrain::capsule_clearance(const double* a, const double* b, const double* 
       if (kind_ != TerrainKind::Plane && d > 0.0) {
         const Eigen::Vector3d p = Eigen::Map<const Eigen::Vector3d>(a + 3 * k);
         const Eigen::Vector3d q = Eigen::Map<const Eigen::Vector3d>(b + 3 * k);
-        d = std::sqrt(surface_->segment_distance2(p, q));
+        d = std::min(d, std::sqrt(surface_->segment_distance2(p, q, d * d * (1.0 + 1e-9))));
       }
       out[k] = d - radii[k];
     }
