@@ -187,6 +187,21 @@ def test_a_staircase():
     assert np.isclose(down.signed_distance([0.05, 0.0, -0.05]), 0.05)  # in front of the riser down
 
 
+def test_spheres_and_capsules():
+    plane = PlaneTerrain.from_roll_pitch(0.0, 10.0)
+    a = np.array([[0.0, 0.0, 0.5], [1.0, 0.0, 0.0]])
+    b = np.array([[0.5, 0.0, 0.5], [1.0, 0.0, -0.5]])
+    expected = np.minimum(plane.signed_distance(a), plane.signed_distance(b)) - 0.05
+    assert np.allclose(plane.capsule_clearance(a, b, 0.05), expected, atol=1e-12)
+    assert np.allclose(plane.sphere_clearance(a, [0.1, 0.2]), plane.signed_distance(a) - [0.1, 0.2], atol=1e-12)
+    stairs = StepsTerrain(0.1, 0.3, 2)
+    # A capsule lying across the first riser, clear of it: its distance is the riser's top edge's (0, 0.1).
+    got = stairs.capsule_clearance([-0.2, 0.0, 0.15], [0.2, 0.0, 0.15], 0.01)
+    assert np.isclose(got, 0.05 - 0.01)
+    with pytest.raises(InputError, match="b must have the shape of a"):
+        stairs.capsule_clearance(np.zeros((2, 3)), np.zeros((3, 3)), 0.1)
+
+
 def test_many_threads_give_the_same_answers():
     vertices, faces = bumpy_mesh(10)
     terrains = [MeshTerrain(vertices, faces), egg_crate(0.05, 0.5, extent=(2.0, 2.0), spacing=0.05)]

@@ -56,6 +56,25 @@ class TerrainQueries:
         return self.core.signed_distance(flat).reshape(lead)
 
 
+    def sphere_clearance(self, centres: npt.ArrayLike, radii: npt.ArrayLike) -> np.ndarray:
+        """Spheres' clearance (m): their centres' (..., 3) signed distance minus their radii (...) -> (...)."""
+        flat, lead = _rows(centres, 3, "centres")
+        r = np.ascontiguousarray(np.broadcast_to(np.asarray(radii, float), lead).reshape(-1))
+        return self.core.sphere_clearance(flat, r).reshape(lead)
+
+    def capsule_clearance(self, a: npt.ArrayLike, b: npt.ArrayLike, radii: npt.ArrayLike) -> np.ndarray:
+        """Capsules' clearance (m): segments ``a`` -> ``b`` (..., 3) of radii (...): the segment's distance to the
+        surface minus the radius, exact while the segment is clear of the surface on its positive side; where it
+        touches or crosses it, the smaller of 0 and its ends' signed distances, minus the radius (exact for a
+        plane; for a heightfield or a mesh, an upper bound of minus the penetration)."""
+        fa, lead = _rows(a, 3, "a")
+        fb, lead_b = _rows(b, 3, "b")
+        if lead_b != lead:
+            raise InputError(f"b must have the shape of a, {(*lead, 3)}, got {(*lead_b, 3)}")
+        r = np.ascontiguousarray(np.broadcast_to(np.asarray(radii, float), lead).reshape(-1))
+        return self.core.capsule_clearance(fa, fb, r).reshape(lead)
+
+
 def _rows(a: npt.ArrayLike, columns: int, name: str) -> tuple[np.ndarray, tuple[int, ...]]:
     """``a`` (..., columns) as float rows (N, columns), C-contiguous, and its leading shape. NaN passes (gives NaN)."""
     try:
