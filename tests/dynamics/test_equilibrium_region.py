@@ -11,7 +11,7 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead._errors import Infeasible, InputError
 from snakehead.dynamics import stability as st
 from snakehead.dynamics.contact_set import ContactSet, flat_contacts
-from snakehead.dynamics.equilibrium_region import equilibrium_region, region_margin, static_equilibrium_lp
+from snakehead.dynamics.equilibrium_region import region_margin, static_equilibrium_lp, static_equilibrium_region
 from snakehead.model.physics import GROUND_FRICTION
 
 #: Grid points nearer the region's boundary than this (m) are not compared (the LPs' tolerances decide them).
@@ -74,7 +74,7 @@ def grid_check(contacts, region, n=13):
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_region_matches_brute_force(name):
     contacts = CASES[name]()
-    region = equilibrium_region(contacts)
+    region = static_equilibrium_region(contacts)
     assert region.bounded and region.area_gap <= 1e-8
     assert len(region.vertices) >= 3
     assert grid_check(contacts, region) > 100
@@ -86,7 +86,7 @@ def test_region_matches_brute_force(name):
 
 def test_region_does_not_depend_on_mass_or_height():
     contacts = step()
-    region = equilibrium_region(contacts)
+    region = static_equilibrium_region(contacts)
     rng = np.random.default_rng(0)
     for p in rng.uniform(region.outer.min(axis=0), region.outer.max(axis=0), (30, 2)):
         m = region_margin(region.vertices, p)
@@ -96,14 +96,14 @@ def test_region_does_not_depend_on_mass_or_height():
 
 def test_slope_steeper_than_friction_has_no_equilibrium():
     with pytest.raises(Infeasible):
-        equilibrium_region(slope(np.radians(40.0), mu=0.5))  # tan 40 = 0.84 > 0.5
+        static_equilibrium_region(slope(np.radians(40.0), mu=0.5))  # tan 40 = 0.84 > 0.5
 
 
 @pytest.mark.parametrize("mu", [1e-3, 0.3, GROUND_FRICTION, 5.0])
 def test_flat_ground_region_is_the_support_polygon(mu):
     rng = np.random.default_rng(int(mu * 1000))
     xy = rng.uniform(-0.6, 0.6, (12, 2))
-    region = equilibrium_region(flat_contacts(xy, mu))
+    region = static_equilibrium_region(flat_contacts(xy, mu))
     hull = xy[st.hull_indices(xy)]
     np.testing.assert_allclose(region.vertices, hull, atol=1e-9)
     probe = rng.uniform(-0.8, 0.8, (200, 2))
@@ -118,7 +118,7 @@ def test_flat_ground_region_is_the_robots_support_polygon():
     q[0:7:2] = 0.4  # the base in a plane arc
     base = BasePlacement(0.2, -0.1, 0.5)
     poly = st.support_polygon(robot, q, base, contact="footprint")
-    region = equilibrium_region(flat_contacts(poly))
+    region = static_equilibrium_region(flat_contacts(poly))
     np.testing.assert_allclose(region.vertices, poly, atol=1e-9)
     com = st.center_of_mass(robot, q, base)
     assert region_margin(region.vertices, com[:2]) == pytest.approx(
@@ -130,7 +130,7 @@ def test_flat_ground_region_is_the_robots_support_polygon():
        hs.floats(0.05, 2.0))
 def test_flat_ground_any_points(points, mu):
     xy = np.round(np.array(points), 3)  # a millimetre grid: no near-collinear slivers below the LPs' tolerance
-    region = equilibrium_region(flat_contacts(xy, mu))
+    region = static_equilibrium_region(flat_contacts(xy, mu))
     hull = xy[st.hull_indices(xy)]
     if len(hull) >= 3:
         np.testing.assert_allclose(region.vertices, hull, atol=1e-9)
@@ -140,7 +140,7 @@ def test_flat_ground_any_points(points, mu):
 
 
 def test_collinear_flat_contacts_give_a_segment():
-    region = equilibrium_region(flat_contacts([[0, 0], [1, 0], [2, 0]]))
+    region = static_equilibrium_region(flat_contacts([[0, 0], [1, 0], [2, 0]]))
     np.testing.assert_allclose(region.vertices, [[0, 0], [2, 0]], atol=1e-12)
     assert region_margin(region.vertices, [1, 0]) == pytest.approx(0.0, abs=1e-12)
 
@@ -153,6 +153,6 @@ def test_bad_input():
     with pytest.raises(InputError):
         flat_contacts([[0, 0]], mu=-1)
     with pytest.raises(InputError):
-        equilibrium_region(step(), tolerance=-1)
+        static_equilibrium_region(step(), tolerance=-1)
     with pytest.raises(InputError):
         region_margin([[0, 0], [1, 0], [0, 1]], [1, 2, 3])

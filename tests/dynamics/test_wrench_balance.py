@@ -8,12 +8,14 @@ from snakehead import BasePlacement, SnakeRobot
 from snakehead._errors import InputError
 from snakehead.dynamics import stability as st
 from snakehead.dynamics.contact_set import ContactSet, contact_wrench_cone, flat_contacts
+from snakehead.dynamics.equilibrium_region import region_margin
 from snakehead.dynamics.wrench_balance import (
     cwc_margin,
     gravito_inertial_wrench,
     gravito_inertial_wrenches,
     is_balanced_lp,
     zmp_on_plane,
+    zmp_support_area,
 )
 from snakehead.model.physics import GRAVITY
 
@@ -128,3 +130,33 @@ def test_bad_input():
         cwc_margin(np.zeros((3, 5)), np.zeros(6))
     with pytest.raises(InputError):
         zmp_on_plane(np.zeros(4))
+
+
+def test_zmp_support_area_on_flat_ground_with_high_friction_is_the_support_polygon():
+    rng = np.random.default_rng(9)
+    xy = rng.uniform(-0.5, 0.5, (9, 2))
+    A = contact_wrench_cone(flat_contacts(xy, mu=50.0))
+    for com in ([0.0, 0.0, 0.3], [0.2, -0.1, 0.05]):
+        area = zmp_support_area(A, com)
+        np.testing.assert_allclose(area, xy[st.hull_indices(xy)], atol=1e-9)
+
+
+def test_zmp_support_area_against_the_span_lp():
+    """Points of the area are balanced (the force through the CoM and the ZMP, by LP), points outside are not."""
+    rng = np.random.default_rng(4)
+    p = rng.uniform(-0.4, 0.4, (6, 3)) * [1, 1, 0.3]
+    n = np.column_stack([rng.normal(0, 0.3, (6, 2)), np.ones(6)])
+    contacts = ContactSet(p, n, 0.6)
+    A = contact_wrench_cone(contacts)
+    com, h = np.array([0.05, 0.0, 0.35]), 0.05
+    area = zmp_support_area(A, com, h)
+    lo, hi = area.min(axis=0) - 0.1, area.max(axis=0) + 0.1
+    compared = 0
+    for xy in rng.uniform(lo, hi, (150, 2)):
+        m = region_margin(area, xy)
+        if abs(m) < 1e-6:
+            continue
+        f = com - np.r_[xy, h]  # the contact force through the ZMP and the CoM (any positive scale)
+        assert is_balanced_lp(contacts, -np.r_[f, np.cross(com, f)]) == (m > 0)
+        compared += 1
+    assert compared > 140

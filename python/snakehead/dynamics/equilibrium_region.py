@@ -8,7 +8,7 @@ rates). Divided by m g, the unknowns are the cone multipliers lambda >= 0 and th
 drops out (gravity is along z), so the region is a vertical cylinder and only its cross-section is computed: the
 projection onto (x, y) of the polytope {(lambda, x, y)}, by Bretl and Lall's incremental algorithm.
 
-* :func:`equilibrium_region` -- the region as a counter-clockwise convex polygon, with its outer bound.
+* :func:`static_equilibrium_region` -- the region as a counter-clockwise convex polygon, with its outer bound.
 * :func:`region_margin` -- signed distance (m) of CoM positions to the region's boundary, positive inside.
 
 On flat ground the moments of the horizontal forces have no horizontal part, so the region is the convex hull of the
@@ -27,10 +27,10 @@ from .._validate import finite_array
 from .contact_set import ContactSet, contact_wrench_span
 from .stability import polygon_margin_many
 
-__all__ = ["REGION_AREA_TOLERANCE", "REGION_RADIUS", "REGION_MAX_LPS", "EquilibriumRegion", "equilibrium_region",
-           "region_margin", "static_equilibrium_lp", "convex_ccw"]
+__all__ = ["REGION_AREA_TOLERANCE", "REGION_RADIUS", "REGION_MAX_LPS", "EquilibriumRegion",
+           "static_equilibrium_region", "region_margin", "static_equilibrium_lp", "convex_ccw"]
 
-#: Default stop of :func:`equilibrium_region` (m^2): the outer and inner polygons' areas agree within this (a square
+#: Default stop of :func:`static_equilibrium_region` (m^2): the outer and inner polygons' areas agree within this (a square
 #: of 0.1 mm sides). A region that is an exact polygon ends earlier, when no direction finds a new vertex.
 REGION_AREA_TOLERANCE = 1e-8
 #: Half-width (m) of the square about the contacts' centroid that bounds the CoM in the LPs: opposing contacts with
@@ -46,7 +46,7 @@ _EDGE_TOLERANCE = 1e-9
 
 @dataclass(frozen=True)
 class EquilibriumRegion:
-    """The result of :func:`equilibrium_region`.
+    """The result of :func:`static_equilibrium_region`.
 
     vertices (k, 2) m: the inner polygon (the hull of the support points found, counter-clockwise; every point of it
     is in static equilibrium); outer (j, 2) m: the outer polygon (the intersection of the supporting half-planes
@@ -148,7 +148,7 @@ def convex_ccw(points: npt.ArrayLike, eps: float = 1e-12) -> np.ndarray:
     """The vertices of a convex polygon given as a closed counter-clockwise sequence of its boundary points (k, 2):
     repeated points (within ``eps`` m) and points on an edge (turn below ``eps`` of the edges' lengths) removed,
     starting at the lowest x (then lowest y), as :func:`~snakehead.dynamics.stability.support_polygon` starts. Two
-    points for a segment, one for a point. The support points of :func:`equilibrium_region` come in this order
+    points for a segment, one for a point. The support points of :func:`static_equilibrium_region` come in this order
     already, so no hull is taken (a hull of the nearly collinear points an LP's round-off makes is fragile)."""
     v = [np.asarray(p, float) for p in finite_array(points, "points", (None, 2))]
     changed = True
@@ -183,7 +183,7 @@ def _outer_polygon(pts: list[np.ndarray], dirs: list[np.ndarray]) -> np.ndarray:
     return convex_ccw(out)
 
 
-def equilibrium_region(contacts: ContactSet, *, tolerance: float = REGION_AREA_TOLERANCE,
+def static_equilibrium_region(contacts: ContactSet, *, tolerance: float = REGION_AREA_TOLERANCE,
                        radius: float = REGION_RADIUS, max_lps: int = REGION_MAX_LPS) -> EquilibriumRegion:
     """The static-equilibrium region of the centre of mass on ``contacts``: the (x, y) positions (m, world) of the
     CoM at which forces inside the linearised friction cones hold the robot at rest (Bretl and Lall 2008).

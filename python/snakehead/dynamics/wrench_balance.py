@@ -18,24 +18,30 @@ cone (CWC) of :func:`~.contact_set.contact_wrench_cone`: A w_c <= 0.
 * :func:`is_balanced_lp` -- the same verdict from the span form by one feasibility LP (no face enumeration).
 * :func:`zmp_on_plane` -- the ZMP of the contact wrench on a horizontal virtual plane z = h (Eqs. 39-40 with
   p_z = h); on flat ground and h = 0 it is :func:`~snakehead.dynamics.stability.zmp`.
+* :func:`zmp_support_area` -- where that ZMP may lie for a given CoM (Caron, Pham and Nakamura, "ZMP support areas
+  for multi-contact mobility under frictional constraints", IEEE T-RO 2017), with no rate of angular momentum about
+  the CoM: on flat ground with high friction, the support polygon.
 
 On flat ground with high friction the CWC test and the ZMP-in-support-polygon test of Section 3.1 agree: the cone's
 horizontal-moment faces are those of the ZMP in the polygon, and friction bounds no wrench a slow motion asks for.
 """
 from __future__ import annotations
 
+import cdd  # pycddlib: the ZMP support area's vertices from its half-planes
 import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linprog
 
-from .._errors import InputError
+from .._errors import Infeasible, InputError
 from .._validate import finite_array
 from ..model.physics import GRAVITY  # g in Eq. 38 is (0, 0, -GRAVITY)
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .contact_set import ContactSet, contact_wrench_span, wrenches
+from .equilibrium_region import REGION_RADIUS, convex_ccw
 from .stability import center_of_mass, joint_velocities, momenta
 
-__all__ = ["gravito_inertial_wrench", "gravito_inertial_wrenches", "cwc_margin", "is_balanced_lp", "zmp_on_plane"]
+__all__ = ["gravito_inertial_wrench", "gravito_inertial_wrenches", "cwc_margin", "is_balanced_lp", "zmp_on_plane",
+           "zmp_support_area"]
 
 
 def _gravity(mass: float) -> np.ndarray:
@@ -125,3 +131,34 @@ def zmp_on_plane(gravito_inertial: npt.ArrayLike, height: float = 0.0) -> np.nda
     px = (h * w[..., 0] - w[..., 4]) / fz
     py = (h * w[..., 1] + w[..., 3]) / fz
     return np.stack([px, py], axis=-1)
+
+
+def zmp_support_area(A: npt.ArrayLike, com: npt.ArrayLike, height: float = 0.0,
+                     radius: float = REGION_RADIUS) -> np.ndarray:
+    """The ZMP support area on the plane z = ``height`` (m) for the CoM at ``com`` (3,) m: the ZMPs p at which the
+    contacts with the face form A (m, 6) (:func:`~.contact_set.contact_wrench_cone`, moments about the world origin)
+    can exert the wrench of a motion with dL_G/dt = 0 (Caron, Pham and Nakamura 2017): (k, 2) counter-clockwise.
+
+    With dL_G/dt = 0 the contact force passes through the CoM and, by the ZMP's definition, through p: it is
+    a (c - p) with a > 0, its moment about the origin c x a (c - p), so p is in the area iff
+    A (c - p, c x (c - p)) <= 0: half-planes in p, linear for a fixed c. Their intersection (cddlib, H to V form)
+    is cut to the square of half-width ``radius`` about the CoM (friction may leave it unbounded). Infeasible when
+    the area is empty (no such motion balances).
+    """
+    A = finite_array(A, "A", (None, 6))
+    c = finite_array(com, "com", (3,))
+    h = float(finite_array(height, "height", ()))
+    cx = np.array([[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]])  # c x . as a matrix
+    # A_f (c - p) + A_t cx (c - p) <= 0 with p = (x, y, h): M (c - p) <= 0, M = A_f + A_t cx
+    M = A[:, :3] + A[:, 3:] @ cx
+    # M (c - p) = M (c_x, c_y, c_z - h) - M[:, :2] (x, y) <= 0, i.e. G (x, y) <= b; then the square about c
+    box = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    G = np.vstack([-M[:, :2], box])
+    b = np.r_[-(M @ np.array([c[0], c[1], c[2] - h])), radius + box @ c[:2]]
+    mat = cdd.matrix_from_array(np.column_stack([b, -G]).tolist(), rep_type=cdd.RepType.INEQUALITY)
+    gens = np.array(cdd.copy_generators(cdd.polyhedron_from_matrix(mat)).array, float).reshape(-1, 3)
+    pts = gens[gens[:, 0] > 0.5, 1:]
+    if len(pts) == 0:
+        raise Infeasible("the ZMP support area is empty: no ZMP balances a motion with this CoM")
+    order = np.argsort(np.arctan2(*(pts - pts.mean(axis=0)).T[::-1]))
+    return convex_ccw(pts[order])
