@@ -1,6 +1,9 @@
 """Dynamic balance in the contact wrench cone: the gravito-inertial wrench from the robot's momenta, its ZMP on the
 plane z = 0 against Eqs. 39-40 (stability.zmp), and on flat ground with high friction the CWC verdict against the
-ZMP-in-support-polygon verdict of Section 3.1; the face form's margin against the span form's LP."""
+ZMP-in-support-polygon verdict of Section 3.1; the face form's margin against the span form's LP; the ZMP support area.
+
+Still to come with the terrain simulation: the contact forces MuJoCo finds for the robot resting and moving on uneven
+terrain, checked against these cones (a balanced motion's contact wrench inside the CWC, a tipping one outside)."""
 import numpy as np
 import pytest
 

@@ -35,13 +35,14 @@ __all__ = ["FRICTION_CONE_EDGES", "ContactSet", "flat_contacts", "friction_cone_
 FRICTION_CONE_EDGES = 8
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ContactSet:
     """k point contacts of the robot with the ground.
 
     points (k, 3) m world; normals (k, 3) unit, pointing out of the ground into the robot (normalised here); mu the
     Coulomb friction coefficient (default the ground's, :data:`~snakehead.model.physics.GROUND_FRICTION`); edges the
-    number of edges of each linearised friction cone (:data:`FRICTION_CONE_EDGES`). The arrays are read-only copies.
+    number of edges of each linearised friction cone (:data:`FRICTION_CONE_EDGES`). The arrays are read-only copies;
+    two sets are equal only when they are the same object (arrays have no single truth value).
     """
 
     points: np.ndarray

@@ -44,7 +44,7 @@ REGION_MAX_LPS = 500
 _EDGE_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class EquilibriumRegion:
     """The result of :func:`static_equilibrium_region`.
 
