@@ -42,6 +42,25 @@ def test_the_shipped_slope():
     assert np.isclose(s.terrain.height([1.0, 0.0]), np.tan(np.radians(5.0)))
 
 
+def test_planning_on_terrain_is_refused_not_planned_on_flat_ground(tmp_path: Path):
+    """The planner does not yet plan on terrain: a terrain scene is refused with a line saying so (CLI exit 2),
+    never planned as if the ground were flat."""
+    import subprocess
+    import sys
+
+    import snakehead
+
+    path = Path(__import__("snakehead.scenes", fromlist=["x"]).__file__).with_name("slope.toml")
+    with pytest.raises(InputError, match="plans on flat ground only"):
+        snakehead.plan(path)
+    r = subprocess.run([sys.executable, "-m", "snakehead", "plan", "--scene", str(path), "--out", str(tmp_path / "out")],
+                       capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 2, r.stderr
+    assert "plans on flat ground only" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())  # nothing half-written
+
+
 def round_trip(path: Path):
     first = load_scene(path)
     again = path.with_name("again.toml")

@@ -25,6 +25,7 @@ and what a controller keeps from one plan for the next (:mod:`.plan_cache`).
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -41,6 +42,7 @@ from ..retiming.timing import resolve_limits
 from ..scenes.scene import Scene, Target, load_scene
 from ..solve.head_controller import HeadController
 from ..solve.whole_body import PlanSolves, clear_of_obstacles
+from ..terrain.surfaces import FlatGround
 from . import plan_bounds
 from .base_choice import choose_base, out_of_range, shape_of
 from .fallbacks import retime_slower
@@ -58,8 +60,10 @@ def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement
         scene = targets
         obstacles = sequence(obstacles, "obstacles")
         if obstacles:
-            scene = Scene(name=scene.name, targets=scene.targets, obstacles=tuple(scene.obstacles) + obstacles,
-                          robot_file=scene.robot_file, base=scene.base, description=scene.description, path=scene.path)
+            scene = dataclasses.replace(scene, obstacles=tuple(scene.obstacles) + obstacles)
+        if not isinstance(scene.terrain, FlatGround):  # a plan on z = 0 under a slope would be a silent wrong answer
+            raise InputError(f"scene {scene.name!r}: its [terrain] is {type(scene.terrain).__name__}; this release "
+                             "reads and checks terrain but plans on flat ground only")
         return scene
     if isinstance(targets, (str, os.PathLike)):
         return as_scene(load_scene(targets), obstacles=obstacles, base=base)
