@@ -32,8 +32,8 @@ A scene file is TOML::
     hole_diameter = 0.07
 
     [[obstacles]]
-    kind = "mesh"                           # a mesh file's convex hull (STL, OBJ, DAE...; a path inside the
-    file = "rock.stl"                       #   scene file's folder), its origin at position (m), turned by yaw (rad,
+    kind = "mesh"                           # a mesh file's convex hull (STL, OBJ, DAE...; path relative to the
+    file = "rock.stl"                       #   scene file), its origin at position (m), turned by yaw (rad,
     position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
 
     [terrain]                               # optional: the ground (default: flat, z = 0); kind = "plane",
@@ -85,7 +85,7 @@ from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, Wall
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, Terrain
-from .terrain_table import scene_file_inside, terrain_entry, terrain_from_table
+from .terrain_table import terrain_entry, terrain_from_table
 
 APPROACHES = ("free", "line")
 
@@ -279,8 +279,9 @@ def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObs
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
         if kind == "mesh":
-            path = scene_file_inside(folder or Path("."), entry["file"], "mesh")  # untrusted: its own folder only
-            return MeshObstacle.load(path, _number_list(entry["position"], "position"),
+            if not isinstance(entry["file"], str) or not entry["file"]:
+                raise InputError(f"file must be a mesh file's path, got {entry['file']!r}")
+            return MeshObstacle.load((folder or Path(".")) / entry["file"], _number_list(entry["position"], "position"),
                                      _number(entry.get("yaw", 0.0), "yaw"),
                                      _number_list(entry.get("scale", [1.0, 1.0, 1.0]), "scale"), where="mesh")
         if kind == "box":
