@@ -31,7 +31,7 @@ void bind_limit_ratios(py::module_& m) {
   m.def(
       "limit_ratios",
       [](Array qd, Array qdd, Array tau, Array Pdot, Array Ldot, Array com, Array normal, Array offset,
-         Array velocity, Array acceleration, Array torque, double Mg, double friction) {
+         Array velocity, Array acceleration, Array torque, double Mg, double friction, double Mg_x, double Mg_y) {
         if (qd.ndim() != 2 || normal.ndim() != 3) throw InputError("limit_ratios: qd must be (N, n), normal (N, E, 2)");
         const py::ssize_t N = qd.shape(0), n = qd.shape(1), E = normal.shape(1);
         check_shape(qdd, {N, n}, "qdd");
@@ -47,7 +47,7 @@ void bind_limit_ratios(py::module_& m) {
           py::gil_scoped_release release;
           r = limit_ratios(N, n, E, qd.data(), qdd.data(), tau.data(), Pdot.data(), Ldot.data(), com.data(),
                            normal.data(), offset.data(), velocity.data(), acceleration.data(), torque.data(), Mg,
-                           friction);
+                           friction, Mg_x, Mg_y);
         }
         py::dict out;
         out["velocity"] = to_array(r.velocity);
@@ -59,9 +59,10 @@ void bind_limit_ratios(py::module_& m) {
       },
       py::arg("qd"), py::arg("qdd"), py::arg("tau"), py::arg("Pdot"), py::arg("Ldot"), py::arg("com"),
       py::arg("normal"), py::arg("offset"), py::arg("velocity"), py::arg("acceleration"), py::arg("torque"),
-      py::arg("Mg"), py::arg("friction"),
+      py::arg("Mg"), py::arg("friction"), py::arg("Mg_x") = 0.0, py::arg("Mg_y") = 0.0,
       "Per sample (N,): the largest |value| / limit of qd, qdd and tau (N, n), the friction used "
-      "(|dP_xy/dt| / (friction (Mg + dP_z/dt)), inf where the ground would pull) and the ZMP's signed distance inside "
+      "(|dP_xy/dt - (Mg_x, Mg_y)| / (friction (Mg + dP_z/dt)), inf where the ground would pull; Mg_x, Mg_y: the "
+      "weight along a slope's ground, zero on flat ground) and the ZMP's signed distance inside "
       "its polygon (normal (N, E, 2) inward, offset (N, E); -inf where the ground would pull): a dict of arrays.");
 }
 

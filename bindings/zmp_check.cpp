@@ -1,3 +1,4 @@
+#include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -28,7 +29,7 @@ void bind_zmp_check(py::module_& m) {
       "zmp_check",
       [](const PathChecker& c, const Doubles& t, const Doubles& q, const Doubles& qd, const Indices& contact_shapes,
          long points_per_shape, const Indices& clearance_shapes, bool ground_key, std::vector<int> key_joints,
-         double tolerance, long chunk, double gravity, std::optional<std::shared_ptr<const ZmpPrefix>> resume,
+         double tolerance, long chunk, Eigen::Vector3d gravity, std::optional<std::shared_ptr<const ZmpPrefix>> resume,
          long keep) {
         const long n = c.n_joints();
         const long T = samples_of("q", q, n);
@@ -67,8 +68,8 @@ void bind_zmp_check(py::module_& m) {
       py::arg("points_per_shape"), py::arg("clearance_shapes"), py::arg("ground_key"), py::arg("key_joints"),
       py::arg("tolerance"), py::arg("chunk"), py::arg("gravity"), py::arg("resume") = py::none(), py::arg("keep") = 0,
       "The ZMP check of a sampled motion (Eqs. 25-40) in one pass (zmp_check.hpp): a dict of zmp (T, 2), margin "
-      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (m/s^2) from "
-      "snakehead.model.physics.GRAVITY. resume: a ZmpPrefix whose samples this motion begins with (taken over when "
+      "(T,), P, L, com (T, 3) and clearance (T,): the lowest z of clearance_shapes; gravity (3,) m/s^2 in the ground "
+      "frame (BasePlacement.gravity). resume: a ZmpPrefix whose samples this motion begins with (taken over when "
       "everything it was made from is the same, to the bit: resumed says how many samples); keep > 0: kept is the "
       "ZmpPrefix of the first keep samples (else None)");
 }

@@ -26,7 +26,7 @@ double largest_ratio(const double* x, const double* limit, long n) {
 LimitRatios limit_ratios(long N, long n, long E, const double* qd, const double* qdd, const double* tau,
                          const double* Pdot, const double* Ldot, const double* com, const double* normal,
                          const double* offset, const double* velocity, const double* acceleration,
-                         const double* torque, double Mg, double friction) {
+                         const double* torque, double Mg, double friction, double Mg_x, double Mg_y) {
   if (N < 0 || n < 1 || E < 1) throw InputError("limit_ratios: at least one joint and one polygon edge are needed");
   constexpr double kInf = std::numeric_limits<double>::infinity();
   LimitRatios r;
@@ -49,7 +49,8 @@ LimitRatios limit_ratios(long N, long n, long E, const double* qd, const double*
         margin = std::min(margin, ((0.0 + u[0] * x) + u[1] * y) - offset[k * E + e]);
       }
       r.zmp_margin[k] = lifting ? margin : -kInf;
-      r.friction[k] = lifting ? std::hypot(Pdot[3 * k], Pdot[3 * k + 1]) / (friction * safe) : kInf;
+      const double along_x = Pdot[3 * k] - Mg_x, along_y = Pdot[3 * k + 1] - Mg_y;  // the ground's push along it
+      r.friction[k] = lifting ? std::hypot(along_x, along_y) / (friction * safe) : kInf;
     }
   });
   return r;

@@ -49,6 +49,29 @@ std::vector<int> convex_hull(const Eigen::Ref<const Points>& points) {
   return hull;
 }
 
+namespace {
+
+// Drops from `order` (sorted by x, then y) each point within eps of a point kept before it that is not the one just
+// before it: round-off twins such as x = 0.1 and 0.10000000000000003 sort apart when points with x = 0.1 and a
+// larger y lie between them, and the chain would pop the corners between them for the later twin, then drop it as a
+// duplicate (a triangle came out as a segment). Twins next to each other are left to the chain's own test.
+void drop_distant_twins(const Eigen::Ref<const Points>& points, double eps, std::vector<int>& order) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const int i = order[k];
+    bool twin = false;
+    for (std::size_t m = kept; m-- > 1 && !twin;) {  // back over the kept points within eps in x, but the last
+      const int j = order[m - 1];
+      if (points(i, 0) - points(j, 0) > eps) break;
+      twin = std::abs(points(i, 1) - points(j, 1)) <= eps;
+    }
+    if (!twin) order[kept++] = i;
+  }
+  order.resize(kept);
+}
+
+}  // namespace
+
 void convex_hull_into(const Eigen::Ref<const Points>& points, HullWork& work, std::vector<int>& hull) {
   const int n = static_cast<int>(points.rows());
   std::vector<int>& order = work.order;
@@ -60,6 +83,7 @@ void convex_hull_into(const Eigen::Ref<const Points>& points, HullWork& work, st
   double scale = 1.0;
   for (int i = 0; i < n; ++i) scale = std::max({scale, std::abs(points(i, 0)), std::abs(points(i, 1))});
   const double eps = 1e-12 * scale;
+  drop_distant_twins(points, eps, order);
   auto half = [&](auto begin, auto end, std::vector<int>& out) {
     out.clear();
     for (auto it = begin; it != end; ++it) {

@@ -218,7 +218,8 @@ class SupportRuns {
 
 void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
   if (spec.chunk < 1 || spec.points_per_shape < 1) throw InputError("zmp_check: chunk and points_per_shape must be >= 1");
-  if (!(std::isfinite(spec.gravity) && spec.gravity > 0.0)) throw InputError("zmp_check: gravity must be finite and > 0");
+  if (!(spec.gravity.allFinite() && spec.gravity.z() < 0.0))
+    throw InputError("zmp_check: gravity must be finite with g_z < 0 (the ground below)");
   for (long s : spec.contact_shapes) check_shape_index("contact", s, shapes);
   for (long s : spec.clearance_shapes) check_shape_index("clearance", s, shapes);
   for (int j : spec.key_joints)
@@ -228,7 +229,8 @@ void check_spec(const ZmpCheckSpec& spec, const ShapeSet& shapes, long n) {
 bool same_spec(const ZmpCheckSpec& a, const ZmpCheckSpec& b) {
   return a.contact_shapes == b.contact_shapes && a.points_per_shape == b.points_per_shape &&
          a.clearance_shapes == b.clearance_shapes && a.ground_key == b.ground_key && a.key_joints == b.key_joints &&
-         a.shaped_links == b.shaped_links && a.tolerance == b.tolerance && a.chunk == b.chunk;
+         a.shaped_links == b.shaped_links && a.tolerance == b.tolerance && a.chunk == b.chunk &&
+         a.gravity == b.gravity;
 }
 
 // How zmp_check may take a kept prefix over (see ZmpPrefix): not at all, as it is (made at this origin: to the bit), or
@@ -303,7 +305,9 @@ void zmp_and_margins(const RigidBodyChain& chain, const ZmpCheckSpec& spec, cons
   time_derivative(t, out.angular.data(), T, 3, Ldot.data());   // Eq. 34's dL/dt
   double M = 0.0;
   for (double m : chain.mass) M += m;
-  const double Mg = M * spec.gravity;
+  const double Mg = M * -spec.gravity.z();  // the weight's share across the ground
+  const bool leaning = spec.gravity.x() != 0.0 || spec.gravity.y() != 0.0;  // a slope: the weight pulls along it
+  const double Mgx = M * spec.gravity.x(), Mgy = M * spec.gravity.y();
   out.zmp.resize(static_cast<std::size_t>(2 * T));
   out.margin.resize(static_cast<std::size_t>(T));
   parallel_for(T, kZmpSamplesPerThread, [&](long begin, long end) {
@@ -315,8 +319,10 @@ void zmp_and_margins(const RigidBodyChain& chain, const ZmpCheckSpec& spec, cons
         out.margin[k] = -kInf;
         continue;
       }
-      const Eigen::Vector2d p((Mg * c[0] - Ldot[3 * k + 1]) / den,   // Eq. 39 (p_z = 0)
-                              (Mg * c[1] + Ldot[3 * k]) / den);      // Eq. 40
+      // Eqs. 39-40 (p_z = 0); on a slope the weight's moment about the ground plane adds M (g_x, g_y) c_z
+      const double mx = leaning ? Mg * c[0] + Mgx * c[2] : Mg * c[0];
+      const double my = leaning ? Mg * c[1] + Mgy * c[2] : Mg * c[1];
+      const Eigen::Vector2d p((mx - Ldot[3 * k + 1]) / den, (my + Ldot[3 * k]) / den);
       out.zmp[2 * k] = p.x();
       out.zmp[2 * k + 1] = p.y();
       if (!p.allFinite()) throw InputError("zmp_check: the ZMP is not finite (qd or t out of range)");

@@ -25,7 +25,9 @@ struct ZmpCheckSpec {
   std::vector<int> shaped_links;      // links with shapes (ground key: which touch)
   double tolerance = 1e-3;
   long chunk = 4096;
-  double gravity = std::numeric_limits<double>::quiet_NaN();  // m/s^2: the caller's (model.physics.GRAVITY)
+  // g (m/s^2) in the ground frame (the caller's: BasePlacement.gravity): (0, 0, -GRAVITY) on flat ground; on a
+  // slope it leans, and the ZMP on the ground plane takes the lean in (g_x, g_y != 0; g_z < 0 always)
+  Eigen::Vector3d gravity = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct ZmpCheck {

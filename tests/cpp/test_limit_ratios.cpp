@@ -51,3 +51,19 @@ TEST(LimitRatios, ClosedForms) {
                             normal.data(), offset.data(), velocity.data(), acceleration.data(), torque.data(), Mg, mu),
                InputError);
 }
+
+TEST(LimitRatios, OnASlopeTheGroundPushesAgainstTheWeightAlongIt) {
+  // one sample, the weight's part along the ground M g_xy = (-6, 0) N: the contact force along the ground is
+  // dP_xy/dt - M g_xy = (3 + 6, 4) and the friction used |(9, 4)| / (mu (Mg + dP_z/dt)) = sqrt(97) / 10
+  const long N = 1, n = 1, E = 1;
+  const std::vector<double> normal{1, 0}, offset{0}, qd{0}, qdd{0}, tau{0}, limit{1};
+  const std::vector<double> Pdot{3, 4, 10}, Ldot{0, 0, 0}, com{0.3, 0.4, 0.1};
+  const LimitRatios r = limit_ratios(N, n, E, qd.data(), qdd.data(), tau.data(), Pdot.data(), Ldot.data(), com.data(),
+                                     normal.data(), offset.data(), limit.data(), limit.data(), limit.data(), 10.0, 0.5,
+                                     -6.0, 0.0);
+  EXPECT_NEAR(r.friction[0], std::sqrt(97.0) / 10.0, 1e-15);
+  const LimitRatios flat = limit_ratios(N, n, E, qd.data(), qdd.data(), tau.data(), Pdot.data(), Ldot.data(),
+                                        com.data(), normal.data(), offset.data(), limit.data(), limit.data(),
+                                        limit.data(), 10.0, 0.5);
+  EXPECT_NEAR(flat.friction[0], 0.5, 1e-15);
+}

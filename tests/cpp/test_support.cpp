@@ -44,6 +44,21 @@ TEST(ConvexHull, DegenerateSets) {
   EXPECT_TRUE(snakehead::convex_hull(Points(0, 2)).empty());
 }
 
+TEST(ConvexHull, PointsApartByRoundOffKeepEveryCorner) {
+  // the twin of (0.1, 0.1394) at x = 0.10000000000000003 sorts after (0.1, 0.44) and (0.1, 0.5638): the hull is the
+  // triangle (-0.08, 0.43), (0.1, 0.1394), (0.1, 0.5638), not a segment
+  Points p(5, 2);
+  p << 0.10000000000000003, 0.1394, 0.1, 0.5638, 0.1, 0.44, 0.1, 0.1394, -0.08, 0.43;
+  std::vector<int> h = snakehead::convex_hull(p);
+  ASSERT_EQ(h.size(), 3u);
+  EXPECT_NE(std::find(h.begin(), h.end(), 4), h.end());
+  EXPECT_NE(std::find(h.begin(), h.end(), 1), h.end());
+  const bool low = std::find(h.begin(), h.end(), 0) != h.end() || std::find(h.begin(), h.end(), 3) != h.end();
+  EXPECT_TRUE(low);
+  EXPECT_NEAR(snakehead::hull_margin(p, Eigen::Vector2d(0.0, 0.4)), 0.0, 0.1);  // inside: not a segment's -distance
+  EXPECT_GT(snakehead::hull_margin(p, Eigen::Vector2d(0.05, 0.4)), 0.0);
+}
+
 TEST(HullMargin, InsideOutsideAndDegenerate) {
   const Points p = square_with_inside_and_edge_points();
   EXPECT_DOUBLE_EQ(snakehead::hull_margin(p, Eigen::Vector2d(1.0, 1.0)), 1.0);   // centre: 1 from each edge

@@ -42,22 +42,23 @@ def test_the_shipped_slope():
     assert np.isclose(s.terrain.height([1.0, 0.0]), np.tan(np.radians(5.0)))
 
 
-def test_planning_on_terrain_is_refused_not_planned_on_flat_ground(tmp_path: Path):
-    """The planner does not yet plan on terrain: a terrain scene is refused with a line saying so (CLI exit 2),
-    never planned as if the ground were flat."""
+def test_planning_on_a_terrain_other_than_a_plane_is_refused_not_planned_on_flat_ground(tmp_path: Path):
+    """The planner plans on flat ground and on planes (tests/planning/test_plan_on_slope.py); a scene on a
+    heightfield, mesh or steps is refused with a line saying so (CLI exit 2), never planned as if the ground were
+    flat."""
     import subprocess
     import sys
 
     import snakehead
 
-    path = Path(__import__("snakehead.scenes", fromlist=["x"]).__file__).with_name("slope.toml")
-    with pytest.raises(InputError, match="plans on flat ground only"):
+    path = scene(tmp_path, 'kind = "steps"\nstep_height = 0.05\nstep_depth = 0.3\ncount = 3\n')
+    with pytest.raises(InputError, match="plans on flat ground and on planes"):
         snakehead.plan(path)
     r = subprocess.run([sys.executable, "-m", "snakehead", "plan", "--scene", str(path), "--out", str(tmp_path / "out")],
                        capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 2, r.stderr
-    assert "plans on flat ground only" in r.stderr and "Traceback" not in r.stderr
+    assert "plans on flat ground and on planes" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())  # nothing half-written
 
 

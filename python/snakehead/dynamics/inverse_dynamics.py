@@ -29,7 +29,6 @@ import numpy.typing as npt
 from .. import _core
 from .._errors import InputError
 from .._validate import finite_array, positive
-from ..model.physics import GRAVITY
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .stability import momenta_from_velocities
 
@@ -119,7 +118,7 @@ def inverse_dynamics(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd
     """Joint torques (N m) that move the body along q, qd, qdd with the root link lying still on the ground.
 
     q (rad), qd (rad/s), qdd (rad/s^2): (T, n) each, or (n,) each (-> (n,)). ``base``: where the root lies (its
-    height and yaw; gravity is along the world's -z). ``gravity``: "carried" (default: each link's weight counts by
+    height and yaw; gravity is its ground frame's, along -z but on a slope). ``gravity``: "carried" (default: each link's weight counts by
     its lifted share, :func:`carried_weights`: a link resting on the ground, and what lies beyond it, is carried by
     the ground), "full" (every link's weight: the body as a fixed-base arm) or "none" (inertial terms only).
     Inertial terms (the links' accelerations, Coriolis and centrifugal terms) always count in full.
@@ -149,7 +148,7 @@ def newton_euler(robot: SnakeRobot, q: npt.ArrayLike, qd: npt.ArrayLike, qdd: np
 
     # in the world frame: the root link is still, so its frame is as good as any inertial one, and the momentum rates
     # come out about the world origin (Eqs. 33-34) directly
-    g = np.array([0.0, 0.0, -GRAVITY]) if gravity != "none" else np.zeros(3)
+    g = base.gravity if gravity != "none" else np.zeros(3)  # (0, 0, -GRAVITY) but on a slope
     chain = robot.body.model
     masses = (list(chain.joint_child_links), chain.joint_axes, robot.masses, robot.coms, robot.inertias)
     # the pass itself (C++ core, per sample): forward, the links' angular velocities and accelerations and their

@@ -205,21 +205,23 @@ def static_margin(robot: SnakeRobot, q: npt.ArrayLike, base: BasePlacement | Non
     tolerance = float(finite_array(tolerance, "tolerance", ()))
     frames = robot.frames_many(q[None, :], base)
     return float(static_margins_of_frames(robot, frames, center_of_mass(robot, q[None, :], base, frames=frames),
-                                          contact, tolerance)[0])
+                                          contact, tolerance, base)[0])
 
 
 def static_margins_of_frames(robot: SnakeRobot, frames: np.ndarray, com: np.ndarray, contact: str = "endpoints",
-                             tolerance: float = GROUND_TOLERANCE) -> np.ndarray:
+                             tolerance: float = GROUND_TOLERANCE, base: BasePlacement | None = None) -> np.ndarray:
     """:func:`static_margin` of many configurations at once from their world frames (T, n_links, 4, 4)
     (:meth:`SnakeRobot.frames_many`) and centres of mass (T, 3) (:func:`center_of_mass`): (T,) m. Each sample's
     support polygon is the hull of its own touching contact points (the C++ core's hull, one per sample, without
     the GIL). The arrays are taken as they are (for the library's inner loops, e.g. the whole-body solve's checks of
-    a batch of candidates). ``Infeasible`` when a sample has no base link on the ground."""
+    a batch of candidates); ``base``: the placement the frames are at, whose ground's gravity leans the CoM's
+    projection on a slope (:func:`com_on_ground`; default: flat ground). ``Infeasible`` when a sample has no base
+    link on the ground."""
     pts, active = _contact_points_many(robot, frames, contact, tolerance)
     if not active.any(axis=1).all():
         raise Infeasible("no base link touches the ground: there is no support polygon")
     return _core.hull_margins(np.ascontiguousarray(pts, dtype=np.float64), np.ascontiguousarray(active),
-                              np.ascontiguousarray(com[:, :2], dtype=np.float64))
+                              np.ascontiguousarray(as_base(base).below_along_gravity(com), dtype=np.float64))
 
 
 def is_statically_stable(robot: SnakeRobot, q: np.ndarray, base: BasePlacement | None = None, *,
@@ -316,13 +318,20 @@ def momenta(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement
 # ------------------------------------------------------------------------------------------------
 # Eqs. 32-40: zero-moment point
 # ------------------------------------------------------------------------------------------------
-def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz: float = 0.0) -> np.ndarray:
-    """Eqs. 39-40: (T, 2) ZMP on the plane z = pz from the CoM (T, 3) and the momentum rates (T, 3)."""
-    den = M * GRAVITY + Pdot[:, 2]
+def _zmp_from(com: np.ndarray, Pdot: np.ndarray, Ldot: np.ndarray, M: float, pz: float = 0.0,
+              gravity: np.ndarray | None = None) -> np.ndarray:
+    """Eqs. 39-40: (T, 2) ZMP on the plane z = pz from the CoM (T, 3) and the momentum rates (T, 3); ``gravity``
+    (3,) in the ground frame (default (0, 0, -GRAVITY)): on a slope the weight's moment adds M g_xy (c_z - pz)."""
+    G = GRAVITY if gravity is None else float(-gravity[2])
+    den = M * G + Pdot[:, 2]
     # the ground cannot pull: where M g + dP_z/dt <= 0 the robot leaves the ground and there is no ZMP (NaN)
     den = np.where(den > 0.0, den, np.nan)
-    px = (M * GRAVITY * com[:, 0] + pz * Pdot[:, 0] - Ldot[:, 1]) / den  # Eq. 39
-    py = (M * GRAVITY * com[:, 1] + pz * Pdot[:, 1] + Ldot[:, 0]) / den  # Eq. 40
+    mx, my = M * G * com[:, 0], M * G * com[:, 1]
+    if gravity is not None and (gravity[0] != 0.0 or gravity[1] != 0.0):
+        mx = mx + M * gravity[0] * (com[:, 2] - pz)
+        my = my + M * gravity[1] * (com[:, 2] - pz)
+    px = (mx + pz * Pdot[:, 0] - Ldot[:, 1]) / den  # Eq. 39
+    py = (my + pz * Pdot[:, 1] + Ldot[:, 0]) / den  # Eq. 40
     return np.stack([px, py], axis=1)
 
 
@@ -333,7 +342,7 @@ def _zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement, q
     P, L, com = _momenta(robot, q, qd, base, frames)
     Pdot = _time_derivative(t, P)  # Eq. 33's dP/dt
     Ldot = _time_derivative(t, L)  # Eq. 34's dL/dt
-    return _zmp_from(com, Pdot, Ldot, robot.total_mass), P, L, com, q
+    return _zmp_from(com, Pdot, Ldot, robot.total_mass, gravity=base.gravity), P, L, com, q
 
 
 def zmp(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, base: BasePlacement | None = None, qd: np.ndarray | None = None
@@ -461,7 +470,7 @@ def dynamic_stability_in_core(robot: SnakeRobot, t: np.ndarray, q: np.ndarray, b
     made = made if made is not None else checker(robot, base)
     out = _core.zmp_check(made, t, np.ascontiguousarray(q), np.ascontiguousarray(qd, float), g.shapes_of(links),
                           g.contact_points_per_shape, g.shapes_of(robot.lifted_links), contact == "ground",
-                          key_joints, tolerance, SAMPLE_CHUNK, GRAVITY, resume, max(0, keep))
+                          key_joints, tolerance, SAMPLE_CHUNK, base.gravity, resume, max(0, keep))
     if kept is not None:
         kept.resumed = int(out["resumed"])
         if out["kept"] is not None:
@@ -495,7 +504,7 @@ def dynamic_stability_in_python(robot: SnakeRobot, t: np.ndarray, q: np.ndarray,
         del f
     Pdot = _time_derivative(t, P)  # Eq. 33's dP/dt
     Ldot = _time_derivative(t, L)  # Eq. 34's dL/dt
-    p = _zmp_from(com, Pdot, Ldot, robot.total_mass)
+    p = _zmp_from(com, Pdot, Ldot, robot.total_mass, gravity=base.gravity)
     del Pdot, Ldot
     flying = ~np.all(np.isfinite(p), axis=1)
     xy = np.where(flying[:, None], 0.0, p)

@@ -22,7 +22,6 @@ fixed marker frames named ``NAME__aligned``, when the URDF's turn another way.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from typing import Any, Mapping
@@ -32,7 +31,6 @@ import numpy.typing as npt
 
 from .. import _core
 from .._errors import InputTypeError
-from .._validate import finite_array
 from ..geometry.shapes import ShapeSet
 from . import frames as kin
 from . import robot_geometry as geo
@@ -40,42 +38,14 @@ from . import robot_parts as rp
 from . import straight_body as sb
 from .body_frame import ALIGNED_SUFFIX, Straightness, straightness
 from .chain import Chain
+from .placement import BasePlacement, GroundFrame
 from .robot_build import build, check_snake, is_xml_text
 from .robot_file import default_robot_file, default_urdf_path, read_robot_file
 from .robot_parts import RobotParts
 from .straight_body import PITCH, YAW
 
-__all__ = ["SnakeRobot", "BasePlacement", "RobotParts", "as_robot", "as_base", "default_robot_file",
+__all__ = ["SnakeRobot", "BasePlacement", "GroundFrame", "RobotParts", "as_robot", "as_base", "default_robot_file",
            "default_urdf_path", "YAW", "PITCH", "ALIGNED_SUFFIX"]
-
-
-@dataclass(frozen=True)
-class BasePlacement:
-    """Where the base lies on the ground: the body frame (:attr:`SnakeRobot.body_in_root`; the root link's frame
-    for snakes written along x) at planar position (x, y), turned by ``yaw``.
-
-    x, y in m (world), yaw in rad about the world z-axis. The root frame's height is the robot's
-    (:attr:`SnakeRobot.body_axis_height`: the base's shapes rest on the ground), so a placement fits any robot:
-    ``robot.root_pose(base)`` is the 4x4 world pose. The default puts the root frame (the tail end) at the origin
-    with the body along world +x.
-    """
-
-    x: float = 0.0
-    y: float = 0.0
-    yaw: float = 0.0
-
-    def __post_init__(self) -> None:
-        finite_array([self.x, self.y, self.yaw], "base placement (x, y, yaw)", (3,))
-        for name in ("x", "y", "yaw"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-
-    def matrix(self, height: float) -> np.ndarray:
-        """World pose (4, 4) of the root frame with its origin ``height`` m above the ground."""
-        c, s = np.cos(self.yaw), np.sin(self.yaw)
-        T = np.eye(4)
-        T[:2, :2] = [[c, -s], [s, c]]
-        T[:3, 3] = (self.x, self.y, float(height))
-        return T
 
 
 class SnakeRobot:

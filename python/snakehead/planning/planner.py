@@ -26,6 +26,7 @@ and what a controller keeps from one plan for the next (:mod:`.plan_cache`).
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -34,15 +35,16 @@ from typing import Any, Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from .._errors import InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
+from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong, entry_point, inputs_checked
 from .._validate import integer, joint_vector, sequence
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
+from ..model.placement import GroundFrame
 from ..model.robot import BasePlacement, SnakeRobot
 from ..retiming.timing import resolve_limits
+from ..scenes.ground_scene import base_on_slope, scene_in_ground_frame
 from ..scenes.scene import Scene, Target, load_scene
 from ..solve.head_controller import HeadController
 from ..solve.whole_body import PlanSolves, clear_of_obstacles
-from ..terrain.surfaces import FlatGround
 from . import plan_bounds
 from .base_choice import choose_base, out_of_range, shape_of
 from .fallbacks import retime_slower
@@ -55,16 +57,15 @@ from .waypoints import Waypoints
 
 
 def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
-    """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``)."""
+    """A :class:`Scene` from a scene, a scene file's path, or (position, direction) pairs (with ``obstacles``), in
+    the frame it is planned in: on a plane terrain the plane's ground frame (``scenes.ground_scene``; its base
+    placement then holds the frame), else as it is. InputError for a terrain that cannot be planned on yet."""
     if isinstance(targets, Scene):
         scene = targets
         obstacles = sequence(obstacles, "obstacles")
         if obstacles:
             scene = dataclasses.replace(scene, obstacles=tuple(scene.obstacles) + obstacles)
-        if not isinstance(scene.terrain, FlatGround):  # a plan on z = 0 under a slope would be a silent wrong answer
-            raise InputError(f"scene {scene.name!r}: its [terrain] is {type(scene.terrain).__name__}; this release "
-                             "reads and checks terrain but plans on flat ground only")
-        return scene
+        return scene_in_ground_frame(scene)[0]
     if isinstance(targets, (str, os.PathLike)):
         return as_scene(load_scene(targets), obstacles=obstacles, base=base)
     return Scene.from_targets(targets, obstacles=obstacles, base=base)
@@ -122,9 +123,16 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
 
     Returns a :class:`Plan` (``success``, ``failure``, ``t``, ``q``, ``targets`` with their errors,
     ``min_zmp_margin_m``, ``min_ground_clearance_m``, ``duration_s``, ``planning_time_s``).
+
+    On a slope (a scene whose ``[terrain]`` is a plane) the plan is made in the plane's ground frame
+    (:class:`~snakehead.model.placement.GroundFrame`: the slope is z = 0 there and gravity leans) and returned in
+    it: ``plan.base.ground.matrix`` takes its poses to the world. The scene's targets, obstacles and base (and
+    ``base``) are given in the world. A slope steeper than the friction holds (tan > mu) is ``Infeasible``.
     """
     t_start = time.perf_counter()
     scene = as_scene(targets, obstacles=obstacles, base=base)
+    if base is not None and scene.base is not None:  # a base given in the world, on the scene's slope
+        base = base_on_slope(base, scene.base.ground)
     if progress is not None and not callable(progress):
         raise InputTypeError(f"progress must be a function of a PlanProgress (or None), got {type(progress).__name__}")
     lines = check_size(scene)  # before anything is solved
@@ -133,6 +141,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     robot = controller.robot
     if timing:  # checked before anything is planned: a bad option is the caller's, found at once
         check_timing(robot, timing)
+    check_slope(scene.name, controller.base.ground, resolve_limits(robot, **(timing or {})).friction)
     start_q, base_shape = _start_shapes(robot, start_q, base_shape)
     inputs_checked()  # from here on an InputError would be a bug of the planner's (the entry point says so)
     obstacles = list(scene.obstacles)
@@ -171,6 +180,16 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if allow_relocation and relocation is None:
         plan.out_of_range = out_of_range(robot, chosen, scene.reported)
     return plan
+
+
+def check_slope(name: str, ground: GroundFrame, friction: float) -> None:
+    """Infeasible when the ground ``ground`` is steeper than ``friction`` holds a body lying still on it
+    (tan(slope) > mu: the weight's pull along the slope exceeds what friction gives)."""
+    slope = math.radians(ground.slope_deg)
+    if math.tan(slope) > friction:
+        raise Infeasible(f"scene {name!r}: its ground slopes {ground.slope_deg:.1f} deg, steeper than the friction "
+                         f"holds a body lying on it (tan {ground.slope_deg:.1f} deg = {math.tan(slope):.3f} > "
+                         f"mu = {friction:g}): the base would slide")
 
 
 def _check_options(timing: Any, method: Any, seed: Any, allow_relocation: Any) -> None:
@@ -401,4 +420,4 @@ def _finish(name: str, plan: Waypoints, targets: Any, t_start: float, obstacles:
                 timing_failure=plan.timing_failure, motion_proof=proof)
 
 
-__all__ = ["plan", "as_scene"]
+__all__ = ["plan", "as_scene", "check_slope"]

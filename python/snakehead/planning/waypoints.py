@@ -186,7 +186,7 @@ class Waypoints:
         link lying on the ground (``contact="ground"``); once the head is up (after the lift: ``lift_index`` set),
         the smaller of that and the base's own (``_base_margins``): a motion must not lean on a neck or head
         link that touches the ground at a checked configuration and may leave it in between."""
-        com = stability.center_of_mass(self.robot, qs, self.base)[:, :2]
+        com = self.base.below_along_gravity(stability.center_of_mass(self.robot, qs, self.base))
         margin = stability.support_margins(self.robot, qs, com, self.base, contact=PLAN_CONTACT)
         if self.lift_index is not None:
             margin = np.minimum(margin, self._base_margins(qs, com))

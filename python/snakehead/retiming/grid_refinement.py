@@ -90,8 +90,10 @@ def probe_support(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits
     a, b = stage, stage + 1
     changed = (np.any(support.offset[a] != support.offset[b], axis=1)
                | np.any(support.normal[a] != support.normal[b], axis=(1, 2)))
+    if not base.on_flat_ground:  # as Support.of keeps it: moved along gravity to the ground point below
+        com = np.column_stack([base.below_along_gravity(com), com[:, 2]])
     near = Support(support.normal[nearer], support.offset[nearer], com, support.static[nearer],
-                   support.required[nearer])
+                   support.required[nearer], support.weight[nearer])
     if not changed.any():
         return near
     own = Support.of(robot, q[changed], base, limits.zmp_margin)

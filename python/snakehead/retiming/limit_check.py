@@ -12,7 +12,6 @@ from .. import _core
 from .._errors import InputTypeError
 from .._validate import finite_array
 from ..dynamics.inverse_dynamics import InverseDynamics, newton_euler
-from ..model.physics import GRAVITY
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from .retiming_limits import RetimingLimits
 from .support_polygon import Support
@@ -63,7 +62,8 @@ def limit_ratios(robot: SnakeRobot, base: BasePlacement, limits: RetimingLimits,
     c = np.ascontiguousarray
     ratios = _core.limit_ratios(c(qd), c(qdd), c(dyn.tau), c(dyn.Pdot), c(dyn.Ldot), c(support.com), c(support.normal),
                                 c(support.offset), c(limits.velocity, float), c(limits.acceleration, float),
-                                c(limits.torque, float), robot.total_mass * GRAVITY, float(limits.friction))
+                                c(limits.torque, float), robot.total_mass * base.gravity_across,
+                                float(limits.friction), *(robot.total_mass * base.gravity[:2]))
     ratios["zmp_slack"] = ratios["zmp_margin"] - support.required
     return ratios
 

@@ -32,10 +32,11 @@ def stability_rows(robot: SnakeRobot, support: Support, limits: RetimingLimits, 
     """The stability constraints at N configurations as F w <= g on w = (dP/dt, dL/dt) (N, 6):
     F (N, E + FRICTION_SIDES + 1, 6), g (N, E + FRICTION_SIDES + 1): the ZMP's rows (:func:`zmp_rows`), then the
     friction's and the normal force's (:func:`friction_rows`)."""
-    Mg = robot.total_mass * GRAVITY
     N = support.offset.shape[0]
+    weight = support.weight[0] if N else np.array([0.0, 0.0, -robot.total_mass * GRAVITY])
+    Mg = float(-weight[2])  # the weight across the ground: M GRAVITY on flat ground
     F_zmp, g_zmp = zmp_rows(Mg, support, limits.zmp_margin, extra_margin)
-    F_fr, g_fr = friction_rows(Mg, limits.friction)
+    F_fr, g_fr = friction_rows(Mg, limits.friction, weight[:2])
     F = np.concatenate([F_zmp, np.broadcast_to(F_fr, (N,) + F_fr.shape)], axis=1)
     g = np.concatenate([g_zmp, np.broadcast_to(g_fr, (N, len(g_fr)))], axis=1)
     return F, g
@@ -58,13 +59,17 @@ def zmp_rows(Mg: float, support: Support, zmp_margin: float, extra_margin: float
     return F_zmp, g_zmp
 
 
-def friction_rows(Mg: float, friction: float) -> tuple[np.ndarray, np.ndarray]:
+def friction_rows(Mg: float, friction: float, weight_along: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """F (FRICTION_SIDES + 1, 6), g (FRICTION_SIDES + 1,), the same at every configuration: the polygon inscribed in
-    |dP_xy/dt| <= ``friction`` (M g + dP_z/dt), then M g + dP_z/dt >= MIN_NORMAL_SHARE M g. ``Mg``: the weight (N)."""
+    |dP_xy/dt - M g_xy| <= ``friction`` (M g + dP_z/dt), then M g + dP_z/dt >= MIN_NORMAL_SHARE M g. ``Mg``: the
+    weight across the ground (N); ``weight_along``: M g_xy (2,) N, its part along a slope (None: flat ground)."""
     theta = 2 * np.pi * np.arange(FRICTION_SIDES) / FRICTION_SIDES
     mu = friction * np.cos(np.pi / FRICTION_SIDES)  # the inscribed polygon's apothem
     F_fr = np.zeros((FRICTION_SIDES + 1, 6))
     F_fr[:-1, 0], F_fr[:-1, 1], F_fr[:-1, 2] = np.cos(theta), np.sin(theta), -mu  # u . dP_xy/dt <= mu N
     F_fr[-1, 2] = -1.0  # -dP_z/dt <= (1 - MIN_NORMAL_SHARE) M g
     g_fr = np.r_[np.full(FRICTION_SIDES, mu * Mg), (1.0 - MIN_NORMAL_SHARE) * Mg]
+    if weight_along is not None and (weight_along[0] != 0.0 or weight_along[1] != 0.0):
+        g_fr[:-1] += np.cos(theta) * weight_along[0] + np.sin(theta) * weight_along[1]  # u . (dP_xy/dt - M g_xy)
     return F_fr, g_fr

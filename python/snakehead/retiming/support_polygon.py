@@ -27,13 +27,17 @@ ZMP_DYNAMIC_ROOM = 0.002
 class Support:
     """The ground support of configurations q (N, n), computed once: each polygon's edges (padded to one count by
     repeating the first) as inward unit normals (N, E, 2) and offsets d (N, E) (inside: n . p >= d); the centre of
-    mass (N, 3); its static margin (N,) m; the margin (N,) m the ZMP must keep there (:func:`required_margins`)."""
+    mass (N, 3), on a slope moved along gravity to the ground point below it at its own height (so that Eqs. 39-40
+    with M g's part across the ground give the slope's ZMP: ``BasePlacement.below_along_gravity``); its static
+    margin (N,) m; the margin (N,) m the ZMP must keep there (:func:`required_margins`); the weight M g (N, 3) N in
+    the ground frame (the same at every configuration: (0, 0, -M GRAVITY) on flat ground)."""
 
     normal: np.ndarray
     offset: np.ndarray
     com: np.ndarray
     static: np.ndarray
     required: np.ndarray
+    weight: np.ndarray
 
     @classmethod
     def of(cls, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, zmp_margin: float,
@@ -53,8 +57,11 @@ class Support:
         normal = np.stack([-e[..., 1], e[..., 0]], axis=-1) / np.linalg.norm(e, axis=-1, keepdims=True)  # inside
         offset = (normal * a).sum(-1)
         com = stability.center_of_mass(robot, q, base, frames=frames)
+        if not base.on_flat_ground:
+            com = np.column_stack([base.below_along_gravity(com), com[:, 2]])
         static = ((normal * com[:, None, :2]).sum(-1) - offset).min(axis=1)
-        return cls(normal, offset, com, static, required_margins(static, zmp_margin))
+        weight = np.broadcast_to(robot.total_mass * base.gravity, (len(com), 3)).copy()
+        return cls(normal, offset, com, static, required_margins(static, zmp_margin), weight)
 
     def take(self, index: np.ndarray) -> "Support":
         """The support of the configurations ``index`` (an index array into the N)."""

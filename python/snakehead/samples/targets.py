@@ -78,8 +78,8 @@ def reachable_targets(controller: HeadController, kind: str, count: int, rng: np
             q[ground_yaw] = rng.uniform(robot.lower[ground_yaw], robot.upper[ground_yaw])
         if kind == "place":
             x, y = rng.uniform(-reach, reach, 2)
-            base = BasePlacement(float(controller.base.x + x), float(controller.base.y + y),
-                                 float(rng.uniform(-np.pi, np.pi)))
+            base = controller.base.moved(float(controller.base.x + x), float(controller.base.y + y),
+                                         float(rng.uniform(-np.pi, np.pi)))  # on the controller's ground
         # stable on the links that lie on the ground whatever the pose (the base's, and the neck's before it
         # lifts: the body problem's ground links, as the whole-body solve's check takes them): a neck or head link
         # resting on the ground does not count (the pose must keep them above it)

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import _core
 from ..ground_contact import GROUND_TOLERANCE
-from ..model.robot import SnakeRobot
+from ..model.robot import BasePlacement, SnakeRobot
 
 __all__ = ["contact_points", "first_lifted_link", "ground_links", "link_coms", "static_margins"]
 
@@ -51,7 +51,8 @@ def link_coms(robot: SnakeRobot, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return heavy, G[..., :3, 3] + np.einsum("...lij,lj->...li", G[..., :3, :3], robot.coms[heavy])
 
 
-def static_margins(robot: SnakeRobot, frames: np.ndarray, links: np.ndarray) -> np.ndarray:
+def static_margins(robot: SnakeRobot, frames: np.ndarray, links: np.ndarray, base: BasePlacement | None = None
+                   ) -> np.ndarray:
     """Static margin (m, > 0 inside) of the body's centre of mass in the support polygon of ``links``, for many
     configurations from their world frames (K, n_links, 4, 4): (K,). The contacts of each
     (:func:`contact_points`) are masked, and every polygon's margin is taken in one call of the core's hull
@@ -67,7 +68,8 @@ def static_margins(robot: SnakeRobot, frames: np.ndarray, links: np.ndarray) -> 
     heavy, c_i = link_coms(robot, frames)
     c = (m[heavy, None] * c_i).sum(-2) / m[heavy].sum()
     xy = np.ascontiguousarray(pts[..., :2])
-    margins = _core.hull_margins(xy, np.ascontiguousarray(keep), np.ascontiguousarray(c[:, :2]))
+    below = c[:, :2] if base is None else base.below_along_gravity(c)  # along gravity on a slope
+    margins = _core.hull_margins(xy, np.ascontiguousarray(keep), np.ascontiguousarray(below))
     # a degenerate hull's margin (minus the distance to its segment) is <= 0: only those samples are looked at
     for k in np.flatnonzero(margins <= 0):
         if len(_core.convex_hull_2d(np.ascontiguousarray(xy[k, keep[k]]))) < 3:

@@ -123,15 +123,21 @@ class BodyProblem:
         """:meth:`margin_and_gradient`'s margin alone (no Jacobians: for checks), from the frames (n_links, 4, 4)."""
         return float(self.margins(F[None])[0])
 
-    def margins(self, frames: np.ndarray) -> np.ndarray:
-        """:meth:`margin` of many configurations at once, from their world frames (K, n_links, 4, 4): (K,)
-        (:func:`~.base_support.static_margins` over the ground links)."""
-        return base_support.static_margins(self.robot, frames, self.ground_links)
+    def margins(self, frames: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
+        """:meth:`margin` of many configurations at once, from their world frames (K, n_links, 4, 4) at ``base``
+        (default: on flat ground): (K,) (:func:`~.base_support.static_margins` over the ground links)."""
+        return base_support.static_margins(self.robot, frames, self.ground_links, base)
 
     def margin_and_gradient(self, F: np.ndarray, base: BasePlacement) -> tuple[float, np.ndarray]:
         """Signed distance of the CoM's ground projection to the support polygon's nearest edge (> 0 inside) and
-        its gradient (n + 3,) through the active edge."""
+        its gradient (n + 3,) through the active edge. On a slope the projection is along gravity
+        (``BasePlacement.below_along_gravity``)."""
         c, Jc = self.com_and_jacobian(F, base)
+        if not base.on_flat_ground:
+            lean = base.gravity[:2] / base.gravity_across  # d(projection)/d c_z
+            c, Jc = c.copy(), Jc.copy()
+            c[:2] += c[2] * lean
+            Jc[:2] += lean[:, None] * Jc[2]
         pts, links = self.contact_points(F)
         idx = stability.hull_indices(pts[:, :2])
         if len(idx) < 3:

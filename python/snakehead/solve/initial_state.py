@@ -55,8 +55,8 @@ def initial_margins(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement | Non
     qs = np.atleast_2d(np.asarray(qs, float))
     frames = robot.frames_many(qs, base)
     com = stability.center_of_mass(robot, qs, base, frames=frames)
-    margin = np.minimum(stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE),
-                        static_margins(robot, frames, ground_links(robot)))
+    margin = np.minimum(stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE, base),
+                        static_margins(robot, frames, ground_links(robot), base))
     ground = coll.ground_clearance(robot, qs, base)[:, robot.lifted_links].min(axis=1, initial=np.inf)
     clear = (ground >= -coll.GROUND_TOLERANCE) & (coll.self_clearance(robot, qs, base) > 0.0)
     return np.where(clear, margin, -np.inf)

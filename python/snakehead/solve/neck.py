@@ -174,4 +174,4 @@ def base_move_into_range(P_hd: npt.ArrayLike, P0_local: npt.ArrayLike, base: Bas
     c, s = np.cos(yaw), np.sin(yaw)
     offset = np.array([[c, -s], [s, c]]) @ P0_local[:2, 3]
     x, y = P0_xy - offset
-    return BasePlacement(float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw))))
+    return base.moved(float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw))))

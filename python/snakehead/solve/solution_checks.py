@@ -75,9 +75,9 @@ def check_solutions(robot: SnakeRobot, qs: np.ndarray, base: BasePlacement, posi
     pe = np.linalg.norm(head[:, :3, 3] - position, axis=1)
     de = np.degrees(np.arccos(np.clip(head[:, :3, 0] @ direction, -1.0, 1.0)))
     com = stability.center_of_mass(robot, qs, base, frames=frames)
-    margin = stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE)
+    margin = stability.static_margins_of_frames(robot, frames, com, "ground", GROUND_TOLERANCE, base)
     if problem is not None:
-        margin = np.minimum(margin, problem.margins(frames))
+        margin = np.minimum(margin, problem.margins(frames, base))
     lifted = robot.lifted_links
     ground = robot.geometry.lowest_z(frames, lifted).min(axis=1) if len(lifted) else np.full(len(qs), np.inf)
     selfc = pair_min_distances(frames, robot.geometry, frames, robot.geometry, robot.self_collision_pairs)

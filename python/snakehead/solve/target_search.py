@@ -296,8 +296,8 @@ class TargetSearch:
             if s.success and (found := self.moved(s.q, placed, 0)):
                 return found
             moved_starts.append((s.q, placed))
-        for b in ([placed] if placed is not None else []) + placements(self.prob, P0_local, self.position,
-                                                                      self.direction):
+        moved = [base.moved(p.x, p.y, p.yaw) for p in placements(self.prob, P0_local, self.position, self.direction)]
+        for b in ([placed] if placed is not None else []) + moved:  # on base's ground
             if q[:robot.lift_joints.start].tobytes() in self.rejected_shapes or not self.afford():
                 break
             candidates = self.candidates_at(q, b)

@@ -99,7 +99,7 @@ class RefinementProblem:
         q[self.free] = z[:len(self.free)]
         if self.move_base:
             x, y, yaw = z[len(self.free):]
-            return q, BasePlacement(float(x), float(y), float(yaw))
+            return q, self.base0.moved(float(x), float(y), float(yaw))
         return q, self.base0
 
     def pack(self, q: np.ndarray, base: BasePlacement) -> np.ndarray:
