@@ -1,5 +1,6 @@
 """Files, written so that a failure never leaves a half-written file (:func:`atomic_open`: a temporary file in the
-same folder, flushed to disk, then renamed over the destination, an atomic step on POSIX file systems), and read
+same folder, flushed to disk, then renamed over the destination, an atomic step on POSIX file systems; or, by
+:func:`write_new_file`, linked to a name nothing holds, never over a file), and read
 without trusting them (:func:`read_npz`: .npz archives checked before anything is unpacked or allocated)."""
 from __future__ import annotations
 
@@ -74,6 +75,53 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
     with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:
         f.write(text)
     return Path(path)
+
+
+def write_new_file(path: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` as a new file, atomically and never over anything: a temporary file beside it,
+    flushed to disk, then linked to ``path`` (a hard link is made only where nothing is: FileExistsError when
+    ``path`` exists, a symbolic link included, and nothing is written); on any other failure no file is left at
+    ``path`` and the error is an InputError "cannot write ..."."""
+    target = Path(path)
+    try:
+        fd, tmp = _create_beside(target)
+    except OSError as exc:
+        raise InputError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, _FILE_MODE)
+        try:
+            os.link(tmp, target)
+        except FileExistsError:
+            raise
+        except OSError:  # a file system without hard links: create the file exclusively, written whole or removed
+            _write_exclusive(target, data)
+    except FileExistsError:
+        raise
+    except OSError as exc:
+        raise InputError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from exc
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    return target
+
+
+def _write_exclusive(target: Path, data: bytes) -> None:
+    """``data`` in a new file ``target`` (O_EXCL, not through a symbolic link), removed if not written whole."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    fd = os.open(target, flags, 0o666)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(target)
+        raise
 
 
 def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str, np.ndarray]:

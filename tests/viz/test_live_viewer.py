@@ -10,6 +10,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from types import SimpleNamespace
@@ -46,8 +47,8 @@ def assert_same_scene(a: Scene, b: Scene) -> None:
         for field in ("centre", "size", "rotation", "normal", "hole_diameter", "hole_offset", "pose", "scale"):
             if hasattr(o, field):
                 np.testing.assert_allclose(getattr(o, field), getattr(p, field), atol=1e-12)
-        if isinstance(o, MeshObstacle):
-            assert o.path.resolve() == p.path.resolve()
+        if isinstance(o, MeshObstacle):  # the same hull (read from a copy when saved in another folder)
+            np.testing.assert_array_equal(o.vertices, p.vertices)
 
 
 @pytest.mark.parametrize("name", ["spheres", "hole"])
@@ -74,10 +75,13 @@ def test_a_scene_of_every_kind_round_trips(tmp_path):
     out = tmp_path / "out" / "scene.toml"
     out.parent.mkdir()
     text = save_scene(scene, out).read_text()
-    assert 'robot = "../robot.toml"' in text and 'file = "../meshes/rock.stl"' in text  # beside the file it names
+    # the robot file named where it is; the mesh copied beside the file (a scene file reads only its own folder's)
+    assert 'robot = "../robot.toml"' in text and 'file = "rock.stl"' in text
+    assert (out.parent / "rock.stl").read_bytes() == (tmp_path / "meshes" / "rock.stl").read_bytes()
     again = load_scene(out)
     assert_same_scene(again, scene)
     assert again.robot_file.resolve() == robot_file.resolve()
+    assert again.obstacles[2].path.resolve() == (out.parent / "rock.stl").resolve()
     assert scene_to_toml(again, out.parent) == text  # and again the same text
 
 
@@ -218,6 +222,22 @@ def test_the_scene_is_saved_as_a_scene_file(live, tmp_path):
     with pytest.raises(InputError, match="bare name"):
         live.save_named(str(tmp_path / "elsewhere.toml"))  # the page saves nowhere else
     assert not (tmp_path / "elsewhere.toml").exists()
+
+
+def test_the_page_saves_a_scene_with_a_mesh_beside_a_copy_of_it(live, tmp_path, monkeypatch):
+    """The page's save copies the scene's mesh files into the save folder (a scene file reads only its own folder's
+    files), once: saved again, the same copy is named."""
+    import trimesh
+
+    trimesh.creation.box(extents=(0.2, 0.3, 0.25)).export(tmp_path / "boulder.stl")
+    rock = MeshObstacle.load(tmp_path / "boulder.stl", [0.9, -0.6, 0.125])
+    monkeypatch.setattr(live, "_scene", dataclasses.replace(live._scene, obstacles=(rock,)))
+    for _ in range(2):
+        assert live.save_named("with a mesh") == "with a mesh.toml"
+    again = load_scene(live.saves.folder / "with a mesh.toml")
+    assert_same_scene(again, live.scene())
+    assert again.obstacles[0].path.resolve() == (live.saves.folder / "boulder.stl").resolve()
+    assert sorted(p.name for p in live.saves.folder.glob("boulder*")) == ["boulder.stl"]
 
 
 def test_the_mujoco_check_shows_its_errors_beside_the_plans(live):

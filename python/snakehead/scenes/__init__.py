@@ -12,7 +12,8 @@ from .scene import (
                     save_scene,
                     scene_from_dict,
                     scene_to_toml,
+                    with_meshes_in,
 )
 
 __all__ = ["Scene", "Target", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
-           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS"]
+           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "with_meshes_in"]

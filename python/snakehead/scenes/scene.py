@@ -32,8 +32,8 @@ A scene file is TOML::
     hole_diameter = 0.07
 
     [[obstacles]]
-    kind = "mesh"                           # a mesh file's convex hull (STL, OBJ, DAE...; path relative to the
-    file = "rock.stl"                       #   scene file), its origin at position (m), turned by yaw (rad,
+    kind = "mesh"                           # a mesh file's convex hull (STL, OBJ, DAE...; a path inside the
+    file = "rock.stl"                       #   scene file's folder), its origin at position (m), turned by yaw (rad,
     position = [0.6, -0.3, 0.0]             #   optional), scaled (optional, default [1, 1, 1])
 
     [terrain]                               # optional: the ground (default: flat, z = 0); kind = "plane",
@@ -41,6 +41,11 @@ A scene file is TOML::
     pitch_deg = -5.0                        #   (:mod:`snakehead.scenes.terrain_table`)
 
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
+
+A scene file is not trusted: a mesh obstacle's ``file`` (as the terrain's) must lie inside the scene file's folder
+once symbolic links are resolved (:func:`~snakehead.scenes.terrain_table.scene_file_inside`): ``../``, an absolute
+path or a link leading out of the folder is an :class:`~snakehead._errors.InputError` naming the scene file, the
+entry and the path.
 
 Names (``snakehead._validate.name_text``): a target's name is one line of printable text of at most
 :data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator
@@ -52,7 +57,8 @@ at most 100 bytes). A description may also hold newlines and tabs. Anything else
 :class:`~snakehead._errors.InputError` naming the field.
 
 :func:`save_scene` writes a scene file (:func:`scene_to_toml`: its text) that :func:`load_scene` reads back as the
-same scene.
+same scene. Saved into another folder, a scene's mesh files are copied into that folder, beside the scene file
+(:func:`with_meshes_in`), since the file it writes may name only files in its own folder.
 
 Sizes are bounded: a scene holds at most :data:`MAX_TARGETS` targets (via poses included) and a scene file is at
 most :data:`MAX_SCENE_FILE_BYTES` bytes, refused before anything is planned (``snakehead.InputError``); a plan also
@@ -60,8 +66,11 @@ bounds the motion's length (``snakehead.planning.plan_bounds.MAX_MOTION_S``).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
@@ -69,23 +78,26 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._errors import InputError, InputTypeError
-from .._files import write_text_atomic
+from .._files import write_new_file, write_text_atomic
 from .._validate import (
+    RESERVED_FILE_NAMES,
     display_text,
     duration,
     file_name_part,
     file_problem,
     finite_float,
+    input_file,
     name_text,
     sequence,
     unit_vector3,
     world_position,
 )
+from ..geometry.meshes import MAX_MESH_BYTES
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, Terrain
-from .terrain_table import terrain_entry, terrain_from_table
+from .terrain_table import scene_file_inside, terrain_entry, terrain_from_table
 
 APPROACHES = ("free", "line")
 
@@ -278,10 +290,9 @@ def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObs
         raise InputError(f"{where}: kind must be one of {sorted(_OBSTACLE_KEYS)}, got {kind!r}")
     check_keys(entry, *_OBSTACLE_KEYS[kind], where)
     try:
-        if kind == "mesh":
-            if not isinstance(entry["file"], str) or not entry["file"]:
-                raise InputError(f"file must be a mesh file's path, got {entry['file']!r}")
-            return MeshObstacle.load((folder or Path(".")) / entry["file"], _number_list(entry["position"], "position"),
+        if kind == "mesh":  # untrusted: a file in the scene file's own folder only, as the terrain's
+            path = scene_file_inside(folder if folder is not None else Path.cwd(), entry["file"], "mesh")
+            return MeshObstacle.load(path, _number_list(entry["position"], "position"),
                                      _number(entry.get("yaw", 0.0), "yaw"),
                                      _number_list(entry.get("scale", [1.0, 1.0, 1.0]), "scale"), where="mesh")
         if kind == "box":
@@ -297,7 +308,8 @@ def _obstacle_from(entry: Any, where: str, folder: Path | None = None) -> BoxObs
 
 
 def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = None, where: str = "scene") -> Scene:
-    """A :class:`Scene` from the contents of a scene file (``folder`` resolves the robot file's path)."""
+    """A :class:`Scene` from the contents of a scene file (``folder``: the scene file's, None: the working folder;
+    the robot file's path is relative to it, and its mesh and terrain files lie inside it)."""
     data = _table(data, where)
     check_keys(data, *_SCENE_KEYS, where)
     if not isinstance(data["targets"], list) or not data["targets"]:
@@ -343,21 +355,108 @@ def load_scene(path: str | os.PathLike) -> Scene:
 # --- writing ----------------------------------------------------------------------------------------------
 def save_scene(scene: Scene, path: str | os.PathLike) -> Path:
     """Write ``scene`` as a scene file at ``path`` (atomically) that :func:`load_scene` reads back as the same
-    scene: its robot file and mesh files named relative to the file's folder. Returns the path. InputError for an
-    obstacle a scene file cannot hold (see :func:`scene_to_toml`) or a path that cannot be written."""
+    scene: its robot file named relative to the file's folder, its mesh files inside that folder (those elsewhere
+    copied there first, :func:`with_meshes_in`). Returns the path. InputError for an obstacle a scene file cannot
+    hold (see :func:`scene_to_toml`) or a path that cannot be written."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     out = Path(path)
-    return write_text_atomic(out, scene_to_toml(scene, out.resolve().parent))
+    folder = out.absolute().parent.resolve()  # where the file goes (a link at ``path`` is replaced, not followed)
+    text = _scene_text(scene, folder, meshes_inside=False)  # what a scene file cannot say, before a file is copied
+    meshes = [ob for ob in scene.obstacles if isinstance(ob, MeshObstacle)]
+    if meshes:
+        if not folder.is_dir():
+            raise InputError(f"cannot write {os.fspath(out)!r}: its folder {os.fspath(folder)!r} does not exist")
+        if any(Path(ob.path).resolve() == folder / out.name for ob in meshes):
+            raise InputError(f"cannot write {os.fspath(out)!r}: it is the scene's mesh file")
+        text = scene_to_toml(with_meshes_in(scene, folder, scene_file=folder / out.name), folder)
+    return write_text_atomic(out, text)
+
+
+#: A copied mesh file's name: its source's, these characters only (others become "_"), at most this long (stem).
+_MESH_NAME_CHARS = re.compile(r"[^A-Za-z0-9_-]+")
+_MESH_STEM_CHARS = 60
+#: The names tried for a copy (``rock.stl``, ``rock-2.stl``, ... ``rock-100.stl``) before it is refused.
+_MESH_NAME_TRIES = 100
+
+
+def with_meshes_in(scene: Scene, folder: str | os.PathLike, *, scene_file: str | os.PathLike | None = None) -> Scene:
+    """``scene`` with each mesh obstacle's file inside ``folder`` (an existing folder, where a scene file goes: a
+    scene file names only files in its own folder). A mesh file already inside it (links resolved) is kept; any
+    other is copied into it, beside the scene file, under its own name (ASCII letters, digits, ``_`` and ``-``; others
+    become ``_``) or, when a different file holds that name, ``NAME-2``, ``NAME-3``...; a file of that name with the
+    same bytes is used as it is. Nothing is written over: a copy is a new file, written whole or not at all
+    (``snakehead._files.write_new_file``), nor named as the scene file about to be written (``scene_file``, if
+    given). InputError if a mesh file cannot be read or copied."""
+    if not isinstance(scene, Scene):
+        raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
+    root = Path(folder).resolve()
+    taken = Path(scene_file).absolute().parent.resolve() / Path(scene_file).name if scene_file is not None else None
+    copies: dict[Path, Path] = {}  # a source file -> its copy (one copy for the obstacles that share a file)
+    obstacles = []
+    for k, ob in enumerate(scene.obstacles):
+        if isinstance(ob, MeshObstacle):
+            source = Path(ob.path).resolve()
+            if not source.is_relative_to(root):
+                if source not in copies:
+                    copies[source] = _copy_mesh(source, root, f"scene {scene.name!r}, obstacles[{k}]", taken)
+                ob = dataclasses.replace(ob, path=copies[source])
+        obstacles.append(ob)
+    return dataclasses.replace(scene, obstacles=tuple(obstacles))
+
+
+def _copy_name(source: Path) -> tuple[str, str]:
+    """The stem and suffix a copy of ``source`` is named by (a portable name, not hidden, not a device name)."""
+    stem = _MESH_NAME_CHARS.sub("_", source.stem).strip("_-")[:_MESH_STEM_CHARS] or "mesh"
+    if stem.lower() in RESERVED_FILE_NAMES:
+        stem = f"mesh_{stem}"
+    suffix = source.suffix if re.fullmatch(r"\.[A-Za-z0-9]{1,10}", source.suffix) else ""
+    return stem, suffix
+
+
+def _copy_mesh(source: Path, root: Path, where: str, taken: Path | None = None) -> Path:
+    """A copy of the mesh file ``source`` in ``root`` (see :func:`with_meshes_in`): its path."""
+    data = input_file(source, f"{where}: mesh file", MAX_MESH_BYTES).read_bytes()
+    stem, suffix = _copy_name(source)
+    for n in range(1, _MESH_NAME_TRIES + 1):
+        target = root / (f"{stem}{suffix}" if n == 1 else f"{stem}-{n}{suffix}")
+        if target == taken:  # the scene file's own name
+            continue
+        if _holds(target, data):
+            return target
+        try:
+            return write_new_file(target, data)
+        except FileExistsError:  # another file has the name: the next one
+            continue
+    raise InputError(f"{where}: mesh file {os.fspath(source)!r} is not copied into {os.fspath(root)!r}: "
+                     f"{stem}{suffix} to {stem}-{_MESH_NAME_TRIES}{suffix} are all other files there")
+
+
+def _holds(path: Path, data: bytes) -> bool:
+    """Whether ``path`` is a regular file (not a link) holding ``data`` exactly."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError:
+        return False
+    with os.fdopen(fd, "rb") as f:
+        info = os.fstat(f.fileno())
+        return stat.S_ISREG(info.st_mode) and info.st_size == len(data) and f.read(len(data) + 1) == data
 
 
 def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
     """The scene file (TOML text) of ``scene``, its paths relative to ``folder`` (where the file goes). Numbers are
     written to their last digit, so that they read back exactly. InputError for what a scene file cannot say: a box
     not upright (turned other than about z), a wall not standing on the ground (as ``WallWithHole.standing`` makes
-    it), a mesh obstacle tilted, a terrain generated rather than read from a file (a heightfield's or a mesh's)."""
+    it), a mesh obstacle tilted or its file outside ``folder`` (a scene file reads only files in its own folder:
+    :func:`save_scene` copies them there, or :func:`with_meshes_in` first), a terrain generated rather than read from
+    a file (a heightfield's or a mesh's)."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
+    return _scene_text(scene, folder)
+
+
+def _scene_text(scene: Scene, folder: str | os.PathLike, meshes_inside: bool = True) -> str:
+    """:func:`scene_to_toml`'s text (``meshes_inside``: a mesh file outside ``folder`` is an InputError)."""
     where = Path(folder).resolve()
     lines = [f"name = {toml_string(scene.name)}"]
     if scene.description:
@@ -370,7 +469,7 @@ def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
     for t in scene.targets:
         lines += ["", "[[targets]]"] + [f"{k} = {v}" for k, v in _target_entry(t).items()]
     for k, ob in enumerate(scene.obstacles):
-        entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]")
+        entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]", meshes_inside)
         lines += ["", "[[obstacles]]"] + [f"{key} = {v}" for key, v in entry.items()]
     terrain = terrain_entry(scene.terrain, where, f"scene {scene.name!r}, terrain")
     if terrain is not None:
@@ -412,8 +511,9 @@ def _yaw_of(R: np.ndarray, where: str, what: str) -> float:
     return yaw
 
 
-def _obstacle_entry(ob: Any, folder: Path, where: str) -> dict[str, str]:
-    """An obstacle's keys as TOML values (the entry :func:`_obstacle_from` reads)."""
+def _obstacle_entry(ob: Any, folder: Path, where: str, inside: bool = True) -> dict[str, str]:
+    """An obstacle's keys as TOML values (the entry :func:`_obstacle_from` reads; ``inside``: a mesh file outside
+    ``folder`` is an InputError, as :func:`_obstacle_from` would refuse it)."""
     if isinstance(ob, BoxObstacle):
         return {"kind": '"box"', "centre": _toml_floats(ob.centre), "size": _toml_floats(ob.size),
                 "yaw": _toml_float(_yaw_of(ob.rotation, where, "the box"))}
@@ -426,7 +526,13 @@ def _obstacle_entry(ob: Any, folder: Path, where: str) -> dict[str, str]:
         return {"kind": '"wall_with_hole"', "hole_centre": _toml_floats(ob.centre), "normal": _toml_floats(ob.normal),
                 "size": _toml_floats(ob.size), "hole_diameter": _toml_float(ob.hole_diameter)}
     if isinstance(ob, MeshObstacle):
-        return {"kind": '"mesh"', "file": toml_string(path_from(folder, ob.path)),
+        name = path_from(folder, ob.path)
+        if inside:
+            try:
+                scene_file_inside(folder, name, where)
+            except InputError as exc:
+                raise InputError(f"{exc} (save_scene copies it into the folder)") from None
+        return {"kind": '"mesh"', "file": toml_string(name),
                 "position": _toml_floats(ob.pose[:3, 3]),
                 "yaw": _toml_float(_yaw_of(ob.pose[:3, :3], where, "the mesh")), "scale": _toml_floats(ob.scale)}
     raise InputTypeError(f"{where}: not an obstacle: {type(ob).__name__}")
@@ -444,5 +550,5 @@ def paper_scene(name: str) -> Scene:
 
 
 __all__ = ["Target", "Scene", "load_scene", "save_scene", "scene_to_toml", "scene_from_dict", "paper_scene",
-           "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "MAX_SCENE_FILE_BYTES", "DEFAULT_LINE_STEP",
+           "with_meshes_in", "PAPER_SCENES", "APPROACHES", "MAX_TARGETS", "MAX_SCENE_FILE_BYTES", "DEFAULT_LINE_STEP",
            "check_target_count"]

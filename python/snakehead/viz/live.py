@@ -11,7 +11,8 @@ is told about its own actions are its own (:class:`.live_panel.ClientPanel`); th
 
 Safe to serve: the server sits behind :mod:`.server_guard` (Host and Origin allow-lists, a token in the printed
 URL, no framing, only the messages the page sends; :attr:`LiveViewer.url`). The page saves only bare file names
-into one folder fixed at start, never over a file this session did not write (:mod:`.save_folder`). Every value a
+into one folder fixed at start, never over a file this session did not write (:mod:`.save_folder`); the scene's
+mesh files are copied there beside them, never over a file either. Every value a
 browser sends is checked here: a speed not offered, a time that is not a number of the motion, a gizmo's pose that
 is not finite are refused (the panel says so to that browser) and playback goes on. At most :data:`MAX_TARGETS`
 targets; a motion longer than :data:`MAX_MOTION_S` is not played.
@@ -47,14 +48,15 @@ import numpy.typing as npt
 
 from .._errors import InputError, InputTypeError
 from .._validate import unit_vector3, world_position
+from ..geometry.obstacles import MeshObstacle
 from ..model.robot import SnakeRobot
 from ..planning.planner import plan
-from ..scenes.scene import Scene, Target, save_scene, scene_to_toml
+from ..scenes.scene import Scene, Target, save_scene, scene_to_toml, with_meshes_in
 from ..sim.simulate_plan import simulate
 from ..solve.head_controller import HeadController
 from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, gizmo_pose, live_motion
 from .live_panel import MOTION_WATCH_JS, ClientPanel, ClientPanels, DynamicsCheck, Replan, errors_text, shown_text
-from .save_folder import SaveFolder
+from .save_folder import SaveFolder, bare_name
 from .server_guard import ServerGuard, guarded_server
 from .viewer_arrays import FRAME_STEP_S, camera_for, obstacle_arrays
 from .viewer_nodes import add_ground, add_obstacles, camera_to
@@ -276,8 +278,20 @@ class LiveViewer:
     def save_named(self, name: str) -> str:
         """Save the scene as the page's "save scene" does: as the bare file ``name`` (``.toml`` added) in the save
         folder, never over a file this session did not write (:class:`.save_folder.SaveFolder`); the bare name.
+        The scene's mesh files are copied into the save folder first unless they are there already (a scene file
+        reads only files in its own folder; :func:`~snakehead.scenes.scene.with_meshes_in`: never over a file).
         InputError, in words a browser may be shown, if not saved."""
-        return self.saves.write(name, scene_to_toml(self.scene(), self.saves.folder))
+        bare = bare_name(name)  # the client's name is checked before anything is written
+        scene = self.scene()
+        if any(isinstance(ob, MeshObstacle) for ob in scene.obstacles):
+            try:
+                self.saves.folder.mkdir(parents=True, exist_ok=True)
+                scene = with_meshes_in(scene, self.saves.folder)
+            except (OSError, InputError) as exc:  # the details (paths, the OS's words) stay on the server
+                LOG.warning("could not copy the scene's mesh files into %s: %s", self.saves.folder, exc)
+                raise InputError(f"{bare} was not saved: the scene's mesh files could not be copied beside it (the "
+                                 "server's log says why)") from None
+        return self.saves.write(bare, scene_to_toml(scene, self.saves.folder))
 
     def close(self) -> None:
         """Stop the threads and the server (a plan running is left to finish in its daemon thread)."""
