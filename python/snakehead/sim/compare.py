@@ -71,7 +71,9 @@ def compare(robot: SnakeRobot, planned_t: np.ndarray, planned_q: np.ndarray, res
     ``targets``: a sequence whose items are a time (s; the desired head pose is then the planned one at that
     time) or (time, position (3,) m, direction (3,)) with either of position/direction None for the planned
     one; default: the end of the plan. The simulated head at each target time is interpolated between ticks.
-    ``base`` defaults to the result's.
+    ``base`` defaults to the result's. On a slope everything (the targets, the plan's and the simulation's poses,
+    momenta and ZMP) is in the ground frame of ``base``, as the plan and :func:`snakehead.sim.simulate_trajectory`
+    give them: "world" and "horizontal" below are that frame's.
 
     Returns a dict of floats (SI units) and lists:
 

@@ -1,6 +1,11 @@
 """What the paper compares (Section 4), measured on MuJoCo's state: the robot's momenta about the world origin, its
 contacts with the ground, and their centre of pressure (the zero-moment point); tick by tick, or recorded over a whole
 run and computed at its end (:class:`TickLog`, the tracking loop's record: the same numbers to the bit).
+
+Everything here is in the model's ground frame (``SimModel.ground``: the plan's; the world on flat ground, where
+nothing is turned): MuJoCo's world quantities are turned into it where they are read (:func:`points_in_ground`,
+:func:`vectors_in_ground`), so that "the world origin", "the ground plane z = 0" and "horizontal" below are the
+ground frame's on a slope, as the planner's momenta and ZMP are.
 """
 from __future__ import annotations
 
@@ -8,15 +13,37 @@ from typing import Any
 
 import numpy as np
 
+from ..model.placement import GroundFrame
 from ..model.robot import SnakeRobot
-from .mjcf import SimModel, import_mujoco
+from .mjcf import SimModel, import_mujoco, in_ground
 
 __all__ = ["momenta_of_state", "momenta_per_body", "ground_contacts", "center_of_pressure", "contacts_decodable",
-           "TickLog"]
+           "points_in_ground", "vectors_in_ground", "TickLog"]
+
+
+def points_in_ground(ground: GroundFrame, points: np.ndarray) -> np.ndarray:
+    """World ``points`` (..., 3) in the ground frame; the same array on flat ground (the numbers bit for bit)."""
+    return points if ground.is_world else ground.to_ground(points)
+
+
+def vectors_in_ground(ground: GroundFrame, vectors: np.ndarray) -> np.ndarray:
+    """World free vectors (..., 3) (forces, velocities, momenta) in the ground frame's axes; the same array on flat
+    ground."""
+    return vectors if ground.is_world else ground.direction_to_ground(vectors)
+
+
+def _momenta_in_ground(ground: GroundFrame, mass: float, com: np.ndarray, linvel: np.ndarray, angmom: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """P = M v_c and L_O = L_c + c x P about the ground frame's origin, in its axes, from the world's centre of mass
+    ``com``, its velocity ``linvel`` and the angular momentum about it ``angmom`` ((..., 3) each). A translation
+    and a rotation of the frame: v_c and L_c only turn, c moves with the origin."""
+    P = mass * vectors_in_ground(ground, linvel)
+    return P, vectors_in_ground(ground, angmom) + _cross3(points_in_ground(ground, com), P)
 
 
 def momenta_of_state(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Linear (kg m/s) and angular (kg m^2/s) momentum of the robot about the world origin, (3,) each.
+    """Linear (kg m/s) and angular (kg m^2/s) momentum of the robot about the world origin, (3,) each (the ground
+    frame's origin, in its axes, on a slope).
 
     From MuJoCo's subtree quantities of the root link (``mj_subtreeVel``): P = M v_c,
     L_O = L_c + c x P, with L_c the angular momentum about the subtree's centre of mass c.
@@ -25,6 +52,9 @@ def momenta_of_state(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     mj = import_mujoco()
     mj.mj_subtreeVel(sim.model, data)
     b = sim.root_body
+    if not sim.ground.is_world:
+        return _momenta_in_ground(sim.ground, sim.model.body_subtreemass[b], data.subtree_com[b],
+                                  data.subtree_linvel[b], data.subtree_angmom[b])
     P = sim.model.body_subtreemass[b] * data.subtree_linvel[b]
     c = data.subtree_com[b]
     L = data.subtree_angmom[b] + _cross3(c, P)
@@ -41,7 +71,8 @@ def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     """The same momenta summed link by link (paper Eqs. 27-31) from ``mj_objectVelocity`` at each body's CoM.
 
-    An independent path to :func:`momenta_of_state`, used to check it.
+    An independent path to :func:`momenta_of_state`, used to check it; in the ground frame on a slope (each link's
+    momenta turned, its centre of mass moved into the frame).
     """
     mj = import_mujoco()
     m = sim.model
@@ -55,6 +86,11 @@ def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
         w, v = v6[:3], v6[3:]
         R = data.ximat[b].reshape(3, 3)
         Iw = R @ np.diag(m.body_inertia[b]) @ R.T
+        if not sim.ground.is_world:  # the link's velocity and spin momentum turned, its CoM in the frame
+            p = mass * vectors_in_ground(sim.ground, v)
+            P += p
+            L += np.cross(points_in_ground(sim.ground, data.xipos[b]), p) + vectors_in_ground(sim.ground, Iw @ w)
+            continue
         p = mass * v
         P += p
         L += np.cross(data.xipos[b], p) + Iw @ w
@@ -62,7 +98,8 @@ def momenta_per_body(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ground_contacts(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Contact points (k, 3) m and forces on the robot (k, 3) N, world frame, of every robot-floor contact."""
+    """Contact points (k, 3) m and forces on the robot (k, 3) N of every robot-floor contact, in the model's ground
+    frame (the world's on flat ground)."""
     if data.ncon == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))
     contacts = data.contact  # the contact list's fields as arrays (ncon, ...): one read, not one per contact
@@ -73,7 +110,7 @@ def ground_contacts(sim: SimModel, data: Any) -> tuple[np.ndarray, np.ndarray]:
     frame = contacts.frame[rows].reshape(-1, 3, 3)  # rows: normal (geom1 -> geom2), tangents
     f = np.einsum("kij,ki->kj", frame, _contact_forces(sim, data, rows))  # force of geom1 on geom2, world
     f[g1[rows] != sim.floor_geom] *= -1.0  # on the robot
-    return contacts.pos[rows].copy(), f
+    return points_in_ground(sim.ground, contacts.pos[rows].copy()), vectors_in_ground(sim.ground, f)
 
 
 def _contact_forces(sim: SimModel, data: Any, rows: np.ndarray) -> np.ndarray:
@@ -98,7 +135,9 @@ def _contact_forces(sim: SimModel, data: Any, rows: np.ndarray) -> np.ndarray:
 
 
 def center_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray:
-    """The ZMP / centre of pressure on the ground plane z = 0 of contact forces, (2,) m; NaN without load.
+    """The ZMP / centre of pressure on the ground plane z = 0 of contact forces, (2,) m; NaN without load. (On a
+    slope: give the points and forces in the ground frame, as :func:`ground_contacts` does, for the point on the
+    slope.)
 
     The point p on z = 0 about which the contact forces have no horizontal moment:
     p_x = sum(x_i f_zi - z_i f_xi) / sum f_zi,  p_y = sum(y_i f_zi - z_i f_yi) / sum f_zi.
@@ -210,10 +249,16 @@ class TickLog:
                                "tau": self.tau, "com": self.com}
         out["head_pose"] = self._poses(sim.body_ids[robot.body.link_index(robot.parts.head_tip)])
         out["root_pose"] = self._poses(sim.root_body)
-        out["base_positions"] = self.xpos[:, sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]]
-        out["P"] = sim.model.body_subtreemass[sim.root_body] * self.linvel
-        out["L"] = self.angmom + _cross3(self.com, out["P"])
-        points, forces = self._ground_contacts()  # per step
+        base_bodies = sim.body_ids[:robot.link_index(robot.parts.base_end) + 1]
+        out["base_positions"] = points_in_ground(sim.ground, self.xpos[:, base_bodies])
+        if sim.ground.is_world:
+            out["P"] = sim.model.body_subtreemass[sim.root_body] * self.linvel
+            out["L"] = self.angmom + _cross3(self.com, out["P"])
+        else:
+            out["P"], out["L"] = _momenta_in_ground(sim.ground, sim.model.body_subtreemass[sim.root_body], self.com,
+                                                    self.linvel, self.angmom)
+            out["com"] = points_in_ground(sim.ground, self.com)
+        points, forces = self._ground_contacts()  # per step, in the ground frame
         tick = self.tick.array()
         first = np.flatnonzero(np.diff(tick, prepend=-1) != 0)  # each tick's first step
         out["contact_points"] = [points[i] for i in first]
@@ -224,15 +269,16 @@ class TickLog:
         return out
 
     def _poses(self, body: int) -> np.ndarray:
-        """(N, 4, 4) world poses of ``body`` at every tick."""
+        """(N, 4, 4) poses of ``body`` at every tick (ground frame)."""
         T = np.zeros((len(self.xpos), 4, 4))
         T[:, :3, :3] = self.xmat[:, body].reshape(-1, 3, 3)
         T[:, :3, 3] = self.xpos[:, body]
         T[:, 3, 3] = 1.0
-        return T
+        return in_ground(self.sim.ground, T)
 
     def _ground_contacts(self) -> tuple[list, list]:
-        """Every physics step's :func:`ground_contacts`: the points and forces of the robot-floor contacts."""
+        """Every physics step's :func:`ground_contacts`: the points and forces of the robot-floor contacts (ground
+        frame)."""
         if self.live:
             return [p for p, _ in self.contacts], [f for _, f in self.contacts]
         counts = self.ncon.array()
@@ -251,6 +297,7 @@ class TickLog:
         f = np.einsum("kij,ki->kj", self.frame.array()[rows].reshape(-1, 3, 3), local)
         f[geom[rows, 0] != floor] *= -1.0  # on the robot
         points = self.pos.array()[rows]
+        points, f = points_in_ground(self.sim.ground, points), vectors_in_ground(self.sim.ground, f)
         end = np.cumsum(np.bincount(tick[rows], minlength=len(counts))).tolist()
         start = [0] + end[:-1]
         return [points[a:b] for a, b in zip(start, end)], [f[a:b] for a, b in zip(start, end)]

@@ -16,6 +16,13 @@ it), generated from the robot's own data, not from the URDF importer:
   (:mod:`snakehead.geometry.obstacles`; a wall's round hole becomes a staircase of boxes inscribed in it,
   :func:`obstacle_boxes`; a mesh obstacle is a mesh of its convex hull). The robot's shapes collide with the ground and the
   obstacles; not with each other unless ``self_collision=True`` (parent/child pairs never);
+* on a slope (``ground``, a :class:`~snakehead.model.placement.GroundFrame` other than the world's: a plan's
+  ``base.ground``) the ground plane is the slope, tilted in the world (at the frame's origin, turned by its
+  rotation), and the obstacles, the robot's placement and everything measured are given in the ground frame as the
+  planner's are: MuJoCo simulates in the world (gravity (0, 0, -GRAVITY) always), and the model's own readers
+  (:meth:`SimModel.frames`, :mod:`snakehead.sim.measurements`) turn what it measures back into the ground frame,
+  the one boundary between the two. On flat ground (the world frame) nothing is turned: the numbers are the same
+  to the bit;
 * timestep 1 ms (physics) under the 2 ms control period of the paper; integrator ``implicitfast``;
   contact ``solref = (0.005 s, 1)`` (stiff: the resting body sinks ~1 um into the ground);
 * servo-like joints: armature 1e-3 kg m^2 (reflected rotor inertia of a small geared servo) and viscous damping
@@ -34,16 +41,17 @@ import numpy as np
 import numpy.typing as npt
 
 from .._errors import InputError, InputTypeError, InternalError
-from .._validate import duration, finite_array, non_negative, positive
+from .._validate import duration, finite_array, integer, non_negative, positive
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.physics import GRAVITY, GROUND_FRICTION
-from ..model.robot import BasePlacement, SnakeRobot, as_robot
+from ..model.placement import WORLD_FRAME, GroundFrame
+from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..trajectory.interpolation import CONTROL_PERIOD
 from .gains import default_torque_limits
 
 __all__ = ["DEFAULT_TIMESTEP", "DEFAULT_CONTROL_DT", "MAX_TIMESTEP", "MAX_CONTROL_DT", "MAX_PHYSICS_STEPS",
            "import_mujoco", "DEFAULT_HOLE_SLICES", "obstacle_boxes", "FREE_JOINT", "FLOOR", "shape_geom",
-           "add_shape_geom", "build_spec", "SimModel", "build_model"]
+           "add_shape_geom", "SLOPE_NOSLIP_ITERATIONS", "build_spec", "SimModel", "build_model", "in_ground"]
 
 
 #: Physics timestep (s) and control period (s) used by default; the simulated controller runs at the planner's rate.
@@ -216,6 +224,16 @@ def add_shape_geom(spec: Any, body: Any, robot: SnakeRobot, k: int, **options: A
                          quat=g["quat"], **extra, **options)
 
 
+#: Iterations of MuJoCo's no-slip solver on a slope (:func:`build_spec`). MuJoCo's soft contacts let a body creep
+#: under a steady tangential load that lies well inside the friction cone (the contact's regularisation turns force
+#: into a small slip velocity): on a slope the weight's downhill part is such a load all the time, and a bent body
+#: lying on a 5 deg slope with friction 0.8 crept 0.02 mm/s, 0.16 mm/s while the head was raised (3 mm over a
+#: 20 s plan; the head, 0.5 m away, moved several mm). The no-slip solver (a projected Gauss-Seidel pass on the
+#: friction forces after the main solver) removes that creep and leaves real sliding (beyond the cone) as it was;
+#: measured: 0.0003 mm in 1 s at rest on 5 and 15 deg, and 0.89 m in 1 s on 25 deg with friction 0.3, the Coulomb
+#: figure. On flat ground the tangential loads are the motion's brief ones and the model keeps MuJoCo's default (0).
+SLOPE_NOSLIP_ITERATIONS = 10
+
 #: MuJoCo's smallest mass or principal moment of a moving body (mjMINVAL).
 _MUJOCO_MINVAL = 1e-15
 
@@ -223,7 +241,8 @@ _MUJOCO_MINVAL = 1e-15
 def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, friction: float = GROUND_FRICTION,
                joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
-               contact_solref: tuple = (0.005, 1.0)) -> Any:
+               contact_solref: tuple = (0.005, 1.0), ground: GroundFrame = WORLD_FRAME,
+               noslip_iterations: int | None = None) -> Any:
     """The MuJoCo model of the robot (free-floating root) on a ground plane with the scene's obstacles, as a
     ``mujoco.MjSpec`` built element by element from the robot's own data (``spec.compile()`` gives the
     ``MjModel``; ``spec.to_xml()`` its MJCF text, for reading only).
@@ -236,6 +255,10 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     as they are and cannot add elements. Units SI; ``timestep`` s, ``friction`` the sliding coefficient,
     ``joint_damping`` N m s/rad, ``armature`` kg m^2, ``torque_limit`` N m (scalar or (n,); default
     :func:`snakehead.sim.gains.default_torque_limits`: the URDF effort), ``contact_solref`` (time constant s, damping ratio) of every contact.
+    ``ground``: the frame of the plane the robot lies on (default the world's: the floor at z = 0); on a slope the
+    floor is that plane in the world and the ``obstacles``, given in the ground frame as a plan's are, are put
+    through the frame's pose (``ground.matrix``). ``noslip_iterations``: MuJoCo's no-slip solver's iterations
+    (``opt.noslip_iterations``), None for the default: 0 on flat ground, :data:`SLOPE_NOSLIP_ITERATIONS` on a slope.
     """
     mj = import_mujoco()
     robot = as_robot(robot)
@@ -248,12 +271,20 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     solref = finite_array(contact_solref, "contact_solref", (2,))
     if solref[0] < 2 * timestep or solref[1] <= 0:
         raise InputError(f"contact_solref time constant must be >= 2 timesteps ({2 * timestep} s), got {solref}")
+    if not isinstance(ground, GroundFrame):
+        raise InputTypeError(f"ground must be a GroundFrame, got {type(ground).__name__}")
+    if noslip_iterations is None:
+        noslip_iterations = 0 if ground.is_world else SLOPE_NOSLIP_ITERATIONS
+    noslip = integer(noslip_iterations, "noslip_iterations", least=0, most=1000)
     boxes = obstacle_boxes(obstacles, hole_slices)
     lim = _torque_limits(robot, torque_limit)
     _check_names(robot)
     surface = dict(solref=solref, friction=[friction, 0.005, 0.0001])  # sliding, torsional, rolling
     spec = _empty_spec(mj, timestep)
-    _add_ground_and_obstacles(mj, spec, boxes, [o for o in obstacles if isinstance(o, MeshObstacle)], surface)
+    if noslip:  # (MuJoCo's default, 0, is left unset: the flat-ground model as it always was)
+        spec.option.noslip_iterations = noslip
+    _add_ground_and_obstacles(mj, spec, boxes, [o for o in obstacles if isinstance(o, MeshObstacle)], surface,
+                              ground)
     _add_bodies(mj, spec, robot, joint_damping, armature, self_collision, surface)
     for j, joint in enumerate(robot.body.joint_names):
         act = spec.add_actuator(name=f"act_{joint}", target=joint, trntype=mj.mjtTrn.mjTRN_JOINT)
@@ -277,20 +308,36 @@ def _empty_spec(mj: Any, timestep: float) -> Any:
 
 
 def _add_ground_and_obstacles(mj: Any, spec: Any, boxes: Sequence, meshes: Sequence[MeshObstacle],
-                              surface: dict) -> None:
-    """The floor, the obstacles' boxes (``obstacle_<k>``) and their meshes' hulls (after the boxes)."""
+                              surface: dict, ground: GroundFrame = WORLD_FRAME) -> None:
+    """The floor (the ground frame's z = 0 plane), the obstacles' boxes (``obstacle_<k>``) and their meshes' hulls
+    (after the boxes), the obstacles given in the ground frame."""
     world = spec.worldbody
+    floor = {} if ground.is_world else {"pos": np.array(ground.origin), "quat": _quat_array(_rotation(ground))}
     world.add_geom(name=FLOOR, type=mj.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], contype=0, conaffinity=1,
-                   **surface)
+                   **floor, **surface)
     for k, ob in enumerate(boxes):
-        world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=ob.centre,
-                       quat=_quat_array(ob.rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
+        centre, rotation = _placed(ground, ob.centre, ob.rotation)
+        world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=centre,
+                       quat=_quat_array(rotation), size=0.5 * np.asarray(ob.size, float), contype=0,
                        conaffinity=1, **surface)
     for k, rock in enumerate(meshes):
         mesh = spec.add_mesh(name=f"obstacle_hull_{k}", uservert=np.asarray(rock.vertices, dtype=float).reshape(-1).tolist())
         mesh.inertia = mj.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+        centre, rotation = _placed(ground, rock.pose[:3, 3], rock.pose[:3, :3])
         world.add_geom(name=f"obstacle_{len(boxes) + k}", type=mj.mjtGeom.mjGEOM_MESH, meshname=mesh.name,
-                       pos=rock.pose[:3, 3], quat=_quat_array(rock.pose[:3, :3]), contype=0, conaffinity=1, **surface)
+                       pos=centre, quat=_quat_array(rotation), contype=0, conaffinity=1, **surface)
+
+
+def _rotation(ground: GroundFrame) -> np.ndarray:
+    """The ground frame's rotation (3, 3): its axes' world directions as columns."""
+    return np.reshape(ground.rotation, (3, 3))
+
+
+def _placed(ground: GroundFrame, position: npt.ArrayLike, rotation: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """A pose given in the ground frame (position (3,), rotation (3, 3)) in the world; as it is on flat ground."""
+    if ground.is_world:
+        return np.asarray(position), np.asarray(rotation)
+    return ground.to_world(position), _rotation(ground) @ np.asarray(rotation, float)
 
 
 def _add_bodies(mj: Any, spec: Any, robot: SnakeRobot, joint_damping: float, armature: float, self_collision: bool,
@@ -343,7 +390,9 @@ class SimModel:
 
     ``body_ids[i]`` is the MuJoCo body of ``robot.link_names[i]``; ``qpos_adr`` / ``dof_adr`` (n,) the joint
     addresses; ``root_body`` the free-floating link; ``robot_geoms`` the ids of the robot's geoms;
-    ``shape_geoms`` (S,) the geom of each shape of ``robot.geometry.shapes``.
+    ``shape_geoms`` (S,) the geom of each shape of ``robot.geometry.shapes``; ``ground`` the frame of the plane
+    the robot lies on (:func:`build_spec`): what :meth:`frames` (and :mod:`snakehead.sim.measurements`) read is in
+    it, and :meth:`set_state` places the robot in it.
     """
 
     robot: SnakeRobot
@@ -358,26 +407,57 @@ class SimModel:
     torque_limit: np.ndarray
     shape_geoms: np.ndarray | None = None
     spec: object = None  #: the mujoco.MjSpec it was compiled from (``spec.to_xml()`` to read it)
+    ground: GroundFrame = WORLD_FRAME
 
     def set_state(self, data: Any, q: np.ndarray, base: BasePlacement | None = None, lift: float = 0.0) -> None:
-        """Put the body frame at ``base`` (the root link at ``robot.root_pose(base)``, raised by ``lift`` m) and the
-        joints at ``q``; zero velocities; kinematics."""
+        """Put the body frame at ``base`` (the root link at ``robot.root_pose(base)``, raised by ``lift`` m off the
+        ground) and the joints at ``q``; zero velocities; kinematics. On a slope the root link's world pose is
+        ``ground.matrix @ robot.root_pose(base)``, raised along the slope's normal; ``base`` must lie on the model's
+        ground (``base.ground == self.ground``; None: the default placement on it)."""
         mj = import_mujoco()
-        T = self.robot.root_pose(base)
         data.qpos[:] = 0.0
-        data.qvel[:] = 0.0
-        data.qpos[0:3] = T[:3, 3] + (0.0, 0.0, lift)
+        data.qvel[:] = 0.0  # at rest: a free joint's velocities are zero in any frame
+        if self.ground.is_world:
+            if base is not None and not as_base(base).ground.is_world:
+                raise InputError(f"the base {base!r} lies on a slope but the model was built on flat ground; build "
+                                 "it with ground=base.ground")
+            T = self.robot.root_pose(base)
+            data.qpos[0:3] = T[:3, 3] + (0.0, 0.0, lift)
+        else:
+            T = self._root_in_world(base, lift)
+            data.qpos[0:3] = T[:3, 3]
         data.qpos[3:7] = _quat_array(T[:3, :3])
         data.qpos[self.qpos_adr] = q
         mj.mj_forward(self.model, data)
 
+    def _root_in_world(self, base: BasePlacement | None, lift: float) -> np.ndarray:
+        """The root link's world pose (4, 4) at ``base`` on the model's slope, raised ``lift`` m along its normal."""
+        base = BasePlacement(ground=self.ground) if base is None else as_base(base)
+        if base.ground != self.ground:
+            raise InputError(f"the base {base!r} lies on another ground than the model's ({self.ground!r}); build the "
+                             "model with ground=base.ground")
+        T = self.robot.root_pose(base).copy()
+        T[2, 3] += lift
+        return self.ground.matrix @ T
+
     def frames(self, data: Any) -> np.ndarray:
-        """World poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics)."""
+        """Poses (n_links, 4, 4) of every frame of ``robot.link_names`` in ``data`` (after kinematics), in the model's
+        ground frame (the world's on flat ground), as ``robot.frames(q, base)`` gives them."""
         out = np.zeros((len(self.body_ids), 4, 4))
         out[:, :3, :3] = data.xmat[self.body_ids].reshape(-1, 3, 3)
         out[:, :3, 3] = data.xpos[self.body_ids]
         out[:, 3, 3] = 1.0
-        return out
+        return in_ground(self.ground, out)
+
+
+def in_ground(ground: GroundFrame, poses: np.ndarray) -> np.ndarray:
+    """World poses (..., 4, 4) in the ground frame: ``inv(ground.matrix) @ poses``; the same array on flat ground."""
+    if ground.is_world:
+        return poses
+    out = poses.copy()
+    out[..., :3, :] = np.einsum("ji,...jk->...ik", _rotation(ground), poses[..., :3, :])
+    out[..., :3, 3] -= np.asarray(ground.origin) @ _rotation(ground)
+    return out
 
 
 def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
@@ -404,4 +484,5 @@ def build_model(robot: SnakeRobot, **kwargs: Any) -> SimModel:
                     root_body=int(body_ids[0]),
                     floor_geom=mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, FLOOR),
                     robot_geoms=robot_geoms, shape_geoms=shape_geoms,
-                    torque_limit=_torque_limits(robot, kwargs.get("torque_limit")), spec=spec)
+                    torque_limit=_torque_limits(robot, kwargs.get("torque_limit")), spec=spec,
+                    ground=kwargs.get("ground", WORLD_FRAME))

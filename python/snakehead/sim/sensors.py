@@ -10,7 +10,10 @@ streams into a pose.
   accelerometer reads the specific force plus white noise (ACCEL_NOISE_DENSITY). The true angular velocity over a
   control period is the rotation between the link's orientations at its ends, so that integrating a noise-free
   gyro gives the orientation back exactly. The accelerometer's true value is gravity alone (quasi-static: the
-  gaits at 0.5 Hz move the links by less than 0.1 m/s^2, 1 % of g; not modelled).
+  gaits at 0.5 Hz move the links by less than 0.1 m/s^2, 1 % of g; not modelled). Both read the link's orientation
+  in MuJoCo's world (``data.xmat``), where gravity is (0, 0, -GRAVITY) on a slope too: on a slope the reading of a
+  link lying on it leans by the slope's angle, as a real IMU's does (not the ground-frame poses of
+  :meth:`snakehead.sim.mjcf.SimModel.frames`, where gravity leans instead).
 * :class:`HeadSensor` -- a camera in the head that sees a target's fiducial marker (at a known world pose:
   MARKER_AHEAD_M ahead of each of the scene's targets along its direction) and measures its pose relative to the
   head tip frame: position with HEAD_POSITION_NOISE_M per axis and orientation with HEAD_DIRECTION_NOISE_DEG per
@@ -116,7 +119,8 @@ class Encoders:
 
 class Imu:
     """A MEMS IMU (see the module): ``read(R_now, dt)`` gives (gyro (3,) rad/s, accel (3,) m/s^2) in the IMU's
-    axes for the control period of ``dt`` s that ended with the IMU link at world orientation ``R_now``.
+    axes for the control period of ``dt`` s that ended with the IMU link at world orientation ``R_now`` (MuJoCo's
+    world, gravity along -z, also on a slope).
     ``start(R)`` puts it on a link at orientation R (the gyro's bias is kept). Figures: the module's constants."""
 
     def __init__(self, *, gyro_noise_density: float = GYRO_NOISE_DENSITY,

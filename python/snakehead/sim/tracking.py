@@ -25,6 +25,12 @@ distal links). Gravity compensation (``gravity_compensation``):
 Default gains and torque limits come from each joint's load (:mod:`snakehead.sim.gains`), so they suit any robot's
 masses; the torque limit is the URDF's effort (a 3 N m servo cannot lift the default robot's head part from flat:
 joint 10 needs ~3.9 N m).
+
+On a slope (a ``base`` whose ground frame is not the world's, as a plan made there has) the ground plane is the
+slope, tilted in the world (:func:`snakehead.sim.build_spec` with ``ground=base.ground``), and what is recorded is
+in the ground frame, like the plan: the poses, momenta, centre of mass, contacts and ZMP (turned back from MuJoCo's
+world at one boundary, :meth:`snakehead.sim.mjcf.SimModel.frames` and :mod:`snakehead.sim.measurements`). The
+gravity compensation works on MuJoCo's world quantities, where gravity is (0, 0, -GRAVITY) on any slope.
 """
 from __future__ import annotations
 
@@ -97,7 +103,11 @@ class SimResult:
     robot-floor contacts at the tick's first physics step;
     base_positions (N, nb, 3) world origins of the base-part frames; base_slide_m / base_lift_m the largest
     horizontal / upward displacement of any of them from the first tick (m). root_pose (N, 4, 4): the root frame's
-    world pose at every tick; end_state: the simulated state after the last tick (continue from it).
+    world pose at every tick; end_state: the simulated state after the last tick (continue from it; MuJoCo's own
+    state, in the world).
+
+    "World" is the ground frame of ``base`` (``base.ground``): the world on flat ground; on a slope the frame whose
+    z = 0 plane is the slope, so that "horizontal" and "upward" are along and across it, as in the plan.
     """
 
     t: np.ndarray
@@ -187,7 +197,8 @@ def gravity_torques(sim: SimModel, data: Any, weights: np.ndarray) -> np.ndarray
 
     tau_j = -a_j . sum_i W_ji (c_i - p_j) x (m_i g): a_j, p_j the joint's world axis and anchor, c_i, m_i each
     link's centre of mass and mass, W (n, n_links) from :func:`carried_weights`. With every W = 1 on the
-    distal links this is the gravity part of MuJoCo's ``qfrc_bias`` on the joints (tested).
+    distal links this is the gravity part of MuJoCo's ``qfrc_bias`` on the joints (tested). Read from MuJoCo's world
+    quantities, where g = (0, 0, -GRAVITY) also when the ground is a slope.
     """
     m = sim.model
     jid = m.dof_jntid[sim.dof_adr]
@@ -237,7 +248,8 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                         torque_limit: npt.ArrayLike | None = None, friction: float = GROUND_FRICTION,
                         joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (),
                         hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
-                        drop: float = 2e-4, state: SimState | None = None) -> SimResult:
+                        drop: float = 2e-4, state: SimState | None = None,
+                        noslip_iterations: int | None = None) -> SimResult:
     """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
@@ -265,7 +277,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                                  drop)
     sim = build_model(robot, timestep=o.timestep, friction=friction, joint_damping=joint_damping,
                       armature=o.armature, torque_limit=torque_limit, obstacles=obstacles, hole_slices=hole_slices,
-                      self_collision=self_collision)
+                      self_collision=self_collision, ground=base.ground, noslip_iterations=noslip_iterations)
     sim.model.actuator_biasprm[:, 1] = -o.kp
     sim.model.actuator_biasprm[:, 2] = -o.kd
     d = _start_data(sim, q[0], base, o.drop, state)
@@ -277,6 +289,8 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                     settle=o.settle, hold=o.hold, gravity_compensation=o.mode,
                     friction=float(friction), joint_damping=float(joint_damping), armature=o.armature,
                     n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
+    if not base.on_flat_ground:
+        settings.update(slope_deg=base.ground.slope_deg, noslip_iterations=int(sim.model.opt.noslip_iterations))
     # the state's clock: the plan's without ``state``, else going on from the state's time
     t_end = (ts[-1] if state is None else float(state.time) + o.settle + ts[-1] - t[0]) + o.control_dt
     return SimResult(t=ts, q_ref=q_ref, **rec, base=base, torque_limit=sim.torque_limit, settings=settings,
