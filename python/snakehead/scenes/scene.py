@@ -324,7 +324,8 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
     if "base" in data:
         b = _table(data["base"], f"{where}: base")
         check_keys(b, *_BASE_KEYS, f"{where}: base")
-        base = BasePlacement(*(_number(b.get(k, 0.0), f"{where}: base.{k}") for k in ("x", "y", "yaw")))
+        x, y, yaw = (_number(b.get(k, 0.0), f"{where}: base.{k}") for k in ("x", "y", "yaw"))
+        base = BasePlacement(x, y, yaw)  # in the world (scenes.ground_scene puts it in a slope's frame)
     robot_file = None
     if "robot" in data:
         if not isinstance(data["robot"], str) or not data["robot"]:
