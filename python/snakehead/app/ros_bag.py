@@ -20,6 +20,14 @@ or RViz"):
     :data:`STATIC_MARKER_PERIOD` (stamped 0), the support polygon and the ZMP on the ground every
     :data:`MARKER_PERIOD`.
 
+  A plan on a slope holds its body, targets and obstacles in its ground frame (``plan.base.ground``: z the plane's
+  normal). Its bag puts that frame on :data:`TF` as ``world`` -> :data:`GROUND_FRAME` (the same transform at every
+  stamp: ``ros2 bag play`` publishes a recorded ``/tf_static`` without its latching QoS, which tf2's listeners
+  would not take), and places the root and the targets under it (``ground`` -> root, ``ground`` ->
+  ``target/NAME``); every marker is in ``ground`` (its header's frame), and the static ones add the tilted ground
+  plane (namespace "ground_plane", :func:`ground_plane_marker`). On flat ground there is no ``ground`` frame: the
+  bag is the one written before slopes.
+
   Time stamps, in the messages' headers and as the bag's log times, are nanoseconds from the start of the motion
   (its first sample at 0). Every channel offers no recorded QoS (``ros2 bag play`` publishes with its defaults).
 * ``NAME.mcap`` of a closed loop (:func:`write_loop_bag`, ``snakehead plan --start``): the whole sequence as MuJoCo
@@ -63,7 +71,8 @@ if TYPE_CHECKING:
     from ..model.robot import SnakeRobot
     from ..planning.plan_result import Plan
 
-__all__ = ["WORLD_FRAME", "TARGET_FRAME_PREFIX", "TRUE_BASE_FRAME", "ESTIMATED_BASE_FRAME", "JOINT_STATES",
+__all__ = ["WORLD_FRAME", "GROUND_FRAME", "GROUND_PLANE_COLOR", "GROUND_PLANE_THICKNESS", "GROUND_PLANE_MARGIN",
+           "ground_frame_of", "ground_plane_marker", "TARGET_FRAME_PREFIX", "TRUE_BASE_FRAME", "ESTIMATED_BASE_FRAME", "JOINT_STATES",
            "PLANNED_JOINT_STATES", "TF", "ROBOT_DESCRIPTION", "MARKERS", "TOPIC_TYPES", "TF_PERIOD", "MARKER_PERIOD",
            "STATIC_MARKER_PERIOD", "TARGET_COLOR", "OBSTACLE_COLOR", "POLYGON_COLOR", "ZMP_COLOR",
            "SIMULATED_ZMP_COLOR", "ARROW_LENGTH", "TARGET_DOT", "ZMP_DOT", "LINE_WIDTH", "TEXT_HEIGHT",
@@ -73,6 +82,13 @@ __all__ = ["WORLD_FRAME", "TARGET_FRAME_PREFIX", "TRUE_BASE_FRAME", "ESTIMATED_B
 
 #: The fixed frame everything is placed in (world coordinates: z up, the ground at z = 0).
 WORLD_FRAME = "world"
+#: A plan's ground frame on a slope (z = 0 the plane, z its upward normal), a child of :data:`WORLD_FRAME`.
+GROUND_FRAME = "ground"
+#: The ground plane's marker on a slope: colour (r, g, b, a), thickness (m, below the plane) and margin (m) around
+#: the body's and the targets' ground-frame x, y.
+GROUND_PLANE_COLOR = (0.55, 0.45, 0.4, 0.35)
+GROUND_PLANE_THICKNESS = 0.002
+GROUND_PLANE_MARGIN = 0.3
 #: The targets' frames are named this prefix and their names (:func:`frame_name`).
 TARGET_FRAME_PREFIX = "target/"
 #: The closed loop's body frame, as MuJoCo had it and as the loop estimated it.
@@ -236,34 +252,43 @@ def _quaternions(T: np.ndarray) -> np.ndarray:
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
-def _tf_messages(stamps: np.ndarray, children: Sequence[str], poses: np.ndarray) -> list[bytes]:
-    """TFMessages ``world`` -> each child at each stamp: ``poses`` (T, m, 4, 4) world (or (m, 4, 4): the same at
-    every stamp)."""
+def _tf_messages(stamps: np.ndarray, children: Sequence[str], poses: np.ndarray,
+                 parents: str | Sequence[str] = WORLD_FRAME) -> list[bytes]:
+    """TFMessages ``parents`` (one frame, or one per child) -> each child at each stamp: ``poses`` (T, m, 4, 4) in
+    the parents (or (m, 4, 4): the same at every stamp)."""
     poses = np.broadcast_to(poses, (len(stamps), len(children), 4, 4))
-    return msgs.tf_message_cdr(stamps, WORLD_FRAME, children, poses[..., :3, 3], _quaternions(poses))
+    return msgs.tf_message_cdr(stamps, parents, children, poses[..., :3, 3], _quaternions(poses))
+
+
+def ground_frame_of(base: Any) -> str:
+    """The frame a plan on ``base`` (a :class:`~snakehead.model.robot.BasePlacement`) is written in: :data:`WORLD_FRAME`
+    on flat ground, :data:`GROUND_FRAME` on a slope."""
+    return WORLD_FRAME if base.ground.is_world else GROUND_FRAME
 
 
 # --- markers ------------------------------------------------------------------------------------------------------
 def _marker(ns: str, marker_id: int, kind: int, *, stamp_ns: int = 0, position: npt.ArrayLike = (0.0, 0.0, 0.0),
             orientation: npt.ArrayLike = IDENTITY, scale: Sequence[float] = (1.0, 1.0, 1.0),
             color: Sequence[float] = (1.0, 1.0, 1.0, 1.0), points: np.ndarray | None = None, text: str = "",
-            delete: bool = False) -> dict:
-    """A Marker in ``world``: its pose (``position`` m, ``orientation`` quaternion x, y, z, w), sizes in m,
-    ``points`` (k, 3) in its pose's frame; ADD, or DELETE with ``delete``."""
+            delete: bool = False, frame_id: str = WORLD_FRAME) -> dict:
+    """A Marker in ``frame_id`` (``world``, or ``ground`` on a slope): its pose (``position`` m, ``orientation``
+    quaternion x, y, z, w), sizes in m, ``points`` (k, 3) in its pose's frame; ADD, or DELETE with ``delete``."""
     x, y, z = np.asarray(position, float).tolist()
     qx, qy, qz, qw = np.asarray(orientation, float).reshape(4).tolist()
     r, g, b, a = (float(c) for c in color)
     pts = [] if points is None else [{"x": px, "y": py, "z": pz} for px, py, pz in np.asarray(points, float).tolist()]
-    return {"header": {"stamp": msgs.stamp(stamp_ns), "frame_id": WORLD_FRAME}, "ns": ns, "id": int(marker_id),
+    return {"header": {"stamp": msgs.stamp(stamp_ns), "frame_id": frame_id}, "ns": ns, "id": int(marker_id),
             "type": kind, "action": 2 if delete else 0,  # DELETE / ADD
             "pose": {"position": {"x": x, "y": y, "z": z}, "orientation": {"x": qx, "y": qy, "z": qz, "w": qw}},
             "scale": dict(zip("xyz", (float(v) for v in scale))), "color": {"r": r, "g": g, "b": b, "a": a},
             "points": pts, "text": text}
 
 
-def target_markers(targets: Sequence[Any], diameters: dict[str, float] | None = None) -> list[dict]:
+def target_markers(targets: Sequence[Any], diameters: dict[str, float] | None = None, *,
+                   frame_id: str = WORLD_FRAME) -> list[dict]:
     """Per target: an arrow of :data:`ARROW_LENGTH` ending at it along its direction, a sphere (the scene's
-    ``sphere_diameter``, else a dot) and its name above it (namespaces "targets", "target_names")."""
+    ``sphere_diameter``, else a dot) and its name above it (namespaces "targets", "target_names"), in ``frame_id``
+    (the targets' frame)."""
     frames = target_frames(targets)
     if not frames:
         return []
@@ -273,17 +298,19 @@ def target_markers(targets: Sequence[Any], diameters: dict[str, float] | None = 
         p, x = T[:3, 3], T[:3, 0]
         d = (diameters or {}).get(tg.name) or TARGET_DOT
         out += [_marker("targets", 2 * k, msgs.ARROW, position=p - ARROW_LENGTH * x, orientation=quat,
-                        scale=(ARROW_LENGTH, 0.006, 0.012), color=TARGET_COLOR),
+                        scale=(ARROW_LENGTH, 0.006, 0.012), color=TARGET_COLOR, frame_id=frame_id),
                 _marker("targets", 2 * k + 1, msgs.SPHERE, position=p, scale=(d, d, d),
-                        color=TARGET_COLOR[:3] + (0.5,)),
+                        color=TARGET_COLOR[:3] + (0.5,), frame_id=frame_id),
                 _marker("target_names", k, msgs.TEXT_VIEW_FACING, position=p + [0.0, 0.0, d / 2 + TEXT_HEIGHT],
-                        scale=(0.0, 0.0, TEXT_HEIGHT), color=(1.0, 1.0, 1.0, 1.0), text=str(tg.name))]
+                        scale=(0.0, 0.0, TEXT_HEIGHT), color=(1.0, 1.0, 1.0, 1.0), text=str(tg.name),
+                        frame_id=frame_id)]
     return out
 
 
-def obstacle_markers(obstacles: Sequence[Any]) -> list[dict]:
+def obstacle_markers(obstacles: Sequence[Any], *, frame_id: str = WORLD_FRAME) -> list[dict]:
     """The obstacles' convex shapes (namespace "obstacles"): boxes as cubes, spheres and cylinders as such, convex
-    pieces (a wall's around its hole, a mesh's hull) as one triangle list per obstacle."""
+    pieces (a wall's around its hole, a mesh's hull) as one triangle list per obstacle, in ``frame_id`` (the
+    obstacles' frame)."""
     out: list[dict] = []
     for obstacle in obstacles:
         triangles = []
@@ -297,37 +324,53 @@ def obstacle_markers(obstacles: Sequence[Any]) -> list[dict]:
                           "sphere": (msgs.SPHERE, [2 * shape.radius] * 3),
                           "cylinder": (msgs.CYLINDER, [2 * shape.radius, 2 * shape.radius, shape.size[1]])}[shape.kind]
             out.append(_marker("obstacles", len(out), kind, position=T[:3, 3], orientation=_quaternions(T),
-                               scale=size, color=OBSTACLE_COLOR))
+                               scale=size, color=OBSTACLE_COLOR, frame_id=frame_id))
         if triangles:
             out.append(_marker("obstacles", len(out), msgs.TRIANGLE_LIST, points=np.concatenate(triangles),
-                               color=OBSTACLE_COLOR))
+                               color=OBSTACLE_COLOR, frame_id=frame_id))
     return out
 
 
+def ground_plane_marker(points: npt.ArrayLike) -> dict:
+    """The tilted ground plane (namespace "ground_plane") in :data:`GROUND_FRAME`: a slab :data:`GROUND_PLANE_THICKNESS`
+    thick just below its z = 0, over the x, y of ``points`` (k, 3) m of the ground frame (the body, the targets)
+    and :data:`GROUND_PLANE_MARGIN` around them. Its z-axis is the plane's normal (the frame's)."""
+    xy = np.asarray(points, float).reshape(-1, 3)[:, :2]
+    lo, hi = xy.min(axis=0) - GROUND_PLANE_MARGIN, xy.max(axis=0) + GROUND_PLANE_MARGIN
+    centre = 0.5 * (lo + hi)
+    return _marker("ground_plane", 0, msgs.CUBE, position=(centre[0], centre[1], -GROUND_PLANE_THICKNESS / 2),
+                   scale=(*(hi - lo), GROUND_PLANE_THICKNESS), color=GROUND_PLANE_COLOR, frame_id=GROUND_FRAME)
+
+
 def ground_markers(stamp_ns: int, polygon: np.ndarray, zmp: np.ndarray, *, zmp_ns: str = "zmp",
-                   zmp_color: Sequence[float] = ZMP_COLOR) -> list[dict]:
-    """The support polygon (k, 2) world (x, y) m as a closed line (namespace "support_polygon"; deleted when it has
-    fewer than 2 vertices) and the ZMP (2,) m as a dot (namespace ``zmp_ns``; deleted when not finite), on the
-    ground."""
+                   zmp_color: Sequence[float] = ZMP_COLOR, frame_id: str = WORLD_FRAME) -> list[dict]:
+    """The support polygon (k, 2) (x, y) m of ``frame_id`` (the world, or the ground frame on a slope) as a closed
+    line (namespace "support_polygon"; deleted when it has fewer than 2 vertices) and the ZMP (2,) m as a dot
+    (namespace ``zmp_ns``; deleted when not finite), on the ground."""
     ring = np.c_[np.r_[polygon, polygon[:1]], np.full(len(polygon) + 1, GROUND_MARK_Z)] if len(polygon) else None
     return [_marker("support_polygon", 0, msgs.LINE_STRIP, stamp_ns=stamp_ns, scale=(LINE_WIDTH, 0, 0),
-                    color=POLYGON_COLOR, points=ring, delete=len(polygon) < 2),
+                    color=POLYGON_COLOR, points=ring, delete=len(polygon) < 2, frame_id=frame_id),
             _marker(zmp_ns, 0, msgs.SPHERE, stamp_ns=stamp_ns, position=[*np.nan_to_num(zmp[:2]), GROUND_MARK_Z],
-                    scale=(ZMP_DOT,) * 3, color=zmp_color, delete=not bool(np.isfinite(zmp).all()))]
+                    scale=(ZMP_DOT,) * 3, color=zmp_color, delete=not bool(np.isfinite(zmp).all()),
+                    frame_id=frame_id)]
 
 
 def _add_static_markers(bag: _Bag, targets: Sequence[Any], obstacles: Sequence[Any], scene: Any,
-                        t_end_s: float) -> None:
-    """Targets and obstacles every :data:`STATIC_MARKER_PERIOD` from 0 to ``t_end_s`` (one encoding: stamped 0)."""
+                        t_end_s: float, frame_id: str = WORLD_FRAME, plane: dict | None = None) -> None:
+    """Targets and obstacles (in ``frame_id``) and the ground ``plane``'s marker if any, every
+    :data:`STATIC_MARKER_PERIOD` from 0 to ``t_end_s`` (one encoding: stamped 0)."""
     diameters = {t.name: t.sphere_diameter for t in scene.targets} if scene is not None else {}
-    data = _encoder(TOPIC_TYPES[MARKERS])({"markers": target_markers(targets, diameters) + obstacle_markers(obstacles)})
+    markers = target_markers(targets, diameters, frame_id=frame_id) + obstacle_markers(obstacles, frame_id=frame_id)
+    data = _encoder(TOPIC_TYPES[MARKERS])({"markers": markers + ([plane] if plane is not None else [])})
     for s in _stamps(np.arange(0.0, t_end_s + 1e-9, STATIC_MARKER_PERIOD)).tolist():
         bag.add(MARKERS, s, data)
 
 
 def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None) -> None:
-    """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``;
-    with ``simulated`` (a SimResult of the plan), its ZMP beside (namespace "zmp_simulated")."""
+    """The plan's support polygon and ZMP every :data:`MARKER_PERIOD`, on a clock where the plan starts at ``t0_s``,
+    in the plan's frame (:func:`ground_frame_of`); with ``simulated`` (a SimResult of the plan), its ZMP beside
+    (namespace "zmp_simulated")."""
+    frame = ground_frame_of(plan.base)
     t = np.asarray(plan.t, float)
     idx = samples_every(t, MARKER_PERIOD)
     vertices, count = stability.support_polygons(plan.robot, plan.q[idx], plan.base, contact=PLAN_CONTACT)
@@ -337,10 +380,10 @@ def _add_plan_markers(bag: _Bag, plan: Plan, t0_s: float, simulated: Any = None)
         ticks = np.searchsorted(simulated.t, t[idx] - 1e-9).clip(0, len(simulated.t) - 1)
         sim_zmp = np.asarray(simulated.zmp, float)[ticks]
     for j, k in enumerate(idx):
-        markers = ground_markers(int(stamps[j]), vertices[j, :count[j]], plan.stability.zmp[k])
+        markers = ground_markers(int(stamps[j]), vertices[j, :count[j]], plan.stability.zmp[k], frame_id=frame)
         if sim_zmp is not None:
             markers += ground_markers(int(stamps[j]), vertices[j, :count[j]], sim_zmp[j], zmp_ns="zmp_simulated",
-                                      zmp_color=SIMULATED_ZMP_COLOR)[1:]
+                                      zmp_color=SIMULATED_ZMP_COLOR, frame_id=frame)[1:]
         bag.add_message(MARKERS, int(stamps[j]), {"markers": markers})
 
 
@@ -363,8 +406,17 @@ def write_plan_bag(plan: Plan, path: str | os.PathLike) -> Path:
     fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
     poses = np.concatenate([roots[:, None], fixed], axis=1)
     tf_stamps = stamps[idx]
-    bag.add_many(TF, tf_stamps, _tf_messages(tf_stamps, children, poses))
-    _add_static_markers(bag, plan.targets, plan.obstacles, plan.scene, float(t[-1] - t[0]))
+    frame, plane = ground_frame_of(plan.base), None
+    if frame == GROUND_FRAME:  # on a slope: world -> ground, then the root and the targets in the ground frame
+        children, poses = [GROUND_FRAME, *children], np.concatenate(
+            [np.broadcast_to(plan.base.ground.matrix, (len(idx), 1, 4, 4)), poses], axis=1)
+        seen = samples_every(t, STATIC_MARKER_PERIOD)
+        plane = ground_plane_marker(np.concatenate([
+            robot.frames_many(np.asarray(plan.q, float)[seen], plan.base)[..., :3, 3].reshape(-1, 3),
+            np.array([tg.position for tg in plan.targets], float).reshape(-1, 3)]))
+    parents = [WORLD_FRAME if child == GROUND_FRAME else frame for child in children]
+    bag.add_many(TF, tf_stamps, _tf_messages(tf_stamps, children, poses, parents))
+    _add_static_markers(bag, plan.targets, plan.obstacles, plan.scene, float(t[-1] - t[0]), frame, plane)
     _add_plan_markers(bag, plan, 0.0)
     return bag.write(path)
 
@@ -397,13 +449,21 @@ def write_loop_bag(run: LoopRun, path: str | os.PathLike) -> Path:
     body = robot.body_in_root
     moving = np.stack([robot.description_root_pose(roots[idx], q[idx]), roots[idx] @ body], axis=1)
     fixed = np.broadcast_to(np.array([T for _, T in goals]).reshape(-1, 4, 4), (len(idx), len(goals), 4, 4))
-    bag.add_many(TF, stamps[idx], _tf_messages(stamps[idx], [robot.description_root, TRUE_BASE_FRAME]
-                                                + [f for f, _ in goals], np.concatenate([moving, fixed], axis=1)))
+    # the head phases' plan on a slope is in its ground frame: world -> ground on /tf, its targets and markers in it
+    frame = ground_frame_of(run.plan.base) if run.plan is not None else WORLD_FRAME
+    if frame == GROUND_FRAME:
+        assert run.plan is not None
+        fixed = np.concatenate([fixed, np.broadcast_to(run.plan.base.ground.matrix, (len(idx), 1, 4, 4))], axis=1)
+    names = [robot.description_root, TRUE_BASE_FRAME] + [f for f, _ in goals]
+    parents = [WORLD_FRAME, WORLD_FRAME] + [frame] * len(goals) + ([WORLD_FRAME] if frame == GROUND_FRAME else [])
+    bag.add_many(TF, stamps[idx], _tf_messages(stamps[idx], names + ([GROUND_FRAME] if frame == GROUND_FRAME else []),
+                                               np.concatenate([moving, fixed], axis=1), parents))
     known = idx[np.isfinite(estimates[idx]).all(axis=(1, 2))]
     if len(known):  # (a run whose ground phases kept no estimate has none)
         bag.add_many(TF, stamps[known], _tf_messages(stamps[known], [ESTIMATED_BASE_FRAME],
                                                      estimates[known, None] @ body))
-    _add_static_markers(bag, targets, list(run.scene.obstacles), run.scene, float(t[-1]))
+    obstacles = run.plan.obstacles if run.plan is not None and frame == GROUND_FRAME else run.scene.obstacles
+    _add_static_markers(bag, targets, list(obstacles), run.scene, float(t[-1]), frame)
     if run.plan is not None:
         p = run.plan
         bag.add_joint_states(PLANNED_JOINT_STATES, _stamps(run.head_t0_s + p.t - p.t[0]),

@@ -197,22 +197,25 @@ def joint_state_cdr(stamps_ns: npt.ArrayLike, names: Sequence[str], position: np
     return [row.tobytes() for row in rows]
 
 
-def tf_message_cdr(stamps_ns: npt.ArrayLike, parent: str, children: Sequence[str], translation: npt.ArrayLike,
-                   rotation: npt.ArrayLike) -> list[bytes]:
+def tf_message_cdr(stamps_ns: npt.ArrayLike, parent: str | Sequence[str], children: Sequence[str],
+                   translation: npt.ArrayLike, rotation: npt.ArrayLike) -> list[bytes]:
     """CDR-encoded ``tf2_msgs/msg/TFMessage`` messages: one per stamp of ``stamps_ns`` (T,) ns, each with a
-    transform ``parent`` -> ``children[j]`` stamped alike: ``translation`` (T, m, 3) m and ``rotation`` (T, m, 4)
-    quaternions (x, y, z, w). Laid out once and filled in, as :func:`joint_state_cdr`."""
+    transform ``parent`` (one frame for all, or one per child) -> ``children[j]`` stamped alike: ``translation``
+    (T, m, 3) m and ``rotation`` (T, m, 4) quaternions (x, y, z, w). Laid out once and filled in, as
+    :func:`joint_state_cdr`."""
     stamps = _checked_stamps(stamps_ns)
     m = len(children)
+    parents = [parent] * m if isinstance(parent, str) else list(parent)
+    invariant(len(parents) == m, f"{len(parents)} parents for {m} children")
     p = np.asarray(translation, float).reshape(len(stamps), m, 3)
     r = np.asarray(rotation, float).reshape(len(stamps), m, 4)
     cdr = _Cdr()
     cdr.uint32(m)
     at = []
-    for child in children:
+    for frame, child in zip(parents, children):
         at_stamp = cdr.uint32(0)
         cdr.uint32(0)
-        cdr.string(parent)
+        cdr.string(frame)
         cdr.string(child)
         at.append((at_stamp, cdr.float64s(3), cdr.float64s(4)))
     rows = cdr.rows(len(stamps))

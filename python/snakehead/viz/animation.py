@@ -21,8 +21,8 @@ from PIL import Image
 
 from .._errors import InputError
 from .body import draw_body, draw_scenery
-from .figure_geometry import Sphere, body_faces, plan_spheres, scene_bounds, view_angles
-from .figure_style import literal, new_figure, setup_axes3d
+from .figure_geometry import Sphere, body_faces, plan_spheres, scene_bounds, view_angles, world_frames
+from .figure_style import literal, new_figure, setup_axes3d, slope_text
 
 if TYPE_CHECKING:
     from matplotlib.text import Text
@@ -37,7 +37,8 @@ __all__ = ["BodyAnimation", "PALETTE_FRAMES", "gif_palette", "animate", "clock_t
 class BodyAnimation:
     """Frames of a plan's motion drawn on one figure. ``figure``: the Matplotlib figure (showing the first frame
     once drawn); ``times`` (F,) s: the plan's time of each frame; ``fps``: frames per second of the GIF;
-    ``frames`` (F, L, 4, 4): the world frames of the body's links at each frame; ``plan``: the plan drawn."""
+    ``frames`` (F, L, 4, 4): the world frames of the body's links at each frame (on a slope: the plan's ground-frame
+    poses turned into the world); ``plan``: the plan drawn."""
 
     figure: Figure
     times: np.ndarray
@@ -111,7 +112,8 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
             size: tuple[float, float] = (5.0, 4.0), dpi: int = 80) -> BodyAnimation:
     """The planned motion as an animation: at most ``max_frames`` frames evenly spaced in time, played at ``fps``
     frames/s (so faster than real time for long plans: the title shows the factor), ``size`` inches at ``dpi``.
-    The head tip's path so far is traced. ``spheres``: as :func:`~snakehead.viz.body.plot_snapshots`."""
+    The head tip's path so far is traced. ``spheres``: as :func:`~snakehead.viz.body.plot_snapshots`. On a slope
+    the motion is drawn in the world on the tilted ground, the slope's angle beside the speed."""
     fps = float(fps)
     if not (np.isfinite(fps) and fps > 0):
         raise InputError(f"fps must be positive, got {fps!r}")
@@ -122,17 +124,19 @@ def animate(plan: Plan, *, spheres: Sequence[Sphere] | None = None, fps: float =
     t = plan.t
     n = int(min(max_frames, len(t)))
     idx = np.unique(np.linspace(0, len(t) - 1, n).round().astype(int))
-    frames = robot.frames_many(plan.q[idx], plan.base)
+    ground = plan.base.ground
+    frames = world_frames(ground, robot.frames_many(plan.q[idx], plan.base))
     tip = frames[:, robot.link_index(robot.parts.head_tip), :3, 3]
     speedup = (t[-1] - t[0]) / max(len(idx) / fps, 1e-9)
     fig = new_figure(figsize=size, dpi=dpi)
     ax = fig.add_subplot(1, 1, 1, projection="3d", computed_zorder=False)
     lo, hi = scene_bounds(plan, spheres)
-    setup_axes3d(ax, lo, hi, *view_angles(plan), zoom=0.92)
+    setup_axes3d(ax, lo, hi, *view_angles(plan), zoom=0.92, plane=ground)
     draw_scenery(ax, plan, spheres)
     body = draw_body(ax, robot, frames[0])
     (trace,) = ax.plot(tip[:1, 0], tip[:1, 1], tip[:1, 2], ":", color="k", lw=1.0)
-    clock = _clock(fig, f"{literal(plan.name)}: t = ", t[idx], f" s  (x{speedup:.1f} speed)")
+    slope = f", {slope_text(ground)}" if slope_text(ground) else ""
+    clock = _clock(fig, f"{literal(plan.name)}: t = ", t[idx], f" s  (x{speedup:.1f} speed{slope})")
     fig.subplots_adjust(left=0.0, right=0.96, bottom=0.02, top=0.98)
     return BodyAnimation(figure=fig, times=t[idx], fps=fps, frames=frames, plan=plan,
                          _artists=(body, trace, clock), _speedup=speedup)

@@ -10,13 +10,15 @@
 
 The geometry they draw (faces, footprints, obstacles, spheres, bounds) is in :mod:`.figure_geometry`, re-exported
 here. Every function returns a :class:`matplotlib.figure.Figure`; write it with :func:`snakehead.viz.save`.
-Positions in m, times in s, world frame with z up and the ground at z = 0.
+Positions in m, times in s, drawn in the world frame (z up). A plan on a slope holds its body, targets and obstacles
+in its ground frame (``plan.base.ground``): they are drawn turned into the world, on the tilted ground, and the
+slope's angle is in the legend (the animation's: its title line).
 """
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -47,8 +49,10 @@ from .figure_geometry import (
     plan_spheres,
     scene_bounds,
     shape_footprints,
+    terrain_mesh,
     view_angles,
     wall_faces,
+    world_frames,
 )
 from .figure_style import (
     BASE_COLOR,
@@ -61,6 +65,7 @@ from .figure_style import (
     literal,
     new_figure,
     setup_axes3d,
+    slope_text,
 )
 
 if TYPE_CHECKING:
@@ -92,25 +97,61 @@ def _sphere_mesh(centre: np.ndarray, diameter: float, n: int = 14) -> tuple[np.n
     return (centre[0] + r * np.cos(u) * np.sin(v), centre[1] + r * np.sin(u) * np.sin(v), centre[2] + r * np.cos(v))
 
 
+def _in_world(plan: Plan) -> tuple[Callable[[Any], Any], Callable[[Any], Any]]:
+    """Functions that turn points and directions (..., 3) of the plan's ground frame into the world (on flat ground:
+    the arrays as they are)."""
+    ground = plan.base.ground
+    if ground.is_world:
+        return (lambda p: p), (lambda d: d)
+    return ground.to_world, ground.direction_to_world
+
+
 def draw_scenery(ax: Axes3D, plan: Plan, spheres: Sequence[Sphere], *, arrows: bool = True) -> None:
-    """The spheres, the plan's obstacles (boxes; walls with the hole's rim) and, with ``arrows``, each target as an
-    arrow along its direction ending at the target."""
+    """The spheres, the plan's obstacles (boxes; walls with the hole's rim), its scene's terrain (a heightfield, a
+    mesh, a staircase; over the axes' limits, set first) and, with ``arrows``, each target as an arrow along its
+    direction ending at the target; in the world (``spheres`` in the plan's ground frame, as its targets)."""
+    point, direction = _in_world(plan)
     for centre, diameter in spheres:
-        ax.plot_surface(*_sphere_mesh(np.asarray(centre, float), diameter), color=SPHERE_COLOR, alpha=0.55,
+        ax.plot_surface(*_sphere_mesh(point(np.asarray(centre, float)), diameter), color=SPHERE_COLOR, alpha=0.55,
                         linewidth=0)
     for ob in plan.obstacles:
         if isinstance(ob, WallWithHole):
-            ax.add_collection3d(Poly3DCollection(wall_faces(ob), facecolor=WALL_COLOR, edgecolor="none", alpha=0.35))
-            rim = hole_rim(ob)
+            ax.add_collection3d(Poly3DCollection(point(wall_faces(ob)), facecolor=WALL_COLOR, edgecolor="none",
+                                                 alpha=0.35))
+            rim = point(hole_rim(ob))
             ax.plot(rim[:, 0], rim[:, 1], rim[:, 2], "-", color="k", lw=1.0)
         elif isinstance(ob, (BoxObstacle, MeshObstacle)):
             faces = box_faces(ob) if isinstance(ob, BoxObstacle) else mesh_obstacle_faces(ob)
-            ax.add_collection3d(Poly3DCollection(faces, facecolor=OBSTACLE_COLOR, edgecolor="k", linewidths=0.3,
-                                                 alpha=0.45), autolim=False)  # faces of several sizes: no autoscale
+            ax.add_collection3d(Poly3DCollection([point(f) for f in faces], facecolor=OBSTACLE_COLOR, edgecolor="k",
+                                                 linewidths=0.3, alpha=0.45), autolim=False)  # no autoscale
+    _draw_terrain(ax, getattr(getattr(plan, "scene", None), "terrain", None))
     if arrows and len(plan.targets):  # one collection of arrows: one per target made the figure grow per target
-        d = 0.08 * np.array([tg.direction for tg in plan.targets], float)
-        p = np.array([tg.position for tg in plan.targets], float) - d  # each arrow ends at its target
+        d = 0.08 * direction(np.array([tg.direction for tg in plan.targets], float))
+        p = point(np.array([tg.position for tg in plan.targets], float)) - d  # each arrow ends at its target
         ax.quiver(p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2], color="k", lw=1.0, arrow_length_ratio=0.3)
+
+
+#: Heights per side of the grid a scene's terrain is drawn on in a figure (over the axes' x and y).
+FIGURE_TERRAIN_SIDE = 41
+
+
+def _draw_terrain(ax: Axes3D, terrain: Any) -> None:
+    """A scene's terrain (a heightfield, a mesh, a staircase: what :func:`.figure_geometry.terrain_mesh` draws; not
+    flat ground or a plane) over the axes' x and y: its heights (``terrain.height``) on a grid of
+    :data:`FIGURE_TERRAIN_SIDE` per side, a quad per cell whose corners all have a surface within the z limits (3-D
+    axes do not clip what reaches beyond them)."""
+    if not len(terrain_mesh(terrain, 2)[1]):
+        return
+    (x0, x1), (y0, y1), (z0, z1) = ax.get_xlim(), ax.get_ylim(), ax.get_zlim()
+    X, Y = np.meshgrid(np.linspace(x0, x1, FIGURE_TERRAIN_SIDE), np.linspace(y0, y1, FIGURE_TERRAIN_SIDE),
+                       indexing="ij")
+    Z = terrain.height(np.stack([X, Y], axis=-1))
+    P = np.stack([X, Y, Z], axis=-1)
+    quads = np.stack([P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]], axis=2).reshape(-1, 4, 3)
+    keep = np.all(np.isfinite(quads[..., 2]) & (quads[..., 2] >= z0) & (quads[..., 2] <= z1), axis=1)
+    if keep.any():
+        ax.add_collection3d(Poly3DCollection(quads[keep], facecolor=GROUND_COLOR, edgecolor="none", alpha=0.3),
+                            autolim=False)
 
 
 def draw_body(ax: Axes3D, robot: SnakeRobot, frames: np.ndarray, alpha: float = 0.95) -> Poly3DCollection:
@@ -133,6 +174,8 @@ def _part_legend(fig: Figure, plan: Plan, spheres: Sequence[Sphere]) -> None:
         handles.append(Patch(color=WALL_COLOR, alpha=0.35, label=f"wall, hole {1000 * wall.hole_diameter:.0f} mm"))
     if any(isinstance(o, (BoxObstacle, MeshObstacle)) for o in plan.obstacles):
         handles.append(Patch(color=OBSTACLE_COLOR, alpha=0.45, label="obstacles"))
+    if slope_text(plan.base.ground):
+        handles.append(Patch(color=GROUND_COLOR, alpha=0.3, label=f"ground: {slope_text(plan.base.ground)}"))
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
 
 
@@ -287,7 +330,7 @@ class _SnapshotLayout:
     def panel(self, k: int) -> Axes3D:
         """Panel k: its 3-D axes over the scene's box, with the ground and the scenery."""
         ax = self.figure.add_subplot(self.grid[k], projection="3d", computed_zorder=False)
-        setup_axes3d(ax, self.lo, self.hi, self.elev, self.azim, labels=False, zoom=1.2)
+        setup_axes3d(ax, self.lo, self.hi, self.elev, self.azim, labels=False, zoom=1.2, plane=self.plan.base.ground)
         draw_scenery(ax, self.plan, self.spheres)
         return ax
 
@@ -296,8 +339,9 @@ class _SnapshotLayout:
         after them, in order: the body, the tip, the still artists of a higher zorder than the body's, the title."""
         robot, plan = self.plan.robot, self.plan
         label, time, q = self.picks[k]
-        body = draw_body(ax, robot, robot.frames(q, plan.base))
-        tip = ax.scatter(*robot.head_pose(q, plan.base)[:3, 3], color="k", s=6)
+        frames = world_frames(plan.base.ground, robot.frames(q, plan.base))
+        body = draw_body(ax, robot, frames)
+        tip = ax.scatter(*frames[robot.link_index(robot.parts.head_tip), :3, 3], color="k", s=6)
         ax.set_title(f"({chr(ord('a') + k)}) {literal(label)}\nt = {time:.1f} s", fontsize=8)
         children = ax.get_children()
         over = sorted([a for a in (*ax.collections, *ax.lines, *ax.patches, *ax.texts)
@@ -316,19 +360,24 @@ def plot_head_solution(robot: SnakeRobot, solution: HeadSolution) -> Figure:
     centre should go: the target), P_d and r_d (Eqs. 19-20: the desired neck end), and the neck end B0 and its
     x-axis r_a that Eq. 22 reached; the neck and head drawn as their joint chain. Lengths in m.
     """
-    frames = robot.frames(solution.q, solution.base)
+    ground = solution.base.ground
+    frames = robot.frames(solution.q, solution.base)  # in the ground frame (the right panel's), drawn in the world
     fig = new_figure(figsize=(12, 5.5))
     ax = fig.add_subplot(1, 2, 1, projection="3d")
-    draw_body(ax, robot, frames)
-    p, d = solution.desired_frame[:3, 3], 0.08 * solution.desired_frame[:3, 0]
+    drawn = world_frames(ground, frames)
+    draw_body(ax, robot, drawn)
+    desired = world_frames(ground, solution.desired_frame)
+    p, d = desired[:3, 3], 0.08 * desired[:3, 0]
     ax.quiver(p[0], p[1], p[2], d[0], d[1], d[2], color="k", lw=1.2, arrow_length_ratio=0.3)
-    pts = frames[:, :3, 3]
-    lo = np.minimum(pts.min(axis=0), p) - 0.08
-    hi = np.maximum(pts.max(axis=0), p) + 0.08
-    setup_axes3d(ax, lo, hi, elev=22.0, azim=-60.0)
+    shown = drawn[:, :3, 3]
+    lo = np.minimum(shown.min(axis=0), p) - 0.08
+    hi = np.maximum(shown.max(axis=0), p) + 0.08
+    setup_axes3d(ax, lo, hi, elev=22.0, azim=-60.0, plane=ground)
+    slope = f"; on a {slope_text(ground)}" if slope_text(ground) else ""
     ax.set_title(f"head at the target: {1000 * solution.position_error_m:.4f} mm, "
-                 f"{solution.direction_error_deg:.4f} deg\nstatic margin {1000 * solution.static_margin_m:.1f} mm",
-                 fontsize=9)
+                 f"{solution.direction_error_deg:.4f} deg\nstatic margin {1000 * solution.static_margin_m:.1f} mm"
+                 f"{slope}", fontsize=9)
+    pts = frames[:, :3, 3]
 
     ax2 = fig.add_subplot(1, 2, 2)
     g = solution.neck_goal

@@ -20,7 +20,7 @@ from ..dynamics import stability as st
 from ..model.robot import BasePlacement, SnakeRobot
 from ..sim.compare import zmp_margins
 from .figure_geometry import shape_footprints
-from .figure_style import PLANNED_COLOR, SIMULATED_COLOR, new_figure
+from .figure_style import PLANNED_COLOR, SIMULATED_COLOR, new_figure, slope_text
 
 if TYPE_CHECKING:
     from ..sim.tracking import SimResult
@@ -136,10 +136,11 @@ def plot_zmp(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, *, base: Bas
         margins_sim = zmp_margins(robot, simulated, t, q, base, contact=contact)
     fig.colorbar(sc, ax=ax, label="t (s)", shrink=0.8)
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title((f"Fig. {figure}: " if figure else "") + "ZMP (Eqs. 39-40) in the support polygon (Eq. 24)",
-                 fontsize=10)
+    slope = slope_text(base.ground)  # on a slope: x and y of the ground frame, in the sloping plane
+    ax.set_xlabel("x in the ground plane (m)" if slope else "x (m)")
+    ax.set_ylabel("y in the ground plane (m)" if slope else "y (m)")
+    ax.set_title((f"Fig. {figure}: " if figure else "") + "ZMP (Eqs. 39-40) in the support polygon (Eq. 24)"
+                 + (f", on a {slope}" if slope else ""), fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     ax2.plot(t, 1000 * dyn.margin, color=PLANNED_COLOR, lw=1.8, label="planned ZMP")

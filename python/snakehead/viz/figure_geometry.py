@@ -4,9 +4,11 @@ coplanar triangles merged into one polygon, so that a box is drawn as its six fa
 (:func:`shape_footprints`), the obstacles' faces (:func:`box_faces`, :func:`mesh_obstacle_faces`, :func:`wall_faces`
 for a wall with a hole, :func:`hole_rim`), the spheres at a plan's targets, the points along the body's axis, a box
 around a plan's scene and the angle it is seen from, and the parts' colours (:func:`part_colors`: base grey, neck
-orange, head blue).
+orange, head blue); poses of a plan's ground frame in the world (:func:`world_frames`) and a scene's terrain as
+triangles (:func:`terrain_mesh`).
 
-Positions in m, world frame with z up and the ground at z = 0.
+Positions in m. A plan holds its body, targets and obstacles in its ground frame (``plan.base.ground``: the world
+frame on flat ground, z up and the ground at z = 0); the figures draw them in the world, where a slope is tilted.
 """
 from __future__ import annotations
 
@@ -19,7 +21,9 @@ from scipy.spatial import ConvexHull
 
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..geometry.shapes import shape_mesh
+from ..model.placement import GroundFrame
 from ..model.robot import SnakeRobot
+from ..terrain.surfaces import HeightfieldTerrain, MeshTerrain, StepsTerrain
 from .figure_style import BASE_COLOR, HEAD_COLOR, NECK_COLOR
 
 if TYPE_CHECKING:
@@ -27,7 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = ["FIGURE_SEGMENTS", "Sphere", "part_colors", "convex_facets", "BodyDrawing", "body_drawing", "body_faces",
            "shape_footprints", "mesh_obstacle_faces", "box_faces", "wall_faces", "hole_rim", "plan_spheres",
-           "scene_bounds", "view_angles", "body_points"]
+           "scene_bounds", "view_angles", "body_points", "TERRAIN_DRAW_SIDE", "world_frames", "terrain_mesh"]
 
 #: Segments around a cylinder's or a sphere's axis in the figures.
 FIGURE_SEGMENTS = 16
@@ -228,7 +232,9 @@ def plan_spheres(plan: Plan) -> list[Sphere]:
 
 
 def scene_bounds(plan: Plan, spheres: Sequence[Sphere] = (), margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners (3,) m of a box holding the body over the whole motion, the scenery and the ground."""
+    """Lower and upper corners (3,) m of a box holding the body over the whole motion, the scenery (``spheres`` in
+    the plan's ground frame, as its targets) and the ground's origin, in the world (on a slope: the ground frame's
+    points turned into the world)."""
     step = max(1, len(plan.q) // 200)
     pts = plan.robot.frames_many(plan.q[::step], plan.base)[..., :3, 3].reshape(-1, 3)
     extra = [pts, np.zeros((1, 3))]
@@ -245,6 +251,9 @@ def scene_bounds(plan: Plan, spheres: Sequence[Sphere] = (), margin: float = 0.0
         elif isinstance(ob, MeshObstacle):
             extra.append(ob.world_vertices)
     allp = np.vstack(extra)
+    ground = plan.base.ground
+    if not ground.is_world:
+        allp = ground.to_world(allp)
     return allp.min(axis=0) - margin, allp.max(axis=0) + margin
 
 
@@ -260,3 +269,45 @@ def body_points(robot: SnakeRobot, frames: np.ndarray) -> np.ndarray:
     """
     idx = np.r_[0, robot.joint_frames, robot.link_index(robot.parts.head_tip)]
     return np.take(frames, idx, axis=-3)[..., :3, 3]
+
+
+#: Heights per side at most of a heightfield as the figures and the viewer draw it (a finer grid is drawn at every
+#: k-th height, its last row and column kept).
+TERRAIN_DRAW_SIDE = 129
+
+
+def world_frames(ground: GroundFrame, frames: np.ndarray) -> np.ndarray:
+    """Poses (..., 4, 4) of the ground frame ``ground`` (a plan's ``base.ground``) in the world: the same array on flat
+    ground (the world frame), ``ground.matrix @ frames`` on a slope."""
+    return frames if ground.is_world else ground.matrix @ np.asarray(frames, float)
+
+
+def _every(n: int, most: int) -> np.ndarray:
+    """Indices 0 .. n - 1 at a stride that keeps at most ``most`` of them, the last one included."""
+    step = max(1, -(-(n - 1) // max(most - 1, 1)))
+    return np.unique(np.r_[np.arange(0, n, step), n - 1])
+
+
+def terrain_mesh(terrain: object, side: int = TERRAIN_DRAW_SIDE) -> tuple[np.ndarray, np.ndarray]:
+    """A scene's terrain as triangles to draw: vertices (V, 3) m in the world and triangles (T, 3) (vertex indices).
+    A heightfield's grid (at most ``side`` heights per side: :data:`TERRAIN_DRAW_SIDE`), split along the diagonals
+    the terrain's queries use; a mesh's triangles; a staircase's treads and risers. None (V = T = 0) for flat
+    ground and a plane, which the figures and the viewer draw as the ground of the plan's ground frame."""
+    if isinstance(terrain, HeightfieldTerrain):
+        h = np.asarray(terrain.heights, float)
+        nx, ny = h.shape
+        i, j = _every(nx, side), _every(ny, side)
+        x0, y0, z0 = np.asarray(terrain.origin, float)
+        sx, sy = np.asarray(terrain.extent, float)
+        X, Y = np.meshgrid(x0 + i * sx / (nx - 1), y0 + j * sy / (ny - 1), indexing="ij")
+        vertices = np.column_stack([X.ravel(), Y.ravel(), (z0 + h[np.ix_(i, j)]).ravel()])
+        m = len(j)
+        a = (np.arange(len(i) - 1)[:, None] * m + np.arange(m - 1)[None, :]).ravel()  # corner (i, j) of each cell
+        triangles = np.concatenate([np.column_stack([a, a + m, a + m + 1]), np.column_stack([a, a + m + 1, a + 1])])
+        return vertices, triangles.astype(np.int64)
+    if isinstance(terrain, MeshTerrain):
+        return np.asarray(terrain.vertices, float), np.asarray(terrain.faces, np.int64)
+    if isinstance(terrain, StepsTerrain):
+        vertices, triangles = terrain.triangles()
+        return np.asarray(vertices, float), np.asarray(triangles, np.int64)
+    return np.zeros((0, 3)), np.zeros((0, 3), np.int64)

@@ -7,7 +7,8 @@ current plan's support polygon at its start, the ZMP's trace and the ZMP now, an
 the plan's state (planning, its errors, or why it failed), play/pause, time and speed; adding and removing targets;
 the MuJoCo check of the current plan (its errors beside the plan's); saving the targets and obstacles as a scene
 file (TOML) in the viewer's save folder. What one browser chooses (the target to remove, the file name) and what it
-is told about its own actions are its own (:class:`.live_panel.ClientPanel`); the rest is shared.
+is told about its own actions are its own (:class:`.live_panel.ClientPanel`); the rest is shared. On a slope (a base
+on a ground frame) all of it is in the ground frame, under one node at the frame's world pose (:mod:`.live_nodes`).
 
 Safe to serve: the server sits behind :mod:`.server_guard` (Host and Origin allow-lists, a token in the printed
 URL, no framing, only the messages the page sends; :attr:`LiveViewer.url`). The page saves only bare file names
@@ -54,12 +55,11 @@ from ..planning.planner import plan
 from ..scenes.scene import Scene, Target, save_scene, scene_to_toml, with_meshes_in
 from ..sim.simulate_plan import simulate
 from ..solve.head_controller import HeadController
-from .live_nodes import ROOT, LiveMotion, MotionNodes, TargetGizmos, gizmo_pose, live_motion
+from .live_nodes import LiveMotion, draw_live_scene, gizmo_pose, live_motion
 from .live_panel import MOTION_WATCH_JS, ClientPanel, ClientPanels, DynamicsCheck, Replan, errors_text, shown_text
 from .save_folder import SaveFolder, bare_name
 from .server_guard import ServerGuard, guarded_server
-from .viewer_arrays import FRAME_STEP_S, camera_for, obstacle_arrays
-from .viewer_nodes import add_ground, add_obstacles, camera_to
+from .viewer_arrays import FRAME_STEP_S
 
 __all__ = ["LiveViewer", "Replan", "DynamicsCheck", "MOTION_WATCH_JS", "MAX_TARGETS", "MAX_MOTION_S", "SPEEDS"]
 
@@ -85,10 +85,6 @@ GIZMO_SHARE = 0.08
 NEW_TARGET_SHARE = 0.05
 #: s a target added in the viewer (or the one made when no scene is given) is held, as Scene.from_targets does.
 NEW_TARGET_HOLD_S = 1.0
-#: Strength of the hemisphere light that lights the sides the default lights leave dark (no environment map here).
-FILL_LIGHT = 1.5
-#: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
-GROUND_MARGIN_M = 0.2
 #: Targets at most in the live viewer (a scene with more is refused at start; "add target" stops there): each adds
 #: a few seconds to the motion and to every plan.
 MAX_TARGETS = 16
@@ -410,6 +406,7 @@ class LiveViewer:
                 return
             with self.server.atomic():
                 self._motion, self._t = motion, 0.0
+                self._root.place(motion.plan.base.ground)  # (a plan's ground frame is the scene's: no change)
                 self._nodes.start(motion)
                 self._paths_due = time.perf_counter() + PATHS_DELAY_S
                 self._time.max = max(round(motion.duration_s, 1), 0.1)
@@ -512,25 +509,11 @@ class LiveViewer:
             raise
 
     def _draw_scene(self) -> None:
-        s = self.server.scene
-        # lit by viser's default lights and a fill light, without shadows or an environment map: each costs a browser
-        # that renders in software (no GPU) much of its frame time, which a new motion waits for
-        # (bench/live_latency.py)
-        s.configure_environment_map(hdri=None)
-        s.configure_default_lights(enabled=True, cast_shadow=False)
-        s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
-                               intensity=FILL_LIGHT)
-        self._nodes = MotionNodes(s, self.robot, self.controller.q_initial, self.controller.base)
-        arrays = obstacle_arrays(self._scene.obstacles)
-        add_obstacles(s, f"{ROOT}/obstacles", **arrays)
-        self._gizmos = TargetGizmos(s, GIZMO_SHARE * self.robot.body_length, self._released)
-        for target in self._targets:
-            self._gizmos.add(target)
-        shown = [self._nodes.start_positions, np.array([t.position for t in self._targets]),
-                 arrays["obstacle_centres"], arrays["wall_vertices"], np.zeros((1, 3))]
-        lo, hi = np.vstack(shown).min(axis=0), np.vstack(shown).max(axis=0)
-        add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
-        camera_to(self.server.initial_camera, *camera_for(lo - 0.05, hi + 0.05))
+        """The still scene (:func:`.live_nodes.draw_live_scene`), in the ground frame of the controller's base."""
+        self._root, self._nodes, self._gizmos = draw_live_scene(
+            self.server, self.robot, self.controller.q_initial, self.controller.base,
+            dataclasses.replace(self._scene, targets=tuple(self._targets)), GIZMO_SHARE * self.robot.body_length,
+            self._released)
 
     def _panel(self) -> None:
         """The shared panel; each browser's own part is added when it connects (:meth:`_client_panel`)."""

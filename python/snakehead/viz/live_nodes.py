@@ -5,7 +5,14 @@
 * :class:`MotionNodes`: the viser nodes that play it -- the robot (:class:`.viewer_nodes.RobotNodes`), the ZMP, and
   paths of a fixed number of segments, so that a new plan moves the points of nodes that exist and rebuilds none;
 * :class:`TargetGizmos`: the targets as transform gizmos (the x-axis the head's direction) with their arrows and
-  names (:func:`.viewer_nodes.add_target_marker`), and the release of a gizmo as a callback.
+  names (:func:`.viewer_nodes.add_target_marker`), and the release of a gizmo as a callback;
+* :func:`draw_live_scene`: the still scene the viewer starts with -- the lights, the root node at the ground frame's
+  world pose (:class:`GroundNode`), the robot, the obstacles, the gizmos, the ground grid, a terrain, the camera.
+
+Everything of :data:`ROOT` is in the plans' ground frame (the world's on flat ground): the root node holds the
+frame's world pose, so on a slope the robot, the paths, the support polygon, the ZMP, the obstacles, the gizmos
+and the ground grid are turned into the world by that one transform; a gizmo's pose, which a browser sends in its
+parent's frame, is a target's pose in the ground frame, as the planner takes it.
 """
 from __future__ import annotations
 
@@ -19,24 +26,51 @@ from .._errors import InputError
 from ..dynamics.stability import support_polygon
 from ..scenes.scene import Target
 from ..solve.head import frame_along
-from .viewer_arrays import FRAME_STEP_S, frame_indices, quaternions_wxyz, robot_meshes, shape_colors, shape_poses
-from .viewer_nodes import POLYGON_RGB, TIP_PATH_RGB, ZMP_RGB, RobotNodes, add_target_marker
+from .figure_geometry import terrain_mesh
+from .viewer_arrays import (
+    FRAME_STEP_S,
+    camera_for,
+    frame_indices,
+    obstacle_arrays,
+    quaternions_wxyz,
+    robot_meshes,
+    shape_colors,
+    shape_poses,
+)
+from .viewer_nodes import (
+    POLYGON_RGB,
+    TIP_PATH_RGB,
+    ZMP_RGB,
+    RobotNodes,
+    add_ground,
+    add_obstacles,
+    add_target_marker,
+    add_terrain,
+    camera_to,
+    terrain_node,
+)
 
 if TYPE_CHECKING:
     import viser
 
+    from ..model.placement import GroundFrame
     from ..model.robot import BasePlacement, SnakeRobot
     from ..planning.plan_result import Plan
+    from ..scenes.scene import Scene
 
-__all__ = ["PATH_SEGMENTS", "POLYGON_EDGES", "ROOT", "LiveMotion", "live_motion", "wxyz_along", "x_axis", "gizmo_pose",
-           "TargetGizmos", "MotionNodes"]
+__all__ = ["PATH_SEGMENTS", "POLYGON_EDGES", "ROOT", "FILL_LIGHT", "GROUND_MARGIN_M", "LiveMotion", "live_motion",
+           "wxyz_along", "x_axis", "gizmo_pose", "TargetGizmos", "MotionNodes", "GroundNode", "draw_live_scene"]
 
 #: Segments of the head tip's path and of the ZMP's trace: fixed, so that a new plan moves their points only.
 PATH_SEGMENTS = 200
 #: Edges of the support polygon's node (a polygon of fewer repeats its last vertex; one of more is resampled).
 POLYGON_EDGES = 64
-#: Where the live viewer's nodes are in viser's scene tree.
+#: Where the live viewer's nodes are in viser's scene tree: a node at the ground frame's world pose.
 ROOT = "/live"
+#: Strength of the hemisphere light that lights the sides the default lights leave dark (no environment map here).
+FILL_LIGHT = 1.5
+#: m: the margin around what the viewer shows at start for the ground grid (as the viewer's).
+GROUND_MARGIN_M = 0.2
 
 @dataclass
 class LiveMotion:
@@ -208,3 +242,65 @@ class MotionNodes:
         self.frame = k
         self.robot.move(motion.positions[k], motion.wxyz[k])
         self.zmp.position = (float(motion.zmp[k, 0]), float(motion.zmp[k, 1]), 0.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# the ground frame and the still scene
+# ----------------------------------------------------------------------------------------------
+class GroundNode:
+    """The live viewer's root node (:data:`ROOT`) at the ground frame's world pose: the identity on flat ground, the
+    plane's frame on a slope. Made before any node under it; :meth:`place` moves it (and all under it) to another
+    plan's ground frame."""
+
+    def __init__(self, scene_api: viser.SceneApi, ground: GroundFrame) -> None:
+        self.ground = ground
+        pose = self._pose(ground)
+        self.handle = scene_api.add_frame(ROOT, show_axes=False, position=pose["position"], wxyz=pose["wxyz"])
+
+    @staticmethod
+    def _pose(ground: GroundFrame) -> dict[str, np.ndarray]:
+        G = ground.matrix
+        return dict(position=G[:3, 3], wxyz=quaternions_wxyz(G[None, :3, :3])[0])
+
+    def place(self, ground: GroundFrame) -> None:
+        """Put the root at ``ground``'s world pose (nothing is sent when it is there already)."""
+        if ground != self.ground:
+            self.ground = ground
+            pose = self._pose(ground)
+            self.handle.position, self.handle.wxyz = pose["position"], pose["wxyz"]
+
+    def to_world(self, points: np.ndarray) -> np.ndarray:
+        """Points (..., 3) of the ground frame in the world."""
+        return points if self.ground.is_world else self.ground.to_world(points)
+
+
+def draw_live_scene(server: viser.ViserServer, robot: SnakeRobot, q: np.ndarray, base: BasePlacement, scene: Scene,
+                    gizmo_size: float, on_release: Callable[[Any, Any], None]) -> tuple[GroundNode, MotionNodes,
+                                                                                        TargetGizmos]:
+    """The still scene the live viewer starts with: the lights, the root node at ``base``'s ground frame, the robot
+    at ``q`` on ``base``, ``scene``'s obstacles and a gizmo per target, the ground grid under what is shown (in the
+    ground frame: tilted on a slope), the scene's terrain (a heightfield, a mesh, a staircase; in the world) and the
+    initial camera on what is shown (in the world)."""
+    s = server.scene
+    # lit by viser's default lights and a fill light, without shadows or an environment map: each costs a browser
+    # that renders in software (no GPU) much of its frame time, which a new motion waits for
+    # (bench/live_latency.py)
+    s.configure_environment_map(hdri=None)
+    s.configure_default_lights(enabled=True, cast_shadow=False)
+    root = GroundNode(s, base.ground)  # first: the parent of every node below
+    s.add_light_hemisphere(f"{ROOT}/fill light", sky_color=(255, 255, 255), ground_color=(120, 120, 120),
+                           intensity=FILL_LIGHT)
+    nodes = MotionNodes(s, robot, q, base)
+    arrays = obstacle_arrays(scene.obstacles)
+    add_obstacles(s, f"{ROOT}/obstacles", **arrays)
+    gizmos = TargetGizmos(s, gizmo_size, on_release)
+    for target in scene.targets:
+        gizmos.add(target)
+    shown = np.vstack([nodes.start_positions, np.array([t.position for t in scene.targets]).reshape(-1, 3),
+                       arrays["obstacle_centres"], arrays["wall_vertices"], np.zeros((1, 3))])
+    lo, hi = shown.min(axis=0), shown.max(axis=0)
+    add_ground(s, f"{ROOT}/ground", lo - GROUND_MARGIN_M, hi + GROUND_MARGIN_M)
+    add_terrain(s, terrain_node(ROOT), *terrain_mesh(scene.terrain))
+    world = root.to_world(shown)
+    camera_to(server.initial_camera, *camera_for(world.min(axis=0) - 0.05, world.max(axis=0) + 0.05))
+    return root, nodes, gizmos

@@ -5,7 +5,8 @@ blue) moving along the planned motion, with play/pause and a time slider; the ta
 desired direction); the obstacles; the support polygon and the zero-moment point's trace on the ground (with the
 ZMP and the centre of mass's ground projection now); the head tip's path; and the head's reachability map as voxels
 coloured by their index (the paper's 20-step bar, Figs. 4-5), attached to the head's base frame and hidden until
-toggled on.
+toggled on. On a slope all of it is drawn in the plan's ground frame under one node that holds the frame's world
+pose, on a tilted ground grid; a scene's terrain (a heightfield, a mesh, a staircase) is drawn in the world.
 
 Three ways to it:
 
@@ -46,6 +47,7 @@ from .viewer_arrays import (
     CAMERA_FOV_DEG,
     CAMERA_VIEW_DEG,
     FRAME_STEP_S,
+    GROUND_FIELDS,
     MESH_FIELDS,
     OBSTACLE_FIELDS,
     VIEWER_SEGMENTS,
@@ -53,6 +55,7 @@ from .viewer_arrays import (
     camera_for,
     distinct_polygons,
     frame_indices,
+    ground_arrays,
     obstacle_arrays,
     quaternions_wxyz,
     reach_scene,
@@ -62,7 +65,15 @@ from .viewer_arrays import (
     shape_poses,
     viewer_scene,
 )
-from .viewer_file import MAX_SCENE_BYTES, SCENE_FORMAT, SCENE_SUFFIX, load_viewer_scene, save_viewer_scene, scenes_in
+from .viewer_file import (
+    FLAT_SCENE_FORMAT,
+    MAX_SCENE_BYTES,
+    SCENE_FORMAT,
+    SCENE_SUFFIX,
+    load_viewer_scene,
+    save_viewer_scene,
+    scenes_in,
+)
 from .viewer_nodes import (
     COM_RGB,
     CUBE_TRIANGLES,
@@ -91,10 +102,10 @@ if TYPE_CHECKING:
 __all__ = [
     "html_page", "write_html", "Viewer", "serve",
     # re-exported: the scene's arrays (viewer_arrays), its file (viewer_file), its nodes in viser (viewer_nodes)
-    "CAMERA_FOV_DEG", "CAMERA_VIEW_DEG", "FRAME_STEP_S", "MESH_FIELDS", "OBSTACLE_FIELDS", "VIEWER_SEGMENTS",
-    "ViewerScene", "camera_for", "distinct_polygons", "frame_indices", "obstacle_arrays", "quaternions_wxyz",
-    "reach_scene", "rgb255", "robot_meshes", "shape_colors", "shape_poses", "viewer_scene",
-    "MAX_SCENE_BYTES", "SCENE_FORMAT", "SCENE_SUFFIX", "load_viewer_scene", "save_viewer_scene", "scenes_in",
+    "CAMERA_FOV_DEG", "CAMERA_VIEW_DEG", "FRAME_STEP_S", "GROUND_FIELDS", "MESH_FIELDS", "OBSTACLE_FIELDS",
+    "VIEWER_SEGMENTS", "ViewerScene", "camera_for", "distinct_polygons", "frame_indices", "ground_arrays",
+    "obstacle_arrays", "quaternions_wxyz", "reach_scene", "rgb255", "robot_meshes", "shape_colors", "shape_poses",
+    "viewer_scene", "FLAT_SCENE_FORMAT", "MAX_SCENE_BYTES", "SCENE_FORMAT", "SCENE_SUFFIX", "load_viewer_scene", "save_viewer_scene", "scenes_in",
     "COM_RGB", "CUBE_TRIANGLES", "CUBE_VERTICES", "OBSTACLE_RGB", "POLYGON_RGB", "TARGET_ARROW_M",
     "TARGET_LABEL_HEIGHT_M", "TARGET_RGB", "TIP_PATH_RGB", "WALL_RGB", "ZMP_RGB", "RobotNodes", "SceneNodes",
     "add_ground", "add_obstacles", "add_target_marker", "camera_to", "light_scene", "node_name",

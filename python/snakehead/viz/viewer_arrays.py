@@ -3,12 +3,14 @@ whole-body reach map (:func:`reach_scene`).
 
 A scene holds the robot's collision shapes per frame (each a unit mesh scaled, or a mesh hull), the head tip's
 path, the head's reachability map in the head's base frame, the ZMP, the centre of mass and the support polygons,
-the targets and the obstacles (m, s, world frame, z up; quaternions w, x, y, z). :mod:`.viewer_file` stores it,
-:mod:`.viewer_nodes` puts it in a viser scene.
+the targets and the obstacles (m, s, z up; quaternions w, x, y, z), all in the plan's ground frame, whose world pose
+is ``ground_pose`` (the identity on flat ground: the world frame; on a slope the plane's frame, z its normal); and
+a scene's terrain other than a plane as triangles in the world. :mod:`.viewer_file` stores it, :mod:`.viewer_nodes`
+puts it in a viser scene (the ground frame's nodes under one parent node that holds ``ground_pose``).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
@@ -23,15 +25,16 @@ from ..geometry.shapes import Shape, shape_mesh
 from ..kinematics.reachability.reachability_map import KIND_WHOLE_BODY, require_map
 from ..model.robot import BasePlacement
 from ..planning.plan_many import WORKERS, RobotRecipe
-from .figure_geometry import Sphere, hole_rim, part_colors, plan_spheres, wall_faces
+from .figure_geometry import Sphere, hole_rim, part_colors, plan_spheres, terrain_mesh, wall_faces
 
 if TYPE_CHECKING:
     from ..kinematics.reachability.reachability_map import ReachabilityMap
     from ..planning.plan_result import Plan
 
 __all__ = ["FRAME_STEP_S", "CAMERA_FOV_DEG", "CAMERA_VIEW_DEG", "VIEWER_SEGMENTS", "MESH_FIELDS", "OBSTACLE_FIELDS",
-           "ViewerScene", "camera_for", "quaternions_wxyz", "rgb255", "robot_meshes", "viewer_scene", "reach_scene",
-           "frame_indices", "distinct_polygons", "shape_poses", "shape_colors", "obstacle_arrays"]
+           "GROUND_FIELDS", "ViewerScene", "camera_for", "quaternions_wxyz", "rgb255", "robot_meshes", "viewer_scene",
+           "reach_scene", "frame_indices", "distinct_polygons", "ground_arrays", "shape_poses", "shape_colors",
+           "obstacle_arrays"]
 
 #: s: default spacing of the viewer's frames along the motion (five frames per second of motion).
 FRAME_STEP_S = 0.2
@@ -47,6 +50,9 @@ MESH_FIELDS = ("shape_mesh", "shape_scales", "mesh_vertices", "mesh_triangles", 
 #: The :class:`ViewerScene` fields that hold the obstacles (:func:`obstacle_arrays`).
 OBSTACLE_FIELDS = ("obstacle_centres", "obstacle_sizes", "obstacle_wxyz", "wall_vertices", "wall_triangles",
                    "hole_rims")
+#: The :class:`ViewerScene` fields of the ground: its frame's world pose and a terrain's triangles (flat ground and a
+#: plane have none). A scene on flat ground without terrain leaves them at their defaults (:meth:`ViewerScene.flat`).
+GROUND_FIELDS = ("ground_pose", "terrain_vertices", "terrain_triangles")
 
 
 @dataclass
@@ -67,6 +73,10 @@ class ViewerScene:
     (NaN: drawn as an arrow). Obstacles: boxes ``obstacle_centres`` / ``obstacle_sizes`` (B, 3),
     ``obstacle_wxyz`` (B, 4); walls (and mesh obstacles' hulls) as triangles ``wall_vertices`` (W, 3),
     ``wall_triangles`` (T, 3) and the holes' rims ``hole_rims`` (H, 65, 3).
+
+    Everything above is in the plan's ground frame, whose world pose is ``ground_pose`` (4, 4) (the identity on flat
+    ground); :meth:`to_world` turns points into the world. A terrain other than flat ground or a plane:
+    ``terrain_vertices`` (TV, 3) in the world and ``terrain_triangles`` (TT, 3) (TV = TT = 0 without one).
     """
 
     name: str
@@ -102,19 +112,60 @@ class ViewerScene:
     wall_vertices: np.ndarray
     wall_triangles: np.ndarray
     hole_rims: np.ndarray
+    ground_pose: np.ndarray = field(default_factory=lambda: np.eye(4))
+    terrain_vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    terrain_triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int32))
 
     @property
     def n_frames(self) -> int:
         return len(self.times)
 
-    def bounds(self, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper corners (3,) m of what the scene shows (without the map), with the ground (z = 0)."""
+    @property
+    def on_flat_ground(self) -> bool:
+        """Whether the ground frame is the world frame (``ground_pose`` the identity)."""
+        return bool(np.array_equal(self.ground_pose, np.eye(4)))
+
+    @property
+    def flat(self) -> bool:
+        """On flat ground without a terrain: the scene a viewer of format 2 draws (:mod:`.viewer_file`)."""
+        return self.on_flat_ground and len(self.terrain_triangles) == 0
+
+    def to_world(self, points: np.ndarray) -> np.ndarray:
+        """Points (..., 3) of the ground frame in the world (the same array on flat ground)."""
+        if self.on_flat_ground:
+            return points
+        G = np.asarray(self.ground_pose, float)
+        return np.asarray(points, float) @ G[:3, :3].T + G[:3, 3]
+
+    def com_marks(self) -> np.ndarray:
+        """(F, 2) m: the points of the ground (its frame's z = 0) below the centre of mass along gravity, which the
+        viewer marks: its x, y on flat ground; on a slope, shifted where the weight leans (gravity, the world's -z,
+        turned into the ground frame: minus the third row of the frame's rotation)."""
+        if self.on_flat_ground:
+            return self.com[:, :2]
+        g = -np.asarray(self.ground_pose, float)[2, :3]
+        return self.com[:, :2] + self.com[:, 2:3] * (g[:2] / -g[2])
+
+    def _shown_points(self) -> np.ndarray:
         pts = [self.shape_positions.reshape(-1, 3), self.target_positions, np.zeros((1, 3))]
         if len(self.wall_vertices):
             pts.append(self.wall_vertices)
         if len(self.obstacle_centres):
             pts.append(self.obstacle_centres)
-        allp = np.vstack(pts)
+        return np.vstack(pts)
+
+    def ground_bounds(self, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3,) m in the ground frame of what the scene shows (without the map), with the
+        ground's origin: where the viewer lays its ground grid."""
+        allp = self._shown_points()
+        return allp.min(axis=0) - margin, allp.max(axis=0) + margin
+
+    def bounds(self, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3,) m in the world of what the scene shows (without the map), with the ground's
+        origin (:meth:`ground_bounds` on flat ground)."""
+        if self.on_flat_ground:
+            return self.ground_bounds(margin)
+        allp = self.to_world(self._shown_points())
         return allp.min(axis=0) - margin, allp.max(axis=0) + margin
 
     def camera(self) -> tuple[np.ndarray, np.ndarray]:
@@ -231,8 +282,16 @@ def viewer_scene(plan: Plan, *, workspace_map: ReachabilityMap | None = None, sp
         target_directions=np.array([tg.direction for tg in targets]).reshape(-1, 3),
         target_names=np.array([tg.name for tg in targets], dtype=str),
         target_diameters=np.array([diameters.get(tuple(np.round(tg.position, 9)), np.nan) for tg in targets], float),
-        **obstacle_arrays(plan.obstacles),
+        **obstacle_arrays(plan.obstacles), **ground_arrays(plan),
     )
+
+
+def ground_arrays(plan: Plan) -> dict[str, np.ndarray]:
+    """The :data:`GROUND_FIELDS` of ``plan``: its ground frame's world pose, its scene's terrain's triangles (none
+    for flat ground and a plane: :func:`.figure_geometry.terrain_mesh`)."""
+    vertices, triangles = terrain_mesh(getattr(getattr(plan, "scene", None), "terrain", None))
+    return dict(ground_pose=plan.base.ground.matrix, terrain_vertices=vertices,
+                terrain_triangles=triangles.astype(np.int32))
 
 
 def reach_scene(reach_map: ReachabilityMap, robot: Any, *, title: str = "") -> ViewerScene:

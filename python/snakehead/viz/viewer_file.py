@@ -4,6 +4,11 @@
 :func:`load_viewer_scene` takes a file from anywhere: it checks every array's kind and shape against the others,
 that numbers are finite and indices point inside what they index, and that names are plain text, before the
 viewer draws anything of it.
+
+Two formats: a scene on flat ground without terrain is written as format 2, as before slopes (the same file); a
+scene on a slope or with a terrain as format 3, which adds the ground fields (the ground frame's world pose, the
+terrain's triangles: :data:`~.viewer_arrays.GROUND_FIELDS`), so that a reader of format 2 refuses it rather than
+drawing a slope flat. Both are read.
 """
 from __future__ import annotations
 
@@ -17,21 +22,27 @@ import numpy as np
 from .._errors import InputError
 from .._files import atomic_open, read_npz
 from .._validate import display_text, name_text
-from .viewer_arrays import ViewerScene
+from .viewer_arrays import GROUND_FIELDS, ViewerScene
 
-__all__ = ["SCENE_SUFFIX", "SCENE_FORMAT", "MAX_SCENE_BYTES", "save_viewer_scene", "load_viewer_scene", "scenes_in"]
+__all__ = ["SCENE_SUFFIX", "SCENE_FORMAT", "FLAT_SCENE_FORMAT", "MAX_SCENE_BYTES", "save_viewer_scene", "load_viewer_scene", "scenes_in"]
 
 #: What :func:`save_viewer_scene` appends to a scenario's name.
 SCENE_SUFFIX = "_viewer.npz"
-#: Format of ``NAME_viewer.npz`` (stored in the file; :func:`load_viewer_scene` refuses other versions).
-SCENE_FORMAT = 2
+#: Format of ``NAME_viewer.npz`` on a slope or a terrain (stored in the file; :func:`load_viewer_scene` reads it and
+#: :data:`FLAT_SCENE_FORMAT`, and refuses other versions).
+SCENE_FORMAT = 3
+#: Format of a scene on flat ground without terrain: format 3 without the ground fields.
+FLAT_SCENE_FORMAT = 2
 
 
 def save_viewer_scene(scene: ViewerScene, path: str | Path) -> Path:
-    """Write ``scene`` as a compressed ``.npz`` (atomically); returns the path."""
+    """Write ``scene`` as a compressed ``.npz`` (atomically); returns the path. Format 2 on flat ground without
+    terrain, else 3 (see the module)."""
     path = Path(path)
-    arrays = {f.name: np.asarray(getattr(scene, f.name)) for f in fields(scene)}
-    arrays["format"] = np.asarray(SCENE_FORMAT)
+    flat = scene.flat
+    arrays = {f.name: np.asarray(getattr(scene, f.name)) for f in fields(scene)
+              if not (flat and f.name in GROUND_FIELDS)}
+    arrays["format"] = np.asarray(FLAT_SCENE_FORMAT if flat else SCENE_FORMAT)
     with atomic_open(path, "wb") as f:
         np.savez_compressed(f, **arrays)  # type: ignore[arg-type]
     return path
@@ -56,6 +67,7 @@ _SCENE_ARRAYS = {
     "target_names": ("U", ("N",)), "target_diameters": ("f", ("N",)), "obstacle_centres": ("f", ("B", 3)),
     "obstacle_sizes": ("f", ("B", 3)), "obstacle_wxyz": ("f", ("B", 4)), "wall_vertices": ("f", ("W", 3)),
     "wall_triangles": ("i", ("T", 3)), "hole_rims": ("f", ("H", "R", 3)),
+    "ground_pose": ("f", (4, 4)), "terrain_vertices": ("f", ("TV", 3)), "terrain_triangles": ("i", ("TT", 3)),
 }
 #: Arrays that may hold NaN (polygons are NaN-padded; a target without a diameter is an arrow).
 _SCENE_NAN_ALLOWED = ("polygons", "target_diameters")
@@ -78,7 +90,7 @@ def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
             raise InputError(f"{where}: {key} holds NaN or inf")
     if sizes["F"] < 1 or np.any(np.diff(values["times"]) < 0):
         raise InputError(f"{where}: times must be at least one time, in order")
-    for key, bound in (("polygon_of_frame", "P"), ("wall_triangles", "W")):
+    for key, bound in (("polygon_of_frame", "P"), ("wall_triangles", "W"), ("terrain_triangles", "TV")):
         a = values[key]
         if a.size and (a.min() < 0 or a.max() >= sizes[bound]):
             raise InputError(f"{where}: {key} points outside its {sizes[bound]} entries")
@@ -96,6 +108,10 @@ def _check_scene_arrays(where: str, values: dict[str, np.ndarray]) -> None:
             raise InputError(f"{where}: mesh_triangles of mesh {g} point outside its {vs[g + 1] - vs[g]} vertices")
     if np.any((values["voxel_indices"] < 0) | (values["voxel_indices"] > 100)) or not values["voxel_size"] >= 0:
         raise InputError(f"{where}: voxel_indices must be within [0, 100] and voxel_size >= 0")
+    G = np.asarray(values["ground_pose"], float)
+    R = G[:3, :3]
+    if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0 and np.array_equal(G[3], [0, 0, 0, 1])):
+        raise InputError(f"{where}: ground_pose must be a rigid transform (a rotation and a translation)")
 
 
 def load_viewer_scene(path: str | Path) -> ViewerScene:
@@ -104,14 +120,20 @@ def load_viewer_scene(path: str | Path) -> ViewerScene:
     where = f"{os.fspath(path)}"
     contents = read_npz(path, "viewer scene", max_bytes=MAX_SCENE_BYTES)
     version = contents.pop("format", None)
-    if version is None or version.shape != () or version.dtype.kind not in "iu" or int(version) != SCENE_FORMAT:
-        raise InputError(f"{where}: not a viewer scene of format {SCENE_FORMAT} (format {version!r})")
+    formats = (FLAT_SCENE_FORMAT, SCENE_FORMAT)
+    if version is None or version.shape != () or version.dtype.kind not in "iu" or int(version) not in formats:
+        raise InputError(f"{where}: not a viewer scene of format {FLAT_SCENE_FORMAT} or {SCENE_FORMAT} (format "
+                         f"{version!r})")
     names = {f.name for f in fields(ViewerScene)}
+    if int(version) == FLAT_SCENE_FORMAT:  # flat ground, no terrain: the ground fields at their defaults
+        names -= set(GROUND_FIELDS)
     missing = names - set(contents)
     if missing:
         raise InputError(f"{where}: viewer scene without {sorted(missing)}")
     values: dict[str, Any] = {k: contents[k] for k in names}
-    _check_scene_arrays(where, values)
+    flat: dict[str, Any] = {"ground_pose": np.eye(4), "terrain_vertices": np.zeros((0, 3)),  # a format-2 scene's ground
+                            "terrain_triangles": np.zeros((0, 3), np.int32)}
+    _check_scene_arrays(where, {**flat, **values})
     values["name"] = name_text(str(values["name"]), f"{where}: name")
     values["title"] = display_text(str(values["title"]), f"{where}: title")
     for k, target in enumerate(values["target_names"].tolist()):

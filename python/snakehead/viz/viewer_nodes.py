@@ -1,6 +1,11 @@
 """A :class:`~.viewer_arrays.ViewerScene` in a viser scene: the nodes that draw it (:class:`SceneNodes`, the robot's
-shapes as :class:`RobotNodes`) and the pieces the live viewer shares (ground, obstacles, target markers, lighting,
-the camera).
+shapes as :class:`RobotNodes`) and the pieces the live viewer shares (the ground frame's node, the ground grid, a
+terrain, obstacles, target markers, lighting, the camera).
+
+A plan on a slope is drawn in its ground frame: every node of it sits under one parent node (the viewer's root)
+that holds the ground frame's world pose (:func:`add_ground_frame`), so the body, the targets, the obstacles, the
+ZMP and the support polygons, and the ground grid itself, are turned into the world by that one transform. On flat
+ground there is no such node (the ground frame is the world's) and the scene is the one drawn before slopes.
 
 Colours are RGB 0-255, as viser takes them; the robot's parts take theirs from :func:`.body.part_colors`.
 """
@@ -12,14 +17,15 @@ import numpy as np
 import numpy.typing as npt
 
 from .reachability_figures import index_colors
-from .viewer_arrays import CAMERA_FOV_DEG, MESH_FIELDS, OBSTACLE_FIELDS, ViewerScene
+from .viewer_arrays import CAMERA_FOV_DEG, MESH_FIELDS, OBSTACLE_FIELDS, ViewerScene, quaternions_wxyz
 
 if TYPE_CHECKING:
     import viser
 
 __all__ = ["ZMP_RGB", "COM_RGB", "POLYGON_RGB", "TARGET_RGB", "WALL_RGB", "OBSTACLE_RGB", "TIP_PATH_RGB",
-           "TARGET_ARROW_M", "TARGET_LABEL_HEIGHT_M", "CUBE_VERTICES", "CUBE_TRIANGLES", "SceneNodes", "RobotNodes",
-           "light_scene", "add_ground", "add_obstacles", "add_target_marker", "camera_to", "node_name"]
+           "TARGET_ARROW_M", "TARGET_LABEL_HEIGHT_M", "CUBE_VERTICES", "CUBE_TRIANGLES", "TERRAIN_RGB", "SceneNodes",
+           "RobotNodes", "light_scene", "add_ground_frame", "add_ground", "add_terrain", "add_obstacles",
+           "add_target_marker", "camera_to", "node_name", "terrain_node"]
 
 #: Colours (RGB 0-255) of what the viewer draws besides the robot (its parts: viz.body.part_colors).
 ZMP_RGB = (192, 57, 43)
@@ -29,6 +35,7 @@ TARGET_RGB = (192, 57, 43)
 WALL_RGB = (161, 136, 127)
 OBSTACLE_RGB = (141, 110, 99)
 TIP_PATH_RGB = (90, 90, 90)
+TERRAIN_RGB = (188, 170, 164)
 #: m: a target's arrow runs along its direction from this far behind the target to this far short of it.
 TARGET_ARROW_M = (0.09, 0.01)
 #: m: a target's label is this high above it.
@@ -41,7 +48,8 @@ CUBE_TRIANGLES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5]
 
 
 class SceneNodes:
-    """The nodes of one :class:`ViewerScene` in a viser scene, under ``/ROOT``; :meth:`show_frame` moves them."""
+    """The nodes of one :class:`ViewerScene` in a viser scene, under ``root`` (on a slope a node at the ground frame's
+    world pose: :func:`add_ground_frame`; a terrain beside it, in the world); :meth:`show_frame` moves them."""
 
     LAYERS = ("robot", "reachability map", "ZMP and support polygon", "targets", "obstacles", "head tip path")
 
@@ -51,10 +59,12 @@ class SceneNodes:
         self.frame = -1
         s = scene_api
         light_scene(s)
+        self.ground_frame = add_ground_frame(s, root, data.ground_pose)  # first: the parent of all that follows
+        self.terrain = add_terrain(s, terrain_node(root), data.terrain_vertices, data.terrain_triangles)
         # one parent node per layer, so that a layer shows or hides as one (viser's visibility is inherited)
         self.groups = {layer: s.add_frame(f"{root}/{layer}", show_axes=False)
                        for layer in ("ZMP and support polygon", "targets", "obstacles", "head tip path")}
-        self.ground = add_ground(s, f"{root}/ground", *data.bounds(margin=0.2))
+        self.ground = add_ground(s, f"{root}/ground", *data.ground_bounds(margin=0.2))
         self.robot_nodes = RobotNodes(s, f"{root}/robot", {k: getattr(data, k) for k in MESH_FIELDS},
                                       data.shape_colors, data.shape_positions[0], data.shape_wxyz[0])
         self.robot = self.robot_nodes.frame
@@ -98,8 +108,9 @@ class SceneNodes:
             s.add_line_segments(f"{group}/ZMP path", np.stack([z3[:-1], z3[1:]], axis=1), ZMP_RGB, thickness=0.002)
         self.zmp = s.add_icosphere(f"{group}/ZMP", radius=0.008, color=ZMP_RGB, position=(*data.zmp[0], 0.0),
                                    cast_shadow=False)
+        self.com_marks = data.com_marks()  # below the CoM along gravity (on flat ground: its x, y)
         self.com = s.add_icosphere(f"{group}/CoM ground projection", radius=0.006, color=COM_RGB,
-                                   position=(data.com[0, 0], data.com[0, 1], 0.0), cast_shadow=False)
+                                   position=(*self.com_marks[0], 0.0), cast_shadow=False)
 
     def _add_targets(self, s: viser.SceneApi) -> None:
         """Each target: its arrow and label, and its sphere when it has a diameter."""
@@ -124,7 +135,7 @@ class SceneNodes:
         self.map_frame.position = d.map_frame_positions[k]
         self.map_frame.wxyz = d.map_frame_wxyz[k]
         self.zmp.position = (d.zmp[k, 0], d.zmp[k, 1], 0.0)
-        self.com.position = (d.com[k, 0], d.com[k, 1], 0.0)
+        self.com.position = (self.com_marks[k, 0], self.com_marks[k, 1], 0.0)
         if before < 0 or d.polygon_of_frame[before] != d.polygon_of_frame[k]:
             for i, node in enumerate(self.polygons):
                 node.visible = bool(d.polygon_of_frame[k] == i)
@@ -165,8 +176,33 @@ def light_scene(scene_api: viser.SceneApi) -> None:
     scene_api.configure_environment_map(hdri="warehouse", environment_intensity=0.4)
 
 
+def add_ground_frame(scene_api: viser.SceneApi, name: str, pose: npt.ArrayLike) -> Any:
+    """The node ``name`` at the ground frame's world pose ``pose`` (4, 4): added before anything under it, it is the
+    parent of everything drawn in the ground frame (one transform at one place). None on flat ground (``pose`` the
+    identity): no node, so that a flat scene is drawn as before slopes."""
+    G = np.asarray(pose, float)
+    if np.array_equal(G, np.eye(4)):
+        return None
+    return scene_api.add_frame(name, show_axes=False, position=G[:3, 3], wxyz=quaternions_wxyz(G[None, :3, :3])[0])
+
+
+def terrain_node(root: str) -> str:
+    """Where a terrain is drawn beside the viewer's ``root``: in the world, not under the ground frame's node."""
+    return f"{root} terrain"
+
+
+def add_terrain(scene_api: viser.SceneApi, name: str, vertices: np.ndarray, triangles: np.ndarray) -> Any:
+    """A terrain's triangles (:func:`.figure_geometry.terrain_mesh`, world) as one mesh, both sides shaded; None
+    without triangles."""
+    if not len(triangles):
+        return None
+    return scene_api.add_mesh_simple(name, np.asarray(vertices, np.float32), np.asarray(triangles, np.uint32),
+                                     color=TERRAIN_RGB, side="double", flat_shading=True, cast_shadow=False)
+
+
 def add_ground(scene_api: viser.SceneApi, name: str, lo: np.ndarray, hi: np.ndarray) -> Any:
-    """A ground grid (z = 0) under the box [lo, hi] (3,) m: 0.1 m cells, 0.5 m sections."""
+    """A ground grid (z = 0 of the frame ``name``'s parent: the world, or the ground frame's node on a slope, where it
+    lies in the slope) under the box [lo, hi] (3,) m of that frame: 0.1 m cells, 0.5 m sections."""
     size = float(max(hi[0] - lo[0], hi[1] - lo[1]))
     centre = 0.5 * (lo + hi)
     return scene_api.add_grid(name, width=size, height=size, plane="xy", cell_size=0.1, section_size=0.5,
