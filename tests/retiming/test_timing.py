@@ -368,7 +368,8 @@ def test_limit_ratios_are_the_numpy_formulas_to_the_bit():
     angle = rng.uniform(0, 2 * np.pi, (N, E))
     normal = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
     offset = rng.normal(size=(N, E)) * 0.1
-    support = timing.Support(normal, offset, com, rng.uniform(0.01, 0.05, N), rng.uniform(0.005, 0.01, N))
+    support = timing.Support(normal, offset, com, rng.uniform(0.01, 0.05, N), rng.uniform(0.005, 0.01, N),
+                             np.tile([0.0, 0.0, -Mg], (N, 1)))
     limits = timing.resolve_limits(robot)
     got = limit_check.limit_ratios(robot, snakehead.BasePlacement(), limits, support, np.zeros((N, n)), qd, qdd,
                          dyn=InverseDynamics(tau, Pdot, Ldot))

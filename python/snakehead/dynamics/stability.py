@@ -215,7 +215,7 @@ def static_margins_of_frames(robot: SnakeRobot, frames: np.ndarray, com: np.ndar
     support polygon is the hull of its own touching contact points (the C++ core's hull, one per sample, without
     the GIL). The arrays are taken as they are (for the library's inner loops, e.g. the whole-body solve's checks of
     a batch of candidates); ``base``: the placement the frames are at, whose ground's gravity leans the CoM's
-    projection on a slope (:func:`com_on_ground`; default: flat ground). ``Infeasible`` when a sample has no base
+    projection on a slope (:meth:`~snakehead.model.placement.BasePlacement.below_along_gravity`; default: flat ground). ``Infeasible`` when a sample has no base
     link on the ground."""
     pts, active = _contact_points_many(robot, frames, contact, tolerance)
     if not active.any(axis=1).all():

@@ -115,11 +115,11 @@ WORLD_FRAME = GroundFrame()
 
 @dataclass(frozen=True, repr=False)
 class BasePlacement:
-    """Where the base lies on the ground: the body frame (:attr:`SnakeRobot.body_in_root`; the root link's frame
+    """Where the base lies on the ground: the body frame (:attr:`~snakehead.model.robot.SnakeRobot.body_in_root`; the root link's frame
     for snakes written along x) at planar position (x, y), turned by ``yaw``.
 
     x, y in m, yaw in rad about z, in the ground frame ``ground`` (the world frame on flat ground, the default).
-    The root frame's height is the robot's (:attr:`SnakeRobot.body_axis_height`: the base's shapes rest on the
+    The root frame's height is the robot's (:attr:`~snakehead.model.robot.SnakeRobot.body_axis_height`: the base's shapes rest on the
     ground), so a placement fits any robot: ``robot.root_pose(base)`` is the 4x4 pose in the ground frame,
     ``ground.matrix @ robot.root_pose(base)`` in the world. The default puts the root frame (the tail end) at the
     origin with the body along +x.

@@ -283,17 +283,19 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
         return way.qs[-1]
     lifts = plan_cache_of(controller).lift_paths
     key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
-    kept = lifts.get(key) if not obstacles else None
+    keep = not obstacles and way.base.on_flat_ground  # on a slope a lift safe at one heading may not be at another
+    kept = lifts.get(key) if keep else None
     if kept is not None:
         way.append_path("initial state (head lifted)", *kept)
     else:
         first = len(way.qs) - 1
         method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
-        if not obstacles:
+        if keep:
             lifts.put(key, (np.array(way.qs[first:]), method))
     way.lift_index = way.stop()
-    way.lift_cache = plan_cache_of(controller).timed_lifts
-    way.checked_lifts = plan_cache_of(controller).checked_lifts
+    if way.base.on_flat_ground:  # on a slope the lift's timing and checks depend on the heading: nothing is kept
+        way.lift_cache = plan_cache_of(controller).timed_lifts
+        way.checked_lifts = plan_cache_of(controller).checked_lifts
     return q
 
 
