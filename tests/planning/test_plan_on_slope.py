@@ -164,3 +164,20 @@ def test_the_cli_plans_the_shipped_slope_scene(tmp_path: Path):
                         "--no-sim"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr
     assert any(out.iterdir())
+
+
+def test_a_scene_in_a_ground_frame_is_not_saved_as_if_on_flat_ground(slope_plan, tmp_path: Path):
+    """A scene file holds world poses (and a [terrain] table): a scene whose base lies in a slope's ground frame (a
+    plan's, or the live viewer's on a slope) would load on flat ground, so it is refused by name; the live viewer
+    refuses a scene file on a slope (its gizmos move ground-frame targets)."""
+    from snakehead._errors import InputError
+    from snakehead.scenes.scene import Scene, Target, save_scene
+    from snakehead.viz.live import LiveViewer
+
+    t = slope_plan.targets[0]
+    scene = Scene(name="s", targets=(Target("t", t.position, t.direction),), base=slope_plan.base)
+    with pytest.raises(InputError, match="ground frame"):
+        save_scene(scene, tmp_path / "s.toml")
+    assert not (tmp_path / "s.toml").exists()
+    with pytest.raises(InputError, match="live viewer takes scenes on flat ground"):
+        LiveViewer(load_scene(SLOPE), port=0, save_dir=tmp_path)

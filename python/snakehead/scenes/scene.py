@@ -466,6 +466,9 @@ def _scene_text(scene: Scene, folder: str | os.PathLike, meshes_inside: bool = T
         lines.append(f"robot = {toml_string(path_from(where, scene.robot_file))}")
     if scene.base is not None:
         b = scene.base
+        if not b.on_flat_ground:  # a file holds world poses and a [terrain]: ground-frame poses would load flat
+            raise InputError(f"scene {scene.name!r}: its base lies in a slope's ground frame; a scene file holds world "
+                             "poses with a [terrain] table (save the scene as loaded, not as planned)")
         lines.append(f"base = {{ x = {_toml_float(b.x)}, y = {_toml_float(b.y)}, yaw = {_toml_float(b.yaw)} }}")
     for t in scene.targets:
         lines += ["", "[[targets]]"] + [f"{k} = {v}" for k, v in _target_entry(t).items()]

@@ -55,6 +55,7 @@ from ..planning.planner import plan
 from ..scenes.scene import Scene, Target, save_scene, scene_to_toml, with_meshes_in
 from ..sim.simulate_plan import simulate
 from ..solve.head_controller import HeadController
+from ..terrain.surfaces import FlatGround
 from .live_nodes import LiveMotion, draw_live_scene, gizmo_pose, live_motion
 from .live_panel import MOTION_WATCH_JS, ClientPanel, ClientPanels, DynamicsCheck, Replan, errors_text, shown_text
 from .save_folder import SaveFolder, bare_name
@@ -116,6 +117,9 @@ class LiveViewer:
             raise InputTypeError(f"scene must be a Scene (snakehead.load_scene), got {type(scene).__name__}")
         if not (np.isfinite(frame_step_s) and frame_step_s > 0):
             raise InputError(f"frame_step_s must be a positive number of seconds, got {frame_step_s!r}")
+        if scene is not None and not isinstance(scene.terrain, FlatGround):  # its gizmos move ground-frame targets
+            raise InputError(f"scene {scene.name!r}: the live viewer takes scenes on flat ground; for a slope give a "
+                             "scene whose base lies on the slope's ground frame, its targets in that frame")
         if scene is not None and len(scene.targets) > MAX_TARGETS:
             raise InputError(f"scene {scene.name!r} has {len(scene.targets)} targets: the live viewer takes at most "
                              f"{MAX_TARGETS} ('snakehead plan --scene' plans any number)")
