@@ -405,8 +405,9 @@ def test_checker_refuses_bad_input() -> None:
 
 
 def test_zmp_check_takes_gravity_from_the_caller() -> None:
-    """The core's ZMP uses the gravity it is given (model.physics.GRAVITY from Python, defined once): Eqs. 39-40
-    with that g from the core's own momenta (np.gradient's rates); a bad gravity is an InputError."""
+    """The core's ZMP uses the gravity vector it is given (BasePlacement.gravity from Python: (0, 0, -GRAVITY) on flat
+    ground, leaning on a slope): Eqs. 39-40 with that g from the core's own momenta (np.gradient's rates), plus
+    M g_xy c_z when g leans; a bad gravity is an InputError."""
     from snakehead import InputError, _core
     from snakehead.model.physics import GRAVITY
 
@@ -421,16 +422,18 @@ def test_zmp_check_takes_gravity_from_the_caller() -> None:
     args = (path_check.checker(robot), t, q, qd, g.shapes_of(robot.shaped_links), g.contact_points_per_shape,
             g.shapes_of(robot.lifted_links), True, [], GROUND_TOLERANCE, stability.SAMPLE_CHUNK)
     M = robot.total_mass
-    for gravity in (GRAVITY, 3.0 * GRAVITY):
-        out = _core.zmp_check(*args, gravity)
+    for g_vec in ((0.0, 0.0, -GRAVITY), (0.0, 0.0, -3.0 * GRAVITY), (1.5, -0.8, -0.98 * GRAVITY)):
+        out = _core.zmp_check(*args, np.array(g_vec))
         Pdot, Ldot = np.gradient(out["P"], t, axis=0, edge_order=2), np.gradient(out["L"], t, axis=0, edge_order=2)
+        gravity = -g_vec[2]
+        c = out["com"]
         den = M * gravity + Pdot[:, 2]
-        zmp = np.column_stack([(M * gravity * out["com"][:, 0] - Ldot[:, 1]) / den,
-                               (M * gravity * out["com"][:, 1] + Ldot[:, 0]) / den])
+        zmp = np.column_stack([(M * gravity * c[:, 0] + M * g_vec[0] * c[:, 2] - Ldot[:, 1]) / den,
+                               (M * gravity * c[:, 1] + M * g_vec[1] * c[:, 2] + Ldot[:, 0]) / den])
         np.testing.assert_allclose(out["zmp"], zmp, atol=1e-9, rtol=0)
-    for bad in (np.nan, 0.0, -1.0, np.inf):
+    for bad in ((0.0, 0.0, np.nan), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, -np.inf), (np.nan, 0.0, -9.8)):
         with pytest.raises(InputError, match="gravity"):
-            _core.zmp_check(*args, bad)
+            _core.zmp_check(*args, np.array(bad))
 
 
 def test_zmp_check_on_several_threads_equals_one_thread_to_the_bit() -> None:

@@ -41,8 +41,8 @@ def test_the_users_read_the_one_definition():
     from snakehead.sim import mjcf, tracking
     from snakehead.solve import whole_body
 
-    for name in ("dynamics.stability", "dynamics.inverse_dynamics", "model.generate", "sim.gains", "sim.mjcf",
-                 "sim.tracking"):  # (by module: dynamics.inverse_dynamics is also a function's name)
+    for name in ("dynamics.stability", "model.placement", "model.generate", "sim.gains", "sim.mjcf",
+                 "sim.tracking"):  # (Newton-Euler takes g from the placement: model.placement)
         assert importlib.import_module(f"snakehead.{name}").GRAVITY is physics.GRAVITY, name
     assert whole_body.OBSTACLE_CLEARANCE is margins.OBSTACLE_CLEARANCE
     assert whole_body.SELF_CLEARANCE is margins.SELF_CLEARANCE and whole_body.MIN_MARGIN is margins.SOLUTION_MARGIN
