@@ -65,6 +65,37 @@ def test_face_form_matches_span_form(k):
     assert agree > 50
 
 
+def test_an_inconsistent_floating_point_run_is_redone_in_exact_arithmetic(monkeypatch):
+    """When cddlib's floating-point run reports a numerical inconsistency (seen on ~40 contacts of a body lying on a
+    slope in MuJoCo), the cone is found in exact rationals (GMP): the same cone as the floating-point run where that
+    one succeeds (its faces hold every edge of the span, and the two face forms give one verdict on wrenches not on
+    the boundary; the exact run keeps nearly parallel faces the floating-point one merges)."""
+    import cdd
+
+    contacts = uneven(4, 4)
+    A_float = contact_wrench_cone(contacts)
+    calls = []
+
+    def inconsistent(*args, **kwargs):
+        calls.append(1)
+        raise RuntimeError("*Error: Numerical inconsistency is found.  Use the GMP exact arithmetic.")
+
+    monkeypatch.setattr(cdd, "polyhedron_from_matrix", inconsistent)
+    A_exact = contact_wrench_cone(contacts)
+    assert calls
+    S = contact_wrench_span(contacts)
+    np.testing.assert_allclose(np.linalg.norm(A_exact, axis=1), 1.0)
+    assert np.max(A_exact @ S) <= 1e-9
+    agree = 0
+    for w in sample_wrenches(S, np.random.default_rng(9), 60):
+        a, b = np.max(A_exact @ w), np.max(A_float @ w)
+        if min(abs(a), abs(b)) < 1e-7:
+            continue
+        assert (a < 0) == (b < 0), w
+        agree += 1
+    assert agree > 50
+
+
 def test_lower_dimensional_cone_keeps_its_equalities():
     """Collinear contacts on flat ground: the CWC has no moment about their line; its face form says so with pairs
     of opposite rows (pypoman's face matrix drops them)."""

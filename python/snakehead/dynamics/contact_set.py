@@ -17,8 +17,10 @@ robot (the ground pushes it).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import cdd  # pycddlib: cddlib's double-description method (span to face form of the CWC)
+import cdd.gmp  # its exact rational arithmetic, when the floating-point run is inconsistent
 import numpy as np
 import numpy.typing as npt
 
@@ -130,6 +132,22 @@ def wrench_about(wrench: npt.ArrayLike, point: npt.ArrayLike, new_point: npt.Arr
     return out
 
 
+def _faces_of_generators(gens: np.ndarray) -> tuple[np.ndarray, set[int]]:
+    """cddlib's face form (H (m, 7) rows [b, -A], the linearity rows) of the cone of generator rows ``gens``: in
+    floating point, and in exact rationals (GMP; the floats taken exactly) when cddlib finds the floating-point run
+    numerically inconsistent (many nearly coplanar contacts, e.g. a body lying on a plane)."""
+    try:
+        mat = cdd.matrix_from_array(gens.tolist(), rep_type=cdd.RepType.GENERATOR)
+        faces = cdd.copy_inequalities(cdd.polyhedron_from_matrix(mat))
+        return np.array(faces.array, float).reshape(-1, 7), set(faces.lin_set)
+    except RuntimeError:  # "Numerical inconsistency is found. Use the GMP exact arithmetic."
+        exact = [[Fraction(x) for x in row] for row in gens.tolist()]
+        mat_q = cdd.gmp.matrix_from_array(exact, rep_type=cdd.gmp.RepType.GENERATOR)
+        faces_q = cdd.gmp.copy_inequalities(cdd.gmp.polyhedron_from_matrix(mat_q))
+        return (np.array([[float(x) for x in row] for row in faces_q.array], float).reshape(-1, 7),
+                set(faces_q.lin_set))
+
+
 def contact_wrench_cone(contacts: ContactSet, point: npt.ArrayLike = (0.0, 0.0, 0.0)) -> np.ndarray:
     """The contact wrench cone in face form: A (m, 6) with a wrench w = (f, tau about ``point``) inside the cone iff
     A w <= 0; each row has unit norm.
@@ -144,10 +162,8 @@ def contact_wrench_cone(contacts: ContactSet, point: npt.ArrayLike = (0.0, 0.0, 
     scale = np.max(np.linalg.norm(span, axis=0))
     gens = np.hstack([np.zeros((span.shape[1], 1)), span.T / scale])  # rays: first column 0
     gens = np.vstack([gens, np.r_[1.0, np.zeros(6)]])  # the apex, the origin
-    mat = cdd.matrix_from_array(gens.tolist(), rep_type=cdd.RepType.GENERATOR)
-    faces = cdd.copy_inequalities(cdd.polyhedron_from_matrix(mat))
-    H = np.array(faces.array, float).reshape(-1, 7)  # rows [b, -A]: b - A x >= 0, b = 0 for a cone
-    rows, lin = [], set(faces.lin_set)
+    H, lin = _faces_of_generators(gens)  # rows [b, -A]: b - A x >= 0, b = 0 for a cone
+    rows = []
     for i, h in enumerate(H):
         a = -h[1:]
         norm = float(np.linalg.norm(a))
