@@ -142,7 +142,7 @@ def _faces_of_generators(gens: np.ndarray) -> tuple[np.ndarray, set[int]]:
         return np.array(faces.array, float).reshape(-1, 7), set(faces.lin_set)
     except RuntimeError:  # "Numerical inconsistency is found. Use the GMP exact arithmetic."
         exact = [[Fraction(x) for x in row] for row in gens.tolist()]
-        mat_q = cdd.gmp.matrix_from_array(exact, rep_type=cdd.gmp.RepType.GENERATOR)
+        mat_q = cdd.gmp.matrix_from_array(exact, rep_type=cdd.RepType.GENERATOR)
         faces_q = cdd.gmp.copy_inequalities(cdd.gmp.polyhedron_from_matrix(mat_q))
         return (np.array([[float(x) for x in row] for row in faces_q.array], float).reshape(-1, 7),
                 set(faces_q.lin_set))
