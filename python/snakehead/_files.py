@@ -1,12 +1,14 @@
 """Files, written so that a failure never leaves a half-written file (:func:`atomic_open`: a temporary file in the
 same folder, flushed to disk, then renamed over the destination, an atomic step on POSIX file systems; or, by
-:func:`write_new_file`, linked to a name nothing holds, never over a file), and read
-without trusting them (:func:`read_npz`: .npz archives checked before anything is unpacked or allocated)."""
+:func:`write_new_file`, linked to a name nothing holds, never over a file; :func:`copy_into` copies a file into a
+folder that way), and read without trusting them (:func:`read_npz`: .npz archives checked before anything is unpacked or allocated)."""
 from __future__ import annotations
 
 import contextlib
 import math
 import os
+import re
+import stat
 import zipfile
 import zlib
 from pathlib import Path
@@ -16,7 +18,7 @@ import numpy as np
 from numpy.lib import format as npy
 
 from ._errors import InputError
-from ._validate import input_file
+from ._validate import RESERVED_FILE_NAMES, input_file
 
 
 def _umask() -> int:
@@ -122,6 +124,59 @@ def _write_exclusive(target: Path, data: bytes) -> None:
         with contextlib.suppress(OSError):
             os.unlink(target)
         raise
+
+
+#: A copy's name (:func:`copy_into`): its source's, these characters only (others become "_"), its stem at most
+#: this long.
+_COPY_NAME_CHARS = re.compile(r"[^A-Za-z0-9_-]+")
+_COPY_STEM_CHARS = 60
+#: The names tried for a copy (``rock.stl``, ``rock-2.stl``, ... ``rock-100.stl``) before it is refused.
+COPY_NAME_TRIES = 100
+
+
+def copy_into(source: str | os.PathLike, folder: str | os.PathLike, what: str, max_bytes: int, *,
+              taken: Path | None = None, kind: str = "file") -> Path:
+    """A copy of the file ``source`` (a regular file of at most ``max_bytes`` bytes) in ``folder`` (an existing
+    folder): its path. Named as its source (ASCII letters, digits, ``_`` and ``-``; others become ``_``; ``kind``
+    prefixed to an empty or a device name) or, when a different file holds that name, ``NAME-2``, ``NAME-3``...; a
+    regular file of that name with the same bytes is used as it is. Nothing is written over: a copy is a new file,
+    written whole or not at all (:func:`write_new_file`), nor named ``taken`` (a file about to be written).
+    InputError naming ``what`` if the source cannot be read or no name is free."""
+    src, root = Path(source), Path(folder)
+    data = input_file(src, what, max_bytes).read_bytes()
+    stem, suffix = _copy_name(src, kind)
+    for n in range(1, COPY_NAME_TRIES + 1):
+        target = root / (f"{stem}{suffix}" if n == 1 else f"{stem}-{n}{suffix}")
+        if target == taken:
+            continue
+        if _holds(target, data):
+            return target
+        try:
+            return write_new_file(target, data)
+        except FileExistsError:  # another file has the name: the next one
+            continue
+    raise InputError(f"{what} {os.fspath(src)!r} is not copied into {os.fspath(root)!r}: {stem}{suffix} to "
+                     f"{stem}-{COPY_NAME_TRIES}{suffix} are all other files there")
+
+
+def _copy_name(source: Path, kind: str) -> tuple[str, str]:
+    """The stem and suffix a copy of ``source`` is named by (a portable name, not hidden, not a device name)."""
+    stem = _COPY_NAME_CHARS.sub("_", source.stem).strip("_-")[:_COPY_STEM_CHARS] or kind
+    if stem.lower() in RESERVED_FILE_NAMES:
+        stem = f"{kind}_{stem}"
+    suffix = source.suffix if re.fullmatch(r"\.[A-Za-z0-9]{1,10}", source.suffix) else ""
+    return stem, suffix
+
+
+def _holds(path: Path, data: bytes) -> bool:
+    """Whether ``path`` is a regular file (not a link) holding ``data`` exactly."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError:
+        return False
+    with os.fdopen(fd, "rb") as f:
+        info = os.fstat(f.fileno())
+        return stat.S_ISREG(info.st_mode) and info.st_size == len(data) and f.read(len(data) + 1) == data
 
 
 def read_npz(path: str | os.PathLike, what: str, *, max_bytes: int) -> dict[str, np.ndarray]:

@@ -62,7 +62,9 @@ def test_a_scene_of_every_kind_round_trips(tmp_path):
 
     (tmp_path / "meshes").mkdir()
     trimesh.creation.box(extents=(0.2, 0.3, 0.25)).export(tmp_path / "meshes" / "rock.stl")
-    robot_file = tmp_path / "robot.toml"
+    out = tmp_path / "out" / "scene.toml"
+    (out.parent / "robots").mkdir(parents=True)
+    robot_file = out.parent / "robots" / "robot.toml"  # inside the folder saved in (a robot file is not copied)
     robot_file.write_text("")  # named, not read, by a scene file
     targets = (Target('a "quoted" \\ näme <b>', [0.1 / 3, 0.5, 0.3], [1.0, 2.0, 0.5], hold_s=1.5, sphere_diameter=0.04),
                Target("via", [0.2, 0.4, 0.4], [0, 1, 0], via=True),
@@ -72,11 +74,9 @@ def test_a_scene_of_every_kind_round_trips(tmp_path):
                  MeshObstacle.load(tmp_path / "meshes" / "rock.stl", [0.9, 0.3, 0.125], yaw=-0.4, scale=[1, 2, 1]))
     scene = Scene(name="every_kind", targets=targets, obstacles=obstacles, robot_file=robot_file,
                   base=BasePlacement(0.1, -0.2, 0.3), description="all of it: ünïcode, \\ and \t")
-    out = tmp_path / "out" / "scene.toml"
-    out.parent.mkdir()
     text = save_scene(scene, out).read_text()
     # the robot file named where it is; the mesh copied beside the file (a scene file reads only its own folder's)
-    assert 'robot = "../robot.toml"' in text and 'file = "rock.stl"' in text
+    assert 'robot = "robots/robot.toml"' in text and 'file = "rock.stl"' in text
     assert (out.parent / "rock.stl").read_bytes() == (tmp_path / "meshes" / "rock.stl").read_bytes()
     again = load_scene(out)
     assert_same_scene(again, scene)

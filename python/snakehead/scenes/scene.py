@@ -4,7 +4,7 @@ A scene file is TOML::
 
     name = "spheres"                        # optional (default: the file's stem)
     description = "..."                     # optional
-    robot = "my_snake.toml"                 # optional: a robot file, relative to the scene file
+    robot = "my_snake.toml"                 # optional: a robot file, in the scene file's folder (or below it)
     base = { x = 0.0, y = 0.0, yaw = 0.0 }  # optional: where the base lies (m, m, rad)
 
     [[targets]]                             # in the order the head visits them
@@ -42,10 +42,12 @@ A scene file is TOML::
 
 Unknown keys, missing keys and values of the wrong kind raise ValueError naming the file, the entry and the key.
 
-A scene file is not trusted: a mesh obstacle's ``file`` (as the terrain's) must lie inside the scene file's folder
-once symbolic links are resolved (:func:`~snakehead.scenes.terrain_table.scene_file_inside`): ``../``, an absolute
-path or a link leading out of the folder is an :class:`~snakehead._errors.InputError` naming the scene file, the
-entry and the path.
+A scene file is not trusted: its ``robot`` file, a mesh obstacle's ``file`` and the terrain's must lie inside the
+scene file's folder once symbolic links are resolved (:func:`~snakehead.scenes.terrain_table.scene_file_inside`):
+``../``, an absolute path or a link leading out of the folder is an :class:`~snakehead._errors.InputError` naming the
+scene file, the entry and the path (``snakehead plan`` exits with status 2 before anything is read or written). A
+robot file elsewhere is the user's to give: ``snakehead plan --robot FILE`` (trusted, from anywhere) or
+:func:`snakehead.plan`'s ``robot=``.
 
 Names (``snakehead._validate.name_text``): a target's name is one line of printable text of at most
 :data:`~snakehead._validate.MAX_NAME_CHARS` (200) characters -- anything but control, format and line-separator
@@ -57,8 +59,11 @@ at most 100 bytes). A description may also hold newlines and tabs. Anything else
 :class:`~snakehead._errors.InputError` naming the field.
 
 :func:`save_scene` writes a scene file (:func:`scene_to_toml`: its text) that :func:`load_scene` reads back as the
-same scene. Saved into another folder, a scene's mesh files are copied into that folder, beside the scene file
-(:func:`with_meshes_in`), since the file it writes may name only files in its own folder.
+same scene. Saved into another folder, a scene's mesh files and its terrain's file are copied into that folder,
+beside the scene file (:func:`with_meshes_in`), since the file it writes may name only files in its own folder. Its
+robot file is not copied (a robot is a folder: its URDF, meshes, map): a scene whose robot file lies outside the
+folder it is saved in is refused, with nothing written, saying to save it in the robot file's folder (or a folder
+above it) or to save it without its robot (``robot_file=None``) and give the robot when it is planned (``--robot``).
 
 Sizes are bounded: a scene holds at most :data:`MAX_TARGETS` targets (via poses included) and a scene file is at
 most :data:`MAX_SCENE_FILE_BYTES` bytes, refused before anything is planned (``snakehead.InputError``); a plan also
@@ -69,8 +74,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import re
-import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
@@ -78,15 +81,13 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._errors import InputError, InputTypeError
-from .._files import write_new_file, write_text_atomic
+from .._files import copy_into, write_text_atomic
 from .._validate import (
-    RESERVED_FILE_NAMES,
     display_text,
     duration,
     file_name_part,
     file_problem,
     finite_float,
-    input_file,
     name_text,
     sequence,
     unit_vector3,
@@ -96,7 +97,8 @@ from ..geometry.meshes import MAX_MESH_BYTES
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
 from ..model.robot import BasePlacement
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
-from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, Terrain
+from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, HeightfieldTerrain, MeshTerrain, Terrain
+from ..terrain.terrain_files import MAX_HEIGHTFIELD_BYTES
 from .terrain_table import scene_file_inside, terrain_entry, terrain_from_table
 
 APPROACHES = ("free", "line")
@@ -327,10 +329,14 @@ def scene_from_dict(data: dict, *, name: str = "scene", folder: Path | None = No
         x, y, yaw = (_number(b.get(k, 0.0), f"{where}: base.{k}") for k in ("x", "y", "yaw"))
         base = BasePlacement(x, y, yaw)  # in the world (scenes.ground_scene puts it in a slope's frame)
     robot_file = None
-    if "robot" in data:
+    if "robot" in data:  # untrusted: a file in the scene file's own folder only, as its meshes and terrain
         if not isinstance(data["robot"], str) or not data["robot"]:
             raise InputError(f"{where}: robot must be a robot file's path, got {data['robot']!r}")
-        robot_file = (folder or Path(".")) / data["robot"]
+        try:
+            robot_file = scene_file_inside(folder if folder is not None else Path.cwd(), data["robot"],
+                                           f"{where}: robot")
+        except InputError as exc:
+            raise InputError(f"{exc} (put the robot file beside the scene file, or give it with --robot)") from None
         if (problem := file_problem(robot_file)) is not None:
             raise InputError(f"{where}: its robot file {os.fspath(robot_file)!r}: {problem}")
     for key in ("name", "description"):
@@ -356,114 +362,91 @@ def load_scene(path: str | os.PathLike) -> Scene:
 # --- writing ----------------------------------------------------------------------------------------------
 def save_scene(scene: Scene, path: str | os.PathLike) -> Path:
     """Write ``scene`` as a scene file at ``path`` (atomically) that :func:`load_scene` reads back as the same
-    scene: its robot file named relative to the file's folder, its mesh files inside that folder (those elsewhere
-    copied there first, :func:`with_meshes_in`). Returns the path. InputError for an obstacle a scene file cannot
-    hold (see :func:`scene_to_toml`) or a path that cannot be written."""
+    scene: its robot file named relative to the file's folder (it must lie there or below), its mesh and terrain files
+    inside that folder (those elsewhere copied there first, :func:`with_meshes_in`). Returns the path. InputError,
+    with nothing written or copied, for what a scene file cannot hold (see :func:`scene_to_toml`; a robot file outside
+    the folder among it) or a path that cannot be written."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     out = Path(path)
     folder = out.absolute().parent.resolve()  # where the file goes (a link at ``path`` is replaced, not followed)
-    text = _scene_text(scene, folder, meshes_inside=False)  # what a scene file cannot say, before a file is copied
-    meshes = [ob for ob in scene.obstacles if isinstance(ob, MeshObstacle)]
-    if meshes:
+    text = _scene_text(scene, folder, files_inside=False)  # what a scene file cannot say, before a file is copied
+    files = _scene_files(scene)
+    if files:
         if not folder.is_dir():
             raise InputError(f"cannot write {os.fspath(out)!r}: its folder {os.fspath(folder)!r} does not exist")
-        if any(Path(ob.path).resolve() == folder / out.name for ob in meshes):
-            raise InputError(f"cannot write {os.fspath(out)!r}: it is the scene's mesh file")
+        for kind, file in files:
+            if Path(file).resolve() == folder / out.name:
+                raise InputError(f"cannot write {os.fspath(out)!r}: it is the scene's {kind} file")
         text = scene_to_toml(with_meshes_in(scene, folder, scene_file=folder / out.name), folder)
     return write_text_atomic(out, text)
 
 
-#: A copied mesh file's name: its source's, these characters only (others become "_"), at most this long (stem).
-_MESH_NAME_CHARS = re.compile(r"[^A-Za-z0-9_-]+")
-_MESH_STEM_CHARS = 60
-#: The names tried for a copy (``rock.stl``, ``rock-2.stl``, ... ``rock-100.stl``) before it is refused.
-_MESH_NAME_TRIES = 100
+def _scene_files(scene: Scene) -> list[tuple[str, Path]]:
+    """The files a scene file names besides its robot file: (kind, path) of its mesh obstacles' and its terrain's."""
+    files = [("mesh", Path(ob.path)) for ob in scene.obstacles if isinstance(ob, MeshObstacle)]
+    if isinstance(scene.terrain, (HeightfieldTerrain, MeshTerrain)) and scene.terrain.source is not None:
+        files.append(("terrain", Path(scene.terrain.source)))
+    return files
 
 
 def with_meshes_in(scene: Scene, folder: str | os.PathLike, *, scene_file: str | os.PathLike | None = None) -> Scene:
-    """``scene`` with each mesh obstacle's file inside ``folder`` (an existing folder, where a scene file goes: a
-    scene file names only files in its own folder). A mesh file already inside it (links resolved) is kept; any
-    other is copied into it, beside the scene file, under its own name (ASCII letters, digits, ``_`` and ``-``; others
-    become ``_``) or, when a different file holds that name, ``NAME-2``, ``NAME-3``...; a file of that name with the
-    same bytes is used as it is. Nothing is written over: a copy is a new file, written whole or not at all
-    (``snakehead._files.write_new_file``), nor named as the scene file about to be written (``scene_file``, if
-    given). InputError if a mesh file cannot be read or copied."""
+    """``scene`` with each mesh obstacle's file, and its terrain's file (a heightfield's or a mesh's), inside
+    ``folder`` (an existing folder, where a scene file goes: a scene file names only files in its own folder). A file
+    already inside it (links resolved) is kept; any other is copied into it, beside the scene file, under its own name
+    (ASCII letters, digits, ``_`` and ``-``; others become ``_``) or, when a different file holds that name,
+    ``NAME-2``, ``NAME-3``...; a file of that name with the same bytes is used as it is (one copy for the entries that
+    share a file). Nothing is written over: a copy is a new file, written whole or not at all
+    (``snakehead._files.copy_into``), nor named as the scene file about to be written (``scene_file``, if given).
+    The robot file is left as it is (see :func:`save_scene`). InputError if a file cannot be read or copied."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     root = Path(folder).resolve()
     taken = Path(scene_file).absolute().parent.resolve() / Path(scene_file).name if scene_file is not None else None
-    copies: dict[Path, Path] = {}  # a source file -> its copy (one copy for the obstacles that share a file)
-    obstacles = []
-    for k, ob in enumerate(scene.obstacles):
-        if isinstance(ob, MeshObstacle):
-            source = Path(ob.path).resolve()
-            if not source.is_relative_to(root):
-                if source not in copies:
-                    copies[source] = _copy_mesh(source, root, f"scene {scene.name!r}, obstacles[{k}]", taken)
-                ob = dataclasses.replace(ob, path=copies[source])
-        obstacles.append(ob)
-    return dataclasses.replace(scene, obstacles=tuple(obstacles))
+    copies: dict[Path, Path] = {}  # a source file -> its copy
 
+    def inside(file: Path, where: str, kind: str, max_bytes: int) -> Path:
+        source = Path(file).resolve()
+        if source.is_relative_to(root):
+            return file
+        if source not in copies:
+            copies[source] = copy_into(source, root, f"{where}: {kind} file", max_bytes, taken=taken, kind=kind)
+        return copies[source]
 
-def _copy_name(source: Path) -> tuple[str, str]:
-    """The stem and suffix a copy of ``source`` is named by (a portable name, not hidden, not a device name)."""
-    stem = _MESH_NAME_CHARS.sub("_", source.stem).strip("_-")[:_MESH_STEM_CHARS] or "mesh"
-    if stem.lower() in RESERVED_FILE_NAMES:
-        stem = f"mesh_{stem}"
-    suffix = source.suffix if re.fullmatch(r"\.[A-Za-z0-9]{1,10}", source.suffix) else ""
-    return stem, suffix
-
-
-def _copy_mesh(source: Path, root: Path, where: str, taken: Path | None = None) -> Path:
-    """A copy of the mesh file ``source`` in ``root`` (see :func:`with_meshes_in`): its path."""
-    data = input_file(source, f"{where}: mesh file", MAX_MESH_BYTES).read_bytes()
-    stem, suffix = _copy_name(source)
-    for n in range(1, _MESH_NAME_TRIES + 1):
-        target = root / (f"{stem}{suffix}" if n == 1 else f"{stem}-{n}{suffix}")
-        if target == taken:  # the scene file's own name
-            continue
-        if _holds(target, data):
-            return target
-        try:
-            return write_new_file(target, data)
-        except FileExistsError:  # another file has the name: the next one
-            continue
-    raise InputError(f"{where}: mesh file {os.fspath(source)!r} is not copied into {os.fspath(root)!r}: "
-                     f"{stem}{suffix} to {stem}-{_MESH_NAME_TRIES}{suffix} are all other files there")
-
-
-def _holds(path: Path, data: bytes) -> bool:
-    """Whether ``path`` is a regular file (not a link) holding ``data`` exactly."""
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0))
-    except OSError:
-        return False
-    with os.fdopen(fd, "rb") as f:
-        info = os.fstat(f.fileno())
-        return stat.S_ISREG(info.st_mode) and info.st_size == len(data) and f.read(len(data) + 1) == data
+    obstacles = tuple(dataclasses.replace(ob, path=inside(ob.path, f"scene {scene.name!r}, obstacles[{k}]", "mesh",
+                                                          MAX_MESH_BYTES))
+                      if isinstance(ob, MeshObstacle) else ob for k, ob in enumerate(scene.obstacles))
+    terrain = scene.terrain
+    if isinstance(terrain, (HeightfieldTerrain, MeshTerrain)) and terrain.source is not None:
+        limit = MAX_HEIGHTFIELD_BYTES if isinstance(terrain, HeightfieldTerrain) else MAX_MESH_BYTES
+        source = inside(Path(terrain.source), f"scene {scene.name!r}, terrain", "terrain", limit)
+        if source != terrain.source:
+            terrain = dataclasses.replace(terrain, source=source)
+    return dataclasses.replace(scene, obstacles=obstacles, terrain=terrain)
 
 
 def scene_to_toml(scene: Scene, folder: str | os.PathLike = ".") -> str:
     """The scene file (TOML text) of ``scene``, its paths relative to ``folder`` (where the file goes). Numbers are
     written to their last digit, so that they read back exactly. InputError for what a scene file cannot say: a box
     not upright (turned other than about z), a wall not standing on the ground (as ``WallWithHole.standing`` makes
-    it), a mesh obstacle tilted or its file outside ``folder`` (a scene file reads only files in its own folder:
-    :func:`save_scene` copies them there, or :func:`with_meshes_in` first), a terrain generated rather than read from
-    a file (a heightfield's or a mesh's)."""
+    it), a mesh obstacle tilted, a mesh or terrain file outside ``folder`` (a scene file reads only files in its own
+    folder: :func:`save_scene` copies them there, or :func:`with_meshes_in` first), a robot file outside ``folder``
+    (it is not copied: see :func:`save_scene`), a terrain generated rather than read from a file (a heightfield's or
+    a mesh's)."""
     if not isinstance(scene, Scene):
         raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__}")
     return _scene_text(scene, folder)
 
 
-def _scene_text(scene: Scene, folder: str | os.PathLike, meshes_inside: bool = True) -> str:
-    """:func:`scene_to_toml`'s text (``meshes_inside``: a mesh file outside ``folder`` is an InputError)."""
+def _scene_text(scene: Scene, folder: str | os.PathLike, files_inside: bool = True) -> str:
+    """:func:`scene_to_toml`'s text (``files_inside``: a mesh or terrain file outside ``folder`` is an InputError;
+    a robot file outside it always is)."""
     where = Path(folder).resolve()
     lines = [f"name = {toml_string(scene.name)}"]
     if scene.description:
         lines.append(f"description = {toml_string(scene.description)}")
     if scene.robot_file is not None:
-        lines.append(f"robot = {toml_string(path_from(where, scene.robot_file))}")
+        lines.append(f"robot = {toml_string(_robot_name(scene.name, scene.robot_file, where))}")
     if scene.base is not None:
         b = scene.base
         if not b.on_flat_ground:  # a file holds world poses and a [terrain]: ground-frame poses would load flat
@@ -473,12 +456,27 @@ def _scene_text(scene: Scene, folder: str | os.PathLike, meshes_inside: bool = T
     for t in scene.targets:
         lines += ["", "[[targets]]"] + [f"{k} = {v}" for k, v in _target_entry(t).items()]
     for k, ob in enumerate(scene.obstacles):
-        entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]", meshes_inside)
+        entry = _obstacle_entry(ob, where, f"scene {scene.name!r}, obstacles[{k}]", files_inside)
         lines += ["", "[[obstacles]]"] + [f"{key} = {v}" for key, v in entry.items()]
-    terrain = terrain_entry(scene.terrain, where, f"scene {scene.name!r}, terrain")
+    terrain = terrain_entry(scene.terrain, where, f"scene {scene.name!r}, terrain", files_inside)
     if terrain is not None:
         lines += ["", "[terrain]"] + [f"{key} = {v}" for key, v in terrain.items()]
     return "\n".join(lines) + "\n"
+
+
+def _robot_name(scene: str, robot_file: Path, folder: Path) -> str:
+    """The robot file as a scene file in ``folder`` names it; InputError if it lies outside ``folder`` (links
+    resolved), where :func:`load_scene` would refuse it (the message names no absolute path: the live viewer shows
+    it to a browser)."""
+    name = path_from(folder, robot_file)
+    try:
+        scene_file_inside(folder, name, "robot")
+    except InputError:
+        raise InputError(f"scene {scene!r}: its robot file {name!r} lies outside the folder the scene file goes "
+                         "in, and a scene file names only files in its own folder (a robot file is not copied): save "
+                         "the scene in the robot file's folder or a folder above it, or save it without its robot "
+                         "(robot_file=None) and give the robot when planning (--robot)") from None
+    return name
 
 
 def _toml_float(x: float) -> str:

@@ -155,9 +155,11 @@ def _floats(v: Any) -> str:
     return "[" + ", ".join(repr(float(x)) for x in np.asarray(v, float).ravel()) + "]"
 
 
-def terrain_entry(terrain: Terrain, folder: Path, where: str) -> dict[str, str] | None:
+def terrain_entry(terrain: Terrain, folder: Path, where: str, inside: bool = True) -> dict[str, str] | None:
     """The ``[terrain]`` table's keys as TOML values (None for flat ground, which a scene file leaves out), its
-    files named relative to ``folder``. InputError for a generated heightfield or mesh (no file to name)."""
+    files named relative to ``folder``. InputError for a generated heightfield or mesh (no file to name) and, when
+    ``inside``, for a file outside ``folder``, which :func:`terrain_from_table` would refuse (``save_scene`` copies
+    it into the folder first: :func:`snakehead.scenes.scene.with_meshes_in`)."""
     if isinstance(terrain, FlatGround):
         return None
     if isinstance(terrain, PlaneTerrain):
@@ -170,8 +172,14 @@ def terrain_entry(terrain: Terrain, folder: Path, where: str) -> dict[str, str] 
         if terrain.source is None:
             raise InputError(f"{where}: the terrain was not read from a file, and a scene file can only name its "
                              "heightfield's or mesh's file (save the heights with numpy.save first)")
+        name = path_from(folder, terrain.source)
+        if inside:
+            try:
+                scene_file_inside(folder, name, where)
+            except InputError as exc:
+                raise InputError(f"{exc} (save_scene copies it into the folder)") from None
         entry = {"kind": '"heightfield"' if isinstance(terrain, HeightfieldTerrain) else '"mesh"',
-                 "file": toml_string(path_from(folder, terrain.source))}
+                 "file": toml_string(name)}
         if isinstance(terrain, HeightfieldTerrain):
             entry["extent"] = _floats(terrain.extent)
             entry["origin"] = _floats(terrain.origin)
