@@ -43,22 +43,24 @@ def test_the_shipped_slope():
 
 
 def test_planning_on_a_terrain_other_than_a_plane_is_refused_not_planned_on_flat_ground(tmp_path: Path):
-    """The planner plans on flat ground and on planes (tests/planning/test_plan_on_slope.py); a scene on a
-    heightfield, mesh or steps is refused with a line saying so (CLI exit 2), never planned as if the ground were
+    """The planner plans on flat ground, on planes and at the foot of a staircase up
+    (tests/planning/test_plan_on_slope.py, test_plan_at_a_step.py); a scene on a heightfield or mesh is refused
+    with a line saying so (CLI exit 2), never planned as if the ground were
     flat."""
     import subprocess
     import sys
 
     import snakehead
 
-    path = scene(tmp_path, 'kind = "steps"\nstep_height = 0.05\nstep_depth = 0.3\ncount = 3\n')
-    with pytest.raises(InputError, match="plans on flat ground and on planes"):
+    np.save(tmp_path / "h.npy", np.zeros((4, 4)))
+    path = scene(tmp_path, 'kind = "heightfield"\nfile = "h.npy"\nextent = [1.0, 1.0]\n')
+    with pytest.raises(InputError, match="plans on flat ground, on planes and at the foot"):
         snakehead.plan(path)
     r = subprocess.run([sys.executable, "-m", "snakehead", "plan", "--scene", str(path), "--out", str(tmp_path / "out")],
                        capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 2, r.stderr
-    assert "plans on flat ground and on planes" in r.stderr and "Traceback" not in r.stderr
+    assert "plans on flat ground, on planes and at the foot" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())  # nothing half-written
 
 

@@ -1,10 +1,13 @@
-"""A scene on a slope rewritten in its ground frame, where the planner works (``model.placement``).
+"""A scene on a slope (or at the foot of a staircase) rewritten in its ground frame, where the planner works
+(``model.placement``).
 
 A scene's targets, obstacles and base are written in the world. On a plane terrain the planner plans in the plane's
 frame (:class:`~snakehead.model.placement.GroundFrame`): the ground is z = 0 there and gravity leans. This module
 turns a scene into that frame: the targets' positions and directions, the boxes' and meshes' poses, and the base's
 placement (given in the world as the point of the slope under (x, y) and the heading of the body's course seen from
-above). Flat ground is the world frame: the scene comes back as it is.
+above). At the foot of a staircase up (a ``"steps"`` terrain rising from the base's level) the ground frame is that
+level and the steps become box obstacles (``StepsTerrain.risen_blocks``): the body lies on the level, the neck and
+head keep clear of the steps. Flat ground is the world frame: the scene comes back as it is.
 """
 from __future__ import annotations
 
@@ -13,10 +16,10 @@ import math
 
 import numpy as np
 
-from .._errors import InputError
+from .._errors import Infeasible, InputError
 from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.placement import WORLD_FRAME, BasePlacement, GroundFrame
-from ..terrain.surfaces import FlatGround, PlaneTerrain
+from ..terrain.surfaces import FlatGround, PlaneTerrain, StepsTerrain
 from .scene import Scene
 
 __all__ = ["ground_frame_of", "base_on_slope", "scene_in_ground_frame"]
@@ -30,8 +33,22 @@ def ground_frame_of(scene: Scene) -> GroundFrame:
         return WORLD_FRAME
     if isinstance(terrain, PlaneTerrain):
         return GroundFrame.of_plane(terrain.unit_normal, terrain.point)
-    raise InputError(f"scene {scene.name!r}: its [terrain] is {type(terrain).__name__}; this release plans on flat "
-                     "ground and on planes (kind = \"plane\") only")
+    if isinstance(terrain, StepsTerrain) and terrain.step_height > 0:
+        return GroundFrame.of_plane((0.0, 0.0, 1.0), terrain.start)  # the level at the staircase's foot
+    raise InputError(f"scene {scene.name!r}: its [terrain] is {type(terrain).__name__}"
+                     f"{' (a staircase down)' if isinstance(terrain, StepsTerrain) else ''}; this release plans on "
+                     "flat ground, on planes and at the foot of a staircase up only")
+
+
+def _check_at_the_foot(scene: Scene, steps: StepsTerrain, base: BasePlacement) -> None:
+    """Infeasible unless the base's placement (world) lies on the staircase's apron, below its first riser."""
+    h = math.radians(steps.heading_deg)
+    dx, dy = base.x - steps.start[0], base.y - steps.start[1]
+    u, v = dx * math.cos(h) + dy * math.sin(h), -dx * math.sin(h) + dy * math.cos(h)
+    if not (-steps.apron <= u < 0.0 and abs(v) <= steps.width / 2):
+        raise Infeasible(f"scene {scene.name!r}: the base at ({base.x:g}, {base.y:g}) m does not lie at the foot of "
+                         f"its staircase (the apron, {steps.apron:g} m before the first riser); this release plans "
+                         "from there only")
 
 
 def base_on_slope(base: BasePlacement, frame: GroundFrame) -> BasePlacement:
@@ -64,10 +81,14 @@ def scene_in_ground_frame(scene: Scene) -> tuple[Scene, GroundFrame]:
     """``scene`` in the frame the planner plans it in (:func:`ground_frame_of`) and that frame: on a slope the
     targets, obstacles and base in the plane's frame and the terrain flat there; on flat ground ``scene`` itself."""
     frame = ground_frame_of(scene)
-    if frame.is_world:
+    risen: list = []
+    if isinstance(scene.terrain, StepsTerrain):  # the steps are obstacles above the foot's level
+        _check_at_the_foot(scene, scene.terrain, scene.base if scene.base is not None else BasePlacement())
+        risen = scene.terrain.risen_blocks()
+    if frame.is_world and not risen:
         return scene, frame
     targets = tuple(dataclasses.replace(t, position=frame.to_ground(t.position),
                                         direction=frame.direction_to_ground(t.direction)) for t in scene.targets)
-    obstacles = tuple(_obstacle_in(ob, frame, scene.name) for ob in scene.obstacles)
+    obstacles = tuple(_obstacle_in(ob, frame, scene.name) for ob in (*scene.obstacles, *risen))
     base = base_on_slope(scene.base if scene.base is not None else BasePlacement(), frame)
     return dataclasses.replace(scene, targets=targets, obstacles=obstacles, base=base, terrain=FlatGround()), frame

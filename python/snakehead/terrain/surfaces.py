@@ -29,6 +29,7 @@ import numpy.typing as npt
 from .. import _core
 from .._errors import InputError, InputTypeError
 from .._validate import finite_array, finite_float, integer, positive, vector3
+from ..geometry.obstacles import BoxObstacle
 from ..limits import MAX_TERRAIN_CELLS, MAX_TERRAIN_TRIANGLES
 
 __all__ = ["TerrainQueries", "FlatGround", "PlaneTerrain", "HeightfieldTerrain", "MeshTerrain", "StepsTerrain",
@@ -259,6 +260,24 @@ class StepsTerrain(TerrainQueries):
         faces = np.concatenate([corners + [0, 1, 2], corners + [0, 2, 3]])
         unique, index = np.unique(world, axis=0, return_inverse=True)  # shared corners: one vertex (pseudonormals)
         return unique, index.reshape(-1)[faces].astype(np.int64)
+
+    def risen_blocks(self) -> list[BoxObstacle]:
+        """A staircase up as the solid it raises above its start's level: one box per step, from that level up to
+        the step's tread and from its riser to the staircase's far end, across its width (world). Their union is
+        the ground above ``start``'s level: what a body lying on the apron keeps clear of."""
+        if self.step_height <= 0:
+            raise InputError("a staircase down has no risen blocks: it drops below its start's level")
+        h = math.radians(self.heading_deg)
+        R = np.array([[math.cos(h), -math.sin(h), 0.0], [math.sin(h), math.cos(h), 0.0], [0.0, 0.0, 1.0]])
+        end = self.count * self.step_depth + self.apron
+        blocks = []
+        for k in range(self.count):
+            u0, top = k * self.step_depth, (k + 1) * self.step_height
+            size = np.array([end - u0, self.width, top if k == 0 else self.step_height])
+            bottom = 0.0 if k == 0 else k * self.step_height  # stacked: each box one step high above the one before
+            centre = self.start + R @ np.array([(u0 + end) / 2, 0.0, bottom + size[2] / 2])
+            blocks.append(BoxObstacle(centre, size, R))
+        return blocks
 
     def _quad(self, u0: float, u1: float, z0: float, z1: float) -> np.ndarray:
         """A tread (u0 < u1, z0 = z1: counter-clockwise from above) or a riser (u0 = u1, facing down the stairs)."""
