@@ -185,3 +185,33 @@ def test_a_scene_saved_away_from_its_robot_file_is_refused_with_the_way_out(tmp_
 
     save_scene(dataclasses.replace(scene, robot_file=None), out / "s.toml")
     assert load_scene(out / "s.toml").robot_file is None
+
+
+@pytest.mark.parametrize("key", ["urdf", "packages"])
+def test_a_robot_file_in_the_scenes_folder_reads_nothing_outside_it(tmp_path: Path, key: str):
+    """A robot file beside the scene file is untrusted too: its urdf (and map, packages) must lie in the scene's
+    folder; the same robot file given by the user (--robot) may name files anywhere."""
+    import snakehead
+
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    urdf = outside / "snake.urdf"
+    urdf.write_text(default_urdf_path().read_text())
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    lines = ['base_end = "base_end"', 'neck_end = "neck_end"', 'head_tip = "head_tip"']
+    if key == "urdf":
+        lines.insert(0, 'urdf = "../elsewhere/snake.urdf"')
+    else:
+        (folder / "snake.urdf").write_text(default_urdf_path().read_text())
+        lines = ['urdf = "snake.urdf"'] + lines + ["", "[packages]", 'meshes = "../elsewhere"']
+    (folder / "snake.toml").write_text("\n".join(lines) + "\n")
+    scene = scene_file(folder, "snake.toml")
+    with pytest.raises(InputError, match=f"its {key}.*outside the folder"):
+        snakehead.plan(scene)
+    r = subprocess.run([sys.executable, "-m", "snakehead", "plan", "--scene", str(scene), "--out",
+                        str(tmp_path / "out"), "--no-sim"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2 and "outside the folder" in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    # the user's own robot file may read from anywhere
+    assert snakehead.SnakeRobot.from_file(folder / "snake.toml").n_joints == 16

@@ -50,7 +50,8 @@ def _robot(args: argparse.Namespace) -> SnakeRobot:
     """The robot of --robot (with --trust-xacro), else the default one."""
     if getattr(args, "robot", None) is None:
         return SnakeRobot.default()
-    return SnakeRobot.from_file(args.robot, trust_xacro=bool(getattr(args, "trust_xacro", False)))
+    return SnakeRobot.from_file(args.robot, trust_xacro=bool(getattr(args, "trust_xacro", False)),
+                                inside=getattr(args, "robot_inside", None))
 
 
 def _map(args: argparse.Namespace, robot: SnakeRobot) -> Any:
@@ -149,8 +150,8 @@ def plan_command(args: argparse.Namespace) -> int:
                                      unit_vector3(args.direction, "--direction"))], name="target")
     else:
         scene = load_scene(args.scene)
-    if args.robot is None and scene.robot_file is not None:
-        args.robot = scene.robot_file
+    if args.robot is None and scene.robot_file is not None:  # the scene's, confined to its folder
+        args.robot, args.robot_inside = scene.robot_file, scene.robot_folder
     start = _start(args, paper_default=False)
     out = _writable_dir(args.out)
     robot = _robot(args)

@@ -71,8 +71,7 @@ def run_scenes(scenes: Sequence, out: str | Path, *, controller: HeadController 
     try:
         if controller is None:
             if robot is None:
-                first = scenes[0].robot_file
-                robot = SnakeRobot.from_file(first) if first is not None else SnakeRobot.default()
+                robot = scenes[0].load_robot() or SnakeRobot.default()
             if on_controller is None and start is None:
                 lanes = scene_lanes(scenes, settings)
             with progress.stage("the head's reachability map and its dexterous centre G0"):

@@ -128,10 +128,12 @@ class SnakeRobot:
                    inertia=inertia, density=density)
 
     @classmethod
-    def from_file(cls, path: str | os.PathLike, *, trust_xacro: bool = False) -> "SnakeRobot":
+    def from_file(cls, path: str | os.PathLike, *, trust_xacro: bool = False, inside: Path | None = None
+                  ) -> "SnakeRobot":
         """A robot from a robot file (TOML; :mod:`snakehead.model.robot_file`). ``trust_xacro``: as in
-        :meth:`from_urdf` (a robot file reached through a scene file is never trusted unless the caller says so)."""
-        spec = read_robot_file(path)
+        :meth:`from_urdf` (a robot file reached through a scene file is never trusted unless the caller says so).
+        ``inside``: the folder its urdf, map and packages must lie in (a robot named by a scene file: the scene's)."""
+        spec = read_robot_file(path, inside)
         return cls(spec.urdf, base_end=spec.base_end, neck_end=spec.neck_end, head_tip=spec.head_tip,
                    root=spec.root, map_path=spec.map, source=os.fspath(path), head_axis=spec.head_axis,
                    packages=spec.packages, limits=spec.limits, xacro_args=spec.xacro_args, robot_file=path,

@@ -127,25 +127,35 @@ def _string(data: dict, key: str, where: str) -> str:
     return v
 
 
-def read_robot_file(path: str | os.PathLike) -> RobotFile:
-    """Read and check a robot file (see the module's docstring). ValueError names the file and the problem."""
+def _kept_inside(path: Path, inside: Path | None, where: str, key: str) -> Path:
+    """``path`` when ``inside`` is None or it lies inside ``inside`` once links are resolved; else InputError."""
+    if inside is not None and not path.resolve().is_relative_to(inside.resolve()):
+        raise InputError(f"{where}: its {key} {os.fspath(path)!r} is outside the folder {os.fspath(inside)!r} of the "
+                         "scene file that names this robot; a robot reached through a scene reads only files there")
+    return path
+
+
+def read_robot_file(path: str | os.PathLike, inside: Path | None = None) -> RobotFile:
+    """Read and check a robot file (see the module's docstring). ValueError names the file and the problem.
+    ``inside``: a folder its urdf, map and packages must lie in (a robot named by an untrusted scene file: the
+    scene's folder); None for a robot file the user gives."""
     data = read_toml(path, "robot file")
     where = f"robot file {os.fspath(path)!r}"
     check_keys(data, REQUIRED_KEYS, OPTIONAL_KEYS, where)
     folder = Path(path).resolve().parent
-    urdf = folder / _string(data, "urdf", where)
+    urdf = _kept_inside(folder / _string(data, "urdf", where), inside, where, "urdf")
     if (problem := file_problem(urdf)) is not None:
         raise InputError(f"{where}: its urdf {os.fspath(urdf)!r}: {problem}")
     map_path = None
     if "map" in data:
-        map_path = folder / _string(data, "map", where)
+        map_path = _kept_inside(folder / _string(data, "map", where), inside, where, "map")
         if (problem := file_problem(map_path)) is not None:
             raise InputError(f"{where}: its map {os.fspath(map_path)!r}: {problem}")
     return RobotFile(path=Path(path), urdf=os.fspath(urdf), base_end=_string(data, "base_end", where),
                      neck_end=_string(data, "neck_end", where), head_tip=_string(data, "head_tip", where),
                      root=_string(data, "root", where) if "root" in data else None, map=map_path,
                      head_axis=_head_axis(data, where),
-                     xacro_args=_xacro_args(data, where), packages=_packages(data, folder, where),
+                     xacro_args=_xacro_args(data, where), packages=_packages(data, folder, where, inside),
                      limits=_limits(data, where), home=_home(data, where), **_inertia(data, where))
 
 
@@ -170,12 +180,12 @@ def _xacro_args(data: dict, where: str) -> dict | None:
     return dict(args) or None
 
 
-def _packages(data: dict, folder: Path, where: str) -> dict | None:
+def _packages(data: dict, folder: Path, where: str, inside: Path | None = None) -> dict | None:
     out = {}
     for name, value in _table(data, "packages", where).items():
         if not isinstance(value, str) or not value:
             raise InputError(f"{where}: packages.{name} must be a folder (a non-empty string), got {value!r}")
-        path = folder / value
+        path = _kept_inside(folder / value, inside, where, f"packages.{name}")
         if not path.is_dir():
             raise InputError(f"{where}: packages.{name} = {value!r}: {os.fspath(path)!r} is not a folder")
         out[name] = path

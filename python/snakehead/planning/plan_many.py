@@ -14,6 +14,7 @@ import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Sequence
 
 from .._errors import Infeasible, InputError, InputTypeError, MotionTooLong
@@ -70,17 +71,19 @@ class WorkerControllers:
     def __init__(self) -> None:
         self._local = threading.local()
 
-    def get(self, recipe: RobotRecipe | None, robot_file: str | None, method: str, seed: int | None
-            ) -> HeadController:
+    def get(self, recipe: RobotRecipe | None, robot_file: str | None, method: str, seed: int | None,
+            inside: Path | None = None) -> HeadController:
+        """The thread's controller for these (``inside``: the folder a scene's robot file may read from)."""
         kept: OrderedDict = self._local.__dict__.setdefault("kept", OrderedDict())
-        key = (recipe, robot_file, method, seed)
+        key = (recipe, robot_file, method, seed, inside)
         if key in kept:
             kept.move_to_end(key)
             return kept[key]
         if recipe is not None:
             robot = recipe.build()
         else:
-            robot = SnakeRobot.from_file(robot_file) if robot_file is not None else SnakeRobot.default()
+            robot = (SnakeRobot.from_file(robot_file, inside=inside) if robot_file is not None
+                     else SnakeRobot.default())
         controller = HeadController(robot, method=method, seed=seed)
         kept[key] = controller
         while len(kept) > KEPT_CONTROLLERS:
@@ -172,7 +175,8 @@ def plan_one(recipe: RobotRecipe | None, scene: Scene, options: dict, keep_robot
     controller = options.pop("controller", None)
     if controller is None:
         robot_file = None if scene.robot_file is None else os.fspath(scene.robot_file)
-        controller = WORKERS.get(recipe, robot_file, options.pop("method", "rotated"), options.pop("seed", 1))
+        controller = WORKERS.get(recipe, robot_file, options.pop("method", "rotated"), options.pop("seed", 1),
+                                 scene.robot_folder)
         options.pop("robot", None)
         if options.get("base") is None:  # the controller is reused: its base is set by every plan
             options["base"] = scene.base if scene.base is not None else BasePlacement()

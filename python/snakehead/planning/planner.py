@@ -221,7 +221,7 @@ def _controller_for(scene: Scene, robot: Any, controller: Any, base: BasePlaceme
             controller.base = chosen
         return controller
     if robot is None:
-        robot = SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None else SnakeRobot.default()
+        robot = scene.load_robot() or SnakeRobot.default()
     elif not isinstance(robot, SnakeRobot):
         raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
     return HeadController(robot, base_pose=base if base is not None else scene.base, method=method, seed=seed)

@@ -95,7 +95,7 @@ from .._validate import (
 )
 from ..geometry.meshes import MAX_MESH_BYTES
 from ..geometry.obstacles import OBSTACLE_TYPES, BoxObstacle, MeshObstacle, WallWithHole
-from ..model.robot import BasePlacement
+from ..model.robot import BasePlacement, SnakeRobot
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, HeightfieldTerrain, MeshTerrain, Terrain
 from ..terrain.terrain_files import MAX_HEIGHTFIELD_BYTES
@@ -163,7 +163,7 @@ class Target:
 @dataclass(frozen=True)
 class Scene:
     """Targets (visited in order) and obstacles; optionally the robot file and the base placement they go with, and
-    the terrain (flat ground, z = 0, by default; the planner does not use it yet)."""
+    the terrain (flat ground, z = 0, by default). ``path``: the file it was read from (then untrusted input)."""
 
     name: str
     targets: tuple[Target, ...]
@@ -173,6 +173,19 @@ class Scene:
     description: str = ""
     path: Path | None = None
     terrain: Terrain = field(default_factory=FlatGround)
+
+    @property
+    def robot_folder(self) -> Path | None:
+        """The folder a robot this scene names may read from: the scene file's (a scene read from a file is untrusted
+        input); None for a scene made in code."""
+        return self.path.resolve().parent if self.path is not None else None
+
+    def load_robot(self, *, trust_xacro: bool = False) -> SnakeRobot | None:
+        """The robot ``robot_file`` names (None without one); its urdf, map and packages confined to
+        :attr:`robot_folder`."""
+        if self.robot_file is None:
+            return None
+        return SnakeRobot.from_file(self.robot_file, trust_xacro=trust_xacro, inside=self.robot_folder)
 
     def __post_init__(self) -> None:
         file_name_part(self.name, "a scene's name")  # the pipeline's outputs are NAME_trajectory.csv, NAME.gif...
