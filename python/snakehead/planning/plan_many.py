@@ -240,7 +240,7 @@ def plan_many(target_sets: Sequence[Any], *, executor: Any = None, progress: Pro
 
 def _robot_of(scene: Scene, robots: dict) -> SnakeRobot:
     """The robot of a scene planned without ``robot=``: its robot file's, else the default (built once per call)."""
-    key = None if scene.robot_file is None else os.fspath(scene.robot_file)
+    key = (None if scene.robot_file is None else os.fspath(scene.robot_file), scene.robot_folder)
     if key not in robots:
-        robots[key] = SnakeRobot.from_file(key) if key is not None else SnakeRobot.default()
+        robots[key] = scene.load_robot() or SnakeRobot.default()  # a scene file's: confined to its folder
     return robots[key]

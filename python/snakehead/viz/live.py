@@ -579,9 +579,11 @@ def _controller(scene: Scene | None, robot: SnakeRobot | None, robot_file: str |
         if not isinstance(controller, HeadController):
             raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
         return controller
-    if robot is None:
-        file = robot_file if robot_file is not None else scene.robot_file if scene is not None else None
-        robot = SnakeRobot.from_file(file) if file is not None else SnakeRobot.default()
+    if robot is None:  # the caller's robot_file (trusted), else the scene's (confined to the scene file's folder)
+        if robot_file is not None:
+            robot = SnakeRobot.from_file(robot_file)
+        else:
+            robot = (scene.load_robot() if scene is not None else None) or SnakeRobot.default()
     elif not isinstance(robot, SnakeRobot):
         raise InputTypeError(f"robot must be a SnakeRobot, got {type(robot).__name__}")
     return HeadController(robot, base_pose=scene.base if scene is not None else None, seed=1)
