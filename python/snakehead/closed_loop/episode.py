@@ -264,8 +264,11 @@ class Episode:
             return p, looked.end_state, start_t + LOOK_HOLD_S, k
         nearest = min(seen, key=lambda j: float(np.linalg.norm(head_sensor.markers[j][:3, 3] - head_pose[:3, 3])))
         T_root = sv.root_from_head_reading(robot, self.look(head_pose, nearest), head_sensor.markers[nearest], q_look)
-        dead_reckoned, truth = self.est, _true_pose(robot, looked.root_pose[-1], looked.q[-1])
+        dead_reckoned, truth = self.est, _true_pose(robot, looked.root_pose[-1], looked.q[-1], p.base)
         R_imu = T_root[:3, :3] @ robot.body.fk_all(q_look)[sim.estimator.imu_index][:3, :3]
+        ground = self.loop.ground
+        if not ground.is_world:  # the fix's orientation is the ground frame's; the IMU's filter holds the world's
+            R_imu = ground.matrix[:3, :3] @ R_imu
         body = T_root @ robot.body_in_root
         self.est = sim.estimator.reset(q_look, R_imu, body[:2, 3], math.atan2(body[1, 0], body[0, 0]))
         self.fixes.append({"t_s": float(looked.end_state.time), "source": "head camera", "target": nearest,
@@ -299,7 +302,7 @@ class Episode:
         # against the plan placed where the body truly lies (MuJoCo's, at the head phases' first tick): the
         # simulated ZMP is the true one, and the support polygon at the believed base would count the belief's
         # error (the camera's fix: tenths of a millimetre, 0.1 deg) as the ZMP leaving it
-        lies = _true_pose(robot, head.root_pose[0], head.q[0]).base if head.root_pose is not None else p.base
+        lies = _true_pose(robot, head.root_pose[0], head.q[0], p.base).base if head.root_pose is not None else p.base
         self.metrics = compare(robot, p.t, p.q, head, targets=targets, base=lies)
         self.phases += head_phases(p, plan_t0)
         assert head.end_state is not None
@@ -374,9 +377,10 @@ def look_waypoint(robot: SnakeRobot, p: Plan, camera: sn.HeadSensor) -> int | No
     return None
 
 
-def _true_pose(robot: SnakeRobot, root: np.ndarray, q: np.ndarray) -> BodyPose:
-    """The body's true pose (for the record only) from MuJoCo's root pose (4, 4) and joints (n,)."""
+def _true_pose(robot: SnakeRobot, root: np.ndarray, q: np.ndarray, base: BasePlacement) -> BodyPose:
+    """The body's true pose (for the record only) from MuJoCo's root pose (4, 4; in the ground frame of ``base``,
+    as a simulation of a plan records it) and joints (n,)."""
     frames = root @ robot.body.fk_all(q)
     centres = robot.link_centres(frames[None])[0]
     return BodyPose(root=root.copy(), chassis=virtual_chassis(centres, forward=centres[-1] - centres[0]),
-                    body_in_root=robot.body_in_root)
+                    body_in_root=robot.body_in_root, ground=base.ground)

@@ -20,6 +20,13 @@ orientation of one link (an IMU's attitude), never the simulator's positions.
   z-axis the third principal axis turned upwards. It moves smoothly while a gait's joints cycle, so it says where
   "the body" is better than any one link.
 
+On a slope (a plane terrain: the estimator's ``ground``, a :class:`~snakehead.model.placement.GroundFrame`) every
+pose is in the slope's ground frame, as the planner's are: the IMU measures its orientation against world gravity
+(its tilt is the slope's), and the estimator turns it into the ground frame with the known slope; the height, the
+contacts and the odometry are then those of flat ground in that frame. What the odometry does not model there:
+gravity's pull down the slope, which makes the slipping contacts creep downhill (bench/RESULTS.md, "Gaits on
+slopes").
+
 What it cannot see: how the load is really spread over the contacts, and inertia. In MuJoCo the contact patches
 of a gait slip by a few centimetres per cycle (friction 0.8); the friction balance follows most of that slip in
 sidewinding, turning and the curl on the ground, no-slip odometry none of it (bench/RESULTS.md, "Gaits"); rolling,
@@ -43,6 +50,7 @@ from ..dynamics.sliding import balance_translation
 from ..geometry.shapes import shape_points
 from ..ground_contact import RESTING_TOLERANCE
 from ..locomotion.gaits import virtual_chassis
+from ..model.placement import WORLD_FRAME, GroundFrame
 from ..model.robot import BasePlacement, SnakeRobot, as_robot
 from ..sim.sensors import so3_exp
 
@@ -63,12 +71,15 @@ class BodyPose:
 
     root: world pose (4, 4) of the root frame (the tail link's); chassis: world pose (4, 4) of the virtual chassis;
     body_in_root: the body frame in the root frame (:attr:`SnakeRobot.body_in_root`; identity for snakes written
-    along x), so that :attr:`body` is the body frame's world pose, the frame ``BasePlacement`` places.
+    along x), so that :attr:`body` is the body frame's world pose, the frame ``BasePlacement`` places. "World" is
+    the ground frame ``ground`` (:class:`~snakehead.model.placement.GroundFrame`): the world on flat ground, the
+    slope's frame on a slope (:attr:`base` lies on it).
     """
 
     root: np.ndarray
     chassis: np.ndarray
     body_in_root: np.ndarray = field(default_factory=lambda: np.eye(4))
+    ground: GroundFrame = WORLD_FRAME
 
     @property
     def body(self) -> np.ndarray:
@@ -80,7 +91,7 @@ class BodyPose:
         """The body frame's planar pose (x, y m; yaw rad of its x-axis seen from above), as the planner places
         the base."""
         B = self.body
-        return BasePlacement(float(B[0, 3]), float(B[1, 3]), math.atan2(B[1, 0], B[0, 0]))
+        return BasePlacement(float(B[0, 3]), float(B[1, 3]), math.atan2(B[1, 0], B[0, 0]), self.ground)
 
     @property
     def heading(self) -> float:
@@ -90,7 +101,7 @@ class BodyPose:
 
     @property
     def tilt_deg(self) -> float:
-        """Angle (deg) between the body frame's z-axis and the world's: 0 when the tail lies upright."""
+        """Angle (deg) between the body frame's z-axis and the ground's normal: 0 when the tail lies upright."""
         return math.degrees(math.acos(float(np.clip(self.body[2, 2], -1.0, 1.0))))
 
 
@@ -159,12 +170,18 @@ class BodyPoseEstimator:
     robot: the snake; imu_link: the frame that carries the IMU (default: the shaped link nearest the middle of the
     body); contact_height / patch_height: m; odometry: one of ODOMETRY (see the module). Call :meth:`reset` with
     the known starting pose, then :meth:`update` at every control tick with the measured joint angles and the
-    IMU's world orientation.
+    IMU's world orientation. ``ground``: the plane the body lies on (default flat ground); the IMU's orientation
+    is always the world's (gravity's), the estimate is in ``ground`` (see the module).
     """
 
     def __init__(self, robot: SnakeRobot, imu_link: str | None = None, *, contact_height: float = CONTACT_HEIGHT,
-                 patch_height: float = PATCH_HEIGHT, odometry: str = "friction") -> None:
+                 patch_height: float = PATCH_HEIGHT, odometry: str = "friction",
+                 ground: GroundFrame = WORLD_FRAME) -> None:
         self.robot = as_robot(robot)
+        if not isinstance(ground, GroundFrame):
+            raise InputError(f"ground must be a GroundFrame, got {type(ground).__name__}")
+        self.ground = ground
+        self._to_ground = None if ground.is_world else np.reshape(ground.rotation, (3, 3)).T
         shaped = self.robot.shaped_links
         self._body_in_root = self.robot.body_in_root
         if imu_link is None:
@@ -188,13 +205,18 @@ class BodyPoseEstimator:
         self._origin: np.ndarray | None = None  # the root frame's estimated world position
         self._chassis: Any = None
         self._contacts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._heading_correction = np.eye(3)  # turns the IMU's heading onto the known one (set by reset)
+        self._heading_correction = np.eye(3)  # turns the IMU's heading (about the world's vertical) onto the known
+        # one (set by reset)
 
     # --- the body in world axes, relative to the root origin --------------------------------------
     def _links(self, q: npt.ArrayLike, R_imu: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """Shaped links' poses (k, 4, 4) relative to the root origin in world axes, and the root's world rotation."""
+        """Shaped links' poses (k, 4, 4) relative to the root origin in ground axes, and the root's rotation in the
+        ground frame (the IMU's world orientation, its heading corrected about the world's vertical, turned into the
+        ground frame by the known slope)."""
         q = joint_vector(q, self.robot.n_joints)
         R_imu = self._heading_correction @ rotation_matrix(R_imu, "IMU orientation")
+        if self._to_ground is not None:
+            R_imu = self._to_ground @ R_imu
         F = self.robot.body.fk_all(q)  # in the root frame
         R_root = R_imu @ F[self.imu_index, :3, :3].T
         B = F[self._points.links]
@@ -235,22 +257,31 @@ class BodyPoseEstimator:
         root[:3, 3] = self._origin
         points = self._points.centre_points(self._W) + self._origin
         self._chassis = virtual_chassis(points, self._chassis, points[-1] - points[0])
-        return BodyPose(root=root, chassis=self._chassis, body_in_root=self._body_in_root)
+        return BodyPose(root=root, chassis=self._chassis, body_in_root=self._body_in_root, ground=self.ground)
 
     # --- the estimate ----------------------------------------------------------------------------------
     def reset(self, q: np.ndarray, R_imu: npt.ArrayLike, body_xy: npt.ArrayLike, body_yaw: float | None = None) -> BodyPose:
         """Start from joint angles q (n,), the IMU's world orientation (3, 3) and the body frame's known planar
-        position (x, y) m (a :class:`BasePlacement`'s x and y); with ``body_yaw`` (rad, the known heading of the
-        body frame's x-axis: the placement's yaw), the IMU's heading is corrected onto it from now on (a gyro's
-        heading is only relative)."""
+        position (x, y) m (a :class:`BasePlacement`'s x and y, in the estimator's ground frame); with ``body_yaw``
+        (rad, the known heading of the body frame's x-axis: the placement's yaw), the IMU's heading is corrected
+        onto it from now on (a gyro's heading is only relative: the correction turns about the world's vertical,
+        the axis the attitude filter cannot see; on a slope it is found by a few fixed-point steps, the yaw in the
+        ground frame being nearly the world's)."""
         body_xy = finite_array(body_xy, "body_xy", (2,))
         self._heading_correction = np.eye(3)
         if body_yaw is not None:
-            _, R_root = self._links(q, R_imu)
-            R_body = R_root @ self._body_in_root[:3, :3]
-            a = float(finite_array(body_yaw, "body_yaw", ())) - math.atan2(R_body[1, 0], R_body[0, 0])
-            self._heading_correction = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0],
-                                                 [0.0, 0.0, 1.0]])
+            want = float(finite_array(body_yaw, "body_yaw", ()))
+            a = 0.0
+            for _ in range(1 if self._to_ground is None else 8):
+                _, R_root = self._links(q, R_imu)
+                R_body = R_root @ self._body_in_root[:3, :3]
+                step = _wrap(want - math.atan2(R_body[1, 0], R_body[0, 0])) if self._to_ground is not None else \
+                    want - math.atan2(R_body[1, 0], R_body[0, 0])
+                a += step
+                self._heading_correction = np.array([[math.cos(a), -math.sin(a), 0.0],
+                                                     [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+                if abs(step) < 1e-13:
+                    break
         W, R_root = self._links(q, R_imu)
         points = self._points.world(W)
         offset = R_root @ self._body_in_root[:3, 3]  # the body frame's origin from the root's, world axes

@@ -12,6 +12,13 @@ the next phase starts and whose ``estimate`` is the body's pose as the robot kno
     run = simulator.run(state, make_gait("sidewinding", direction=+1), cycles=2)
     run.estimate.base, run.estimate_error, run.state
 
+On a slope (``ground=``, a :class:`~snakehead.model.placement.GroundFrame`: a plane terrain's, as a plan on it has
+in ``plan.base.ground``) the ground is that plane tilted in the world (:func:`snakehead.sim.build_spec`'s ``ground``,
+gravity still the world's), the placements are in its frame (``lying(base)`` with ``base.ground`` the simulator's),
+and so is every pose a run reports, true or estimated (MuJoCo's turned at one boundary, :meth:`GaitSimulator.true_pose`;
+the estimate through the known slope, :class:`~snakehead.closed_loop.estimate.BodyPoseEstimator`); the IMU still reads
+world gravity, as a real one does. Flat ground (the default) is the world frame, the runs what they always were.
+
 ``run_path(state, q_path, duration_s)`` runs any joint path on the ground the same way (a curl of the body from one
 flat shape to another, which slides it: :mod:`snakehead.dynamics.sliding`).
 
@@ -31,9 +38,10 @@ import numpy.typing as npt
 from .._errors import InputError, InputTypeError
 from .._validate import finite_array, finite_float, joint_vector
 from ..locomotion.gaits import Gait, virtual_chassis
+from ..model.placement import WORLD_FRAME, GroundFrame
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
 from ..sim.gains import default_gains, gain_vector
-from ..sim.mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, build_model, import_mujoco
+from ..sim.mjcf import DEFAULT_CONTROL_DT, DEFAULT_TIMESTEP, build_model, import_mujoco, in_ground
 from ..sim.sensors import OnboardSensors
 from ..sim.tracking import SimState
 from .estimate import AttitudeFilter, BodyPose, BodyPoseEstimator, ShapePoints, pose_error
@@ -46,7 +54,8 @@ class SensorLog:
     """What the estimator of a ground run read (``sensing="onboard"``): where it started (``q0`` the encoders,
     ``R0`` the attitude filter's orientation, ``start_xy`` / ``start_yaw`` the pose it was told), then every control
     tick's encoders ``q`` (K, n) rad, gyro (K, 3) rad/s and accelerometer (K, 3) m/s^2, ``dt`` s apart;
-    ``imu_link`` and ``odometry`` as the estimator's. :func:`replay_estimate` gives the estimate back from it alone."""
+    ``imu_link``, ``odometry`` and ``ground`` (the slope's frame, the world's on flat ground) as the estimator's.
+    :func:`replay_estimate` gives the estimate back from it alone."""
 
     q0: np.ndarray
     R0: np.ndarray
@@ -59,12 +68,13 @@ class SensorLog:
     imu_link: str
     odometry: str
     tilt_time_constant_s: float
+    ground: GroundFrame = WORLD_FRAME
 
 
 def replay_estimate(robot: SnakeRobot, log: SensorLog) -> tuple[BodyPose, np.ndarray]:
     """The estimate at the end of a ground run from its :class:`SensorLog` alone (no simulator): the pose and the
     attitude filter's orientation (3, 3)."""
-    estimator = BodyPoseEstimator(robot, log.imu_link, odometry=log.odometry)
+    estimator = BodyPoseEstimator(robot, log.imu_link, odometry=log.odometry, ground=log.ground)
     attitude = AttitudeFilter(log.tilt_time_constant_s)
     attitude.R = log.R0.copy()
     estimator.reset(log.q0, attitude.R, log.start_xy, log.start_yaw)
@@ -83,7 +93,7 @@ class GaitRun:
     chassis_truth / chassis_estimate (T, 3) m: the virtual chassis' origin; heading_truth / heading_estimate (T,)
     rad; height (T,) m: the highest point of the collision shapes above the ground; contact_fraction (T,): the share of
     the links with shapes touching the ground (within 3 mm); root_truth / root_estimate (T, 4, 4): the root frame's
-    world pose.
+    world pose. On a slope every pose and heading is in the simulator's ground frame.
     """
 
     gait: Gait | None
@@ -147,7 +157,8 @@ class GaitSimulator:
     kp, kd: PD gains (default: derived per joint, :func:`snakehead.sim.gains.default_gains`); imu_link: the frame
     carrying the IMU of the pose estimate (default: mid-body); imu_yaw_drift_deg_per_s: a gyro's heading drift
     (deg/s; the IMU reads the link's true orientation turned by drift x time about the vertical; default 0, a
-    perfect attitude); odometry: the estimate's (:data:`snakehead.closed_loop.estimate.ODOMETRY`); sensors: the robot's own
+    perfect attitude); ground: the plane the robot lies on (a :class:`~snakehead.model.placement.GroundFrame`, default
+    flat ground; see the module); odometry: the estimate's (:data:`snakehead.closed_loop.estimate.ODOMETRY`); sensors: the robot's own
     (:class:`snakehead.sim.sensors.OnboardSensors`: the estimate then reads the encoders and the IMU's gyro and
     accelerometer through an :class:`~snakehead.closed_loop.estimate.AttitudeFilter`, and every run keeps a
     :class:`SensorLog`; None, the default: the true joint angles and the IMU link's true orientation); other keywords
@@ -157,12 +168,16 @@ class GaitSimulator:
     def __init__(self, robot: SnakeRobot, *, kp: npt.ArrayLike | None = None, kd: npt.ArrayLike | None = None,
                  imu_link: str | None = None, imu_yaw_drift_deg_per_s: float = 0.0,
                  control_dt: float = DEFAULT_CONTROL_DT, timestep: float = DEFAULT_TIMESTEP,
-                 odometry: str = "friction", sensors: OnboardSensors | None = None, **model_options: Any) -> None:
+                 odometry: str = "friction", sensors: OnboardSensors | None = None,
+                 ground: GroundFrame = WORLD_FRAME, **model_options: Any) -> None:
         self._mj = import_mujoco()
         self.robot = as_robot(robot)
         n = self.robot.n_joints
         armature = model_options.get("armature", 1e-3)
-        self.sim = build_model(self.robot, timestep=timestep, **model_options)
+        if not isinstance(ground, GroundFrame):
+            raise InputTypeError(f"ground must be a GroundFrame, got {type(ground).__name__}")
+        self.ground = ground
+        self.sim = build_model(self.robot, timestep=timestep, ground=ground, **model_options)
         if kp is None or kd is None:
             kp_load, kd_load = default_gains(self.robot, armature=armature)
             kp = kp_load if kp is None else kp
@@ -177,7 +192,7 @@ class GaitSimulator:
             raise InputError(f"control_dt ({control_dt} s) must be a whole multiple of timestep ({timestep} s)")
         self.control_dt = float(control_dt)
         self.data = self._mj.MjData(m)
-        self.estimator = BodyPoseEstimator(self.robot, imu_link, odometry=odometry)
+        self.estimator = BodyPoseEstimator(self.robot, imu_link, odometry=odometry, ground=ground)
         self.imu_yaw_drift = math.radians(finite_float(imu_yaw_drift_deg_per_s, "imu_yaw_drift_deg_per_s"))
         self.time = 0.0  # simulated time (s) of the state in ``data``
         self._imu_body = int(self.sim.body_ids[self.estimator.imu_index])
@@ -190,9 +205,10 @@ class GaitSimulator:
 
     # --- states -------------------------------------------------------------------------------------
     def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
-        """The robot lying at ``base`` (default placement) with joints ``q`` (default straight), settled on the
-        ground for ``settle_s`` s while its servos hold q."""
-        base = as_base(base)
+        """The robot lying at ``base`` (default placement; on the simulator's ground: ``base.ground`` must be
+        :attr:`ground`) with joints ``q`` (default straight), settled on the ground for ``settle_s`` s while its
+        servos hold q."""
+        base = BasePlacement(ground=self.ground) if base is None else as_base(base)
         q = np.zeros(self.robot.n_joints) if q is None else joint_vector(q, self.robot.n_joints)
         settle_s = finite_float(settle_s, "settle_s")
         if settle_s < 0:
@@ -258,8 +274,8 @@ class GaitSimulator:
             self.attitude.R = np.array(R, float).reshape(3, 3)
 
     def imu_orientation(self) -> np.ndarray:
-        """What a perfect IMU reads now: its link's world orientation (3, 3), turned about the vertical by the
-        drift."""
+        """What a perfect IMU reads now: its link's world orientation (3, 3) (MuJoCo's world, gravity along -z, on
+        a slope too), turned about the vertical by the drift."""
         R = self._imu_true()
         if self.imu_yaw_drift:
             a = self.imu_yaw_drift * self.time
@@ -268,7 +284,8 @@ class GaitSimulator:
         return R
 
     def true_pose(self, previous: BodyPose | None = None) -> BodyPose:
-        """MuJoCo's pose of the body now (ground truth); the chassis' x-axis kept close to ``previous``'s."""
+        """MuJoCo's pose of the body now (ground truth), in the ground frame; the chassis' x-axis kept close to
+        ``previous``'s."""
         d = self.data
         root = np.eye(4)
         rb = self.sim.root_body
@@ -276,16 +293,18 @@ class GaitSimulator:
         root[:3, 3] = d.xpos[rb]
         points = self._points.centre_points(self._shape_frames())
         chassis = virtual_chassis(points, None if previous is None else previous.chassis, points[-1] - points[0])
-        return BodyPose(root=root, chassis=chassis, body_in_root=self.robot.body_in_root)
+        return BodyPose(root=in_ground(self.ground, root), chassis=chassis, body_in_root=self.robot.body_in_root,
+                        ground=self.ground)
 
     def _shape_frames(self) -> np.ndarray:
-        """World poses (k, 4, 4) of the links with collision shapes, now."""
+        """Poses (k, 4, 4) of the links with collision shapes, now, in the ground frame (the world's on flat
+        ground)."""
         d = self.data
         F = np.zeros((len(self._shape_bodies), 4, 4))
         F[:, :3, :3] = d.xmat[self._shape_bodies].reshape(-1, 3, 3)
         F[:, :3, 3] = d.xpos[self._shape_bodies]
         F[:, 3, 3] = 1.0
-        return F
+        return in_ground(self.ground, F)
 
     def _shape_heights(self) -> tuple[float, float]:
         """(highest point of the collision shapes above the ground (m), share of the shaped links whose lowest
@@ -362,7 +381,7 @@ class GaitSimulator:
                             q=np.array([r[0] for r in readings]), gyro=np.array([r[1] for r in readings]),
                             accel=np.array([r[2] for r in readings]), dt=self.control_dt,
                             imu_link=self.estimator.imu_link, odometry=self.estimator.odometry,
-                            tilt_time_constant_s=1.0 / self.attitude.gain)
+                            tilt_time_constant_s=1.0 / self.attitude.gain, ground=self.ground)
         # headings unwrapped from the start's, so that turns beyond half a revolution count in full
         heading_truth = np.unwrap(np.concatenate([[start_truth.heading], arr["ht"]]))[1:]
         heading_estimate = np.unwrap(np.concatenate([[est0.heading], arr["he"]]))[1:]

@@ -88,9 +88,11 @@ from .._validate import positive
 from ..collision import body_collisions as coll
 from ..locomotion import goals as lc
 from ..margins import EXACT_DISTANCE_WITHIN
+from ..model.placement import WORLD_FRAME
 from ..model.robot import BasePlacement, SnakeRobot, as_base
 from ..planning.planner import as_scene
 from ..planning.start_state import bending_state
+from ..scenes.ground_scene import base_on_slope
 from ..scenes.scene import Scene
 from ..sim.sensors import OnboardSensors
 from ..solve.head_controller import HeadController
@@ -163,7 +165,10 @@ class ClosedLoop:
         self.sim_options = dict(sim_options)
         self.sensors = (OnboardSensors.realistic([(tg.position, tg.direction) for tg in self.scene.targets],
                                                  self.obstacles, sensor_seed) if sensing == "onboard" else None)
-        self.simulator = GaitSimulator(self.robot, obstacles=self.obstacles, sensors=self.sensors, **self.sim_options)
+        # on a plane terrain the scene is in the slope's ground frame (as_scene) and its base holds that frame
+        self.ground = self.scene.base.ground if self.scene.base is not None else WORLD_FRAME
+        self.simulator = GaitSimulator(self.robot, obstacles=self.obstacles, sensors=self.sensors, ground=self.ground,
+                                       **self.sim_options)
         self.ground_options = {k: v for k, v in self.sim_options.items()
                                if k in ("friction", "joint_damping", "armature", "timestep", "control_dt",
                                         "hole_slices", "torque_limit")}
@@ -177,19 +182,21 @@ class ClosedLoop:
         """Where the body lies straight when the curl into the bending state alone brings its base to ``base``
         (default: the scene's placement, else the default one): the paper's "current state" (Fig. 17a) before
         its bending state (Fig. 17b)."""
-        base = as_base(base if base is not None else self.scene.base)
+        base = self._on_ground(base if base is not None else self.scene.base)
         return lc.straight_pose_for(self.robot, base, bending_state(self.controller))
 
     @entry_point
     def run(self, start: BasePlacement, q_start: npt.ArrayLike | None = None, *,
             believed_start: BasePlacement | None = None, progress: Callable[[str], None] | None = None) -> LoopRun:
         """Run the loop from the body lying at ``start`` (the body frame's placement) with joints ``q_start``
-        (default straight; a flat shape: pitch joints 0). The loop knows where the body starts
+        (default straight; a flat shape: pitch joints 0); on a slope (a scene whose terrain is a plane) ``start`` is
+        in the slope's ground frame (:attr:`BasePlacement.ground`), or in the world as a scene's base is written.
+        The loop knows where the body starts
         (``believed_start``, default ``start``; give another to start from a wrong belief). ``progress``: called
         with a line of text at every step."""
         robot = self.robot
-        start = as_base(start)
-        believed = start if believed_start is None else as_base(believed_start)
+        start = self._on_ground(start)
+        believed = start if believed_start is None else self._on_ground(believed_start)
         q_now = lc.flat_shape(robot, np.zeros(robot.n_joints) if q_start is None else q_start, "q_start")
         if coll.self_clearance(robot, q_now[None])[0] <= 0.0:
             raise InputError("q_start folds the body onto itself (two links overlap)")
@@ -204,6 +211,13 @@ class ClosedLoop:
                        head_t0_s=ep.head_t0, corrections=max(corrections, 0), planning_time_s=ep.planning,
                        notes=ep.notes, failure=failure, fix=self.fix, sensing=self.sensing, head_extra=ep.extra,
                        servo=ep.servo_log, routes=ep.routes)
+
+    def _on_ground(self, base: BasePlacement | None) -> BasePlacement:
+        """A placement on the loop's ground (the default one when None): on a slope one given in the world is
+        put on it as the planner puts a scene's base (:func:`snakehead.scenes.ground_scene.base_on_slope`), one
+        already in the slope's ground frame is kept."""
+        base = BasePlacement(ground=self.ground) if base is None else as_base(base)
+        return base if self.ground.is_world else base_on_slope(base, self.ground)
 
     def _steps(self, ep: Episode) -> tuple[str | None, int]:
         """The episode's steps (see the module): 1. the goal (after a failed head plan: a correction, a closer

@@ -144,12 +144,12 @@ class RouteFollower:
             if creep and abs(math.degrees(math.remainder(straight_goal.yaw - here.yaw, 2 * math.pi))) \
                     > tolerance.yaw_deg:  # from a staging point on the goal's axis: turn to its heading first
                 m = lc.compose(here, self.offset)
-                facing = lc.compose(BasePlacement(m.x, m.y, straight_goal.yaw), lc.inverse(self.offset))
+                facing = lc.compose(m.moved(m.x, m.y, straight_goal.yaw), lc.inverse(self.offset))
                 return lc.next_step(self.robot, here, facing, rates, tolerance=tolerance, frequency=self.frequency)
             return lc.next_step(self.robot, here, straight_goal, rates, tolerance=tolerance, frequency=self.frequency,
                                 creep=creep)
         w, h = route.waypoints[k], route.headings[k - 1]
-        goal = lc.compose(BasePlacement(float(w[0]), float(w[1]), float(h)), lc.inverse(self.offset))
+        goal = lc.compose(here.moved(float(w[0]), float(w[1]), float(h)), lc.inverse(self.offset))
         return lc.next_step(self.robot, here, goal, rates, tolerance=WAYPOINT_TOLERANCE, frequency=self.frequency,
                             creep=route.creep and k == 1)
 

@@ -3,7 +3,8 @@ and orientation of the overall body"): where a body lying on the ground must go,
 there.
 
 Poses are :class:`~snakehead.model.robot.BasePlacement` s of the root frame (x, y m, yaw rad), composed as planar
-rigid motions (:func:`compose`, :func:`relative`).
+rigid motions (:func:`compose`, :func:`relative`) in the plane the body lies on: on a slope its ground frame, which
+a composed pose keeps (``compose(a, b)`` lies on ``a``'s ground; ``relative`` gives a motion, on no ground).
 
 * The curl: the plan starts in the bending state (the base on its arc, neck and head curled flat), and a body
   lying straight gets there by a joint motion on the ground that slides and turns it. :func:`curl_displacement`
@@ -49,9 +50,9 @@ def wrap_angle(a: float) -> float:
 
 
 def compose(a: BasePlacement, b: BasePlacement) -> BasePlacement:
-    """The pose ``b`` (given in ``a``'s frame) in the world: a * b."""
+    """The pose ``b`` (given in ``a``'s frame) in the world: a * b, on ``a``'s ground (a slope's frame stays)."""
     c, s = math.cos(a.yaw), math.sin(a.yaw)
-    return BasePlacement(a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, a.yaw + b.yaw)
+    return a.moved(a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, a.yaw + b.yaw)
 
 
 def relative(a: BasePlacement, b: BasePlacement) -> BasePlacement:
@@ -169,7 +170,7 @@ class GaitRates:
         if full <= 0:
             return
         a, b = compose(start, offset), compose(end, offset)
-        d = relative(a, BasePlacement(b.x, b.y, a.yaw))  # the middle's travel in the start frame
+        d = relative(a, b.moved(b.x, b.y, a.yaw))  # the middle's travel in the start frame
         S = self._sums
         if gait.name == "sidewinding":
             S["side_m"] += math.hypot(d.x, d.y)
@@ -199,7 +200,7 @@ class GaitRates:
         full = step.cycles * step.scale ** AMPLITUDE_EXPONENT.get(gait.name, 1.0)
         m = compose(start, offset)
         if gait.name == "turning":
-            return BasePlacement(m.x, m.y, m.yaw + gait.direction * full * self.turn_rad)
+            return m.moved(m.x, m.y, m.yaw + gait.direction * full * self.turn_rad)
         if gait.name == "linear_progression":
             return compose(m, BasePlacement(gait.direction * full * self.forward_m, 0.0, 0.0))
         angle = gait.direction * self.sideways_angle_rad
@@ -278,7 +279,7 @@ def next_step(robot: SnakeRobot, current: BasePlacement, goal: BasePlacement, ra
         raise InputError(f"max_cycles must be a positive integer, got {max_cycles!r}")
     offset = chassis_offset(robot)
     here, there = compose(current, offset), compose(goal, offset)
-    error = relative(there, BasePlacement(here.x, here.y, here.yaw))  # the middle in the goal's frame
+    error = relative(there, here)  # the middle in the goal's frame
     along, across = error.x, error.y
     yaw_error = wrap_angle(goal.yaw - current.yaw)  # turn by this to face the goal's way
 
