@@ -104,7 +104,7 @@ def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.
     the flat shape of ``q_shape``, and its solution; (None, None) when all are; ("no curl", None) when the base's
     shape holds no stable curl of the neck and head, ("the start", None) when the start state is in an obstacle."""
     try:
-        q_bend = bending_state(controller, q_shape)
+        q_bend = bending_state(controller, q_shape, base)
     except Infeasible:
         return "no curl", None
     if not clear_of_obstacles(controller.robot, q_bend, obstacles, base):
@@ -119,17 +119,21 @@ def _first_failure(controller: HeadController, base: BasePlacement, q_shape: np.
 def has_curl(controller: HeadController, q: np.ndarray) -> bool:
     """Whether the flat shape of q (its joints before the lift) holds a stable curl of the neck and head (a
     bending state) from which the lift ends in a safe state (:func:`~snakehead.planning.start_state.lift_ends_safe`);
-    the shapes that do not are kept in ``plan_cache_of(controller).shapes_without_curl``."""
+    the shapes that do not are kept in ``plan_cache_of(controller).shapes_without_curl``. On a slope both are
+    judged at the controller's base's ground and heading (the weight leans), and kept for those only."""
     no_curl = plan_cache_of(controller).shapes_without_curl
     key = shape_key(q, controller.robot.lift_joints.start, 12)
+    base = controller.base if not controller.base.on_flat_ground else None  # on a slope: at its ground and heading
+    if base is not None:  # (a slope's answer is never reused at another heading or on another ground)
+        key += repr((base.ground, base.yaw)).encode()
     if key in no_curl:
         return False
     try:
-        bending_state(controller, q)
+        bending_state(controller, q, base)
     except Infeasible:
         no_curl.put(key, True)
         return False
-    if not lift_ends_safe(controller, q):
+    if not lift_ends_safe(controller, q, base):
         no_curl.put(key, True)
         return False
     return True

@@ -51,9 +51,9 @@ from .fallbacks import retime_slower
 from .plan_bounds import check_size, check_timing
 from .plan_cache import plan_cache_of
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
-from .start_state import LIFT_STEPS, bending_state
+from .start_state import LIFT_STEPS, bending_state, lean_lift_ends
 from .target_solves import solve_noted
-from .waypoints import Waypoints
+from .waypoints import NO_DETOUR, Waypoints
 
 
 def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
@@ -158,7 +158,7 @@ def plan(targets: Scene | str | os.PathLike[str] | Sequence[tuple[npt.ArrayLike,
     if start_q is not None and relocation is not None:
         notes.append("start_q is not used: the plan starts at the relocated base, in its bending state")
         start_q = None
-    way.start("bending state", bending_state(controller, q_shape) if start_q is None else start_q)
+    way.start("bending state", bending_state(controller, q_shape, chosen) if start_q is None else start_q)
     q = _lift(way, controller, q_shape)
     run = _Run(controller, scene, lines, chosen, obstacles, way, notes, solved, report)
     run.reach_targets(q)
@@ -280,7 +280,7 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
     robot, obstacles = controller.robot, way.obstacles
     q = shape_of(robot, q_shape, controller.q_initial)
     if not (way.feasible(q[None])[0] and clear_of_obstacles(robot, q, obstacles, way.base)):
-        return way.qs[-1]
+        return way.qs[-1] if way.base.on_flat_ground else _lean_lift(way, controller, q)
     lifts = plan_cache_of(controller).lift_paths
     key = (np.round(way.qs[-1], 9).tobytes(), np.round(q, 9).tobytes())
     keep = not obstacles and way.base.on_flat_ground  # on a slope a lift safe at one heading may not be at another
@@ -289,7 +289,11 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
         way.append_path("initial state (head lifted)", *kept)
     else:
         first = len(way.qs) - 1
+        marks = len(way.qs), len(way.methods)
         method = way.move("initial state (head lifted)", q, n=LIFT_STEPS)
+        if method == NO_DETOUR and not way.base.on_flat_ground:  # a leaning lift that a checked path reaches
+            del way.qs[marks[0]:], way.labels[marks[0]:], way.methods[marks[1]:]
+            return _lean_lift(way, controller, q)
         if keep:
             lifts.put(key, (np.array(way.qs[first:]), method))
     way.lift_index = way.stop()
@@ -297,6 +301,28 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
         way.lift_cache = plan_cache_of(controller).timed_lifts
         way.checked_lifts = plan_cache_of(controller).checked_lifts
     return q
+
+
+def _lean_lift(way: Waypoints, controller: HeadController, q: np.ndarray) -> np.ndarray:
+    """On a slope, where the initial state q is not safe at the plan's base (its weight leans): the lift to the
+    nearest safe lifted state (:func:`~snakehead.planning.start_state.lean_lift_ends`) that a move from the bending
+    state reaches with a checked path (not ``NO_DETOUR``), a stop as the lift is; the start's configuration when
+    none does (the first move then goes straight to the first target, as :func:`_lift`'s)."""
+    robot, obstacles = controller.robot, way.obstacles
+
+    def safe(qs: np.ndarray) -> np.ndarray:
+        ok = way.feasible(qs)
+        for k in np.flatnonzero(ok) if obstacles else ():
+            ok[k] = clear_of_obstacles(robot, qs[k], obstacles, way.base)
+        return ok
+
+    for end in lean_lift_ends(way, q, safe):
+        marks = len(way.qs), len(way.methods)
+        if way.move("initial state (head lifted, leaning)", end, n=LIFT_STEPS) != NO_DETOUR:
+            way.lift_index = way.stop()
+            return end
+        del way.qs[marks[0]:], way.labels[marks[0]:], way.methods[marks[1]:]
+    return way.qs[-1]
 
 
 @dataclass

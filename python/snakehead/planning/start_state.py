@@ -5,6 +5,8 @@ Why the bending state: on the default robot the neck and head (1.7 kg) outweigh 
 cantilever beyond P0 they would tip the body, so they are curled over the base before they rise."""
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from .._errors import Infeasible
@@ -25,6 +27,15 @@ CURL_MARGIN_SLACK = 1e-9
 #: Curls spread over all of them whose composed centre of mass ground_curl checks against the robot's own (a chain
 #: the composition does not model then falls back to the exhaustive search).
 CURL_COM_SPREAD = 16
+#: On a slope, when the initial state is not safe at the plan's base (its weight leans), the lift ends instead at the
+#: safe configuration nearest it among LEAN_LIFT_TRIALS draws per spread of the neck and head joints around it (rad,
+#: LEAN_LIFT_SPREADS, seeded: plans are reproducible): a lifted state from which the targets are moved to as on
+#: flat ground, rather than a move from the curl on the ground straight to the target.
+LEAN_LIFT_SPREADS = (0.1, 0.2, 0.35, 0.5, 0.7)
+LEAN_LIFT_TRIALS = 128
+LEAN_LIFT_SEED = 20231
+#: the lifted states :func:`lean_lift_ends` hands out, nearest first
+LEAN_LIFT_TRIES = 3
 
 
 def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
@@ -35,7 +46,8 @@ def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.n
     return q
 
 
-def bending_state(controller: HeadController, q_shape: np.ndarray | None = None) -> np.ndarray:
+def bending_state(controller: HeadController, q_shape: np.ndarray | None = None,
+                  base: BasePlacement | None = None) -> np.ndarray:
     """The bending state (Figs. 17b, 22a): the base on its arc and the neck and head curled flat on the ground
     inside it, so that lifting them keeps their mass over the base (n,).
 
@@ -44,29 +56,66 @@ def bending_state(controller: HeadController, q_shape: np.ndarray | None = None)
     head's yaw joints are chosen on a grid (15 deg, coarser for many joints) for the largest static margin over the
     base's support polygon alone (the support left once they are lifted), among the curls in which no two non-neighbouring links
     overlap. Deterministic. ``q_shape``: a configuration whose base (and the neck's links that stay on the ground)
-    give the shape on the ground (default: the controller's initial configuration)."""
+    give the shape on the ground (default: the controller's initial configuration). ``base``: where the base lies;
+    on a slope the margin is that of the CoM's point below it along the leaning gravity (:func:`ground_curl`), and
+    the curl is kept for that ground and heading only (on flat ground, or without ``base``, for the shape)."""
     robot = controller.robot
     shape = controller.q_initial if q_shape is None else np.asarray(q_shape, float)
     kept = plan_cache_of(controller).bending_states
     key = shape_key(shape, robot.lift_joints.start)
+    lean = base is not None and not base.on_flat_ground
+    if lean:  # a slope's curl is never reused at another heading or on another ground
+        assert base is not None
+        key += repr((base.ground, base.yaw)).encode()
     q = kept.get(key)
     if q is None:
-        q = kept.put(key, ground_curl(robot, shape))
+        q = kept.put(key, ground_curl(robot, shape, base if lean else None))
     return q.copy()
 
 
-def lift_ends_safe(controller: HeadController, q_shape: np.ndarray) -> bool:
+def lift_ends_safe(controller: HeadController, q_shape: np.ndarray, base: BasePlacement | None = None) -> bool:
     """Whether the lift from the bending state ends in a safe state on a base of the flat shape of ``q_shape``: the
     initial state's neck and head on that base (``planning.planner._lift``'s end) above the ground, clear of itself
     and statically stable with DETOUR_MARGIN (``Waypoints.feasible``; the same at every placement on the flat
     ground; obstacles are the plan's to check). Without it the plan's first move goes from the curl on the ground
-    straight to the target, for which there is often no safe path."""
+    straight to the target, for which there is often no safe path. ``base`` off flat ground: at its ground and
+    heading, where the weight leans, the initial state or one of the lifted states near it that the plan then
+    lifts to (:func:`lean_lift_ends`)."""
     q = shape_of(controller.robot, np.asarray(q_shape, float), controller.q_initial)
-    return bool(Waypoints(controller.robot, BasePlacement()).feasible(q[None])[0])
+    at = _leaning(base)
+    if at is None:
+        return bool(Waypoints(controller.robot, BasePlacement()).feasible(q[None])[0])
+    way = Waypoints(controller.robot, at)
+    return bool(way.feasible(q[None])[0]) or bool(lean_lift_ends(way, q, way.feasible))
 
 
-def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
+def lean_lift_ends(way: Waypoints, q: np.ndarray, safe: Callable[[np.ndarray], np.ndarray]) -> list[np.ndarray]:
+    """Safe lifted states near the initial state q (n,) on a slope (``way.base`` off flat ground), where q itself is
+    not safe: configurations with q's joints before the lift (the base on the ground keeps its shape) and the neck
+    and head joints drawn around q's (LEAN_LIFT_SPREADS, LEAN_LIFT_TRIALS each, seeded), which ``safe`` (m, n) -> (m,)
+    bool passes (``Waypoints.feasible`` and the obstacles'), at most LEAN_LIFT_TRIES of them, nearest to q first
+    (the largest joint change); none when no draw passes."""
+    robot = way.robot
+    movable = np.arange(robot.lift_joints.start, robot.parts.head.stop)
+    rng = np.random.default_rng(LEAN_LIFT_SEED)
+    found: list[np.ndarray] = []
+    for spread in LEAN_LIFT_SPREADS:
+        W = np.tile(q, (LEAN_LIFT_TRIALS, 1))
+        W[:, movable] += rng.normal(0.0, spread, (LEAN_LIFT_TRIALS, len(movable)))
+        W = np.clip(W, robot.lower, robot.upper)
+        ok = np.flatnonzero(safe(W))
+        if ok.size:
+            steady = ok[np.argsort(-way.static_margins(W[ok]), kind="stable")]
+            found += [W[k] for k in steady[:LEAN_LIFT_TRIES - len(found)]]
+        if len(found) >= LEAN_LIFT_TRIES:
+            break
+    return found
+
+
+def ground_curl(robot: SnakeRobot, shape: np.ndarray, base: BasePlacement | None = None) -> np.ndarray:
     """:func:`bending_state` for the base shape of ``shape`` (n,), uncached. ``Infeasible`` when no curl is stable.
+    ``base`` off flat ground: the margins are those of the CoM's point below it along that ground's gravity, the
+    base at its heading (where it lies on the plane does not matter); else (default) on flat ground.
 
     The curl :func:`ground_curl_exhaustive` finds (the largest margin among the curls clear of themselves, every
     curl's margin from the robot's own kinematics), found without the kinematics of every curl: the margins from
@@ -77,6 +126,9 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
     q, yaw, values = _curl_grid(robot, shape)
     if len(yaw) == 0:
         return q
+    at = _leaning(base)
+    if at is not None:
+        return _ground_curl_leaning(robot, q, yaw, values, at)
     poly = stability.support_polygon(robot, q)  # the base's, placement-independent in its own frame
     com = _curl_com(robot, q, yaw, values)
     hull = poly[stability.hull_indices(poly)]
@@ -110,6 +162,57 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
     if not ok.any():
         raise Infeasible(_NO_CURL)
     return qs[ranked[np.argmax(ok)]]
+
+
+def _leaning(base: BasePlacement | None) -> BasePlacement | None:
+    """The placement the curls are weighed at on a slope (``base``'s ground and heading, at the ground's origin);
+    None on flat ground."""
+    if base is None or base.on_flat_ground:
+        return None
+    return BasePlacement(0.0, 0.0, base.yaw, base.ground)
+
+
+def _ground_curl_leaning(robot: SnakeRobot, q: np.ndarray, yaw: np.ndarray, values: np.ndarray,
+                         at: BasePlacement) -> np.ndarray:
+    """:func:`ground_curl` on a slope, the base at ``at``: the fast margins of :func:`ground_curl` with the CoM's
+    point below it along the leaning gravity (``_curl_com`` at ``at``), the curls within twice CURL_MARGIN_SLACK of
+    the first self-clear one ranked by their exact margins (the robot's own kinematics), the first self-clear of
+    those; the exhaustive search when the composition does not model the chain."""
+    poly = stability.support_polygon(robot, q, at)
+    hull = poly[stability.hull_indices(poly)]
+    if len(hull) < 3:
+        raise Infeasible(_NO_CURL)
+    com = _curl_com(robot, q, yaw, values, at)
+    fast = _line_margins(hull, com)
+    order = np.argsort(-fast, kind="stable")
+    order = order[fast[order] > -CURL_MARGIN_SLACK]
+    first, done, size = None, 0, 32
+    while first is None and done < order.size:
+        chunk = order[done:done + size]
+        ok = coll.self_clearance(robot, _curl_configurations(q, yaw, values, chunk)) > BENDING_CLEARANCE
+        first = chunk[np.argmax(ok)] if ok.any() else None
+        done, size = done + size, min(2 * size, 1024)
+    if first is None:
+        raise Infeasible(_NO_CURL)
+    near = order[fast[order] >= fast[first] - 2.0 * CURL_MARGIN_SLACK]
+    rows = np.unique(np.concatenate([near, np.linspace(0, len(com) - 1, CURL_COM_SPREAD).astype(int)]))
+    qs = _curl_configurations(q, yaw, values, rows)
+    exact_com = at.below_along_gravity(stability.center_of_mass(robot, qs, at))
+    if np.abs(exact_com - com[rows]).max() > CURL_MARGIN_SLACK / 4:  # a chain the composition does not model
+        qs = _curl_configurations(q, yaw, values, np.arange(values.shape[1] ** len(yaw)))
+        exact_com = at.below_along_gravity(stability.center_of_mass(robot, qs, at))
+    else:
+        keep = np.isin(rows, near)
+        qs, exact_com = qs[keep], exact_com[keep]
+    margin = stability.polygon_margin_many(np.broadcast_to(poly, (len(qs),) + poly.shape),
+                                           np.ones((len(qs), len(poly)), bool), exact_com)
+    ranked = np.argsort(-margin, kind="stable")
+    ranked = ranked[margin[ranked] > 0]
+    for chunk in np.array_split(ranked, max(1, ranked.size // 500 + 1)) if ranked.size else []:
+        ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
+        if ok.any():
+            return qs[chunk[np.argmax(ok)]]
+    raise Infeasible(_NO_CURL)
 
 
 def ground_curl_exhaustive(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:
@@ -164,8 +267,10 @@ def _curl_configurations(q: np.ndarray, yaw: np.ndarray, values: np.ndarray, row
     return qs
 
 
-def _curl_com(robot: SnakeRobot, q: np.ndarray, yaw: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """World (x, y) of the centre of mass of every curl of the grid (p**k, 2), the base at its default placement.
+def _curl_com(robot: SnakeRobot, q: np.ndarray, yaw: np.ndarray, values: np.ndarray,
+              at: BasePlacement | None = None) -> np.ndarray:
+    """World (x, y) of the centre of mass of every curl of the grid (p**k, 2), the base at its default placement
+    (``at``, on a slope: the ground point below it along the leaning gravity, the base at ``at``).
 
     The links turned by the i-th curl joint and by no later one move rigidly with its child link: their mass
     moment is that link's frame times a fixed vector, and that frame is the previous curl joint's child's times a
@@ -194,6 +299,9 @@ def _curl_com(robot: SnakeRobot, q: np.ndarray, yaw: np.ndarray, values: np.ndar
         prev = F0[child]
         part = frames[:, :3, :3] @ local + frames[:, :3, 3] * m[group].sum()  # (p**(i+1), 3)
         total = (total[:, None] + part.reshape(len(total), -1, 3)).reshape(-1, 3)
+    if at is not None:
+        W = robot.root_pose(at)
+        return at.below_along_gravity((total / M) @ W[:3, :3].T + W[:3, 3])
     W = robot.root_pose(stability.as_base(None))
     return (total / M) @ W[:2, :3].T + W[:2, 3]
 
@@ -206,5 +314,6 @@ def _line_margins(hull: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return (cross / np.hypot(edge[:, 0], edge[:, 1])).min(axis=1)
 
 
-__all__ = ["shape_of", "bending_state", "lift_ends_safe", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
+__all__ = ["shape_of", "bending_state", "lift_ends_safe", "lean_lift_ends", "LEAN_LIFT_SPREADS", "LEAN_LIFT_TRIALS",
+           "LEAN_LIFT_SEED", "LEAN_LIFT_TRIES", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
            "BENDING_CLEARANCE"]
