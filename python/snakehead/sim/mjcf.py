@@ -46,8 +46,10 @@ from ..geometry.obstacles import BoxObstacle, MeshObstacle, WallWithHole
 from ..model.physics import GRAVITY, GROUND_FRICTION
 from ..model.placement import WORLD_FRAME, GroundFrame
 from ..model.robot import BasePlacement, SnakeRobot, as_base, as_robot
+from ..terrain.surfaces import FlatGround
 from ..trajectory.interpolation import CONTROL_PERIOD
 from .gains import default_torque_limits
+from .terrain_field import ROUGH_TERRAINS, add_terrain_floor
 
 __all__ = ["DEFAULT_TIMESTEP", "DEFAULT_CONTROL_DT", "MAX_TIMESTEP", "MAX_CONTROL_DT", "MAX_PHYSICS_STEPS",
            "import_mujoco", "DEFAULT_HOLE_SLICES", "obstacle_boxes", "FREE_JOINT", "FLOOR", "shape_geom",
@@ -242,7 +244,7 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
                joint_damping: float = 0.02, armature: float = 1e-3, torque_limit: float | npt.ArrayLike | None = None,
                obstacles: Sequence = (), hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                contact_solref: tuple = (0.005, 1.0), ground: GroundFrame = WORLD_FRAME,
-               noslip_iterations: int | None = None) -> Any:
+               noslip_iterations: int | None = None, terrain: Any = None) -> Any:
     """The MuJoCo model of the robot (free-floating root) on a ground plane with the scene's obstacles, as a
     ``mujoco.MjSpec`` built element by element from the robot's own data (``spec.compile()`` gives the
     ``MjModel``; ``spec.to_xml()`` its MJCF text, for reading only).
@@ -259,6 +261,8 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     floor is that plane in the world and the ``obstacles``, given in the ground frame as a plan's are, are put
     through the frame's pose (``ground.matrix``). ``noslip_iterations``: MuJoCo's no-slip solver's iterations
     (``opt.noslip_iterations``), None for the default: 0 on flat ground, :data:`SLOPE_NOSLIP_ITERATIONS` on a slope.
+    ``terrain``: a heightfield, mesh or staircase (``snakehead.terrain``) as the floor instead of the plane, an
+    hfield geom named ``floor`` (:mod:`.terrain_field`; world frame only); None or flat ground: the plane.
     """
     mj = import_mujoco()
     robot = as_robot(robot)
@@ -276,6 +280,11 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     if noslip_iterations is None:
         noslip_iterations = 0 if ground.is_world else SLOPE_NOSLIP_ITERATIONS
     noslip = integer(noslip_iterations, "noslip_iterations", least=0, most=1000)
+    if isinstance(terrain, FlatGround):
+        terrain = None
+    if terrain is not None and not (isinstance(terrain, ROUGH_TERRAINS) and ground.is_world):
+        raise InputError("terrain must be a heightfield, mesh or steps terrain (a plane is given as the ground "
+                         f"frame), on the world frame; got {type(terrain).__name__}")
     boxes = obstacle_boxes(obstacles, hole_slices)
     lim = _torque_limits(robot, torque_limit)
     _check_names(robot)
@@ -284,7 +293,7 @@ def build_spec(robot: SnakeRobot, *, timestep: float = DEFAULT_TIMESTEP, frictio
     if noslip:  # (MuJoCo's default, 0, is left unset: the flat-ground model as it always was)
         spec.option.noslip_iterations = noslip
     _add_ground_and_obstacles(mj, spec, boxes, [o for o in obstacles if isinstance(o, MeshObstacle)], surface,
-                              ground)
+                              ground, terrain)
     _add_bodies(mj, spec, robot, joint_damping, armature, self_collision, surface)
     for j, joint in enumerate(robot.body.joint_names):
         act = spec.add_actuator(name=f"act_{joint}", target=joint, trntype=mj.mjtTrn.mjTRN_JOINT)
@@ -308,13 +317,16 @@ def _empty_spec(mj: Any, timestep: float) -> Any:
 
 
 def _add_ground_and_obstacles(mj: Any, spec: Any, boxes: Sequence, meshes: Sequence[MeshObstacle],
-                              surface: dict, ground: GroundFrame = WORLD_FRAME) -> None:
-    """The floor (the ground frame's z = 0 plane), the obstacles' boxes (``obstacle_<k>``) and their meshes' hulls
-    (after the boxes), the obstacles given in the ground frame."""
+                              surface: dict, ground: GroundFrame = WORLD_FRAME, terrain: Any = None) -> None:
+    """The floor (the ground frame's z = 0 plane, or ``terrain`` as an hfield), the obstacles' boxes
+    (``obstacle_<k>``) and their meshes' hulls (after the boxes), the obstacles given in the ground frame."""
     world = spec.worldbody
-    floor = {} if ground.is_world else {"pos": np.array(ground.origin), "quat": _quat_array(_rotation(ground))}
-    world.add_geom(name=FLOOR, type=mj.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], contype=0, conaffinity=1,
-                   **floor, **surface)
+    if terrain is not None:
+        add_terrain_floor(mj, spec, terrain, FLOOR, surface)
+    else:
+        floor = {} if ground.is_world else {"pos": np.array(ground.origin), "quat": _quat_array(_rotation(ground))}
+        world.add_geom(name=FLOOR, type=mj.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], contype=0, conaffinity=1,
+                       **floor, **surface)
     for k, ob in enumerate(boxes):
         centre, rotation = _placed(ground, ob.centre, ob.rotation)
         world.add_geom(name=f"obstacle_{k}", type=mj.mjtGeom.mjGEOM_BOX, pos=centre,

@@ -249,7 +249,7 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                         joint_damping: float = 0.02, armature: float = 1e-3, obstacles: Sequence = (),
                         hole_slices: int = DEFAULT_HOLE_SLICES, self_collision: bool = False,
                         drop: float = 2e-4, state: SimState | None = None,
-                        noslip_iterations: int | None = None) -> SimResult:
+                        noslip_iterations: int | None = None, terrain: Any = None) -> SimResult:
     """Track the planned joint trajectory in MuJoCo with PD control plus gravity compensation.
 
     t (T,) s strictly increasing, q (T, n) rad: the plan (any sampling; the reference is interpolated linearly
@@ -265,7 +265,9 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
     carries the lifted run of links hanging from it, judged from the planned configuration, see
     :func:`carried_weights`), "bias" (MuJoCo's ``qfrc_bias`` on every joint: gravity and Coriolis as if the tail
     were clamped) or "none". ``torque_limit`` N m: scalar or (n,), default the URDF
-    effort (:func:`snakehead.sim.gains.default_torque_limits`). Other keywords go to :func:`snakehead.sim.build_spec`.
+    effort (:func:`snakehead.sim.gains.default_torque_limits`). Other keywords go to :func:`snakehead.sim.build_spec`
+    (``terrain``: a heightfield, mesh or staircase as the floor; the body is put at its height above z = 0: give a
+    ``drop`` above the terrain's highest point under it).
 
     Returns a :class:`SimResult` sampled at every control tick from t[0] through the first tick at or after
     t[-1] + hold (so that any time of the motion, its end included, lies within the recorded span).
@@ -277,7 +279,8 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                                  drop)
     sim = build_model(robot, timestep=o.timestep, friction=friction, joint_damping=joint_damping,
                       armature=o.armature, torque_limit=torque_limit, obstacles=obstacles, hole_slices=hole_slices,
-                      self_collision=self_collision, ground=base.ground, noslip_iterations=noslip_iterations)
+                      self_collision=self_collision, ground=base.ground, noslip_iterations=noslip_iterations,
+                      terrain=terrain)
     sim.model.actuator_biasprm[:, 1] = -o.kp
     sim.model.actuator_biasprm[:, 2] = -o.kd
     d = _start_data(sim, q[0], base, o.drop, state)
@@ -291,6 +294,8 @@ def simulate_trajectory(robot: SnakeRobot, t: npt.ArrayLike, q: npt.ArrayLike, b
                     n_obstacles=len(obstacles), self_collision=bool(self_collision), from_state=state is not None)
     if not base.on_flat_ground:
         settings.update(slope_deg=base.ground.slope_deg, noslip_iterations=int(sim.model.opt.noslip_iterations))
+    if terrain is not None:
+        settings.update(terrain=type(terrain).__name__)
     # the state's clock: the plan's without ``state``, else going on from the state's time
     t_end = (ts[-1] if state is None else float(state.time) + o.settle + ts[-1] - t[0]) + o.control_dt
     return SimResult(t=ts, q_ref=q_ref, **rec, base=base, torque_limit=sim.torque_limit, settings=settings,
