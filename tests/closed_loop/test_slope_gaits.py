@@ -190,3 +190,38 @@ def test_the_loop_reaches_its_staging_pose_and_raises_the_head_on_five_degrees(m
     assert run.fixes[-1]["fix"]["position_error_m"] < 0.002 and run.fixes[-1]["fix"]["yaw_error_deg"] < 0.5
     assert run.metrics["zmp_inside"] and run.metrics["base_lift_m"] < 0.005
     assert run.metrics["final_position_error_m"] < 0.002 and run.metrics["final_direction_error_deg"] < 1.0
+
+
+def test_on_a_slope_the_loop_goes_by_the_curl_it_saw(mujoco, robot):
+    """The friction model's curl knows no slope (on 10 deg the body's curl into the bending state turns some 20 deg
+    less than predicted): once the body curled from straight on a slope, the loop plans the next curl from the
+    motion it saw (estimated), not from the model; on flat ground it keeps the model."""
+    import dataclasses
+
+    from snakehead import HeadController
+    from snakehead.closed_loop.episode import Episode
+    from snakehead.closed_loop.loop import ClosedLoop
+    from snakehead.scenes import Scene
+    from snakehead.terrain.surfaces import PlaneTerrain
+
+    controller = HeadController(robot, seed=1)
+    flat_scene = Scene.from_targets([((-0.0405, 0.5443, 0.3), (0.0, 1.0, 0.0))], name="sphere", hold_s=0.1)
+    steep = dataclasses.replace(flat_scene, terrain=PlaneTerrain.from_roll_pitch(0.0, 10.0))
+    seen = {}
+    for name, scene in (("flat", flat_scene), ("slope", steep)):
+        loop = ClosedLoop(scene, controller=controller, dynamics_check=False)
+        start = loop.straight_start()
+        ep = Episode(loop, start, start, np.zeros(robot.n_joints), lambda text: None)
+        before = ep.est.base
+        ep.curl(ep.q_bend, "curl into the bending state")
+        predicted = lc.curl_displacement(robot, np.zeros(robot.n_joints), ep.q_bend)
+        model_or_seen = ep.curl_motion(np.zeros(robot.n_joints), ep.q_bend)
+        seen[name] = lc.relative(before, ep.est.base)
+        if name == "flat":
+            assert ep.curl_seen is None and model_or_seen == predicted
+        else:
+            assert model_or_seen == seen[name] and ep.curl_seen is not None
+            other = np.where(np.arange(robot.n_joints) == 0, 0.1, 0.0)  # a curl from another shape: the model
+            assert ep.curl_motion(other, ep.q_bend) == lc.curl_displacement(robot, other, ep.q_bend)
+    turned = {k: math.degrees(lc.wrap_angle(v.yaw)) for k, v in seen.items()}
+    assert abs(turned["flat"] - turned["slope"]) > 10.0  # the slope changes the curl's turn by more than 10 deg
