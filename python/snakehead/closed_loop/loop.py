@@ -250,8 +250,7 @@ def _head_controller(scene: Scene, controller: HeadController | None, robot: Sna
     the shipped one) with ``method`` and ``seed``."""
     if controller is None:
         if robot is None:
-            robot = (SnakeRobot.from_file(scene.robot_file) if scene.robot_file is not None
-                     else SnakeRobot.default())
+            robot = scene.load_robot() or SnakeRobot.default()  # a scene file's: confined to its folder
         return HeadController(robot, method=method, seed=seed)
     if not isinstance(controller, HeadController):
         raise InputTypeError(f"controller must be a HeadController, got {type(controller).__name__}")
