@@ -21,6 +21,7 @@ import numpy as np
 
 import snakehead
 from snakehead import InputError
+from snakehead._errors import Infeasible
 from snakehead.model.placement import BasePlacement, GroundFrame
 from snakehead.samples.targets import reachable_targets
 from snakehead.terrain.surfaces import plane_normal_deg
@@ -95,7 +96,7 @@ def main() -> int:
         scene = Scene("step", (Target("t", np.array([0.0, 0.5, 0.3]), np.array([0.0, 1.0, 0.0])),),
                       terrain=step(0.04))
         snakehead.plan(scene)
-    except InputError as exc:
+    except (InputError, Infeasible) as exc:  # refused by name, or (when steps are planned) from where it may not
         print("planner on a step:", exc)
     return 0
 

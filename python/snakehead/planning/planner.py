@@ -51,9 +51,9 @@ from .fallbacks import retime_slower
 from .plan_bounds import check_size, check_timing
 from .plan_cache import plan_cache_of
 from .plan_result import Plan, PlanProgress, ProgressCallback, TargetResult
-from .start_state import LIFT_STEPS, bending_state, lean_lift_ends
+from .start_state import LEAN_LIFT_SCREEN, LEAN_LIFT_TRIES, LIFT_STEPS, bending_state, lean_lift_ends
 from .target_solves import solve_noted
-from .waypoints import NO_DETOUR, Waypoints
+from .waypoints import NO_DETOUR, TRACKED, Waypoints
 
 
 def as_scene(targets: Any, *, obstacles: Sequence[Any] = (), base: BasePlacement | None = None) -> Scene:
@@ -304,10 +304,11 @@ def _lift(way: Waypoints, controller: HeadController, q_shape: np.ndarray) -> np
 
 
 def _lean_lift(way: Waypoints, controller: HeadController, q: np.ndarray) -> np.ndarray:
-    """On a slope, where the initial state q is not safe at the plan's base (its weight leans): the lift to the
-    nearest safe lifted state (:func:`~snakehead.planning.start_state.lean_lift_ends`) that a move from the bending
-    state reaches with a checked path (not ``NO_DETOUR``), a stop as the lift is; the start's configuration when
-    none does (the first move then goes straight to the first target, as :func:`_lift`'s)."""
+    """On a slope, where the initial state q is not safe at the plan's base (its weight leans): the lift to a safe
+    lifted state near it (:func:`~snakehead.planning.start_state.lean_lift_ends`): the first of LEAN_LIFT_SCREEN
+    that a tracked path from the bending state reaches, else the first of LEAN_LIFT_TRIES that a whole-body move
+    reaches with a checked path (not ``NO_DETOUR``); a stop, as the lift is. The start's configuration when none
+    does (the first move then goes straight to the first target, as :func:`_lift`'s)."""
     robot, obstacles = controller.robot, way.obstacles
 
     def safe(qs: np.ndarray) -> np.ndarray:
@@ -316,7 +317,14 @@ def _lean_lift(way: Waypoints, controller: HeadController, q: np.ndarray) -> np.
             ok[k] = clear_of_obstacles(robot, qs[k], obstacles, way.base)
         return ok
 
-    for end in lean_lift_ends(way, q, safe):
+    ends = lean_lift_ends(way, q, safe, LEAN_LIFT_SCREEN)
+    for end in ends:  # the first reached by a checked tracked path (cheap: no detour searched)
+        path = way.tracked_path(end, LIFT_STEPS)
+        if path is not None:
+            way.append_path("initial state (head lifted, leaning)", path, TRACKED)
+            way.lift_index = way.stop()
+            return end
+    for end in ends[:LEAN_LIFT_TRIES]:
         marks = len(way.qs), len(way.methods)
         if way.move("initial state (head lifted, leaning)", end, n=LIFT_STEPS) != NO_DETOUR:
             way.lift_index = way.stop()

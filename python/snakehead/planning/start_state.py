@@ -34,8 +34,10 @@ CURL_COM_SPREAD = 16
 LEAN_LIFT_SPREADS = (0.1, 0.2, 0.35, 0.5, 0.7)
 LEAN_LIFT_TRIALS = 128
 LEAN_LIFT_SEED = 20231
-#: the lifted states :func:`lean_lift_ends` hands out, nearest first
+#: the lifted states :func:`lean_lift_ends` hands out by default: those the lift is tried to by a whole-body move
+#: (with its detours) when none of the LEAN_LIFT_SCREEN first is reached by a tracked path that passes its checks
 LEAN_LIFT_TRIES = 3
+LEAN_LIFT_SCREEN = 48
 
 
 def shape_of(robot: SnakeRobot, q_shape: np.ndarray, q_rest: np.ndarray) -> np.ndarray:
@@ -89,12 +91,13 @@ def lift_ends_safe(controller: HeadController, q_shape: np.ndarray, base: BasePl
     return bool(way.feasible(q[None])[0]) or bool(lean_lift_ends(way, q, way.feasible))
 
 
-def lean_lift_ends(way: Waypoints, q: np.ndarray, safe: Callable[[np.ndarray], np.ndarray]) -> list[np.ndarray]:
+def lean_lift_ends(way: Waypoints, q: np.ndarray, safe: Callable[[np.ndarray], np.ndarray],
+                   most: int = LEAN_LIFT_TRIES) -> list[np.ndarray]:
     """Safe lifted states near the initial state q (n,) on a slope (``way.base`` off flat ground), where q itself is
     not safe: configurations with q's joints before the lift (the base on the ground keeps its shape) and the neck
     and head joints drawn around q's (LEAN_LIFT_SPREADS, LEAN_LIFT_TRIALS each, seeded), which ``safe`` (m, n) -> (m,)
-    bool passes (``Waypoints.feasible`` and the obstacles'), at most LEAN_LIFT_TRIES of them, nearest to q first
-    (the largest joint change); none when no draw passes."""
+    bool passes (``Waypoints.feasible`` and the obstacles'), at most ``most`` of them, those of the smallest spread
+    first, the steadiest first among them (their static margin); none when no draw passes."""
     robot = way.robot
     movable = np.arange(robot.lift_joints.start, robot.parts.head.stop)
     rng = np.random.default_rng(LEAN_LIFT_SEED)
@@ -106,8 +109,8 @@ def lean_lift_ends(way: Waypoints, q: np.ndarray, safe: Callable[[np.ndarray], n
         ok = np.flatnonzero(safe(W))
         if ok.size:
             steady = ok[np.argsort(-way.static_margins(W[ok]), kind="stable")]
-            found += [W[k] for k in steady[:LEAN_LIFT_TRIES - len(found)]]
-        if len(found) >= LEAN_LIFT_TRIES:
+            found += [W[k] for k in steady[:most - len(found)]]
+        if len(found) >= most:
             break
     return found
 
@@ -315,5 +318,5 @@ def _line_margins(hull: np.ndarray, xy: np.ndarray) -> np.ndarray:
 
 
 __all__ = ["shape_of", "bending_state", "lift_ends_safe", "lean_lift_ends", "LEAN_LIFT_SPREADS", "LEAN_LIFT_TRIALS",
-           "LEAN_LIFT_SEED", "LEAN_LIFT_TRIES", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
+           "LEAN_LIFT_SEED", "LEAN_LIFT_TRIES", "LEAN_LIFT_SCREEN", "ground_curl", "ground_curl_exhaustive", "CURL_MARGIN_SLACK", "CURL_COM_SPREAD", "LIFT_STEPS", "BENDING_GRID_DEG", "BENDING_COMBINATIONS",
            "BENDING_CLEARANCE"]

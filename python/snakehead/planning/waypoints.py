@@ -169,6 +169,11 @@ class Waypoints:
         self.append_path(label, qs, method)
         return method
 
+    def tracked_path(self, q: npt.ArrayLike, n: int) -> np.ndarray | None:
+        """The tracked path of n samples from the last state to q when it passes its checks (the first path
+        :meth:`move` tries), else None."""
+        return self._tracked(np.asarray(q, float), n)
+
     def _tracked(self, q: np.ndarray, n: int) -> np.ndarray | None:
         """The tracking Cartesian interpolation's path of n samples from the last state to q, split into steps of
         at most MAX_WAYPOINT_STEP, when it passes :meth:`path_feasible`; else None."""
