@@ -206,7 +206,7 @@ class GaitSimulator:
     # --- states -------------------------------------------------------------------------------------
     def lying(self, base: BasePlacement | None = None, q: npt.ArrayLike | None = None, settle_s: float = 0.3) -> SimState:
         """The robot lying at ``base`` (default placement; on the simulator's ground: ``base.ground`` must be
-        :attr:`ground`) with joints ``q`` (default straight), settled on the ground for ``settle_s`` s while its
+        ``ground``) with joints ``q`` (default straight), settled on the ground for ``settle_s`` s while its
         servos hold q."""
         base = BasePlacement(ground=self.ground) if base is None else as_base(base)
         q = np.zeros(self.robot.n_joints) if q is None else joint_vector(q, self.robot.n_joints)
