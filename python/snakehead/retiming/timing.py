@@ -110,7 +110,8 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
 
     Parameters
     ----------
-    robot : the snake; base : where its base lies (default placement; the result is the same for any).
+    robot : the snake; base : where its base lies (default placement; on flat ground the result is the same for any,
+        on a slope it depends on the heading).
     waypoints : (K, n) joint vectors (rad) within the joint limits, K >= 2. The motion passes through every one,
         starts and ends at rest, and rests at each waypoint index in ``stops``.
     velocity_limit : rad/s, a number or (n,); default :data:`VELOCITY_SHARE` of the URDF's (none where it gives 0).
@@ -139,11 +140,12 @@ def retime(robot: SnakeRobot, waypoints: npt.ArrayLike, base: BasePlacement | No
     """
     clock = time.perf_counter()
     robot = as_robot(robot)
-    as_base(base)  # validated; the timing does not depend on it:
-    # gravity is vertical and the ground flat, so the limits and the balance are the same wherever the base lies
-    # (the friction polygon is taken in the base's frame): the path is timed at the default placement, and one
-    # timing serves every placement (the planner times a lift once per base shape)
-    base = BasePlacement()
+    placed = as_base(base)
+    # on flat ground the timing does not depend on the placement: gravity is vertical and the ground flat, so the
+    # limits and the balance are the same wherever the base lies (the friction polygon is taken in the base's
+    # frame): the path is timed at the default placement, and one timing serves every placement (the planner times a
+    # lift once per base shape). On a slope gravity leans in the base's frame as its heading turns: timed there
+    base = BasePlacement() if placed.on_flat_ground else placed
     W = checked_waypoints(robot, waypoints)
     limits = resolve_limits(robot, velocity_limit=velocity_limit, acceleration_limit=acceleration_limit,
                             torque_limit=torque_limit, zmp_margin=zmp_margin, friction=friction)
