@@ -18,6 +18,7 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -46,12 +47,40 @@ def robot_named(name: str) -> snakehead.SnakeRobot:
     return snakehead.SnakeRobot.default() if name == "default" else published_style(name)
 
 
+class Tally:
+    """Plans made one by one: how many, how many succeeded, their planning times, their failures and (``sim``) the
+    worst head error of the planned ones in MuJoCo."""
+
+    def __init__(self, sim: bool) -> None:
+        self.sim, self.made, self.planned = sim, 0, 0
+        self.worst_mm, self.worst_deg = 0.0, 0.0
+        self.seconds: list[float] = []
+        self.failures: list[str] = []
+
+    def add(self, label: str, make_plan: Callable[[], snakehead.Plan]) -> None:
+        self.made += 1
+        clock = time.perf_counter()
+        plan = make_plan()
+        self.seconds.append(time.perf_counter() - clock)
+        if not plan.success:
+            self.failures.append(f"{label}: {plan.failure}")
+            return
+        self.planned += 1
+        if self.sim:
+            s = snakehead.simulate(plan)
+            self.worst_mm = max(self.worst_mm, 1000 * s.position_error_m)
+            self.worst_deg = max(self.worst_deg, s.direction_error_deg)
+
+    def result(self) -> dict:
+        return {"made": self.made, "planned": self.planned, "worst_mm": self.worst_mm, "worst_deg": self.worst_deg,
+                "median_s": float(np.median(self.seconds)) if self.seconds else float("nan"),
+                "failures": self.failures}
+
+
 def run_slope(robot: snakehead.SnakeRobot, slope_deg: float, count: int, sim: bool) -> dict:
     """Targets made and planned at every heading on a slope rising along world x; counts and worst errors."""
     frame = GroundFrame.of_plane(plane_normal_deg(0.0, -slope_deg), (0.0, 0.0, 0.0))
-    made = planned = 0
-    worst_mm, worst_deg, seconds = 0.0, 0.0, []
-    failures: list[str] = []
+    tally = Tally(sim)
     for k, heading in enumerate(HEADINGS_DEG):
         base = BasePlacement(0.0, 0.0, math.radians(heading), frame)
         controller = snakehead.HeadController(robot, base_pose=base, seed=1)
@@ -59,21 +88,9 @@ def run_slope(robot: snakehead.SnakeRobot, slope_deg: float, count: int, sim: bo
         kinds = ("same", "shape")
         targets = [t for kind in kinds for t in reachable_targets(controller, kind, count // 2, rng)]
         for t in targets:
-            made += 1
-            clock = time.perf_counter()
-            plan = snakehead.plan([(t.position, t.direction)], controller=controller,
-                                  base_shape=t.q if t.kind == "shape" else None)
-            seconds.append(time.perf_counter() - clock)
-            if not plan.success:
-                failures.append(f"{heading:.0f} deg: {plan.failure}")
-                continue
-            planned += 1
-            if sim:
-                s = snakehead.simulate(plan)
-                worst_mm = max(worst_mm, 1000 * s.position_error_m)
-                worst_deg = max(worst_deg, s.direction_error_deg)
-    return {"made": made, "planned": planned, "worst_mm": worst_mm, "worst_deg": worst_deg,
-            "median_s": float(np.median(seconds)) if seconds else float("nan"), "failures": failures}
+            tally.add(f"{heading:.0f} deg", lambda t=t, c=controller: snakehead.plan(
+                [(t.position, t.direction)], controller=c, base_shape=t.q if t.kind == "shape" else None))
+    return tally.result()
 
 
 def run_step(robot: snakehead.SnakeRobot, count: int, sim: bool) -> dict:
@@ -81,9 +98,7 @@ def run_step(robot: snakehead.SnakeRobot, count: int, sim: bool) -> dict:
     step: its risen block) and planned as a scene on that terrain; counts and worst errors."""
     terrain = step(STEP_M)
     blocks = terrain.risen_blocks()
-    made = planned = 0
-    worst_mm, worst_deg, seconds = 0.0, 0.0, []
-    failures: list[str] = []
+    tally = Tally(sim)
     for k, (x, y, heading) in enumerate(STEP_BASES):
         base = BasePlacement(x, y, math.radians(heading))
         controller = snakehead.HeadController(robot, base_pose=base, seed=1)
@@ -91,21 +106,9 @@ def run_step(robot: snakehead.SnakeRobot, count: int, sim: bool) -> dict:
         drawn = reachable_targets(controller, "same", 6 * count, rng)
         targets = [t for t in drawn if clear_of_obstacles(robot, t.q, blocks, base)][:count]
         for t in targets:
-            made += 1
             scene = Scene("step", (Target("t", t.position, t.direction, hold_s=1.0),), base=base, terrain=terrain)
-            clock = time.perf_counter()
-            plan = snakehead.plan(scene, controller=controller)
-            seconds.append(time.perf_counter() - clock)
-            if not plan.success:
-                failures.append(f"base {k}: {plan.failure}")
-                continue
-            planned += 1
-            if sim:
-                s = snakehead.simulate(plan)
-                worst_mm = max(worst_mm, 1000 * s.position_error_m)
-                worst_deg = max(worst_deg, s.direction_error_deg)
-    return {"made": made, "planned": planned, "worst_mm": worst_mm, "worst_deg": worst_deg,
-            "median_s": float(np.median(seconds)) if seconds else float("nan"), "failures": failures}
+            tally.add(f"base {k}", lambda sc=scene, c=controller: snakehead.plan(sc, controller=c))
+    return tally.result()
 
 
 def row(name: str, terrain: str, r: dict, sim: bool) -> str:

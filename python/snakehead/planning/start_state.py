@@ -130,10 +130,8 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray, base: BasePlacement | None
     if len(yaw) == 0:
         return q
     at = _leaning(base)
-    if at is not None:
-        return _ground_curl_leaning(robot, q, yaw, values, at)
-    poly = stability.support_polygon(robot, q)  # the base's, placement-independent in its own frame
-    com = _curl_com(robot, q, yaw, values)
+    poly = stability.support_polygon(robot, q, at)  # the base's, placement-independent in its own frame
+    com = _curl_com(robot, q, yaw, values, at)
     hull = poly[stability.hull_indices(poly)]
     if len(hull) < 3:  # no interior (collinear points): every margin is at most 0, no curl is stable
         raise Infeasible(_NO_CURL)
@@ -152,19 +150,24 @@ def ground_curl(robot: SnakeRobot, shape: np.ndarray, base: BasePlacement | None
     # the robot's own centres of mass of those, and of a spread of all the curls, which the fast ones must equal
     rows = np.unique(np.concatenate([near, np.linspace(0, len(com) - 1, CURL_COM_SPREAD).astype(int)]))
     qs = _curl_configurations(q, yaw, values, rows)
-    exact_com = stability.center_of_mass(robot, qs)[:, :2]
+    exact_com = _com_below(robot, qs, at)
     if np.abs(exact_com - com[rows]).max() > CURL_MARGIN_SLACK / 4:  # a chain the composition does not model
-        return ground_curl_exhaustive(robot, shape)
-    keep = np.isin(rows, near)
-    qs, exact_com = qs[keep], exact_com[keep]
+        if at is None:
+            return ground_curl_exhaustive(robot, shape)
+        qs = _curl_configurations(q, yaw, values, np.arange(values.shape[1] ** len(yaw)))  # every curl, exactly
+        exact_com = _com_below(robot, qs, at)
+    else:
+        keep = np.isin(rows, near)
+        qs, exact_com = qs[keep], exact_com[keep]
     margin = stability.polygon_margin_many(np.broadcast_to(poly, (len(qs),) + poly.shape),
                                            np.ones((len(qs), len(poly)), bool), exact_com)
     ranked = np.argsort(-margin, kind="stable")  # ties in curl order, as the exhaustive search ranks them (the
     ranked = ranked[margin[ranked] > 0]  # default sort orders ties by the CPU's vector width: AVX-512, AVX2)
-    ok = coll.self_clearance(robot, qs[ranked]) > BENDING_CLEARANCE if ranked.size else np.zeros(0, bool)
-    if not ok.any():
-        raise Infeasible(_NO_CURL)
-    return qs[ranked[np.argmax(ok)]]
+    for chunk in np.array_split(ranked, max(1, ranked.size // 500 + 1)) if ranked.size else []:
+        ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
+        if ok.any():
+            return qs[chunk[np.argmax(ok)]]
+    raise Infeasible(_NO_CURL)
 
 
 def _leaning(base: BasePlacement | None) -> BasePlacement | None:
@@ -175,47 +178,12 @@ def _leaning(base: BasePlacement | None) -> BasePlacement | None:
     return BasePlacement(0.0, 0.0, base.yaw, base.ground)
 
 
-def _ground_curl_leaning(robot: SnakeRobot, q: np.ndarray, yaw: np.ndarray, values: np.ndarray,
-                         at: BasePlacement) -> np.ndarray:
-    """:func:`ground_curl` on a slope, the base at ``at``: the fast margins of :func:`ground_curl` with the CoM's
-    point below it along the leaning gravity (``_curl_com`` at ``at``), the curls within twice CURL_MARGIN_SLACK of
-    the first self-clear one ranked by their exact margins (the robot's own kinematics), the first self-clear of
-    those; the exhaustive search when the composition does not model the chain."""
-    poly = stability.support_polygon(robot, q, at)
-    hull = poly[stability.hull_indices(poly)]
-    if len(hull) < 3:
-        raise Infeasible(_NO_CURL)
-    com = _curl_com(robot, q, yaw, values, at)
-    fast = _line_margins(hull, com)
-    order = np.argsort(-fast, kind="stable")
-    order = order[fast[order] > -CURL_MARGIN_SLACK]
-    first, done, size = None, 0, 32
-    while first is None and done < order.size:
-        chunk = order[done:done + size]
-        ok = coll.self_clearance(robot, _curl_configurations(q, yaw, values, chunk)) > BENDING_CLEARANCE
-        first = chunk[np.argmax(ok)] if ok.any() else None
-        done, size = done + size, min(2 * size, 1024)
-    if first is None:
-        raise Infeasible(_NO_CURL)
-    near = order[fast[order] >= fast[first] - 2.0 * CURL_MARGIN_SLACK]
-    rows = np.unique(np.concatenate([near, np.linspace(0, len(com) - 1, CURL_COM_SPREAD).astype(int)]))
-    qs = _curl_configurations(q, yaw, values, rows)
-    exact_com = at.below_along_gravity(stability.center_of_mass(robot, qs, at))
-    if np.abs(exact_com - com[rows]).max() > CURL_MARGIN_SLACK / 4:  # a chain the composition does not model
-        qs = _curl_configurations(q, yaw, values, np.arange(values.shape[1] ** len(yaw)))
-        exact_com = at.below_along_gravity(stability.center_of_mass(robot, qs, at))
-    else:
-        keep = np.isin(rows, near)
-        qs, exact_com = qs[keep], exact_com[keep]
-    margin = stability.polygon_margin_many(np.broadcast_to(poly, (len(qs),) + poly.shape),
-                                           np.ones((len(qs), len(poly)), bool), exact_com)
-    ranked = np.argsort(-margin, kind="stable")
-    ranked = ranked[margin[ranked] > 0]
-    for chunk in np.array_split(ranked, max(1, ranked.size // 500 + 1)) if ranked.size else []:
-        ok = coll.self_clearance(robot, qs[chunk]) > BENDING_CLEARANCE
-        if ok.any():
-            return qs[chunk[np.argmax(ok)]]
-    raise Infeasible(_NO_CURL)
+def _com_below(robot: SnakeRobot, qs: np.ndarray, at: BasePlacement | None) -> np.ndarray:
+    """The (x, y) of the centres of mass of configurations qs (m, n): on flat ground (``at`` None) at the default
+    placement; on a slope the ground points below them along the leaning gravity, the base at ``at``."""
+    if at is None:
+        return stability.center_of_mass(robot, qs)[:, :2]
+    return at.below_along_gravity(stability.center_of_mass(robot, qs, at))
 
 
 def ground_curl_exhaustive(robot: SnakeRobot, shape: np.ndarray) -> np.ndarray:

@@ -99,7 +99,7 @@ from ..model.robot import BasePlacement, SnakeRobot
 from ..model.robot_file import check_keys, path_from, read_toml, toml_string
 from ..terrain.surfaces import TERRAIN_TYPES, FlatGround, HeightfieldTerrain, MeshTerrain, Terrain
 from ..terrain.terrain_files import MAX_HEIGHTFIELD_BYTES
-from .terrain_table import scene_file_inside, terrain_entry, terrain_from_table
+from .terrain_table import scene_file_inside, terrain_entry, terrain_from_table, written_inside
 
 APPROACHES = ("free", "line")
 
@@ -543,10 +543,7 @@ def _obstacle_entry(ob: Any, folder: Path, where: str, inside: bool = True) -> d
     if isinstance(ob, MeshObstacle):
         name = path_from(folder, ob.path)
         if inside:
-            try:
-                scene_file_inside(folder, name, where)
-            except InputError as exc:
-                raise InputError(f"{exc} (save_scene copies it into the folder)") from None
+            written_inside(folder, name, where)
         return {"kind": '"mesh"', "file": toml_string(name),
                 "position": _toml_floats(ob.pose[:3, 3]),
                 "yaw": _toml_float(_yaw_of(ob.pose[:3, :3], where, "the mesh")), "scale": _toml_floats(ob.scale)}

@@ -53,7 +53,7 @@ from ..terrain.surfaces import (
 )
 from ..terrain.terrain_files import read_heights, read_mesh_surface
 
-__all__ = ["TERRAIN_KINDS", "scene_file_inside", "terrain_from_table", "terrain_entry"]
+__all__ = ["TERRAIN_KINDS", "scene_file_inside", "written_inside", "terrain_from_table", "terrain_entry"]
 
 #: Each kind's required and optional keys.
 TERRAIN_KINDS = {
@@ -76,6 +76,15 @@ def scene_file_inside(folder: Path, name: Any, where: str) -> Path:
         raise InputError(f"{where}: file {name!r} is outside the scene file's folder {os.fspath(root)!r}; a scene "
                          "reads only files in its own folder")
     return resolved
+
+
+def written_inside(folder: Path, name: str, where: str) -> None:
+    """InputError unless the file ``name`` a scene file written in ``folder`` would name lies inside it (the check
+    :func:`scene_file_inside` makes when the file is read), saying that ``save_scene`` copies it there."""
+    try:
+        scene_file_inside(folder, name, where)
+    except InputError as exc:
+        raise InputError(f"{exc} (save_scene copies it into the folder)") from None
 
 
 def _numbers(value: Any, where: str, n: int) -> np.ndarray:
@@ -174,10 +183,7 @@ def terrain_entry(terrain: Terrain, folder: Path, where: str, inside: bool = Tru
                              "heightfield's or mesh's file (save the heights with numpy.save first)")
         name = path_from(folder, terrain.source)
         if inside:
-            try:
-                scene_file_inside(folder, name, where)
-            except InputError as exc:
-                raise InputError(f"{exc} (save_scene copies it into the folder)") from None
+            written_inside(folder, name, where)
         entry = {"kind": '"heightfield"' if isinstance(terrain, HeightfieldTerrain) else '"mesh"',
                  "file": toml_string(name)}
         if isinstance(terrain, HeightfieldTerrain):
